@@ -1,0 +1,29 @@
+from __future__ import annotations
+
+import subprocess
+import sys
+
+from kinema import __version__
+from kinema.cli.main import main
+
+
+def test_version_prints_the_package_version(capsys):
+    assert main(["--version"]) == 0
+    assert __version__ in capsys.readouterr().out
+
+
+def test_help_lists_verbs_and_does_not_import_heavy_modules():
+    code = (
+        "import sys; from kinema.cli.main import main; rc = main(['--help']);"
+        "heavy = [m for m in ('mujoco', 'pinocchio', 'zenoh', 'textual', 'meshcat', 'ompl') if m in sys.modules];"
+        "print('HEAVY', heavy); raise SystemExit(rc)"
+    )
+    result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=False)
+    assert result.returncode == 0, result.stderr
+    assert "Commands" in result.stdout
+    assert "HEAVY []" in result.stdout
+
+
+def test_unknown_verb_exits_non_zero(capsys):
+    assert main(["no-such-verb"]) != 0
+    assert "No such command" in capsys.readouterr().err
