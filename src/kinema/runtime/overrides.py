@@ -1,0 +1,284 @@
+"""Parameter overrides: values for an objective's blackboard, applied all-or-nothing before the first tick.
+
+MoveIt Pro's semantics: once the tree is built, each override finds the type of the port that reads
+its name, its text is parsed as YAML into that type, and it is written into the root blackboard, or into
+the blackboards of the subtrees named by ``behavior_namespaces``. Any failure (no port reads that name,
+a value of the wrong type, an unknown namespace) rejects the whole request before the tree ticks:
+overrides never apply partially.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+from kinema.errors import ObjectiveError, did_you_mean
+
+if TYPE_CHECKING:
+    from kinema.bt import Blackboard, Tree
+
+
+@dataclass(frozen=True)
+class ParameterOverride:
+    """One override.
+
+    Attributes:
+        name: the blackboard key (the name of the port's ``{key}``) to set.
+        value: YAML text (``from_yaml=True``, as ``BehaviorParameter.string_value`` carries it) or an
+            already typed value (a double, int, bool, pose or joint state field).
+        behavior_namespaces: subtrees (by ID, instance name or path) whose blackboard receives the value;
+            empty means the root blackboard.
+        from_yaml: whether ``value`` is text to parse as YAML.
+    """
+
+    name: str
+    value: Any
+    behavior_namespaces: tuple[str, ...] = ()
+    from_yaml: bool = True
+
+    @classmethod
+    def parse(cls, assignment: str) -> ParameterOverride:
+        """Parse ``NAME=VALUE`` (the CLI's ``--param``); the value stays YAML text.
+
+        Raises:
+            ObjectiveError: no ``=`` or an empty name.
+        """
+        name, sep, value = assignment.partition("=")
+        if not sep or not name.strip():
+            raise ObjectiveError(f"bad parameter {assignment!r}: expected NAME=VALUE (VALUE in YAML)")
+        return cls(name.strip(), value)
+
+
+def apply_overrides(tree: Tree, overrides: Sequence[ParameterOverride], *, objective_name: str = "") -> None:
+    """Convert every override and write them all into ``tree``'s blackboards, or none of them.
+
+    Raises:
+        ObjectiveError: naming the override, the objective and what would have been accepted.
+    """
+    if not overrides:
+        return
+    writes: list[tuple[Blackboard, str, Any]] = []
+    for override in overrides:
+        for blackboard, scope in _target_blackboards(tree, override, objective_name):
+            writes.append((blackboard, override.name, _convert(blackboard, scope, override, objective_name)))
+    for blackboard, key, value in writes:
+        blackboard.set(key, value)
+
+
+def _target_blackboards(
+    tree: Tree, override: ParameterOverride, objective_name: str
+) -> list[tuple[Blackboard, str]]:
+    if not override.behavior_namespaces:
+        return [(tree.root_blackboard, "")]
+    scopes = _subtree_scopes(tree)
+    targets: list[tuple[Blackboard, str]] = []
+    for namespace in override.behavior_namespaces:
+        matches = [(bb, path) for path, names, bb in scopes if namespace in names]
+        if not matches:
+            choices = sorted({name for _, names, _ in scopes for name in names if name})
+            raise ObjectiveError(
+                f"parameter override {override.name!r} of objective {objective_name!r}: no subtree is named "
+                f"{namespace!r}; {did_you_mean(namespace, choices)}"
+            )
+        targets.extend(matches)
+    return targets
+
+
+def _subtree_scopes(tree: Tree) -> list[tuple[str, set[str], Blackboard]]:
+    """``(path, names it answers to, blackboard)`` for every subtree instance of ``tree``."""
+    scopes = []
+    for subtree in tree.subtrees:
+        path = getattr(subtree, "instance_name", "") or ""
+        names = {path, path.rsplit("/", 1)[-1], getattr(subtree, "tree_id", "") or ""}
+        scopes.append((path, {n for n in names if n}, subtree.blackboard))
+    return scopes
+
+
+def _convert(blackboard: Blackboard, scope: str, override: ParameterOverride, objective_name: str) -> Any:
+    where = f"parameter override {override.name!r} of objective {objective_name!r}"
+    entry = blackboard.get_entry(override.name)
+    if entry is None:
+        keys = _visible_keys(blackboard)
+        place = f"subtree {scope!r}" if scope else "the objective"
+        raise ObjectiveError(
+            f"{where}: no port of {place} reads the blackboard key {override.name!r}; "
+            f"{did_you_mean(override.name, keys)}"
+        )
+    port_type = entry.type
+    try:
+        if override.from_yaml:
+            return parse_yaml_value(str(override.value), port_type)
+        return coerce_value(override.value, port_type)
+    except (ValueError, TypeError) as error:
+        raise ObjectiveError(f"{where}: {error}") from None
+
+
+def _visible_keys(blackboard: Blackboard) -> list[str]:
+    keys: set[str] = set()
+    scope: Blackboard | None = blackboard
+    while scope is not None:
+        keys.update(scope.keys())
+        scope = scope.parent
+    return sorted(keys)
+
+
+def _type_label(port_type: Any) -> str:
+    from kinema.bt.conversions import type_name
+
+    return type_name(port_type)
+
+
+def parse_yaml_value(text: str, port_type: Any) -> Any:
+    """Parse ``text`` as YAML into a value of ``port_type`` (None = any type).
+
+    Strings are taken as written unless quoted in YAML, so ``Look at Table`` and ``007`` stay strings
+    for a string port. Lists also accept BT.CPP's ``1;2;3`` form.
+
+    Raises:
+        ValueError: the text is not YAML, or not a value of that type.
+    """
+    import yaml
+
+    from kinema.bt.conversions import AnyValue, ConversionError, convert_from_string, has_converter
+
+    try:
+        parsed = yaml.safe_load(text) if text.strip() else text
+    except yaml.YAMLError as error:
+        mark = getattr(error, "problem_mark", None)
+        where = f" at column {mark.column + 1}" if mark is not None else ""
+        raise ValueError(f"{text!r} is not valid YAML{where}") from None
+    if port_type is None or port_type is AnyValue:
+        return parsed
+    if port_type is str:
+        return parsed if isinstance(parsed, str) else text
+    if isinstance(parsed, str) and has_converter(port_type) and not _is_class_type(port_type):
+        try:
+            return convert_from_string(port_type, parsed)
+        except ConversionError as error:
+            raise ValueError(f"{text!r} is not a valid {_type_label(port_type)} ({error})") from None
+    return coerce_value(parsed, port_type, text=text)
+
+
+def _is_class_type(port_type: Any) -> bool:
+    return (
+        isinstance(port_type, type)
+        and port_type not in (int, float, str, bool, list)
+        and not issubclass(port_type, enum.Enum)
+    )
+
+
+def coerce_value(value: Any, port_type: Any, *, text: str | None = None) -> Any:
+    """Turn an already parsed value into ``port_type`` without losing information.
+
+    Raises:
+        ValueError: the value does not fit the type (a float for an int port, a word for a bool, ...).
+    """
+    from kinema.bt.conversions import AnyValue, list_item_type
+
+    shown = text if text is not None else repr(value)
+    label = _type_label(port_type)
+    if port_type is None or port_type is AnyValue:
+        return value
+    if port_type is bool:
+        if isinstance(value, bool):
+            return value
+        raise ValueError(f"{shown} is not a bool (port type {label}; use true or false)")
+    if port_type is int:
+        if isinstance(value, int) and not isinstance(value, bool):
+            return value
+        if isinstance(value, float) and value.is_integer():
+            return int(value)
+        raise ValueError(f"{shown} is not an int (port type {label})")
+    if port_type is float:
+        if isinstance(value, int | float) and not isinstance(value, bool):
+            return float(value)
+        raise ValueError(f"{shown} is not a number (port type {label})")
+    if port_type is str:
+        if isinstance(value, str):
+            return value
+        raise ValueError(f"{shown} is not a string (port type {label})")
+    item = list_item_type(port_type)
+    if item is not None or port_type is list:
+        if not isinstance(value, list | tuple):
+            raise ValueError(f"{shown} is not a list (port type {label})")
+        return [coerce_value(v, item) for v in value] if item is not None else list(value)
+    if isinstance(port_type, type) and issubclass(port_type, enum.Enum):
+        if isinstance(value, port_type):
+            return value
+        if isinstance(value, str) and value in port_type.__members__:
+            return port_type.__members__[value]
+        try:
+            return port_type(value)
+        except ValueError:
+            valid = ", ".join(port_type.__members__)
+            raise ValueError(f"{shown} is not a {label} (valid: {valid})") from None
+    if isinstance(port_type, type) and isinstance(value, port_type):
+        return value
+    if isinstance(value, dict):
+        return _from_mapping(port_type, value, shown)
+    from_string = getattr(port_type, "from_string", None)
+    if isinstance(value, str) and callable(from_string):
+        return from_string(value)
+    raise ValueError(f"{shown} cannot be read as {label}")
+
+
+def _from_mapping(port_type: Any, value: dict[str, Any], shown: str) -> Any:
+    """Build a message or dataclass value from a YAML mapping (``{header: {frame_id: world}, ...}``)."""
+    import dataclasses
+
+    if not (isinstance(port_type, type) and dataclasses.is_dataclass(port_type)):
+        raise ValueError(f"{shown} cannot be read as {_type_label(port_type)}")
+    fields = {f.name: f for f in dataclasses.fields(port_type)}
+    unknown = sorted(set(value) - set(fields))
+    if unknown:
+        alternatives = did_you_mean(unknown[0], fields)
+        raise ValueError(f"{shown}: {_type_label(port_type)} has no field {unknown[0]!r}; {alternatives}")
+    try:
+        default = _default_instance(port_type)
+    except TypeError:
+        default = None
+    kwargs: dict[str, Any] = {}
+    for name in fields:
+        current = getattr(default, name) if default is not None else None
+        if name not in value:
+            if default is None:
+                raise ValueError(f"{shown}: field {name!r} of {_type_label(port_type)} is missing")
+            kwargs[name] = current
+            continue
+        kwargs[name] = _field_value(current, value[name], f"{shown}.{name}")
+    return port_type(**kwargs)
+
+
+def _default_instance(port_type: type) -> Any:
+    from kinema.transport import messages  # the transport knows how to build default ROS messages
+
+    return messages.default_message(port_type)
+
+
+def _field_value(current: Any, value: Any, shown: str) -> Any:
+    import dataclasses
+
+    import numpy as np
+
+    if current is not None and dataclasses.is_dataclass(current) and isinstance(value, dict):
+        return _from_mapping(type(current), value, shown)
+    if isinstance(current, np.ndarray):
+        return np.asarray(value, dtype=current.dtype)
+    if isinstance(current, bool):
+        return coerce_value(value, bool, text=shown)
+    if isinstance(current, int):
+        return coerce_value(value, int, text=shown)
+    if isinstance(current, float):
+        return coerce_value(value, float, text=shown)
+    if isinstance(current, str):
+        return coerce_value(value, str, text=shown)
+    if (
+        isinstance(current, list)
+        and isinstance(value, list)
+        and current
+        and dataclasses.is_dataclass(current[0])
+    ):
+        return [_from_mapping(type(current[0]), v, shown) for v in value]
+    return value

@@ -1,0 +1,94 @@
+"""Per-run log folders under the user's state directory.
+
+Every ``kinema run`` writes its logs (the agent's, each driver's, the supervisor's) into a fresh folder
+``<state>/kinema/runs/<YYYYmmdd-HHMMSS>-<config>/``; ``<state>`` is ``$XDG_STATE_HOME`` (or
+``~/.local/state``) on Linux and the platform's equivalent elsewhere. ``kinema logs`` reads the newest
+folder and ``kinema export-logs`` zips it.
+"""
+
+from __future__ import annotations
+
+import re
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+from kinema.errors import KinemaError
+
+# A run folder is kept for later inspection; only this many of the newest are kept around.
+KEEP_RUNS = 20
+
+
+def state_dir() -> Path:
+    """Kinema's state directory (created on demand)."""
+    import platformdirs
+
+    path = platformdirs.user_state_path("kinema")
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+def runs_dir() -> Path:
+    """The folder holding one sub-folder per run."""
+    path = state_dir() / "runs"
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+@dataclass(frozen=True)
+class RunFolder:
+    """The log folder of one run."""
+
+    path: Path
+
+    @property
+    def name(self) -> str:
+        """The folder's name, ``<timestamp>-<config>``."""
+        return self.path.name
+
+    def log_file(self, process: str) -> Path:
+        """The log file of one process of the run (``agent``, ``supervisor``, a driver's name)."""
+        return self.path / f"{process}.log"
+
+    def log_files(self) -> list[Path]:
+        """Every log file in the folder, sorted by name."""
+        return sorted(self.path.glob("*.log"))
+
+    @classmethod
+    def create(cls, config_name: str, *, keep: int = KEEP_RUNS) -> RunFolder:
+        """Create a fresh folder for a run of ``config_name`` and prune the oldest beyond ``keep``."""
+        safe = re.sub(r"[^A-Za-z0-9_.-]+", "_", config_name) or "run"
+        stamp = time.strftime("%Y%m%d-%H%M%S")
+        base = runs_dir()
+        path = base / f"{stamp}-{safe}"
+        suffix = 1
+        while path.exists():
+            suffix += 1
+            path = base / f"{stamp}-{safe}-{suffix}"
+        path.mkdir(parents=True)
+        _prune(base, keep)
+        return cls(path)
+
+    @classmethod
+    def latest(cls) -> RunFolder:
+        """The newest run's folder; raises KinemaError when there has been no run yet."""
+        runs = list_runs()
+        if not runs:
+            raise KinemaError(f"no run logs in {runs_dir()}: start one with `kinema run`")
+        return runs[-1]
+
+
+def list_runs() -> list[RunFolder]:
+    """Every run folder, oldest first."""
+    base = runs_dir()
+    folders = [p for p in base.iterdir() if p.is_dir()]
+    folders.sort(key=lambda p: (p.stat().st_mtime, p.name))
+    return [RunFolder(p) for p in folders]
+
+
+def _prune(base: Path, keep: int) -> None:
+    import shutil
+
+    folders = sorted((p for p in base.iterdir() if p.is_dir()), key=lambda p: (p.stat().st_mtime, p.name))
+    for old in folders[: max(0, len(folders) - keep)]:
+        shutil.rmtree(old, ignore_errors=True)
