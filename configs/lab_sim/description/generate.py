@@ -1,0 +1,509 @@
+"""Write ``lab_sim.urdf`` and ``lab_sim_scene.xml`` from one table of links: the robot's single source of truth.
+
+The robot (a UR5e-sized arm on a linear rail with a parallel two-finger gripper) is described once, below,
+as links with their joint, origin and primitive collision geoms. This script renders that table twice:
+as URDF (for planning with pinocchio) and as the robot part of the MuJoCo scene, which also holds the lab
+table, the tray, the object to pick, a camera, actuators and keyframes. Run it after editing the table::
+
+    python configs/lab_sim/description/generate.py
+
+``tests/sim/model`` checks that the two files agree (forward kinematics to 1e-6, identical collision
+geoms) and that the committed files are what this script writes.
+
+Conventions: SI units, every link frame is world-aligned when all joints are zero (so joint origins are
+pure translations) except ``tool0`` and the gripper below it, whose z axis points out of the flange.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+
+# Gripper: the knuckle angle (0 open .. 0.7929 closed, Robotiq 2F-85 convention) drives both finger
+# slides through a linear coupling, each finger travelling 42.5 mm so the 85 mm stroke closes fully.
+KNUCKLE_CLOSED = 0.7929
+FINGER_TRAVEL = 0.0425
+FINGER_PER_KNUCKLE = FINGER_TRAVEL / KNUCKLE_CLOSED
+FINGER_HALF_THICKNESS = 0.01
+TCP_DEPTH = 0.13  # grasp_link along the gripper z axis, from tool0
+
+TABLE_TOP = 0.75
+CUBE_HALF = 0.025
+CUBE_START = (0.62, 0.30, TABLE_TOP + CUBE_HALF)
+TRAY_CENTER = (0.62, -0.30)
+TRAY_FLOOR = 0.004  # thickness of the tray bottom: thin, so placing and re-picking stay level
+
+
+@dataclass(frozen=True)
+class Geom:
+    """A collision primitive in its link's frame.
+
+    ``kind`` is ``box`` (``size`` = half extents, centred at ``pos``), ``cylinder`` (``fromto`` segment and
+    ``size[0]`` = radius) or ``sphere`` (``size[0]`` = radius at ``pos``).
+    """
+
+    name: str
+    kind: str
+    size: tuple[float, ...]
+    pos: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    fromto: tuple[float, ...] = ()
+    rgba: str = "0.55 0.6 0.65 1"
+    contact: str = ""  # extra MJCF contact attributes (finger pads)
+
+
+@dataclass(frozen=True)
+class Link:
+    """A robot link, the joint that moves it (relative to ``parent``) and its geoms."""
+
+    name: str
+    parent: str
+    joint: str | None = None  # None: fixed to the parent
+    kind: str = "fixed"  # fixed, revolute, prismatic
+    axis: tuple[float, float, float] = (0.0, 0.0, 1.0)
+    xyz: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    quat: tuple[float, float, float, float] = (1.0, 0.0, 0.0, 0.0)  # w x y z
+    limits: tuple[float, float] = (0.0, 0.0)
+    effort: float = 0.0
+    velocity: float = 0.0
+    mass: float = 0.0
+    geoms: tuple[Geom, ...] = field(default_factory=tuple)
+
+
+ARM = "0.55 0.6 0.65 1"
+DARK = "0.15 0.15 0.17 1"
+ACCENT = "0.1 0.45 0.8 1"
+PAD = 'friction="1.5 0.02 0.0005" condim="4" solref="0.004 1" solmix="1000" solimp="0.95 0.99 0.001"'
+R_TOOL = (math.sqrt(0.5), -math.sqrt(0.5), 0.0, 0.0)  # Rx(-pi/2): tool0 z = wrist_3 y
+
+LINKS: tuple[Link, ...] = (
+    Link(
+        "linear_rail_base_link",
+        "world",
+        geoms=(Geom("rail_pedestal", "box", (0.12, 1.3, 0.36), pos=(0.0, 0.0, 0.36), rgba=DARK),),
+    ),
+    Link(
+        "linear_rail_carriage_link",
+        "linear_rail_base_link",
+        "linear_rail_joint",
+        "prismatic",
+        axis=(0.0, 1.0, 0.0),
+        xyz=(0.0, 0.0, 0.72),
+        limits=(-1.0, 1.0),
+        effort=2000.0,
+        velocity=1.0,
+        mass=8.0,
+        geoms=(Geom("rail_carriage", "box", (0.14, 0.14, 0.02), pos=(0.0, 0.0, 0.02), rgba=DARK),),
+    ),
+    Link(
+        "base_link",
+        "linear_rail_carriage_link",
+        xyz=(0.0, 0.0, 0.04),
+        mass=4.0,
+        geoms=(Geom("base", "cylinder", (0.075,), fromto=(0.0, 0.0, 0.0, 0.0, 0.0, 0.09)),),
+    ),
+    Link(
+        "shoulder_link",
+        "base_link",
+        "shoulder_pan_joint",
+        "revolute",
+        axis=(0.0, 0.0, 1.0),
+        xyz=(0.0, 0.0, 0.1625),
+        limits=(-math.pi, math.pi),
+        effort=150.0,
+        velocity=math.pi,
+        mass=3.7,
+        geoms=(
+            Geom("shoulder_column", "cylinder", (0.06,), fromto=(0.0, 0.0, -0.07, 0.0, 0.0, 0.0)),
+            Geom("shoulder_housing", "cylinder", (0.06,), fromto=(0.0, -0.06, 0.0, 0.0, 0.08, 0.0)),
+        ),
+    ),
+    Link(
+        "upper_arm_link",
+        "shoulder_link",
+        "shoulder_lift_joint",
+        "revolute",
+        axis=(0.0, 1.0, 0.0),
+        xyz=(0.0, 0.138, 0.0),
+        limits=(-math.pi, 0.0),
+        effort=150.0,
+        velocity=math.pi,
+        mass=8.4,
+        geoms=(
+            Geom("upper_arm_housing", "cylinder", (0.06,), fromto=(0.0, -0.05, 0.0, 0.0, 0.06, 0.0)),
+            Geom("upper_arm_tube", "cylinder", (0.045,), fromto=(0.06, 0.0, 0.0, 0.37, 0.0, 0.0)),
+        ),
+    ),
+    Link(
+        "forearm_link",
+        "upper_arm_link",
+        "elbow_joint",
+        "revolute",
+        axis=(0.0, 1.0, 0.0),
+        xyz=(0.425, -0.131, 0.0),
+        limits=(-math.pi, math.pi),
+        effort=150.0,
+        velocity=math.pi,
+        mass=2.3,
+        geoms=(
+            Geom("elbow_housing", "cylinder", (0.05,), fromto=(0.0, -0.05, 0.0, 0.0, 0.17, 0.0)),
+            Geom("forearm_tube", "cylinder", (0.038,), fromto=(0.05, 0.0, 0.0, 0.35, 0.0, 0.0)),
+        ),
+    ),
+    Link(
+        "wrist_1_link",
+        "forearm_link",
+        "wrist_1_joint",
+        "revolute",
+        axis=(0.0, 1.0, 0.0),
+        xyz=(0.3922, 0.0, 0.0),
+        limits=(-math.pi, math.pi),
+        effort=28.0,
+        velocity=math.pi,
+        mass=1.2,
+        geoms=(Geom("wrist_1_housing", "cylinder", (0.04,), fromto=(0.0, -0.04, 0.0, 0.0, 0.09, 0.0)),),
+    ),
+    Link(
+        "wrist_2_link",
+        "wrist_1_link",
+        "wrist_2_joint",
+        "revolute",
+        axis=(0.0, 0.0, -1.0),
+        xyz=(0.0, 0.1263, 0.0),
+        limits=(-math.pi, math.pi),
+        effort=28.0,
+        velocity=math.pi,
+        mass=1.2,
+        geoms=(Geom("wrist_2_housing", "cylinder", (0.04,), fromto=(0.0, 0.0, 0.04, 0.0, 0.0, -0.06)),),
+    ),
+    Link(
+        "wrist_3_link",
+        "wrist_2_link",
+        "wrist_3_joint",
+        "revolute",
+        axis=(0.0, 1.0, 0.0),
+        xyz=(0.0, 0.0, -0.0997),
+        limits=(-math.pi, math.pi),
+        effort=28.0,
+        velocity=math.pi,
+        mass=0.25,
+        geoms=(Geom("wrist_3_flange", "cylinder", (0.04,), fromto=(0.0, -0.04, 0.0, 0.0, 0.0996, 0.0)),),
+    ),
+    Link("tool0", "wrist_3_link", xyz=(0.0, 0.0996, 0.0), quat=R_TOOL),
+    Link(
+        "robotiq_85_base_link",
+        "tool0",
+        mass=0.6,
+        geoms=(
+            Geom("gripper_coupling", "cylinder", (0.04,), fromto=(0.0, 0.0, 0.0, 0.0, 0.0, 0.03), rgba=DARK),
+            Geom("gripper_palm", "box", (0.03, 0.07, 0.025), pos=(0.0, 0.0, 0.055), rgba=DARK),
+        ),
+    ),
+    Link(
+        "robotiq_85_left_knuckle_link",
+        "robotiq_85_base_link",
+        "robotiq_85_left_knuckle_joint",
+        "revolute",
+        axis=(1.0, 0.0, 0.0),
+        xyz=(0.0, 0.03, 0.06),
+        limits=(0.0, KNUCKLE_CLOSED),
+        effort=10.0,
+        velocity=2.0,
+        mass=0.02,
+    ),
+    Link(
+        "robotiq_85_left_finger_link",
+        "robotiq_85_base_link",
+        "robotiq_85_left_finger_joint",
+        "prismatic",
+        axis=(0.0, -1.0, 0.0),
+        xyz=(0.0, FINGER_TRAVEL + FINGER_HALF_THICKNESS, TCP_DEPTH - 0.015),
+        limits=(0.0, FINGER_TRAVEL),
+        effort=100.0,
+        velocity=0.2,
+        mass=0.05,
+        geoms=(
+            Geom(
+                "left_finger_pad", "box", (0.011, FINGER_HALF_THICKNESS, 0.035), rgba=ACCENT, contact=PAD
+            ),
+        ),
+    ),
+    Link(
+        "robotiq_85_right_finger_link",
+        "robotiq_85_base_link",
+        "robotiq_85_right_finger_joint",
+        "prismatic",
+        axis=(0.0, 1.0, 0.0),
+        xyz=(0.0, -(FINGER_TRAVEL + FINGER_HALF_THICKNESS), TCP_DEPTH - 0.015),
+        limits=(0.0, FINGER_TRAVEL),
+        effort=100.0,
+        velocity=0.2,
+        mass=0.05,
+        geoms=(
+            Geom(
+                "right_finger_pad", "box", (0.011, FINGER_HALF_THICKNESS, 0.035), rgba=ACCENT, contact=PAD
+            ),
+        ),
+    ),
+    Link("grasp_link", "robotiq_85_base_link", xyz=(0.0, 0.0, TCP_DEPTH)),
+)
+
+MIMIC = {
+    "robotiq_85_left_finger_joint": ("robotiq_85_left_knuckle_joint", FINGER_PER_KNUCKLE),
+    "robotiq_85_right_finger_joint": ("robotiq_85_left_knuckle_joint", FINGER_PER_KNUCKLE),
+}
+
+# name: (kp, kv, force limit) of the position servo on each actuated joint. The gripper servo saturates at
+# 3 N·m on the knuckle, i.e. about 28 N of squeeze per finger through the coupling, whatever the object width.
+SERVOS = {
+    "linear_rail_joint": (20000.0, 1500.0, 2000.0),
+    "shoulder_pan_joint": (2000.0, 150.0, 150.0),
+    "shoulder_lift_joint": (2000.0, 150.0, 150.0),
+    "elbow_joint": (1500.0, 100.0, 150.0),
+    "wrist_1_joint": (300.0, 15.0, 28.0),
+    "wrist_2_joint": (300.0, 15.0, 28.0),
+    "wrist_3_joint": (300.0, 15.0, 28.0),
+    "robotiq_85_left_knuckle_joint": (20.0, 1.0, 3.0),
+}
+
+ARM_JOINTS = (
+    "linear_rail_joint",
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "elbow_joint",
+    "wrist_1_joint",
+    "wrist_2_joint",
+    "wrist_3_joint",
+)
+# The "Home" waypoint: arm folded above the rail, tool pointing down, gripper open.
+HOME = (0.0, 0.0, -2.0, 2.0, -1.5708, -1.5708, 0.0)
+
+
+def _f(x: float) -> str:
+    text = f"{x:.10g}"
+    return "0" if text == "-0" else text
+
+
+def _vec(v: tuple[float, ...] | list[float]) -> str:
+    return " ".join(_f(x) for x in v)
+
+
+def _quat_to_rpy(q: tuple[float, float, float, float]) -> tuple[float, float, float]:
+    w, x, y, z = q
+    roll = math.atan2(2 * (w * x + y * z), 1 - 2 * (x * x + y * y))
+    pitch = math.asin(max(-1.0, min(1.0, 2 * (w * y - z * x))))
+    yaw = math.atan2(2 * (w * z + x * y), 1 - 2 * (y * y + z * z))
+    return roll, pitch, yaw
+
+
+def _cylinder_origin(fromto: tuple[float, ...]) -> tuple[tuple[float, ...], tuple[float, ...], float]:
+    """Centre, URDF rpy and length of a cylinder given by its end points (URDF cylinders run along z)."""
+    p1, p2 = fromto[:3], fromto[3:]
+    centre = tuple((a + b) / 2 for a, b in zip(p1, p2, strict=True))
+    d = [b - a for a, b in zip(p1, p2, strict=True)]
+    length = math.sqrt(sum(c * c for c in d))
+    ux, uy, uz = (c / length for c in d)
+    # Rotation taking z to u: roll about x then pitch about y (rpy convention R = Rz Ry Rx).
+    roll = math.atan2(-uy, math.hypot(ux, uz))
+    pitch = math.atan2(ux, uz)
+    return centre, (roll, pitch, 0.0), length
+
+
+def _urdf_geometry(g: Geom) -> tuple[str, str]:
+    if g.kind == "box":
+        return f'<box size="{_vec([2 * s for s in g.size])}"/>', f'xyz="{_vec(g.pos)}" rpy="0 0 0"'
+    if g.kind == "sphere":
+        return f'<sphere radius="{_f(g.size[0])}"/>', f'xyz="{_vec(g.pos)}" rpy="0 0 0"'
+    centre, rpy, length = _cylinder_origin(g.fromto)
+    return (
+        f'<cylinder radius="{_f(g.size[0])}" length="{_f(length)}"/>',
+        f'xyz="{_vec(centre)}" rpy="{_vec(rpy)}"',
+    )
+
+
+def render_urdf() -> str:
+    """Return the URDF of the robot (a ``world`` root link, as MoveIt Pro requires)."""
+    out = [
+        '<?xml version="1.0"?>',
+        "<!-- Generated by generate.py from its link table; edit that, not this file. -->",
+        '<robot name="lab_sim">',
+        '  <link name="world"/>',
+    ]
+    for link in LINKS:
+        out.append(f'  <link name="{link.name}">')
+        if link.mass > 0:
+            i = 0.01 * link.mass
+            out.append(
+                f'    <inertial><origin xyz="0 0 0" rpy="0 0 0"/><mass value="{_f(link.mass)}"/>'
+                f'<inertia ixx="{_f(i)}" ixy="0" ixz="0" iyy="{_f(i)}" iyz="0" izz="{_f(i)}"/></inertial>'
+            )
+        for g in link.geoms:
+            shape, origin = _urdf_geometry(g)
+            out.append(f'    <visual name="{g.name}"><origin {origin}/><geometry>{shape}</geometry></visual>')
+            out.append(
+                f'    <collision name="{g.name}"><origin {origin}/><geometry>{shape}</geometry></collision>'
+            )
+        out.append("  </link>")
+        jname = link.joint or f"{link.parent}_to_{link.name}"
+        out.append(f'  <joint name="{jname}" type="{link.kind}">')
+        out.append(f'    <parent link="{link.parent}"/><child link="{link.name}"/>')
+        out.append(f'    <origin xyz="{_vec(link.xyz)}" rpy="{_vec(_quat_to_rpy(link.quat))}"/>')
+        if link.kind != "fixed":
+            out.append(f'    <axis xyz="{_vec(link.axis)}"/>')
+            lo, hi = link.limits
+            out.append(
+                f'    <limit lower="{_f(lo)}" upper="{_f(hi)}" effort="{_f(link.effort)}" '
+                f'velocity="{_f(link.velocity)}"/>'
+            )
+        if link.joint in MIMIC:
+            leader, ratio = MIMIC[link.joint]
+            out.append(f'    <mimic joint="{leader}" multiplier="{_f(ratio)}" offset="0"/>')
+        out.append("  </joint>")
+    out.append("</robot>")
+    return "\n".join(out) + "\n"
+
+
+def _mjcf_geom(g: Geom, indent: str) -> str:
+    common = f'name="{g.name}" rgba="{g.rgba}"' + (f" {g.contact}" if g.contact else "")
+    if g.kind == "box":
+        return f'{indent}<geom {common} type="box" size="{_vec(g.size)}" pos="{_vec(g.pos)}"/>'
+    if g.kind == "sphere":
+        return f'{indent}<geom {common} type="sphere" size="{_f(g.size[0])}" pos="{_vec(g.pos)}"/>'
+    return f'{indent}<geom {common} type="cylinder" size="{_f(g.size[0])}" fromto="{_vec(g.fromto)}"/>'
+
+
+def _mjcf_body(link: Link, depth: int) -> list[str]:
+    ind = "  " * depth
+    attrs = f'name="{link.name}" pos="{_vec(link.xyz)}"'
+    if link.quat != (1.0, 0.0, 0.0, 0.0):
+        attrs += f' quat="{_vec(link.quat)}"'
+    if link.parent != "world":
+        attrs += ' gravcomp="1"'
+    out = [f"{ind}<body {attrs}>"]
+    if link.kind != "fixed":
+        jtype = "hinge" if link.kind == "revolute" else "slide"
+        lo, hi = link.limits
+        extra = ' armature="0.1" damping="1"' if link.kind == "revolute" else ' armature="0.1" damping="10"'
+        if link.name.startswith("robotiq"):
+            extra = ' armature="0.001" damping="0.05"'
+        out.append(
+            f'{ind}  <joint name="{link.joint}" type="{jtype}" axis="{_vec(link.axis)}" '
+            f'range="{_f(lo)} {_f(hi)}"{extra}/>'
+        )
+    if link.mass > 0:
+        i = 0.01 * link.mass
+        out.append(f'{ind}  <inertial pos="0 0 0" mass="{_f(link.mass)}" diaginertia="{_f(i)} {_f(i)} {_f(i)}"/>')
+    if link.name == "robotiq_85_left_knuckle_link":
+        out.append(
+            f'{ind}  <geom name="left_knuckle" type="box" size="0.006 0.012 0.02" pos="0 0 0.02" '
+            f'contype="0" conaffinity="0" group="1" mass="0" rgba="{DARK}"/>'
+        )
+    for g in link.geoms:
+        out.append(_mjcf_geom(g, ind + "  "))
+    if link.name == "grasp_link":
+        out.append(f'{ind}  <site name="grasp_site" size="0.005" rgba="1 0 0 1"/>')
+    for child in LINKS:
+        if child.parent == link.name:
+            out.extend(_mjcf_body(child, depth + 1))
+    out.append(f"{ind}</body>")
+    return out
+
+
+def _keyframe_qpos(arm: tuple[float, ...], knuckle: float) -> str:
+    finger = knuckle * FINGER_PER_KNUCKLE
+    cube = (*CUBE_START, 1.0, 0.0, 0.0, 0.0)
+    return _vec([*arm, knuckle, finger, finger, *cube])
+
+
+def render_scene() -> str:
+    """Return the MuJoCo scene: the robot from the link table plus table, tray, cube, camera, actuators."""
+    tx, ty = TRAY_CENTER
+    robot = []
+    for link in LINKS:
+        if link.parent == "world":
+            robot.extend(_mjcf_body(link, 2))
+    actuators = []
+    for joint, (kp, kv, force) in SERVOS.items():
+        lo, hi = next(link.limits for link in LINKS if link.joint == joint)
+        actuators.append(
+            f'    <position name="{joint}" joint="{joint}" kp="{_f(kp)}" kv="{_f(kv)}" '
+            f'ctrlrange="{_f(lo)} {_f(hi)}" forcerange="{_f(-force)} {_f(force)}"/>'
+        )
+    ctrl = _vec([*HOME, 0.0])
+    home_qpos = _keyframe_qpos(HOME, 0.0)
+    lines = [
+        "<!-- Generated by generate.py from its link table; edit that, not this file. -->",
+        '<mujoco model="lab_sim">',
+        '  <compiler angle="radian" autolimits="true"/>',
+        '  <option timestep="0.002" integrator="implicitfast" cone="elliptic" impratio="10"/>',
+        "  <visual>",
+        '    <global offwidth="640" offheight="480"/>',
+        '    <quality shadowsize="2048"/>',
+        "  </visual>",
+        "  <asset>",
+        '    <texture name="grid" type="2d" builtin="checker" rgb1="0.82 0.82 0.84" rgb2="0.74 0.74 0.76" '
+        'width="256" height="256"/>',
+        '    <material name="floor" texture="grid" texrepeat="6 6"/>',
+        "  </asset>",
+        "  <worldbody>",
+        '    <light name="top" pos="0.5 0 3" dir="0 0 -1" directional="true"/>',
+        '    <geom name="floor" type="plane" size="4 4 0.05" material="floor"/>',
+        '    <camera name="scene_camera" pos="2.0 0 1.55" xyaxes="0 1 0 -0.6 0 1.2" fovy="50"/>',
+        f'    <geom name="table" type="box" size="0.35 1.2 {_f(TABLE_TOP / 2)}" '
+        f'pos="0.7 0 {_f(TABLE_TOP / 2)}" rgba="0.76 0.7 0.6 1"/>',
+        *robot,
+        f'    <body name="tray" pos="{_f(tx)} {_f(ty)} {_f(TABLE_TOP)}">',
+        f'      <geom name="tray_floor" type="box" size="0.12 0.14 {_f(TRAY_FLOOR / 2)}" '
+        f'pos="0 0 {_f(TRAY_FLOOR / 2)}" rgba="0.3 0.5 0.35 1"/>',
+        '      <geom name="tray_wall_front" type="box" size="0.125 0.005 0.02" pos="0 0.145 0.02" '
+        'rgba="0.3 0.5 0.35 1"/>',
+        '      <geom name="tray_wall_back" type="box" size="0.125 0.005 0.02" pos="0 -0.145 0.02" '
+        'rgba="0.3 0.5 0.35 1"/>',
+        '      <geom name="tray_wall_left" type="box" size="0.005 0.14 0.02" pos="0.125 0 0.02" '
+        'rgba="0.3 0.5 0.35 1"/>',
+        '      <geom name="tray_wall_right" type="box" size="0.005 0.14 0.02" pos="-0.125 0 0.02" '
+        'rgba="0.3 0.5 0.35 1"/>',
+        "    </body>",
+        f'    <body name="cube" pos="{_vec(CUBE_START)}">',
+        '      <freejoint name="cube_joint"/>',
+        f'      <geom name="cube" type="box" size="{_vec([CUBE_HALF] * 3)}" mass="0.08" '
+        'friction="1 0.01 0.0001" condim="4" rgba="0.85 0.2 0.2 1"/>',
+        "    </body>",
+        "  </worldbody>",
+        "  <contact>",
+        # The rail base is welded to the world, so MuJoCo's parent filter does not cover its children.
+        '    <exclude body1="linear_rail_base_link" body2="linear_rail_carriage_link"/>',
+        '    <exclude body1="linear_rail_base_link" body2="base_link"/>',
+        '    <exclude body1="robotiq_85_left_finger_link" body2="robotiq_85_right_finger_link"/>',
+        "  </contact>",
+        "  <equality>",
+        # Both fingers follow the knuckle: finger = ratio * knuckle (stiff, so the squeeze is transmitted).
+        f'    <joint name="left_finger_coupling" joint1="robotiq_85_left_finger_joint" '
+        f'joint2="robotiq_85_left_knuckle_joint" polycoef="0 {_f(FINGER_PER_KNUCKLE)} 0 0 0" '
+        'solref="0.004 1"/>',
+        f'    <joint name="right_finger_coupling" joint1="robotiq_85_right_finger_joint" '
+        f'joint2="robotiq_85_left_knuckle_joint" polycoef="0 {_f(FINGER_PER_KNUCKLE)} 0 0 0" '
+        'solref="0.004 1"/>',
+        "  </equality>",
+        "  <actuator>",
+        *actuators,
+        "  </actuator>",
+        "  <keyframe>",
+        f'    <key name="default" qpos="{home_qpos}" ctrl="{ctrl}"/>',
+        f'    <key name="home" qpos="{home_qpos}" ctrl="{ctrl}"/>',
+        "  </keyframe>",
+        "</mujoco>",
+    ]
+    return "\n".join(lines) + "\n"
+
+
+def main() -> None:
+    """Write both files next to this script."""
+    (HERE / "lab_sim.urdf").write_text(render_urdf())
+    (HERE / "lab_sim_scene.xml").write_text(render_scene())
+
+
+if __name__ == "__main__":
+    main()
