@@ -256,7 +256,7 @@ MIMIC = {
 }
 
 # name: (kp, kv, force limit) of the position servo on each actuated joint. The gripper servo saturates at
-# 3 N·m on the knuckle, i.e. about 28 N of squeeze per finger through the coupling, whatever the object width.
+# 3 (tendon units: N·m per knuckle radian), i.e. about 28 N of squeeze per finger, whatever the object width.
 SERVOS = {
     "linear_rail_joint": (20000.0, 1500.0, 2000.0),
     "shoulder_pan_joint": (2000.0, 150.0, 150.0),
@@ -265,9 +265,10 @@ SERVOS = {
     "wrist_1_joint": (300.0, 15.0, 28.0),
     "wrist_2_joint": (300.0, 15.0, 28.0),
     "wrist_3_joint": (300.0, 15.0, 28.0),
-    "robotiq_85_left_knuckle_joint": (20.0, 1.0, 3.0),
+    "robotiq_85_left_knuckle_joint": (20.0, 0.5, 3.0),
 }
 
+GRIPPER_JOINT = "robotiq_85_left_knuckle_joint"
 ARM_JOINTS = (
     "linear_rail_joint",
     "shoulder_pan_joint",
@@ -386,8 +387,10 @@ def _mjcf_body(link: Link, depth: int) -> list[str]:
         jtype = "hinge" if link.kind == "revolute" else "slide"
         lo, hi = link.limits
         extra = ' armature="0.1" damping="1"' if link.kind == "revolute" else ' armature="0.1" damping="10"'
-        if link.name.startswith("robotiq"):
-            extra = ' armature="0.001" damping="0.05"'
+        if link.name.startswith("robotiq_85_left_knuckle"):
+            extra = ' armature="0.0001" damping="0.001"'
+        elif link.name.startswith("robotiq"):
+            extra = ' armature="0.05" damping="0.5"'
         out.append(
             f'{ind}  <joint name="{link.joint}" type="{jtype}" axis="{_vec(link.axis)}" '
             f'range="{_f(lo)} {_f(hi)}"{extra}/>'
@@ -427,8 +430,9 @@ def render_scene() -> str:
     actuators = []
     for joint, (kp, kv, force) in SERVOS.items():
         lo, hi = next(link.limits for link in LINKS if link.joint == joint)
+        target = 'tendon="robotiq_85_grip"' if joint == GRIPPER_JOINT else f'joint="{joint}"'
         actuators.append(
-            f'    <position name="{joint}" joint="{joint}" kp="{_f(kp)}" kv="{_f(kv)}" '
+            f'    <position name="{joint}" {target} kp="{_f(kp)}" kv="{_f(kv)}" '
             f'ctrlrange="{_f(lo)} {_f(hi)}" forcerange="{_f(-force)} {_f(force)}"/>'
         )
     ctrl = _vec([*HOME, 0.0])
@@ -478,14 +482,21 @@ def render_scene() -> str:
         '    <exclude body1="linear_rail_base_link" body2="base_link"/>',
         '    <exclude body1="robotiq_85_left_finger_link" body2="robotiq_85_right_finger_link"/>',
         "  </contact>",
+        "  <tendon>",
+        # The gripper servo acts on the fingers through this tendon, whose length is the knuckle angle the
+        # fingers' opening corresponds to, so its ctrl is MoveIt Pro's gripper position (0 open, 0.7929 closed).
+        '    <fixed name="robotiq_85_grip">',
+        f'      <joint joint="robotiq_85_left_finger_joint" coef="{_f(0.5 / FINGER_PER_KNUCKLE)}"/>',
+        f'      <joint joint="robotiq_85_right_finger_joint" coef="{_f(0.5 / FINGER_PER_KNUCKLE)}"/>',
+        "    </fixed>",
+        "  </tendon>",
         "  <equality>",
-        # Both fingers follow the knuckle: finger = ratio * knuckle (stiff, so the squeeze is transmitted).
-        f'    <joint name="left_finger_coupling" joint1="robotiq_85_left_finger_joint" '
-        f'joint2="robotiq_85_left_knuckle_joint" polycoef="0 {_f(FINGER_PER_KNUCKLE)} 0 0 0" '
-        'solref="0.004 1"/>',
-        f'    <joint name="right_finger_coupling" joint1="robotiq_85_right_finger_joint" '
-        f'joint2="robotiq_85_left_knuckle_joint" polycoef="0 {_f(FINGER_PER_KNUCKLE)} 0 0 0" '
-        'solref="0.004 1"/>',
+        # The fingers move together; the knuckle (a light visual link) follows them, so the knuckle joint
+        # reports the real opening and no grip force has to flow through a soft coupling.
+        '    <joint name="finger_coupling" joint1="robotiq_85_right_finger_joint" '
+        'joint2="robotiq_85_left_finger_joint" solref="0.004 1"/>',
+        f'    <joint name="knuckle_follows_fingers" joint1="robotiq_85_left_knuckle_joint" '
+        f'joint2="robotiq_85_left_finger_joint" polycoef="0 {_f(1 / FINGER_PER_KNUCKLE)} 0 0 0"/>',
         "  </equality>",
         "  <actuator>",
         *actuators,
