@@ -1,0 +1,273 @@
+"""Named joint-space waypoints in MoveIt Pro's waypoints YAML.
+
+The file is a YAML list; each item has the fields of ``moveit_studio_agent_msgs/Waypoint``::
+
+    - name: Look at Table
+      description: ''
+      favorite: false
+      joint_group_names: [gripper, linear_actuator, manipulator]
+      joint_state: {header: {...}, name: [...], position: [...], velocity: [], effort: []}
+      multi_dof_joint_state: {header: {...}, joint_names: [], transforms: [], twist: [], wrench: []}
+
+Fields Kinema does not model (a header's frame, multi-DOF states, anything new) are kept as read.
+
+Every change (save, rename, erase) takes the file's lock (a sidecar ``.lock`` file, see
+:mod:`kinema.config.file_lock`), reads the current file, changes it and replaces it atomically, so
+concurrent writers in threads or processes never lose each other's waypoints and readers never see a
+half-written file.
+"""
+
+from __future__ import annotations
+
+import copy
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from kinema.config.atomic_write import atomic_write_text
+from kinema.config.file_lock import locked
+from kinema.config.yamlsource import YamlDocument, load_yaml_file
+from kinema.errors import ConfigError, SourceLocation, did_you_mean
+
+MAX_WAYPOINTS_BYTES = 64 * 1024 * 1024
+_Dumper: type[yaml.SafeDumper] = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # type: ignore[assignment]
+
+
+def _empty_header() -> dict[str, Any]:
+    return {"frame_id": "", "stamp": {"nanosec": 0, "sec": 0}}
+
+
+@dataclass
+class Waypoint:
+    """A named robot configuration.
+
+    Attributes:
+        name: unique within its file.
+        joint_names: the joints of ``positions``, same order.
+        positions: joint positions in rad (revolute) or m (prismatic).
+        joint_group_names: planning groups the waypoint was saved for.
+        description: free text.
+        favorite: shown first in UIs.
+        velocities / efforts: usually empty.
+        raw: the item as read from the file; fields not modeled here are written back from it.
+    """
+
+    name: str
+    joint_names: list[str]
+    positions: list[float]
+    joint_group_names: list[str] = field(default_factory=list)
+    description: str = ""
+    favorite: bool = False
+    velocities: list[float] = field(default_factory=list)
+    efforts: list[float] = field(default_factory=list)
+    raw: dict[str, Any] = field(default_factory=dict, repr=False, compare=False)
+
+    def joint_positions(self) -> dict[str, float]:
+        """Joint name -> position."""
+        return dict(zip(self.joint_names, self.positions, strict=True))
+
+    def to_dict(self) -> dict[str, Any]:
+        """The item as MoveIt Pro writes it (fields not modeled here kept from :attr:`raw`)."""
+        item = copy.deepcopy(self.raw)
+        found = item.get("joint_state")
+        joint_state: dict[str, Any] = found if isinstance(found, dict) else {}
+        joint_state.setdefault("header", _empty_header())
+        joint_state.update(
+            name=list(self.joint_names),
+            position=[float(p) for p in self.positions],
+            velocity=[float(v) for v in self.velocities],
+            effort=[float(e) for e in self.efforts],
+        )
+        item.update(
+            name=self.name,
+            description=self.description,
+            favorite=self.favorite,
+            joint_group_names=list(self.joint_group_names),
+            joint_state=joint_state,
+        )
+        item.setdefault(
+            "multi_dof_joint_state",
+            {"header": _empty_header(), "joint_names": [], "transforms": [], "twist": [], "wrench": []},
+        )
+        return item
+
+    @classmethod
+    def from_dict(cls, item: Any, document: YamlDocument, index: int) -> Waypoint:
+        """Build a waypoint from one list item of a waypoints file.
+
+        Raises:
+            ConfigError: a field is missing or has the wrong type (with file:line).
+        """
+        where = (index,)
+        if not isinstance(item, dict):
+            raise ConfigError(
+                "each waypoint must be a mapping with name:, joint_state:, ...",
+                location=document.location(where),
+            )
+        name = item.get("name")
+        if not isinstance(name, str) or not name:
+            raise ConfigError("a waypoint needs a non-empty string name:", location=document.location(where))
+        joint_state = item.get("joint_state")
+        if not isinstance(joint_state, dict):
+            raise ConfigError(
+                f"waypoint {name!r} needs a joint_state: mapping with name: and position: lists",
+                location=document.location((*where, "joint_state")),
+            )
+        joint_names = _list(joint_state.get("name"), str, document, (*where, "joint_state", "name"), name)
+        positions = _list(
+            joint_state.get("position"), (int, float), document, (*where, "joint_state", "position"), name
+        )
+        if len(joint_names) != len(positions):
+            raise ConfigError(
+                f"waypoint {name!r} has {len(joint_names)} joint names but {len(positions)} positions",
+                location=document.location((*where, "joint_state", "position")),
+            )
+        groups = _list(item.get("joint_group_names"), str, document, (*where, "joint_group_names"), name)
+        return cls(
+            name=name,
+            joint_names=joint_names,
+            positions=[float(p) for p in positions],
+            joint_group_names=groups,
+            description=str(item.get("description") or ""),
+            favorite=bool(item.get("favorite", False)),
+            velocities=[
+                float(v) for v in _list(joint_state.get("velocity"), (int, float), document, where, name)
+            ],
+            efforts=[float(e) for e in _list(joint_state.get("effort"), (int, float), document, where, name)],
+            raw=item,
+        )
+
+
+def _list(
+    value: Any, kind: type | tuple[type, ...], document: YamlDocument, where: tuple[Any, ...], name: str
+) -> list[Any]:
+    if value is None:
+        return []
+    if not isinstance(value, list) or not all(isinstance(v, kind) and not isinstance(v, bool) for v in value):
+        wanted = "strings" if kind is str else "numbers"
+        raise ConfigError(
+            f"waypoint {name!r}: {where[-1]} must be a list of {wanted}", location=document.location(where)
+        )
+    return value
+
+
+class WaypointStore:
+    """The waypoints of one file, read fresh on every call and changed under the file's lock."""
+
+    def __init__(self, path: str | Path) -> None:
+        self.path = Path(path)
+
+    def all(self) -> list[Waypoint]:
+        """Every waypoint, in file order (an absent file has none).
+
+        Raises:
+            ConfigError: the file is not a valid waypoints file (with file:line).
+        """
+        return self._read()
+
+    def names(self) -> list[str]:
+        """The waypoint names, in file order."""
+        return [waypoint.name for waypoint in self._read()]
+
+    def get(self, name: str) -> Waypoint:
+        """Return the waypoint ``name``.
+
+        Raises:
+            ConfigError: no such waypoint; the message lists the closest names.
+        """
+        waypoints = self._read()
+        for waypoint in waypoints:
+            if waypoint.name == name:
+                return waypoint
+        raise ConfigError(
+            f"no waypoint named {name!r} in {self.path}; {did_you_mean(name, [w.name for w in waypoints])}"
+        )
+
+    def save(self, waypoint: Waypoint) -> None:
+        """Add ``waypoint``, or replace the one with the same name (keeping its place in the file)."""
+        if not waypoint.name:
+            raise ConfigError("a waypoint needs a non-empty name")
+        if len(waypoint.joint_names) != len(waypoint.positions):
+            raise ConfigError(
+                f"waypoint {waypoint.name!r} has {len(waypoint.joint_names)} joint names but "
+                f"{len(waypoint.positions)} positions"
+            )
+        with locked(self.path):
+            waypoints = self._read()
+            for index, existing in enumerate(waypoints):
+                if existing.name == waypoint.name:
+                    waypoints[index] = waypoint
+                    break
+            else:
+                waypoints.append(waypoint)
+            self._write(waypoints)
+
+    def rename(self, old: str, new: str) -> None:
+        """Rename waypoint ``old`` to ``new``.
+
+        Raises:
+            ConfigError: ``old`` does not exist, or ``new`` is empty or already taken.
+        """
+        if not new:
+            raise ConfigError("a waypoint needs a non-empty name")
+        with locked(self.path):
+            waypoints = self._read()
+            names = [waypoint.name for waypoint in waypoints]
+            if old not in names:
+                raise ConfigError(f"no waypoint named {old!r} in {self.path}; {did_you_mean(old, names)}")
+            if new != old and new in names:
+                raise ConfigError(f"a waypoint named {new!r} already exists in {self.path}")
+            waypoints[names.index(old)].name = new
+            self._write(waypoints)
+
+    def erase(self, name: str) -> None:
+        """Remove waypoint ``name``.
+
+        Raises:
+            ConfigError: no such waypoint.
+        """
+        with locked(self.path):
+            waypoints = self._read()
+            names = [waypoint.name for waypoint in waypoints]
+            if name not in names:
+                raise ConfigError(f"no waypoint named {name!r} in {self.path}; {did_you_mean(name, names)}")
+            del waypoints[names.index(name)]
+            self._write(waypoints)
+
+    def _read(self) -> list[Waypoint]:
+        if not self.path.exists():
+            return []
+        document = load_yaml_file(self.path, max_bytes=MAX_WAYPOINTS_BYTES)
+        if document.data is None:
+            return []
+        if not isinstance(document.data, list):
+            raise ConfigError(
+                "a waypoints file is a YAML list of waypoints (- name: ...)", location=document.location(())
+            )
+        waypoints: list[Waypoint] = []
+        first_line: dict[str, int] = {}
+        for index, item in enumerate(document.data):
+            waypoint = Waypoint.from_dict(item, document, index)
+            line = document.line((index,))
+            if waypoint.name in first_line:
+                raise ConfigError(
+                    f"two waypoints are named {waypoint.name!r} "
+                    f"(lines {first_line[waypoint.name]} and {line})",
+                    location=SourceLocation(str(self.path), line),
+                )
+            first_line[waypoint.name] = line
+            waypoints.append(waypoint)
+        return waypoints
+
+    def _write(self, waypoints: list[Waypoint]) -> None:
+        text = yaml.dump(
+            [waypoint.to_dict() for waypoint in waypoints],
+            Dumper=_Dumper,
+            default_flow_style=False,
+            sort_keys=True,
+            allow_unicode=True,
+        )
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        atomic_write_text(self.path, text)

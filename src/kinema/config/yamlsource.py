@@ -1,0 +1,162 @@
+"""Reading YAML files so that every key can be traced back to ``file:line``.
+
+Config and waypoint files are small, but their errors must point at the exact line. PyYAML's composer
+(the C one when libyaml is present) builds a node tree that carries line marks; the document is
+constructed from that tree by the safe constructor and, in the same pass, a table from key path to line
+is recorded. Files are read as bytes first so that a non-UTF-8 or a far too large file gets a clear
+message instead of a decoder traceback.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Hashable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from kinema.errors import ConfigError, KinemaError, SourceLocation
+
+_Loader: type[yaml.SafeLoader] = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # type: ignore[assignment]
+
+#: Default size limit of a YAML file; config files are a few kB, waypoint files a few hundred kB.
+MAX_YAML_BYTES = 16 * 1024 * 1024
+
+KeyPath = tuple[Hashable, ...]
+
+
+@dataclass
+class YamlDocument:
+    """A parsed YAML file: its data and the line of every mapping key and list item.
+
+    Attributes:
+        path: the file the document was read from (or a display name).
+        data: the constructed Python value (dicts, lists, scalars).
+        lines: 1-based line of each key path, e.g. ``("hardware", "robot_description", "urdf")``;
+            list items are keyed by their index.
+    """
+
+    path: Path
+    data: Any
+    lines: dict[KeyPath, int] = field(default_factory=dict)
+
+    def line(self, key_path: Sequence[Hashable]) -> int:
+        """Return the line of ``key_path``, or of its longest known prefix (0 when nothing is known)."""
+        path = tuple(key_path)
+        while path:
+            found = self.lines.get(path)
+            if found is not None:
+                return found
+            path = path[:-1]
+        return self.lines.get((), 0)
+
+    def location(self, key_path: Sequence[Hashable] = ()) -> SourceLocation:
+        """Return ``file:line`` of ``key_path`` for error messages."""
+        return SourceLocation(str(self.path), self.line(key_path))
+
+
+def read_text_file(path: Path, *, max_bytes: int, error: type[KinemaError] = ConfigError) -> str:
+    """Read a UTF-8 text file, refusing unreadable, too large and non-UTF-8 files with a clear error."""
+    try:
+        size = path.stat().st_size
+    except FileNotFoundError:
+        raise error("the file does not exist", location=SourceLocation(str(path))) from None
+    except OSError as exc:
+        raise error(f"cannot read the file: {exc.strerror}", location=SourceLocation(str(path))) from None
+    if size > max_bytes:
+        raise error(
+            f"the file is {_megabytes(size)}, larger than the limit of {_megabytes(max_bytes)}",
+            location=SourceLocation(str(path)),
+        )
+    try:
+        data = path.read_bytes()
+    except OSError as exc:
+        raise error(f"cannot read the file: {exc.strerror}", location=SourceLocation(str(path))) from None
+    return decode_utf8(data, str(path), error=error)
+
+
+def decode_utf8(data: bytes, filename: str, *, error: type[KinemaError] = ConfigError) -> str:
+    """Decode ``data`` as UTF-8 (a BOM is allowed); a bad byte is reported with its line."""
+    try:
+        return data.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = data.count(b"\n", 0, exc.start) + 1
+        raise error(
+            f"the file is not UTF-8 text (byte 0x{data[exc.start]:02x} at offset {exc.start})",
+            location=SourceLocation(filename, line),
+        ) from None
+
+
+def _megabytes(size: int) -> str:
+    return f"{size / (1024 * 1024):.1f} MB"
+
+
+def load_yaml_file(path: str | Path, *, max_bytes: int = MAX_YAML_BYTES) -> YamlDocument:
+    """Read and parse one YAML file.
+
+    Raises:
+        ConfigError: the file is missing, unreadable, too large, not UTF-8, not valid YAML, or has a
+            key twice in one mapping; the message carries ``file:line``.
+    """
+    path = Path(path)
+    return parse_yaml(read_text_file(path, max_bytes=max_bytes), path)
+
+
+def parse_yaml(text: str, path: str | Path = "<string>") -> YamlDocument:
+    """Parse YAML text into a :class:`YamlDocument` (see :func:`load_yaml_file` for the errors)."""
+    path = Path(path)
+    loader = _Loader(text)
+    document = YamlDocument(path=path, data=None)
+    try:
+        node = loader.get_single_node()
+        if node is not None:
+            document.data = loader.construct_document(node)
+            document.lines[()] = node.start_mark.line + 1
+            _record_lines(node, document, loader.construct_object)
+    except yaml.MarkedYAMLError as exc:
+        mark = exc.problem_mark or exc.context_mark
+        line = mark.line + 1 if mark is not None else 0
+        problem = " ".join(part for part in (exc.context, exc.problem) if part)
+        raise ConfigError(f"invalid YAML: {problem}", location=SourceLocation(str(path), line)) from None
+    except yaml.YAMLError as exc:
+        raise ConfigError(f"invalid YAML: {exc}", location=SourceLocation(str(path))) from None
+    except RecursionError:
+        raise ConfigError("invalid YAML: nested too deeply", location=SourceLocation(str(path))) from None
+    finally:
+        loader.dispose()
+    return document
+
+
+def _record_lines(node: yaml.Node, document: YamlDocument, construct_key: Callable[[yaml.Node], Any]) -> None:
+    """Walk the node tree beside the constructed value, recording the line of every key and item."""
+    # An explicit loop over a stack: deeply nested (hostile) files must not hit the recursion limit.
+    stack: list[tuple[yaml.Node, Any, KeyPath]] = [(node, document.data, ())]
+    seen: set[int] = set()
+    while stack:
+        current, current_value, path = stack.pop()
+        if id(current) in seen:  # an alias: its lines were recorded where the anchor is
+            continue
+        seen.add(id(current))
+        if isinstance(current, yaml.MappingNode) and isinstance(current_value, dict):
+            first_line: dict[Hashable, int] = {}
+            for key_node, value_node in current.value:
+                if key_node.tag == "tag:yaml.org,2002:merge":
+                    continue
+                key = construct_key(key_node)
+                line = key_node.start_mark.line + 1
+                if key in first_line:
+                    raise ConfigError(
+                        f"the key {key!r} appears twice in one mapping (first on line {first_line[key]})",
+                        location=SourceLocation(str(document.path), line),
+                    )
+                first_line[key] = line
+                child_path = (*path, key)
+                document.lines[child_path] = line
+                if key in current_value:
+                    stack.append((value_node, current_value[key], child_path))
+        elif isinstance(current, yaml.SequenceNode) and isinstance(current_value, list):
+            for index, (item_node, item_value) in enumerate(zip(current.value, current_value, strict=False)):
+                child_path = (*path, index)
+                document.lines[child_path] = item_node.start_mark.line + 1
+                stack.append((item_node, item_value, child_path))
