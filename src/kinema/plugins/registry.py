@@ -1,0 +1,132 @@
+"""The behavior registry: an immutable snapshot of which class implements which behavior ID.
+
+The objective server takes the current snapshot when an objective starts and builds a fresh
+:class:`~kinema.bt.BehaviorTreeFactory` from it, so a hot reload (which swaps in a new snapshot) never
+touches the instances of a running objective; the next run uses the new classes.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator, Mapping
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from kinema.errors import PluginError
+from kinema.plugins.discovery import PluginSpec
+from kinema.plugins.registration import BehaviorRegistration
+
+if TYPE_CHECKING:
+    from kinema.behaviors.context import BehaviorContext
+    from kinema.bt import BehaviorTreeFactory, Clock
+
+
+@dataclass(frozen=True)
+class PluginRecord:
+    """A plugin as loaded: where it came from, what it registered, or why it failed."""
+
+    spec: PluginSpec
+    behaviors: tuple[str, ...] = ()
+    error: PluginError | None = None
+
+    @property
+    def name(self) -> str:
+        """The loader name."""
+        return self.spec.name
+
+    @property
+    def ok(self) -> bool:
+        """True when the plugin loaded and registered without error."""
+        return self.error is None
+
+
+class BehaviorRegistry(Mapping[str, BehaviorRegistration]):
+    """Behavior ID → registration, plus the record of every plugin that took part. Never mutated."""
+
+    def __init__(
+        self,
+        registrations: Mapping[str, BehaviorRegistration] | None = None,
+        plugins: Mapping[str, PluginRecord] | None = None,
+        generation: int = 0,
+    ) -> None:
+        self._registrations = dict(registrations or {})
+        self._plugins = dict(plugins or {})
+        self.generation = generation
+
+    def __getitem__(self, behavior_id: str) -> BehaviorRegistration:
+        return self._registrations[behavior_id]
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self._registrations)
+
+    def __len__(self) -> int:
+        return len(self._registrations)
+
+    @property
+    def plugins(self) -> Mapping[str, PluginRecord]:
+        """Every plugin that was activated, by loader name, including the ones that failed."""
+        return dict(self._plugins)
+
+    def behaviors_of(self, plugin: str) -> list[BehaviorRegistration]:
+        """The registrations of one plugin."""
+        return [record for record in self._registrations.values() if record.plugin == plugin]
+
+    def with_plugin(
+        self, record: PluginRecord, registrations: list[BehaviorRegistration]
+    ) -> BehaviorRegistry:
+        """Return a new registry where ``record``'s plugin provides exactly ``registrations``.
+
+        Raises:
+            PluginError: an ID is already registered by another plugin (the message names both).
+        """
+        merged = {key: value for key, value in self._registrations.items() if value.plugin != record.name}
+        for registration in registrations:
+            other = merged.get(registration.behavior_id)
+            if other is not None:
+                raise PluginError(
+                    f"behavior '{registration.behavior_id}' is registered by both plugin '{other.plugin}' "
+                    f"({other.location}) and plugin '{record.name}' ({registration.location}); "
+                    "rename one of them or remove one loader from behavior_loader_plugins"
+                )
+            merged[registration.behavior_id] = registration
+        plugins = dict(self._plugins)
+        plugins[record.name] = PluginRecord(record.spec, tuple(r.behavior_id for r in registrations), None)
+        return BehaviorRegistry(merged, plugins, self.generation + 1)
+
+    def with_failure(self, record: PluginRecord) -> BehaviorRegistry:
+        """Return a new registry noting that ``record``'s plugin failed; its last good behaviors stay."""
+        plugins = dict(self._plugins)
+        previous = plugins.get(record.name)
+        kept = previous.behaviors if previous is not None else ()
+        plugins[record.name] = PluginRecord(record.spec, kept, record.error)
+        return BehaviorRegistry(self._registrations, plugins, self.generation)
+
+    def populate(self, factory: BehaviorTreeFactory, context: BehaviorContext | None = None) -> None:
+        """Register every behavior into ``factory``, each bound to ``context``.
+
+        Args:
+            factory: a factory, typically fresh for one objective run.
+            context: what the behaviors reach the world through; None gives each behavior an offline
+                context (no transport node), enough to build and validate trees.
+        """
+        from kinema.behaviors.binding import bind_behavior
+        from kinema.behaviors.context import BehaviorContext
+
+        context = context if context is not None else BehaviorContext.offline()
+        for registration in self._registrations.values():
+            factory.register_node_type(bind_behavior(registration, context), registration.behavior_id)
+
+    def create_factory(
+        self, context: BehaviorContext | None = None, *, clock: Clock | None = None
+    ) -> BehaviorTreeFactory:
+        """Return a new factory with the engine's built-in nodes and every behavior of this registry.
+
+        The factory uses ``clock``, else the context's clock, else wall time.
+        """
+        from kinema.bt import BehaviorTreeFactory
+
+        chosen_clock = clock if clock is not None else (context.clock if context is not None else None)
+        factory = (
+            BehaviorTreeFactory(clock=chosen_clock) if chosen_clock is not None else BehaviorTreeFactory()
+        )
+        self.populate(factory, context)
+        return factory
