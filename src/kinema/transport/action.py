@@ -1,0 +1,626 @@
+"""Actions as rcl builds them: three services and two topics under ``<action>/_action/``.
+
+* ``send_goal`` (``Name_SendGoal``): goal id + goal → accepted + stamp;
+* ``cancel_goal`` (``action_msgs/srv/CancelGoal``): cancel one goal, all goals, or all up to a time;
+* ``get_result`` (``Name_GetResult``): held open by the server until the goal ends → status + result;
+* ``feedback`` (``Name_FeedbackMessage``): goal id + feedback;
+* ``status`` (``action_msgs/msg/GoalStatusArray``, transient local): every goal the server knows.
+
+So ``ros2 action send_goal`` against a Kinema action server, and a Kinema client against a ROS 2 action
+server on rmw_zenoh, both work.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+import uuid
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from kinema.errors import TransportError
+from kinema.interfaces import ActionType
+from kinema.transport.keys import LATCHED_QOS, QoS, fully_qualified
+from kinema.transport.messages import from_dict, type_of
+from kinema.transport.pubsub import Publisher, Subscription
+from kinema.transport.service import Responder, ServiceClient, ServiceServer
+
+if TYPE_CHECKING:
+    from kinema.transport.node import Node
+
+log = logging.getLogger(__name__)
+
+STATUS_UNKNOWN = 0
+STATUS_ACCEPTED = 1
+STATUS_EXECUTING = 2
+STATUS_CANCELING = 3
+STATUS_SUCCEEDED = 4
+STATUS_CANCELED = 5
+STATUS_ABORTED = 6
+STATUS_NAMES = {
+    STATUS_UNKNOWN: "UNKNOWN",
+    STATUS_ACCEPTED: "ACCEPTED",
+    STATUS_EXECUTING: "EXECUTING",
+    STATUS_CANCELING: "CANCELING",
+    STATUS_SUCCEEDED: "SUCCEEDED",
+    STATUS_CANCELED: "CANCELED",
+    STATUS_ABORTED: "ABORTED",
+}
+TERMINAL = frozenset({STATUS_SUCCEEDED, STATUS_CANCELED, STATUS_ABORTED})
+_ACTIVE = frozenset({STATUS_ACCEPTED, STATUS_EXECUTING, STATUS_CANCELING})
+
+CANCEL_ERROR_NONE = 0
+CANCEL_ERROR_REJECTED = 1
+CANCEL_ERROR_UNKNOWN_GOAL_ID = 2
+CANCEL_ERROR_GOAL_TERMINATED = 3
+
+# A get_result request is held open until the goal ends; this only bounds a lost request.
+_RESULT_QUERY_TIMEOUT = 7 * 24 * 3600.0
+_ZERO_ID = bytes(16)
+
+
+def _stamp_now() -> dict[str, int]:
+    now = time.time_ns()
+    return {"sec": now // 1_000_000_000, "nanosec": now % 1_000_000_000}
+
+
+def _uuid_bytes(message: Any) -> bytes:
+    return bytes(np.asarray(message.uuid, dtype=np.uint8).tobytes())
+
+
+def _uuid_dict(goal_id: bytes) -> dict[str, Any]:
+    return {"uuid": list(goal_id)}
+
+
+def _action_names(node: Node, name: str) -> str:
+    return fully_qualified(name, node.namespace, node.name)
+
+
+@dataclass(frozen=True)
+class GoalResult:
+    """How a goal ended: its final status (``STATUS_*``) and the result message."""
+
+    status: int
+    result: Any
+
+    @property
+    def status_name(self) -> str:
+        """``SUCCEEDED``, ``CANCELED``, ``ABORTED``, ..."""
+        return STATUS_NAMES.get(self.status, str(self.status))
+
+    @property
+    def succeeded(self) -> bool:
+        """True when the goal SUCCEEDED."""
+        return self.status == STATUS_SUCCEEDED
+
+
+class ServerGoalHandle:
+    """One accepted goal on the server side, handed to the execute callback.
+
+    The execute callback reads ``goal``, sends feedback with :meth:`publish_feedback`, polls
+    :attr:`is_cancel_requested` (or waits on :attr:`cancel_requested_event`) and ends the goal with
+    :meth:`succeed`, :meth:`abort` or :meth:`canceled`. Returning a result without ending the goal
+    succeeds it (or cancels it when a cancel was requested).
+    """
+
+    def __init__(self, server: ActionServer, goal_id: bytes, goal: Any) -> None:
+        self.server = server
+        self.goal_id = goal_id
+        self.goal = goal
+        self.stamp = _stamp_now()
+        self.status = STATUS_ACCEPTED
+        self.result: Any = None
+        self.error: str | None = None
+        self.terminated_at: float | None = None
+        self.cancel_requested_event = threading.Event()
+        self._waiters: list[Responder] = []
+        self._lock = threading.Lock()
+
+    @property
+    def goal_uuid(self) -> uuid.UUID:
+        """The goal id as a UUID."""
+        return uuid.UUID(bytes=self.goal_id)
+
+    @property
+    def is_cancel_requested(self) -> bool:
+        """True once a client asked to cancel this goal (and the cancel callback accepted)."""
+        return self.cancel_requested_event.is_set()
+
+    @property
+    def is_active(self) -> bool:
+        """True until the goal succeeds, aborts or is canceled."""
+        return self.status in _ACTIVE
+
+    def publish_feedback(self, feedback: Any) -> None:
+        """Send feedback (a message or a dict of its fields) to the clients."""
+        action = self.server.action
+        message = (
+            from_dict(action.feedback, feedback)
+            if isinstance(feedback, dict) or feedback is None
+            else feedback
+        )
+        self.server._feedback.publish(
+            from_dict(action.feedback_message, {"goal_id": _uuid_dict(self.goal_id), "feedback": message})
+        )
+
+    def succeed(self, result: Any = None) -> None:
+        """End the goal as SUCCEEDED with ``result`` (message, dict, or None for defaults)."""
+        self._terminate(STATUS_SUCCEEDED, result)
+
+    def abort(self, result: Any = None) -> None:
+        """End the goal as ABORTED."""
+        self._terminate(STATUS_ABORTED, result)
+
+    def canceled(self, result: Any = None) -> None:
+        """End the goal as CANCELED (after a cancel request)."""
+        self._terminate(STATUS_CANCELED, result)
+
+    def _set_status(self, status: int) -> None:
+        with self._lock:
+            if self.status in TERMINAL:
+                return
+            self.status = status
+        self.server._publish_status()
+
+    def _terminate(self, status: int, result: Any, error: str | None = None) -> None:
+        action = self.server.action
+        if result is None or isinstance(result, dict):
+            result = from_dict(action.result, result)
+        elif type_of(result) != action.result:
+            raise TransportError(
+                f"result of {self.server.name} must be {action.result}, got {type_of(result)}"
+            )
+        with self._lock:
+            if self.status in TERMINAL:
+                raise TransportError(
+                    f"goal {self.goal_uuid} of {self.server.name} already ended "
+                    f"as {STATUS_NAMES[self.status]}"
+                )
+            self.status = status
+            self.result = result
+            self.error = error
+            self.terminated_at = time.monotonic()
+            waiters, self._waiters = self._waiters, []
+        self.server._publish_status()
+        for responder in waiters:
+            self._answer(responder)
+
+    def _answer(self, responder: Responder) -> None:
+        response = {"status": self.status, "result": self.result}
+        try:
+            if self.error:
+                responder.reply_then_error(response, self.error)
+            else:
+                responder.reply(response)
+        except Exception:
+            log.exception("cannot send the result of goal %s on %s", self.goal_uuid, self.server.name)
+
+    def _add_waiter(self, responder: Responder) -> None:
+        with self._lock:
+            if self.status not in TERMINAL:
+                self._waiters.append(responder)
+                return
+        self._answer(responder)
+
+
+ExecuteCallback = Callable[[ServerGoalHandle], Any]
+GoalCallback = Callable[[Any], bool]
+CancelCallback = Callable[[ServerGoalHandle], bool]
+
+
+class ActionServer:
+    """Serves one action. Create with ``Node.create_action_server``.
+
+    ``execute_callback(goal_handle)`` runs on its own thread per accepted goal. ``goal_callback(goal)``
+    (default: accept all) decides acceptance; ``cancel_callback(goal_handle)`` (default: accept) decides
+    whether a cancel request is honoured. An exception in the execute callback aborts the goal; Kinema
+    clients then get a TransportError with the message from ``result()``.
+    """
+
+    def __init__(
+        self,
+        node: Node,
+        action_type: str,
+        name: str,
+        execute_callback: ExecuteCallback,
+        *,
+        goal_callback: GoalCallback | None = None,
+        cancel_callback: CancelCallback | None = None,
+        result_timeout: float = 900.0,
+    ) -> None:
+        self.node = node
+        self.action: ActionType = node.session.registry.action(action_type)
+        self.name = _action_names(node, name)
+        self.type_name = self.action.name
+        self._execute_callback = execute_callback
+        self._goal_callback = goal_callback
+        self._cancel_callback = cancel_callback
+        self._result_timeout = result_timeout
+        self._goals: dict[bytes, ServerGoalHandle] = {}
+        self._lock = threading.RLock()
+        self._closed = False
+        base = f"{self.name}/_action"
+        action = self.action
+        self._status = Publisher(node, action.status, f"{base}/status", LATCHED_QOS)
+        self._feedback = Publisher(node, action.feedback_message, f"{base}/feedback", QoS())
+        self._get_result = ServiceServer(
+            node, action.get_result, f"{base}/get_result", self._on_get_result, deferred=True
+        )
+        self._cancel = ServiceServer(node, action.cancel_goal, f"{base}/cancel_goal", self._on_cancel)
+        self._send_goal = ServiceServer(
+            node, action.send_goal, f"{base}/send_goal", self._on_send_goal, after_reply=self._after_send_goal
+        )
+        node._adopt(self)
+        self._publish_status()
+
+    # -- goals -----------------------------------------------------------------------------------
+
+    def goals(self) -> list[ServerGoalHandle]:
+        """Goals the server knows (active, and ended ones not yet expired)."""
+        with self._lock:
+            return list(self._goals.values())
+
+    def _on_send_goal(self, request: Any) -> Any:
+        goal_id = _uuid_bytes(request.goal_id)
+        with self._lock:
+            duplicate = goal_id in self._goals
+        accepted = not duplicate and not self._closed
+        if duplicate:
+            log.warning("%s: goal id %s is already in use; rejected", self.name, uuid.UUID(bytes=goal_id))
+        if accepted and self._goal_callback is not None:
+            accepted = bool(self._goal_callback(request.goal))
+        handle = None
+        if accepted:
+            handle = ServerGoalHandle(self, goal_id, request.goal)
+            with self._lock:
+                self._goals[goal_id] = handle
+        stamp = handle.stamp if handle else _stamp_now()
+        return {"accepted": accepted, "stamp": stamp}
+
+    def _after_send_goal(self, request: Any, response: Any) -> None:
+        if not response["accepted"]:
+            return
+        with self._lock:
+            handle = self._goals.get(_uuid_bytes(request.goal_id))
+        if handle is None:
+            return
+        self._publish_status()
+        thread = threading.Thread(
+            target=self._execute, args=(handle,), name=f"kinema-goal{self.name}", daemon=True
+        )
+        thread.start()
+
+    def _execute(self, handle: ServerGoalHandle) -> None:
+        handle._set_status(STATUS_EXECUTING)
+        try:
+            outcome = self._execute_callback(handle)
+        except Exception as error:
+            log.exception("execute callback of action %s raised", self.name)
+            if handle.status not in TERMINAL:
+                handle._terminate(
+                    STATUS_ABORTED, None, error=f"action {self.name} failed: {type(error).__name__}: {error}"
+                )
+            return
+        if handle.status in TERMINAL:
+            return
+        if outcome is None and not handle.is_cancel_requested:
+            log.warning("execute callback of %s returned without ending the goal; aborting it", self.name)
+            handle.abort()
+        elif handle.is_cancel_requested:
+            handle.canceled(outcome)
+        else:
+            handle.succeed(outcome)
+
+    def _on_get_result(self, request: Any, responder: Responder) -> None:
+        with self._lock:
+            handle = self._goals.get(_uuid_bytes(request.goal_id))
+        if handle is None:
+            responder.reply({"status": STATUS_UNKNOWN})
+            return
+        handle._add_waiter(responder)
+
+    def _on_cancel(self, request: Any) -> Any:
+        goal_id = _uuid_bytes(request.goal_info.goal_id)
+        stamp = request.goal_info.stamp
+        cutoff = stamp.sec * 1_000_000_000 + stamp.nanosec
+        with self._lock:
+            goals = list(self._goals.values())
+        if goal_id != _ZERO_ID:
+            selected = [g for g in goals if g.goal_id == goal_id]
+            if cutoff:
+                selected += [g for g in goals if g.goal_id != goal_id and _ns(g.stamp) <= cutoff]
+            if not selected:
+                return {"return_code": CANCEL_ERROR_UNKNOWN_GOAL_ID}
+        else:
+            selected = [g for g in goals if not cutoff or _ns(g.stamp) <= cutoff]
+        active = [g for g in selected if g.is_active]
+        if selected and not active:
+            return {"return_code": CANCEL_ERROR_GOAL_TERMINATED}
+        canceling = []
+        for handle in active:
+            if handle.status == STATUS_CANCELING:
+                canceling.append(handle)
+                continue
+            accept = True
+            if self._cancel_callback is not None:
+                try:
+                    accept = bool(self._cancel_callback(handle))
+                except Exception:
+                    log.exception("cancel callback of action %s raised; cancel rejected", self.name)
+                    accept = False
+            if accept:
+                handle.cancel_requested_event.set()
+                handle._set_status(STATUS_CANCELING)
+                canceling.append(handle)
+        code = CANCEL_ERROR_NONE if canceling or not active else CANCEL_ERROR_REJECTED
+        return {
+            "return_code": code,
+            "goals_canceling": [{"goal_id": _uuid_dict(g.goal_id), "stamp": g.stamp} for g in canceling],
+        }
+
+    def _publish_status(self) -> None:
+        if self._closed:
+            return
+        now = time.monotonic()
+        with self._lock:
+            for goal_id, handle in list(self._goals.items()):
+                if handle.terminated_at is not None and now - handle.terminated_at > self._result_timeout:
+                    del self._goals[goal_id]
+            statuses = [
+                {"goal_info": {"goal_id": _uuid_dict(h.goal_id), "stamp": h.stamp}, "status": h.status}
+                for h in self._goals.values()
+            ]
+            try:
+                self._status.publish(from_dict(self.action.status, {"status_list": statuses}))
+            except TransportError:
+                log.debug("status publisher of %s closed", self.name)
+
+    def close(self) -> None:
+        """Stop serving; running goals are asked to cancel (their threads end on their own)."""
+        if self._closed:
+            return
+        self._closed = True
+        with self._lock:
+            for handle in self._goals.values():
+                if handle.is_active:
+                    handle.cancel_requested_event.set()
+        for entity in (self._send_goal, self._cancel, self._get_result, self._feedback, self._status):
+            entity.close()
+        self.node._forget(self)
+
+    def __repr__(self) -> str:
+        return f"<ActionServer {self.name} [{self.type_name}]>"
+
+
+def _ns(stamp: Any) -> int:
+    if isinstance(stamp, dict):
+        return int(stamp["sec"]) * 1_000_000_000 + int(stamp["nanosec"])
+    return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
+
+
+class ClientGoalHandle:
+    """A goal sent by an :class:`ActionClient`: its status, feedback, cancel and result."""
+
+    def __init__(
+        self, client: ActionClient, goal_id: bytes, feedback_callback: Callable[[Any], Any] | None
+    ) -> None:
+        self.client = client
+        self.goal_id = goal_id
+        self.accepted = False
+        self.stamp: Any = None
+        self.status = STATUS_UNKNOWN
+        self._feedback_callback = feedback_callback
+        self._done = threading.Event()
+        self._outcome: GoalResult | None = None
+        self._error: TransportError | None = None
+        self._callbacks: list[Callable[[ClientGoalHandle], Any]] = []
+        self._lock = threading.Lock()
+
+    @property
+    def goal_uuid(self) -> uuid.UUID:
+        """The goal id as a UUID."""
+        return uuid.UUID(bytes=self.goal_id)
+
+    @property
+    def status_name(self) -> str:
+        """Name of the latest known status."""
+        return STATUS_NAMES.get(self.status, str(self.status))
+
+    def done(self) -> bool:
+        """True once the result (or a failure to get it) arrived."""
+        return self._done.is_set()
+
+    def add_done_callback(self, callback: Callable[[ClientGoalHandle], Any]) -> None:
+        """Call ``callback(handle)`` when the goal ends (at once if it already has)."""
+        with self._lock:
+            if not self._done.is_set():
+                self._callbacks.append(callback)
+                return
+        callback(self)
+
+    def cancel(self, timeout: float = 5.0) -> bool:
+        """Ask the server to cancel this goal; True when it accepted (the goal is now CANCELING)."""
+        response = self.client._cancel.call(
+            {"goal_info": {"goal_id": _uuid_dict(self.goal_id)}}, timeout=timeout
+        )
+        return any(_uuid_bytes(info.goal_id) == self.goal_id for info in response.goals_canceling)
+
+    def result(self, timeout: float | None = None) -> GoalResult:
+        """Wait for the goal to end and return its status and result.
+
+        Raises:
+            TransportError: the goal was rejected, the wait timed out, the server's execute callback
+                raised (its message), or the server went away.
+        """
+        if not self.accepted:
+            raise TransportError(f"goal {self.goal_uuid} was rejected by {self.client.name}")
+        if not self._done.wait(timeout):
+            raise TransportError(
+                f"goal {self.goal_uuid} on {self.client.name} did not finish within {timeout:g} s "
+                f"(last status {self.status_name})"
+            )
+        if self._error is not None:
+            raise self._error
+        assert self._outcome is not None
+        return self._outcome
+
+    def _on_feedback(self, feedback: Any) -> None:
+        if self._feedback_callback is not None:
+            self._feedback_callback(feedback)
+
+    def _finish(self, outcome: GoalResult | None, error: TransportError | None) -> None:
+        with self._lock:
+            if self._done.is_set():
+                return
+            self._outcome, self._error = outcome, error
+            if outcome is not None:
+                self.status = outcome.status
+            self._done.set()
+            callbacks, self._callbacks = self._callbacks, []
+        for callback in callbacks:
+            try:
+                callback(self)
+            except Exception:
+                log.exception("done callback of goal %s raised", self.goal_uuid)
+
+
+class ActionClient:
+    """Sends goals to one action. Create with ``Node.create_action_client``; thread-safe."""
+
+    def __init__(self, node: Node, action_type: str, name: str) -> None:
+        self.node = node
+        self.action: ActionType = node.session.registry.action(action_type)
+        self.name = _action_names(node, name)
+        self.type_name = self.action.name
+        self._handles: dict[bytes, ClientGoalHandle] = {}
+        self._lock = threading.Lock()
+        self._closed = False
+        base = f"{self.name}/_action"
+        action = self.action
+        self._send_goal = ServiceClient(node, action.send_goal, f"{base}/send_goal")
+        self._cancel = ServiceClient(node, action.cancel_goal, f"{base}/cancel_goal")
+        self._get_result = ServiceClient(node, action.get_result, f"{base}/get_result")
+        self._feedback_sub = Subscription(
+            node, action.feedback_message, f"{base}/feedback", self._on_feedback, QoS()
+        )
+        self._status_sub = Subscription(node, action.status, f"{base}/status", self._on_status, LATCHED_QOS)
+        node._adopt(self)
+
+    def wait_for_server(self, timeout: float = 5.0) -> bool:
+        """Block until the action server's services and topics are all on the graph."""
+        name = self.name
+        return self.node.session.graph_cache().wait_for(
+            lambda graph: graph.action_server_ready(name), timeout
+        )
+
+    def send_goal(
+        self,
+        goal: Any = None,
+        feedback_callback: Callable[[Any], Any] | None = None,
+        *,
+        timeout: float = 5.0,
+    ) -> ClientGoalHandle:
+        """Send a goal (message, dict of fields, or None for defaults) and return its handle.
+
+        ``feedback_callback(feedback)`` is called on a zenoh thread for each feedback message.
+        Check ``handle.accepted``; ``handle.result()`` raises when the goal was rejected.
+        """
+        action = self.action
+        goal_msg = from_dict(action.goal, goal) if goal is None or isinstance(goal, dict) else goal
+        if type_of(goal_msg) != action.goal:
+            raise TransportError(f"goal of {self.name} must be {action.goal}, got {type_of(goal_msg)}")
+        goal_id = uuid.uuid4().bytes
+        handle = ClientGoalHandle(self, goal_id, feedback_callback)
+        with self._lock:
+            self._handles[goal_id] = handle
+        try:
+            response = self._send_goal.call(
+                from_dict(action.send_goal.request, {"goal_id": _uuid_dict(goal_id), "goal": goal_msg}),
+                timeout=timeout,
+            )
+        except TransportError:
+            with self._lock:
+                self._handles.pop(goal_id, None)
+            raise
+        handle.accepted = bool(response.accepted)
+        handle.stamp = response.stamp
+        if not handle.accepted:
+            with self._lock:
+                self._handles.pop(goal_id, None)
+            return handle
+        if handle.status == STATUS_UNKNOWN:
+            handle.status = STATUS_ACCEPTED
+        threading.Thread(
+            target=self._wait_result, args=(handle,), name=f"kinema-result{self.name}", daemon=True
+        ).start()
+        return handle
+
+    def _wait_result(self, handle: ClientGoalHandle) -> None:
+        request = self._get_result.registry.serialize(
+            from_dict(self.action.get_result.request, {"goal_id": _uuid_dict(handle.goal_id)}),
+            self.action.get_result.request,
+        )
+        graph = self.node.session.graph_cache()
+        missing_since: float | None = None
+        try:
+            while not self._closed:
+                try:
+                    response = self._get_result._call_once(request, _RESULT_QUERY_TIMEOUT)
+                except TransportError as error:
+                    handle._finish(None, error)
+                    return
+                if response is not None:
+                    handle._finish(GoalResult(int(response.status), response.result), None)
+                    return
+                # No server matched: it may not be discovered yet, or it went away.
+                if graph.snapshot().action_server_ready(self.name):
+                    missing_since = None
+                else:
+                    missing_since = missing_since or time.monotonic()
+                    if time.monotonic() - missing_since > 2.0:
+                        handle._finish(
+                            None,
+                            TransportError(
+                                f"action server {self.name} went away before goal {handle.goal_uuid} finished"
+                            ),
+                        )
+                        return
+                time.sleep(0.02)
+            handle._finish(None, TransportError(f"action client {self.name} was closed"))
+        finally:
+            with self._lock:
+                self._handles.pop(handle.goal_id, None)
+
+    def _on_feedback(self, message: Any) -> None:
+        with self._lock:
+            handle = self._handles.get(_uuid_bytes(message.goal_id))
+        if handle is not None:
+            handle._on_feedback(message.feedback)
+
+    def _on_status(self, message: Any) -> None:
+        with self._lock:
+            handles = dict(self._handles)
+        for status in message.status_list:
+            handle = handles.get(_uuid_bytes(status.goal_info.goal_id))
+            if handle is not None and not handle.done():
+                handle.status = int(status.status)
+
+    def close(self) -> None:
+        """Stop; waiting ``result()`` calls raise TransportError."""
+        if self._closed:
+            return
+        self._closed = True
+        for entity in (self._send_goal, self._cancel, self._get_result, self._feedback_sub, self._status_sub):
+            entity.close()
+        with self._lock:
+            handles = list(self._handles.values())
+        for handle in handles:
+            handle._finish(None, TransportError(f"action client {self.name} was closed"))
+        self.node._forget(self)
+
+    def __repr__(self) -> str:
+        return f"<ActionClient {self.name} [{self.type_name}]>"

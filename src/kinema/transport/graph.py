@@ -1,0 +1,162 @@
+"""The ROS graph as seen through rmw_zenoh liveliness tokens: nodes, topics, services, actions.
+
+A :class:`GraphCache` subscribes (with history) to ``@ros2_lv/<domain>/**`` the way an rmw_zenoh context
+does, so it knows every entity on the network and learns about new and vanished ones within
+milliseconds. :class:`Graph` is an immutable snapshot with the queries ``ros2 node/topic/service/action
+list`` answer.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from kinema.transport.keys import LIVELINESS_PREFIX, EntityKind, GraphEntity, parse_token
+
+if TYPE_CHECKING:
+    from kinema.transport.session import Session
+
+log = logging.getLogger(__name__)
+
+ACTION_INFIX = "/_action/"
+_ACTION_SERVICES = ("send_goal", "cancel_goal", "get_result")
+_ACTION_TOPICS = ("feedback", "status")
+
+
+@dataclass(frozen=True)
+class Graph:
+    """A snapshot of the graph entities."""
+
+    entities: tuple[GraphEntity, ...]
+
+    def of_kind(self, *kinds: EntityKind) -> list[GraphEntity]:
+        """Entities of the given kinds."""
+        return [entity for entity in self.entities if entity.kind in kinds]
+
+    def nodes(self) -> list[str]:
+        """Fully qualified node names (``/ns/name``), sorted."""
+        return sorted({entity.node_fqn for entity in self.of_kind(EntityKind.NODE)})
+
+    def _names_and_types(self, kinds: Iterable[EntityKind], *, hidden: bool) -> dict[str, list[str]]:
+        found: dict[str, set[str]] = {}
+        for entity in self.of_kind(*kinds):
+            if not hidden and ACTION_INFIX in entity.name:
+                continue
+            found.setdefault(entity.name, set()).add(entity.type_name)
+        return {name: sorted(types) for name, types in sorted(found.items())}
+
+    def topics(self, *, hidden: bool = False) -> dict[str, list[str]]:
+        """Topic name → type names (publishers and subscriptions); action internals only if ``hidden``."""
+        return self._names_and_types((EntityKind.PUBLISHER, EntityKind.SUBSCRIPTION), hidden=hidden)
+
+    def services(self, *, hidden: bool = False) -> dict[str, list[str]]:
+        """Service name → type names (servers and clients); action internals only if ``hidden``."""
+        return self._names_and_types((EntityKind.SERVICE_SERVER, EntityKind.SERVICE_CLIENT), hidden=hidden)
+
+    def service_servers(self, name: str) -> list[GraphEntity]:
+        """Servers offering the service ``name``."""
+        return [entity for entity in self.of_kind(EntityKind.SERVICE_SERVER) if entity.name == name]
+
+    def publishers(self, name: str) -> list[GraphEntity]:
+        """Publishers on the topic ``name``."""
+        return [entity for entity in self.of_kind(EntityKind.PUBLISHER) if entity.name == name]
+
+    def subscriptions(self, name: str) -> list[GraphEntity]:
+        """Subscriptions to the topic ``name``."""
+        return [entity for entity in self.of_kind(EntityKind.SUBSCRIPTION) if entity.name == name]
+
+    def actions(self) -> dict[str, list[str]]:
+        """Action name → action type names, for actions with a server (found by their send_goal service)."""
+        found: dict[str, set[str]] = {}
+        for entity in self.of_kind(EntityKind.SERVICE_SERVER, EntityKind.SERVICE_CLIENT):
+            base, sep, part = entity.name.rpartition(ACTION_INFIX)
+            if sep and part == "send_goal":
+                type_name = entity.type_name
+                if type_name.endswith("_SendGoal"):
+                    type_name = type_name[: -len("_SendGoal")]
+                found.setdefault(base, set()).add(type_name)
+        return {name: sorted(types) for name, types in sorted(found.items())}
+
+    def action_server_ready(self, name: str) -> bool:
+        """True when the action has what rcl requires: its three services and both publishers."""
+        services = {e.name for e in self.of_kind(EntityKind.SERVICE_SERVER)}
+        publishers = {e.name for e in self.of_kind(EntityKind.PUBLISHER)}
+        return all(f"{name}{ACTION_INFIX}{s}" in services for s in _ACTION_SERVICES) and all(
+            f"{name}{ACTION_INFIX}{t}" in publishers for t in _ACTION_TOPICS
+        )
+
+    def node_entities(self, node_fqn: str) -> list[GraphEntity]:
+        """Everything the node ``/ns/name`` declared."""
+        return [
+            entity
+            for entity in self.entities
+            if entity.node_fqn == node_fqn and entity.kind != EntityKind.NODE
+        ]
+
+
+class GraphCache:
+    """Live set of liveliness tokens of one ROS domain (what rmw_zenoh's graph cache holds)."""
+
+    def __init__(self, session: Session) -> None:
+        self._session = session
+        self._tokens: dict[str, GraphEntity] = {}
+        self._changed = threading.Condition()
+        self._subscriber = session.zenoh.liveliness().declare_subscriber(
+            f"{LIVELINESS_PREFIX}/{session.domain_id}/**", self._on_sample, history=True
+        )
+
+    def _on_sample(self, sample: object) -> None:
+        import zenoh
+
+        key = str(sample.key_expr)  # type: ignore[attr-defined]
+        entity = parse_token(key)
+        if entity is None:
+            return
+        with self._changed:
+            if sample.kind == zenoh.SampleKind.DELETE:  # type: ignore[attr-defined]
+                self._tokens.pop(key, None)
+            else:
+                self._tokens[key] = entity
+            self._changed.notify_all()
+
+    def snapshot(self) -> Graph:
+        """The graph as known now."""
+        with self._changed:
+            return Graph(tuple(self._tokens.values()))
+
+    def wait_for(self, predicate: Callable[[Graph], bool], timeout: float) -> bool:
+        """Block until ``predicate(graph)`` holds or ``timeout`` seconds pass; return whether it held."""
+        deadline = time.monotonic() + timeout
+        with self._changed:
+            while True:
+                if predicate(Graph(tuple(self._tokens.values()))):
+                    return True
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    return False
+                self._changed.wait(remaining)
+
+    def close(self) -> None:
+        """Stop following the graph."""
+        try:
+            self._subscriber.undeclare()
+        except Exception:
+            log.debug("graph subscriber already gone", exc_info=True)
+
+
+def query_graph(session: Session, timeout: float = 2.0) -> Graph:
+    """Ask the network for every liveliness token of the session's domain (one round trip)."""
+    replies = session.zenoh.liveliness().get(f"{LIVELINESS_PREFIX}/{session.domain_id}/**", timeout=timeout)
+    entities: dict[str, GraphEntity] = {}
+    for reply in replies:
+        if reply.ok is None:
+            continue
+        key = str(reply.ok.key_expr)
+        entity = parse_token(key)
+        if entity is not None:
+            entities[key] = entity
+    return Graph(tuple(entities.values()))

@@ -1,0 +1,299 @@
+"""Services on rmw_zenoh: a complete queryable per server, a ``get`` per call.
+
+The client sends the CDR request with an attachment (its sequence number and GID); the server replies
+with the CDR response and an attachment echoing that sequence number and GID (rclcpp matches replies by
+it). A handler that raises produces an error reply carrying the message, which the Kinema client raises
+as :class:`~kinema.errors.TransportError`; it is never silently dropped.
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import itertools
+import logging
+import threading
+import time
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+from kinema.errors import TransportError
+from kinema.interfaces import ServiceType
+from kinema.transport.attachment import Attachment
+from kinema.transport.keys import SERVICE_QOS, EntityKind
+from kinema.transport.messages import from_dict, type_of
+from kinema.transport.pubsub import Entity
+
+if TYPE_CHECKING:
+    from kinema.transport.node import Node
+
+log = logging.getLogger(__name__)
+
+# How long a client waits between attempts while no server matches (discovery still propagating).
+_RETRY_PAUSE = 0.02
+
+
+def _as_message(value: Any, type_name: str, what: str) -> Any:
+    if isinstance(value, dict):
+        return from_dict(type_name, value)
+    if type_of(value) != type_name:
+        raise TransportError(f"{what} must be {type_name}, got {type_of(value)}")
+    return value
+
+
+class Responder:
+    """Answers one service request, now or later, from any thread (exactly once)."""
+
+    def __init__(self, server: ServiceServer, query: Any, attachment: Attachment | None) -> None:
+        self._server = server
+        self._query = query
+        self._attachment = attachment
+        self._lock = threading.Lock()
+        self.done = False
+
+    def _finish(self) -> Any:
+        with self._lock:
+            if self.done:
+                raise TransportError(f"request to {self._server.name} was already answered")
+            self.done = True
+            return self._query
+
+    def _reply_attachment(self) -> bytes | None:
+        if self._attachment is None:
+            return None
+        return Attachment(self._attachment.sequence_number, gid=self._attachment.gid).encode()
+
+    def reply(self, response: Any) -> None:
+        """Send the response (a message object or a dict of its fields)."""
+        server = self._server
+        try:
+            message = _as_message(response, server.service.response, f"response of {server.name}")
+            payload = server.registry.serialize(message, server.service.response)
+        except TransportError as error:
+            self.error(str(error))
+            return
+        query = self._finish()
+        try:
+            query.reply(server.key, payload, attachment=self._reply_attachment())
+        finally:
+            query.drop()
+
+    def reply_then_error(self, response: Any, message: str) -> None:
+        """Send a response and then an error reply: ROS clients take the response, Kinema clients raise."""
+        server = self._server
+        payload = server.registry.serialize(
+            _as_message(response, server.service.response, f"response of {server.name}"),
+            server.service.response,
+        )
+        query = self._finish()
+        try:
+            query.reply(server.key, payload, attachment=self._reply_attachment())
+            query.reply_err(message.encode())
+        finally:
+            query.drop()
+
+    def error(self, message: str) -> None:
+        """Send an error reply; the Kinema client raises TransportError with ``message``."""
+        query = self._finish()
+        try:
+            query.reply_err(message.encode())
+        finally:
+            query.drop()
+
+
+Handler = Callable[[Any], Any]
+DeferredHandler = Callable[[Any, Responder], None]
+
+
+class ServiceServer(Entity):
+    """Serves one service. Create with ``Node.create_service``.
+
+    ``handler(request) -> response`` runs on this server's zenoh thread (requests are handled one at a
+    time) unless ``max_concurrent > 1``, in which case up to that many run at once on worker threads.
+    With ``deferred=True`` the handler is ``handler(request, responder)`` and answers later through
+    ``responder.reply(...)`` from any thread (used by action servers for ``get_result``).
+    """
+
+    kind = EntityKind.SERVICE_SERVER
+
+    def __init__(
+        self,
+        node: Node,
+        service: ServiceType,
+        name: str,
+        handler: Handler | DeferredHandler,
+        *,
+        max_concurrent: int = 1,
+        deferred: bool = False,
+        after_reply: Callable[[Any, Any], None] | None = None,
+    ) -> None:
+        super().__init__(node, name, service.name, service.dds_name, service.type_hash, SERVICE_QOS)
+        self.service = service
+        self.registry = node.session.registry
+        self._handler = handler
+        self._deferred = deferred
+        self._after_reply = after_reply
+        self._pool = (
+            concurrent.futures.ThreadPoolExecutor(max_concurrent, thread_name_prefix=f"kinema-srv{name}")
+            if max_concurrent > 1
+            else None
+        )
+        self._queryable = node.session.zenoh.declare_queryable(self.key, self._on_query, complete=True)
+        self._announce()
+
+    def _on_query(self, query: Any) -> None:
+        try:
+            raw_attachment = query.attachment.to_bytes() if query.attachment is not None else None
+            attachment = Attachment.decode(raw_attachment) if raw_attachment else None
+        except TransportError as error:
+            log.warning("request to %s has a bad attachment (%s); replying without one", self.name, error)
+            attachment = None
+        responder = Responder(self, query, attachment)
+        if self._pool is not None:
+            try:
+                self._pool.submit(self._serve, query, responder)
+            except RuntimeError:
+                responder.error(f"service {self.name} is shutting down")
+        else:
+            self._serve(query, responder)
+
+    def _serve(self, query: Any, responder: Responder) -> None:
+        try:
+            payload = query.payload.to_bytes() if query.payload is not None else b""
+            request = self.registry.deserialize(payload, self.service.request)
+        except TransportError as error:
+            responder.error(f"service {self.name}: bad request: {error}")
+            return
+        try:
+            if self._deferred:
+                self._handler(request, responder)  # type: ignore[call-arg]
+                return
+            response = self._handler(request)  # type: ignore[call-arg]
+        except Exception as error:
+            log.exception("handler of service %s [%s] raised", self.name, self.type_name)
+            if not responder.done:
+                responder.error(f"service {self.name} failed: {type(error).__name__}: {error}")
+            return
+        if response is None:
+            responder.error(f"service {self.name} failed: its handler returned no response")
+            return
+        responder.reply(response)
+        if self._after_reply is not None:
+            try:
+                self._after_reply(request, response)
+            except Exception:
+                log.exception("post-reply step of service %s raised", self.name)
+
+    def _undeclare(self) -> None:
+        self._queryable.undeclare()
+        if self._pool is not None:
+            self._pool.shutdown(wait=False, cancel_futures=True)
+
+
+class ServiceClient(Entity):
+    """Calls one service. Create with ``Node.create_client``; thread-safe."""
+
+    kind = EntityKind.SERVICE_CLIENT
+
+    def __init__(self, node: Node, service: ServiceType, name: str) -> None:
+        super().__init__(node, name, service.name, service.dds_name, service.type_hash, SERVICE_QOS)
+        self.service = service
+        self.registry = node.session.registry
+        self._sequence = itertools.count(1)
+        self._lock = threading.Lock()
+        self._pool: concurrent.futures.ThreadPoolExecutor | None = None
+        self._announce()
+
+    def wait_for_service(self, timeout: float = 5.0) -> bool:
+        """Block until a server for this service (name and type) is on the graph; return whether one is."""
+        name, type_name = self.name, self.type_name
+        return self.node.session.graph_cache().wait_for(
+            lambda graph: any(s.type_name == type_name for s in graph.service_servers(name)), timeout
+        )
+
+    def service_is_ready(self) -> bool:
+        """True when a server is on the graph now."""
+        return self.wait_for_service(0.0)
+
+    def call(self, request: Any = None, timeout: float = 5.0) -> Any:
+        """Send ``request`` (message, dict of fields, or None for defaults) and return the response.
+
+        While no server matches (it may still be starting or being discovered) the call is retried
+        until ``timeout``.
+
+        Raises:
+            TransportError: no server answered within ``timeout``, or the server replied with an error
+                (its message is in the exception).
+        """
+        if request is None:
+            request = {}
+        message = _as_message(request, self.service.request, f"request of {self.name}")
+        payload = self.registry.serialize(message, self.service.request)
+        deadline = time.monotonic() + timeout
+        while True:
+            remaining = deadline - time.monotonic()
+            outcome = self._call_once(payload, max(remaining, 0.001))
+            if outcome is not None:
+                return outcome
+            if time.monotonic() + _RETRY_PAUSE >= deadline:
+                raise TransportError(
+                    f"no server for service {self.name} [{self.type_name}] answered within {timeout:g} s"
+                )
+            time.sleep(_RETRY_PAUSE)
+
+    def _call_once(self, payload: bytes, timeout: float) -> Any | None:
+        import zenoh
+
+        if self._closed:
+            raise TransportError(f"client of {self.name} is closed")
+        with self._lock:
+            sequence = next(self._sequence)
+        attachment = Attachment(sequence, gid=self.gid).encode()
+        replies = self.node.session.zenoh.get(
+            self.key,
+            target=zenoh.QueryTarget.ALL_COMPLETE,
+            consolidation=zenoh.ConsolidationMode.NONE,
+            payload=payload,
+            attachment=attachment,
+            timeout=timeout,
+        )
+        response: Any = None
+        answered = False
+        errors: list[str] = []
+        for reply in replies:
+            if reply.ok is not None:
+                if answered:
+                    continue
+                sample = reply.ok
+                if sample.attachment is not None:
+                    echoed = Attachment.decode(sample.attachment.to_bytes())
+                    if echoed.sequence_number != sequence:
+                        log.warning(
+                            "reply on %s echoes sequence %d, expected %d",
+                            self.name,
+                            echoed.sequence_number,
+                            sequence,
+                        )
+                response = self.registry.deserialize(sample.payload.to_bytes(), self.service.response)
+                answered = True
+            else:
+                errors.append(reply.err.payload.to_string())
+        if errors:
+            message = errors[0]
+            if message == "Timeout":
+                raise TransportError(f"service {self.name} did not answer within {timeout:g} s")
+            raise TransportError(message)
+        return response if answered else None
+
+    def call_async(self, request: Any = None, timeout: float = 5.0) -> concurrent.futures.Future[Any]:
+        """Like :meth:`call` on a worker thread; the future holds the response or the TransportError."""
+        with self._lock:
+            if self._pool is None:
+                self._pool = concurrent.futures.ThreadPoolExecutor(
+                    4, thread_name_prefix=f"kinema-cli{self.name}"
+                )
+            pool = self._pool
+        return pool.submit(self.call, request, timeout)
+
+    def _undeclare(self) -> None:
+        if self._pool is not None:
+            self._pool.shutdown(wait=False, cancel_futures=True)

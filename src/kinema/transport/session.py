@@ -1,0 +1,370 @@
+"""Zenoh sessions: join the Kinema router, or host it in this process.
+
+Topology (the same as ROS 2 with rmw_zenoh): one **router** listens on ``tcp/127.0.0.1:7447``; every
+process opens one **peer** session that connects to it and, through gossip, talks directly to the other
+peers. ``kinema run`` hosts the router in its own process (a zenoh-python session in ``router`` mode) or,
+when something already listens there (another Kinema, or ``rmw_zenohd``), joins it as a peer.
+
+Multicast scouting is always off, so nothing leaves loopback unless an endpoint says so and separate test
+runs on different ports never see each other. Timestamping is on because latched (transient local)
+topics need it.
+
+Environment: ``KINEMA_ZENOH_CONNECT`` (comma-separated endpoints, default ``tcp/127.0.0.1:7447``),
+``ROS_DOMAIN_ID`` (default 0), ``KINEMA_ZENOH_CONFIG`` (a zenoh JSON5 config file used as the base).
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import logging
+import os
+import threading
+import time
+import weakref
+from collections.abc import Iterable, Mapping, Sequence
+from typing import TYPE_CHECKING, Any, Literal
+
+from kinema.errors import TransportError
+
+if TYPE_CHECKING:
+    import zenoh
+
+    from kinema.interfaces import TypeRegistry
+    from kinema.transport.graph import GraphCache
+
+log = logging.getLogger(__name__)
+
+DEFAULT_ENDPOINT = "tcp/127.0.0.1:7447"
+ENV_CONNECT = "KINEMA_ZENOH_CONNECT"
+ENV_CONFIG = "KINEMA_ZENOH_CONFIG"
+ENV_DOMAIN = "ROS_DOMAIN_ID"
+# Peers listen on an ephemeral loopback port so that gossip can link them directly; without a listen
+# key a zenoh peer would listen on every interface.
+PEER_LISTEN = "tcp/127.0.0.1:0"
+
+Mode = Literal["peer", "client", "router"]
+
+_open_sessions: weakref.WeakSet[Session] = weakref.WeakSet()
+_exit_hook_lock = threading.Lock()
+_exit_hook_installed = False
+
+
+def _close_all_at_exit() -> None:
+    for session in list(_open_sessions):
+        session.close()
+
+
+def _install_exit_hook() -> None:
+    """Close forgotten sessions before the interpreter joins threads.
+
+    zenoh-python runs each callback entity on a non-daemon thread; an unclosed session would make
+    ``threading._shutdown`` wait forever. ``atexit`` runs too late, ``threading._register_atexit`` (what
+    ``concurrent.futures`` uses) runs first.
+    """
+    global _exit_hook_installed
+    with _exit_hook_lock:
+        if _exit_hook_installed:
+            return
+        register = getattr(threading, "_register_atexit", None)
+        if register is not None:
+            register(_close_all_at_exit)
+        _exit_hook_installed = True
+
+
+def resolve_endpoints(connect: str | Sequence[str] | None) -> list[str]:
+    """Endpoints to connect to: the argument, else ``KINEMA_ZENOH_CONNECT``, else the default router."""
+    if connect is None:
+        connect = os.environ.get(ENV_CONNECT) or DEFAULT_ENDPOINT
+    items = connect.split(",") if isinstance(connect, str) else list(connect)
+    endpoints = [item.strip() for item in items if item.strip()]
+    for endpoint in endpoints:
+        if "/" not in endpoint:
+            raise TransportError(
+                f"bad zenoh endpoint {endpoint!r}: expected <protocol>/<address>, e.g. {DEFAULT_ENDPOINT}"
+            )
+    return endpoints
+
+
+def resolve_domain_id(domain_id: int | None) -> int:
+    """The ROS domain id: the argument, else ``ROS_DOMAIN_ID``, else 0."""
+    if domain_id is not None:
+        value: Any = domain_id
+    else:
+        value = os.environ.get(ENV_DOMAIN, "").strip() or 0
+    try:
+        resolved = int(value)
+    except ValueError:
+        raise TransportError(f"{ENV_DOMAIN}={value!r} is not an integer (valid: 0-232)") from None
+    if not 0 <= resolved <= 232:
+        raise TransportError(f"ROS domain id {resolved} is out of range (valid: 0-232)")
+    return resolved
+
+
+def build_config(
+    mode: Mode,
+    *,
+    listen: Iterable[str] = (),
+    connect: Iterable[str] = (),
+    config_file: str | None = None,
+    overrides: Mapping[str, Any] | None = None,
+) -> zenoh.Config:
+    """A zenoh config for Kinema: loopback by default, multicast off, gossip and timestamping on.
+
+    ``config_file`` (JSON5, zenoh's own format) is the base when given; ``overrides`` maps zenoh config
+    paths (``"transport/link/tls/root_ca_certificate"``) to JSON values and is applied last.
+    """
+    import zenoh
+
+    config_file = config_file or os.environ.get(ENV_CONFIG) or None
+    try:
+        config = zenoh.Config.from_file(config_file) if config_file else zenoh.Config()
+    except Exception as error:
+        raise TransportError(f"{config_file}: cannot load zenoh config: {error}") from error
+    settings: dict[str, Any] = {
+        "mode": mode,
+        "scouting/multicast/enabled": False,
+        "scouting/gossip/enabled": True,
+        # Multicast is off, so there is nothing to wait for when opening.
+        "scouting/delay": 0,
+        "timestamping/enabled": True,
+    }
+    listen = list(listen)
+    connect = list(connect)
+    if listen or not config_file:
+        settings["listen/endpoints"] = listen
+    if connect or not config_file:
+        settings["connect/endpoints"] = connect
+    settings.update(overrides or {})
+    for key, value in settings.items():
+        try:
+            config.insert_json5(key, json.dumps(value))
+        except Exception as error:
+            raise TransportError(f"bad zenoh config value {key}={value!r}: {error}") from error
+    return config
+
+
+class Session:
+    """One zenoh session plus what every Kinema node on it shares (domain id, ids, graph cache).
+
+    Create it with :func:`open_session` or :func:`host_router`; close it (or use ``with``) when done.
+    Closing closes every node created on it.
+    """
+
+    def __init__(
+        self,
+        raw: zenoh.Session,
+        *,
+        domain_id: int,
+        mode: Mode,
+        endpoints: Sequence[str] = (),
+        listen: Sequence[str] = (),
+    ) -> None:
+        self.zenoh = raw
+        self.domain_id = domain_id
+        self.mode: Mode = mode
+        self.endpoints = list(endpoints)
+        self.listen = list(listen)
+        self.zid = str(raw.info.zid())
+        self._ids = itertools.count()
+        self._lock = threading.Lock()
+        self._closers: list[Any] = []
+        self._graph: GraphCache | None = None
+        self._closed = False
+        _open_sessions.add(self)
+        _install_exit_hook()
+
+    @property
+    def is_router(self) -> bool:
+        """True when this process hosts the router."""
+        return self.mode == "router"
+
+    @property
+    def closed(self) -> bool:
+        """True once :meth:`close` ran."""
+        return self._closed
+
+    @property
+    def registry(self) -> TypeRegistry:
+        """The interface registry (all bundled interfaces loaded)."""
+        from kinema.interfaces import load_interfaces
+
+        return load_interfaces()
+
+    def next_entity_id(self) -> int:
+        """Session-wide counter for node and entity ids, as rmw_zenoh numbers them."""
+        with self._lock:
+            return next(self._ids)
+
+    def graph_cache(self) -> GraphCache:
+        """The live view of the ROS graph (created on first use)."""
+        with self._lock:
+            if self._graph is None:
+                from kinema.transport.graph import GraphCache
+
+                self._graph = GraphCache(self)
+            return self._graph
+
+    def _register_closer(self, closer: Any) -> None:
+        with self._lock:
+            self._closers.append(closer)
+
+    def _unregister_closer(self, closer: Any) -> None:
+        with self._lock:
+            if closer in self._closers:
+                self._closers.remove(closer)
+
+    def connected_routers(self) -> list[str]:
+        """Zenoh ids of the routers this session is linked to."""
+        return [str(zid) for zid in self.zenoh.info.routers_zid()]
+
+    def connected_peers(self) -> list[str]:
+        """Zenoh ids of the peers this session is linked to directly."""
+        return [str(zid) for zid in self.zenoh.info.peers_zid()]
+
+    def close(self) -> None:
+        """Close every node and the zenoh session; safe to call twice."""
+        with self._lock:
+            if self._closed:
+                return
+            self._closed = True
+            closers = list(reversed(self._closers))
+            self._closers.clear()
+            graph = self._graph
+        for closer in closers:
+            try:
+                closer.close()
+            except Exception:
+                log.exception("error while closing %r", closer)
+        if graph is not None:
+            graph.close()
+        try:
+            self.zenoh.close()
+        except Exception:
+            log.exception("error while closing the zenoh session")
+        _open_sessions.discard(self)
+
+    def __enter__(self) -> Session:
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        role = (
+            f"router on {','.join(self.listen)}"
+            if self.is_router
+            else f"{self.mode} → {','.join(self.endpoints) or '-'}"
+        )
+        return f"<kinema Session {self.zid[:8]} domain {self.domain_id} {role}>"
+
+
+def _open_raw(config: zenoh.Config, what: str) -> zenoh.Session:
+    import zenoh
+
+    try:
+        return zenoh.open(config)
+    except zenoh.ZError as error:
+        raise TransportError(f"cannot open a zenoh session ({what}): {error}") from error
+
+
+def open_session(
+    connect: str | Sequence[str] | None = None,
+    domain_id: int | None = None,
+    *,
+    mode: Literal["peer", "client"] = "peer",
+    listen: Sequence[str] | None = None,
+    config_file: str | None = None,
+    config_overrides: Mapping[str, Any] | None = None,
+    connect_timeout: float = 2.0,
+) -> Session:
+    """Join the Kinema zenoh network (the router at ``connect``) and return the session.
+
+    Args:
+        connect: endpoint(s) of the router; default ``KINEMA_ZENOH_CONNECT`` or ``tcp/127.0.0.1:7447``.
+            An empty list opens a standalone session (in-process use only).
+        domain_id: ROS domain id; default ``ROS_DOMAIN_ID`` or 0.
+        mode: ``peer`` (default; direct links to other peers via gossip) or ``client`` (everything
+            through the router).
+        listen: peer listen endpoints; default one ephemeral loopback port.
+        config_file: zenoh JSON5 config used as the base (default ``KINEMA_ZENOH_CONFIG``).
+        config_overrides: zenoh config paths → values, applied last.
+        connect_timeout: how long to wait for the link to a router or peer (seconds).
+
+    Raises:
+        TransportError: nothing answers at the endpoints within ``connect_timeout``.
+    """
+    endpoints = resolve_endpoints(connect) if connect is None or connect else []
+    domain = resolve_domain_id(domain_id)
+    listen_endpoints = list(listen) if listen is not None else ([PEER_LISTEN] if mode == "peer" else [])
+    config = build_config(
+        mode, listen=listen_endpoints, connect=endpoints, config_file=config_file, overrides=config_overrides
+    )
+    where = ", ".join(endpoints) or "no endpoint"
+    raw = _open_raw(config, f"{mode} connecting to {where}")
+    session = Session(raw, domain_id=domain, mode=mode, endpoints=endpoints, listen=listen_endpoints)
+    if endpoints:
+        deadline = time.monotonic() + connect_timeout
+        while not (session.connected_routers() or session.connected_peers()):
+            if time.monotonic() >= deadline:
+                session.close()
+                raise TransportError(
+                    f"no Kinema router answers at {where} (start one with `kinema run`, "
+                    f"or point --connect / {ENV_CONNECT} at a running one)"
+                )
+            time.sleep(0.005)
+    return session
+
+
+def host_router(
+    listen: str | Sequence[str] | None = None,
+    domain_id: int | None = None,
+    *,
+    connect: Sequence[str] = (),
+    config_file: str | None = None,
+    config_overrides: Mapping[str, Any] | None = None,
+) -> Session:
+    """Host the zenoh router in this process and return its session (usable like any other).
+
+    Args:
+        listen: endpoint(s) to listen on; default ``tcp/127.0.0.1:7447``.
+        connect: other routers to link to (multi-machine, or two routers on one host).
+
+    Raises:
+        TransportError: the endpoint is taken (another router runs there) or invalid.
+    """
+    listen_endpoints = resolve_endpoints(listen or DEFAULT_ENDPOINT)
+    domain = resolve_domain_id(domain_id)
+    config = build_config(
+        "router",
+        listen=listen_endpoints,
+        connect=list(connect),
+        config_file=config_file,
+        overrides=config_overrides,
+    )
+    raw = _open_raw(config, f"router listening on {', '.join(listen_endpoints)}")
+    return Session(raw, domain_id=domain, mode="router", endpoints=list(connect), listen=listen_endpoints)
+
+
+def host_or_join(
+    endpoint: str | None = None,
+    domain_id: int | None = None,
+    *,
+    config_file: str | None = None,
+    config_overrides: Mapping[str, Any] | None = None,
+) -> Session:
+    """Host the router at ``endpoint``, or join the one already listening there (what ``kinema run`` does).
+
+    ``endpoint`` defaults to the first of ``KINEMA_ZENOH_CONNECT`` or ``tcp/127.0.0.1:7447``.
+    """
+    target = endpoint or resolve_endpoints(None)[0]
+    try:
+        return host_router(target, domain_id, config_file=config_file, config_overrides=config_overrides)
+    except TransportError as hosting_error:
+        log.info("cannot host the router at %s (%s); joining it", target, hosting_error)
+        try:
+            return open_session(target, domain_id, config_file=config_file, config_overrides=config_overrides)
+        except TransportError as joining_error:
+            raise TransportError(
+                f"cannot host a router at {target} ({hosting_error}) nor join one there ({joining_error})"
+            ) from joining_error
