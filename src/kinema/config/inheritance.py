@@ -351,6 +351,8 @@ def merge_layers(layers: list[tuple[str, dict[str, Any]]]) -> tuple[dict[str, An
     origins: dict[KeyPath, str] = {}
     for package, layer in layers:
         _merge_into(merged, layer, (), package, origins)
+    if "based_on_package" in merged:  # keep it first, where config.yaml files put it
+        merged = {"based_on_package": merged.pop("based_on_package"), **merged}
     return merged, origins
 
 

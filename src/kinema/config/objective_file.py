@@ -122,11 +122,16 @@ def parse_objective_file(path: Path) -> ParsedObjectiveFile:
     """
     text = read_text_file(path, max_bytes=MAX_OBJECTIVE_BYTES, error=ObjectiveError)
     root = parse_xml(text, str(path))
-    return objectives_of(root, path)
+    return objectives_of(root, path, text)
 
 
-def objectives_of(root: etree._Element, path: Path) -> ParsedObjectiveFile:
-    """Extract the objectives of an already parsed objective document (see :func:`parse_objective_file`)."""
+def objectives_of(root: etree._Element, path: Path, text: str | None = None) -> ParsedObjectiveFile:
+    """Extract the objectives of an already parsed objective document (see :func:`parse_objective_file`).
+
+    ``text`` (the document's source) lets each objective's line be the line its ``<BehaviorTree`` tag
+    starts on; libxml2 reports the line where a multi-line start tag ends.
+    """
+    source_lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n") if text is not None else None
     filename = str(path)
     if root.tag != "root":
         raise ObjectiveError(
@@ -143,7 +148,7 @@ def objectives_of(root: etree._Element, path: Path) -> ParsedObjectiveFile:
     warnings: list[str] = []
     seen: dict[str, int] = {}
     for tree in trees:
-        line = tree.sourceline or 0
+        line = _tag_start_line(source_lines, "<BehaviorTree", tree.sourceline or 0)
         tree_id = tree.get("ID")
         if not tree_id:
             raise ObjectiveError(
@@ -164,6 +169,16 @@ def objectives_of(root: etree._Element, path: Path) -> ParsedObjectiveFile:
             f"(it defines {', '.join(repr(i) for i in seen)})"
         )
     return ParsedObjectiveFile(objectives, warnings)
+
+
+def _tag_start_line(source_lines: list[str] | None, opener: str, reported: int) -> int:
+    """Walk back from the line libxml2 reported to the line where ``opener`` appears."""
+    if source_lines is None or reported <= 0:
+        return reported
+    for line in range(min(reported, len(source_lines)), max(reported - 200, 0), -1):
+        if opener in source_lines[line - 1]:
+            return line
+    return reported
 
 
 def _subtree_models(root: etree._Element) -> dict[str, etree._Element]:

@@ -177,6 +177,7 @@ class ObjectiveLibrary:
         if root.get("main_tree_to_execute") is None:
             root.set("main_tree_to_execute", objective_id)
         objectives_of(root, Path(f"<objective {objective_id!r}>"))  # same checks as loading, before writing
+        etree.indent(root, space="  ")
         text = '<?xml version="1.0" encoding="UTF-8" ?>\n' + etree.tostring(root, encoding="unicode") + "\n"
         if (
             previous is not None

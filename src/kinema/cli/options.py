@@ -1,0 +1,62 @@
+"""Options shared by the verbs that work on a workspace and a config package.
+
+``-w/--workspace`` and ``-c/--config`` take precedence over ``KINEMA_WORKSPACE``/``KINEMA_CONFIG`` and
+over what ``kinema configure`` stored (see :func:`kinema.config.active_selection`). A verb decorated
+with :func:`selection_options` receives ``workspace`` and ``config`` arguments; :func:`resolve_selection`
+turns them into a :class:`~kinema.config.Workspace` and a config name.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+from typing import Any, TypeVar
+
+import click
+
+F = TypeVar("F", bound=Callable[..., Any])
+
+workspace_option = click.option(
+    "-w",
+    "--workspace",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Workspace folder (default: $KINEMA_WORKSPACE, else the one set with `kinema configure`).",
+)
+config_option = click.option(
+    "-c",
+    "--config",
+    default=None,
+    metavar="NAME",
+    help="Config package (default: $KINEMA_CONFIG, else the one set with `kinema configure`).",
+)
+verbose_option = click.option(
+    "-v", "--verbose", is_flag=True, help="Also print notices: unknown keys, overlays, shadowed objectives."
+)
+
+
+def selection_options(function: F) -> F:
+    """Add ``-w/--workspace`` and ``-c/--config`` to a click command."""
+    return workspace_option(config_option(function))
+
+
+def resolve_selection(
+    workspace: Path | None, config: str | None, *, need_config: bool = True
+) -> tuple[Any, str]:
+    """Return the :class:`~kinema.config.Workspace` and config name a verb should use.
+
+    Raises:
+        ConfigError: no config is selected (when ``need_config``), or the workspace is not one.
+    """
+    from kinema.config import Workspace, active_selection
+
+    selection = active_selection(workspace, config)
+    found = Workspace.discover(selection.workspace) if selection.workspace else Workspace.bundled_only()
+    name = selection.require_config() if need_config else (selection.config or "")
+    return found, name
+
+
+def print_notices(notices: list[str]) -> None:
+    """Print verbose-mode notices on stderr."""
+    for notice in notices:
+        click.secho(f"note: {notice}", err=True, fg="yellow")

@@ -1,0 +1,94 @@
+"""``kinema configure`` and ``kinema init``: choosing and creating workspaces."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import click
+
+from kinema.errors import ConfigError
+
+
+@click.command()
+@click.option(
+    "-w",
+    "--workspace",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Workspace folder (one with src/). Asked for when missing; empty means none (bundled configs only).",
+)
+@click.option(
+    "-c", "--config", default=None, metavar="NAME", help="Config package to use. Asked for when missing."
+)
+def configure(workspace: Path | None, config: str | None) -> None:
+    """Set the active workspace and config package for later commands.
+
+    The choice is stored in the user's config folder (~/.config/kinema/selection.yaml on Linux);
+    KINEMA_WORKSPACE and KINEMA_CONFIG override it, and every verb's -w/-c override both.
+    """
+    from kinema.config import Workspace, active_selection, store_selection
+    from kinema.config.selection import CONFIG_ENV, WORKSPACE_ENV
+    from kinema.config.workspace import find_workspace_root
+    from kinema.errors import did_you_mean
+
+    current = active_selection()
+    if workspace is None:
+        answer = click.prompt(
+            "Workspace folder (empty: none, bundled configs only)",
+            default=str(current.workspace) if current.workspace else "",
+            show_default=bool(current.workspace),
+        )
+        workspace = Path(answer) if answer.strip() else None
+    root = find_workspace_root(workspace) if workspace is not None and str(workspace) else None
+    found = Workspace.discover(root) if root is not None else Workspace.bundled_only()
+    names = [package.name for package in found.config_packages()]
+    if config is None:
+        if not names:
+            raise ConfigError(f"there are no config packages in {found.describe()}")
+        default = current.config if current.config in names else names[0]
+        click.echo("Config packages: " + ", ".join(names))
+        config = click.prompt("Config package", default=default, type=click.Choice(names), show_choices=False)
+    all_names = [package.name for package in found.config_packages(include_hidden=True)]
+    if not found.has_package(config) or not found.package(config).is_config:
+        raise ConfigError(
+            f"no config package named {config!r} in {found.describe()}; {did_you_mean(config, all_names)}"
+        )
+    path = store_selection(root, found.package(config).name)
+    click.echo(f"workspace: {root if root is not None else '(none, bundled configs only)'}")
+    click.echo(f"config:    {found.package(config).name}")
+    click.echo(f"stored in {path}")
+    for variable in (WORKSPACE_ENV, CONFIG_ENV):
+        if os.environ.get(variable):
+            click.secho(f"note: {variable} is set and overrides this choice", err=True, fg="yellow")
+
+
+@click.command()
+@click.argument("path", type=click.Path(file_okay=False, path_type=Path))
+def init(path: Path) -> None:
+    """Create an empty workspace at PATH (a folder with src/ for your packages).
+
+    Then select it with `kinema configure -w PATH -c lab_sim` and add a config package with
+    `kinema new config NAME --based-on lab_sim`.
+    """
+    path = path.expanduser()
+    if path.exists() and not path.is_dir():
+        raise ConfigError(f"{path} exists and is not a folder")
+    src = path / "src"
+    if src.is_dir():
+        raise ConfigError(f"{path} is already a workspace (it has src/)")
+    src.mkdir(parents=True)
+    readme = path / "README.md"
+    if not readme.exists():
+        readme.write_text(
+            "# Kinema workspace\n\n"
+            "Packages live in `src/`: config packages (`config/config.yaml`) and behavior packages.\n\n"
+            "```bash\n"
+            f"kinema configure -w {path} -c lab_sim\n"
+            "kinema new config my_robot_config --based-on lab_sim\n"
+            "kinema config show -c my_robot_config --provenance\n"
+            "```\n",
+            encoding="utf-8",
+        )
+    click.echo(f"created workspace {path.resolve()}")
+    click.echo(f"next: kinema configure -w {path} -c lab_sim")

@@ -1,0 +1,39 @@
+"""Which package names Kinema accepts: ROS package names (REP 144), which are also Python identifiers.
+
+Lowercase letters, digits and single underscores, starting with a letter and not ending with an
+underscore: ``my_robot_config``, ``lab_sim2``. The same rule is repeated in each template's
+``hooks/pre_gen_project.py``.
+"""
+
+from __future__ import annotations
+
+import keyword
+import re
+
+from kinema.errors import ScaffoldError
+
+_PACKAGE_NAME = re.compile(r"^[a-z](?:[a-z0-9]|_(?!_))*$")
+MAX_NAME_LENGTH = 100
+_NAME_RULE = (
+    "use lowercase letters, digits and single underscores, starting with a letter (e.g. my_robot_config)"
+)
+
+
+def package_name_problem(name: str) -> str | None:
+    """Return why ``name`` is not a valid package name, or None when it is valid."""
+    if not name:
+        return "the name is empty"
+    if len(name) > MAX_NAME_LENGTH:
+        return f"the name is longer than {MAX_NAME_LENGTH} characters"
+    if not _PACKAGE_NAME.match(name) or name.endswith("_"):
+        return _NAME_RULE
+    if keyword.iskeyword(name):
+        return "the name is a Python keyword"
+    return None
+
+
+def check_package_name(name: str, *, what: str = "package name") -> None:
+    """Raise a ScaffoldError when ``name`` is not a valid package name."""
+    problem = package_name_problem(name)
+    if problem is not None:
+        raise ScaffoldError(f"{name!r} is not a valid {what}: {problem}")
