@@ -1,4 +1,4 @@
-"""Write ``lab_sim.urdf`` and ``lab_sim_scene.xml`` from one table of links: the robot's single source of truth.
+"""Write ``lab_sim.urdf`` and ``lab_sim_scene.xml`` from one table of links (the single source of truth).
 
 The robot (a UR5e-sized arm on a linear rail with a parallel two-finger gripper) is described once, below,
 as links with their joint, origin and primitive collision geoms. This script renders that table twice:
@@ -225,9 +225,7 @@ LINKS: tuple[Link, ...] = (
         velocity=0.2,
         mass=0.05,
         geoms=(
-            Geom(
-                "left_finger_pad", "box", (0.011, FINGER_HALF_THICKNESS, 0.035), rgba=ACCENT, contact=PAD
-            ),
+            Geom("left_finger_pad", "box", (0.011, FINGER_HALF_THICKNESS, 0.035), rgba=ACCENT, contact=PAD),
         ),
     ),
     Link(
@@ -242,9 +240,7 @@ LINKS: tuple[Link, ...] = (
         velocity=0.2,
         mass=0.05,
         geoms=(
-            Geom(
-                "right_finger_pad", "box", (0.011, FINGER_HALF_THICKNESS, 0.035), rgba=ACCENT, contact=PAD
-            ),
+            Geom("right_finger_pad", "box", (0.011, FINGER_HALF_THICKNESS, 0.035), rgba=ACCENT, contact=PAD),
         ),
     ),
     Link("grasp_link", "robotiq_85_base_link", xyz=(0.0, 0.0, TCP_DEPTH)),
@@ -397,7 +393,9 @@ def _mjcf_body(link: Link, depth: int) -> list[str]:
         )
     if link.mass > 0:
         i = 0.01 * link.mass
-        out.append(f'{ind}  <inertial pos="0 0 0" mass="{_f(link.mass)}" diaginertia="{_f(i)} {_f(i)} {_f(i)}"/>')
+        out.append(
+            f'{ind}  <inertial pos="0 0 0" mass="{_f(link.mass)}" diaginertia="{_f(i)} {_f(i)} {_f(i)}"/>'
+        )
     if link.name == "robotiq_85_left_knuckle_link":
         out.append(
             f'{ind}  <geom name="left_knuckle" type="box" size="0.006 0.012 0.02" pos="0 0 0.02" '
@@ -484,7 +482,7 @@ def render_scene() -> str:
         "  </contact>",
         "  <tendon>",
         # The gripper servo acts on the fingers through this tendon, whose length is the knuckle angle the
-        # fingers' opening corresponds to, so its ctrl is MoveIt Pro's gripper position (0 open, 0.7929 closed).
+        # fingers' opening corresponds to: its ctrl is MoveIt Pro's gripper position (0 open, 0.7929 closed).
         '    <fixed name="robotiq_85_grip">',
         f'      <joint joint="robotiq_85_left_finger_joint" coef="{_f(0.5 / FINGER_PER_KNUCKLE)}"/>',
         f'      <joint joint="robotiq_85_right_finger_joint" coef="{_f(0.5 / FINGER_PER_KNUCKLE)}"/>',

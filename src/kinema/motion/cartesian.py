@@ -1,0 +1,140 @@
+"""Cartesian paths: move a tool frame along straight lines (with slerped orientation) by IK interpolation."""
+
+from __future__ import annotations
+
+import itertools
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+import numpy as np
+
+from kinema.errors import MotionError
+from kinema.motion.collision import CollisionChecker
+from kinema.motion.inverse_kinematics import IkOptions, ik
+from kinema.motion.kinematics import fk
+from kinema.motion.trajectory import JointPath
+
+
+@dataclass(frozen=True)
+class CartesianResult:
+    """A Cartesian path and how much of the requested motion it covers.
+
+    Attributes:
+        path: the joint path over the group's joints (its first row is the start).
+        fraction: share of the requested Cartesian length achieved, 0..1 (1 = all of it).
+        reason: why it stopped early ("" when ``fraction`` is 1).
+    """
+
+    path: JointPath
+    fraction: float
+    reason: str = ""
+
+
+def _slerp(qa: np.ndarray, qb: np.ndarray, t: float) -> np.ndarray:
+    dot = float(np.dot(qa, qb))
+    if dot < 0:
+        qb, dot = -qb, -dot
+    if dot > 0.9995:
+        q = qa + t * (qb - qa)
+        return q / np.linalg.norm(q)
+    theta = np.arccos(dot)
+    return (np.sin((1 - t) * theta) * qa + np.sin(t * theta) * qb) / np.sin(theta)
+
+
+def plan_cartesian_path(
+    checker: CollisionChecker,
+    start: np.ndarray,
+    world_T_waypoints: Sequence[np.ndarray],
+    group: str = "manipulator",
+    frame: str | None = None,
+    *,
+    max_step: float = 0.005,
+    max_rotation_step: float = 0.05,
+    jump_threshold: float = 0.3,
+    position_only: bool = False,
+) -> CartesianResult:
+    """Move ``frame`` through ``world_T_waypoints`` in straight lines, solving IK every ``max_step`` metres.
+
+    Each step's IK is seeded with the previous step's answer, so the arm stays on one branch. The path
+    stops early (``fraction`` < 1) at the first step with no IK solution, a joint jump larger than
+    ``jump_threshold`` (rad or m), or a collision.
+
+    Args:
+        checker: collision checker (robot model, scene, padding).
+        start: full configuration ``(n,)`` the motion starts from.
+        world_T_waypoints: poses of ``frame`` to pass through, each ``(4, 4)``, world frame.
+        group: planning group that moves.
+        frame: tool frame; the group's tip link by default.
+        max_step: largest translation between IK solutions (m).
+        max_rotation_step: largest rotation between IK solutions (rad).
+        jump_threshold: largest joint change allowed between consecutive solutions.
+        position_only: only the position of ``frame`` follows the line.
+
+    Raises:
+        MotionError: no waypoints, an unknown group/frame, or a start in collision.
+    """
+    from scipy.spatial.transform import Rotation
+
+    model = checker.model
+    g = model.group(group)
+    tip = frame or g.tip_link
+    if tip is None:
+        raise MotionError(f"group {group!r} has no tip link; pass frame=")
+    if not world_T_waypoints:
+        raise MotionError("a Cartesian path needs at least one waypoint")
+    q = np.clip(np.asarray(start, dtype=float), model.lower, model.upper)
+    if checker.in_collision(q):
+        raise MotionError(f"start state is in collision: {checker.describe(q)}")
+    cols = list(g.indices)
+    data = model.new_data()
+    current = fk(model, q, tip, data)
+    poses = [current, *(np.asarray(T, dtype=float) for T in world_T_waypoints)]
+    total = sum(float(np.linalg.norm(b[:3, 3] - a[:3, 3])) for a, b in itertools.pairwise(poses))
+    rotation_total = sum(
+        float((Rotation.from_matrix(a[:3, :3]).inv() * Rotation.from_matrix(b[:3, :3])).magnitude())
+        for a, b in itertools.pairwise(poses)
+    )
+    rows = [q[cols].copy()]
+    done = 0.0
+    done_rotation = 0.0
+    options = IkOptions(attempts=1, max_iterations=50)
+    reason = ""
+    for a, b in itertools.pairwise(poses):
+        qa = Rotation.from_matrix(a[:3, :3]).as_quat()
+        qb = Rotation.from_matrix(b[:3, :3]).as_quat()
+        seg = float(np.linalg.norm(b[:3, 3] - a[:3, 3]))
+        angle = float((Rotation.from_matrix(a[:3, :3]).inv() * Rotation.from_matrix(b[:3, :3])).magnitude())
+        steps = max(1, int(np.ceil(max(seg / max_step, 0 if position_only else angle / max_rotation_step))))
+        for s in range(1, steps + 1):
+            t = s / steps
+            target = np.eye(4)
+            target[:3, 3] = a[:3, 3] + t * (b[:3, 3] - a[:3, 3])
+            target[:3, :3] = Rotation.from_quat(_slerp(qa, qb, t)).as_matrix()
+            try:
+                q_next = ik(model, target, q, group, tip, position_only=position_only, options=options)
+            except MotionError:
+                reason = f"no IK solution at {np.round(target[:3, 3], 4).tolist()}"
+                break
+            jump = float(np.abs(q_next[cols] - q[cols]).max())
+            if jump > jump_threshold:
+                reason = f"joint jump of {jump:.3f} exceeds the threshold {jump_threshold}"
+                break
+            if checker.first_invalid(np.array([q, q_next]), 0.01) is not None:
+                reason = f"collision: {checker.describe(q_next)}"
+                break
+            q = q_next
+            rows.append(q[cols].copy())
+        else:
+            done += seg
+            done_rotation += angle
+            continue
+        done += seg * (s - 1) / steps
+        done_rotation += angle * (s - 1) / steps
+        break
+    if total > 1e-9:
+        fraction = done / total
+    elif rotation_total > 1e-9:
+        fraction = done_rotation / rotation_total
+    else:
+        fraction = 1.0
+    return CartesianResult(JointPath(g.joint_names, np.array(rows)), min(1.0, fraction), reason)

@@ -1,0 +1,193 @@
+"""Collision checking of the robot against itself and the planning scene (coal through pinocchio).
+
+Self-collision pairs are every pair of robot links that can move relative to each other, minus the pairs
+the SRDF disables. Robot-scene pairs carry the ``padding`` as a safety margin, so the robot keeps that
+distance from obstacles while self-collision stays exact (padding links against each other would make
+folded but valid poses, and the gripper's own fingers, "collide").
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from kinema.errors import MotionError
+from kinema.motion.planning_scene import CollisionObject, PlanningScene
+
+if TYPE_CHECKING:
+    from kinema.motion.robot_model import RobotModel
+
+
+def _coal_shape(obj: CollisionObject):
+    import coal
+
+    if obj.shape == "box":
+        return coal.Box(*(2 * np.asarray(obj.size, dtype=float)))
+    if obj.shape == "cylinder":
+        return coal.Cylinder(float(obj.size[0]), 2 * float(obj.size[1]))
+    if obj.shape == "capsule":
+        return coal.Capsule(float(obj.size[0]), 2 * float(obj.size[1]))
+    return coal.Sphere(float(obj.size[0]))
+
+
+class CollisionChecker:
+    """Answers "is configuration ``q`` in collision?" for one robot model and one planning scene.
+
+    Not thread-safe (it owns pinocchio scratch data); make one per thread. Changes to the scene are
+    picked up on the next check (the scene's ``version`` is compared).
+
+    Args:
+        model: the robot model (its URDF collision geometry is used).
+        scene: obstacles; an empty scene when omitted.
+        padding: safety distance (m) kept between robot links and scene objects.
+    """
+
+    def __init__(self, model: RobotModel, scene: PlanningScene | None = None, padding: float = 0.0) -> None:
+        import pinocchio as pin
+
+        self.model = model
+        self.scene = scene if scene is not None else PlanningScene()
+        self._padding = float(padding)
+        try:
+            self._robot_geoms = pin.buildGeomFromUrdf(
+                model.pin_model, str(model.urdf_path), pin.GeometryType.COLLISION
+            )
+        except (RuntimeError, ValueError) as exc:
+            raise MotionError(f"cannot build collision geometry from {model.urdf_path}: {exc}") from exc
+        self._data = model.new_data()
+        self._scene_version = -1
+        self._build()
+
+    @property
+    def padding(self) -> float:
+        """Safety distance (m) between robot and scene objects."""
+        return self._padding
+
+    @padding.setter
+    def padding(self, value: float) -> None:
+        if value < 0:
+            raise MotionError(f"link padding must be >= 0 m, got {value}")
+        self._padding = float(value)
+        for k in self._scene_pairs:
+            self._geom_data.collisionRequests[k].security_margin = self._padding
+
+    def _link_of(self, geom_index: int) -> str:
+        gm = self._geom_model
+        if geom_index >= self._n_robot:
+            return gm.geometryObjects[geom_index].name
+        return self.model.pin_model.frames[gm.geometryObjects[geom_index].parentFrame].name
+
+    def _build(self) -> None:
+        import pinocchio as pin
+
+        gm = self._robot_geoms.copy()
+        self._n_robot = gm.ngeoms
+        for obj in self.scene.objects.values():
+            placement = pin.SE3(np.asarray(obj.world_T_object, dtype=float))
+            gm.addGeometryObject(pin.GeometryObject(obj.name, 0, 0, placement, _coal_shape(obj)))
+        semantic = self.model.semantic
+        robot = list(range(self._n_robot))
+        scene_pairs = []
+        for a in robot:
+            ga = gm.geometryObjects[a]
+            for b in robot[a + 1 :]:
+                gb = gm.geometryObjects[b]
+                if ga.parentJoint == gb.parentJoint:
+                    continue  # rigidly attached: their distance never changes
+                if semantic.collision_disabled(self._link_of_obj(ga), self._link_of_obj(gb)):
+                    continue
+                gm.addCollisionPair(pin.CollisionPair(a, b))
+            if ga.parentJoint == 0:
+                continue  # fixed to the world, like the scene
+            for b in range(self._n_robot, gm.ngeoms):
+                scene_pairs.append(gm.collisionPairs.__len__())
+                gm.addCollisionPair(pin.CollisionPair(a, b))
+        self._geom_model = gm
+        self._geom_data = pin.GeometryData(gm)
+        self._scene_pairs = scene_pairs
+        for k in scene_pairs:
+            self._geom_data.collisionRequests[k].security_margin = self._padding
+        self._scene_version = self.scene.version
+
+    def _link_of_obj(self, geom) -> str:
+        return self.model.pin_model.frames[geom.parentFrame].name
+
+    @property
+    def pair_count(self) -> int:
+        """Number of geometry pairs each check tests."""
+        return len(self._geom_model.collisionPairs)
+
+    def in_collision(self, q: np.ndarray) -> bool:
+        """True when configuration ``q`` (shape ``(n,)``) touches itself or the scene (within the padding)."""
+        import pinocchio as pin
+
+        if self.scene.version != self._scene_version:
+            self._build()
+        return bool(
+            pin.computeCollisions(
+                self.model.pin_model,
+                self._data,
+                self._geom_model,
+                self._geom_data,
+                self.model.pin_configuration(np.asarray(q, dtype=float)),
+                True,
+            )
+        )
+
+    def is_valid(self, q: np.ndarray) -> bool:
+        """True when ``q`` is inside the joint limits and collision-free."""
+        return self.model.within_limits(q) and not self.in_collision(q)
+
+    def colliding_pairs(self, q: np.ndarray) -> list[tuple[str, str]]:
+        """All colliding pairs at ``q`` as (link or object, link or object) names, for error messages."""
+        import pinocchio as pin
+
+        if self.scene.version != self._scene_version:
+            self._build()
+        pin.computeCollisions(
+            self.model.pin_model,
+            self._data,
+            self._geom_model,
+            self._geom_data,
+            self.model.pin_configuration(np.asarray(q, dtype=float)),
+            False,
+        )
+        pairs = []
+        for k, pair in enumerate(self._geom_model.collisionPairs):
+            if self._geom_data.collisionResults[k].isCollision():
+                names = (self._link_of(pair.first), self._link_of(pair.second))
+                if names not in pairs:
+                    pairs.append(names)
+        return pairs
+
+    def describe(self, q: np.ndarray) -> str:
+        """A short sentence naming what collides at ``q`` ("wrist_3_link - table, ...")."""
+        pairs = self.colliding_pairs(q)
+        if not pairs:
+            return "no collision"
+        return ", ".join(f"{a} - {b}" for a, b in pairs[:4]) + (
+            f" (+{len(pairs) - 4} more)" if len(pairs) > 4 else ""
+        )
+
+    def first_invalid(self, path: np.ndarray, max_step: float = 0.01) -> int | None:
+        """Check a piecewise-linear joint path at a resolution of ``max_step`` (rad or m per joint).
+
+        Args:
+            path: configurations, shape ``(N, n)``.
+            max_step: largest change of any joint between two checked configurations.
+
+        Returns:
+            The index of the segment (0-based, the segment from ``path[i]`` to ``path[i+1]``; ``N-1`` for a
+            lone last point) containing the first invalid configuration, or None when the path is valid.
+        """
+        path = np.asarray(path, dtype=float)
+        if not self.is_valid(path[0]):
+            return 0
+        for i in range(len(path) - 1):
+            a, b = path[i], path[i + 1]
+            steps = max(1, int(np.ceil(np.abs(b - a).max() / max_step)))
+            for s in range(1, steps + 1):
+                if not self.is_valid(a + (b - a) * (s / steps)):
+                    return i
+        return None

@@ -1,0 +1,138 @@
+"""Inverse kinematics: damped least squares on pinocchio, within joint limits, from several seeds."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from kinema.errors import MotionError
+
+if TYPE_CHECKING:
+    from kinema.motion.robot_model import RobotModel
+
+
+@dataclass(frozen=True)
+class IkOptions:
+    """Tuning of :func:`ik`.
+
+    Attributes:
+        position_tolerance: accepted position error (m).
+        orientation_tolerance: accepted orientation error (rad).
+        max_iterations: iterations per seed.
+        attempts: seeds tried in all: the given seed first, then random ones inside the limits.
+        damping: damped-least-squares damping (m² / rad²).
+        max_step: largest joint change per iteration (rad or m); without it the first Gauss-Newton step
+            from a far seed jumps to a limit or flips the wrist and the iteration gets stuck.
+        rng_seed: seed of the random restarts (deterministic by default).
+    """
+
+    position_tolerance: float = 1e-4
+    orientation_tolerance: float = 1e-3
+    max_iterations: int = 100
+    attempts: int = 10
+    damping: float = 1e-6
+    max_step: float = 0.2
+    rng_seed: int = 0
+
+
+def ik(
+    model: RobotModel,
+    world_T_target: np.ndarray,
+    seed: np.ndarray,
+    group: str = "manipulator",
+    frame: str | None = None,
+    *,
+    position_only: bool = False,
+    options: IkOptions | None = None,
+    accept: Callable[[np.ndarray], bool] | None = None,
+) -> np.ndarray:
+    """Find a configuration that puts ``frame`` at ``world_T_target``, moving only ``group``'s joints.
+
+    The seed is tried first, so the answer stays on the seed's elbow/wrist branch when one exists there;
+    random seeds inside the limits follow. Every solution respects the position limits.
+
+    Args:
+        model: the robot model.
+        world_T_target: target pose of ``frame`` in the world frame, shape ``(4, 4)``.
+        seed: full configuration ``(n,)``; joints outside ``group`` keep these values.
+        group: planning group whose joints move.
+        frame: the frame to place; defaults to the group's tip link.
+        position_only: ignore orientation.
+        options: tolerances, iterations and number of seeds.
+        accept: an extra test a solution must pass (e.g. "not in collision"); rejected solutions count as
+            failed attempts.
+
+    Returns:
+        The configuration ``(n,)``.
+
+    Raises:
+        MotionError: "no IK solution", with the remaining error and the reason.
+    """
+    import pinocchio as pin
+
+    opts = options or IkOptions()
+    g = model.group(group)
+    tip = frame or g.tip_link
+    if tip is None:
+        raise MotionError(f"group {group!r} has no tip link; pass frame= (one of the robot's links)")
+    fid = model.frame_id(tip)
+    target = pin.SE3(np.asarray(world_T_target, dtype=float))
+    cols = np.array(g.indices)
+    lo, hi = model.lower[cols], model.upper[cols]
+    data = model.new_data()
+    pm = model.pin_model
+    rows = slice(0, 3) if position_only else slice(0, 6)
+    m = 3 if position_only else 6
+    rng = np.random.default_rng(opts.rng_seed)
+    seed = np.clip(np.asarray(seed, dtype=float), model.lower, model.upper)
+    best_error = (np.inf, np.inf)
+    rejected = 0
+
+    for attempt in range(opts.attempts):
+        q = seed.copy()
+        if attempt > 0:
+            q[cols] = rng.uniform(lo, hi)
+        for _ in range(opts.max_iterations):
+            pq = model.pin_configuration(q)
+            pin.framesForwardKinematics(pm, data, pq)
+            current_T_target = data.oMf[fid].actInv(target)
+            err = pin.log(current_T_target).vector
+            if position_only:
+                # Position error in the world frame, so the Jacobian rows below match it.
+                err = np.concatenate([target.translation - data.oMf[fid].translation, np.zeros(3)])
+                pos_err, rot_err = float(np.linalg.norm(err[:3])), 0.0
+            else:
+                pos_err, rot_err = float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:]))
+            if pos_err < opts.position_tolerance and rot_err < opts.orientation_tolerance:
+                if accept is None or accept(q):
+                    return q
+                rejected += 1
+                break
+            if (pos_err, rot_err) < best_error:
+                best_error = (pos_err, rot_err)
+            if position_only:
+                J = pin.computeFrameJacobian(pm, data, pq, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+                J = (J @ model.mimic_map)[rows][:, cols]
+                e = err[:3]
+            else:
+                J = pin.computeFrameJacobian(pm, data, pq, fid, pin.ReferenceFrame.LOCAL)
+                J = (pin.Jlog6(current_T_target.inverse()) @ J @ model.mimic_map)[:, cols]
+                e = err
+            dq = J.T @ np.linalg.solve(J @ J.T + opts.damping * np.eye(m), e)
+            largest = float(np.abs(dq).max())
+            if largest > opts.max_step:
+                dq *= opts.max_step / largest
+            q[cols] = np.clip(q[cols] + dq, lo, hi)
+    reason = (
+        f"{rejected} solution(s) found but rejected (e.g. in collision)"
+        if rejected
+        else "the target may be out of reach or outside the joint limits"
+    )
+    raise MotionError(
+        f"no IK solution for {tip!r} in group {group!r} at position "
+        f"{np.round(target.translation, 4).tolist()} after {opts.attempts} seeds: best error "
+        f"{best_error[0]:.4f} m / {best_error[1]:.4f} rad; {reason}"
+    )
