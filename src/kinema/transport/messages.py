@@ -50,6 +50,10 @@ _INTEGERS = {
 _FLOATS = {"float32", "float64", "float128"}
 
 
+def _at(where: str) -> str:
+    return f"{where}: " if where else ""
+
+
 def _registry(registry: TypeRegistry | None) -> TypeRegistry:
     return registry if registry is not None else load_interfaces()
 
@@ -84,7 +88,7 @@ def _convert_base(base: str, value: Any, where: str) -> Any:
             return float(value)
     elif isinstance(value, str):
         return value
-    raise TransportError(f"{where}: expected {base}, got {type(value).__name__} {value!r}")
+    raise TransportError(f"{_at(where)}expected {base}, got {type(value).__name__} {value!r}")
 
 
 def _default(registry: TypeRegistry, desc: Any, where: str) -> Any:
@@ -114,12 +118,12 @@ def _convert(registry: TypeRegistry, desc: Any, value: Any, where: str) -> Any:
             and sub_kind == Nodetype.BASE
             and sub_rest[0] in ("uint8", "byte", "octet", "char")
         ):
-            raise TransportError(f"{where}: expected a list, got {type(value).__name__} {value!r}")
+            raise TransportError(f"{_at(where)}expected a list, got {type(value).__name__} {value!r}")
     items = list(value)
     if kind == Nodetype.ARRAY and len(items) != size:
-        raise TransportError(f"{where}: expected exactly {size} items, got {len(items)}")
+        raise TransportError(f"{_at(where)}expected exactly {size} items, got {len(items)}")
     if kind == Nodetype.SEQUENCE and size and len(items) > size:
-        raise TransportError(f"{where}: at most {size} items allowed, got {len(items)}")
+        raise TransportError(f"{_at(where)}at most {size} items allowed, got {len(items)}")
     converted = [
         _convert(registry, (sub_kind, sub_rest), item, f"{where}[{i}]") for i, item in enumerate(items)
     ]
@@ -136,14 +140,14 @@ def _build(registry: TypeRegistry, type_name: str, data: Any, where: str) -> Any
         data = {}
     if not isinstance(data, Mapping):
         raise TransportError(
-            f"{where}: expected a mapping of {type_name} fields, got {type(data).__name__} {data!r}"
+            f"{_at(where)}expected a mapping of {type_name} fields, got {type(data).__name__} {data!r}"
         )
     fields = _fields(registry, type_name)
     names = [name for name, _ in fields]
     for key in data:
         if key not in names:
             raise TransportError(
-                f"{where}: {type_name} has no field {key!r} ({did_you_mean(str(key), names)})"
+                f"{_at(where)}{type_name} has no field {key!r} ({did_you_mean(str(key), names)})"
             )
     values = {}
     for name, desc in fields:
