@@ -121,7 +121,9 @@ def parse_xml(text: str | bytes, filename: str = "<string>") -> etree._Element:
     except etree.XMLSyntaxError as error:
         line = error.lineno or 0
         message = str(error.msg or error).split(", line")[0]
-        raise ObjectiveError(f"XML syntax error: {message}", location=SourceLocation(filename, line)) from None
+        raise ObjectiveError(
+            f"XML syntax error: {message}", location=SourceLocation(filename, line)
+        ) from None
     if root is None:
         raise ObjectiveError("the XML document is empty", location=SourceLocation(filename))
     _check_depth(root, filename)
@@ -135,7 +137,8 @@ def _check_depth(root: etree._Element, filename: str) -> None:
         element, depth = stack.pop()
         if depth > MAX_DEPTH:
             raise ObjectiveError(
-                f"elements nest deeper than {MAX_DEPTH} levels", location=SourceLocation(filename, element.sourceline or 0)
+                f"elements nest deeper than {MAX_DEPTH} levels",
+                location=SourceLocation(filename, element.sourceline or 0),
             )
         stack.extend((child, depth + 1) for child in element if isinstance(child.tag, str))
 
@@ -146,5 +149,7 @@ def parse_xml_file(path: str | Path) -> etree._Element:
     try:
         data = path.read_bytes()
     except OSError as error:
-        raise ObjectiveError(f"cannot read the file: {error.strerror}", location=SourceLocation(str(path))) from None
+        raise ObjectiveError(
+            f"cannot read the file: {error.strerror}", location=SourceLocation(str(path))
+        ) from None
     return parse_xml(data, str(path))

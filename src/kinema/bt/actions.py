@@ -1,0 +1,263 @@
+"""Built-in leaf nodes (reference §2.5)."""
+
+from __future__ import annotations
+
+import threading
+from typing import Any
+
+from kinema.bt.conversions import ConversionError, convert_from_string, has_converter, type_name
+from kinema.bt.decorators import entry_key_of
+from kinema.bt.errors import BTLogicError, BTRuntimeError, ScriptParseError
+from kinema.bt.node import (
+    ConditionNode,
+    NodeConfig,
+    PortError,
+    StatefulActionNode,
+    SyncActionNode,
+    script_bool,
+)
+from kinema.bt.ports import PortInfo, bidirectional_port, blackboard_pointer, input_port
+from kinema.bt.script import Script, parse_script
+from kinema.bt.status import FAILURE, RUNNING, SUCCESS, NodeStatus
+
+
+class AlwaysSuccessNode(SyncActionNode):
+    """Returns SUCCESS."""
+
+    def tick(self) -> NodeStatus:
+        return SUCCESS
+
+
+class AlwaysFailureNode(SyncActionNode):
+    """Returns FAILURE."""
+
+    def tick(self) -> NodeStatus:
+        return FAILURE
+
+
+def _literal_code(config: NodeConfig) -> str | None:
+    raw = config.input_ports.get("code")
+    if isinstance(raw, str) and blackboard_pointer(raw, "code") is None:
+        return raw
+    return None
+
+
+class ScriptNode(SyncActionNode):
+    """Runs the ``code`` script and returns SUCCESS (an empty script does nothing)."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [input_port("code", str, description="Piece of code that can be parsed")]
+
+    def __init__(self, name: str, config: NodeConfig | None = None) -> None:
+        super().__init__(name, config)
+        self._code = ""
+        self._script: Script | None = None
+        code = _literal_code(self.config)
+        if code:
+            self._load(code)
+
+    def _load(self, code: str) -> None:
+        try:
+            self._script = parse_script(code)
+        except ScriptParseError as error:
+            raise BTRuntimeError(
+                f"Error in the script \"{code}\" of node '{self.full_path}': {error.message}"
+            ) from None
+        self._code = code
+
+    def tick(self) -> NodeStatus:
+        code = self.get_input("code", str)
+        if code != self._code:
+            if code == "":
+                self._script = None
+                self._code = ""
+            else:
+                self._load(code)
+        if self._script is not None:
+            self._script.run(self.config.blackboard, self.config.enums)
+        return SUCCESS
+
+
+class ScriptConditionNode(ConditionNode):
+    """SUCCESS if the ``code`` script evaluates to true, else FAILURE."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            input_port(
+                "code", None, description="Piece of code that can be parsed. Must return false or true"
+            )
+        ]
+
+    def __init__(self, name: str, config: NodeConfig | None = None) -> None:
+        super().__init__(name, config)
+        self._code = ""
+        self._script: Script | None = None
+        code = _literal_code(self.config)
+        if code:
+            self._load(code)
+
+    def _load(self, code: str) -> None:
+        try:
+            self._script = parse_script(code)
+        except ScriptParseError as error:
+            raise BTRuntimeError(
+                f"Error in the script \"{code}\" of node '{self.full_path}': {error.message}"
+            ) from None
+        self._code = code
+
+    def tick(self) -> NodeStatus:
+        code = self.get_input("code", str)
+        if code != self._code:
+            if code == "":
+                self._script = None
+                self._code = ""
+            else:
+                self._load(code)
+        if self._script is None:
+            raise BTRuntimeError(
+                f"ScriptCondition '{self.full_path}' has an empty script (bad_function_call)"
+            )
+        value = self._script.run(self.config.blackboard, self.config.enums)
+        return SUCCESS if script_bool(value) else FAILURE
+
+
+class SetBlackboardNode(SyncActionNode):
+    """Copies ``value`` (a literal or ``{key}``) into the entry named by ``output_key``."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            input_port("value", None, description="Value to be written into the output_key"),
+            bidirectional_port(
+                "output_key",
+                None,
+                description="Name of the blackboard entry where the value should be written",
+            ),
+        ]
+
+    def tick(self) -> NodeStatus:
+        result = self.try_get_input("output_key", str)
+        if not result.ok:
+            raise BTRuntimeError("missing port [output_key]")
+        output_key: str = result.value
+        if "value" not in self.config.input_ports:
+            raise BTRuntimeError(f"SetBlackboard '{self.full_path}': missing port [value]")
+        value_str = self.config.input_ports["value"]
+        bb = self.config.blackboard
+        dst = bb.get_entry(output_key)
+        source_key = blackboard_pointer(value_str, "value") if isinstance(value_str, str) else None
+        if source_key is not None and value_str.strip() != "=":
+            src = bb.get_entry(source_key)
+            if src is None:
+                raise BTRuntimeError("Can't find the port referred by [value]")
+            if dst is None:
+                dst = bb.create_entry(output_key, src.type)
+            out_value: Any = src.value
+        else:
+            out_value = value_str
+        if out_value is None:
+            return FAILURE
+        if dst is not None and dst.type is not str and isinstance(out_value, str):
+            if has_converter(dst.type):
+                try:
+                    out_value = convert_from_string(dst.type, out_value, self.config.enums)
+                except ConversionError as error:
+                    raise BTLogicError(
+                        f"Can't convert string [{out_value}] to type [{type_name(dst.type)}]: {error.message}"
+                    ) from None
+            else:
+                # BT.CPP parses with the entry's (absent) converter and stores the resulting empty value.
+                dst.value = None
+                bb.notify_written(output_key, dst)
+                return SUCCESS
+        if dst is None:
+            dst = bb.create_entry(output_key, _type_of_literal(out_value))
+        bb.set(output_key, out_value)
+        return SUCCESS
+
+
+def _type_of_literal(value: Any) -> Any:
+    return str if isinstance(value, str) else type(value)
+
+
+class UnsetBlackboardNode(SyncActionNode):
+    """Removes ``key`` from the local blackboard scope (never through ``@`` or remapping)."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [input_port("key", str, description="Key of the entry to remove")]
+
+    def tick(self) -> NodeStatus:
+        try:
+            key = self.get_input("key")
+        except PortError:
+            raise BTRuntimeError("missing input port [key]") from None
+        self.config.blackboard.unset(key)
+        return SUCCESS
+
+
+class SleepNode(StatefulActionNode):
+    """RUNNING for ``msec`` milliseconds of the tree's clock, then SUCCESS."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [input_port("msec", int)]
+
+    def __init__(self, name: str, config: NodeConfig | None = None) -> None:
+        super().__init__(name, config)
+        self._fired = threading.Event()
+        self._timer: Any = None
+
+    def _on_timer(self) -> None:
+        self._fired.set()
+        self.emit_wake_up_signal()
+
+    def on_start(self) -> NodeStatus:
+        try:
+            msec = self.get_input("msec")
+        except PortError:
+            raise BTRuntimeError("Missing parameter [msec] in SleepNode") from None
+        if msec <= 0:
+            return SUCCESS
+        clock = self.config.clock
+        if clock is None:
+            raise BTRuntimeError(f"SleepNode '{self.full_path}' is not part of a tree with a clock")
+        self._fired.clear()
+        self._timer = clock.call_later(msec / 1000.0, self._on_timer)
+        return RUNNING
+
+    def on_running(self) -> NodeStatus:
+        if self._fired.is_set():
+            self._fired.clear()
+            self._timer = None
+            return SUCCESS
+        return RUNNING
+
+    def on_halted(self) -> None:
+        if self._timer is not None:
+            self._timer.cancel()
+            self._timer = None
+        self._fired.clear()
+
+
+class WasEntryUpdatedNode(SyncActionNode):
+    """SUCCESS if the ``entry`` blackboard key was written since this node last looked."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [input_port("entry", description="Entry to check")]
+
+    def __init__(self, name: str, config: NodeConfig | None = None) -> None:
+        super().__init__(name, config)
+        self._key = entry_key_of(self)
+        self._sequence_id = 0
+
+    def tick(self) -> NodeStatus:
+        entry = self.config.blackboard.get_entry(self._key)
+        if entry is None:
+            return FAILURE
+        previous = self._sequence_id
+        self._sequence_id = entry.sequence_id
+        return SUCCESS if previous != entry.sequence_id else FAILURE

@@ -1,0 +1,137 @@
+"""The one time source of the engine (DESIGN invariant 3).
+
+Every time-based node (Sleep, Delay, Timeout) and ``Tree.sleep`` ask the tree's :class:`Clock`, never
+``time.time()``: wall time on hardware, simulated time in a headless simulation that may run faster
+than real time. A clock answers ``now()`` in seconds and runs callbacks after a delay on *its* time
+scale; a callback runs on the clock's own thread, so it must only set flags and emit wake-up signals.
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import threading
+import time
+from collections.abc import Callable
+from typing import Protocol, runtime_checkable
+
+
+@runtime_checkable
+class TimerHandle(Protocol):
+    """What ``Clock.call_later`` returns."""
+
+    def cancel(self) -> None:
+        """Stop the callback from running; harmless if it already ran."""
+
+
+@runtime_checkable
+class Clock(Protocol):
+    """A source of time that can also schedule callbacks on that time scale."""
+
+    def now(self) -> float:
+        """Seconds on this clock (monotonic, arbitrary origin)."""
+
+    def call_later(self, delay: float, callback: Callable[[], None]) -> TimerHandle:
+        """Run ``callback`` once, ``delay`` seconds (of this clock) from now, on the clock's thread."""
+
+
+class _Timer:
+    __slots__ = ("callback", "cancelled", "due")
+
+    def __init__(self, due: float, callback: Callable[[], None]) -> None:
+        self.due = due
+        self.callback = callback
+        self.cancelled = False
+
+    def cancel(self) -> None:
+        self.cancelled = True
+
+
+class WallClock:
+    """Monotonic wall time with one lazily started daemon thread that fires timers in order.
+
+    ``realtime`` tells ``Tree.sleep`` that waiting on a condition variable with a timeout measures
+    the same time as this clock, so it can skip scheduling a timer.
+    """
+
+    realtime = True
+
+    def __init__(self) -> None:
+        self._heap: list[tuple[float, int, _Timer]] = []
+        self._counter = itertools.count()
+        self._cond = threading.Condition()
+        self._thread: threading.Thread | None = None
+
+    def now(self) -> float:
+        return time.monotonic()
+
+    def call_later(self, delay: float, callback: Callable[[], None]) -> _Timer:
+        timer = _Timer(time.monotonic() + max(delay, 0.0), callback)
+        with self._cond:
+            heapq.heappush(self._heap, (timer.due, next(self._counter), timer))
+            if self._thread is None or not self._thread.is_alive():
+                self._thread = threading.Thread(target=self._run, name="kinema-bt-clock", daemon=True)
+                self._thread.start()
+            self._cond.notify()
+        return timer
+
+    def _run(self) -> None:
+        while True:
+            with self._cond:
+                while True:
+                    while self._heap and self._heap[0][2].cancelled:
+                        heapq.heappop(self._heap)
+                    if not self._heap:
+                        self._cond.wait(timeout=5.0)
+                        if not self._heap:
+                            self._thread = None
+                            return
+                        continue
+                    due = self._heap[0][0]
+                    remaining = due - time.monotonic()
+                    if remaining <= 0:
+                        timer = heapq.heappop(self._heap)[2]
+                        break
+                    self._cond.wait(timeout=remaining)
+            if not timer.cancelled:
+                timer.callback()
+
+
+class ManualClock:
+    """A clock that only moves when told to: for tests and for simulations that own time.
+
+    ``advance(dt)`` moves time forward and runs, on the caller's thread, every callback that fell due.
+    """
+
+    realtime = False
+
+    def __init__(self, start: float = 0.0) -> None:
+        self._now = start
+        self._heap: list[tuple[float, int, _Timer]] = []
+        self._counter = itertools.count()
+        self._lock = threading.Lock()
+
+    def now(self) -> float:
+        return self._now
+
+    def call_later(self, delay: float, callback: Callable[[], None]) -> _Timer:
+        timer = _Timer(self._now + max(delay, 0.0), callback)
+        with self._lock:
+            heapq.heappush(self._heap, (timer.due, next(self._counter), timer))
+        return timer
+
+    def advance(self, dt: float) -> None:
+        """Move time forward by ``dt`` seconds, firing due callbacks in order."""
+        self.set_time(self._now + dt)
+
+    def set_time(self, t: float) -> None:
+        """Jump to time ``t`` (never backwards), firing due callbacks in order."""
+        while True:
+            with self._lock:
+                if not self._heap or self._heap[0][0] > t:
+                    break
+                due, _, timer = heapq.heappop(self._heap)
+            self._now = max(self._now, due)
+            if not timer.cancelled:
+                timer.callback()
+        self._now = max(self._now, t)

@@ -1,0 +1,92 @@
+"""Name rules for node types, tree IDs, ports and instance names (BT.CPP docs/name_validation_rules.md)."""
+
+from __future__ import annotations
+
+from kinema.bt.ports import RESERVED_PORT_NAMES
+
+_FORBIDDEN = frozenset(" \t\n\r<>&\"'/\\:*?|.")
+
+RESERVED_ATTRIBUTES = frozenset(
+    {
+        "name",
+        "ID",
+        "_autoremap",
+        "_failureIf",
+        "_successIf",
+        "_skipIf",
+        "_while",
+        "_onSuccess",
+        "_onFailure",
+        "_onHalted",
+        "_post",
+    }
+)
+PRE_CONDITIONS = ("_failureIf", "_successIf", "_skipIf", "_while")
+POST_CONDITIONS = ("_onSuccess", "_onFailure", "_onHalted", "_post")
+
+
+def forbidden_char(name: str, *, allow_space: bool = False) -> str | None:
+    """The first forbidden character of ``name``, or None (UTF-8 beyond ASCII is allowed)."""
+    for c in name:
+        if ord(c) >= 0x80:
+            continue
+        if c == " " and allow_space:
+            continue
+        if ord(c) < 32 or ord(c) == 127 or c in _FORBIDDEN:
+            return c
+    return None
+
+
+def describe_char(c: str) -> str:
+    """How an error message shows a forbidden character."""
+    if ord(c) < 32 or ord(c) == 127:
+        return f"control character (ASCII {ord(c)})"
+    return f"'{c}'"
+
+
+def model_name_problem(name: str, *, tree_id: bool = False) -> str | None:
+    """Why ``name`` is not a valid node type / tree ID, or None.
+
+    Tree IDs may contain spaces: MoveIt Pro objectives are named like "Move to Waypoint", which
+    BT.CPP 4.10's validator would reject; Kinema must load those files unchanged.
+    """
+    if not name:
+        return "Model/Node type name cannot be empty"
+    if name in ("Root", "root"):
+        return "'Root' is a reserved name and cannot be used as a node type"
+    c = forbidden_char(name, allow_space=tree_id)
+    if c is not None:
+        return f"Model name '{name}' contains forbidden character {describe_char(c)}"
+    return None
+
+
+def port_name_problem(name: str) -> str | None:
+    """Why ``name`` is not a valid port name, or None."""
+    if not name:
+        return "Port name cannot be empty"
+    if name[0].isdigit():
+        return f"Port name '{name}' cannot start with a digit"
+    c = forbidden_char(name)
+    if c is not None:
+        return f"Port name '{name}' contains forbidden character {describe_char(c)}"
+    if name in RESERVED_PORT_NAMES or name in RESERVED_ATTRIBUTES:
+        return f"Port name '{name}' is a reserved attribute name"
+    return None
+
+
+def is_allowed_port_name(name: str) -> bool:
+    """``IsAllowedPortName``: an attribute that is treated as a port."""
+    if not name or not (name[0].isalpha() and ord(name[0]) < 0x80):
+        return False
+    if forbidden_char(name) is not None:
+        return False
+    return name not in RESERVED_ATTRIBUTES
+
+
+def instance_name_problem(name: str) -> str | None:
+    """Why ``name`` is not a valid instance name (only control characters are refused), or None."""
+    for c in name:
+        code = ord(c)
+        if (code < 32 and c not in "\t\n\r") or code == 127:
+            return f"Instance name '{name}' contains invalid control character (ASCII {code})"
+    return None

@@ -1,0 +1,400 @@
+"""Loading BT.CPP v4 XML documents into a library of tree definitions (BT.CPP's ``XMLParser``).
+
+A factory owns one :class:`TreeLibrary`; it is cumulative, so trees loaded earlier stay visible to
+``<SubTree ID=...>`` in later documents. Loading a document processes its ``<include>``s first, then
+verifies the whole document (unknown nodes, child counts, IDs), then reads the ``<SubTree>`` port
+models of ``<TreeNodesModel>``, then registers each ``<BehaviorTree>``.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from lxml import etree
+
+from kinema.bt.errors import BTRuntimeError
+from kinema.bt.manifest import NodeType
+from kinema.bt.names import model_name_problem, port_name_problem
+from kinema.bt.ports import NO_DEFAULT, PortDirection, PortInfo
+from kinema.bt.xmlsource import MAX_DEPTH, parse_xml, parse_xml_file
+from kinema.errors import SourceLocation
+
+if TYPE_CHECKING:
+    from kinema.bt.manifest import NodeManifest
+
+EXPLICIT_TAGS = frozenset({"Action", "Condition", "Control", "Decorator", "SubTree"})
+_PORT_TAGS = {
+    "input_port": PortDirection.INPUT,
+    "output_port": PortDirection.OUTPUT,
+    "inout_port": PortDirection.INOUT,
+}
+
+
+def element_children(element: etree._Element) -> list[etree._Element]:
+    """Child elements only (comments and processing instructions skipped)."""
+    return [child for child in element if isinstance(child.tag, str)]
+
+
+def line_of(element: etree._Element) -> int:
+    """The 1-based source line of an element (0 if unknown)."""
+    return element.sourceline or 0
+
+
+class TreeDefinition:
+    """A ``<BehaviorTree>`` as loaded: its ID, element and file.
+
+    ``attributes`` keeps everything written on the element (``_description``, ``_favorite`` ...), so
+    an objective can be written back unchanged in meaning.
+    """
+
+    __slots__ = ("element", "filename", "id")
+
+    def __init__(self, tree_id: str, element: etree._Element, filename: str) -> None:
+        self.id = tree_id
+        self.element = element
+        self.filename = filename
+
+    @property
+    def attributes(self) -> dict[str, str]:
+        """Attributes of the ``<BehaviorTree>`` element (metadata included)."""
+        return dict(self.element.attrib)
+
+    @property
+    def root_element(self) -> etree._Element | None:
+        """The single child element (the tree's root node)."""
+        children = element_children(self.element)
+        return children[0] if children else None
+
+    @property
+    def location(self) -> SourceLocation:
+        """``file:line`` of the ``<BehaviorTree>`` element."""
+        return SourceLocation(self.filename, line_of(self.element))
+
+    def to_xml(self) -> str:
+        """The ``<BehaviorTree>`` element as XML text."""
+        return etree.tostring(self.element, encoding="unicode")
+
+
+class SubtreeModel:
+    """``<TreeNodesModel><SubTree ID>``: ports with defaults, description and metadata."""
+
+    __slots__ = ("description", "id", "metadata", "ports")
+
+    def __init__(self, subtree_id: str) -> None:
+        self.id = subtree_id
+        self.ports: dict[str, PortInfo] = {}
+        self.description = ""
+        self.metadata: list[tuple[str, str]] = []
+
+
+def read_metadata(model: etree._Element) -> list[tuple[str, str]]:
+    """``(key, value)`` pairs of every ``<MetadataFields><Metadata k="v"/>`` under ``model``."""
+    pairs: list[tuple[str, str]] = []
+    for fields in model.iter("MetadataFields"):
+        for item in fields.iter("Metadata"):
+            pairs.extend((str(k), str(v)) for k, v in item.attrib.items())
+    return pairs
+
+
+def located_error(message: str, filename: str, line: int) -> BTRuntimeError:
+    """A BT RuntimeError that carries ``file:line``."""
+    return BTRuntimeError(message, location=SourceLocation(filename, line))
+
+
+class TreeLibrary:
+    """The trees and SubTree models loaded into one factory (cumulative)."""
+
+    def __init__(self) -> None:
+        self.trees: dict[str, TreeDefinition] = {}
+        self.subtree_models: dict[str, SubtreeModel] = {}
+        self.node_models: dict[str, etree._Element] = {}
+        self.current_path = Path.cwd()
+        self.first_main_tree: str | None = None
+        self.documents_loaded = 0
+        self._suffix = 0
+
+    def clear(self) -> None:
+        """Forget every tree (the factory's ``clear_registered_behavior_trees``)."""
+        self.trees.clear()
+        self.subtree_models.clear()
+        self.node_models.clear()
+        self.current_path = Path.cwd()
+        self.first_main_tree = None
+        self.documents_loaded = 0
+        self._suffix = 0
+
+    # -- loading ---------------------------------------------------------------------------------
+
+    def load_text(self, text: str, filename: str, manifests: dict[str, NodeManifest]) -> etree._Element:
+        """Load XML text; relative includes resolve against the library's current path."""
+        root = parse_xml(text, filename)
+        self._load_document(root, filename, manifests, include_stack=[])
+        return root
+
+    def load_file(self, path: str | Path, manifests: dict[str, NodeManifest]) -> etree._Element:
+        """Load an XML file; its directory becomes the current path (as BT.CPP does)."""
+        path = Path(path)
+        root = parse_xml_file(path)
+        self.current_path = path.resolve().parent
+        self._load_document(root, str(path), manifests, include_stack=[str(path.resolve())])
+        return root
+
+    def _load_document(
+        self,
+        root: etree._Element,
+        filename: str,
+        manifests: dict[str, NodeManifest],
+        include_stack: list[str],
+    ) -> None:
+        if root.tag != "root":
+            raise located_error("The XML must have a root node called <root>", filename, line_of(root))
+        for include in root.findall("include"):
+            self._load_include(include, filename, manifests, include_stack)
+        verify_document(root, filename, manifests)
+        self._read_models(root, filename)
+        if self.documents_loaded == 0 and self.first_main_tree is None:
+            self.first_main_tree = root.get("main_tree_to_execute")
+        self.documents_loaded += 1
+        for element in root.findall("BehaviorTree"):
+            tree_id = element.get("ID")
+            if tree_id is None:
+                tree_id = f"BehaviorTree_{self._suffix}"
+                self._suffix += 1
+            self.trees[tree_id] = TreeDefinition(tree_id, element, filename)
+
+    def _load_include(
+        self,
+        include: etree._Element,
+        filename: str,
+        manifests: dict[str, NodeManifest],
+        include_stack: list[str],
+    ) -> None:
+        path_attr = include.get("path")
+        if path_attr is None:
+            raise located_error("Invalid <include> tag: missing 'path' attribute", filename, line_of(include))
+        file_path = Path(path_attr)
+        if include.get("ros_pkg") is not None and not file_path.is_absolute():
+            raise located_error(
+                "Using attribute [ros_pkg] in <include>, but Kinema has no ROS package index; "
+                "use a path relative to the including file instead",
+                filename,
+                line_of(include),
+            )
+        if not file_path.is_absolute():
+            file_path = self.current_path / file_path
+        resolved = str(file_path.resolve())
+        if resolved in include_stack:
+            chain = " -> ".join([*include_stack, resolved])
+            raise located_error(f"<include> cycle: {chain}", filename, line_of(include))
+        if len(include_stack) > 64:
+            raise located_error("<include> nests deeper than 64 files", filename, line_of(include))
+        if not file_path.is_file():
+            raise located_error(
+                f'<include path="{path_attr}">: no such file {file_path}', filename, line_of(include)
+            )
+        previous = self.current_path
+        self.current_path = file_path.resolve().parent
+        try:
+            child_root = parse_xml_file(file_path)
+            self._load_document(child_root, str(file_path), manifests, [*include_stack, resolved])
+        finally:
+            self.current_path = previous
+
+    def _read_models(self, root: etree._Element, filename: str) -> None:
+        for models in root.findall("TreeNodesModel"):
+            for model in element_children(models):
+                model_id = model.get("ID")
+                if model.tag != "SubTree":
+                    if model_id:
+                        self.node_models[model_id] = model
+                    continue
+                if model_id is None:
+                    raise located_error(
+                        "Missing attribute 'ID' in SubTree element within TreeNodesModel",
+                        filename,
+                        line_of(model),
+                    )
+                subtree_model = self.subtree_models.setdefault(model_id, SubtreeModel(model_id))
+                subtree_model.description = model.get("description", subtree_model.description)
+                subtree_model.metadata = read_metadata(model) or subtree_model.metadata
+                for port_element in element_children(model):
+                    direction = _PORT_TAGS.get(str(port_element.tag))
+                    if direction is None:
+                        continue
+                    name = port_element.get("name")
+                    if name is None:
+                        raise located_error(
+                            "Missing attribute [name] in port (SubTree model)",
+                            filename,
+                            line_of(port_element),
+                        )
+                    problem = port_name_problem(name)
+                    if problem is not None:
+                        raise located_error(
+                            f"Error at line {line_of(port_element)}: {problem}",
+                            filename,
+                            line_of(port_element),
+                        )
+                    default = port_element.get("default")
+                    subtree_model.ports[name] = PortInfo(
+                        name,
+                        direction,
+                        None,
+                        NO_DEFAULT if default is None else default,
+                        port_element.get("description", "") or (port_element.text or "").strip(),
+                    )
+
+    # -- main tree -------------------------------------------------------------------------------
+
+    def main_tree_of(self, root: etree._Element, before: set[str]) -> str | None:
+        """The tree ``createTreeFromText`` instantiates for document ``root`` (BT.CPP's rules)."""
+        main = root.get("main_tree_to_execute")
+        if main:
+            return main
+        with_id = [e.get("ID") for e in root.findall("BehaviorTree") if e.get("ID")]
+        if len(with_id) == 1 and len(root.findall("BehaviorTree")) == 1:
+            return with_id[0]
+        new = [tree_id for tree_id in self.trees if tree_id not in before]
+        if len(new) == 1:
+            return new[0]
+        if self.first_main_tree:
+            return self.first_main_tree
+        if len(self.trees) == 1:
+            return next(iter(self.trees))
+        raise BTRuntimeError("[main_tree_to_execute] was not specified correctly")
+
+
+def verify_document(root: etree._Element, filename: str, manifests: dict[str, NodeManifest]) -> None:
+    """BT.CPP's ``VerifyXML``: raise the first structural problem of a document."""
+    problems = find_structure_problems(root, filename, manifests, first_only=True)
+    if problems:
+        line, message = problems[0]
+        raise located_error(f"Error at line {line}: -> {message}", filename, line)
+
+
+def find_structure_problems(
+    root: etree._Element,
+    filename: str,
+    manifests: dict[str, NodeManifest],
+    *,
+    first_only: bool = False,
+    known_trees: set[str] | None = None,
+) -> list[tuple[int, str]]:
+    """Structural problems of a document as ``(line, message)`` (VerifyXML's checks).
+
+    With ``known_trees``, ``<SubTree ID>`` values that name no known tree are reported too.
+    """
+    from kinema.errors import did_you_mean
+
+    problems: list[tuple[int, str]] = []
+
+    def report(line: int, message: str) -> bool:
+        problems.append((line, message))
+        return first_only
+
+    models = root.findall("TreeNodesModel")
+    if len(models) > 1 and report(line_of(models[1]), "Only a single node <TreeNodesModel> is supported"):
+        return problems
+    top_level = element_children(root)
+    tree_elements = root.findall("BehaviorTree")
+    for element in tree_elements:
+        tree_id = element.get("ID") or ""
+        line = line_of(element)
+        if (
+            not tree_id
+            and len(top_level) > 1
+            and report(line, "The tag <BehaviorTree> must have the attribute [ID]")
+        ):
+            return problems
+        if tree_id:
+            problem = model_name_problem(tree_id, tree_id=True)
+            if problem and report(line, problem):
+                return problems
+        if tree_id in manifests and report(
+            line, "The attribute [ID] of tag <BehaviorTree> must not use the name of a registered Node"
+        ):
+            return problems
+        if len(element_children(element)) != 1 and report(
+            line, f"The tag <BehaviorTree> with ID '{tree_id}' must have exactly 1 child"
+        ):
+            return problems
+        stack = [(child, 1) for child in reversed(element_children(element))]
+        while stack:
+            node, depth = stack.pop()
+            if _verify_node(node, depth, manifests, report, known_trees, did_you_mean):
+                return problems
+            stack.extend((child, depth + 1) for child in reversed(element_children(node)))
+    return problems
+
+
+def _verify_node(node, depth, manifests, report, known_trees, did_you_mean) -> bool:
+    """Check one node element; return True to stop (first_only and a problem was found)."""
+    line = line_of(node)
+    if depth > MAX_DEPTH:
+        return report(
+            line, f"Maximum XML nesting depth exceeded (limit: {MAX_DEPTH}). The XML is too deeply nested."
+        )
+    name = str(node.tag)
+    node_id = node.get("ID") or ""
+    children = element_children(node)
+    explicit = name in EXPLICIT_TAGS
+    if explicit and not node_id:
+        return report(line, f"The tag <{name}> must have the attribute [ID]")
+    if name == "SubTree":
+        if children and report(line, f"<SubTree> with ID '{node_id}' should not have any child"):
+            return True
+        problem = model_name_problem(node_id, tree_id=True)
+        if problem and report(line, problem):
+            return True
+        if node_id in manifests and report(
+            line, "The attribute [ID] of tag <SubTree> must not use the name of a registered Node"
+        ):
+            return True
+        if known_trees is not None and node_id not in known_trees:
+            return report(
+                line,
+                f"SubTree ID '{node_id}' is not a known BehaviorTree; {did_you_mean(node_id, known_trees)}",
+            )
+        return False
+    lookup = node_id if explicit else name
+    if not explicit:
+        problem = model_name_problem(name)
+        if problem and report(line, problem):
+            return True
+    manifest = manifests.get(lookup)
+    if manifest is None:
+        if known_trees is not None:
+            return report(line, f"Node not recognized: {lookup}; {did_you_mean(lookup, manifests)}")
+        return report(line, f"Node not recognized: {lookup}")
+    category = manifest.category
+    count = len(children)
+    if category is NodeType.DECORATOR and count != 1:
+        return report(line, f"The node '{lookup}' must have exactly 1 child")
+    if category is NodeType.CONTROL:
+        if count == 0:
+            return report(line, f"The node '{lookup}' must have 1 or more children")
+        if lookup == "TryCatch" and count < 2:
+            return report(line, "The node 'TryCatch' must have at least 2 children")
+        if lookup == "ReactiveSequence":
+            async_count = 0
+            for child in children:
+                child_manifest = manifests.get(str(child.tag))
+                if child_manifest is None:
+                    return report(line_of(child), f"Unknown node type: {child.tag}")
+                if child_manifest.category is NodeType.CONTROL and child.tag == "AsyncSequence":
+                    async_count += 1
+                    if async_count > 1:
+                        return report(line, "A ReactiveSequence cannot have more than one async child.")
+    if category in (NodeType.ACTION, NodeType.CONDITION) and count != 0:
+        return report(line, f"The node '{lookup}' must not have any child")
+    return False
+
+
+def relative_to_cwd(path: str) -> str:
+    """``path`` relative to the working directory when it is below it (for messages)."""
+    try:
+        return os.path.relpath(path)
+    except ValueError:
+        return path
