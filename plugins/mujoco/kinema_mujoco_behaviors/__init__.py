@@ -1,0 +1,13 @@
+"""Simulation-only behaviors (MuJoCo state, keyframes).
+
+Loaded by ``kinema::MujocoBehaviorsLoader`` (alias ``moveit_pro::behaviors::MujocoBehaviorsLoader``).
+"""
+
+from __future__ import annotations
+
+from kinema.plugins import RegisterBehavior, hookimpl
+
+
+@hookimpl
+def register_behaviors(register: RegisterBehavior) -> None:
+    """Register the mujoco behaviors."""

@@ -1,0 +1,84 @@
+"""What every Kinema behavior shares: metadata, the context, the logger, required inputs.
+
+:class:`Behavior` is a mixin; authors derive from one of the concrete bases
+(:class:`~kinema.behaviors.SyncBehavior`, :class:`~kinema.behaviors.AsyncBehavior`, ...), which combine
+it with the matching engine node type.
+"""
+
+from __future__ import annotations
+
+import inspect
+from typing import Any, ClassVar
+
+from kinema.behaviors.context import BehaviorContext
+from kinema.behaviors.logger import BehaviorLogger
+from kinema.behaviors.required_inputs import get_required_inputs
+
+_OFFLINE_CONTEXT: BehaviorContext | None = None
+
+
+def _offline_context() -> BehaviorContext:
+    global _OFFLINE_CONTEXT
+    if _OFFLINE_CONTEXT is None:
+        _OFFLINE_CONTEXT = BehaviorContext.offline()
+    return _OFFLINE_CONTEXT
+
+
+class Behavior:
+    """Mixin giving a BT node Kinema's behavior services.
+
+    Class attributes:
+        subcategory: where editors and ``kinema behaviors`` group it (MoveIt Pro's ``subcategory``).
+        description: one paragraph for editors; defaults to the first paragraph of the docstring.
+    """
+
+    __slots__ = ()
+
+    subcategory: ClassVar[str] = "User Created Behaviors"
+    description: ClassVar[str] = ""
+
+    # Set on the per-registry subclass made by kinema.behaviors.binding (never by authors).
+    kinema_context: ClassVar[BehaviorContext | None] = None
+    kinema_plugin: ClassVar[str] = ""
+
+    _logger: BehaviorLogger | None = None
+
+    @classmethod
+    def metadata(cls) -> dict[str, str]:
+        """The behavior's metadata as MoveIt Pro names it (``subcategory``, ``description``).
+
+        Called when the behavior is registered and when models are exported; must not depend on an
+        instance.
+        """
+        description = cls.description
+        if not description:
+            doc = inspect.getdoc(cls) or ""
+            description = doc.split("\n\n", 1)[0].replace("\n", " ").strip()
+        return {"subcategory": cls.subcategory, "description": description}
+
+    @property
+    def context(self) -> BehaviorContext:
+        """The shared context (transport node, clock, robot model, log sink) of the tree."""
+        context = type(self).kinema_context
+        return context if context is not None else _offline_context()
+
+    @property
+    def logger(self) -> BehaviorLogger:
+        """This node's logger: ``publish_info/publish_warn/publish_failure`` become toasts."""
+        if self._logger is None:
+            self._logger = self.context.logger_for(
+                behavior_id=str(getattr(self, "registration_id", type(self).__name__)),
+                node_name=str(getattr(self, "name", "")),
+                node_path=str(getattr(self, "full_path", "")),
+                plugin=type(self).kinema_plugin,
+            )
+        return self._logger
+
+    def get_required_inputs(self, *names: str) -> tuple[Any, ...]:
+        """Return the values of the input ports ``names``, or raise one error naming every missing one.
+
+        Raises:
+            MissingInputsError: one or more ports have no value; catch it, ``publish_failure`` its
+                message and return FAILURE, or let it fail the objective.
+        """
+        return get_required_inputs(self, *names)

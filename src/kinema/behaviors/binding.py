@@ -1,0 +1,58 @@
+"""How a registered behavior class receives its context: a per-registry subclass.
+
+The engine constructs nodes as ``cls(name, config)`` and knows nothing about robots. When a registry
+populates a factory, each behavior class is wrapped in a thin subclass that carries the
+:class:`BehaviorContext` and the plugin name as class attributes, and that names the behavior and the
+plugin in any exception escaping ``tick`` or ``halt``. The author's class is never modified, so the
+same class can be bound to several contexts at once (a running objective and the next one).
+"""
+
+from __future__ import annotations
+
+import functools
+from typing import TYPE_CHECKING, Any
+
+from kinema.behaviors.faults import BehaviorExecutionError, behavior_fault
+from kinema.bt import NodeStatus
+from kinema.bt.errors import NodeExecutionError
+
+if TYPE_CHECKING:
+    from kinema.behaviors.context import BehaviorContext
+    from kinema.plugins.registration import BehaviorRegistration
+
+
+def bind_behavior(registration: BehaviorRegistration, context: BehaviorContext) -> type:
+    """Return a subclass of ``registration.cls`` bound to ``context`` and stamped with its plugin."""
+    base = registration.cls
+    base_tick = base.tick  # type: ignore[attr-defined]
+    base_halt = base.halt  # type: ignore[attr-defined]
+
+    @functools.wraps(base_tick)
+    def tick(self: Any) -> NodeStatus:
+        try:
+            return base_tick(self)
+        except (NodeExecutionError, BehaviorExecutionError):
+            raise
+        except Exception as error:
+            raise behavior_fault(self, error, "tick") from error
+
+    @functools.wraps(base_halt)
+    def halt(self: Any) -> None:
+        try:
+            base_halt(self)
+        except (NodeExecutionError, BehaviorExecutionError):
+            raise
+        except Exception as error:
+            raise behavior_fault(self, error, "halt") from error
+
+    namespace = {
+        "__slots__": (),
+        "__module__": base.__module__,
+        "__qualname__": base.__qualname__,
+        "__doc__": base.__doc__,
+        "kinema_context": context,
+        "kinema_plugin": registration.plugin,
+        "tick": tick,
+        "halt": halt,
+    }
+    return type(base.__name__, (base,), namespace)
