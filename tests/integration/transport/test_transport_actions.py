@@ -1,0 +1,176 @@
+"""Actions: feedback and result, cancel, rejection, handler failures, status updates."""
+
+from __future__ import annotations
+
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+import pytest
+
+from kinema.errors import TransportError
+from kinema.transport import (
+    STATUS_ABORTED,
+    STATUS_CANCELED,
+    STATUS_SUCCEEDED,
+    Node,
+    ServerGoalHandle,
+    Session,
+)
+
+FIB = "example_interfaces/action/Fibonacci"
+
+
+def _fibonacci(handle: ServerGoalHandle) -> dict[str, list[int]]:
+    sequence = [0, 1]
+    for _ in range(max(handle.goal.order - 2, 0)):
+        sequence.append(sequence[-1] + sequence[-2])
+        handle.publish_feedback({"sequence": sequence})
+    return {"sequence": sequence[: handle.goal.order]}
+
+
+def _client(connect: Callable[[], Session], name: str) -> Any:
+    client = Node(connect(), "client").create_action_client(FIB, name)
+    assert client.wait_for_server(5)
+    return client
+
+
+def test_goal_succeeds_with_feedback_and_result(connect: Callable[[], Session]) -> None:
+    Node(connect(), "server").create_action_server(FIB, "/fibonacci", _fibonacci)
+    feedback: list[list[int]] = []
+    handle = _client(connect, "/fibonacci").send_goal(
+        {"order": 6}, lambda f: feedback.append(f.sequence.tolist())
+    )
+    assert handle.accepted
+    outcome = handle.result(timeout=5)
+    assert outcome.status == STATUS_SUCCEEDED and outcome.succeeded
+    assert outcome.result.sequence.tolist() == [0, 1, 1, 2, 3, 5]
+    assert feedback[-1] == [0, 1, 1, 2, 3, 5]
+    assert handle.status == STATUS_SUCCEEDED
+
+
+def test_cancel_reaches_the_execute_callback(connect: Callable[[], Session]) -> None:
+    started = threading.Event()
+
+    def until_canceled(handle: ServerGoalHandle) -> None:
+        started.set()
+        assert handle.cancel_requested_event.wait(5)
+        handle.canceled({"sequence": [7]})
+
+    Node(connect(), "server").create_action_server(FIB, "/slow", until_canceled)
+    handle = _client(connect, "/slow").send_goal({"order": 1})
+    assert started.wait(5)
+    assert handle.cancel(timeout=5)
+    outcome = handle.result(timeout=5)
+    assert outcome.status == STATUS_CANCELED
+    assert outcome.result.sequence.tolist() == [7]
+
+
+def test_cancel_callback_can_refuse(connect: Callable[[], Session]) -> None:
+    release = threading.Event()
+
+    def stubborn(handle: ServerGoalHandle) -> dict[str, list[int]]:
+        release.wait(5)
+        return {"sequence": [1]}
+
+    Node(connect(), "server").create_action_server(
+        FIB, "/stubborn", stubborn, cancel_callback=lambda h: False
+    )
+    handle = _client(connect, "/stubborn").send_goal({"order": 1})
+    assert not handle.cancel(timeout=5)
+    release.set()
+    assert handle.result(timeout=5).status == STATUS_SUCCEEDED
+
+
+def test_rejected_goal(connect: Callable[[], Session]) -> None:
+    Node(connect(), "server").create_action_server(
+        FIB, "/picky", _fibonacci, goal_callback=lambda goal: goal.order < 10
+    )
+    client = _client(connect, "/picky")
+    rejected = client.send_goal({"order": 50})
+    assert not rejected.accepted
+    with pytest.raises(TransportError, match="rejected"):
+        rejected.result(timeout=1)
+    assert client.send_goal({"order": 3}).result(timeout=5).succeeded
+
+
+def test_execute_exception_reaches_the_client_as_an_error(connect: Callable[[], Session]) -> None:
+    def broken(handle: ServerGoalHandle) -> None:
+        raise RuntimeError("gripper on fire")
+
+    server = Node(connect(), "server").create_action_server(FIB, "/broken", broken)
+    handle = _client(connect, "/broken").send_goal({"order": 1})
+    with pytest.raises(TransportError, match="RuntimeError: gripper on fire"):
+        handle.result(timeout=5)
+    assert [goal.status for goal in server.goals()] == [STATUS_ABORTED]
+
+
+def test_status_topic_follows_the_goal(connect: Callable[[], Session]) -> None:
+    statuses: list[list[int]] = []
+    release = threading.Event()
+
+    def waits(handle: ServerGoalHandle) -> dict[str, list[int]]:
+        release.wait(5)
+        return {"sequence": [1]}
+
+    Node(connect(), "server").create_action_server(FIB, "/watched", waits)
+    watcher = Node(connect(), "watcher")
+    watcher.create_subscription(
+        "action_msgs/msg/GoalStatusArray",
+        "/watched/_action/status",
+        lambda m: statuses.append([s.status for s in m.status_list]),
+        latched=True,
+    )
+    handle = _client(connect, "/watched").send_goal({"order": 1})
+    deadline = time.monotonic() + 5
+    while [2] not in statuses and time.monotonic() < deadline:
+        time.sleep(0.01)
+    release.set()
+    assert handle.result(timeout=5).succeeded
+    deadline = time.monotonic() + 5
+    while [4] not in statuses and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert [2] in statuses and [4] in statuses  # EXECUTING, then SUCCEEDED
+
+
+_FOREVER_SERVER = """
+import sys, threading
+from kinema.transport import Node, open_session
+session = open_session(sys.argv[1])
+Node(session, "doomed").create_action_server(
+    "example_interfaces/action/Fibonacci", "/vanishing", lambda handle: threading.Event().wait(60))
+print("ready", flush=True)
+threading.Event().wait(60)
+"""
+
+
+def test_killed_server_fails_the_pending_result(connect: Callable[[], Session], router_endpoint: str) -> None:
+    server = subprocess.Popen(
+        [sys.executable, "-c", _FOREVER_SERVER, router_endpoint], stdout=subprocess.PIPE, text=True
+    )
+    try:
+        assert server.stdout is not None and server.stdout.readline().strip() == "ready"
+        handle = _client(connect, "/vanishing").send_goal({"order": 1})
+        assert handle.accepted
+        server.send_signal(signal.SIGKILL)
+        with pytest.raises(TransportError, match="went away"):
+            handle.result(timeout=15)
+    finally:
+        server.kill()
+        server.wait(10)
+
+
+def test_closing_the_server_cancels_running_goals(connect: Callable[[], Session]) -> None:
+    def until_canceled(handle: ServerGoalHandle) -> None:
+        handle.cancel_requested_event.wait(10)
+
+    server_session = connect()
+    Node(server_session, "server").create_action_server(FIB, "/closing", until_canceled)
+    handle = _client(connect, "/closing").send_goal({"order": 1})
+    time.sleep(0.1)
+    server_session.close()
+    assert handle.result(timeout=10).status == STATUS_CANCELED

@@ -1,0 +1,101 @@
+"""Sessions: two routers linked together, joining or hosting, environment, prompt exit."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+import textwrap
+from collections.abc import Callable
+
+import pytest
+
+from kinema.errors import TransportError
+from kinema.transport import (
+    Node,
+    host_or_join,
+    host_router,
+    open_session,
+    resolve_domain_id,
+    resolve_endpoints,
+)
+
+
+def test_service_call_across_two_linked_routers(endpoints: Callable[[], str]) -> None:
+    first_endpoint, second_endpoint = endpoints(), endpoints()
+    with (
+        host_router(first_endpoint) as first,
+        host_router(second_endpoint, connect=[first_endpoint]) as second,
+    ):
+        with open_session(first_endpoint) as server_session, open_session(second_endpoint) as client_session:
+            Node(server_session, "far_server").create_service(
+                "example_interfaces/srv/AddTwoInts", "/add_two_ints", lambda r: {"sum": r.a + r.b}
+            )
+            client = Node(client_session, "near_client").create_client(
+                "example_interfaces/srv/AddTwoInts", "/add_two_ints"
+            )
+            assert client.call({"a": 40, "b": 2}, timeout=10).sum == 42
+        assert first.connected_routers() or first.connected_peers()
+        assert second.connected_routers() or second.connected_peers()
+
+
+def test_host_or_join_joins_an_existing_router(endpoints: Callable[[], str]) -> None:
+    endpoint = endpoints()
+    with host_or_join(endpoint) as hosting:
+        assert hosting.is_router
+        with host_or_join(endpoint) as joining:
+            assert not joining.is_router
+            assert hosting.zid in joining.connected_routers()
+
+
+def test_open_session_fails_fast_without_a_router(endpoints: Callable[[], str]) -> None:
+    with pytest.raises(TransportError, match=r"no Kinema router answers at tcp/127\.0\.0\.1"):
+        open_session(endpoints(), connect_timeout=0.2)
+
+
+def test_environment_selects_endpoint_and_domain(monkeypatch: pytest.MonkeyPatch) -> None:
+    monkeypatch.setenv("KINEMA_ZENOH_CONNECT", "tcp/10.0.0.5:7447, tcp/10.0.0.6:7447")
+    monkeypatch.setenv("ROS_DOMAIN_ID", "7")
+    assert resolve_endpoints(None) == ["tcp/10.0.0.5:7447", "tcp/10.0.0.6:7447"]
+    assert resolve_endpoints("tcp/127.0.0.1:9000") == ["tcp/127.0.0.1:9000"]
+    assert resolve_domain_id(None) == 7
+    assert resolve_domain_id(3) == 3
+    monkeypatch.setenv("ROS_DOMAIN_ID", "seven")
+    with pytest.raises(TransportError, match="ROS_DOMAIN_ID"):
+        resolve_domain_id(None)
+
+
+def test_domains_do_not_see_each_other(router_endpoint: str, router: object) -> None:
+    with (
+        open_session(router_endpoint, domain_id=3) as three,
+        open_session(router_endpoint, domain_id=4) as four,
+    ):
+        Node(three, "adder").create_service(
+            "example_interfaces/srv/AddTwoInts", "/add_two_ints", lambda r: {"sum": r.a + r.b}
+        )
+        with pytest.raises(TransportError, match="no server"):
+            Node(four, "caller").create_client("example_interfaces/srv/AddTwoInts", "/add_two_ints").call(
+                timeout=0.3
+            )
+
+
+_FORGETFUL = textwrap.dedent(
+    """
+    import sys
+    from kinema.transport import Node, host_router
+    session = host_router(sys.argv[1])
+    node = Node(session, "forgetful")
+    node.create_subscription("std_msgs/msg/String", "/chatter", print)
+    node.create_service("example_interfaces/srv/AddTwoInts", "/add", lambda r: {"sum": 1})
+    node.create_action_server("example_interfaces/action/Fibonacci", "/fib", lambda h: {})
+    print(node.create_client("example_interfaces/srv/AddTwoInts", "/add").call(timeout=5).sum)
+    # no session.close(): the interpreter must still exit
+    """
+)
+
+
+def test_process_exits_without_closing_its_session(endpoints: Callable[[], str]) -> None:
+    done = subprocess.run(
+        [sys.executable, "-c", _FORGETFUL, endpoints()], capture_output=True, text=True, timeout=60
+    )
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "1"
