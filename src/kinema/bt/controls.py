@@ -45,14 +45,15 @@ class SequenceNode(ControlNode):
                     self._idx = idx
                     self.emit_wake_up_signal()
                     return RUNNING
-            elif status is RUNNING:
+                continue
+            if status is RUNNING:
                 self._idx = idx
                 return RUNNING
-            elif status is FAILURE:
+            if status is FAILURE:
                 self.reset_children()
                 self._idx = 0
                 return FAILURE
-            elif status is SKIPPED:
+            if status is SKIPPED:
                 idx += 1
                 self._skipped += 1
             else:
@@ -188,7 +189,8 @@ class ReactiveSequenceNode(ControlNode):
         all_skipped = True
         if self._status is IDLE:
             self._running_child = -1
-        _set_status_unchecked(self, RUNNING)
+        if self._status is not RUNNING:
+            _set_status_unchecked(self, RUNNING)
         children = self.children
         for index, child in enumerate(children):
             status = child.execute_tick()
@@ -227,7 +229,8 @@ class ReactiveFallbackNode(ControlNode):
         all_skipped = True
         if self._status is IDLE:
             self._running_child = -1
-        _set_status_unchecked(self, RUNNING)
+        if self._status is not RUNNING:
+            _set_status_unchecked(self, RUNNING)
         children = self.children
         for index, child in enumerate(children):
             status = child.execute_tick()

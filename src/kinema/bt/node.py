@@ -188,13 +188,24 @@ class TreeNode:
             raise
         except Exception as error:
             raise self._wrap_exception(error) from error
-        if status is not self._status:
-            if status is SKIPPED:
-                return status
-            self._set_status(status)
+        prev = self._status
+        if status is not prev:
+            if status is SUCCESS or status is FAILURE:
+                # Inlined _set_status for the common case: this is the hot path of every tick.
+                self._status = status
+                if self._observers:
+                    self._notify(prev, status)
+            elif status is not SKIPPED:
+                self._set_status(status)
         elif status is IDLE or (status is RUNNING and self._forbid_running):
             self._set_status(status)
         return status
+
+    def _notify(self, prev: NodeStatus, new: NodeStatus) -> None:
+        clock = self.config.clock
+        now = clock.now() if clock is not None else 0.0
+        for callback in tuple(self._observers):
+            callback(now, self, prev, new)
 
     def _wrap_exception(self, error: Exception) -> NodeExecutionError:
         if isinstance(error, BTError):
@@ -591,7 +602,11 @@ class ControlNode(TreeNode):
             if status is not IDLE:
                 if status is RUNNING:
                     child.halt_node()
-                child.reset_status()
+                    child.reset_status()
+                elif child._observers:
+                    child.reset_status()
+                else:
+                    child._status = IDLE
 
     def halt_child(self, index: int) -> None:
         """Halt child ``index`` if RUNNING, then reset it to IDLE."""

@@ -31,9 +31,12 @@ class EvalError(BTRuntimeError):
     """An operator or assignment failed while a script ran."""
 
 
+_NUMBER = (int, float)
+
+
 def is_num(v: Any) -> bool:
     """A number in the script world (int, float, bool, IntEnum)."""
-    return isinstance(v, int | float)
+    return isinstance(v, _NUMBER)
 
 
 def to_bool(v: Any) -> bool:
@@ -183,8 +186,8 @@ class Binary(Expr):
             raise _not_init("left", op)
         if rv is None:
             raise _not_init("right", op)
-        lnum = is_num(lv)
-        rnum = is_num(rv)
+        lnum = isinstance(lv, _NUMBER)
+        rnum = isinstance(rv, _NUMBER)
         if lnum and rnum:
             if op == "+":
                 return float(lv) + float(rv)
@@ -261,8 +264,8 @@ class Comparison(Expr):
                 raise _not_init("left", op)
             if rhs is None:
                 raise _not_init("right", op)
-            lnum = is_num(lhs)
-            rnum = is_num(rhs)
+            lnum = isinstance(lhs, _NUMBER)
+            rnum = isinstance(rhs, _NUMBER)
             if lnum and rnum:
                 ok = _compare(op, float(lhs), float(rhs))
             elif isinstance(lhs, str) and isinstance(rhs, str):
@@ -363,8 +366,8 @@ class Assignment(Expr):
         else:
             if dst is None:
                 raise _not_init("left", op)
-            if is_num(value):
-                if not is_num(dst):
+            if isinstance(value, _NUMBER):
+                if not isinstance(dst, _NUMBER):
                     raise EvalError("This Assignment operator can't be used with a non-numeric type")
                 lv, rv = float(dst), float(value)
                 if op == "+=":
@@ -383,7 +386,7 @@ class Assignment(Expr):
                 temp = dst + value
             else:
                 raise EvalError("Operation not permitted")
-            new = copy_into(temp, dst)
+            new = temp if type(temp) is type(dst) else copy_into(temp, dst)
         entry.value = new
         bb.notify_written(key, entry)
         return new
