@@ -248,8 +248,6 @@ def _check(
     expected = _PYTHON_TYPES[kind]
     if kind == "number" and isinstance(value, bool):
         _fail(document, path, value, kind)
-    if kind == "str" and isinstance(value, (int, float)) and not isinstance(value, bool):
-        return  # a number where a name is expected (e.g. `ip: 10`) is harmless; YAML typed it
     _expect(document, path, value, expected, kind)
 
 

@@ -194,7 +194,7 @@ class WaypointStore:
                 f"waypoint {waypoint.name!r} has {len(waypoint.joint_names)} joint names but "
                 f"{len(waypoint.positions)} positions"
             )
-        with locked(self.path):
+        with self._locked():
             waypoints = self._read()
             for index, existing in enumerate(waypoints):
                 if existing.name == waypoint.name:
@@ -212,7 +212,7 @@ class WaypointStore:
         """
         if not new:
             raise ConfigError("a waypoint needs a non-empty name")
-        with locked(self.path):
+        with self._locked():
             waypoints = self._read()
             names = [waypoint.name for waypoint in waypoints]
             if old not in names:
@@ -228,7 +228,7 @@ class WaypointStore:
         Raises:
             ConfigError: no such waypoint.
         """
-        with locked(self.path):
+        with self._locked():
             waypoints = self._read()
             names = [waypoint.name for waypoint in waypoints]
             if name not in names:
@@ -236,10 +236,14 @@ class WaypointStore:
             del waypoints[names.index(name)]
             self._write(waypoints)
 
+    def _locked(self):  # type: ignore[no-untyped-def]
+        self.path.parent.mkdir(parents=True, exist_ok=True)
+        return locked(self.path)
+
     def _read(self) -> list[Waypoint]:
         if not self.path.exists():
             return []
-        document = load_yaml_file(self.path, max_bytes=MAX_WAYPOINTS_BYTES)
+        document = load_yaml_file(self.path, max_bytes=MAX_WAYPOINTS_BYTES, track_lines=False)
         if document.data is None:
             return []
         if not isinstance(document.data, list):
@@ -247,17 +251,16 @@ class WaypointStore:
                 "a waypoints file is a YAML list of waypoints (- name: ...)", location=document.location(())
             )
         waypoints: list[Waypoint] = []
-        first_line: dict[str, int] = {}
+        first_index: dict[str, int] = {}
         for index, item in enumerate(document.data):
             waypoint = Waypoint.from_dict(item, document, index)
-            line = document.line((index,))
-            if waypoint.name in first_line:
+            if waypoint.name in first_index:
+                first, line = document.line((first_index[waypoint.name],)), document.line((index,))
                 raise ConfigError(
-                    f"two waypoints are named {waypoint.name!r} "
-                    f"(lines {first_line[waypoint.name]} and {line})",
+                    f"two waypoints are named {waypoint.name!r} (lines {first} and {line})",
                     location=SourceLocation(str(self.path), line),
                 )
-            first_line[waypoint.name] = line
+            first_index[waypoint.name] = index
             waypoints.append(waypoint)
         return waypoints
 

@@ -39,7 +39,17 @@ class YamlDocument:
 
     path: Path
     data: Any
-    lines: dict[KeyPath, int] = field(default_factory=dict)
+    _lines: dict[KeyPath, int] | None = field(default_factory=dict, repr=False)
+    _text: str | None = field(default=None, repr=False)
+
+    @property
+    def lines(self) -> dict[KeyPath, int]:
+        """The line table (computed on first use for documents parsed with ``track_lines=False``)."""
+        if self._lines is None:
+            self._lines = {}
+            if self._text is not None:
+                _compose_lines(self._text, self, strict=False)
+        return self._lines
 
     def line(self, key_path: Sequence[Hashable]) -> int:
         """Return the line of ``key_path``, or of its longest known prefix (0 when nothing is known)."""
@@ -92,46 +102,79 @@ def _megabytes(size: int) -> str:
     return f"{size / (1024 * 1024):.1f} MB"
 
 
-def load_yaml_file(path: str | Path, *, max_bytes: int = MAX_YAML_BYTES) -> YamlDocument:
+def load_yaml_file(
+    path: str | Path, *, max_bytes: int = MAX_YAML_BYTES, track_lines: bool = True
+) -> YamlDocument:
     """Read and parse one YAML file.
+
+    With ``track_lines=False`` the file is parsed faster and the line table is computed only when an
+    error message asks for a line (a key written twice is then not detected).
 
     Raises:
         ConfigError: the file is missing, unreadable, too large, not UTF-8, not valid YAML, or has a
             key twice in one mapping; the message carries ``file:line``.
     """
     path = Path(path)
-    return parse_yaml(read_text_file(path, max_bytes=max_bytes), path)
+    return parse_yaml(read_text_file(path, max_bytes=max_bytes), path, track_lines=track_lines)
 
 
-def parse_yaml(text: str, path: str | Path = "<string>") -> YamlDocument:
+def parse_yaml(text: str, path: str | Path = "<string>", *, track_lines: bool = True) -> YamlDocument:
     """Parse YAML text into a :class:`YamlDocument` (see :func:`load_yaml_file` for the errors)."""
-    path = Path(path)
-    loader = _Loader(text)
-    document = YamlDocument(path=path, data=None)
+    document = YamlDocument(path=Path(path), data=None)
+    if track_lines:
+        _compose_lines(text, document, strict=True)
+        return document
+    document._lines, document._text = None, text
     try:
-        node = loader.get_single_node()
-        if node is not None:
-            document.data = loader.construct_document(node)
-            document.lines[()] = node.start_mark.line + 1
-            _record_lines(node, document, loader.construct_object)
-    except yaml.MarkedYAMLError as exc:
-        mark = exc.problem_mark or exc.context_mark
-        line = mark.line + 1 if mark is not None else 0
-        problem = " ".join(part for part in (exc.context, exc.problem) if part)
-        raise ConfigError(f"invalid YAML: {problem}", location=SourceLocation(str(path), line)) from None
-    except yaml.YAMLError as exc:
-        raise ConfigError(f"invalid YAML: {exc}", location=SourceLocation(str(path))) from None
-    except RecursionError:
-        raise ConfigError("invalid YAML: nested too deeply", location=SourceLocation(str(path))) from None
-    finally:
-        loader.dispose()
+        document.data = yaml.load(text, Loader=_Loader)
+    except (yaml.YAMLError, RecursionError) as exc:
+        raise _yaml_error(exc, document.path) from None
     return document
 
 
-def _record_lines(node: yaml.Node, document: YamlDocument, construct_key: Callable[[yaml.Node], Any]) -> None:
+def _compose_lines(text: str, document: YamlDocument, *, strict: bool) -> None:
+    """Parse ``text`` into ``document.data`` and fill its line table; ``strict`` rejects repeated keys."""
+    loader = _Loader(text)
+    lines = document._lines if document._lines is not None else {}
+    document._lines = lines
+    try:
+        node = loader.get_single_node()
+        if node is not None:
+            data = loader.construct_document(node)
+            if strict or document.data is None:
+                document.data = data
+            lines[()] = node.start_mark.line + 1
+            _record_lines(node, data, lines, document.path, loader.construct_object, strict)
+    except (yaml.YAMLError, RecursionError) as exc:
+        raise _yaml_error(exc, document.path) from None
+    finally:
+        loader.dispose()
+
+
+def _yaml_error(exc: BaseException, path: Path) -> ConfigError:
+    if isinstance(exc, RecursionError):
+        return ConfigError("invalid YAML: nested too deeply", location=SourceLocation(str(path)))
+    if isinstance(exc, yaml.MarkedYAMLError):
+        mark = exc.problem_mark or exc.context_mark
+        line = mark.line + 1 if mark is not None else 0
+        problem = " ".join(part for part in (exc.context, exc.problem) if part)
+        if exc.context_mark is not None and mark is not None and exc.context_mark.line != mark.line:
+            problem += f" (the construct began on line {exc.context_mark.line + 1})"
+        return ConfigError(f"invalid YAML: {problem}", location=SourceLocation(str(path), line))
+    return ConfigError(f"invalid YAML: {exc}", location=SourceLocation(str(path)))
+
+
+def _record_lines(
+    node: yaml.Node,
+    data: Any,
+    lines: dict[KeyPath, int],
+    path_name: Path,
+    construct_key: Callable[[yaml.Node], Any],
+    strict: bool,
+) -> None:
     """Walk the node tree beside the constructed value, recording the line of every key and item."""
     # An explicit loop over a stack: deeply nested (hostile) files must not hit the recursion limit.
-    stack: list[tuple[yaml.Node, Any, KeyPath]] = [(node, document.data, ())]
+    stack: list[tuple[yaml.Node, Any, KeyPath]] = [(node, data, ())]
     seen: set[int] = set()
     while stack:
         current, current_value, path = stack.pop()
@@ -146,17 +189,19 @@ def _record_lines(node: yaml.Node, document: YamlDocument, construct_key: Callab
                 key = construct_key(key_node)
                 line = key_node.start_mark.line + 1
                 if key in first_line:
+                    if not strict:
+                        continue
                     raise ConfigError(
                         f"the key {key!r} appears twice in one mapping (first on line {first_line[key]})",
-                        location=SourceLocation(str(document.path), line),
+                        location=SourceLocation(str(path_name), line),
                     )
                 first_line[key] = line
                 child_path = (*path, key)
-                document.lines[child_path] = line
+                lines[child_path] = line
                 if key in current_value:
                     stack.append((value_node, current_value[key], child_path))
         elif isinstance(current, yaml.SequenceNode) and isinstance(current_value, list):
             for index, (item_node, item_value) in enumerate(zip(current.value, current_value, strict=False)):
                 child_path = (*path, index)
-                document.lines[child_path] = item_node.start_mark.line + 1
+                lines[child_path] = item_node.start_mark.line + 1
                 stack.append((item_node, item_value, child_path))

@@ -1,0 +1,178 @@
+from __future__ import annotations
+
+import shutil
+import subprocess
+import sys
+import threading
+from pathlib import Path
+
+import pytest
+
+from kinema.config import Waypoint, WaypointStore
+from kinema.errors import ConfigError
+
+JOINTS = ["linear_rail_joint", "shoulder_pan_joint"]
+
+
+def _waypoint(name: str, *positions: float) -> Waypoint:
+    return Waypoint(
+        name=name,
+        joint_names=list(JOINTS),
+        positions=list(positions or (0.0, 0.0)),
+        joint_group_names=["manipulator"],
+    )
+
+
+@pytest.fixture
+def compat_store(shared_dir: Path, tmp_path: Path) -> WaypointStore:
+    path = tmp_path / "ur_waypoints.yaml"
+    shutil.copy(shared_dir / "compat" / "moveit_pro" / "config" / "lab_sim_ur_waypoints.yaml", path)
+    return WaypointStore(path)
+
+
+def test_moveit_pro_waypoints_file_parses(compat_store: WaypointStore):
+    names = compat_store.names()
+    assert len(names) == 28
+    assert {"Home", "Look at Table", "3 Waypoint Pick Pose", "Park Far Right"} <= set(names)
+    home = compat_store.get("Home")
+    assert home.joint_names[:2] == ["robotiq_85_left_knuckle_joint", "linear_rail_joint"]
+    assert len(home.positions) == 8
+    assert home.joint_group_names == ["gripper", "linear_actuator", "manipulator"]
+    assert home.favorite is True
+    assert home.joint_positions()["linear_rail_joint"] == pytest.approx(0.20879448072947002)
+
+
+def test_rewriting_a_moveit_pro_file_keeps_it_byte_identical(shared_dir: Path, compat_store: WaypointStore):
+    compat_store.save(compat_store.get("Home"))
+    original = (shared_dir / "compat" / "moveit_pro" / "config" / "lab_sim_ur_waypoints.yaml").read_text()
+    assert compat_store.path.read_text() == original
+
+
+def test_get_save_rename_erase(tmp_path: Path):
+    store = WaypointStore(tmp_path / "w" / "waypoints.yaml")
+    assert store.names() == []
+    store.save(_waypoint("A", 0.1, 0.2))
+    store.save(_waypoint("B"))
+    store.save(_waypoint("A", 0.3, 0.4))  # replaces in place
+    assert store.names() == ["A", "B"]
+    assert store.get("A").positions == [0.3, 0.4]
+    store.rename("A", "C")
+    assert store.names() == ["C", "B"]
+    store.erase("B")
+    assert store.names() == ["C"]
+    # the file is MoveIt Pro's shape
+    text = store.path.read_text()
+    assert "multi_dof_joint_state:" in text and "joint_state:" in text and "- description: ''" in text
+    store.erase("C")
+    assert store.names() == []
+    assert store.path.read_text().strip() == "[]"
+
+
+def test_errors_name_the_waypoint_and_the_alternatives(tmp_path: Path):
+    store = WaypointStore(tmp_path / "waypoints.yaml")
+    store.save(_waypoint("Home"))
+    store.save(_waypoint("Away"))
+    with pytest.raises(ConfigError, match=r"no waypoint named 'Hom'.*did you mean 'Home'"):
+        store.get("Hom")
+    with pytest.raises(ConfigError, match="already exists"):
+        store.rename("Home", "Away")
+    with pytest.raises(ConfigError, match="no waypoint named 'Nope'"):
+        store.rename("Nope", "X")
+    with pytest.raises(ConfigError, match="no waypoint named 'Nope'"):
+        store.erase("Nope")
+    with pytest.raises(ConfigError, match="2 joint names but 1 positions"):
+        store.save(Waypoint("Bad", list(JOINTS), [1.0]))
+    assert store.names() == ["Home", "Away"]
+
+
+@pytest.mark.parametrize(
+    ("text", "line", "words"),
+    [
+        ("a: 1\n", 1, "is a YAML list"),
+        ("- name: A\n  joint_state: {name: [a], position: [1, 2]}\n", 2, "1 joint names but 2 positions"),
+        ("- joint_state: {}\n", 1, "non-empty string name"),
+        ("- name: A\n  joint_state: {name: [a], position: [x]}\n", 2, "position must be a list of numbers"),
+        ("- name: A\n  joint_state: 5\n", 2, "needs a joint_state"),
+        (
+            "- name: A\n  joint_state: {name: [], position: []}\n"
+            "- name: A\n  joint_state: {name: [], position: []}\n",
+            3,
+            "two waypoints are named 'A' (lines 1 and 3)",
+        ),
+        ("- [\n", 2, "invalid YAML"),
+    ],
+)
+def test_bad_waypoint_files_are_clear_errors(tmp_path: Path, text: str, line: int, words: str):
+    path = tmp_path / "waypoints.yaml"
+    path.write_text(text)
+    with pytest.raises(ConfigError) as caught:
+        WaypointStore(path).names()
+    assert str(caught.value).startswith(f"{path}:{line}:"), str(caught.value)
+    assert words in str(caught.value)
+
+
+def test_non_utf8_waypoints_file(tmp_path: Path):
+    path = tmp_path / "waypoints.yaml"
+    path.write_bytes(b"- name: caf\xe9\n")
+    with pytest.raises(ConfigError, match="not UTF-8"):
+        WaypointStore(path).names()
+
+
+def test_concurrent_threads_never_lose_a_waypoint(tmp_path: Path):
+    store_path = tmp_path / "waypoints.yaml"
+    store_path.write_text("[]\n")
+    threads, per_thread = 6, 8
+    errors: list[BaseException] = []
+
+    def writer(index: int) -> None:
+        try:
+            store = WaypointStore(store_path)  # each thread its own store, like separate requests
+            for k in range(per_thread):
+                store.save(_waypoint(f"t{index}-{k}", float(index), float(k)))
+        except BaseException as error:  # reported below; a thread cannot raise into the test
+            errors.append(error)
+
+    workers = [threading.Thread(target=writer, args=(i,)) for i in range(threads)]
+    for worker in workers:
+        worker.start()
+    for worker in workers:
+        worker.join(timeout=60)
+    assert errors == []
+    names = WaypointStore(store_path).names()
+    assert len(names) == threads * per_thread
+    assert set(names) == {f"t{i}-{k}" for i in range(threads) for k in range(per_thread)}
+
+
+WRITER = """
+import sys
+from kinema.config import Waypoint, WaypointStore
+store = WaypointStore(sys.argv[1])
+prefix = sys.argv[2]
+for k in range(int(sys.argv[3])):
+    store.save(Waypoint(f"{prefix}-{k}", ["j"], [float(k)]))
+    if k % 5 == 4:
+        store.rename(f"{prefix}-{k}", f"{prefix}-{k}-renamed")
+"""
+
+
+def test_concurrent_processes_never_lose_a_waypoint(tmp_path: Path):
+    store_path = tmp_path / "waypoints.yaml"
+    processes, per_process = 3, 10
+    running = [
+        subprocess.Popen(
+            [sys.executable, "-c", WRITER, str(store_path), f"p{i}", str(per_process)], stderr=subprocess.PIPE
+        )
+        for i in range(processes)
+    ]
+    for process in running:
+        _, stderr = process.communicate(timeout=120)
+        assert process.returncode == 0, stderr.decode()
+    names = set(WaypointStore(store_path).names())
+    expected = {
+        f"p{i}-{k}-renamed" if k % 5 == 4 else f"p{i}-{k}"
+        for i in range(processes)
+        for k in range(per_process)
+    }
+    assert names == expected
+    # readers never saw, and nothing left behind, a temporary file
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["waypoints.yaml", "waypoints.yaml.lock"]
