@@ -1,0 +1,139 @@
+"""The lab_sim description files: one source of truth, URDF and MJCF agree, the scene suits a driver."""
+
+from __future__ import annotations
+
+import runpy
+
+import numpy as np
+import pytest
+import yaml
+
+from kinema.motion import frame_poses
+from kinema.resources import bundled_dir
+
+ARM = (
+    "linear_rail_joint",
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "elbow_joint",
+    "wrist_1_joint",
+    "wrist_2_joint",
+    "wrist_3_joint",
+)
+GRIPPER = "robotiq_85_left_knuckle_joint"
+
+LAB_SIM = bundled_dir("configs") / "lab_sim"
+
+
+def test_committed_files_are_what_the_generator_writes(description):
+    gen = runpy.run_path(str(LAB_SIM / "description" / "generate.py"))
+    assert description.urdf.read_text() == gen["render_urdf"](), "run configs/lab_sim/description/generate.py"
+    assert description.mjcf.read_text() == gen["render_scene"](), (
+        "run configs/lab_sim/description/generate.py"
+    )
+
+
+def _mujoco_qpos(cell, model, q):
+    """MuJoCo qpos for planning configuration q (mimic fingers filled in), objects left where they are."""
+    pq = model.pin_configuration(q)
+    qpos = cell.d.qpos.copy()
+    for name in (*ARM, GRIPPER, "robotiq_85_left_finger_joint", "robotiq_85_right_finger_joint"):
+        jid = model.pin_model.getJointId(name)
+        qpos[cell.m.jnt_qposadr[cell.m.joint(name).id]] = pq[model.pin_model.idx_qs[jid]]
+    return qpos
+
+
+def test_forward_kinematics_of_urdf_and_mjcf_agree(description, cell):
+    """100 random configurations: every link's pose from pinocchio (URDF) matches MuJoCo (MJCF) to 1e-6."""
+    import mujoco
+
+    model = description.load_model()
+    rng = np.random.default_rng(42)
+    data = model.new_data()
+    compared = 0
+    for _ in range(100):
+        q = rng.uniform(model.lower, model.upper)
+        cell.d.qpos[:] = _mujoco_qpos(cell, model, q)
+        mujoco.mj_kinematics(cell.m, cell.d)
+        for link, T in frame_poses(model, q, data).items():
+            if link == "world" or mujoco.mj_name2id(cell.m, mujoco.mjtObj.mjOBJ_BODY, link) < 0:
+                continue
+            body = cell.d.body(link)
+            assert np.abs(body.xpos - T[:3, 3]).max() < 1e-6, link
+            assert np.abs(body.xmat.reshape(3, 3) - T[:3, :3]).max() < 1e-6, link
+            compared += 1
+    assert compared >= 100 * 14
+
+
+def test_collision_geoms_of_urdf_and_mjcf_agree(description, cell):
+    """Same primitives at the same places: the planner checks what the simulator simulates."""
+    import mujoco
+    import pinocchio as pin
+
+    model = description.load_model()
+    geoms = pin.buildGeomFromUrdf(model.pin_model, str(description.urdf), pin.GeometryType.COLLISION)
+    q = model.configuration({"shoulder_lift_joint": -1.2, "elbow_joint": 1.3, "wrist_2_joint": 0.7})
+    data, gdata = model.new_data(), pin.GeometryData(geoms)
+    pin.updateGeometryPlacements(model.pin_model, data, geoms, gdata, model.pin_configuration(q))
+    cell.d.qpos[:] = _mujoco_qpos(cell, model, q)
+    mujoco.mj_kinematics(cell.m, cell.d)
+    urdf_centres = sorted(tuple(np.round(p.translation, 6)) for p in gdata.oMg)
+    robot_bodies = {cell.m.body(model_link).id for model_link in model.link_names if model_link != "world"}
+    mj_centres = sorted(
+        tuple(np.round(cell.d.geom_xpos[g], 6))
+        for g in range(cell.m.ngeom)
+        if cell.m.geom_bodyid[g] in robot_bodies and cell.m.geom_contype[g] != 0
+    )
+    assert len(urdf_centres) == len(mj_centres) == 16
+    assert np.abs(np.array(urdf_centres) - np.array(mj_centres)).max() < 1e-6
+
+
+def test_scene_is_ready_for_a_driver(cell):
+    import mujoco
+
+    m = cell.m
+    assert m.opt.timestep == pytest.approx(0.002)
+    assert {m.actuator(i).name for i in range(m.nu)} == {*ARM, GRIPPER}  # one position servo per joint
+    assert m.actuator(GRIPPER).ctrlrange.tolist() == pytest.approx([0.0, 0.7929])
+    assert {m.key(i).name for i in range(m.nkey)} >= {"default", "home"}
+    assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_CAMERA, "scene_camera") >= 0
+    free = [
+        m.body(m.jnt_bodyid[j]).name for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE
+    ]
+    assert free == ["cube"]
+    assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "tray") >= 0
+    assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "grasp_site") >= 0
+
+
+def test_robot_holds_the_default_keyframe(cell):
+    """With ctrl from the keyframe the servos hold the arm still and the cube rests on the table."""
+    q0 = cell.arm_q()
+    cube0 = cell.body_pos("cube")
+    cell.step(2.0)
+    assert np.abs(cell.arm_q() - q0).max() < 1e-3
+    assert np.linalg.norm(cell.body_pos("cube") - cube0) < 1e-3
+    assert cell.d.ncon <= 8  # only cube-table contacts: the robot touches nothing
+
+
+def test_waypoints_file_has_moveit_pro_format_and_names():
+    entries = yaml.safe_load((LAB_SIM / "waypoints" / "lab_sim_waypoints.yaml").read_text())
+    names = {e["name"] for e in entries}
+    assert {
+        "3 Waypoint Mid Point",
+        "3 Waypoint Pick Pose",
+        "3 Waypoint Place Pose",
+        "Look at Table",
+        "Home",
+    } <= names
+    for e in entries:
+        assert e["joint_group_names"] == ["gripper", "linear_actuator", "manipulator"]
+        assert e["joint_state"]["name"] == [GRIPPER, *ARM]
+        assert len(e["joint_state"]["position"]) == 8
+        assert set(e) == {
+            "description",
+            "favorite",
+            "joint_group_names",
+            "joint_state",
+            "multi_dof_joint_state",
+            "name",
+        }

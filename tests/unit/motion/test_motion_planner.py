@@ -1,0 +1,101 @@
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kinema.errors import MotionError
+from kinema.motion import PlanningOptions, fk, plan_joint_goal
+
+PICK_AND_PLACE = [
+    ("3 Waypoint Mid Point", "3 Waypoint Pick Pose"),
+    ("3 Waypoint Pick Pose", "3 Waypoint Mid Point"),
+    ("3 Waypoint Mid Point", "3 Waypoint Place Pose"),
+    ("3 Waypoint Place Pose", "3 Waypoint Mid Point"),
+    ("Home", "Look at Table"),
+    ("Look at Table", "3 Waypoint Mid Point"),
+    ("3 Waypoint Mid Point", "Home"),
+]
+
+
+def _full(model, start, path):
+    cols = list(model.group("manipulator").indices)
+    rows = np.repeat(start[None, :], len(path.positions), axis=0)
+    rows[:, cols] = path.positions
+    return rows
+
+
+@pytest.mark.parametrize(("start", "goal"), PICK_AND_PLACE)
+def test_waypoint_moves_are_planned_and_collision_free(model, checker, waypoint_q, arm_goal, start, goal):
+    q0 = waypoint_q(start)
+    path = plan_joint_goal(checker, q0, arm_goal(goal))
+    assert path.joint_names == model.group("manipulator").joint_names
+    np.testing.assert_allclose(path.positions[0], q0[:7])
+    np.testing.assert_allclose(path.positions[-1], waypoint_q(goal)[:7], atol=1e-9)
+    assert checker.first_invalid(_full(model, q0, path), max_step=0.005) is None
+
+
+def test_planner_goes_around_an_obstacle(model, checker, waypoint_q, arm_goal):
+    """A wall between mid point and pick pose: the straight move is blocked and OMPL finds a way."""
+    mid, pick = waypoint_q("3 Waypoint Mid Point"), waypoint_q("3 Waypoint Pick Pose")
+    a, b = fk(model, mid, "grasp_link")[:3, 3], fk(model, pick, "grasp_link")[:3, 3]
+    block = np.eye(4)
+    block[:3, 3] = (a + b) / 2  # where the straight move takes the gripper halfway
+    checker.scene.add_box("block", (0.03, 0.03, 0.03), block)
+    assert checker.first_invalid(np.array([mid, pick]), 0.02) is not None
+    path = plan_joint_goal(
+        checker, mid, arm_goal("3 Waypoint Pick Pose"), options=PlanningOptions(timeout=5.0)
+    )
+    assert len(path.positions) > 2
+    assert checker.first_invalid(_full(model, mid, path), max_step=0.005) is None
+
+
+def test_goal_in_collision_names_the_links(model, checker, waypoint_q):
+    goal = {"shoulder_lift_joint": -0.2, "elbow_joint": 0.5, "wrist_1_joint": -1.8}
+    with pytest.raises(MotionError, match=r"goal state is in collision: .*table"):
+        plan_joint_goal(checker, waypoint_q("Home"), goal)
+
+
+def test_start_in_collision(model, checker, waypoint_q, arm_goal):
+    start = model.configuration({"shoulder_lift_joint": -0.2, "elbow_joint": 0.5}, waypoint_q("Home"))
+    with pytest.raises(MotionError, match=r"start state is in collision"):
+        plan_joint_goal(checker, start, arm_goal("Home"))
+
+
+def test_unknown_joint_names_list_the_valid_ones(checker, waypoint_q):
+    with pytest.raises(
+        MotionError, match=r"unknown joint 'elbow'.*valid joints: linear_rail_joint, shoulder_pan"
+    ):
+        plan_joint_goal(checker, waypoint_q("Home"), {"elbow": 1.0})
+
+
+def test_joint_outside_the_group_is_rejected(checker, waypoint_q):
+    with pytest.raises(
+        MotionError, match=r"'robotiq_85_left_knuckle_joint' is not in planning group 'manipulator'"
+    ):
+        plan_joint_goal(checker, waypoint_q("Home"), {"robotiq_85_left_knuckle_joint": 0.5})
+
+
+def test_goal_outside_limits(checker, waypoint_q):
+    with pytest.raises(MotionError, match=r"linear_rail_joint = 1.5000 is outside its limits"):
+        plan_joint_goal(checker, waypoint_q("Home"), {"linear_rail_joint": 1.5})
+
+
+def test_unknown_group_and_planner(checker, waypoint_q):
+    with pytest.raises(MotionError, match=r"unknown planning group 'arm'"):
+        plan_joint_goal(checker, waypoint_q("Home"), {}, group="arm")
+    with pytest.raises(MotionError, match=r"unknown planner 'RRTConect'.*RRTConnect"):
+        plan_joint_goal(checker, waypoint_q("Home"), {}, options=PlanningOptions(planner="RRTConect"))
+
+
+def test_unreachable_goal_times_out_with_a_reason(model, checker, waypoint_q):
+    """A wall across the rail: moving only the rail, the arm can never get past it. The planner must give
+    up at its timeout (and say so) instead of hanging."""
+    home = waypoint_q("Home")
+    wall = np.eye(4)
+    wall[:3, 3] = (0.3, 0.5, 1.1)
+    checker.scene.add_box("wall", (0.15, 0.01, 0.25), wall)
+    goal = {"linear_rail_joint": 0.9}
+    assert not checker.in_collision(home)
+    assert not checker.in_collision(model.configuration(goal, home))
+    with pytest.raises(MotionError, match=r"no collision-free path found within 0.30 s \(RRTConnect"):
+        plan_joint_goal(checker, home, goal, group="linear_actuator", options=PlanningOptions(timeout=0.3))

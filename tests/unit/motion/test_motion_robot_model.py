@@ -1,0 +1,99 @@
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from kinema.errors import MotionError
+from kinema.motion import RobotModel, fk
+from kinema.motion.joint_limits import parse_joint_limits
+from kinema.motion.srdf import parse_srdf
+
+ARM = (
+    "linear_rail_joint",
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "elbow_joint",
+    "wrist_1_joint",
+    "wrist_2_joint",
+    "wrist_3_joint",
+)
+
+
+def test_joints_are_moveit_pro_names_and_mimic_fingers_are_not_coordinates(model):
+    assert model.joint_names == (*ARM, "robotiq_85_left_knuckle_joint")
+    assert set(model.mimics) == {"robotiq_85_left_finger_joint", "robotiq_85_right_finger_joint"}
+
+
+@pytest.mark.parametrize(
+    ("group", "joints", "tip"),
+    [
+        ("manipulator", ARM, "grasp_link"),
+        ("gripper", ("robotiq_85_left_knuckle_joint",), None),
+        ("linear_actuator", ("linear_rail_joint",), None),
+    ],
+)
+def test_srdf_groups_resolve_to_joints(model, group, joints, tip):
+    g = model.group(group)
+    assert g.joint_names == joints
+    assert g.tip_link == tip
+    assert [model.joint_names[i] for i in g.indices] == list(joints)
+
+
+def test_limits_combine_urdf_positions_and_yaml_velocities(model):
+    rail = model.limits["linear_rail_joint"]
+    assert (rail.lower, rail.upper) == (-1.0, 1.0)
+    assert rail.max_velocity == 0.8 and rail.max_acceleration == 2.0
+    assert model.limits["robotiq_85_left_knuckle_joint"].upper == pytest.approx(0.7929)
+    assert np.all(np.isfinite(model.max_acceleration))
+
+
+def test_unknown_names_list_the_valid_ones(model):
+    with pytest.raises(MotionError, match=r"unknown planning group 'manipulater'.*manipulator"):
+        model.group("manipulater")
+    with pytest.raises(MotionError, match=r"unknown joint 'elbow'.*elbow_joint"):
+        model.configuration({"elbow": 1.0})
+    with pytest.raises(MotionError, match=r"unknown frame 'tool'.*tool0"):
+        fk(model, model.neutral(), "tool")
+
+
+def test_fingers_follow_the_knuckle(model):
+    q_open = model.configuration({"robotiq_85_left_knuckle_joint": 0.0})
+    q_closed = model.configuration({"robotiq_85_left_knuckle_joint": 0.7929})
+    gap = {}
+    for label, q in (("open", q_open), ("closed", q_closed)):
+        left = fk(model, q, "robotiq_85_left_finger_link")[:3, 3]
+        right = fk(model, q, "robotiq_85_right_finger_link")[:3, 3]
+        gap[label] = float(np.linalg.norm(left - right)) - 2 * 0.01  # minus the two pad half-thicknesses
+    assert gap["open"] == pytest.approx(0.085, abs=1e-6)
+    assert gap["closed"] == pytest.approx(0.0, abs=1e-6)
+
+
+def test_named_states_from_the_srdf(model):
+    q = model.named_state("gripper", "close")
+    assert q[model.index("robotiq_85_left_knuckle_joint")] == pytest.approx(0.7929)
+    with pytest.raises(MotionError, match=r"no named state 'shut'.*close"):
+        model.named_state("gripper", "shut")
+
+
+def test_srdf_errors_point_at_the_file_and_line(tmp_path):
+    bad = tmp_path / "bad.srdf"
+    bad.write_text(
+        '<robot name="r">\n  <group name="arm">\n    <chain base_link="a"/>\n  </group>\n</robot>\n'
+    )
+    with pytest.raises(MotionError, match=r"tip_link") as info:
+        parse_srdf(bad)
+    assert str(info.value).startswith(f"{bad}:3:")
+
+
+def test_joint_limits_errors_name_the_joint(tmp_path):
+    bad = tmp_path / "joint_limits.yaml"
+    bad.write_text("joint_limits:\n  elbow_joint:\n    has_velocity_limits: true\n    max_velocity: fast\n")
+    with pytest.raises(MotionError, match=r"elbow_joint.max_velocity must be a number"):
+        parse_joint_limits(bad)
+
+
+def test_group_with_unknown_joint_is_rejected(tmp_path, description):
+    srdf = tmp_path / "r.srdf"
+    srdf.write_text('<robot name="r"><group name="arm"><joint name="elbo_joint"/></group></robot>')
+    with pytest.raises(MotionError, match=r"unknown joint 'elbo_joint'.*elbow_joint"):
+        RobotModel.from_urdf(description.urdf, srdf)
