@@ -1,0 +1,158 @@
+"""The config verbs as a user types them: exit codes, output, and `error: ...` instead of tracebacks."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+
+from kinema.cli.main import main
+
+
+def run(capsys: pytest.CaptureFixture[str], *args: str) -> tuple[int, str, str]:
+    code = main(list(args))
+    captured = capsys.readouterr()
+    return code, captured.out, captured.err
+
+
+def test_init_configure_new_show_list_round_trip(capsys, tmp_path: Path):
+    workspace = tmp_path / "my_ws"
+    code, out, _ = run(capsys, "init", str(workspace))
+    assert code == 0 and (workspace / "src").is_dir()
+    code, out, _ = run(capsys, "configure", "-w", str(workspace), "-c", "lab_sim")
+    assert code == 0 and "config:    lab_sim" in out
+    code, out, _ = run(capsys, "new", "config", "my_cell", "--based-on", "lab_sim", "--no-input")
+    assert code == 0, out
+    assert (workspace / "src" / "my_cell" / "config" / "config.yaml").is_file()
+    code, out, _ = run(capsys, "config", "show", "-c", "my_cell", "--json", "--provenance")
+    assert code == 0
+    shown = json.loads(out)
+    assert shown["chain"] == ["lab_sim", "my_cell"]
+    assert shown["config"]["based_on_package"] == "lab_sim"
+    assert shown["provenance"]["objectives.objective_library_paths.my_cell_objectives"] == "my_cell"
+    assert shown["provenance"]["hardware.robot_description.urdf"] == "lab_sim"
+    code, out, _ = run(capsys, "config", "list")
+    assert code == 0
+    lines = {line.split()[1] if line.startswith("*") else line.split()[0]: line for line in out.splitlines()}
+    assert lines["lab_sim"].startswith("*")  # the active config
+    assert "my_cell" in lines and "lab_sim" in lines["my_cell"]
+    code, out, _ = run(capsys, "config", "chain", "-c", "my_cell")
+    assert code == 0 and [line.split()[0] for line in out.splitlines()] == ["lab_sim", "my_cell"]
+    code, out, _ = run(capsys, "objective", "list", "-c", "my_cell", "--json")
+    assert code == 0
+    assert {"Open Gripper", "Close Gripper"} <= {o["id"] for o in json.loads(out)["objectives"]}
+
+
+def test_config_show_yaml_with_provenance_comments(capsys):
+    code, out, _ = run(capsys, "config", "show", "-c", "example_config", "--provenance")
+    assert code == 0
+    assert out.startswith("# config example_config (chain: lab_sim → example_config)")
+    assert "  joint_group_name: manipulator  # lab_sim" in out
+    assert "      - kinema::CoreBehaviorsLoader  # lab_sim" in out
+    assert (
+        "example_objectives: {package_name: example_config, relative_path: objectives}  # example_config"
+        in out
+    )
+
+
+def test_config_show_plain_yaml_reads_back(capsys):
+    import yaml
+
+    code, out, _ = run(capsys, "config", "show", "-c", "lab_sim")
+    assert code == 0
+    data = yaml.safe_load(out)
+    assert data["objectives"]["waypoints_file"]["relative_path"] == "waypoints/lab_sim_waypoints.yaml"
+
+
+def test_objective_show_prints_metadata_ports_and_xml(capsys):
+    code, out, _ = run(capsys, "objective", "show", "Open and Close Gripper", "-c", "example_config")
+    assert code == 0
+    assert "open_and_close_gripper.xml:" in out
+    assert "favorite:    yes" in out
+    assert '<SubTree ID="Open Gripper" />' in out
+    code, out, _ = run(capsys, "objective", "show", "Open Gripper", "-c", "lab_sim", "--xml")
+    assert code == 0 and out.startswith("<?xml")
+
+
+def test_verbose_prints_notices(capsys, tmp_path: Path):
+    run(capsys, "init", str(tmp_path / "w"))
+    code, _, err = run(capsys, "config", "show", "-c", "lab_sim", "-v")
+    assert code == 0 and "note:" in err and "not used by Kinema" in err
+
+
+@pytest.mark.parametrize(
+    ("args", "words"),
+    [
+        (("config", "show"), "no config package is selected"),
+        (("config", "show", "-c", "lab_sm"), "did you mean 'lab_sim'"),
+        (("config", "chain", "-c", "nope"), "no config package named 'nope'"),
+        (("objective", "show", "Nope", "-c", "lab_sim"), "no objective named 'Nope'"),
+        (("objective", "list", "-c", "lab_sim", "-w", "/definitely/not/here"), "does not exist"),
+        (
+            ("new", "config", "Bad-Name", "-b", "lab_sim", "--no-input", "-o", "/tmp"),
+            "not a valid package name",
+        ),
+        (
+            ("new", "config", "fine_name", "-b", "no_parent", "--no-input", "-o", "/tmp"),
+            "cannot base 'fine_name' on 'no_parent'",
+        ),
+        (("new", "config", "fine_name", "--no-input", "-o", "/tmp"), "--based-on PARENT is missing"),
+        (("configure", "-w", "", "-c", "no_such_config"), "no config package named 'no_such_config'"),
+    ],
+)
+def test_bad_input_is_one_error_line_and_exit_code_1(capsys, args: tuple[str, ...], words: str):
+    code, _, err = run(capsys, *args)
+    assert code == 1
+    assert err.startswith("error: ")
+    assert words in err
+    assert "Traceback" not in err
+
+
+def test_broken_workspace_config_is_an_error_not_a_traceback(capsys, ws):
+    package = ws.config("broken")
+    (package / "config" / "config.yaml").write_bytes(b"hardware: [\xff\n")
+    code, _, err = run(capsys, "config", "show", "-w", str(ws.root), "-c", "broken")
+    assert code == 1 and err.startswith("error: ") and "not UTF-8" in err
+    (package / "config" / "config.yaml").write_text("hardware: [\n")
+    code, _, err = run(capsys, "config", "show", "-w", str(ws.root), "-c", "broken")
+    assert code == 1 and "config.yaml:2: invalid YAML" in err
+    code, out, _ = run(capsys, "config", "list", "-w", str(ws.root))
+    assert code == 0 and "broken" in out and "error:" in out  # one broken package does not hide the list
+
+
+def test_duplicate_packages_error_names_both_paths(capsys, ws):
+    first = ws.config("twin", folder="a/twin")
+    second = ws.config("twin", folder="b/twin")
+    code, _, err = run(capsys, "config", "list", "-w", str(ws.root))
+    assert code == 1 and str(first) in err and str(second) in err
+
+
+def test_objective_list_reports_broken_files_and_lists_the_rest(capsys, ws):
+    ws.config("robot")
+    ws.objective("robot", "Fine")
+    (ws.root / "src" / "robot" / "objectives" / "bad.xml").write_text("<root>\n<BehaviorTree ID='x'>\n")
+    code, out, err = run(capsys, "objective", "list", "-w", str(ws.root), "-c", "robot")
+    assert code == 0
+    assert "Fine" in out
+    assert "bad.xml:3: XML syntax error" in err
+
+
+def test_init_refuses_an_existing_workspace(capsys, tmp_path: Path):
+    assert run(capsys, "init", str(tmp_path / "w"))[0] == 0
+    code, _, err = run(capsys, "init", str(tmp_path / "w"))
+    assert code == 1 and "already a workspace" in err
+
+
+def test_configure_prompts_for_missing_values(capsys, monkeypatch: pytest.MonkeyPatch, tmp_path: Path):
+    import io
+
+    run(capsys, "init", str(tmp_path / "w"))
+    monkeypatch.setattr("sys.stdin", io.StringIO(f"{tmp_path / 'w'}\nexample_config\n"))
+    code, out, _ = run(capsys, "configure")
+    assert code == 0
+    assert "config:    example_config" in out
+    from kinema.config import active_selection
+
+    assert active_selection().config == "example_config"
+    assert active_selection().workspace == (tmp_path / "w").resolve()
