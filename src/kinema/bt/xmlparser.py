@@ -9,6 +9,7 @@ models of ``<TreeNodesModel>``, then registers each ``<BehaviorTree>``.
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -127,18 +128,25 @@ class TreeLibrary:
 
     # -- loading ---------------------------------------------------------------------------------
 
-    def load_text(self, text: str, filename: str, manifests: dict[str, NodeManifest]) -> etree._Element:
-        """Load XML text; relative includes resolve against the library's current path."""
+    def load_text(
+        self, text: str, filename: str, manifests: dict[str, NodeManifest], *, verify: bool = True
+    ) -> etree._Element:
+        """Load XML text; relative includes resolve against the library's current path.
+
+        ``verify=False`` skips BT.CPP's structural checks (the validator reports them itself).
+        """
         root = parse_xml(text, filename)
-        self._load_document(root, filename, manifests, include_stack=[])
+        self._load_document(root, filename, manifests, include_stack=[], verify=verify)
         return root
 
-    def load_file(self, path: str | Path, manifests: dict[str, NodeManifest]) -> etree._Element:
+    def load_file(
+        self, path: str | Path, manifests: dict[str, NodeManifest], *, verify: bool = True
+    ) -> etree._Element:
         """Load an XML file; its directory becomes the current path (as BT.CPP does)."""
         path = Path(path)
         root = parse_xml_file(path)
         self.current_path = path.resolve().parent
-        self._load_document(root, str(path), manifests, include_stack=[str(path.resolve())])
+        self._load_document(root, str(path), manifests, include_stack=[str(path.resolve())], verify=verify)
         return root
 
     def _load_document(
@@ -147,12 +155,14 @@ class TreeLibrary:
         filename: str,
         manifests: dict[str, NodeManifest],
         include_stack: list[str],
+        verify: bool = True,
     ) -> None:
         if root.tag != "root":
             raise located_error("The XML must have a root node called <root>", filename, line_of(root))
         for include in root.findall("include"):
-            self._load_include(include, filename, manifests, include_stack)
-        verify_document(root, filename, manifests)
+            self._load_include(include, filename, manifests, include_stack, verify)
+        if verify:
+            verify_document(root, filename, manifests)
         self._read_models(root, filename)
         if self.documents_loaded == 0 and self.first_main_tree is None:
             self.first_main_tree = root.get("main_tree_to_execute")
@@ -170,6 +180,7 @@ class TreeLibrary:
         filename: str,
         manifests: dict[str, NodeManifest],
         include_stack: list[str],
+        verify: bool = True,
     ) -> None:
         path_attr = include.get("path")
         if path_attr is None:
@@ -198,7 +209,7 @@ class TreeLibrary:
         self.current_path = file_path.resolve().parent
         try:
             child_root = parse_xml_file(file_path)
-            self._load_document(child_root, str(file_path), manifests, [*include_stack, resolved])
+            self._load_document(child_root, str(file_path), manifests, [*include_stack, resolved], verify)
         finally:
             self.current_path = previous
 
@@ -286,8 +297,6 @@ def find_structure_problems(
 
     With ``known_trees``, ``<SubTree ID>`` values that name no known tree are reported too.
     """
-    from kinema.errors import did_you_mean
-
     problems: list[tuple[int, str]] = []
 
     def report(line: int, message: str) -> bool:
@@ -323,13 +332,19 @@ def find_structure_problems(
         stack = [(child, 1) for child in reversed(element_children(element))]
         while stack:
             node, depth = stack.pop()
-            if _verify_node(node, depth, manifests, report, known_trees, did_you_mean):
+            if _verify_node(node, depth, manifests, report, known_trees):
                 return problems
             stack.extend((child, depth + 1) for child in reversed(element_children(node)))
     return problems
 
 
-def _verify_node(node, depth, manifests, report, known_trees, did_you_mean) -> bool:
+def _verify_node(
+    node: etree._Element,
+    depth: int,
+    manifests: dict[str, NodeManifest],
+    report: Callable[[int, str], bool],
+    known_trees: set[str] | None,
+) -> bool:
     """Check one node element; return True to stop (first_only and a problem was found)."""
     line = line_of(node)
     if depth > MAX_DEPTH:
@@ -355,7 +370,8 @@ def _verify_node(node, depth, manifests, report, known_trees, did_you_mean) -> b
         if known_trees is not None and node_id not in known_trees:
             return report(
                 line,
-                f"SubTree ID '{node_id}' is not a known BehaviorTree; {did_you_mean(node_id, known_trees)}",
+                f"SubTree ID '{node_id}' is not a known BehaviorTree{unknown_hint(node_id, known_trees)} "
+                "(give the file that defines it too, or <include> it)",
             )
         return False
     lookup = node_id if explicit else name
@@ -366,7 +382,7 @@ def _verify_node(node, depth, manifests, report, known_trees, did_you_mean) -> b
     manifest = manifests.get(lookup)
     if manifest is None:
         if known_trees is not None:
-            return report(line, f"Node not recognized: {lookup}; {did_you_mean(lookup, manifests)}")
+            return report(line, f"Node not recognized: {lookup}{unknown_hint(lookup, manifests)}")
         return report(line, f"Node not recognized: {lookup}")
     category = manifest.category
     count = len(children)
@@ -390,6 +406,16 @@ def _verify_node(node, depth, manifests, report, known_trees, did_you_mean) -> b
     if category in (NodeType.ACTION, NodeType.CONDITION) and count != 0:
         return report(line, f"The node '{lookup}' must not have any child")
     return False
+
+
+def unknown_hint(value: str, choices: object) -> str:
+    """ "; did you mean 'X'?" when a registered name is close to ``value``, else ""."""
+    import difflib
+
+    close = difflib.get_close_matches(value, sorted(choices), n=3, cutoff=0.6)  # type: ignore[call-overload]
+    if not close:
+        return ""
+    return "; did you mean " + " or ".join(repr(c) for c in close) + "?"
 
 
 def relative_to_cwd(path: str) -> str:

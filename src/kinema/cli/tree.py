@@ -1,0 +1,122 @@
+"""``kinema tree``: run, validate and describe BehaviorTree.CPP v4 objective files."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import click
+
+if TYPE_CHECKING:
+    from kinema.bt import NodeStatus, TreeNode
+
+_COLORS = {"SUCCESS": "green", "FAILURE": "red", "RUNNING": "yellow", "SKIPPED": "blue", "IDLE": "cyan"}
+
+
+def _styled(status: NodeStatus, color: bool) -> str:
+    return click.style(status.name, fg=_COLORS[status.name]) if color else status.name
+
+
+@click.group()
+def tree() -> None:
+    """Run, validate and describe behavior-tree objectives (BT.CPP v4 XML)."""
+
+
+@tree.command()
+@click.argument("file", type=click.Path(exists=True, dir_okay=False, path_type=Path))
+@click.option("-t", "--tree", "tree_id", metavar="ID", help="Tree to run (default: the file's main tree).")
+@click.option(
+    "-r", "--rate", type=click.FloatRange(min=0.1), default=100.0, show_default=True, help="Tick rate in Hz."
+)
+@click.option("--timeout", type=click.FloatRange(min=0.0), help="Halt the tree after this many seconds.")
+@click.option("-q", "--quiet", is_flag=True, help="Print only the final status, not every status change.")
+@click.option("-b", "--blackboard", "show_blackboard", is_flag=True, help="Print the blackboard at the end.")
+def run(
+    file: Path, tree_id: str | None, rate: float, timeout: float | None, quiet: bool, show_blackboard: bool
+) -> None:
+    """Tick the objective in FILE until it finishes; print status changes and the final status.
+
+    Uses the built-in nodes. Exits 0 only if the tree ends in SUCCESS; Ctrl-C halts the tree.
+    """
+    from kinema.bt import BehaviorTreeFactory, NodeStatus
+
+    factory = BehaviorTreeFactory()
+    if tree_id is None:
+        behavior_tree = factory.create_tree_from_file(file)
+    else:
+        factory.register_behavior_tree_from_file(file)
+        behavior_tree = factory.create_tree(tree_id)
+    clock = factory.clock
+    start = clock.now()
+    color = sys.stdout.isatty()
+
+    def on_change(timestamp: float, node: TreeNode, prev: NodeStatus, new: NodeStatus) -> None:
+        click.echo(
+            f"[{timestamp - start:8.3f}] {node.full_path:<32} {_styled(prev, color)} -> {_styled(new, color)}"
+        )
+
+    if not quiet:
+        behavior_tree.add_status_observer(on_change)
+    period = 1.0 / rate
+    status = NodeStatus.IDLE
+    try:
+        status = behavior_tree.tick_once()
+        while status is NodeStatus.RUNNING:
+            if timeout is not None and clock.now() - start >= timeout:
+                behavior_tree.halt_tree()
+                click.echo(f"timeout: halted after {timeout:g} s", err=True)
+                break
+            behavior_tree.sleep(period)
+            status = behavior_tree.tick_once()
+    except KeyboardInterrupt:
+        behavior_tree.halt_tree()
+        click.echo("interrupted: tree halted", err=True)
+        sys.exit(130)
+    if show_blackboard:
+        for scope, values in behavior_tree.blackboard_snapshot().items():
+            for key, (type_name, value) in sorted(values.items()):
+                click.echo(f"  {scope}: {key} ({type_name}) = {value!r}")
+    click.echo(f"final status: {_styled(status, color)}")
+    if status is not NodeStatus.SUCCESS:
+        sys.exit(1)
+
+
+@tree.command()
+@click.argument(
+    "files", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path)
+)
+@click.option("--json", "as_json", is_flag=True, help="Print the problems as a JSON list.")
+def validate(files: tuple[Path, ...], as_json: bool) -> None:
+    """Check objective FILES together: node IDs, ports, scripts, subtrees.
+
+    Every problem is printed as file:line: message. A SubTree may call a tree defined in another of
+    the FILES. Exits 1 if any problem was found.
+    """
+    from kinema.bt.validation import count_trees, validate_files
+
+    problems = validate_files(list(files))
+    if as_json:
+        rows: list[dict[str, Any]] = [
+            {"file": p.location.file, "line": p.location.line, "message": p.message} for p in problems
+        ]
+        click.echo(json.dumps(rows, indent=2))
+    else:
+        for problem in problems:
+            click.echo(str(problem))
+        bad = {p.location.file for p in problems}
+        for file in files:
+            if str(file) not in bad:
+                click.echo(f"{file}: OK ({count_trees(file)} trees)")
+    if problems:
+        sys.exit(1)
+
+
+@tree.command()
+@click.option("--builtin", is_flag=True, help="Include the built-in nodes (Sequence, Retry, ...).")
+def nodes(builtin: bool) -> None:
+    """Print the TreeNodesModel XML (Groot2 format) of the registered node types."""
+    from kinema.bt import BehaviorTreeFactory, write_tree_nodes_model_xml
+
+    click.echo(write_tree_nodes_model_xml(BehaviorTreeFactory(), include_builtin=builtin), nl=False)
