@@ -1,0 +1,75 @@
+"""Kinema's pytest plugin (entry point ``pytest11: kinema``): fixtures for behavior authors.
+
+* ``tick_behavior(cls, inputs, node=...)`` → :class:`~kinema.testing.BehaviorRun` (status, outputs, toasts);
+* ``build_tree(xml, registry=..., behaviors=[...], node=...)`` → a :class:`~kinema.bt.Tree`;
+* ``run_objective(xml_or_path, registry=..., node=...)`` → status, blackboard values and toasts;
+* ``kinema_node``: a transport node on a private in-process network (no router, no other process);
+* ``publish_repeatedly(node, type, topic, message)``: a context manager publishing in the background;
+* ``package_registry``: the behaviors of the behavior package under test, loaded by path as the runtime
+  loads them (the package is the folder holding the ``pyproject.toml`` pytest runs from).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from pathlib import Path
+from typing import Any
+
+import pytest
+
+from kinema.testing import harness
+
+
+@pytest.fixture
+def tick_behavior() -> Callable[..., harness.BehaviorRun]:
+    """Run one behavior class to completion: ``tick_behavior(MyBehavior, {"int_1": 2}, node=kinema_node)``."""
+    return harness.tick_behavior
+
+
+@pytest.fixture
+def build_tree() -> Callable[..., Any]:
+    """Build a tree from XML: ``build_tree(xml, behaviors=[MyBehavior])`` or ``registry=package_registry``."""
+    return harness.build_tree
+
+
+@pytest.fixture
+def run_objective() -> Callable[..., harness.ObjectiveRunResult]:
+    """Run an objective (XML text or a file) to completion with the given registry or behaviors."""
+    return harness.run_objective
+
+
+@pytest.fixture
+def publish_repeatedly() -> Callable[..., Any]:
+    """``with publish_repeatedly(node, "std_msgs/msg/String", "/chatter", {"data": "hi"}): ...``."""
+    return harness.publish_repeatedly
+
+
+@pytest.fixture
+def kinema_session() -> Iterator[Any]:
+    """A transport session of its own (peer, loopback, no router): tests never see other processes."""
+    from kinema.transport import open_session
+
+    session = open_session([])
+    try:
+        yield session
+    finally:
+        session.close()
+
+
+@pytest.fixture
+def kinema_node(kinema_session: Any) -> Iterator[Any]:
+    """A transport node on :func:`kinema_session`; behaviors and test servers share it."""
+    from kinema.transport import Node
+
+    node = Node(kinema_session, "kinema_test")
+    try:
+        yield node
+    finally:
+        node.close()
+
+
+@pytest.fixture(scope="session")
+def package_registry(request: pytest.FixtureRequest) -> Any:
+    """The registry of the behavior package under test (its ``pyproject.toml`` is pytest's rootdir)."""
+    root = Path(request.config.rootpath)
+    return harness.load_behavior_package(root)
