@@ -14,6 +14,7 @@ import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from kinema.errors import KinemaError, PluginError
 from kinema.plugins.discovery import PluginSpec, available_plugins, select_loaders
@@ -23,6 +24,9 @@ from kinema.plugins.importer import describe_exception, import_fresh, purge_modu
 from kinema.plugins.manager import KinemaPluginManager
 from kinema.plugins.registration import BehaviorRegistration
 from kinema.plugins.registry import BehaviorRegistry, PluginRecord
+
+if TYPE_CHECKING:
+    from kinema.config import ResolvedConfig
 
 ReloadSubscriber = Callable[[ReloadEvent], None]
 
@@ -63,6 +67,12 @@ class BehaviorHost:
         self._lock = threading.RLock()
         self._watcher: DirectoryWatcher | None = None
 
+    @classmethod
+    def for_config(cls, resolved: ResolvedConfig) -> BehaviorHost:
+        """A host for a resolved config: its unioned ``behavior_loader_plugins`` and its workspace."""
+        names = [name for group in resolved.behavior_loader_plugins.values() for name in group]
+        return cls(names, resolved.workspace.root)
+
     @property
     def registry(self) -> BehaviorRegistry:
         """The current registry snapshot (swapped atomically by reloads)."""
@@ -77,9 +87,16 @@ class BehaviorHost:
         """Discover and load every active plugin; a failing plugin is recorded and the others still load."""
         catalog, discovery_errors = available_plugins(self.workspace)
         selection = select_loaders(self.loader_names, catalog)
-        report = LoadReport(list(selection.warnings), [*discovery_errors, *selection.errors])
+        report = self.load_specs(selection.plugins)
+        report.warnings[:0] = selection.warnings
+        report.errors[:0] = [*discovery_errors, *selection.errors]
+        return report
+
+    def load_specs(self, specs: Iterable[PluginSpec]) -> LoadReport:
+        """Load the given plugins (already discovered and selected) into the registry."""
+        report = LoadReport()
         with self._lock:
-            for spec in selection.plugins:
+            for spec in specs:
                 error = self._load_one(spec)
                 if error is not None:
                     report.errors.append(error)
