@@ -13,34 +13,46 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from kinema.testing import harness
+if TYPE_CHECKING:
+    from kinema.testing import harness
+
+# The plugin loads in every pytest run of an environment where Kinema is installed, so Kinema itself is
+# imported only when a fixture is used.
 
 
 @pytest.fixture
 def tick_behavior() -> Callable[..., harness.BehaviorRun]:
     """Run one behavior class to completion: ``tick_behavior(MyBehavior, {"int_1": 2}, node=kinema_node)``."""
+    from kinema.testing import harness
+
     return harness.tick_behavior
 
 
 @pytest.fixture
 def build_tree() -> Callable[..., Any]:
     """Build a tree from XML: ``build_tree(xml, behaviors=[MyBehavior])`` or ``registry=package_registry``."""
+    from kinema.testing import harness
+
     return harness.build_tree
 
 
 @pytest.fixture
 def run_objective() -> Callable[..., harness.ObjectiveRunResult]:
     """Run an objective (XML text or a file) to completion with the given registry or behaviors."""
+    from kinema.testing import harness
+
     return harness.run_objective
 
 
 @pytest.fixture
 def publish_repeatedly() -> Callable[..., Any]:
     """``with publish_repeatedly(node, "std_msgs/msg/String", "/chatter", {"data": "hi"}): ...``."""
+    from kinema.testing import harness
+
     return harness.publish_repeatedly
 
 
@@ -71,5 +83,7 @@ def kinema_node(kinema_session: Any) -> Iterator[Any]:
 @pytest.fixture(scope="session")
 def package_registry(request: pytest.FixtureRequest) -> Any:
     """The registry of the behavior package under test (its ``pyproject.toml`` is pytest's rootdir)."""
+    from kinema.testing import harness
+
     root = Path(request.config.rootpath)
     return harness.load_behavior_package(root)
