@@ -445,6 +445,8 @@ def render_scene() -> str:
         '    <quality shadowsize="2048"/>',
         "  </visual>",
         "  <asset>",
+        '    <texture name="sky" type="skybox" builtin="gradient" rgb1="0.75 0.8 0.85" rgb2="0.35 0.4 0.45" '
+        'width="128" height="128"/>',
         '    <texture name="grid" type="2d" builtin="checker" rgb1="0.82 0.82 0.84" rgb2="0.74 0.74 0.76" '
         'width="256" height="256"/>',
         '    <material name="floor" texture="grid" texrepeat="6 6"/>',
@@ -452,7 +454,7 @@ def render_scene() -> str:
         "  <worldbody>",
         '    <light name="top" pos="0.5 0 3" dir="0 0 -1" directional="true"/>',
         '    <geom name="floor" type="plane" size="4 4 0.05" material="floor"/>',
-        '    <camera name="scene_camera" pos="2.0 0 1.55" xyaxes="0 1 0 -0.6 0 1.2" fovy="50"/>',
+        '    <camera name="scene_camera" pos="2.1 0 1.9" xyaxes="0 1 0 -1.05 0 1.6" fovy="55"/>',
         f'    <geom name="table" type="box" size="0.35 1.2 {_f(TABLE_TOP / 2)}" '
         f'pos="0.7 0 {_f(TABLE_TOP / 2)}" rgba="0.76 0.7 0.6 1"/>',
         *robot,
