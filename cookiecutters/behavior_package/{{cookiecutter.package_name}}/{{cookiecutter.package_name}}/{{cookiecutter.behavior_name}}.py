@@ -1,0 +1,1 @@
+{% include cookiecutter.behavior_type ~ "/behavior.py.jinja" %}

@@ -1,0 +1,265 @@
+"""``kinema new behavior``: a behavior package, or one more behavior in one, from a template.
+
+A new package gets ``pyproject.toml`` (with its ``kinema.behaviors`` loader entry point), the behavior
+module, the registration in ``__init__.py``, an example objective and a passing test. With an existing
+package, the behavior module, its test and its example objective are added and the behavior is
+registered in the package's ``__init__.py``. Every name is checked before anything is written.
+
+When the active config package lives in the same workspace, its ``config/config.yaml`` gains the
+package's loader under ``objectives.behavior_loader_plugins`` and the package's ``objectives/`` folder
+under ``objectives.objective_library_paths`` (comments and layout kept), so the behavior and its example
+objective are usable at once.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from kinema.config.workspace import Workspace
+from kinema.errors import ConfigError, ScaffoldError, did_you_mean
+from kinema.scaffold.generate import generate
+from kinema.scaffold.names import package_name_problem
+
+TEMPLATE = "behavior_package"
+BEHAVIOR_TYPES = ("sync", "async", "service_client", "action_client", "topic_subscriber", "topic_publisher")
+
+
+@dataclass
+class NewBehavior:
+    """What ``new_behavior`` did.
+
+    Attributes:
+        behavior_id: the registered ID (CamelCase of the name).
+        package: the behavior package name.
+        package_dir: its folder.
+        loader_name: the loader name configs list in ``behavior_loader_plugins``.
+        created_package: True for a new package, False when a behavior was added to an existing one.
+        files: the files written (or changed) in the package.
+        config_file: the config.yaml that was updated, or None.
+        config_changes: what was added to it, one line each.
+    """
+
+    behavior_id: str
+    package: str
+    package_dir: Path
+    loader_name: str
+    created_package: bool
+    files: list[Path] = field(default_factory=list)
+    config_file: Path | None = None
+    config_changes: list[str] = field(default_factory=list)
+
+
+def behavior_id_for(name: str) -> str:
+    """The behavior ID (and class name) for a snake_case name: ``my_service_client`` → ``MyServiceClient``."""
+    return "".join(part[:1].upper() + part[1:] for part in name.split("_") if part)
+
+
+def check_behavior_name(name: str) -> None:
+    """Raise ScaffoldError unless ``name`` is a snake_case name usable as module and package name."""
+    problem = package_name_problem(name)
+    if problem is not None:
+        raise ScaffoldError(
+            f"{name!r} is not a valid behavior name: {problem.replace('my_robot_config', 'my_behavior')}"
+        )
+
+
+def check_behavior_type(behavior_type: str) -> None:
+    """Raise ScaffoldError unless ``behavior_type`` is one of :data:`BEHAVIOR_TYPES`."""
+    if behavior_type not in BEHAVIOR_TYPES:
+        raise ScaffoldError(
+            f"unknown behavior type {behavior_type!r}; {did_you_mean(behavior_type, BEHAVIOR_TYPES)}"
+        )
+
+
+def new_behavior(
+    name: str,
+    behavior_type: str,
+    *,
+    workspace: Workspace,
+    package: str | None = None,
+    config: str | None = None,
+    description: str | None = None,
+) -> NewBehavior:
+    """Create behavior ``name`` of ``behavior_type`` in a new package, or in ``package``.
+
+    Args:
+        name: snake_case behavior name; the module is ``<name>.py``, the ID is CamelCase(name).
+        behavior_type: one of :data:`BEHAVIOR_TYPES`.
+        workspace: the workspace (its ``src/`` receives new packages).
+        package: an existing behavior package of the workspace to add the behavior to; None creates a
+            package named ``name``.
+        config: the active config package; when it lives in ``workspace`` its config.yaml is updated.
+        description: the new package's description.
+
+    Raises:
+        ScaffoldError: invalid name or type, no workspace, a taken package name or module, an unknown
+            package (with the valid ones); nothing is written then.
+    """
+    from kinema.plugins.discovery import PluginSource, default_loader_name, read_behavior_package
+
+    check_behavior_name(name)
+    check_behavior_type(behavior_type)
+    if workspace.root is None:
+        raise ScaffoldError(
+            "no workspace is selected, so there is no src/ to create the behavior package in; pass -w PATH, "
+            "or select one with `kinema configure -w PATH` (create one with `kinema init PATH`)"
+        )
+    behavior_id = behavior_id_for(name)
+    context = {"behavior_name": name, "behavior_id": behavior_id, "behavior_type": behavior_type}
+    config_package = _workspace_config(workspace, config)
+
+    if package is None:
+        if workspace.has_package(name):
+            existing = workspace.package(name)
+            raise ScaffoldError(
+                f"a package named {name!r} already exists ({existing.path}); add the behavior to it with "
+                f"--package {name}, or choose another name"
+            )
+        loader = default_loader_name(name)
+        values = {
+            **context,
+            "package_name": name,
+            "loader_name": loader,
+            "description": description or f"Kinema behaviors of {name}",
+        }
+        package_dir = generate(TEMPLATE, workspace.root / "src", values)
+        files = sorted(path for path in package_dir.rglob("*") if path.is_file())
+        result = NewBehavior(behavior_id, name, package_dir, loader, True, files)
+    else:
+        package_dir = _behavior_package_dir(workspace, package)
+        specs = read_behavior_package(package_dir, PluginSource.WORKSPACE)
+        loader = specs[0].name
+        module_dir = package_dir / specs[0].module.split(".")[0]
+        targets = {
+            "module": module_dir / f"{name}.py",
+            "test": package_dir / "tests" / f"test_{name}.py",
+            "objective": package_dir / "objectives" / f"{name}.xml",
+        }
+        taken = [path for path in targets.values() if path.exists()]
+        if taken:
+            raise ScaffoldError(f"{taken[0]} already exists; choose another behavior name")
+        init = module_dir / "__init__.py"
+        new_init = _register_in_init(init.read_text(encoding="utf-8"), name, behavior_id, init)
+        values = {**context, "package_name": module_dir.name, "loader_name": loader}
+        with tempfile.TemporaryDirectory(prefix="kinema-new-behavior-") as scratch:
+            baked = generate(TEMPLATE, scratch, values)
+            sources = {
+                "module": baked / module_dir.name / f"{name}.py",
+                "test": baked / "tests" / f"test_{name}.py",
+                "objective": baked / "objectives" / f"{name}.xml",
+            }
+            for key, target in targets.items():
+                target.parent.mkdir(parents=True, exist_ok=True)
+                shutil.copyfile(sources[key], target)
+        from kinema.config.atomic_write import atomic_write_text
+
+        atomic_write_text(init, new_init)
+        result = NewBehavior(behavior_id, package, package_dir, loader, False, [*targets.values(), init])
+
+    if config_package is not None:
+        result.config_file = config_package.config_file
+        result.config_changes = add_to_config(config_package.config_file, result.package, loader)
+    return result
+
+
+def _workspace_config(workspace: Workspace, config: str | None):  # type: ignore[no-untyped-def]
+    if not config or not workspace.has_package(config):
+        return None
+    package = workspace.package(config)
+    if package.origin != "workspace" or not package.is_config:
+        return None
+    return package
+
+
+def _behavior_package_dir(workspace: Workspace, package: str) -> Path:
+    from kinema.plugins.discovery import PluginSource, read_behavior_package
+
+    candidates = {
+        p.name: p.path
+        for p in workspace.packages.values()
+        if p.origin == "workspace" and (p.path / "pyproject.toml").is_file()
+    }
+    behavior_packages = [
+        n for n, path in candidates.items() if read_behavior_package(path, PluginSource.WORKSPACE)
+    ]
+    if package not in behavior_packages:
+        raise ScaffoldError(
+            f"no behavior package named {package!r} in {workspace.root / 'src'}; "
+            f"{did_you_mean(package, behavior_packages)}"
+        )
+    return candidates[package]
+
+
+_IMPORT = re.compile(r"^from \.\w+ import .+$")
+_REGISTER = re.compile(r"^(\s+)register\(")
+
+
+def _register_in_init(text: str, name: str, behavior_id: str, path: Path) -> str:
+    """``text`` of a package's ``__init__.py`` with ``from .name import ID`` and ``register(ID)`` added."""
+    lines = text.splitlines()
+    import_line = f"from .{name} import {behavior_id}"
+    imports = [i for i, line in enumerate(lines) if _IMPORT.match(line)]
+    registers = [i for i, line in enumerate(lines) if _REGISTER.match(line)]
+    if not imports or not registers:
+        raise ScaffoldError(
+            f"cannot find where {path} imports and registers its behaviors; add "
+            f"'{import_line}' and 'register({behavior_id})' in its register_behaviors() yourself"
+        )
+    last_register = registers[-1]
+    indent = _REGISTER.match(lines[last_register]).group(1)  # type: ignore[union-attr]
+    lines.insert(last_register + 1, f"{indent}register({behavior_id})")
+    first, last = imports[0], imports[-1]
+    block = sorted({*lines[first : last + 1], import_line})
+    lines[first : last + 1] = block
+    return "\n".join(lines) + "\n"
+
+
+def add_to_config(config_file: Path, package: str, loader: str) -> list[str]:
+    """Add ``loader`` and the package's ``objectives/`` library to a config.yaml; return what changed.
+
+    The file is edited as a round trip (comments, order and quoting kept) and replaced atomically.
+
+    Raises:
+        ConfigError: the file cannot be parsed, or ``objectives`` is not a mapping.
+    """
+    from ruamel.yaml import YAML
+    from ruamel.yaml.comments import CommentedMap, CommentedSeq
+    from ruamel.yaml.error import YAMLError
+
+    from kinema.config.atomic_write import atomic_write_text
+
+    yaml = YAML()
+    yaml.preserve_quotes = True
+    yaml.indent(mapping=2, sequence=4, offset=2)
+    try:
+        data = yaml.load(config_file.read_text(encoding="utf-8"))
+    except YAMLError as error:
+        raise ConfigError(f"{config_file}: cannot update it, it does not parse: {error}") from None
+    if data is None:
+        data = CommentedMap()
+    objectives = data.setdefault("objectives", CommentedMap())
+    if not isinstance(objectives, dict):
+        raise ConfigError(f"{config_file}: 'objectives' must be a mapping to add a behavior loader to it")
+    changes: list[str] = []
+    loaders = objectives.setdefault("behavior_loader_plugins", CommentedMap())
+    already = any(loader in (names or []) for names in loaders.values())
+    if not already:
+        entry = loaders.setdefault(package, CommentedSeq())
+        entry.append(loader)
+        changes.append(f"objectives.behavior_loader_plugins.{package}: + {loader}")
+    libraries = objectives.setdefault("objective_library_paths", CommentedMap())
+    key = f"{package}_objectives"
+    if key not in libraries:
+        libraries[key] = CommentedMap([("package_name", package), ("relative_path", "objectives")])
+        changes.append(f"objectives.objective_library_paths.{key}: {package}/objectives")
+    if changes:
+        import io
+
+        buffer = io.StringIO()
+        yaml.dump(data, buffer)
+        atomic_write_text(config_file, buffer.getvalue())
+    return changes
