@@ -225,60 +225,14 @@ def coerce_value(value: Any, port_type: Any, *, text: str | None = None) -> Any:
 
 
 def _from_mapping(port_type: Any, value: dict[str, Any], shown: str) -> Any:
-    """Build a message or dataclass value from a YAML mapping (``{header: {frame_id: world}, ...}``)."""
-    import dataclasses
-
-    if not (isinstance(port_type, type) and dataclasses.is_dataclass(port_type)):
+    """Build a ROS message value from a YAML mapping (``{header: {frame_id: world}, pose: ...}``)."""
+    type_name = getattr(port_type, "__msgtype__", None)
+    if not isinstance(type_name, str):
         raise ValueError(f"{shown} cannot be read as {_type_label(port_type)}")
-    fields = {f.name: f for f in dataclasses.fields(port_type)}
-    unknown = sorted(set(value) - set(fields))
-    if unknown:
-        alternatives = did_you_mean(unknown[0], fields)
-        raise ValueError(f"{shown}: {_type_label(port_type)} has no field {unknown[0]!r}; {alternatives}")
+    from kinema.errors import TransportError
+    from kinema.transport.messages import from_dict
+
     try:
-        default = _default_instance(port_type)
-    except TypeError:
-        default = None
-    kwargs: dict[str, Any] = {}
-    for name in fields:
-        current = getattr(default, name) if default is not None else None
-        if name not in value:
-            if default is None:
-                raise ValueError(f"{shown}: field {name!r} of {_type_label(port_type)} is missing")
-            kwargs[name] = current
-            continue
-        kwargs[name] = _field_value(current, value[name], f"{shown}.{name}")
-    return port_type(**kwargs)
-
-
-def _default_instance(port_type: type) -> Any:
-    from kinema.transport import messages  # the transport knows how to build default ROS messages
-
-    return messages.default_message(port_type)
-
-
-def _field_value(current: Any, value: Any, shown: str) -> Any:
-    import dataclasses
-
-    import numpy as np
-
-    if current is not None and dataclasses.is_dataclass(current) and isinstance(value, dict):
-        return _from_mapping(type(current), value, shown)
-    if isinstance(current, np.ndarray):
-        return np.asarray(value, dtype=current.dtype)
-    if isinstance(current, bool):
-        return coerce_value(value, bool, text=shown)
-    if isinstance(current, int):
-        return coerce_value(value, int, text=shown)
-    if isinstance(current, float):
-        return coerce_value(value, float, text=shown)
-    if isinstance(current, str):
-        return coerce_value(value, str, text=shown)
-    if (
-        isinstance(current, list)
-        and isinstance(value, list)
-        and current
-        and dataclasses.is_dataclass(current[0])
-    ):
-        return [_from_mapping(type(current[0]), v, shown) for v in value]
-    return value
+        return from_dict(type_name, value)
+    except TransportError as error:
+        raise ValueError(f"{shown} is not a valid {type_name}: {error}") from None

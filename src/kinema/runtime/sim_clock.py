@@ -44,6 +44,9 @@ class SimClock:
     started before a reset still waits its full duration.
     """
 
+    # Tells ``Tree.sleep`` that waiting on wall time would not measure this clock's time.
+    realtime = False
+
     def __init__(self, start: float = 0.0) -> None:
         self._now = start
         self._timers: list[_Timer] = []

@@ -1,0 +1,76 @@
+"""``kinema logs`` and ``kinema export-logs``: read and archive the logs of the latest run."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import click
+
+if TYPE_CHECKING:
+    from kinema.runtime.run_folder import RunFolder
+
+_RUN_HELP = "A run folder name (see the state folder's runs/) instead of the newest run."
+
+
+def _run_folder(run_name: str | None) -> RunFolder:
+    from kinema.errors import KinemaError, did_you_mean
+    from kinema.runtime.run_folder import RunFolder, list_runs
+
+    if run_name is None:
+        return RunFolder.latest()
+    runs = {run.name: run for run in list_runs()}
+    if run_name not in runs:
+        raise KinemaError(f"no run named {run_name!r}; {did_you_mean(run_name, runs)}")
+    return runs[run_name]
+
+
+@click.command()
+@click.option("-f", "--follow", is_flag=True, help="Keep printing new entries as they come (Ctrl-C stops).")
+@click.option(
+    "--level",
+    default="debug",
+    show_default=True,
+    metavar="LEVEL",
+    help="Only entries at or above this level: debug, info, warning, error, critical.",
+)
+@click.option("--run", "run_name", default=None, metavar="NAME", help=_RUN_HELP)
+def logs(follow: bool, level: str, run_name: str | None) -> None:
+    """Print the logs of the latest `kinema run` (agent, drivers, supervisor), merged in time order."""
+    from kinema.runtime.log_files import follow_entries, level_number, merged_entries
+
+    try:
+        min_level = level_number(level)
+    except ValueError as error:
+        raise click.BadParameter(str(error), param_hint="--level") from None
+    folder = _run_folder(run_name)
+    for entry in merged_entries(folder.log_files(), min_level=min_level):
+        click.echo(entry.text)
+    if follow:
+        try:
+            for entry in follow_entries(folder.path, min_level=min_level):
+                click.echo(entry.text)
+        except KeyboardInterrupt:
+            return
+
+
+@click.command("export-logs")
+@click.option(
+    "-o",
+    "--output",
+    type=click.Path(dir_okay=False, path_type=Path),
+    default=None,
+    help="The zip file to write (default: kinema-logs-<run>.zip in the current folder).",
+)
+@click.option("--run", "run_name", default=None, metavar="NAME", help=_RUN_HELP)
+def export_logs(output: Path | None, run_name: str | None) -> None:
+    """Zip the log folder of the latest run (to attach to a bug report)."""
+    import zipfile
+
+    folder = _run_folder(run_name)
+    target = output if output is not None else Path.cwd() / f"kinema-logs-{folder.name}.zip"
+    files = sorted(p for p in folder.path.rglob("*") if p.is_file())
+    with zipfile.ZipFile(target, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+        for path in files:
+            archive.write(path, Path(folder.name) / path.relative_to(folder.path))
+    click.echo(f"wrote {target} ({len(files)} files from {folder.path})")
