@@ -15,7 +15,7 @@ from kinema.motion.kinematics import fk
 from kinema.motion.trajectory import JointPath
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds numpy arrays: compare fields explicitly
 class CartesianResult:
     """A Cartesian path and how much of the requested motion it covers.
 

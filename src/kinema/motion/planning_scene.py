@@ -13,7 +13,7 @@ from kinema.errors import MotionError, did_you_mean
 SHAPES = ("box", "cylinder", "sphere", "capsule")
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds numpy arrays: compare fields explicitly
 class CollisionObject:
     """One primitive obstacle.
 
@@ -132,9 +132,9 @@ class PlanningScene:
             size = m.geom_size[gi]
             gtype = int(m.geom_type[gi])
             if gtype == mujoco.mjtGeom.mjGEOM_PLANE:
-                half = (size[0] if size[0] > 0 else 5.0, size[1] if size[1] > 0 else 5.0, 0.05)
+                plane = (float(size[0]) if size[0] > 0 else 5.0, float(size[1]) if size[1] > 0 else 5.0, 0.05)
                 T[:3, 3] = T[:3, 3] - T[:3, 2] * 0.05
-                scene.add(CollisionObject(name, "box", half, T))
+                scene.add(CollisionObject(name, "box", plane, T))
             elif gtype == mujoco.mjtGeom.mjGEOM_BOX:
                 scene.add(CollisionObject(name, "box", tuple(float(s) for s in size[:3]), T))
             elif gtype == mujoco.mjtGeom.mjGEOM_CYLINDER:

@@ -153,8 +153,8 @@ class RobotModel:
         # Maps active joint velocities to pinocchio's full velocity vector (mimic followers included).
         self.mimic_map = np.zeros((pin_model.nv, len(self.joint_names)))
         for name in pin_names:
-            mimic = self.mimics.get(name)
-            leader, factor = (mimic.leader, mimic.multiplier) if mimic else (name, 1.0)
+            follows = self.mimics.get(name)
+            leader, factor = (follows.leader, follows.multiplier) if follows else (name, 1.0)
             self.mimic_map[self._pin_v_index[name], self._index[leader]] = factor
         self._mimic_offsets = np.zeros(pin_model.nq)
         for name, mimic in self.mimics.items():
@@ -203,14 +203,14 @@ class RobotModel:
             chain: list[str] = []
             link = tip_link
             while link != base_link:
-                joint = child_to_joint.get(link)
-                if joint is None:
+                parent_joint = child_to_joint.get(link)
+                if parent_joint is None:
                     raise MotionError(
                         f"SRDF group {name!r}: no chain from {base_link!r} to {tip_link!r}; "
                         f"{did_you_mean(link, self._all_links())}"
                     )
-                chain.append(joint.name)
-                link = joint.parent
+                chain.append(parent_joint.name)
+                link = parent_joint.parent
             joints.extend(reversed(chain))
         for joint in d.joints:
             if joint not in self._urdf_joints:
@@ -220,14 +220,14 @@ class RobotModel:
                 )
             joints.append(joint)
         for link in d.links:
-            joint = child_to_joint.get(link)
+            moving = child_to_joint.get(link)
             if link not in self._all_links():
                 raise MotionError(
                     f"SRDF group {name!r} names unknown link {link!r}; "
                     f"{did_you_mean(link, self._all_links())}"
                 )
-            if joint is not None:
-                joints.append(joint.name)
+            if moving is not None:
+                joints.append(moving.name)
         for sub in d.subgroups:
             if sub not in defs:
                 raise MotionError(

@@ -9,7 +9,7 @@ import numpy as np
 from kinema.errors import MotionError
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds numpy arrays: compare fields explicitly
 class JointPath:
     """A piecewise-linear path in joint space, not yet timed.
 
@@ -31,7 +31,7 @@ class JointPath:
         )
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # holds numpy arrays: compare fields explicitly
 class JointTrajectory:
     """A timed joint trajectory, like ``trajectory_msgs/JointTrajectory``.
 

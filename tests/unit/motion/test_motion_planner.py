@@ -34,6 +34,15 @@ def test_waypoint_moves_are_planned_and_collision_free(model, checker, waypoint_
     assert checker.first_invalid(_full(model, q0, path), max_step=0.005) is None
 
 
+def test_reset_mujoco_robot_pose_plans_to_every_waypoint(model, checker, waypoints, arm_goal):
+    """The pose the compat objective "Reset MuJoCo Robot" sets (arm straight up) is a valid start."""
+    reset = model.configuration({"shoulder_lift_joint": -1.57})
+    assert not checker.in_collision(reset)
+    for name in waypoints:
+        path = plan_joint_goal(checker, reset, arm_goal(name))
+        assert checker.first_invalid(_full(model, reset, path), max_step=0.005) is None
+
+
 def test_planner_goes_around_an_obstacle(model, checker, waypoint_q, arm_goal):
     """A wall between mid point and pick pose: the straight move is blocked and OMPL finds a way."""
     mid, pick = waypoint_q("3 Waypoint Mid Point"), waypoint_q("3 Waypoint Pick Pose")
