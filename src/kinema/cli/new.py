@@ -69,3 +69,67 @@ def new_config(
     path = new_config_package(name, based_on, output_dir, workspace=found, no_input=no_input)
     click.echo(f"created config package {name} in {path}")
     click.echo(f"try: kinema config show -c {name} --provenance")
+
+
+@new.command("behavior")
+@click.argument("name")
+@click.option(
+    "-t",
+    "--type",
+    "behavior_type",
+    type=click.Choice(
+        ["sync", "async", "service_client", "action_client", "topic_subscriber", "topic_publisher"]
+    ),
+    default="async",
+    show_default=True,
+    help="The base class: sync (one tick), async (work off the tick thread), service_client (AddTwoInts), "
+    "action_client (Fibonacci), topic_subscriber / topic_publisher (std_msgs/String).",
+)
+@click.option(
+    "-p",
+    "--package",
+    default=None,
+    metavar="PKG",
+    help="Add the behavior to this existing behavior package of the workspace instead of creating one.",
+)
+@workspace_option
+@click.option(
+    "-c",
+    "--config",
+    default=None,
+    metavar="NAME",
+    help="Config package to register the new loader in (default: the active one, if it is in the workspace).",
+)
+def new_behavior(
+    name: str, behavior_type: str, package: str | None, workspace: Path | None, config: str | None
+) -> None:
+    """Create behavior NAME (snake_case; its ID is the CamelCase form) in the workspace's src/.
+
+    Without --package, a behavior package named NAME is created: pyproject.toml with its loader entry
+    point, the behavior module, the registration, an example objective and a passing test. The example
+    works before any edit (e.g. async sums int_1 and int_2; service_client calls /add_two_ints). When the
+    active config package is in the workspace, the loader and the example objectives are added to its
+    config.yaml. Nothing is written when a name is invalid or taken.
+    """
+    from kinema.cli.options import resolve_selection
+    from kinema.scaffold.behavior_package import new_behavior as create
+
+    found, active = resolve_selection(workspace, config, need_config=False)
+    result = create(name, behavior_type, workspace=found, package=package, config=active or None)
+    if result.created_package:
+        click.echo(f"created behavior package {result.package} in {result.package_dir}")
+    else:
+        click.echo(f"added behavior {result.behavior_id} to {result.package} ({result.package_dir})")
+    for path in result.files:
+        click.echo(f"  {path.relative_to(result.package_dir)}")
+    click.echo(f"behavior {result.behavior_id} ({behavior_type}), loader {result.loader_name}")
+    if result.config_file is not None and result.config_changes:
+        click.echo(f"updated {result.config_file}:")
+        for change in result.config_changes:
+            click.echo(f"  {change}")
+    elif result.config_file is None:
+        click.echo(
+            "to use it, add the loader to your config package's objectives.behavior_loader_plugins "
+            f'(e.g. {result.package}: ["{result.loader_name}"])'
+        )
+    click.echo(f"test it: kinema test --packages-select {result.package}")
