@@ -18,6 +18,7 @@ import shutil
 import tempfile
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 from kinema.config.workspace import Workspace
 from kinema.errors import ConfigError, ScaffoldError, did_you_mean
@@ -248,13 +249,17 @@ def add_to_config(config_file: Path, package: str, loader: str) -> list[str]:
     loaders = objectives.setdefault("behavior_loader_plugins", CommentedMap())
     already = any(loader in (names or []) for names in loaders.values())
     if not already:
+        comment = _take_trailing_comment(loaders)
         entry = loaders.setdefault(package, CommentedSeq())
         entry.append(loader)
+        _put_trailing_comment(loaders, comment)
         changes.append(f"objectives.behavior_loader_plugins.{package}: + {loader}")
     libraries = objectives.setdefault("objective_library_paths", CommentedMap())
     key = f"{package}_objectives"
     if key not in libraries:
+        comment = _take_trailing_comment(libraries)
         libraries[key] = CommentedMap([("package_name", package), ("relative_path", "objectives")])
+        _put_trailing_comment(libraries, comment)
         changes.append(f"objectives.objective_library_paths.{key}: {package}/objectives")
     if changes:
         import io
@@ -263,3 +268,46 @@ def add_to_config(config_file: Path, package: str, loader: str) -> list[str]:
         yaml.dump(data, buffer)
         atomic_write_text(config_file, buffer.getvalue())
     return changes
+
+
+def _last_scalar_slot(node: Any) -> tuple[Any, Any] | None:
+    """The mapping and key of the last scalar under ``node`` (where ruamel keeps a trailing comment)."""
+    from ruamel.yaml.comments import CommentedMap
+
+    while isinstance(node, CommentedMap) and len(node):
+        key = list(node)[-1]
+        child = node[key]
+        if isinstance(child, CommentedMap) and len(child):
+            node = child
+            continue
+        return node, key
+    return None
+
+
+def _take_trailing_comment(node: Any) -> Any:
+    """Detach the comment lines that follow ``node``'s last entry (they introduce what comes after it).
+
+    Without this, entries appended to ``node`` would land below those comment lines, as if the comments
+    were about them.
+    """
+    slot = _last_scalar_slot(node)
+    if slot is None:
+        return None
+    mapping, key = slot
+    items = mapping.ca.items.get(key)
+    if not items or len(items) < 3 or items[2] is None:
+        return None
+    comment, items[2] = items[2], None
+    return comment
+
+
+def _put_trailing_comment(node: Any, comment: Any) -> None:
+    """Attach ``comment`` after ``node``'s (new) last entry."""
+    if comment is None:
+        return
+    slot = _last_scalar_slot(node)
+    if slot is None:
+        return
+    mapping, key = slot
+    items = mapping.ca.items.setdefault(key, [None, None, None, None])
+    items[2] = comment

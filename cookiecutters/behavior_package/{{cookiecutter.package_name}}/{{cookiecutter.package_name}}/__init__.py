@@ -1,4 +1,7 @@
-"""{{ cookiecutter.description }} (loader ``{{ cookiecutter.loader_name }}``)."""
+"""{{ cookiecutter.description }}.
+
+Loader: ``{{ cookiecutter.loader_name }}``.
+"""
 
 from __future__ import annotations
 
