@@ -18,17 +18,23 @@ if TYPE_CHECKING:
 class WakeUpSignal:
     """One flag plus a condition variable per tree: nodes emit it, ``Tree.sleep`` waits on it."""
 
-    __slots__ = ("_cond", "_flag")
+    __slots__ = ("_cond", "_flag", "listener")
 
     def __init__(self) -> None:
         self._cond = threading.Condition(threading.Lock())
         self._flag = False
+        # Called after every emit: lets a ticker that waits on its own condition (the objective
+        # server's tick thread) tick again at once.
+        self.listener: Callable[[], None] | None = None
 
     def emit(self) -> None:
         """Set the flag and wake any waiter (safe from any thread)."""
         with self._cond:
             self._flag = True
             self._cond.notify_all()
+        listener = self.listener
+        if listener is not None:
+            listener()
 
     def consume(self) -> bool:
         """Clear the flag; True if it was set (``waitFor(0)``)."""
