@@ -294,12 +294,21 @@ def open_session(
     Raises:
         TransportError: nothing answers at the endpoints within ``connect_timeout``.
     """
-    endpoints = resolve_endpoints(connect) if connect is None or connect else []
+    from_file = bool(config_file or os.environ.get(ENV_CONFIG))
+    if connect is None and from_file and not os.environ.get(ENV_CONNECT):
+        endpoints: list[str] = []  # the config file says where to connect
+    else:
+        endpoints = resolve_endpoints(connect) if connect is None or connect else []
     domain = resolve_domain_id(domain_id)
-    listen_endpoints = list(listen) if listen is not None else ([PEER_LISTEN] if mode == "peer" else [])
+    if listen is not None:
+        listen_endpoints = list(listen)
+    else:
+        listen_endpoints = [PEER_LISTEN] if mode == "peer" and not from_file else []
     config = build_config(
         mode, listen=listen_endpoints, connect=endpoints, config_file=config_file, overrides=config_overrides
     )
+    if from_file and not endpoints:
+        endpoints = _configured_endpoints(config, "connect/endpoints", mode)
     where = ", ".join(endpoints) or "no endpoint"
     raw = _open_raw(config, f"{mode} connecting to {where}")
     session = Session(raw, domain_id=domain, mode=mode, endpoints=endpoints, listen=listen_endpoints)
@@ -327,13 +336,15 @@ def host_router(
     """Host the zenoh router in this process and return its session (usable like any other).
 
     Args:
-        listen: endpoint(s) to listen on; default ``tcp/127.0.0.1:7447``.
+        listen: endpoint(s) to listen on; default ``tcp/127.0.0.1:7447``, or the config file's.
         connect: other routers to link to (multi-machine, or two routers on one host).
 
     Raises:
         TransportError: the endpoint is taken (another router runs there) or invalid.
     """
-    listen_endpoints = resolve_endpoints(listen or DEFAULT_ENDPOINT)
+    from_file = bool(config_file or os.environ.get(ENV_CONFIG))
+    # With a config file and no explicit endpoint, the file's own listen endpoints apply.
+    listen_endpoints = resolve_endpoints(listen) if listen else ([] if from_file else [DEFAULT_ENDPOINT])
     domain = resolve_domain_id(domain_id)
     config = build_config(
         "router",
@@ -342,8 +353,18 @@ def host_router(
         config_file=config_file,
         overrides=config_overrides,
     )
-    raw = _open_raw(config, f"router listening on {', '.join(listen_endpoints)}")
+    if not listen_endpoints:
+        listen_endpoints = _configured_endpoints(config, "listen/endpoints", "router")
+    raw = _open_raw(config, f"router listening on {', '.join(listen_endpoints) or 'no endpoint'}")
     return Session(raw, domain_id=domain, mode="router", endpoints=list(connect), listen=listen_endpoints)
+
+
+def _configured_endpoints(config: zenoh.Config, key: str, mode: str) -> list[str]:
+    """Endpoints a zenoh config sets for ``mode`` (a plain list, or a per-mode map)."""
+    value = json.loads(config.get_json(key))
+    if isinstance(value, dict):
+        value = value.get(mode, [])
+    return [str(item) for item in value or []]
 
 
 def host_or_join(
