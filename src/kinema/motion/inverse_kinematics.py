@@ -23,6 +23,8 @@ class IkOptions:
         orientation_tolerance: accepted orientation error (rad).
         max_iterations: iterations per seed.
         attempts: seeds tried in all: the given seed first, then random ones inside the limits.
+        restart_solutions: when the given seed fails, random restarts stop after this many solutions and
+            the one closest to the seed is returned.
         damping: damped-least-squares damping (m² / rad²).
         max_step: largest joint change per iteration (rad or m); without it the first Gauss-Newton step
             from a far seed jumps to a limit or flips the wrist and the iteration gets stuck.
@@ -33,6 +35,7 @@ class IkOptions:
     orientation_tolerance: float = 1e-3
     max_iterations: int = 100
     attempts: int = 10
+    restart_solutions: int = 3
     damping: float = 1e-6
     max_step: float = 0.2
     rng_seed: int = 0
@@ -51,8 +54,9 @@ def ik(
 ) -> np.ndarray:
     """Find a configuration that puts ``frame`` at ``world_T_target``, moving only ``group``'s joints.
 
-    The seed is tried first, so the answer stays on the seed's elbow/wrist branch when one exists there;
-    random seeds inside the limits follow. Every solution respects the position limits.
+    The seed is tried first, so the answer stays on the seed's elbow/wrist branch when one exists there.
+    Otherwise random seeds inside the limits follow, and of the solutions they find the one closest to the
+    seed (in joint space) is returned. Every solution respects the position limits.
 
     Args:
         model: the robot model.
@@ -90,8 +94,11 @@ def ik(
     seed = np.clip(np.asarray(seed, dtype=float), model.lower, model.upper)
     best_error = (np.inf, np.inf)
     rejected = 0
+    found: list[np.ndarray] = []
 
     for attempt in range(opts.attempts):
+        if len(found) >= opts.restart_solutions:
+            break
         q = seed.copy()
         if attempt > 0:
             q[cols] = rng.uniform(lo, hi)
@@ -108,8 +115,11 @@ def ik(
                 pos_err, rot_err = float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:]))
             if pos_err < opts.position_tolerance and rot_err < opts.orientation_tolerance:
                 if accept is None or accept(q):
-                    return q
-                rejected += 1
+                    if attempt == 0:
+                        return q
+                    found.append(q)
+                else:
+                    rejected += 1
                 break
             if (pos_err, rot_err) < best_error:
                 best_error = (pos_err, rot_err)
@@ -126,6 +136,8 @@ def ik(
             if largest > opts.max_step:
                 dq *= opts.max_step / largest
             q[cols] = np.clip(q[cols] + dq, lo, hi)
+    if found:
+        return min(found, key=lambda sol: float(np.linalg.norm(sol - seed)))
     reason = (
         f"{rejected} solution(s) found but rejected (e.g. in collision)"
         if rejected

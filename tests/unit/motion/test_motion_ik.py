@@ -77,3 +77,24 @@ def test_ik_accept_hook_rejects_solutions(model, waypoint_q):
 def test_ik_group_without_tip_needs_a_frame(model):
     with pytest.raises(MotionError, match="has no tip link"):
         ik(model, np.eye(4), model.neutral(), group="gripper")
+
+
+def test_restarts_return_the_solution_closest_to_the_seed(model, waypoint_q):
+    """When the seed itself cannot converge (one iteration allowed), restarts run and the closest wins."""
+    pick = waypoint_q("3 Waypoint Pick Pose")
+    target = fk(model, pick, "grasp_link")
+    seed = waypoint_q("3 Waypoint Mid Point")
+    few = IkOptions(max_iterations=1, attempts=3)
+    with pytest.raises(MotionError, match="no IK solution"):
+        ik(model, target, seed, options=few)
+    solutions = []
+    opts = IkOptions(attempts=40, restart_solutions=3, rng_seed=3)
+
+    def record(q):
+        solutions.append(q.copy())
+        return len(solutions) > 1  # reject the seed's own solution so that restarts have to run
+
+    q = ik(model, target, seed, options=opts, accept=record)
+    accepted = solutions[1:]
+    assert len(accepted) == 3
+    assert np.linalg.norm(q - seed) == pytest.approx(min(np.linalg.norm(s - seed) for s in accepted))
