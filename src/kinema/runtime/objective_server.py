@@ -12,6 +12,7 @@ snapshots, finished runs), always on the tick thread.
 
 from __future__ import annotations
 
+import copy
 import itertools
 import logging
 import threading
@@ -21,6 +22,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol
 
+from kinema.bt.node import node_children
+from kinema.bt.status import NodeStatus
 from kinema.errors import KinemaError, ObjectiveError, did_you_mean
 from kinema.runtime.objective_status import ObjectiveStatus
 from kinema.runtime.overrides import ParameterOverride, apply_overrides
@@ -225,6 +228,7 @@ class ObjectiveServer:
         self._inbox: deque[ObjectiveRun | _Cancel | _Call] = deque()
         self._wake = threading.Condition()
         self._woken = False
+        self._tick_now = False
         self._stopping = False
         self._thread: threading.Thread | None = None
         # Owned by the tick thread:
@@ -233,6 +237,8 @@ class ObjectiveServer:
         self._pending_changes: list[NodeStatusChange] = []
         self._last_snapshot = 0.0
         self._failures: list[tuple[str, str]] = []
+        self._failure_notes: dict[str, str] = {}
+        self._notes_lock = threading.Lock()
         # Read by any thread (a consistent pair, replaced atomically):
         self._status: tuple[ObjectiveStatus, str] = (ObjectiveStatus.IDLE, "")
 
@@ -327,7 +333,16 @@ class ObjectiveServer:
         # A tree's wake-up signal (a behavior finished its work off-thread): tick again at once.
         with self._wake:
             self._woken = True
+            self._tick_now = True
             self._wake.notify()
+
+    def note_failure(self, node_path: str, message: str) -> None:
+        """Remember why a node is failing (a behavior's ``publish_failure``), for the run's error message.
+
+        Safe from any thread; notes are cleared when the next objective loads.
+        """
+        with self._notes_lock:
+            self._failure_notes[node_path] = message
 
     # -- tick thread ------------------------------------------------------------------------------
 
@@ -339,6 +354,7 @@ class ObjectiveServer:
                 if not self._woken and not self._stopping and (timeout is None or timeout > 0):
                     self._wake.wait(timeout)
                 self._woken = False
+                tick_now, self._tick_now = self._tick_now, False
                 stopping = self._stopping
                 inbox = list(self._inbox)
                 self._inbox.clear()
@@ -351,7 +367,7 @@ class ObjectiveServer:
             if start is not None:
                 self._load(start)
                 next_tick = time.monotonic()
-            if self._tree is not None and time.monotonic() >= next_tick - 1e-4:
+            if self._tree is not None and (tick_now or time.monotonic() >= next_tick - 1e-4):
                 next_tick += self._period
                 now = time.monotonic()
                 if next_tick < now:
@@ -431,12 +447,12 @@ class ObjectiveServer:
             return
         self._tree = tree
         self._failures = []
+        with self._notes_lock:
+            self._failure_notes = {}
         self._pending_changes = []
         self._last_snapshot = 0.0
         tree.add_status_observer(self._on_node_status)
-        add_wake_up = getattr(tree, "add_wake_up_callback", None)
-        if add_wake_up is not None:
-            add_wake_up(self._wake_up)
+        tree.wake_up.listener = self._wake_up
         self._set_status(ObjectiveStatus.RUNNING, name)
 
     def _build(self, request: ObjectiveRequest) -> tuple[Tree, str]:
@@ -455,7 +471,7 @@ class ObjectiveServer:
             limit = MAX_OBJECTIVE_XML_BYTES / 1e6
             raise ObjectiveError(f"the objective XML is {size / 1e6:.1f} MB; the limit is {limit:.1f} MB")
         name = main_tree_id(xml)
-        return factory.create_tree_from_text(xml), name
+        return _create_from_scratch_text(factory, xml), name
 
     def _tick(self) -> None:
         tree, run = self._tree, self._run
@@ -474,9 +490,9 @@ class ObjectiveServer:
             return
         self._flush_node_changes(run)
         self._maybe_snapshot(run, force=status.is_completed)
-        if status.name == "SUCCESS":
+        if status is NodeStatus.SUCCESS:
             self._end(run, ObjectiveResult.success(run.objective_name), ObjectiveStatus.SUCCESS)
-        elif status.name == "FAILURE":
+        elif status is NodeStatus.FAILURE:
             self._end(
                 run,
                 ObjectiveResult.failure(self._failure_message(run), run.objective_name),
@@ -518,9 +534,8 @@ class ObjectiveServer:
                 timestamp, int(node.uid), path, node.registration_id, node.name, int(previous), int(status)
             )
         )
-        if status.name == "FAILURE" and not getattr(node, "children", None):
-            message = getattr(node, "failure_message", "") or ""
-            self._failures.append((path, message))
+        if status is NodeStatus.FAILURE and not node_children(node):
+            self._failures.append((path, node.registration_id))
 
     def _flush_node_changes(self, run: ObjectiveRun) -> None:
         if not self._pending_changes:
@@ -549,9 +564,11 @@ class ObjectiveServer:
     def _failure_message(self, run: ObjectiveRun) -> str:
         if not self._failures:
             return f"objective {run.objective_name!r} returned FAILURE"
-        path, message = self._failures[-1]
+        path, registration_id = self._failures[-1]
+        with self._notes_lock:
+            message = self._failure_notes.get(path, "")
         detail = f": {message}" if message else " returned FAILURE"
-        return f"objective {run.objective_name!r} failed: node '{path}'{detail}"
+        return f"objective {run.objective_name!r} failed: node '{path}' [{registration_id}]{detail}"
 
 
 def main_tree_id(xml: str) -> str:
@@ -584,3 +601,24 @@ def blackboard_entries(tree: Tree) -> list[tuple[str, str, str, Any]]:
         for key, (type_name, value) in values.items():
             entries.append((scope, key, type_name, value))
     return entries
+
+
+def _create_from_scratch_text(factory: BehaviorTreeFactory, xml: str) -> Tree:
+    """Build the main tree of an ad-hoc XML document without adding its trees to ``factory``.
+
+    An XML string sent to ``/do_objective`` may define trees named like library objectives; they must
+    shadow the library for this run only, never replace it for later runs.
+    """
+    saved = factory.library
+    scratch = copy.copy(saved)
+    scratch.trees = dict(saved.trees)
+    scratch.node_models = dict(saved.node_models)
+    # Models are updated in place when a document declares ports for a known SubTree.
+    scratch.subtree_models = (
+        copy.deepcopy(saved.subtree_models) if "TreeNodesModel" in xml else dict(saved.subtree_models)
+    )
+    factory.library = scratch
+    try:
+        return factory.create_tree_from_text(xml, filename="<objective XML>")
+    finally:
+        factory.library = saved

@@ -1,0 +1,259 @@
+"""The objective server core (no transport): one run at a time, preemption, cancel, overrides, errors."""
+
+from __future__ import annotations
+
+import threading
+import time
+from collections.abc import Iterator
+
+import pytest
+
+from kinema.bt import BehaviorTreeFactory
+from kinema.runtime.error_codes import MoveItErrorCode
+from kinema.runtime.objective_server import (
+    FactoryTreeSource,
+    NodeStatusChange,
+    ObjectiveRequest,
+    ObjectiveRun,
+    ObjectiveServer,
+)
+from kinema.runtime.objective_status import ObjectiveStatus
+from kinema.runtime.overrides import ParameterOverride
+from kinema.runtime.result import ObjectiveResult
+
+LIBRARY = """
+<root BTCPP_format="4">
+  <BehaviorTree ID="Quick">
+    <Sequence><Script code="done := true"/></Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Forever">
+    <KeepRunningUntilFailure><Sleep msec="20"/></KeepRunningUntilFailure>
+  </BehaviorTree>
+  <BehaviorTree ID="Fails">
+    <Sequence name="main"><AlwaysSuccess/><AlwaysFailure name="broken"/></Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Typed">
+    <Sequence>
+      <Sleep msec="{delay}"/>
+      <SetBlackboard value="{greeting}" output_key="echo"/>
+    </Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Outer">
+    <Sequence><SubTree ID="Inner" name="inner_call" msec="{outer_ms}"/></Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Inner">
+    <Sleep msec="{msec}"/>
+  </BehaviorTree>
+</root>
+"""
+
+
+class Recorder:
+    """A listener that keeps everything the server reports."""
+
+    def __init__(self) -> None:
+        self.statuses: list[tuple[ObjectiveStatus, str]] = []
+        self.changes: list[NodeStatusChange] = []
+        self.snapshots: list[list[tuple[str, str, str, object]]] = []
+        self.results: list[ObjectiveResult] = []
+
+    def on_status(self, status: ObjectiveStatus, objective_name: str) -> None:
+        self.statuses.append((status, objective_name))
+
+    def on_node_status(self, objective_name: str, changes: list[NodeStatusChange]) -> None:
+        self.changes.extend(changes)
+
+    def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, object]]) -> None:
+        self.snapshots.append(entries)
+
+    def on_run_finished(self, run: ObjectiveRun, result: ObjectiveResult) -> None:
+        self.results.append(result)
+
+
+@pytest.fixture
+def recorder() -> Recorder:
+    return Recorder()
+
+
+@pytest.fixture
+def server(recorder: Recorder) -> Iterator[ObjectiveServer]:
+    factory = BehaviorTreeFactory()
+    factory.register_behavior_tree_from_text(LIBRARY)
+    with ObjectiveServer(FactoryTreeSource(factory), listeners=[recorder]) as running:
+        yield running
+
+
+def _wait_status(server: ObjectiveServer, status: ObjectiveStatus, timeout: float = 5.0) -> None:
+    deadline = time.monotonic() + timeout
+    while server.status[0] is not status:
+        assert time.monotonic() < deadline, f"status stayed {server.status}"
+        time.sleep(0.002)
+
+
+def test_a_quick_objective_succeeds_and_reports_each_state(
+    server: ObjectiveServer, recorder: Recorder
+) -> None:
+    result = server.submit(ObjectiveRequest("Quick")).wait(5)
+    assert result == ObjectiveResult.success("Quick")
+    assert [s for s, _ in recorder.statuses] == [
+        ObjectiveStatus.LOADING,
+        ObjectiveStatus.RUNNING,
+        ObjectiveStatus.SUCCESS,
+    ]
+    # The final blackboard is always published (scope = the main tree's ID; scripts store numbers).
+    assert ("Quick", "done", "double", 1.0) in recorder.snapshots[-1]
+
+
+def test_cancel_halts_a_looping_objective_within_a_tick(server: ObjectiveServer) -> None:
+    run = server.submit(ObjectiveRequest("Forever"))
+    _wait_status(server, ObjectiveStatus.RUNNING)
+    started = time.monotonic()
+    assert server.cancel()
+    result = run.wait(5)
+    assert result is not None and result.cancelled
+    assert result.error_code == MoveItErrorCode.PREEMPTED
+    assert time.monotonic() - started < 1.0
+    assert server.status == (ObjectiveStatus.CANCELLED, "Forever")
+    assert not server.cancel()  # nothing runs any more
+
+
+def test_a_new_request_preempts_the_running_one(server: ObjectiveServer) -> None:
+    first = server.submit(ObjectiveRequest("Forever"))
+    _wait_status(server, ObjectiveStatus.RUNNING)
+    second = server.submit(ObjectiveRequest("Quick"))
+    assert second.wait(5) == ObjectiveResult.success("Quick")
+    first_result = first.wait(5)
+    assert first_result is not None and first_result.cancelled
+    assert "newer" in first_result.error_message
+
+
+def test_failure_names_the_failing_node_path(server: ObjectiveServer) -> None:
+    result = server.submit(ObjectiveRequest("Fails")).wait(5)
+    assert result is not None and result.error_code == MoveItErrorCode.FAILURE
+    assert result.error_message == "objective 'Fails' failed: node 'broken' [AlwaysFailure] returned FAILURE"
+
+
+def test_a_failure_note_from_the_behavior_is_the_message(server: ObjectiveServer, recorder: Recorder) -> None:
+    # The agent forwards a behavior's publish_failure toast; the node path ties it to the failing node.
+    factory = server._source.factory()  # type: ignore[attr-defined]
+    factory.register_simple_action("Grumpy", lambda node: _note_and_fail(server, node))
+    xml = '<root BTCPP_format="4"><BehaviorTree ID="G"><Grumpy name="g"/></BehaviorTree></root>'
+    result = server.submit(ObjectiveRequest(objective_xml=xml)).wait(5)
+    assert result is not None
+    assert result.error_message == "objective 'G' failed: node 'g' [Grumpy]: gripper is jammed"
+
+
+def _note_and_fail(server: ObjectiveServer, node: object) -> object:
+    from kinema.bt import NodeStatus
+
+    server.note_failure(node.full_path, "gripper is jammed")  # type: ignore[attr-defined]
+    return NodeStatus.FAILURE
+
+
+def test_unknown_objective_lists_the_alternatives(server: ObjectiveServer) -> None:
+    result = server.submit(ObjectiveRequest("Quik")).wait(5)
+    assert result is not None and result.failed
+    assert "unknown objective 'Quik'" in result.error_message and "Quick" in result.error_message
+    assert server.status[0] is ObjectiveStatus.FAILURE
+
+
+@pytest.mark.parametrize(
+    ("xml", "reason"),
+    [
+        ("<root><BehaviorTree ID='X'><Nope/></BehaviorTree></root>", "Nope"),
+        ("this is not xml", "XML"),
+        ("", "no objective"),
+        ("<" * (3 * 1024 * 1024), "limit"),
+    ],
+)
+def test_malformed_xml_fails_with_a_reason_and_the_server_keeps_serving(
+    server: ObjectiveServer, xml: str, reason: str
+) -> None:
+    result = server.submit(ObjectiveRequest(objective_xml=xml)).wait(10)
+    assert result is not None and result.failed
+    assert reason in result.error_message
+    assert server.submit(ObjectiveRequest("Quick")).wait(5) == ObjectiveResult.success("Quick")
+
+
+def test_the_name_wins_over_the_xml(server: ObjectiveServer) -> None:
+    run = server.submit(ObjectiveRequest("Quick", objective_xml="garbage"))
+    assert run.wait(5) == ObjectiveResult.success("Quick")
+
+
+def test_adhoc_xml_does_not_replace_library_objectives(server: ObjectiveServer) -> None:
+    shadow = '<root BTCPP_format="4"><BehaviorTree ID="Quick"><AlwaysFailure/></BehaviorTree></root>'
+    result = server.submit(ObjectiveRequest(objective_xml=shadow)).wait(5)
+    assert result is not None and result.failed
+    assert server.submit(ObjectiveRequest("Quick")).wait(5) == ObjectiveResult.success("Quick")
+
+
+def test_overrides_are_typed_by_the_port_that_reads_them(server: ObjectiveServer) -> None:
+    overrides = (ParameterOverride("delay", "10"), ParameterOverride("greeting", "hello"))
+    assert server.submit(ObjectiveRequest("Typed", overrides=overrides)).wait(5) == ObjectiveResult.success(
+        "Typed"
+    )
+
+
+@pytest.mark.parametrize(
+    ("overrides", "reason"),
+    [
+        ((ParameterOverride("delay", "soon"),), "'soon' is not a valid"),
+        ((ParameterOverride("dealy", "10"),), "delay"),
+        ((ParameterOverride("delay", "10", ("nowhere",)),), "no subtree is named 'nowhere'"),
+    ],
+)
+def test_bad_overrides_reject_the_request_before_the_first_tick(
+    server: ObjectiveServer, recorder: Recorder, overrides: tuple[ParameterOverride, ...], reason: str
+) -> None:
+    result = server.submit(ObjectiveRequest("Typed", overrides=overrides)).wait(5)
+    assert result is not None and result.failed
+    assert reason in result.error_message
+    assert ObjectiveStatus.RUNNING not in [s for s, _ in recorder.statuses]
+    assert recorder.changes == []
+
+
+def test_namespaced_overrides_reach_only_that_subtree(server: ObjectiveServer) -> None:
+    overrides = (ParameterOverride("msec", "5", ("inner_call",)),)
+    ok = server.submit(ObjectiveRequest("Outer", overrides=overrides)).wait(5)
+    # The subtree maps msec to {outer_ms}, so the value lands in the root key outer_ms.
+    assert ok == ObjectiveResult.success("Outer")
+
+
+def test_a_burst_of_requests_leaves_the_server_idle_and_responsive(server: ObjectiveServer) -> None:
+    runs = []
+    for index in range(200):
+        runs.append(server.submit(ObjectiveRequest("Forever")))
+        if index % 2:
+            server.cancel(reason="burst cancel", timeout=0)
+    server.cancel()
+    results = [run.wait(5) for run in runs]
+    assert all(result is not None and result.cancelled for result in results)
+    assert server.status[0] in (ObjectiveStatus.CANCELLED, ObjectiveStatus.IDLE)
+    assert server.submit(ObjectiveRequest("Quick")).wait(5) == ObjectiveResult.success("Quick")
+
+
+def test_node_status_changes_carry_paths(server: ObjectiveServer, recorder: Recorder) -> None:
+    server.submit(ObjectiveRequest("Fails")).wait(5)
+    paths = {change.node_path for change in recorder.changes}
+    assert {"main", "broken"} <= paths
+
+
+def test_call_soon_runs_between_ticks(server: ObjectiveServer) -> None:
+    seen: list[str] = []
+    server.submit(ObjectiveRequest("Forever"))
+    _wait_status(server, ObjectiveStatus.RUNNING)
+    assert server.call_soon(lambda: seen.append(threading.current_thread().name) or 7) == 7
+    assert seen == ["kinema-tick"]
+    server.cancel()
+
+
+def test_stopping_preempts_the_running_objective(recorder: Recorder) -> None:
+    factory = BehaviorTreeFactory()
+    factory.register_behavior_tree_from_text(LIBRARY)
+    server = ObjectiveServer(FactoryTreeSource(factory), listeners=[recorder])
+    server.start()
+    run = server.submit(ObjectiveRequest("Forever"))
+    _wait_status(server, ObjectiveStatus.RUNNING)
+    server.stop()
+    result = run.result
+    assert result is not None and result.cancelled
