@@ -1,0 +1,144 @@
+"""The behavior package template: every type bakes into a package whose own tests pass as generated."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from kinema.config import Workspace, resolve_config
+from kinema.errors import ScaffoldError
+from kinema.plugins import BehaviorHost
+from kinema.resources import bundled_dir
+from kinema.scaffold.behavior_package import BEHAVIOR_TYPES, behavior_id_for, new_behavior
+from kinema.testing import load_behavior_package
+
+
+def _run_package_tests(package_dir: Path) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
+    return subprocess.run(
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:randomly"],
+        cwd=package_dir,
+        capture_output=True,
+        text=True,
+        timeout=180,
+        env=env,
+    )
+
+
+@pytest.mark.parametrize("behavior_type", BEHAVIOR_TYPES)
+def test_each_type_bakes_into_a_package_whose_tests_pass(workspace: Path, behavior_type: str) -> None:
+    name = f"my_{behavior_type}"
+    result = new_behavior(name, behavior_type, workspace=Workspace.discover(workspace))
+    package_dir = workspace / "src" / name
+    assert result.created_package and result.package_dir == package_dir
+    assert result.behavior_id == behavior_id_for(name)
+    for relative in ("pyproject.toml", f"{name}/__init__.py", f"{name}/{name}.py", f"objectives/{name}.xml"):
+        assert (package_dir / relative).is_file(), relative
+    assert list(load_behavior_package(package_dir)) == [result.behavior_id]
+
+    outcome = _run_package_tests(package_dir)
+    assert outcome.returncode == 0, outcome.stdout + outcome.stderr
+    assert " passed" in outcome.stdout and "failed" not in outcome.stdout
+
+    if shutil.which("ruff"):
+        lint = subprocess.run(
+            ["ruff", "check", "--isolated", "--line-length", "110", "--select", "E,F,W,I,B,UP", "."],
+            cwd=package_dir,
+            capture_output=True,
+            text=True,
+        )
+        assert lint.returncode == 0, lint.stdout
+
+
+def test_a_behavior_added_to_a_package_is_registered_and_tested(workspace: Path) -> None:
+    new_behavior("adders", "async", workspace=Workspace.discover(workspace))
+    added = new_behavior(
+        "add_client", "service_client", workspace=Workspace.discover(workspace), package="adders"
+    )
+    package_dir = workspace / "src" / "adders"
+    assert not added.created_package
+    assert added.loader_name == "adders::AddersBehaviorsLoader"
+    assert (package_dir / "adders" / "add_client.py").is_file()
+    assert sorted(load_behavior_package(package_dir)) == ["AddClient", "Adders"]
+    outcome = _run_package_tests(package_dir)
+    assert outcome.returncode == 0, outcome.stdout + outcome.stderr
+    assert "6 passed" in outcome.stdout
+
+
+@pytest.mark.parametrize(
+    ("name", "behavior_type", "package", "message"),
+    [
+        ("Bad-Name", "async", None, "not a valid behavior name"),
+        ("1st_behavior", "async", None, "not a valid behavior name"),
+        ("class", "async", None, "keyword"),
+        ("double__underscore", "async", None, "not a valid behavior name"),
+        ("good_name", "asynchronous", None, "unknown behavior type 'asynchronous'.*async"),
+        ("good_name", "async", "no_such_package", "no behavior package named 'no_such_package'"),
+    ],
+)
+def test_bad_input_is_refused_before_anything_is_written(
+    workspace: Path, name: str, behavior_type: str, package: str | None, message: str
+) -> None:
+    with pytest.raises(ScaffoldError, match=message):
+        new_behavior(name, behavior_type, workspace=Workspace.discover(workspace), package=package)
+    assert list((workspace / "src").iterdir()) == []
+
+
+def test_a_taken_package_name_or_module_is_refused(workspace: Path) -> None:
+    new_behavior("adders", "async", workspace=Workspace.discover(workspace))
+    before = sorted(p for p in (workspace / "src").rglob("*"))
+    with pytest.raises(ScaffoldError, match=r"already exists.*--package adders"):
+        new_behavior("adders", "sync", workspace=Workspace.discover(workspace))
+    with pytest.raises(ScaffoldError, match=r"adders\.py already exists"):
+        new_behavior("adders", "sync", workspace=Workspace.discover(workspace), package="adders")
+    assert sorted(p for p in (workspace / "src").rglob("*")) == before
+
+
+def test_the_workspace_config_gets_the_loader_and_keeps_its_comments(workspace_with_config: Path) -> None:
+    result = new_behavior(
+        "my_adder", "async", workspace=Workspace.discover(workspace_with_config), config="my_config"
+    )
+    config_file = workspace_with_config / "src" / "my_config" / "config" / "config.yaml"
+    assert result.config_file == config_file
+    text = config_file.read_text()
+    for comment in ("# my_config: the robot config", "# Our own objectives.", "# More behaviors go here."):
+        assert comment in text
+    resolved = resolve_config("my_config", Workspace.discover(workspace_with_config))
+    assert resolved.behavior_loader_plugins["my_adder"] == ["my_adder::MyAdderBehaviorsLoader"]
+    # Unioned with the parents' loaders: example_config's tutorial behaviors stay active.
+    assert "kinema::ExampleBehaviorsLoader" in resolved.behavior_loader_plugins["examples"]
+    host = BehaviorHost.for_config(resolved)
+    report = host.load()
+    assert report.ok, report.errors
+    assert {"MyAdder", "MyBehavior", "MyServiceClient"} <= set(host.registry)
+    assert "my_adder_objectives" in [library.key for library in resolved.objective_library_paths]
+
+
+def test_a_bundled_config_is_never_edited(workspace: Path) -> None:
+    example = bundled_dir("configs") / "example_config" / "config" / "config.yaml"
+    before = example.read_text()
+    found = Workspace.discover(workspace)
+    result = new_behavior("my_adder", "async", workspace=found, config="example_config")
+    assert result.config_file is None
+    assert example.read_text() == before
+
+
+def test_the_template_refuses_bad_input_when_cookiecutter_runs_it_directly(tmp_path: Path) -> None:
+    from cookiecutter.exceptions import FailedHookException
+    from cookiecutter.main import cookiecutter
+
+    template = bundled_dir("cookiecutters") / "behavior_package"
+    with pytest.raises(FailedHookException):
+        cookiecutter(
+            str(template),
+            no_input=True,
+            output_dir=str(tmp_path),
+            extra_context={"behavior_name": "Not-Valid"},
+            default_config=True,
+        )
+    assert list(tmp_path.iterdir()) == []
