@@ -1,0 +1,303 @@
+"""The Kinema terminal UI: browse configs and objectives, run them, watch the live blackboard.
+
+The app is a subscriber like any SDK client: it holds a :class:`RuntimeConnection`, receives its events on
+background threads into an inbox, and drains the inbox on the UI thread, keeping only the newest
+heartbeat, clock sample and blackboard snapshot, so a fast stream can never queue up behind the screen.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections import deque
+from collections.abc import Iterable
+from dataclasses import dataclass, field
+
+from textual.app import App, SystemCommand
+from textual.binding import Binding
+from textual.screen import Screen
+
+from kinema.tui.blackboard_model import BlackboardModel
+from kinema.tui.connection import (
+    BlackboardSnapshot,
+    ClockSample,
+    ConnectionChanged,
+    ConnectionState,
+    Heartbeat,
+    LogEntry,
+    LogLevel,
+    NodeStatusBatch,
+    NodeStatusUpdate,
+    ObjectivesChanged,
+    ReloadNotice,
+    RuntimeConnection,
+    RuntimeEvent,
+)
+from kinema.tui.messages import ModeSelected, RuntimeCallFailed, RuntimeCallSucceeded, RuntimeEventsArrived
+from kinema.tui.runtime_status import RuntimeStatus
+from kinema.tui.screens.base import KinemaScreen
+from kinema.tui.screens.behaviors import BehaviorsScreen
+from kinema.tui.screens.blackboard import BlackboardScreen
+from kinema.tui.screens.configs import ConfigsScreen
+from kinema.tui.screens.logs import LogsScreen
+from kinema.tui.screens.objectives import ObjectivesScreen
+from kinema.tui.screens.waypoints import WaypointsScreen
+from kinema.tui.widgets.nav_bar import SCREENS
+
+log = logging.getLogger("kinema.tui")
+
+MAX_LOGS = 2000
+MAX_RELOADS = 200
+TOAST_SEVERITY = {LogLevel.ERROR: "error", LogLevel.WARN: "warning"}
+
+
+@dataclass
+class EventInbox:
+    """Events from the connection's threads, waiting for the UI thread. Thread-safe."""
+
+    lock: threading.Lock = field(default_factory=threading.Lock)
+    ordered: list[RuntimeEvent] = field(default_factory=list)
+    heartbeat: Heartbeat | None = None
+    clock: ClockSample | None = None
+    blackboard: BlackboardSnapshot | None = None
+    signalled: bool = False
+
+    def put(self, event: RuntimeEvent) -> bool:
+        """Queue ``event``; returns True when the UI thread must be woken (the inbox was idle)."""
+        with self.lock:
+            if isinstance(event, Heartbeat):
+                # Heartbeats matter in order only around status changes; keep every change, the last beat.
+                if self.heartbeat is not None and self.heartbeat.status != event.status:
+                    self.ordered.append(self.heartbeat)
+                self.heartbeat = event
+            elif isinstance(event, ClockSample):
+                self.clock = event
+            elif isinstance(event, BlackboardSnapshot):
+                self.blackboard = event
+            else:
+                self.ordered.append(event)
+            wake = not self.signalled
+            self.signalled = True
+            return wake
+
+    def drain(self) -> list[RuntimeEvent]:
+        """Take everything queued, in order, with the newest heartbeat/clock/blackboard last."""
+        with self.lock:
+            events: list[RuntimeEvent] = self.ordered
+            self.ordered = []
+            for latest in (self.heartbeat, self.clock, self.blackboard):
+                if latest is not None:
+                    events.append(latest)
+            self.heartbeat = self.clock = self.blackboard = None
+            self.signalled = False
+            return events
+
+
+class KinemaApp(App[None]):
+    """The Kinema TUI.
+
+    Args:
+        connection: the runtime to show (an :class:`~kinema.tui.sdk_connection.SdkConnection`, or a
+            :class:`~kinema.tui.fake_connection.FakeConnection` in tests).
+        owns_runtime: True when this app was opened by ``kinema run`` (closing it stops the runtime).
+        initial_mode: the screen to open first.
+    """
+
+    TITLE = "Kinema"
+    CSS_PATH = "app.tcss"
+    MODES = {
+        "configs": ConfigsScreen,
+        "objectives": ObjectivesScreen,
+        "blackboard": BlackboardScreen,
+        "behaviors": BehaviorsScreen,
+        "logs": LogsScreen,
+        "waypoints": WaypointsScreen,
+    }
+    BINDINGS = [
+        *(
+            Binding(
+                key,
+                f"switch_mode('{mode}')",
+                label,
+                show=False,
+                id=f"app.{mode}",
+                tooltip=f"Show the {label} screen",
+            )
+            for mode, label, key in SCREENS
+        ),
+        Binding("q", "quit", "Quit", id="app.quit", tooltip="Close the app"),
+        Binding(
+            "ctrl+x",
+            "cancel_objective",
+            "Cancel objective",
+            id="app.cancel",
+            show=False,
+            tooltip="Cancel the running objective from any screen",
+        ),
+    ]
+
+    def __init__(
+        self, connection: RuntimeConnection, *, owns_runtime: bool = False, initial_mode: str = "objectives"
+    ) -> None:
+        super().__init__()
+        self.connection = connection
+        self.owns_runtime = owns_runtime
+        self.initial_mode = initial_mode
+        self.status = RuntimeStatus(endpoint=connection.endpoint)
+        self.blackboard = BlackboardModel()
+        self.logs: deque[LogEntry] = deque(maxlen=MAX_LOGS)
+        self.reloads: deque[ReloadNotice] = deque(maxlen=MAX_RELOADS)
+        self.node_statuses: dict[str, dict[tuple[int, str], NodeStatusUpdate]] = {}
+        self.inbox = EventInbox()
+        self.views: list[KinemaScreen] = []
+        self.sub_title = connection.endpoint + ("  (closing stops the runtime)" if owns_runtime else "")
+
+    # -- lifecycle ----------------------------------------------------------------------------------
+
+    def on_mount(self) -> None:
+        self.switch_mode(self.initial_mode)
+        self.connection.open(self._receive)
+
+    def on_unmount(self) -> None:
+        try:
+            self.connection.close()
+        except Exception:
+            log.exception("closing the runtime connection failed")
+
+    def register_view(self, screen: KinemaScreen) -> None:
+        """A screen was mounted; it receives runtime updates from now on."""
+        if screen not in self.views:
+            self.views.append(screen)
+
+    def unregister_view(self, screen: KinemaScreen) -> None:
+        """A screen was unmounted."""
+        if screen in self.views:
+            self.views.remove(screen)
+
+    # -- runtime events -----------------------------------------------------------------------------
+
+    def _receive(self, event: RuntimeEvent) -> None:
+        """The connection's listener (any thread): queue, and wake the UI thread once."""
+        if self.inbox.put(event):
+            self.post_message(RuntimeEventsArrived())
+
+    def on_runtime_events_arrived(self, _: RuntimeEventsArrived) -> None:
+        self.process_events(self.inbox.drain())
+
+    def process_events(self, events: Iterable[RuntimeEvent]) -> None:
+        """Apply events to the app's state and hand them down to the screens (UI thread)."""
+        status_changed = False
+        for event in events:
+            if isinstance(event, ConnectionChanged):
+                was = self.status.state
+                self.status.apply_connection(event)
+                status_changed = True
+                if event.state is ConnectionState.CONNECTED and was is not ConnectionState.CONNECTED:
+                    self._views_call(lambda view: view.runtime_connected())
+                if event.state is ConnectionState.DISCONNECTED and was is ConnectionState.CONNECTED:
+                    self.notify(
+                        event.detail or "The runtime stopped answering.",
+                        title="Disconnected",
+                        severity="error",
+                    )
+                elif event.state is ConnectionState.CONNECTED and was is ConnectionState.DISCONNECTED:
+                    self.notify(f"Connected to {event.endpoint}", title="Reconnected")
+            elif isinstance(event, Heartbeat):
+                was_connected = self.status.state is ConnectionState.CONNECTED
+                if self.status.apply_heartbeat(event):
+                    self.node_statuses.pop(event.objective_name, None)
+                    name = event.objective_name
+                    self._views_call(lambda view: view.runtime_run_started(name))  # noqa: B023 - called now
+                if not was_connected:
+                    self._views_call(lambda view: view.runtime_connected())
+                status_changed = True
+            elif isinstance(event, ClockSample):
+                self.status.apply_clock(event)
+                status_changed = True
+            elif isinstance(event, NodeStatusBatch):
+                latest = self.node_statuses.setdefault(event.objective_name, {})
+                for update in event.updates:
+                    latest[(update.uid, update.node_path)] = update
+                self._views_call(lambda view: view.runtime_node_statuses(event))  # noqa: B023 - called now
+            elif isinstance(event, BlackboardSnapshot):
+                diff = self.blackboard.apply(event.objective_name, event.stamp, event.entries)
+                if diff:
+                    self._views_call(lambda view: view.runtime_blackboard(diff))  # noqa: B023 - called now
+            elif isinstance(event, LogEntry):
+                self.add_log(event, toast=True)
+            elif isinstance(event, ReloadNotice):
+                self.reloads.append(event)
+                self._views_call(lambda view: view.runtime_reload(event))  # noqa: B023 - called now
+                if not event.ok:
+                    where = f"{event.location}: " if event.location else ""
+                    self.notify(f"{where}{event.message}", title="Reload failed", severity="error", timeout=8)
+            elif isinstance(event, ObjectivesChanged):
+                self._views_call(lambda view: view.runtime_objectives_changed())
+        if status_changed:
+            for view in self.views:
+                view.show_status(self.status)
+
+    def add_log(self, entry: LogEntry, *, toast: bool = False) -> None:
+        """Keep ``entry`` for the Logs screen and, for runtime toasts, show it as a notification."""
+        self.logs.append(entry)
+        self._views_call(lambda view: view.runtime_log(entry))
+        if toast and entry.level <= LogLevel.INFO:
+            self.notify(entry.message, severity=TOAST_SEVERITY.get(entry.level, "information"))  # type: ignore[arg-type]
+
+    def _views_call(self, hook: object) -> None:
+        for view in list(self.views):
+            try:
+                hook(view)  # type: ignore[operator]
+            except Exception as error:
+                log.exception("a screen failed to take a runtime update")
+                self.logs.append(
+                    LogEntry(f"{type(view).__name__}: {error}", LogLevel.ERROR, time.time(), "ui")
+                )
+
+    # -- messages from screens ----------------------------------------------------------------------
+
+    def on_runtime_call_failed(self, message: RuntimeCallFailed) -> None:
+        self.add_log(LogEntry(f"{message.what} failed: {message.error}", LogLevel.ERROR, time.time(), "ui"))
+        self.notify(message.error, title=f"{message.what} failed", severity="error", timeout=8)
+
+    def on_runtime_call_succeeded(self, message: RuntimeCallSucceeded) -> None:
+        self.add_log(LogEntry(message.what, LogLevel.INFO, time.time(), "ui"))
+        self.notify(message.what, timeout=3)
+
+    def on_mode_selected(self, message: ModeSelected) -> None:
+        self.switch_mode(message.mode)
+
+    # -- actions and commands -----------------------------------------------------------------------
+
+    def action_cancel_objective(self) -> None:
+        screen = self.screen
+        if isinstance(screen, KinemaScreen):
+            screen.call_runtime("Cancel the objective", self.connection.cancel_objective, announce=True)
+
+    def get_system_commands(self, screen: Screen[object]) -> Iterable[SystemCommand]:
+        yield from super().get_system_commands(screen)
+        for mode, label, key in SCREENS:
+            yield SystemCommand(
+                f"Go to {label}",
+                f"Show the {label} screen (key {key})",
+                lambda mode=mode: self.switch_mode(mode),
+            )  # type: ignore[misc]
+        yield SystemCommand(
+            "Cancel objective", "Cancel the running objective (ctrl+x)", self.action_cancel_objective
+        )
+
+
+def run_app(
+    connection: RuntimeConnection, owns_runtime: bool = False, initial_mode: str = "objectives"
+) -> None:
+    """Open the TUI on ``connection`` and return when the user closes it.
+
+    Args:
+        connection: the runtime to attach to.
+        owns_runtime: True for ``kinema run``: the caller stops the runtime after this returns; the app
+            says so in its title. An attached app (``kinema ui``) leaves the runtime running.
+        initial_mode: the first screen (``configs``, ``objectives``, ``blackboard``, ``behaviors``,
+            ``logs``, ``waypoints``).
+    """
+    KinemaApp(connection, owns_runtime=owns_runtime, initial_mode=initial_mode).run()

@@ -1,0 +1,279 @@
+"""The TUI's view of a runtime: one small adapter interface, the values it returns and the events it sends.
+
+The app never talks to the transport or the SDK directly. It holds a :class:`RuntimeConnection`, calls
+its blocking methods from worker threads, and receives :data:`RuntimeEvent` values from it on any thread.
+Two implementations exist: :class:`kinema.tui.sdk_connection.SdkConnection` (a real runtime, through
+:mod:`kinema.sdk`) and :class:`kinema.tui.fake_connection.FakeConnection` (scripted, for tests, snapshots
+and benchmarks). Nothing here imports textual, so this module is testable on its own.
+"""
+
+from __future__ import annotations
+
+import enum
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING, Protocol
+
+if TYPE_CHECKING:
+    from kinema.config import Workspace
+
+
+class ConnectionState(enum.StrEnum):
+    """Whether the runtime answers."""
+
+    CONNECTING = "connecting"
+    CONNECTED = "connected"
+    DISCONNECTED = "disconnected"
+
+
+class NodeStatus(enum.IntEnum):
+    """A behavior tree node's status as ``kinema_msgs/NodeStatusChange`` numbers it."""
+
+    IDLE = 0
+    RUNNING = 1
+    SUCCESS = 2
+    FAILURE = 3
+    SKIPPED = 4
+
+
+class LogLevel(enum.IntEnum):
+    """``moveit_studio_agent_msgs/Log`` levels (lower is more severe), plus DEBUG for local messages."""
+
+    ERROR = 1
+    WARN = 2
+    INFO = 3
+    DEBUG = 4
+
+
+@dataclass(frozen=True)
+class PortSummary:
+    """A port of an objective (its subtree interface) or of a behavior.
+
+    Attributes:
+        name: the port name.
+        direction: ``"input"``, ``"output"`` or ``"inout"``.
+        default: the default as written (``{key}`` for a blackboard default), "" when none.
+        description: one line for a person.
+        type_name: the value type when known (behaviors), "" otherwise.
+    """
+
+    name: str
+    direction: str
+    default: str = ""
+    description: str = ""
+    type_name: str = ""
+
+
+@dataclass(frozen=True)
+class ObjectiveSummary:
+    """An objective of the runtime's library (``kinema_msgs/ObjectiveInfo``)."""
+
+    name: str
+    description: str = ""
+    subcategory: str = ""
+    runnable: bool = True
+    favorite: bool = False
+    package: str = ""
+    file_path: str = ""
+    ports: tuple[PortSummary, ...] = ()
+
+
+@dataclass(frozen=True)
+class WaypointSummary:
+    """A saved waypoint (``moveit_studio_agent_msgs/Waypoint``)."""
+
+    name: str
+    description: str = ""
+    favorite: bool = False
+    joint_names: tuple[str, ...] = ()
+    positions: tuple[float, ...] = ()
+    joint_group_names: tuple[str, ...] = ()
+
+
+@dataclass(frozen=True)
+class BehaviorSummary:
+    """A behavior of the registry: what objectives can use as ``<Action ID=...>``.
+
+    Attributes:
+        id: the behavior ID.
+        plugin: the plugin (loader name) that registered it.
+        source: where the plugin came from (``bundled``, ``entry point``, ``workspace``) and its path.
+        location: ``file:line`` of the class.
+        ports: the behavior's ports.
+        metadata: subcategory, description, ...
+    """
+
+    id: str
+    plugin: str = ""
+    source: str = ""
+    location: str = ""
+    ports: tuple[PortSummary, ...] = ()
+    metadata: Mapping[str, str] = field(default_factory=dict)
+
+
+# --- events: what a connection reports, on any thread -----------------------------------------
+
+
+@dataclass(frozen=True)
+class ConnectionChanged:
+    """The runtime started or stopped answering. ``detail`` says why, for a person."""
+
+    state: ConnectionState
+    endpoint: str
+    detail: str = ""
+
+
+@dataclass(frozen=True)
+class Heartbeat:
+    """One ``/objective_server_heartbeat``: the server's process time, objective and status."""
+
+    process_time: float
+    objective_name: str
+    status: str
+
+
+@dataclass(frozen=True)
+class NodeStatusUpdate:
+    """One node of the running tree changed status."""
+
+    uid: int
+    node_path: str
+    node_id: str
+    node_name: str
+    status: NodeStatus
+    previous: NodeStatus = NodeStatus.IDLE
+
+
+@dataclass(frozen=True)
+class NodeStatusBatch:
+    """The node status changes of one tick of ``objective_name``."""
+
+    objective_name: str
+    updates: tuple[NodeStatusUpdate, ...]
+
+
+@dataclass(frozen=True)
+class BlackboardEntry:
+    """One blackboard entry; ``scope`` is the subtree path ("" for the root blackboard)."""
+
+    scope: str
+    key: str
+    type_name: str
+    value: str
+
+
+@dataclass(frozen=True)
+class BlackboardSnapshot:
+    """Every blackboard entry of the running (or last) objective, at ``stamp`` (seconds)."""
+
+    objective_name: str
+    stamp: float
+    entries: tuple[BlackboardEntry, ...]
+
+
+@dataclass(frozen=True)
+class LogEntry:
+    """A log message or behavior toast (``publish_info/warn/failure``)."""
+
+    message: str
+    level: LogLevel = LogLevel.INFO
+    stamp: float = 0.0
+    source: str = ""
+
+
+@dataclass(frozen=True)
+class ClockSample:
+    """Simulation time from ``/clock`` and the real-time factor measured over the last window."""
+
+    sim_time: float
+    real_time_factor: float | None = None
+
+
+@dataclass(frozen=True)
+class ReloadNotice:
+    """A hot reload happened (or failed). ``location`` is ``file:line`` for failures."""
+
+    ok: bool
+    kind: str
+    subject: str
+    message: str
+    location: str = ""
+    behaviors: tuple[str, ...] = ()
+    stamp: float = 0.0
+
+
+@dataclass(frozen=True)
+class ObjectivesChanged:
+    """The runtime's objective library changed (an objective file was saved): list it again."""
+
+
+RuntimeEvent = (
+    ConnectionChanged
+    | Heartbeat
+    | NodeStatusBatch
+    | BlackboardSnapshot
+    | LogEntry
+    | ClockSample
+    | ReloadNotice
+    | ObjectivesChanged
+)
+EventListener = Callable[[RuntimeEvent], None]
+
+
+class RuntimeConnection(Protocol):
+    """What the TUI needs from a runtime. Blocking methods run on worker threads, never on the UI thread.
+
+    Every method that talks to the runtime raises :class:`kinema.errors.KinemaError` (usually a
+    ``TransportError`` or ``ObjectiveError``) with a message for a person when it fails; the app shows
+    the message and keeps running.
+    """
+
+    @property
+    def endpoint(self) -> str:
+        """Where the runtime is (``tcp/127.0.0.1:7447``), for the status bar."""
+
+    @property
+    def config_name(self) -> str | None:
+        """The config package the runtime runs (preselected in the Configs screen), if known."""
+
+    def open(self, listener: EventListener) -> None:
+        """Start receiving events; returns at once. Reconnects on its own while open.
+
+        ``listener`` is called on background threads and must not block.
+        """
+
+    def close(self) -> None:
+        """Stop receiving events and release the session (does not stop the runtime)."""
+
+    def workspace(self) -> Workspace:
+        """The workspace whose config packages the Configs screen browses."""
+
+    def list_objectives(self) -> list[ObjectiveSummary]:
+        """The runtime's objective library."""
+
+    def objective_xml(self, name: str) -> str:
+        """The BT.CPP v4 XML document that defines objective ``name``."""
+
+    def start_objective(self, name: str, overrides: Mapping[str, str]) -> None:
+        """Start objective ``name`` with overrides (port name -> YAML text); returns once accepted."""
+
+    def cancel_objective(self) -> None:
+        """Cancel whatever objective runs."""
+
+    def list_waypoints(self) -> list[WaypointSummary]:
+        """The saved waypoints."""
+
+    def move_to_waypoint(self, name: str) -> None:
+        """Start moving the robot to waypoint ``name``."""
+
+    def save_waypoint(self, name: str, joint_group_names: tuple[str, ...] = ()) -> WaypointSummary:
+        """Save the robot's current joint state as waypoint ``name``."""
+
+    def rename_waypoint(self, name: str, new_name: str) -> None:
+        """Rename waypoint ``name`` to ``new_name``."""
+
+    def erase_waypoint(self, name: str) -> None:
+        """Delete waypoint ``name``."""
+
+    def list_behaviors(self) -> list[BehaviorSummary]:
+        """The behaviors the runtime's config can use."""

@@ -1,0 +1,66 @@
+"""What the status bar shows, kept up to date from heartbeats, ``/clock`` samples and connection changes.
+
+Elapsed time is measured on the runtime's own clock (heartbeat process time), so it is right even when
+the terminal is slow to draw, and deterministic in tests.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from kinema.tui.connection import ClockSample, ConnectionChanged, ConnectionState, Heartbeat
+
+ACTIVE_STATUSES = frozenset({"Loading", "Running"})
+
+
+@dataclass
+class RuntimeStatus:
+    """The runtime as the status bar describes it."""
+
+    state: ConnectionState = ConnectionState.CONNECTING
+    endpoint: str = ""
+    detail: str = ""
+    objective: str = ""
+    status: str = "Unknown"
+    elapsed: float | None = None
+    sim_time: float | None = None
+    real_time_factor: float | None = None
+    _started_at: float | None = None
+
+    @property
+    def running(self) -> bool:
+        """True while an objective is loading or running."""
+        return self.status in ACTIVE_STATUSES
+
+    def apply_connection(self, event: ConnectionChanged) -> None:
+        """Take a connection change; a lost runtime forgets its objective and clock."""
+        self.state = event.state
+        self.endpoint = event.endpoint
+        self.detail = event.detail
+        if event.state is not ConnectionState.CONNECTED:
+            self.status = "Unknown"
+            self.sim_time = None
+            self.real_time_factor = None
+            self._started_at = None
+
+    def apply_heartbeat(self, beat: Heartbeat) -> bool:
+        """Take a heartbeat; returns True when a new run started (so per-run views reset)."""
+        started = beat.status in ACTIVE_STATUSES and (
+            self.status not in ACTIVE_STATUSES or beat.objective_name != self.objective
+        )
+        if started:
+            self._started_at = beat.process_time
+        if self._started_at is not None and (
+            beat.status in ACTIVE_STATUSES or self.status in ACTIVE_STATUSES
+        ):
+            self.elapsed = max(0.0, beat.process_time - self._started_at)
+        self.objective = beat.objective_name
+        self.status = beat.status
+        if self.state is not ConnectionState.CONNECTED:
+            self.state = ConnectionState.CONNECTED
+        return started
+
+    def apply_clock(self, sample: ClockSample) -> None:
+        """Take a ``/clock`` sample."""
+        self.sim_time = sample.sim_time
+        self.real_time_factor = sample.real_time_factor

@@ -1,0 +1,1 @@
+"""The screens of the Kinema TUI, one per area (the app's modes)."""

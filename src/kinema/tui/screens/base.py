@@ -1,0 +1,128 @@
+"""What every screen of the app shares: the navigation tabs, the status bar, the footer, runtime calls."""
+
+from __future__ import annotations
+
+import logging
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+from textual.app import ComposeResult
+from textual.message import Message
+from textual.screen import Screen
+from textual.widgets import Footer
+
+from kinema.errors import KinemaError
+from kinema.tui.messages import RuntimeCallFailed, RuntimeCallSucceeded
+from kinema.tui.widgets.nav_bar import NavBar
+from kinema.tui.widgets.status_bar import StatusBar
+
+if TYPE_CHECKING:
+    from kinema.tui.app import KinemaApp
+    from kinema.tui.blackboard_model import BlackboardDiff
+    from kinema.tui.connection import LogEntry, NodeStatusBatch, ReloadNotice
+    from kinema.tui.runtime_status import RuntimeStatus
+
+log = logging.getLogger("kinema.tui")
+
+
+class KinemaScreen(Screen[None]):
+    """A screen of the app. Subclasses set :attr:`MODE` and implement :meth:`compose_body`.
+
+    The app calls the ``runtime_*`` hooks (attributes down); a screen overrides those it cares about.
+    """
+
+    MODE = ""
+
+    @property
+    def kinema(self) -> KinemaApp:
+        """The app, typed."""
+        return self.app  # type: ignore[return-value]
+
+    def compose(self) -> ComposeResult:
+        yield NavBar(self.MODE)
+        yield from self.compose_body()
+        yield StatusBar(id="status-bar")
+        yield Footer()
+
+    def compose_body(self) -> ComposeResult:
+        """The screen's own widgets."""
+        yield from ()
+
+    def on_mount(self) -> None:
+        self.kinema.register_view(self)
+        self.show_status(self.kinema.status)
+
+    def on_unmount(self) -> None:
+        self.kinema.unregister_view(self)
+
+    def on_screen_resume(self) -> None:
+        self.show_status(self.kinema.status)
+
+    def show_status(self, status: RuntimeStatus) -> None:
+        """Show the runtime status in this screen's status bar."""
+        for bar in self.query(StatusBar):
+            bar.show(status)
+
+    # -- calling the runtime off the UI thread ---------------------------------------------------
+
+    def call_runtime(
+        self,
+        what: str,
+        call: Callable[[], Any],
+        done: Callable[[Any], Message | None] | None = None,
+        *,
+        announce: bool = False,
+    ) -> None:
+        """Run ``call`` on a worker thread; post ``done(result)`` back to this screen.
+
+        A failure is posted to the app as :class:`RuntimeCallFailed` (shown, never raised), so a runtime
+        that went away or refused the request never takes the app down.
+
+        Args:
+            what: what the user asked for, for messages ("Run 'Pick Object'").
+            call: the blocking call.
+            done: builds the message to post with the result, or None.
+            announce: notify the user on success.
+        """
+
+        def work() -> None:
+            try:
+                result = call()
+            except KinemaError as error:
+                self.app.post_message(RuntimeCallFailed(what, str(error)))
+                return
+            except Exception as error:
+                log.exception("%s failed", what)
+                self.app.post_message(RuntimeCallFailed(what, f"{type(error).__name__}: {error}"))
+                return
+            if done is not None:
+                message = done(result)
+                if message is not None:
+                    self.post_message(message)
+            if announce:
+                self.app.post_message(RuntimeCallSucceeded(what))
+
+        self.run_worker(work, thread=True, group=what, name=what)
+
+    # -- hooks the app calls --------------------------------------------------------------------
+
+    def runtime_connected(self) -> None:
+        """The runtime (re)appeared: reload what this screen shows."""
+
+    def runtime_run_started(self, objective_name: str) -> None:
+        """A new objective run started."""
+
+    def runtime_node_statuses(self, batch: NodeStatusBatch) -> None:
+        """Nodes of the running tree changed status."""
+
+    def runtime_blackboard(self, diff: BlackboardDiff) -> None:
+        """The blackboard changed (``diff`` against what the app had)."""
+
+    def runtime_log(self, entry: LogEntry) -> None:
+        """A log message or toast arrived."""
+
+    def runtime_reload(self, notice: ReloadNotice) -> None:
+        """A hot reload happened."""
+
+    def runtime_objectives_changed(self) -> None:
+        """The objective library changed."""

@@ -1,0 +1,281 @@
+"""Objectives: the library with search and filters, an objective's ports, live tree, XML; Run and Cancel."""
+
+from __future__ import annotations
+
+from rich.text import Text
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Horizontal, Vertical
+from textual.widgets import (
+    Checkbox,
+    DataTable,
+    Input,
+    OptionList,
+    Select,
+    Static,
+    TabbedContent,
+    TabPane,
+    TextArea,
+)
+from textual.widgets.option_list import Option
+
+from kinema.errors import KinemaError
+from kinema.tui.connection import ConnectionState, NodeStatusBatch, ObjectiveSummary, RuntimeConnection
+from kinema.tui.messages import ObjectiveOutlineLoaded, ObjectiveRunRequested, ObjectivesLoaded
+from kinema.tui.screens.base import KinemaScreen
+from kinema.tui.tree_outline import build_outline
+from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
+from kinema.tui.widgets.override_form import OverrideForm
+
+ALL = "__all__"
+
+
+def filter_objectives(
+    objectives: list[ObjectiveSummary],
+    text: str = "",
+    subcategory: str = ALL,
+    favorites_only: bool = False,
+    runnable_only: bool = False,
+) -> list[ObjectiveSummary]:
+    """The objectives that pass the search text and filters, favorites first, then by name."""
+    needle = text.strip().lower()
+    chosen = [
+        o
+        for o in objectives
+        if (not needle or needle in o.name.lower() or needle in o.description.lower())
+        and (subcategory == ALL or o.subcategory == subcategory)
+        and (not favorites_only or o.favorite)
+        and (not runnable_only or o.runnable)
+    ]
+    return sorted(chosen, key=lambda o: (not o.favorite, o.name.lower()))
+
+
+class ObjectivesScreen(KinemaScreen):
+    """Browse, inspect and run objectives."""
+
+    MODE = "objectives"
+    BINDINGS = [
+        Binding(
+            "r", "run", "Run", id="objectives.run", tooltip="Run the selected objective with the parameters"
+        ),
+        Binding("x", "cancel", "Cancel", id="objectives.cancel", tooltip="Cancel the running objective"),
+        Binding("slash", "search", "Search", id="objectives.search", tooltip="Search objectives by name"),
+        Binding("f", "toggle('favorites')", "Favorites", id="objectives.favorites", tooltip="Only favorites"),
+        Binding("u", "toggle('runnable')", "Runnable", id="objectives.runnable", tooltip="Only runnable"),
+        Binding("t", "tab('tree')", "Tree", id="objectives.tree", tooltip="The behavior tree"),
+        Binding("m", "tab('xml')", "XML", id="objectives.xml", tooltip="The objective's XML"),
+        Binding("p", "tab('parameters')", "Parameters", id="objectives.parameters", tooltip="Overrides"),
+        Binding("f5", "reload", "Reload", id="objectives.reload", tooltip="List the objectives again"),
+    ]
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.objectives: list[ObjectiveSummary] = []
+        self.shown_objectives: list[ObjectiveSummary] = []
+        self.selected: ObjectiveSummary | None = None
+
+    def compose_body(self) -> ComposeResult:
+        with Horizontal(classes="split"):
+            with Vertical(classes="sidebar"):
+                yield Input(placeholder="/ search objectives", id="objective-search")
+                yield Select([], prompt="All subcategories", id="subcategory", allow_blank=True)
+                with Horizontal(classes="checks"):
+                    yield Checkbox("Favorites", id="favorites", compact=True, tooltip="Only favorites (f)")
+                    yield Checkbox(
+                        "Runnable", id="runnable", compact=True, tooltip="Only runnable objectives (u)"
+                    )
+                yield OptionList(id="objective-list")
+                yield Static("", id="objective-count", classes="muted")
+            with Vertical(classes="main"):
+                yield Static("", id="objective-title", classes="pane-title")
+                yield Static("", id="objective-description")
+                with TabbedContent(initial="tree", id="objective-tabs"):
+                    with TabPane("Tree", id="tree"):
+                        yield BehaviorTreeView(id="behavior-tree")
+                    with TabPane("XML", id="xml"):
+                        yield TextArea("", language="xml", read_only=True, id="objective-xml")
+                    with TabPane("Parameters", id="parameters"):
+                        yield OverrideForm(id="override-form")
+                    with TabPane("Ports", id="ports"):
+                        yield DataTable(id="port-table", cursor_type="row", zebra_stripes=True)
+
+    def on_mount(self) -> None:
+        super().on_mount()
+        ports = self.query_one("#port-table", DataTable)
+        ports.add_column("Port", key="name")
+        ports.add_column("Direction", key="direction")
+        ports.add_column("Default", key="default")
+        ports.add_column("Description", key="description")
+        self.query_one("#objective-list", OptionList).focus()
+        if self.kinema.status.state is ConnectionState.CONNECTED:
+            self.action_reload()
+
+    # -- loading -----------------------------------------------------------------------------------
+
+    def action_reload(self) -> None:
+        self.call_runtime("List objectives", self.kinema.connection.list_objectives, ObjectivesLoaded)
+
+    def runtime_connected(self) -> None:
+        self.action_reload()
+
+    def runtime_objectives_changed(self) -> None:
+        self.action_reload()
+
+    def on_objectives_loaded(self, message: ObjectivesLoaded) -> None:
+        self.objectives = message.objectives
+        subcategories = sorted({o.subcategory for o in self.objectives if o.subcategory})
+        select = self.query_one("#subcategory", Select)
+        current = select.value
+        select.set_options([(name, name) for name in subcategories])
+        if current in subcategories:
+            select.value = current
+        self._refilter()
+
+    def _refilter(self) -> None:
+        select = self.query_one("#subcategory", Select)
+        subcategory = select.value if isinstance(select.value, str) else ALL
+        self.shown_objectives = filter_objectives(
+            self.objectives,
+            self.query_one("#objective-search", Input).value,
+            subcategory,
+            self.query_one("#favorites", Checkbox).value,
+            self.query_one("#runnable", Checkbox).value,
+        )
+        options = self.query_one("#objective-list", OptionList)
+        options.clear_options()
+        for objective in self.shown_objectives:
+            label = Text()
+            label.append("★ " if objective.favorite else "  ", style="yellow")
+            label.append(objective.name, style="" if objective.runnable else "dim")
+            if not objective.runnable:
+                label.append("  subtree", style="dim italic")
+            options.add_option(Option(label, id=objective.name))
+        self.query_one("#objective-count", Static).update(
+            f"{len(self.shown_objectives)} of {len(self.objectives)} objectives"
+        )
+        names = [o.name for o in self.shown_objectives]
+        if self.selected is not None and self.selected.name in names:
+            options.highlighted = names.index(self.selected.name)
+        elif names:
+            options.highlighted = 0
+
+    def on_input_changed(self, event: Input.Changed) -> None:
+        if event.input.id == "objective-search":
+            self._refilter()
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        if event.input.id == "objective-search":
+            self.query_one("#objective-list", OptionList).focus()
+
+    def on_select_changed(self, event: Select.Changed) -> None:
+        self._refilter()
+
+    def on_checkbox_changed(self, event: Checkbox.Changed) -> None:
+        self._refilter()
+
+    def on_option_list_option_highlighted(self, event: OptionList.OptionHighlighted) -> None:
+        found = next((o for o in self.shown_objectives if o.name == event.option.id), None)
+        if found is not None and found != self.selected:
+            self.select_objective(found)
+
+    def select_objective(self, objective: ObjectiveSummary) -> None:
+        """Show ``objective``: description, ports, parameter form; load its XML and tree."""
+        self.selected = objective
+        title = Text(objective.name, style="bold")
+        if objective.favorite:
+            title.append("  ★", style="yellow")
+        if objective.subcategory:
+            title.append(f"  {objective.subcategory}", style="dim")
+        if not objective.runnable:
+            title.append("  (subtree only)", style="dim italic")
+        self.query_one("#objective-title", Static).update(title)
+        where = f"{objective.package}: {objective.file_path}" if objective.package else objective.file_path
+        description = Text(objective.description or "(no description)")
+        if where:
+            description.append(f"\n{where}", style="dim")
+        self.query_one("#objective-description", Static).update(description)
+        ports = self.query_one("#port-table", DataTable)
+        ports.clear()
+        for port in objective.ports:
+            ports.add_row(port.name, port.direction, port.default, port.description)
+        self.run_worker(self.query_one(OverrideForm).show_objective(objective), group="override-form")
+        self.query_one(BehaviorTreeView).show_outline(None, "loading …")
+        connection = self.kinema.connection
+        self.call_runtime(
+            f"Read objective {objective.name!r}",
+            lambda: _load_outline(connection, objective.name),
+            lambda loaded: loaded,
+        )
+
+    def on_objective_outline_loaded(self, message: ObjectiveOutlineLoaded) -> None:
+        if self.selected is None or message.name != self.selected.name:
+            return
+        self.query_one("#objective-xml", TextArea).load_text(message.xml)
+        view = self.query_one(BehaviorTreeView)
+        view.show_outline(message.outline, message.error)
+        latest = self.kinema.node_statuses.get(message.name)
+        if latest:
+            view.apply_statuses(latest.values())
+
+    # -- running -----------------------------------------------------------------------------------
+
+    def action_run(self) -> None:
+        if self.selected is None:
+            self.notify("Select an objective first.", severity="warning")
+            return
+        if not self.selected.runnable:
+            self.notify(
+                f"{self.selected.name!r} is a subtree only; run an objective that uses it.",
+                severity="warning",
+            )
+            return
+        self.post_message(ObjectiveRunRequested(self.selected.name, self.query_one(OverrideForm).overrides()))
+
+    def on_objective_run_requested(self, message: ObjectiveRunRequested) -> None:
+        connection = self.kinema.connection
+        self.query_one(TabbedContent).active = "tree"
+        self.query_one(BehaviorTreeView).reset_statuses()
+        what = f"Run {message.name!r}"
+        if message.overrides:
+            what += " with " + ", ".join(f"{k}={v}" for k, v in message.overrides.items())
+        self.call_runtime(
+            what, lambda: connection.start_objective(message.name, message.overrides), announce=True
+        )
+
+    def action_cancel(self) -> None:
+        self.call_runtime("Cancel the objective", self.kinema.connection.cancel_objective, announce=True)
+
+    def action_search(self) -> None:
+        self.query_one("#objective-search", Input).focus()
+
+    def action_toggle(self, which: str) -> None:
+        self.query_one(f"#{which}", Checkbox).toggle()
+
+    def action_tab(self, tab: str) -> None:
+        self.query_one(TabbedContent).active = tab
+
+    # -- live status -------------------------------------------------------------------------------
+
+    def runtime_run_started(self, objective_name: str) -> None:
+        if self.selected is not None and self.selected.name == objective_name:
+            self.query_one(BehaviorTreeView).reset_statuses()
+
+    def runtime_node_statuses(self, batch: NodeStatusBatch) -> None:
+        if self.selected is not None and self.selected.name == batch.objective_name:
+            self.query_one(BehaviorTreeView).apply_statuses(batch.updates)
+
+
+def _load_outline(connection: RuntimeConnection, name: str) -> ObjectiveOutlineLoaded:
+    xml = connection.objective_xml(name)
+
+    def load_subtree(subtree_id: str) -> str | None:
+        try:
+            return connection.objective_xml(subtree_id)
+        except KinemaError:
+            return None
+
+    try:
+        outline = build_outline(xml, name, filename=f"<objective {name!r}>", load_subtree=load_subtree)
+    except KinemaError as error:
+        return ObjectiveOutlineLoaded(name, xml, None, str(error))
+    return ObjectiveOutlineLoaded(name, xml, outline)

@@ -1,0 +1,176 @@
+"""Waypoints: list, move to, save the current state as a waypoint, rename, delete."""
+
+from __future__ import annotations
+
+from rich.text import Text
+from textual.app import ComposeResult
+from textual.binding import Binding
+from textual.containers import Horizontal, Vertical
+from textual.widgets import DataTable, Static
+
+from kinema.tui.connection import ConnectionState, WaypointSummary
+from kinema.tui.dialogs.confirm import ConfirmDialog
+from kinema.tui.dialogs.text_prompt import TextPromptDialog
+from kinema.tui.messages import WaypointsLoaded
+from kinema.tui.screens.base import KinemaScreen
+
+
+class WaypointsScreen(KinemaScreen):
+    """The saved waypoints of the runtime's config."""
+
+    MODE = "waypoints"
+    BINDINGS = [
+        Binding("enter", "move", "Move to", id="waypoints.move", tooltip="Move the robot to the waypoint"),
+        Binding(
+            "s", "save", "Save current", id="waypoints.save", tooltip="Save the current state as a waypoint"
+        ),
+        Binding("n", "rename", "Rename", id="waypoints.rename", tooltip="Rename the selected waypoint"),
+        Binding("d", "delete", "Delete", id="waypoints.delete", tooltip="Delete the selected waypoint"),
+        Binding("f5", "reload", "Reload", id="waypoints.reload", tooltip="List the waypoints again"),
+    ]
+
+    def __init__(self) -> None:
+        super().__init__()
+        self.waypoints: list[WaypointSummary] = []
+
+    def compose_body(self) -> ComposeResult:
+        with Horizontal(classes="split"):
+            with Vertical(classes="main"):
+                yield DataTable(id="waypoint-table", cursor_type="row", zebra_stripes=True)
+            with Vertical(classes="side-panel"):
+                yield Static("", id="waypoint-title", classes="pane-title")
+                yield DataTable(id="joint-table", cursor_type="row", zebra_stripes=True)
+
+    def on_mount(self) -> None:
+        super().on_mount()
+        table = self.query_one("#waypoint-table", DataTable)
+        table.add_column("", key="favorite", width=2)
+        table.add_column("Waypoint", key="name")
+        table.add_column("Groups", key="groups")
+        table.add_column("Description", key="description")
+        joints = self.query_one("#joint-table", DataTable)
+        joints.add_column("Joint", key="joint")
+        joints.add_column("Position", key="position")
+        table.focus()
+        if self.kinema.status.state is ConnectionState.CONNECTED:
+            self.action_reload()
+
+    def action_reload(self) -> None:
+        self.call_runtime("List waypoints", self.kinema.connection.list_waypoints, WaypointsLoaded)
+
+    def runtime_connected(self) -> None:
+        self.action_reload()
+
+    def on_waypoints_loaded(self, message: WaypointsLoaded) -> None:
+        table = self.query_one("#waypoint-table", DataTable)
+        previous = self.selected()
+        self.waypoints = sorted(message.waypoints, key=lambda w: (not w.favorite, w.name.lower()))
+        table.clear()
+        for waypoint in self.waypoints:
+            table.add_row(
+                Text("★", style="yellow") if waypoint.favorite else "",
+                waypoint.name,
+                ", ".join(waypoint.joint_group_names),
+                waypoint.description,
+                key=waypoint.name,
+            )
+        names = [w.name for w in self.waypoints]
+        if previous is not None and previous.name in names:
+            table.move_cursor(row=names.index(previous.name))
+        self._show(self.selected())
+
+    def selected(self) -> WaypointSummary | None:
+        """The waypoint under the cursor."""
+        table = self.query_one("#waypoint-table", DataTable)
+        if not self.waypoints or table.row_count == 0:
+            return None
+        row = min(table.cursor_row, len(self.waypoints) - 1)
+        return self.waypoints[row]
+
+    def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
+        if event.data_table.id == "waypoint-table":
+            self._show(self.selected())
+
+    def on_data_table_row_selected(self, event: DataTable.RowSelected) -> None:
+        if event.data_table.id == "waypoint-table":
+            self.action_move()
+
+    def _show(self, waypoint: WaypointSummary | None) -> None:
+        joints = self.query_one("#joint-table", DataTable)
+        joints.clear()
+        title = self.query_one("#waypoint-title", Static)
+        if waypoint is None:
+            title.update(Text("No waypoint selected", style="dim"))
+            return
+        title.update(Text(waypoint.name, style="bold"))
+        for name, position in zip(waypoint.joint_names, waypoint.positions, strict=False):
+            joints.add_row(name, f"{position:+.4f}")
+
+    def action_move(self) -> None:
+        waypoint = self.selected()
+        if waypoint is None:
+            self.notify("No waypoint selected.", severity="warning")
+            return
+        connection = self.kinema.connection
+        self.call_runtime(
+            f"Move to waypoint {waypoint.name!r}",
+            lambda: connection.move_to_waypoint(waypoint.name),
+            announce=True,
+        )
+
+    def action_save(self) -> None:
+        connection = self.kinema.connection
+
+        def save(name: str | None) -> None:
+            if name:
+                self.call_runtime(
+                    f"Save waypoint {name!r}",
+                    lambda: (connection.save_waypoint(name), connection.list_waypoints())[1],
+                    WaypointsLoaded,
+                    announce=True,
+                )
+
+        self.app.push_screen(
+            TextPromptDialog("Save the robot's current state as waypoint:", placeholder="waypoint name"), save
+        )
+
+    def action_rename(self) -> None:
+        waypoint = self.selected()
+        if waypoint is None:
+            self.notify("No waypoint selected.", severity="warning")
+            return
+        connection = self.kinema.connection
+
+        def rename(new_name: str | None) -> None:
+            if new_name and new_name != waypoint.name:
+                self.call_runtime(
+                    f"Rename waypoint {waypoint.name!r} to {new_name!r}",
+                    lambda: (
+                        connection.rename_waypoint(waypoint.name, new_name),
+                        connection.list_waypoints(),
+                    )[1],
+                    WaypointsLoaded,
+                    announce=True,
+                )
+
+        self.app.push_screen(
+            TextPromptDialog(f"Rename waypoint {waypoint.name!r} to:", waypoint.name), rename
+        )
+
+    def action_delete(self) -> None:
+        waypoint = self.selected()
+        if waypoint is None:
+            self.notify("No waypoint selected.", severity="warning")
+            return
+        connection = self.kinema.connection
+
+        def delete(confirmed: bool | None) -> None:
+            if confirmed:
+                self.call_runtime(
+                    f"Delete waypoint {waypoint.name!r}",
+                    lambda: (connection.erase_waypoint(waypoint.name), connection.list_waypoints())[1],
+                    WaypointsLoaded,
+                    announce=True,
+                )
+
+        self.app.push_screen(ConfirmDialog(f"Delete waypoint {waypoint.name!r}?", "Delete"), delete)

@@ -1,0 +1,62 @@
+"""The bottom status line: connection, the heartbeat (objective, status, elapsed) and sim time."""
+
+from __future__ import annotations
+
+from rich.text import Text
+from textual.widgets import Static
+
+from kinema.tui.connection import ConnectionState
+from kinema.tui.runtime_status import RuntimeStatus
+
+_STATE_STYLE = {
+    ConnectionState.CONNECTED: ("●", "green"),
+    ConnectionState.CONNECTING: ("◌", "yellow"),
+    ConnectionState.DISCONNECTED: ("○", "red"),
+}
+STATUS_STYLE = {
+    "Running": "bold yellow",
+    "Loading": "yellow",
+    "Success": "bold green",
+    "Failure": "bold red",
+    "Cancelled": "magenta",
+    "Idle": "dim",
+    "Unknown": "dim",
+}
+
+
+class StatusBar(Static):
+    """Shows a :class:`RuntimeStatus`; the app sets it with :meth:`show` (attributes down)."""
+
+    DEFAULT_CSS = """
+    StatusBar { height: 1; background: $panel; color: $text; padding: 0 1; }
+    """
+
+    def show(self, status: RuntimeStatus) -> None:
+        """Render ``status``."""
+        self.update(render_status(status))
+
+
+def render_status(status: RuntimeStatus) -> Text:
+    """The status line as rich text (also used by tests to check wording)."""
+    symbol, colour = _STATE_STYLE[status.state]
+    text = Text()
+    text.append(f"{symbol} {status.state.value}", style=f"bold {colour}")
+    if status.endpoint:
+        text.append(f" {status.endpoint}", style="dim")
+    if status.state is ConnectionState.DISCONNECTED:
+        if status.detail:
+            text.append(f" — {status.detail}", style="red")
+        return text
+    text.append("  │  ")
+    if status.objective:
+        text.append(status.objective, style="bold")
+        text.append(" ")
+    text.append(status.status, style=STATUS_STYLE.get(status.status, ""))
+    if status.elapsed is not None and status.objective:
+        text.append(f" {status.elapsed:.1f} s")
+    if status.sim_time is not None:
+        text.append("  │  sim ")
+        text.append(f"{status.sim_time:.2f} s")
+        if status.real_time_factor is not None:
+            text.append(f"  RTF {status.real_time_factor:.2f}x")
+    return text
