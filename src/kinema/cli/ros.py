@@ -55,7 +55,14 @@ def _node(connect: str | None, timeout: float) -> Iterator[Node]:
 
 
 def _graph(node: Node, timeout: float) -> Graph:
-    return node.graph(timeout=min(timeout, 2.0))
+    """The network's graph; asks again while only this process shows up (links may still be forming)."""
+    deadline = time.monotonic() + timeout
+    own = node.session.zid
+    while True:
+        graph = node.graph(timeout=max(0.05, min(deadline - time.monotonic(), 2.0)))
+        if any(entity.zid != own for entity in graph.entities) or time.monotonic() >= deadline:
+            return graph
+        time.sleep(0.05)
 
 
 def _print_names(names_and_types: dict[str, list[str]], show_types: bool, as_json: bool) -> None:
@@ -64,6 +71,25 @@ def _print_names(names_and_types: dict[str, list[str]], show_types: bool, as_jso
         return
     for name, types in names_and_types.items():
         click.echo(f"{name} [{', '.join(types)}]" if show_types else name)
+
+
+def _print_endpoints(graph: Graph, kinds: tuple[str, ...], hidden: bool) -> None:
+    """One line per endpoint: name, role, node, type and RIHS01 hash (to spot definition mismatches)."""
+    from kinema.transport.keys import EntityKind
+
+    roles = {
+        EntityKind.PUBLISHER: "publisher",
+        EntityKind.SUBSCRIPTION: "subscription",
+        EntityKind.SERVICE_SERVER: "server",
+        EntityKind.SERVICE_CLIENT: "client",
+    }
+    rows = sorted(
+        (entity.name, roles[entity.kind], entity.node_fqn, entity.type_name, entity.type_hash)
+        for entity in graph.of_kind(*(EntityKind(kind) for kind in kinds))
+        if hidden or "/_action/" not in entity.name
+    )
+    for row in rows:
+        click.echo("  ".join(row))
 
 
 def _discover_type(
