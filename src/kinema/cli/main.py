@@ -95,7 +95,10 @@ def cli() -> None:
 def main(argv: list[str] | None = None) -> int:
     """Run the CLI; handled errors print one line on stderr and exit 1, never a traceback."""
     try:
-        cli.main(args=argv, prog_name="kinema", standalone_mode=False)
+        # Outside standalone mode click returns (rather than raises) the code of `raise Exit(code)`.
+        result = cli.main(args=argv, prog_name="kinema", standalone_mode=False)
+        if isinstance(result, int) and not isinstance(result, bool):
+            return result
     except click.exceptions.Abort:
         click.echo("Aborted.", err=True)
         return 130
