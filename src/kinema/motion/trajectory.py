@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -62,6 +63,44 @@ class JointTrajectory:
             raise MotionError("a trajectory needs at least one point")
         if n > 1 and np.any(np.diff(self.times) <= 0):
             raise MotionError("trajectory times must increase strictly")
+
+    @classmethod
+    def from_points(
+        cls,
+        joint_names: Sequence[str],
+        times: Sequence[float],
+        positions: Sequence[Sequence[float]],
+        velocities: Sequence[Sequence[float]] | None = None,
+        accelerations: Sequence[Sequence[float]] | None = None,
+    ) -> JointTrajectory:
+        """Build a trajectory from plain lists (a received ``trajectory_msgs/JointTrajectory``, say).
+
+        Missing velocities are estimated by central differences (zero at both ends), so :meth:`sample`
+        passes through the points smoothly instead of stopping at each; missing accelerations are zero.
+
+        Raises:
+            MotionError: inconsistent lengths or times that do not increase.
+        """
+        shape = (len(times), len(joint_names))
+        try:
+            t = np.asarray(times, dtype=float)
+            q = np.asarray(positions, dtype=float).reshape(shape)
+            if velocities is None or len(velocities) == 0:
+                qd = np.zeros_like(q)
+                if len(t) > 2:
+                    qd[1:-1] = (q[2:] - q[:-2]) / (t[2:] - t[:-2])[:, None]
+            else:
+                qd = np.asarray(velocities, dtype=float).reshape(shape)
+            if accelerations is None or len(accelerations) == 0:
+                qdd = np.zeros_like(q)
+            else:
+                qdd = np.asarray(accelerations, dtype=float).reshape(shape)
+        except ValueError as exc:
+            raise MotionError(
+                f"a trajectory of {shape[0]} points over {shape[1]} joints ({', '.join(joint_names)}) "
+                f"needs {shape[0]} rows of {shape[1]} values each: {exc}"
+            ) from exc
+        return cls(tuple(joint_names), t, q, qd, qdd)
 
     @property
     def duration(self) -> float:

@@ -88,3 +88,16 @@ def test_malformed_trajectory_is_rejected():
         JointTrajectory(("a",), np.array([0.0, 0.0]), np.zeros((2, 1)), np.zeros((2, 1)), np.zeros((2, 1)))
     with pytest.raises(MotionError, match="positions must have shape"):
         JointTrajectory(("a",), np.array([0.0]), np.zeros((1, 2)), np.zeros((1, 1)), np.zeros((1, 1)))
+
+
+def test_from_points_fills_in_velocities_so_motion_does_not_stop_at_points():
+    traj = JointTrajectory.from_points(["a"], [0.0, 1.0, 2.0], [[0.0], [1.0], [2.0]])
+    assert traj.velocities[:, 0].tolist() == [0.0, 1.0, 0.0]
+    assert traj.sample(1.0)[1][0] == pytest.approx(1.0)
+    with pytest.raises(MotionError, match="times must increase"):
+        JointTrajectory.from_points(["a"], [0.0, 0.0], [[0.0], [1.0]])
+
+
+def test_from_points_rejects_mismatched_lengths():
+    with pytest.raises(MotionError, match="needs 2 rows of 2 values"):
+        JointTrajectory.from_points(["a", "b"], [0.0, 1.0], [[0.0, 1.0], [1.0]])
