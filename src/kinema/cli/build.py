@@ -1,0 +1,150 @@
+"""``kinema build`` and ``kinema test``: prepare and check a workspace's behavior packages."""
+
+from __future__ import annotations
+
+import sys
+from pathlib import Path
+
+import click
+
+from kinema.cli.options import selection_options
+
+
+def _model_path(workspace_root: Path | None, config: str) -> Path:
+    if workspace_root is not None:
+        return workspace_root / "build" / "kinema" / config / "tree_nodes_model.xml"
+    import platformdirs
+
+    return Path(platformdirs.user_cache_dir("kinema")) / config / "tree_nodes_model.xml"
+
+
+@click.command()
+@click.argument(
+    "target", type=click.Choice(["all", "user_workspace"]), default="user_workspace", required=False
+)
+@click.option(
+    "--packages-select",
+    multiple=True,
+    metavar="PKG",
+    help="Only these behavior packages (repeat the option for several).",
+)
+@click.option("--skip-install", is_flag=True, help="Do not install dependencies; only validate and export.")
+@selection_options
+def build(
+    target: str,
+    packages_select: tuple[str, ...],
+    skip_install: bool,
+    workspace: Path | None,
+    config: str | None,
+) -> None:
+    """Install dependencies, validate the objectives and export the TreeNodesModel for Groot2.
+
+    1. pip-installs what each behavior package of the workspace declares in [project] dependencies
+       (already satisfied requirements are skipped, so it is fast and offline when nothing changed);
+    2. loads the active config's behavior plugins and validates every objective of its objective
+       library against them (unknown behaviors, ports, types, missing subtrees), printing file:line;
+    3. writes the TreeNodesModel XML of the config's behaviors and prints its path.
+
+    TARGET is accepted for MoveIt Pro habits: `all` and `user_workspace` do the same here (there is no
+    image to build; behavior packages are loaded from their folders). Exits 1 on any error.
+    """
+    from kinema.cli.options import resolve_selection
+    from kinema.config import resolve_config
+    from kinema.plugins import BehaviorHost
+    from kinema.plugins.dependencies import pip_install, unsatisfied, workspace_behavior_packages
+    from kinema.plugins.validation import validate_objectives, write_tree_nodes_model
+
+    found, name = resolve_selection(workspace, config)
+    errors = 0
+    packages = workspace_behavior_packages(found.root, packages_select) if found.root is not None else []
+    if packages_select and found.root is None:
+        raise click.UsageError("--packages-select needs a workspace (-w PATH)")
+    if not skip_install:
+        for index, package in enumerate(packages, start=1):
+            prefix = f"[{index}/{len(packages)}] {package.name}:"
+            missing = unsatisfied(package.dependencies)
+            if not missing:
+                click.echo(f"{prefix} dependencies satisfied ({len(package.dependencies)})")
+                continue
+            click.echo(f"{prefix} installing {', '.join(missing)}")
+            pip_install(missing, lambda line: click.echo(f"    {line}"))
+
+    resolved = resolve_config(name, found)
+    host = BehaviorHost.for_config(resolved)
+    report = host.load()
+    for warning in report.warnings:
+        click.secho(f"warning: {warning}", err=True, fg="yellow")
+    for error in report.errors:
+        click.secho(str(error), err=True, fg="red")
+        errors += 1
+    registry = host.registry
+    click.echo(f"{len(registry)} behaviors from {len(host.plugins)} plugins for config {resolved.name}")
+
+    file_count, problems = validate_objectives(resolved, registry)
+    for problem in problems:
+        click.secho(str(problem), err=True, fg="red")
+    errors += len(problems)
+    click.echo(f"validated {file_count} objective files: {len(problems)} problems")
+
+    model = write_tree_nodes_model(registry, _model_path(found.root, resolved.name))
+    click.echo(f"TreeNodesModel for Groot2: {model}")
+    if errors:
+        click.secho(f"build failed: {errors} errors", err=True, fg="red")
+        raise click.exceptions.Exit(1)
+
+
+@click.command()
+@click.option(
+    "--packages-select",
+    multiple=True,
+    metavar="PKG",
+    help="Only these behavior packages (repeat the option for several).",
+)
+@click.option(
+    "-w",
+    "--workspace",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    help="Workspace folder (default: $KINEMA_WORKSPACE, else the one set with `kinema configure`).",
+)
+@click.argument("pytest_args", nargs=-1, type=click.UNPROCESSED)
+def test(packages_select: tuple[str, ...], workspace: Path | None, pytest_args: tuple[str, ...]) -> None:
+    """Run the tests of the workspace's behavior packages with Kinema's pytest plugin.
+
+    Each package's tests run in their own pytest process from the package folder, with the fixtures of
+    kinema.testing (tick_behavior, build_tree, run_objective, kinema_node, package_registry). Extra
+    arguments after `--` go to pytest, e.g. `kinema test -- -k adds -x`. Exits 1 if any test fails.
+    """
+    import subprocess
+
+    from kinema.cli.options import resolve_selection
+    from kinema.errors import KinemaError
+    from kinema.plugins.dependencies import workspace_behavior_packages
+
+    found, _ = resolve_selection(workspace, None, need_config=False)
+    if found.root is None:
+        raise KinemaError("no workspace is selected: pass -w PATH or run `kinema configure -w PATH`")
+    packages = workspace_behavior_packages(found.root, packages_select)
+    if not packages:
+        click.echo(f"no behavior packages in {found.root / 'src'} (create one with `kinema new behavior`)")
+        return
+    failed: list[str] = []
+    plugin_args = [] if _plugin_installed() else ["-p", "kinema.testing.plugin"]
+    for package in packages:
+        if not package.has_tests:
+            click.echo(f"{package.name}: no tests/ folder, skipped")
+            continue
+        click.secho(f"== {package.name} ({package.path})", bold=True)
+        command = [sys.executable, "-m", "pytest", *plugin_args, *pytest_args]
+        if subprocess.run(command, cwd=package.path).returncode != 0:
+            failed.append(package.name)
+    if failed:
+        click.secho(f"tests failed in: {', '.join(failed)}", err=True, fg="red")
+        raise click.exceptions.Exit(1)
+    click.secho(f"all tests passed ({len(packages)} packages)", fg="green")
+
+
+def _plugin_installed() -> bool:
+    from importlib import metadata
+
+    return any(entry.name == "kinema" for entry in metadata.entry_points(group="pytest11"))
