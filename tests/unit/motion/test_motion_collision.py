@@ -78,3 +78,22 @@ def test_first_invalid_finds_the_colliding_segment(model, lab_scene, waypoint_q)
     through_table = model.configuration({**HOME, "shoulder_lift_joint": -0.2, "elbow_joint": 0.5}, mid)
     assert checker.first_invalid(np.array([mid, waypoint_q("Home")])) is None
     assert checker.first_invalid(np.array([waypoint_q("Home"), mid, through_table])) == 1
+
+
+def test_free_bodies_can_join_the_scene(description, model):
+    scene = PlanningScene.from_mjcf(description.mjcf, model.link_names, include_free_bodies=True)
+    cube = scene.objects["cube"]
+    assert cube.shape == "box" and cube.size == pytest.approx((0.025, 0.025, 0.025))
+    np.testing.assert_allclose(cube.world_T_object[:3, 3], (0.62, 0.30, 0.775), atol=1e-6)
+
+
+def test_importing_motion_is_light():
+    import subprocess
+    import sys
+
+    code = (
+        "import sys, kinema.motion, kinema.motion.trajectory;"
+        "print([m for m in ('pinocchio', 'ompl', 'toppra', 'mujoco', 'coal') if m in sys.modules])"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.strip() == "[]"
