@@ -129,14 +129,20 @@ def topic() -> None:
 @click.option("-t", "--show-types", is_flag=True, help="Show each topic's type.")
 @click.option("-a", "--include-hidden", is_flag=True, help="Include action internals (…/_action/…).")
 @click.option("--json", "as_json", is_flag=True, help="Print {topic: [types]} as JSON.")
+@click.option(
+    "-v", "--verbose", is_flag=True, help="One line per publisher/subscription with node and type hash."
+)
 @_common(2.0)
 def topic_list(
-    show_types: bool, include_hidden: bool, as_json: bool, connect: str | None, timeout: float
+    show_types: bool, include_hidden: bool, as_json: bool, verbose: bool, connect: str | None, timeout: float
 ) -> None:
     """List the topics that have a publisher or a subscription."""
     with _node(connect, timeout) as node:
-        topics = _graph(node, timeout).topics(hidden=include_hidden)
-    _print_names(topics, show_types, as_json)
+        graph = _graph(node, timeout)
+    if verbose:
+        _print_endpoints(graph, ("MP", "MS"), include_hidden)
+        return
+    _print_names(graph.topics(hidden=include_hidden), show_types, as_json)
 
 
 @topic.command("echo")
@@ -315,14 +321,18 @@ def service() -> None:
 @click.option("-t", "--show-types", is_flag=True, help="Show each service's type.")
 @click.option("-a", "--include-hidden", is_flag=True, help="Include action internals (…/_action/…).")
 @click.option("--json", "as_json", is_flag=True, help="Print {service: [types]} as JSON.")
+@click.option("-v", "--verbose", is_flag=True, help="One line per server/client with node and type hash.")
 @_common(2.0)
 def service_list(
-    show_types: bool, include_hidden: bool, as_json: bool, connect: str | None, timeout: float
+    show_types: bool, include_hidden: bool, as_json: bool, verbose: bool, connect: str | None, timeout: float
 ) -> None:
     """List the services that have a server or a client."""
     with _node(connect, timeout) as node:
-        services = _graph(node, timeout).services(hidden=include_hidden)
-    _print_names(services, show_types, as_json)
+        graph = _graph(node, timeout)
+    if verbose:
+        _print_endpoints(graph, ("SS", "SC"), include_hidden)
+        return
+    _print_names(graph.services(hidden=include_hidden), show_types, as_json)
 
 
 @service.command("call")

@@ -69,6 +69,7 @@ def test_list_verbs_show_names_and_types(
     assert "/add_two_ints [example_interfaces/srv/AddTwoInts]" in out.splitlines()
     assert not any("_action" in line for line in out.splitlines())
     code, out, _ = _run(capsys, "service", "list", "-v", "--connect", router_endpoint)
+    assert code == 0
     assert (
         "/add_two_ints  server  /demo_server  example_interfaces/srv/AddTwoInts  "
         "RIHS01_e118de6bf5eeb66a2491b5bda11202e7b68f198d6f67922cf30364858239c81a"
