@@ -108,3 +108,31 @@ def test_unreachable_goal_times_out_with_a_reason(model, checker, waypoint_q):
     assert not checker.in_collision(model.configuration(goal, home))
     with pytest.raises(MotionError, match=r"no collision-free path found within 0.30 s \(RRTConnect"):
         plan_joint_goal(checker, home, goal, group="linear_actuator", options=PlanningOptions(timeout=0.3))
+
+
+@pytest.mark.parametrize(
+    ("start", "goal", "object_at"),
+    [
+        ("3 Waypoint Mid Point", "3 Waypoint Pick Pose", "table"),
+        ("3 Waypoint Mid Point", "3 Waypoint Place Pose", "tray"),
+    ],
+)
+def test_open_gripper_comes_down_around_the_cube_without_touching_it(
+    model, description, waypoint_q, arm_goal, start, goal, object_at
+):
+    """The planned approach never touches the cube waiting at the pick (or place) spot, though the planner
+    does not know the cube is there: the waypoints make the straight move come down around it."""
+    from kinema.motion import CollisionChecker, PlanningScene
+
+    scene = PlanningScene.from_mjcf(description.mjcf, model.link_names, include_free_bodies=True)
+    cube = scene.objects.pop("cube")
+    planner_checker = CollisionChecker(model, scene, padding=0.01)
+    path = plan_joint_goal(planner_checker, waypoint_q(start), arm_goal(goal))
+    if object_at == "tray":
+        T = cube.world_T_object.copy()
+        T[1, 3] = -T[1, 3]  # the tray spot mirrors the pick spot across the rail's middle
+        T[2, 3] += 0.004  # on the tray floor
+        cube = type(cube)(cube.name, cube.shape, cube.size, T)
+    with_cube = PlanningScene({"cube": cube})
+    cube_checker = CollisionChecker(model, with_cube, padding=0.005)
+    assert cube_checker.first_invalid(_full(model, waypoint_q(start), path), max_step=0.002) is None
