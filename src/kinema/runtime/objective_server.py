@@ -460,6 +460,10 @@ class ObjectiveServer:
         if request.objective_name:
             names = self._source.objective_names()
             if request.objective_name not in names:
+                explain = getattr(self._source, "load_error", None)
+                problem = explain(request.objective_name) if explain is not None else None
+                if problem:
+                    raise ObjectiveError(f"objective {request.objective_name!r} cannot run: {problem}")
                 alternatives = did_you_mean(request.objective_name, names)
                 raise ObjectiveError(f"unknown objective {request.objective_name!r}; {alternatives}")
             return factory.create_tree(request.objective_name), request.objective_name

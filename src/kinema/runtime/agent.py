@@ -1,0 +1,534 @@
+"""The agent: the objective server served on the transport, with its streams and library services.
+
+Serves (names in :mod:`kinema.runtime.names`): ``/execute_objective``, ``/cancel_objective``,
+``/do_objective`` (action), the objective list and XML services, ``/get_saved_waypoints`` and
+``/edit_waypoints``. Publishes the heartbeat (10 Hz and on every change, latched), node status changes,
+a latched blackboard snapshot (at most 10 Hz, only when it changed) and the behaviors' log messages
+(toasts, plus hot-reload events).
+
+Build one with :meth:`Agent.for_config` (what ``kinema run`` does, through ``python -m
+kinema.runtime.agent``) or directly from an :class:`ObjectiveServer` for tests and embedding.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from kinema.errors import KinemaError, ObjectiveError
+from kinema.runtime import names
+from kinema.runtime.error_codes import MoveItErrorCode
+from kinema.runtime.objective_server import (
+    NodeStatusChange,
+    ObjectiveRequest,
+    ObjectiveRun,
+    ObjectiveServer,
+)
+from kinema.runtime.objective_status import ObjectiveStatus
+from kinema.runtime.overrides import ParameterOverride
+from kinema.runtime.result import ObjectiveResult
+
+if TYPE_CHECKING:
+    from kinema.behaviors.logger import LogMessage, LogSink
+    from kinema.bt import Clock
+    from kinema.config import ObjectiveInfo, WaypointStore
+    from kinema.plugins import BehaviorHost, ReloadEvent
+    from kinema.runtime.objective_source import LibraryTreeSource
+    from kinema.transport import Node, Session
+
+log = logging.getLogger("kinema.agent")
+
+# Blackboard values are rendered for display; longer renderings are cut.
+MAX_VALUE_CHARS = 2000
+LOG_ERROR, LOG_WARN, LOG_INFO = 1, 2, 3
+
+
+def _stamp(seconds: float) -> dict[str, int]:
+    sec = int(seconds)
+    return {"sec": sec, "nanosec": int((seconds - sec) * 1e9)}
+
+
+def overrides_from_messages(parameters: Sequence[Any]) -> tuple[ParameterOverride, ...]:
+    """Turn ``BehaviorParameter`` messages into overrides (string values are YAML text).
+
+    Raises:
+        ObjectiveError: a parameter without a name, or of an unknown type.
+    """
+    result = []
+    for parameter in parameters:
+        name = parameter.description.name
+        kind = int(parameter.description.type)
+        namespaces = tuple(str(n) for n in parameter.behavior_namespaces)
+        if not name:
+            raise ObjectiveError("a parameter override has an empty name")
+        if kind == 0:
+            result.append(ParameterOverride(name, parameter.string_value, namespaces))
+        elif kind == 1:
+            result.append(ParameterOverride(name, parameter.pose_value, namespaces, from_yaml=False))
+        elif kind == 2:
+            result.append(ParameterOverride(name, float(parameter.double_value), namespaces, from_yaml=False))
+        elif kind == 3:
+            result.append(ParameterOverride(name, int(parameter.int_value), namespaces, from_yaml=False))
+        elif kind == 4:
+            result.append(ParameterOverride(name, bool(parameter.bool_value), namespaces, from_yaml=False))
+        elif kind == 5:
+            result.append(ParameterOverride(name, parameter.joint_state_value, namespaces, from_yaml=False))
+        else:
+            raise ObjectiveError(
+                f"parameter override {name!r} has type {kind}; valid: 0 (string, YAML), 1 (pose), "
+                f"2 (double), 3 (int), 4 (bool), 5 (joint state)"
+            )
+    return tuple(result)
+
+
+def render_value(value: Any) -> str:
+    """A blackboard value as one line of YAML flow text (messages as their fields), cut when long."""
+    import yaml
+
+    from kinema.transport.messages import to_dict
+
+    try:
+        data = to_dict(value)
+        if isinstance(data, str | int | float | bool | list | dict | type(None)):
+            text = yaml.safe_dump(data, default_flow_style=True, width=1 << 30).strip()
+            if text.endswith("\n..."):
+                text = text[:-4].strip()
+            text = text.removesuffix("...").strip()
+        else:
+            text = repr(value)
+    except Exception:
+        text = repr(value)
+    return text if len(text) <= MAX_VALUE_CHARS else text[: MAX_VALUE_CHARS - 1] + "…"
+
+
+class _Streams:
+    """Publishes what the server reports (a :class:`ServerListener`, called on the tick thread)."""
+
+    def __init__(self, node: Node, clock: Clock | None) -> None:
+        self._node = node
+        self._clock = clock
+        self._heartbeat = node.create_publisher(names.HEARTBEAT_TYPE, names.HEARTBEAT, latched=True)
+        self._node_status = node.create_publisher(names.NODE_STATUS_TYPE, names.NODE_STATUS)
+        self._blackboard = node.create_publisher(names.BLACKBOARD_TYPE, names.BLACKBOARD, latched=True)
+        self._log = node.create_publisher(names.LOG_TYPE, names.LOG)
+        self._status: tuple[ObjectiveStatus, str] = (ObjectiveStatus.IDLE, "")
+        self._last_blackboard: list[tuple[str, str, str, str]] | None = None
+        self._lock = threading.Lock()
+
+    def publish_heartbeat(self) -> None:
+        from kinema.transport.messages import msg
+
+        status, name = self._status
+        now = time.time()
+        clock_now = self._clock.now() if self._clock is not None and not _is_wall(self._clock) else now
+        message = msg(
+            names.HEARTBEAT_TYPE,
+            process_timestamp=_stamp(now),
+            ros_timestamp=_stamp(clock_now),
+            objective_name=name,
+            objective_status=str(status),
+        )
+        with self._lock:
+            self._heartbeat.publish(message)
+
+    def publish_log(self, level: int, text: str) -> None:
+        from kinema.transport.messages import msg
+
+        try:
+            self._log.publish(msg(names.LOG_TYPE, message=text, log_level=level))
+        except KinemaError:
+            log.debug("log publisher closed", exc_info=True)
+
+    # ServerListener
+    def on_status(self, status: ObjectiveStatus, objective_name: str) -> None:
+        self._status = (status, objective_name)
+        log.info("objective %r: %s", objective_name, status)
+        self.publish_heartbeat()
+
+    def on_node_status(self, objective_name: str, changes: list[NodeStatusChange]) -> None:
+        from kinema.transport.messages import msg
+
+        items = [
+            {
+                "stamp": _stamp(change.timestamp),
+                "objective_name": objective_name,
+                "uid": change.uid,
+                "node_path": change.node_path,
+                "node_id": change.node_id,
+                "node_name": change.node_name,
+                "previous_status": change.previous,
+                "status": change.status,
+            }
+            for change in changes
+        ]
+        self._node_status.publish(msg(names.NODE_STATUS_TYPE, changes=items))
+
+    def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
+        from kinema.transport.messages import msg
+
+        rendered = [(scope, key, type_name, render_value(value)) for scope, key, type_name, value in entries]
+        if rendered == self._last_blackboard:
+            return
+        self._last_blackboard = rendered
+        self._blackboard.publish(
+            msg(
+                names.BLACKBOARD_TYPE,
+                stamp=_stamp(time.time()),
+                objective_name=objective_name,
+                entries=[
+                    {"scope": scope, "key": key, "type_name": type_name, "value_yaml": value}
+                    for scope, key, type_name, value in rendered
+                ],
+            )
+        )
+
+    def on_run_finished(self, run: ObjectiveRun, result: ObjectiveResult) -> None:
+        if result.succeeded:
+            log.info("%s", result)
+        elif result.cancelled:
+            log.info("%s", result)
+            self.publish_log(LOG_WARN, str(result))
+        else:
+            log.error("%s", result)
+            self.publish_log(LOG_ERROR, str(result))
+
+
+def _is_wall(clock: Clock) -> bool:
+    return bool(getattr(clock, "realtime", False))
+
+
+def result_message(result: ObjectiveResult) -> dict[str, Any]:
+    """A ``MoveItErrorCodes`` dict for a result."""
+    return {"val": int(result.error_code), "message": result.error_message, "source": names.NODE_NAME}
+
+
+class Agent:
+    """Serves an :class:`ObjectiveServer` on a transport node.
+
+    Args:
+        session: the transport session (the agent creates its node on it).
+        server: the objective server (the agent starts and stops it).
+        source: the tree source, for the objective list services (optional).
+        waypoints: the waypoint store served by the waypoint services (optional).
+        log_sink: the behaviors' log sink; its messages are published as toasts (optional).
+        clock: the runtime clock, for the heartbeat's ``ros_timestamp``.
+    """
+
+    def __init__(
+        self,
+        session: Session,
+        server: ObjectiveServer,
+        *,
+        source: LibraryTreeSource | None = None,
+        waypoints: WaypointStore | None = None,
+        log_sink: LogSink | None = None,
+        clock: Clock | None = None,
+        node: Node | None = None,
+    ) -> None:
+        from kinema.transport import Node
+
+        self.session = session
+        self.server = server
+        self.source = source
+        self.waypoints = waypoints
+        self.clock = clock
+        self.node = node if node is not None else Node(session, names.NODE_NAME)
+        self._streams = _Streams(self.node, clock)
+        server.add_listener(self._streams)
+        self._goal_runs: dict[bytes, ObjectiveRun] = {}
+        self._goal_lock = threading.Lock()
+        self._stop = threading.Event()
+        self._joint_state: Any = None
+        self._unsubscribe: list[Any] = []
+        if log_sink is not None:
+            self._unsubscribe.append(log_sink.subscribe(self._on_behavior_log))
+        self._heartbeat_thread = threading.Thread(
+            target=self._heartbeat_loop, name="kinema-heartbeat", daemon=True
+        )
+        self._declare()
+
+    def _declare(self) -> None:
+        node = self.node
+        node.create_service(
+            names.EXECUTE_OBJECTIVE_TYPE, names.EXECUTE_OBJECTIVE, self._on_execute, deferred=True
+        )
+        node.create_service(names.CANCEL_OBJECTIVE_TYPE, names.CANCEL_OBJECTIVE, self._on_cancel)
+        node.create_action_server(
+            names.DO_OBJECTIVE_TYPE,
+            names.DO_OBJECTIVE,
+            self._on_do_objective,
+            cancel_callback=self._on_cancel_goal,
+        )
+        node.create_service(names.LIST_OBJECTIVES_TYPE, names.LIST_OBJECTIVES, self._on_list_objectives)
+        node.create_service(names.GET_OBJECTIVE_XML_TYPE, names.GET_OBJECTIVE_XML, self._on_get_objective_xml)
+        node.create_service(names.GET_WAYPOINTS_TYPE, names.GET_WAYPOINTS, self._on_get_waypoints)
+        node.create_service(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, self._on_edit_waypoints)
+        if self.waypoints is not None:
+            node.create_subscription(names.JOINT_STATES_TYPE, names.JOINT_STATES, self._on_joint_states)
+
+    # -- lifecycle -----------------------------------------------------------------------------------
+
+    def start(self) -> None:
+        """Start ticking and publishing the heartbeat."""
+        self.server.start()
+        self._streams.publish_heartbeat()
+        self._heartbeat_thread.start()
+
+    def close(self) -> None:
+        """Stop the server (a running objective ends PREEMPTED) and withdraw every endpoint."""
+        self._stop.set()
+        for unsubscribe in self._unsubscribe:
+            unsubscribe()
+        self.server.stop()
+        if self._heartbeat_thread.is_alive():
+            self._heartbeat_thread.join(1.0)
+        self.node.close()
+
+    def __enter__(self) -> Agent:
+        self.start()
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def _heartbeat_loop(self) -> None:
+        while not self._stop.wait(names.HEARTBEAT_PERIOD_S):
+            try:
+                self._streams.publish_heartbeat()
+            except KinemaError:
+                if self._stop.is_set():
+                    return
+                log.debug("heartbeat not published", exc_info=True)
+
+    # -- objectives ----------------------------------------------------------------------------------
+
+    def _on_execute(self, request: Any, responder: Any) -> None:
+        try:
+            overrides = overrides_from_messages(request.parameter_overrides)
+        except ObjectiveError as error:
+            result = ObjectiveResult.failure(str(error), request.objective_name)
+            responder.reply({"error_code": result_message(result)})
+            return
+        if not request.objective_name:
+            result = ObjectiveResult.failure("ExecuteObjective needs an objective_name")
+            responder.reply({"error_code": result_message(result)})
+            return
+        run = self.server.submit(ObjectiveRequest(request.objective_name, "", overrides, "execute_objective"))
+
+        def reply(result: ObjectiveResult) -> None:
+            try:
+                responder.reply({"error_code": result_message(result)})
+            except Exception:
+                log.debug("could not answer /execute_objective (client gone?)", exc_info=True)
+
+        run.add_done_callback(reply)
+
+    def _on_cancel(self, request: Any) -> dict[str, Any]:
+        cancelled = self.server.cancel(reason="cancelled by /cancel_objective")
+        if cancelled:
+            return {"status": {"success": True, "error_message": ""}}
+        return {"status": {"success": False, "error_message": "no objective is running"}}
+
+    def _on_do_objective(self, handle: Any) -> Any:
+        goal = handle.goal
+        try:
+            overrides = overrides_from_messages(goal.parameter_overrides)
+        except ObjectiveError as error:
+            result = ObjectiveResult.failure(str(error), goal.objective_name)
+            handle.abort({"error_code": result_message(result), "error_message": result.error_message})
+            return None
+        request = ObjectiveRequest(goal.objective_name, goal.objective_xml_string, overrides, "do_objective")
+        run = self.server.submit(request)
+        with self._goal_lock:
+            self._goal_runs[handle.goal_id] = run
+        try:
+            if handle.is_cancel_requested:
+                self.server.cancel(run, reason="goal cancelled", timeout=0)
+            result = run.wait()
+        finally:
+            with self._goal_lock:
+                self._goal_runs.pop(handle.goal_id, None)
+        assert result is not None
+        payload = {"error_code": result_message(result), "error_message": result.error_message}
+        if result.succeeded:
+            handle.succeed(payload)
+        elif result.cancelled:
+            handle.canceled(payload)
+        else:
+            handle.abort(payload)
+        return None
+
+    def _on_cancel_goal(self, handle: Any) -> bool:
+        with self._goal_lock:
+            run = self._goal_runs.get(handle.goal_id)
+        if run is not None:
+            # Non-blocking: the tick thread halts the tree right away; the execute thread reports it.
+            self.server.cancel(run, reason="goal cancelled", timeout=0)
+        return True
+
+    # -- library -----------------------------------------------------------------------------------
+
+    def _on_list_objectives(self, request: Any) -> dict[str, Any]:
+        if self.source is None:
+            names_only = self.server._source.objective_names()
+            return {
+                "status": {"success": True},
+                "objectives": [{"name": n, "runnable": True} for n in names_only],
+            }
+        infos = self.source.objectives()
+        if request.subcategory:
+            infos = [info for info in infos if info.subcategory == request.subcategory]
+        return {
+            "status": {"success": True, "error_message": ""},
+            "objectives": [_info_dict(i) for i in infos],
+        }
+
+    def _on_get_objective_xml(self, request: Any) -> dict[str, Any]:
+        if self.source is None:
+            return {"status": {"success": False, "error_message": "this agent has no objective library"}}
+        for info in self.source.objectives():
+            if info.id == request.objective_name:
+                try:
+                    return {"status": {"success": True}, "xml": Path(info.file).read_text(encoding="utf-8")}
+                except OSError as error:
+                    return {"status": {"success": False, "error_message": f"{info.file}: {error}"}}
+        from kinema.errors import did_you_mean
+
+        known = [info.id for info in self.source.objectives()]
+        message = (
+            f"no objective named {request.objective_name!r}; {did_you_mean(request.objective_name, known)}"
+        )
+        return {"status": {"success": False, "error_message": message}}
+
+    # -- waypoints ---------------------------------------------------------------------------------
+
+    def _on_joint_states(self, message: Any) -> None:
+        self._joint_state = message
+
+    def _on_get_waypoints(self, request: Any) -> dict[str, Any]:
+        if self.waypoints is None:
+            return {"status": {"success": False, "error_message": "the config has no waypoints file"}}
+        try:
+            waypoints = self.waypoints.all()
+        except KinemaError as error:
+            return {"status": {"success": False, "error_message": str(error)}}
+        return {"status": {"success": True}, "waypoints": [_waypoint_dict(w) for w in waypoints]}
+
+    def _on_edit_waypoints(self, request: Any) -> dict[str, Any]:
+        if self.waypoints is None:
+            return {"status": {"success": False, "error_message": "the config has no waypoints file"}}
+        operation = int(request.operation)
+        try:
+            if operation == 0:
+                waypoint = self._save_current(request.waypoint_name, list(request.joint_group_names))
+                return {"status": {"success": True}, "new_waypoint": _waypoint_dict(waypoint)}
+            if operation == 1:
+                self.waypoints.rename(request.waypoint_name, request.existing_waypoint_new_name)
+                renamed = self.waypoints.get(request.existing_waypoint_new_name)
+                return {"status": {"success": True}, "new_waypoint": _waypoint_dict(renamed)}
+            if operation == 2:
+                self.waypoints.erase(request.waypoint_name)
+                return {"status": {"success": True}}
+        except KinemaError as error:
+            return {"status": {"success": False, "error_message": str(error)}}
+        return {
+            "status": {
+                "success": False,
+                "error_message": f"unknown operation {operation}; valid: 0 (SAVE), 1 (RENAME), 2 (ERASE)",
+            }
+        }
+
+    def _save_current(self, name: str, groups: list[str]) -> Any:
+        from kinema.config import Waypoint
+
+        assert self.waypoints is not None
+        state = self._joint_state
+        if state is None:
+            raise ObjectiveError(f"cannot save waypoint {name!r}: no /joint_states received yet")
+        waypoint = Waypoint(
+            name=name,
+            joint_names=[str(n) for n in state.name],
+            positions=[float(p) for p in state.position],
+            joint_group_names=groups,
+        )
+        self.waypoints.save(waypoint)
+        return waypoint
+
+    # -- logs ----------------------------------------------------------------------------------------
+
+    def _on_behavior_log(self, message: LogMessage) -> None:
+        level = {"info": LOG_INFO, "warn": LOG_WARN, "failure": LOG_ERROR}.get(str(message.level), LOG_INFO)
+        where = message.node_path or message.node_name or message.behavior_id
+        if str(message.level) == "failure" and message.node_path:
+            self.server.note_failure(message.node_path, message.text)
+        self._streams.publish_log(level, f"[{where}] {message.text}" if where else message.text)
+
+    def on_reload_event(self, event: ReloadEvent) -> None:
+        """Publish a hot-reload outcome as a toast (subscribe it to the behavior host)."""
+        self._streams.publish_log(LOG_INFO if event.ok else LOG_ERROR, str(event))
+        if str(event.kind) == "objectives_changed" and self.source is not None:
+            self.source.invalidate_objectives()
+
+
+def _info_dict(info: ObjectiveInfo) -> dict[str, Any]:
+    directions = {"input": 0, "output": 1, "inout": 2}
+    ports = []
+    for port in info.ports:
+        direction = getattr(port.direction, "value", port.direction)
+        ports.append(
+            {
+                "name": port.name,
+                "direction": directions.get(str(direction).lower(), 0)
+                if not isinstance(direction, int)
+                else direction,
+                "default_value": port.default or "",
+                "description": port.description or "",
+            }
+        )
+    return {
+        "name": info.id,
+        "description": info.description or "",
+        "subcategory": info.subcategory or "",
+        "runnable": bool(info.runnable),
+        "favorite": bool(info.favorite),
+        "package": info.package or "",
+        "file_path": str(info.file),
+        "ports": ports,
+    }
+
+
+def _waypoint_dict(waypoint: Any) -> dict[str, Any]:
+    return {
+        "name": waypoint.name,
+        "description": waypoint.description,
+        "favorite": waypoint.favorite,
+        "joint_group_names": list(waypoint.joint_group_names),
+        "joint_state": {
+            "name": list(waypoint.joint_names),
+            "position": [float(p) for p in waypoint.positions],
+            "velocity": [float(v) for v in waypoint.velocities],
+            "effort": [float(e) for e in waypoint.efforts],
+        },
+    }
+
+
+def error_code_of(result_msg: Any) -> int:
+    """The ``val`` of a MoveItErrorCodes message (0 when absent)."""
+    return int(getattr(result_msg, "val", MoveItErrorCode.UNDEFINED))
+
+
+def build_host(resolved: Any) -> BehaviorHost:
+    """Load the behavior plugins a resolved config activates; failures are logged, not fatal."""
+    from kinema.plugins import BehaviorHost
+
+    host = BehaviorHost.for_config(resolved)
+    report = host.load()
+    for warning in report.warnings:
+        log.warning("plugins: %s", warning)
+    for error in report.errors:
+        log.error("plugins: %s", error)
+    return host

@@ -1,0 +1,199 @@
+"""The agent as a process: ``python -m kinema.runtime.agent_process --config lab_sim ...``.
+
+``kinema run`` starts it as a child (so the tick thread never competes with the supervisor or a UI for
+the GIL, and a crash in a behavior cannot take the router down); tests start it with ``--objectives``
+folders and ``--host-router`` on a free port so they need no config package and no other process.
+It prints nothing on stdout; with ``--ready-fd N`` it writes ``ready`` to that file descriptor once
+every service is declared, which is how the supervisor knows objectives can be started.
+"""
+
+from __future__ import annotations
+
+import argparse
+import logging
+import os
+import signal
+import sys
+import threading
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any, Literal
+
+from kinema.errors import KinemaError
+
+if TYPE_CHECKING:
+    from kinema.runtime.agent import Agent
+    from kinema.transport import Session
+
+log = logging.getLogger("kinema.agent")
+
+ClockChoice = Literal["auto", "wall", "sim"]
+
+
+@dataclass
+class AgentOptions:
+    """How to build an agent.
+
+    Attributes:
+        config: the config package (None: no config, only ``objective_dirs`` and built-in nodes).
+        workspace: the workspace to resolve ``config`` in (None: the active one).
+        objective_dirs: extra objective folders (added after the config's libraries).
+        tick_rate_hz: ticks per second.
+        clock: ``sim`` follows ``/clock``; ``wall`` is wall time; ``auto`` picks sim when the config has
+            a simulator.
+        hot_reload: watch behavior packages and objective folders.
+    """
+
+    config: str | None = None
+    workspace: Path | None = None
+    objective_dirs: list[Path] = field(default_factory=list)
+    tick_rate_hz: float = 100.0
+    clock: ClockChoice = "auto"
+    hot_reload: bool = True
+
+
+def build_agent(options: AgentOptions, session: Session) -> Agent:
+    """Resolve the config, load behaviors and objectives, and return an :class:`Agent` (not started)."""
+    from kinema.behaviors.context import BehaviorContext
+    from kinema.behaviors.logger import LogSink
+    from kinema.bt import WallClock
+    from kinema.runtime import names
+    from kinema.runtime.agent import Agent, build_host
+    from kinema.runtime.objective_server import ObjectiveServer
+    from kinema.runtime.objective_source import LibraryTreeSource, library_from_folders
+    from kinema.runtime.sim_clock import SimClock
+    from kinema.transport import Node
+
+    resolved = None
+    if options.config:
+        from kinema.config import Workspace, resolve_config
+
+        workspace = Workspace.discover(options.workspace) if options.workspace else None
+        resolved = resolve_config(options.config, workspace)
+    use_sim = options.clock == "sim" or (
+        options.clock == "auto" and resolved is not None and resolved.mujoco_model_path is not None
+    )
+    clock: Any = SimClock() if use_sim else WallClock()
+    node = Node(session, names.NODE_NAME)
+    if use_sim:
+        node.create_subscription(names.CLOCK_TYPE, names.CLOCK, clock.on_clock_message)
+        log.info("time follows %s (simulation time)", names.CLOCK)
+    sink = LogSink()
+    context = BehaviorContext(node, clock=clock, log_sink=sink, robot_model=_robot_model_provider(resolved))
+    host = build_host(resolved) if resolved is not None else None
+    extra = [Path(folder) for folder in options.objective_dirs]
+
+    def load_library() -> Any:
+        from kinema.config import LibraryPath, ObjectiveLibrary
+
+        if resolved is None:
+            return library_from_folders(extra)
+        paths = list(resolved.objective_library_paths)
+        paths += [
+            LibraryPath(f"extra{i}", folder, resolved.name, resolved.name) for i, folder in enumerate(extra)
+        ]
+        library = ObjectiveLibrary.from_libraries(paths, resolved.chain)
+        library.resolved = resolved
+        return library
+
+    source = LibraryTreeSource(load_library, host=host, context=context, clock=clock)
+    source.factory()  # load now: errors show at start, and the first objective starts fast
+    waypoints = None
+    if resolved is not None and resolved.waypoints_path is not None:
+        from kinema.config import WaypointStore
+
+        waypoints = WaypointStore(resolved.waypoints_path)
+    server = ObjectiveServer(source, tick_rate_hz=options.tick_rate_hz)
+    agent = Agent(session, server, source=source, waypoints=waypoints, log_sink=sink, clock=clock, node=node)
+    if host is not None:
+        host.subscribe(agent.on_reload_event)
+        if options.hot_reload:
+            folders = [p.path for p in resolved.objective_library_paths] if resolved is not None else []
+            host.watch([*folders, *extra])
+    elif options.hot_reload and extra:
+        from kinema.plugins import BehaviorHost
+
+        watcher_host = BehaviorHost([])
+        watcher_host.subscribe(agent.on_reload_event)
+        watcher_host.watch(extra)
+    return agent
+
+
+def _robot_model_provider(resolved: Any) -> Any:
+    if resolved is None:
+        return None
+
+    def load() -> Any:
+        from kinema.motion.robot_model import RobotModel
+
+        return RobotModel.from_urdf(resolved.urdf_path, resolved.srdf_path, resolved.joint_limits_path)
+
+    return load
+
+
+def _parser() -> argparse.ArgumentParser:
+    parser = argparse.ArgumentParser(prog="python -m kinema.runtime.agent_process", description=__doc__)
+    parser.add_argument("--config", "-c", help="config package to run")
+    parser.add_argument("--workspace", "-w", type=Path, help="workspace to resolve the config in")
+    parser.add_argument("--objectives", action="append", type=Path, default=[], help="extra objective folder")
+    parser.add_argument("--connect", help="router endpoint to join (default KINEMA_ZENOH_CONNECT or 7447)")
+    parser.add_argument(
+        "--host-router", metavar="ENDPOINT", help="host the router here instead of joining one"
+    )
+    parser.add_argument("--tick-rate", type=float, default=100.0, help="ticks per second (default 100)")
+    parser.add_argument("--clock", choices=("auto", "wall", "sim"), default="auto", help="time source")
+    parser.add_argument("--no-hot-reload", action="store_true", help="do not watch files")
+    parser.add_argument("--log-file", type=Path, help="write the log there (run format)")
+    parser.add_argument("--ready-fd", type=int, help="write 'ready' to this file descriptor when serving")
+    parser.add_argument("--verbose", "-v", action="store_true", help="log at DEBUG level")
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the agent until SIGTERM/SIGINT; exit 1 with one line on stderr when it cannot start."""
+    from kinema.runtime.log_files import configure_process_logging
+
+    args = _parser().parse_args(argv)
+    configure_process_logging(args.log_file, verbose=args.verbose)
+    stop = threading.Event()
+    signal.signal(signal.SIGTERM, lambda *_: stop.set())
+    signal.signal(signal.SIGINT, lambda *_: stop.set())
+    options = AgentOptions(
+        config=args.config,
+        workspace=args.workspace,
+        objective_dirs=args.objectives,
+        tick_rate_hz=args.tick_rate,
+        clock=args.clock,
+        hot_reload=not args.no_hot_reload,
+    )
+    try:
+        from kinema.transport import host_router, open_session
+
+        session = host_router(args.host_router) if args.host_router else open_session(args.connect)
+    except KinemaError as error:
+        log.error("%s", error)
+        print(f"error: {error}", file=sys.stderr)
+        return 1
+    try:
+        agent = build_agent(options, session)
+        agent.start()
+    except KinemaError as error:
+        log.error("%s", error)
+        print(f"error: {error}", file=sys.stderr)
+        session.close()
+        return 1
+    log.info("agent serving (config %s, pid %d)", options.config or "-", os.getpid())
+    if args.ready_fd is not None:
+        with os.fdopen(args.ready_fd, "w") as ready:
+            ready.write("ready\n")
+    try:
+        stop.wait()
+    finally:
+        log.info("agent stopping")
+        agent.close()
+        session.close()
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,41 @@
+"""The names the agent serves and publishes (MoveIt Pro's where they exist, Kinema's otherwise).
+
+Clients (the SDK, the TUI, ``kinema objective``) import this module only; it imports nothing.
+"""
+
+from __future__ import annotations
+
+NODE_NAME = "objective_server"
+
+EXECUTE_OBJECTIVE = "/execute_objective"
+EXECUTE_OBJECTIVE_TYPE = "moveit_studio_sdk_msgs/srv/ExecuteObjective"
+CANCEL_OBJECTIVE = "/cancel_objective"
+CANCEL_OBJECTIVE_TYPE = "moveit_studio_sdk_msgs/srv/CancelObjective"
+DO_OBJECTIVE = "/do_objective"
+DO_OBJECTIVE_TYPE = "moveit_studio_sdk_msgs/action/DoObjectiveSequence"
+
+HEARTBEAT = "/objective_server_heartbeat"
+HEARTBEAT_TYPE = "moveit_studio_agent_msgs/msg/ObjectiveServerStatus"
+HEARTBEAT_PERIOD_S = 0.1
+
+NODE_STATUS = "/objective_server/node_status"
+NODE_STATUS_TYPE = "kinema_msgs/msg/NodeStatusChanges"
+BLACKBOARD = "/objective_server/blackboard"
+BLACKBOARD_TYPE = "kinema_msgs/msg/BlackboardSnapshot"
+LOG = "/objective_server/log"
+LOG_TYPE = "moveit_studio_agent_msgs/msg/Log"
+
+LIST_OBJECTIVES = "/objective_server/list_objectives"
+LIST_OBJECTIVES_TYPE = "kinema_msgs/srv/ListObjectives"
+GET_OBJECTIVE_XML = "/objective_server/get_objective_xml"
+GET_OBJECTIVE_XML_TYPE = "kinema_msgs/srv/GetObjectiveXml"
+
+GET_WAYPOINTS = "/get_saved_waypoints"
+GET_WAYPOINTS_TYPE = "moveit_studio_agent_msgs/srv/GetWaypoints"
+EDIT_WAYPOINTS = "/edit_waypoints"
+EDIT_WAYPOINTS_TYPE = "moveit_studio_agent_msgs/srv/EditWaypoints"
+
+CLOCK = "/clock"
+CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
+JOINT_STATES = "/joint_states"
+JOINT_STATES_TYPE = "sensor_msgs/msg/JointState"

@@ -1,0 +1,139 @@
+"""Where the agent's trees come from: the behavior registry plus the objective library, kept current.
+
+The factory is rebuilt lazily, on the tick thread, the first time an objective loads after the behavior
+registry was swapped by a hot reload or the objective files changed, so a running objective keeps the
+classes it was built with (DESIGN invariant 1 and §4).
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+from collections.abc import Callable
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from kinema.errors import KinemaError
+
+if TYPE_CHECKING:
+    from kinema.behaviors.context import BehaviorContext
+    from kinema.bt import BehaviorTreeFactory, Clock
+    from kinema.config import ObjectiveInfo, ObjectiveLibrary
+    from kinema.plugins import BehaviorHost
+
+log = logging.getLogger("kinema.objective_server")
+
+
+@dataclass(frozen=True)
+class LibraryProblem:
+    """An objective file that could not be registered, and why."""
+
+    file: str
+    message: str
+
+
+class LibraryTreeSource:
+    """A :class:`~kinema.runtime.objective_server.TreeSource` over a behavior host and an objective library.
+
+    Args:
+        load_library: builds the current :class:`ObjectiveLibrary` (called again after objective files
+            change).
+        host: the behavior host (None: only the engine's built-in nodes).
+        context: what behaviors reach the world through.
+        clock: the runtime clock (sim time in simulation).
+    """
+
+    def __init__(
+        self,
+        load_library: Callable[[], ObjectiveLibrary],
+        *,
+        host: BehaviorHost | None,
+        context: BehaviorContext | None,
+        clock: Clock,
+    ) -> None:
+        self._load_library = load_library
+        self._host = host
+        self._context = context
+        self._clock = clock
+        self._lock = threading.Lock()
+        self._factory: BehaviorTreeFactory | None = None
+        self._registry: Any = None
+        self._library: ObjectiveLibrary | None = None
+        self._objectives_stale = True
+        self._problems: dict[str, LibraryProblem] = {}
+        self._loaded: list[str] = []
+
+    # -- TreeSource ---------------------------------------------------------------------------------
+
+    def factory(self) -> BehaviorTreeFactory:
+        """The factory for the next run (rebuilt when behaviors or objectives changed)."""
+        with self._lock:
+            registry = self._host.registry if self._host is not None else None
+            if self._factory is None or self._objectives_stale or registry is not self._registry:
+                self._rebuild(registry)
+            assert self._factory is not None
+            return self._factory
+
+    def objective_names(self) -> list[str]:
+        """Objectives that can run by name (the ones whose file registered)."""
+        self.factory()
+        return list(self._loaded)
+
+    def load_error(self, objective_name: str) -> str | None:
+        """Why ``objective_name`` (in the library) is not runnable, or None."""
+        problem = self._problems.get(objective_name)
+        return None if problem is None else f"{problem.file}: {problem.message}"
+
+    # -- library --------------------------------------------------------------------------------
+
+    def invalidate_objectives(self) -> None:
+        """Objective files changed: reload the library before the next run."""
+        with self._lock:
+            self._objectives_stale = True
+
+    def objectives(self) -> list[ObjectiveInfo]:
+        """The library's objectives with their metadata (sorted by ID)."""
+        with self._lock:
+            if self._library is None or self._objectives_stale:
+                self._library = self._load_library()
+            return self._library.sorted()
+
+    def _rebuild(self, registry: Any) -> None:
+        from kinema.bt import BehaviorTreeFactory
+
+        if self._library is None or self._objectives_stale:
+            self._library = self._load_library()
+            self._objectives_stale = False
+        for error in self._library.errors:
+            log.warning("objective library: %s", error)
+        if registry is not None:
+            factory = registry.create_factory(self._context, clock=self._clock)
+        else:
+            factory = BehaviorTreeFactory(clock=self._clock)
+        problems: dict[str, LibraryProblem] = {}
+        files = self._library.files()
+        ids_by_file: dict[Path, list[str]] = {}
+        for info in self._library.objectives.values():
+            ids_by_file.setdefault(info.file, []).append(info.id)
+        for path in files:
+            try:
+                factory.register_behavior_tree_from_file(path)
+            except KinemaError as error:
+                log.warning("objective file %s not loaded: %s", path, error)
+                for objective_id in ids_by_file.get(path, []):
+                    problems[objective_id] = LibraryProblem(str(path), str(error))
+        self._factory = factory
+        self._registry = registry
+        self._problems = problems
+        registered = set(factory.registered_behavior_trees())
+        self._loaded = sorted(i for i in self._library.objectives if i in registered and i not in problems)
+        log.info("objective library: %d objectives runnable, %d not loaded", len(self._loaded), len(problems))
+
+
+def library_from_folders(folders: list[Path]) -> ObjectiveLibrary:
+    """An objective library made of plain folders (no config package), e.g. for tests."""
+    from kinema.config import LibraryPath, ObjectiveLibrary
+
+    paths = [LibraryPath(f"folder{index}", Path(f), "", "") for index, f in enumerate(folders)]
+    return ObjectiveLibrary.from_libraries(paths, [])
