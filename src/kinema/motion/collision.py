@@ -73,10 +73,9 @@ class CollisionChecker:
             self._geom_data.collisionRequests[k].security_margin = self._padding
 
     def _link_of(self, geom_index: int) -> str:
-        gm = self._geom_model
-        if geom_index >= self._n_robot:
-            return gm.geometryObjects[geom_index].name
-        return self.model.pin_model.frames[gm.geometryObjects[geom_index].parentFrame].name
+        """The robot link (or scene object) a geometry belongs to."""
+        geom = self._geom_model.geometryObjects[geom_index]
+        return geom.name if geom_index >= self._n_robot else self._link_of_obj(geom)
 
     def _build(self) -> None:
         import pinocchio as pin
@@ -101,7 +100,7 @@ class CollisionChecker:
             if ga.parentJoint == 0:
                 continue  # fixed to the world, like the scene
             for b in range(self._n_robot, gm.ngeoms):
-                scene_pairs.append(gm.collisionPairs.__len__())
+                scene_pairs.append(len(gm.collisionPairs))
                 gm.addCollisionPair(pin.CollisionPair(a, b))
         self._geom_model = gm
         self._geom_data = pin.GeometryData(gm)
