@@ -1,0 +1,550 @@
+"""The MuJoCo driver: a simulated robot served as ros2_control-like controllers on the transport.
+
+In-process::
+
+    from kinema.drivers.mujoco import MujocoDriver, MujocoDriverSettings
+    from kinema.transport import open_session
+
+    with open_session(endpoint) as session:
+        settings = MujocoDriverSettings.from_config("lab_sim", sim_speed=math.inf)
+        with MujocoDriver(session, settings) as driver:      # start() ... stop()
+            ...
+
+As a process: ``python -m kinema.drivers.mujoco --config lab_sim --sim-speed max`` (see ``--help``).
+
+What it serves (names in :mod:`kinema.drivers.mujoco.names`): ``/clock`` and ``/joint_states`` at the
+publish rate of sim time; ``/joint_trajectory_controller/follow_joint_trajectory`` and
+``/robotiq_gripper_controller/gripper_cmd``; ``/controller_manager/list_controllers`` and
+``/controller_manager/switch_controller(s)``; ``/mujoco/set_state`` (keyframe and/or joint positions),
+``/mujoco/bodies`` (free body poses), ``/mujoco/keyframes`` and the ``/mujoco/scene_state`` topic.
+"""
+
+from __future__ import annotations
+
+import logging
+import threading
+import time
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+
+from kinema.drivers.mujoco import names
+from kinema.drivers.mujoco.controller_manager import Controller, ControllerManager, JointStateBroadcaster
+from kinema.drivers.mujoco.execution import Execution
+from kinema.drivers.mujoco.gripper_controller import GripperController
+from kinema.drivers.mujoco.model_index import ModelIndex
+from kinema.drivers.mujoco.scene_state import (
+    apply_joint_state,
+    check_joint_positions,
+    free_body_poses,
+    reset_to_keyframe,
+)
+from kinema.drivers.mujoco.settings import MujocoDriverSettings
+from kinema.drivers.mujoco.sim_speed import format_sim_speed
+from kinema.drivers.mujoco.simulation import Simulation
+from kinema.drivers.mujoco.trajectory_controller import JointTrajectoryController
+from kinema.drivers.mujoco.trajectory_goal import INVALID_GOAL, GoalRejected, parse_trajectory_goal
+from kinema.drivers.protocol import ServedInterface
+from kinema.errors import DriverError
+from kinema.transport import Node, ServerGoalHandle, Session
+
+log = logging.getLogger("kinema.drivers.mujoco")
+
+# Wall time between feedback messages of a running goal (feedback is posted at the publish rate).
+FEEDBACK_PERIOD = 0.05
+# How long stop() waits for running goals to send their results.
+RESULT_GRACE = 1.0
+
+
+def _stamp(seconds: float) -> dict[str, int]:
+    nanoseconds = round(seconds * 1e9)
+    return {"sec": nanoseconds // 1_000_000_000, "nanosec": nanoseconds % 1_000_000_000}
+
+
+def _load_model(settings: MujocoDriverSettings) -> Any:
+    import mujoco
+
+    path = settings.model_path
+    if not path.is_file():
+        raise DriverError(f"MuJoCo scene {path} does not exist")
+    try:
+        return mujoco.MjModel.from_xml_path(str(path))
+    except ValueError as error:
+        raise DriverError(f"{path}: MuJoCo cannot load the scene: {error}") from error
+
+
+class MujocoDriver:
+    """Simulates a MuJoCo scene and serves its controllers (implements :class:`kinema.drivers.Driver`).
+
+    Args:
+        session: the transport session to serve on.
+        settings: the scene, speed, rates and controllers.
+
+    Raises:
+        DriverError: the scene cannot be loaded, or the start keyframe does not exist.
+    """
+
+    name = "mujoco"
+
+    def __init__(self, session: Session, settings: MujocoDriverSettings) -> None:
+        import mujoco
+
+        self.session = session
+        self.settings = settings
+        self.model = _load_model(settings)
+        self.data = mujoco.MjData(self.model)
+        self.index = ModelIndex.from_model(self.model)
+        if settings.keyframe:
+            reset_to_keyframe(self.model, self.data, self.index, settings.keyframe)
+        else:
+            mujoco.mj_forward(self.model, self.data)
+        self._controllers = self._build_controllers()
+        self.controller_manager = ControllerManager(
+            list(self._controllers.values()), update_rate=round(1.0 / self.index.timestep)
+        )
+        self.simulation = Simulation(
+            self.model,
+            self.data,
+            speed=settings.sim_speed,
+            publish_period=1.0 / settings.publish_rate,
+            before_step=self._before_step,
+            on_publish=self._on_publish,
+        )
+        types = session.registry.typestore.types
+        self._time_type = types["builtin_interfaces/msg/Time"]
+        self._clock_type = types[names.CLOCK_TYPE]
+        self._joint_state_type = types[names.JOINT_STATES_TYPE]
+        self._header_type = types["std_msgs/msg/Header"]
+        self._joint_names = self.index.joint_names
+        self._joint_qpos = np.array([j.qpos_address for j in self.index.joints], dtype=int)
+        self._joint_dofs = np.array([j.dof_address for j in self.index.joints], dtype=int)
+        self._nodes: list[Node] = []
+        self._publishers: dict[str, Any] = {}
+        # Running goals by goal id, with the controller that runs each (for cancel requests).
+        self._executions: dict[bytes, tuple[Any, Execution]] = {}
+        self._goals_running = 0
+        self._goals_lock = threading.Condition()
+        self._last_scene_publish = 0.0
+        self._started = False
+        self._stopped = False
+
+    # -- public API ----------------------------------------------------------------------------------
+
+    @property
+    def sim_time(self) -> float:
+        """Sim time of the last published step, s."""
+        return self.simulation.sim_time
+
+    @property
+    def failure(self) -> BaseException | None:
+        """The error that stopped the physics thread, if one did."""
+        return self.simulation.failure
+
+    @property
+    def running(self) -> bool:
+        """True between :meth:`start` and :meth:`stop` while the physics thread runs."""
+        return self.simulation.running
+
+    def start(self) -> None:
+        """Serve everything in :meth:`interfaces` and start stepping."""
+        if self._started:
+            raise DriverError("the MuJoCo driver was already started")
+        self._started = True
+        try:
+            self._serve()
+            for name in self.settings.active_controllers:
+                controller = self._controllers.get(name)
+                if controller is not None:
+                    controller.activate(self.data)
+            self.simulation.start()
+        except BaseException:
+            self.stop()
+            raise
+        self._publish_scene_state()
+        active = [c.name for c in self._controllers.values() if c.active]
+        log.info(
+            "MuJoCo driver ready: %s%s, keyframe %s, sim speed %s, %d joints, controllers active: %s",
+            self.settings.model_path.name,
+            f" (config {self.settings.config})" if self.settings.config else "",
+            self.settings.keyframe or "(none)",
+            format_sim_speed(self.settings.sim_speed),
+            len(self._joint_names),
+            ", ".join(active) or "none",
+        )
+
+    def stop(self) -> None:
+        """Stop stepping, end running goals (aborted) and withdraw everything served."""
+        if self._stopped:
+            return
+        self._stopped = True
+        self.simulation.stop()
+        for controller in self._controllers.values():
+            shutdown = getattr(controller, "shutdown", None)
+            if shutdown is not None:
+                shutdown("the MuJoCo driver stopped")
+        with self._goals_lock:
+            self._goals_lock.wait_for(lambda: self._goals_running == 0, RESULT_GRACE)
+        for node in reversed(self._nodes):
+            node.close()
+        self._nodes.clear()
+        log.info("MuJoCo driver stopped at sim time %.3f s", self.simulation.sim_time)
+
+    def interfaces(self) -> list[ServedInterface]:
+        """The topics, services and actions this driver offers."""
+        served = [
+            ServedInterface("topic", names.CLOCK_TOPIC, names.CLOCK_TYPE, "simulation time"),
+            ServedInterface(
+                "topic", names.SCENE_STATE_TOPIC, names.SCENE_STATE_TYPE, "qpos and free bodies, for viewers"
+            ),
+            ServedInterface(
+                "service", names.SET_STATE_SERVICE, names.SET_STATE_TYPE, "set joints or reset to a keyframe"
+            ),
+            ServedInterface(
+                "service", names.BODIES_SERVICE, names.BODIES_TYPE, "free bodies and their poses"
+            ),
+            ServedInterface(
+                "service", names.KEYFRAMES_SERVICE, names.KEYFRAMES_TYPE, "the model's keyframes"
+            ),
+            ServedInterface(
+                "service", names.LIST_CONTROLLERS_SERVICE, names.LIST_CONTROLLERS_TYPE, "controllers"
+            ),
+            ServedInterface(
+                "service",
+                names.SWITCH_CONTROLLERS_SERVICE,
+                names.SWITCH_CONTROLLERS_TYPE,
+                "(de)activate controllers",
+            ),
+            ServedInterface(
+                "service",
+                names.SWITCH_CONTROLLERS_ALIAS,
+                names.SWITCH_CONTROLLERS_TYPE,
+                "(de)activate controllers",
+            ),
+        ]
+        if names.JOINT_STATE_BROADCASTER in self._controllers:
+            served.append(
+                ServedInterface("topic", names.JOINT_STATES_TOPIC, names.JOINT_STATES_TYPE, "joint states")
+            )
+        if names.JOINT_TRAJECTORY_CONTROLLER in self._controllers:
+            served.append(
+                ServedInterface(
+                    "action",
+                    names.FOLLOW_JOINT_TRAJECTORY_ACTION,
+                    names.FOLLOW_JOINT_TRAJECTORY_TYPE,
+                    "track a timed joint trajectory",
+                )
+            )
+        if names.GRIPPER_CONTROLLER in self._controllers:
+            served.append(
+                ServedInterface(
+                    "action", names.GRIPPER_COMMAND_ACTION, names.GRIPPER_COMMAND_TYPE, "move the gripper"
+                )
+            )
+        return served
+
+    def __enter__(self) -> MujocoDriver:
+        self.start()
+        return self
+
+    def __exit__(self, *_exc: object) -> None:
+        self.stop()
+
+    # -- construction ------------------------------------------------------------------------------
+
+    def _build_controllers(self) -> dict[str, Controller]:
+        settings = self.settings
+        wanted = list(dict.fromkeys([*settings.active_controllers, *settings.inactive_controllers]))
+        gripper_joint = None
+        if settings.gripper_joint:
+            found = [j for j in self.index.actuated_joints if j.name == settings.gripper_joint]
+            gripper_joint = found[0] if found else None
+        arm = [j for j in self.index.actuated_joints if gripper_joint is None or j.name != gripper_joint.name]
+        available: dict[str, Callable[[], Controller]] = {
+            names.JOINT_STATE_BROADCASTER: lambda: JointStateBroadcaster(
+                names.JOINT_STATE_BROADCASTER, self.index.joint_names
+            ),
+        }
+        if arm:
+            gains = np.array([self.model.actuator_gainprm[j.actuator, 0] for j in arm])
+            damping = np.array([-self.model.actuator_biasprm[j.actuator, 2] for j in arm])
+            feedforward = np.divide(damping, gains, out=np.zeros_like(gains), where=gains > 0)
+            available[names.JOINT_TRAJECTORY_CONTROLLER] = lambda: JointTrajectoryController(
+                names.JOINT_TRAJECTORY_CONTROLLER, arm, feedforward, self.index.timestep
+            )
+        if gripper_joint is not None:
+            available[names.GRIPPER_CONTROLLER] = lambda: GripperController(
+                names.GRIPPER_CONTROLLER, gripper_joint, self.model, settings.gripper
+            )
+        elif settings.gripper_joint:
+            log.warning(
+                "the scene has no actuated joint %r: no %s", settings.gripper_joint, names.GRIPPER_CONTROLLER
+            )
+        controllers: dict[str, Controller] = {}
+        for name in wanted:
+            factory = available.get(name.lstrip("/"))
+            if factory is None:
+                log.warning(
+                    "controller %r (from the config) is not simulated; the MuJoCo driver offers: %s",
+                    name,
+                    ", ".join(available),
+                )
+                continue
+            controllers[name.lstrip("/")] = factory()
+        return controllers
+
+    def _serve(self) -> None:
+        mujoco_node = self._node("mujoco")
+        self._publishers["clock"] = mujoco_node.create_publisher(names.CLOCK_TYPE, names.CLOCK_TOPIC)
+        self._publishers["scene"] = mujoco_node.create_publisher(
+            names.SCENE_STATE_TYPE, names.SCENE_STATE_TOPIC, latched=True
+        )
+        mujoco_node.create_service(names.SET_STATE_TYPE, names.SET_STATE_SERVICE, self._on_set_state)
+        mujoco_node.create_service(names.BODIES_TYPE, names.BODIES_SERVICE, self._on_bodies)
+        mujoco_node.create_service(names.KEYFRAMES_TYPE, names.KEYFRAMES_SERVICE, self._on_keyframes)
+        manager_node = self._node("controller_manager")
+        manager_node.create_service(
+            names.LIST_CONTROLLERS_TYPE, names.LIST_CONTROLLERS_SERVICE, self._on_list_controllers
+        )
+        for service in (names.SWITCH_CONTROLLERS_SERVICE, names.SWITCH_CONTROLLERS_ALIAS):
+            manager_node.create_service(names.SWITCH_CONTROLLERS_TYPE, service, self._on_switch_controllers)
+        if names.JOINT_STATE_BROADCASTER in self._controllers:
+            self._publishers["joint_states"] = self._node(names.JOINT_STATE_BROADCASTER).create_publisher(
+                names.JOINT_STATES_TYPE, names.JOINT_STATES_TOPIC
+            )
+        if names.JOINT_TRAJECTORY_CONTROLLER in self._controllers:
+            self._node(names.JOINT_TRAJECTORY_CONTROLLER).create_action_server(
+                names.FOLLOW_JOINT_TRAJECTORY_TYPE,
+                names.FOLLOW_JOINT_TRAJECTORY_ACTION,
+                self._execute_trajectory,
+                cancel_callback=self._cancel_goal,
+            )
+        if names.GRIPPER_CONTROLLER in self._controllers:
+            self._node(names.GRIPPER_CONTROLLER).create_action_server(
+                names.GRIPPER_COMMAND_TYPE,
+                names.GRIPPER_COMMAND_ACTION,
+                self._execute_gripper,
+                cancel_callback=self._cancel_goal,
+            )
+
+    def _node(self, name: str) -> Node:
+        node = Node(self.session, name)
+        self._nodes.append(node)
+        return node
+
+    # -- the physics thread ------------------------------------------------------------------------
+
+    def _before_step(self) -> None:
+        for controller in self._controllers.values():
+            if getattr(controller, "busy", False):
+                controller.update(self.data)  # type: ignore[attr-defined]
+
+    def _on_publish(self) -> None:
+        data = self.data
+        now = float(data.time)
+        stamp = self._time_type(**_stamp(now))
+        self._publishers["clock"].publish(self._clock_type(clock=stamp))
+        broadcaster = self._controllers.get(names.JOINT_STATE_BROADCASTER)
+        if broadcaster is not None and broadcaster.active:
+            self._publishers["joint_states"].publish(
+                self._joint_state_type(
+                    header=self._header_type(stamp=stamp, frame_id=""),
+                    name=self._joint_names,
+                    position=data.qpos[self._joint_qpos],
+                    velocity=data.qvel[self._joint_dofs],
+                    effort=data.qfrc_actuator[self._joint_dofs],
+                )
+            )
+        for controller in self._controllers.values():
+            if getattr(controller, "busy", False):
+                controller.post_feedback(data)  # type: ignore[attr-defined]
+        wall = time.perf_counter()
+        if wall - self._last_scene_publish >= 1.0 / self.settings.scene_state_rate:
+            self._publish_scene_state(wall)
+
+    def _publish_scene_state(self, wall: float | None = None) -> None:
+        self._last_scene_publish = time.perf_counter() if wall is None else wall
+        data = self.data
+        self._publishers["scene"].publish(
+            {
+                "stamp": _stamp(float(data.time)),
+                "qpos": data.qpos.tolist(),
+                "bodies": [_body(pose) for pose in free_body_poses(data, self.index)],
+            }
+        )
+
+    def _set_state(
+        self, keyframe: str, positions: dict[str, float], velocities: dict[str, float] | None
+    ) -> str:
+        check_joint_positions(self.index, positions)
+        if keyframe:
+            self.index.keyframe_id(keyframe)
+        if not keyframe and not positions:
+            raise DriverError(
+                "nothing to set: give a keyframe (one of: "
+                + (", ".join(self.index.keyframes) or "none")
+                + ") and/or joint_state names and positions"
+            )
+        if keyframe:
+            reset_to_keyframe(self.model, self.data, self.index, keyframe)
+        moved = (
+            apply_joint_state(self.model, self.data, self.index, positions, velocities) if positions else []
+        )
+        for controller in self._controllers.values():
+            on_reset = getattr(controller, "on_state_reset", None)
+            if on_reset is not None:
+                on_reset(self.data)
+        self._publish_scene_state()
+        parts = []
+        if keyframe:
+            parts.append(f"reset to keyframe {keyframe!r}")
+        if moved:
+            parts.append(f"set {len(moved)} joint{'s' if len(moved) != 1 else ''}")
+        message = " and ".join(parts) + f" at sim time {float(self.data.time):.3f} s"
+        log.info("simulation state %s", message)
+        return message
+
+    # -- services (transport threads) --------------------------------------------------------------
+
+    def _on_list_controllers(self, _request: Any) -> dict[str, Any]:
+        return {"controller": self.simulation.call(self.controller_manager.list_states)}
+
+    def _on_switch_controllers(self, request: Any) -> dict[str, Any]:
+        ok, message = self.simulation.call(
+            lambda: self.controller_manager.switch(
+                [str(n) for n in request.activate_controllers],
+                [str(n) for n in request.deactivate_controllers],
+                int(request.strictness),
+                self.data,
+            )
+        )
+        return {"ok": ok, "message": message}
+
+    def _on_set_state(self, request: Any) -> dict[str, Any]:
+        joint_state = request.joint_state
+        joint_names = [str(n) for n in joint_state.name]
+        positions = [float(v) for v in joint_state.position]
+        velocities = [float(v) for v in joint_state.velocity]
+        if len(positions) != len(joint_names):
+            return {
+                "success": False,
+                "message": f"joint_state has {len(joint_names)} names but {len(positions)} positions",
+            }
+        if velocities and len(velocities) != len(joint_names):
+            return {
+                "success": False,
+                "message": f"joint_state has {len(joint_names)} names but {len(velocities)} velocities",
+            }
+        keyframe = str(request.keyframe).strip()
+        try:
+            message = self.simulation.call(
+                lambda: self._set_state(
+                    keyframe,
+                    dict(zip(joint_names, positions, strict=True)),
+                    dict(zip(joint_names, velocities, strict=True)) if velocities else None,
+                )
+            )
+        except DriverError as error:
+            log.warning("set_state refused: %s", error)
+            return {"success": False, "message": str(error)}
+        return {"success": True, "message": message}
+
+    def _on_bodies(self, _request: Any) -> dict[str, Any]:
+        now, poses = self.simulation.call(
+            lambda: (float(self.data.time), free_body_poses(self.data, self.index))
+        )
+        return {"stamp": _stamp(now), "bodies": [_body(pose) for pose in poses]}
+
+    def _on_keyframes(self, _request: Any) -> dict[str, Any]:
+        return {"names": list(self.index.keyframes), "initial": self.settings.keyframe or ""}
+
+    # -- actions (goal threads) --------------------------------------------------------------------
+
+    def _execute_trajectory(self, handle: ServerGoalHandle) -> None:
+        controller = self._controllers[names.JOINT_TRAJECTORY_CONTROLLER]
+        assert isinstance(controller, JointTrajectoryController)
+        limits = {j.name: j.limits for j in controller.joints if j.limits is not None}
+        try:
+            goal = parse_trajectory_goal(
+                handle.goal, controller.joint_names, limits, self.settings.tolerances, self.index.timestep
+            )
+        except GoalRejected as rejected:
+            log.warning("%s: goal rejected: %s", controller.name, rejected.message)
+            handle.abort({"error_code": rejected.code, "error_string": rejected.message})
+            return
+        self._run_goal(
+            handle,
+            controller,
+            lambda execution: controller.start(execution, goal, self.data),
+            {"error_code": INVALID_GOAL, "error_string": "the MuJoCo driver stopped"},
+        )
+
+    def _execute_gripper(self, handle: ServerGoalHandle) -> None:
+        controller = self._controllers[names.GRIPPER_CONTROLLER]
+        assert isinstance(controller, GripperController)
+        command = handle.goal.command
+        position, effort = float(command.position), float(command.max_effort)
+        self._run_goal(
+            handle, controller, lambda execution: controller.start(execution, position, effort, self.data), {}
+        )
+
+    def _run_goal(
+        self,
+        handle: ServerGoalHandle,
+        controller: Any,
+        start: Callable[[Execution], None],
+        stopped_result: dict[str, Any],
+    ) -> None:
+        execution = Execution(f"{controller.name} goal {handle.goal_uuid}")
+        with self._goals_lock:
+            self._goals_running += 1
+            self._executions[handle.goal_id] = (controller, execution)
+        try:
+            self.simulation.submit(lambda: start(execution))
+            cancel_sent = False
+            while not execution.done.wait(FEEDBACK_PERIOD):
+                if handle.is_cancel_requested and not cancel_sent:
+                    # Normally the cancel callback already queued this; this covers a cancel that
+                    # arrived before the goal was registered.
+                    cancel_sent = self._queue_cancel(controller, execution)
+                feedback = execution.take_feedback()
+                if feedback is not None:
+                    handle.publish_feedback(feedback)
+                if not self.simulation.running:
+                    execution.finish("aborted", stopped_result)
+            outcome = execution.outcome
+            assert outcome is not None
+            if outcome.status == "succeeded":
+                handle.succeed(outcome.result)
+            elif outcome.status == "canceled":
+                handle.canceled(outcome.result)
+            else:
+                handle.abort(outcome.result)
+        finally:
+            with self._goals_lock:
+                self._executions.pop(handle.goal_id, None)
+                self._goals_running -= 1
+                self._goals_lock.notify_all()
+
+    def _cancel_goal(self, handle: ServerGoalHandle) -> bool:
+        with self._goals_lock:
+            running = self._executions.get(handle.goal_id)
+        if running is not None:
+            self._queue_cancel(*running)
+        return True
+
+    def _queue_cancel(self, controller: Any, execution: Execution) -> bool:
+        try:
+            self.simulation.submit(lambda: controller.cancel(execution, self.data))
+        except DriverError:
+            return False
+        return True
+
+
+def _body(pose: Any) -> dict[str, Any]:
+    x, y, z = pose.position
+    qx, qy, qz, qw = pose.orientation
+    return {
+        "name": pose.name,
+        "pose": {"position": {"x": x, "y": y, "z": z}, "orientation": {"x": qx, "y": qy, "z": qz, "w": qw}},
+    }

@@ -1,0 +1,37 @@
+"""The names and types the MuJoCo driver serves, for clients (behaviors, CLI, viewer) to import.
+
+This module imports nothing heavy, so a client can use the names without loading mujoco.
+"""
+
+from __future__ import annotations
+
+CLOCK_TOPIC = "/clock"
+CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
+JOINT_STATES_TOPIC = "/joint_states"
+JOINT_STATES_TYPE = "sensor_msgs/msg/JointState"
+
+FOLLOW_JOINT_TRAJECTORY_ACTION = "/joint_trajectory_controller/follow_joint_trajectory"
+FOLLOW_JOINT_TRAJECTORY_TYPE = "control_msgs/action/FollowJointTrajectory"
+GRIPPER_COMMAND_ACTION = "/robotiq_gripper_controller/gripper_cmd"
+GRIPPER_COMMAND_TYPE = "control_msgs/action/GripperCommand"
+
+LIST_CONTROLLERS_SERVICE = "/controller_manager/list_controllers"
+LIST_CONTROLLERS_TYPE = "controller_manager_msgs/srv/ListControllers"
+# ros2_control's controller_manager names the service in the singular; the plural spelling is served too
+# because MoveIt Pro documents it that way.
+SWITCH_CONTROLLERS_SERVICE = "/controller_manager/switch_controller"
+SWITCH_CONTROLLERS_ALIAS = "/controller_manager/switch_controllers"
+SWITCH_CONTROLLERS_TYPE = "controller_manager_msgs/srv/SwitchController"
+
+SET_STATE_SERVICE = "/mujoco/set_state"
+SET_STATE_TYPE = "kinema_msgs/srv/SetMujocoState"
+BODIES_SERVICE = "/mujoco/bodies"
+BODIES_TYPE = "kinema_msgs/srv/GetSimBodies"
+KEYFRAMES_SERVICE = "/mujoco/keyframes"
+KEYFRAMES_TYPE = "kinema_msgs/srv/ListKeyframes"
+SCENE_STATE_TOPIC = "/mujoco/scene_state"
+SCENE_STATE_TYPE = "kinema_msgs/msg/SceneState"
+
+JOINT_TRAJECTORY_CONTROLLER = "joint_trajectory_controller"
+GRIPPER_CONTROLLER = "robotiq_gripper_controller"
+JOINT_STATE_BROADCASTER = "joint_state_broadcaster"

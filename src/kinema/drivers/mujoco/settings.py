@@ -1,0 +1,95 @@
+"""What the MuJoCo driver runs: the scene, the start keyframe, speed, rates, controllers, tolerances.
+
+:meth:`MujocoDriverSettings.from_config` reads them from a config package: the scene and keyframe
+from ``hardware.simulation.{mujoco_model, mujoco_keyframe}``, the controllers from
+``ros2_control.controllers_active_at_startup`` / ``controllers_inactive_at_startup``.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from kinema.drivers.mujoco.gripper_controller import GripperSettings
+from kinema.drivers.mujoco.names import (
+    GRIPPER_CONTROLLER,
+    JOINT_STATE_BROADCASTER,
+    JOINT_TRAJECTORY_CONTROLLER,
+)
+from kinema.drivers.mujoco.trajectory_goal import ToleranceDefaults
+from kinema.errors import ConfigError
+
+if TYPE_CHECKING:
+    from kinema.config import ResolvedConfig, Workspace
+
+DEFAULT_CONTROLLERS = (JOINT_STATE_BROADCASTER, JOINT_TRAJECTORY_CONTROLLER, GRIPPER_CONTROLLER)
+
+
+@dataclass(frozen=True)
+class MujocoDriverSettings:
+    """Everything the driver needs to run a scene.
+
+    Attributes:
+        model_path: the MJCF scene.
+        keyframe: keyframe to start from (None: the model's default state).
+        sim_speed: sim seconds per wall second; ``math.inf`` for as fast as possible.
+        publish_rate: rate of ``/clock``, ``/joint_states`` and action feedback, Hz of sim time.
+        scene_state_rate: rate of the scene-state topic for viewers, Hz of wall time.
+        active_controllers: controllers active at start.
+        inactive_controllers: controllers loaded but inactive at start.
+        gripper_joint: the joint the gripper controller commands (None: no gripper controller).
+        tolerances: the trajectory controller's default tolerances.
+        gripper: the gripper controller's thresholds.
+        config: the config package the settings came from ("" when built by hand).
+    """
+
+    model_path: Path
+    keyframe: str | None = None
+    sim_speed: float = 1.0
+    publish_rate: float = 100.0
+    scene_state_rate: float = 30.0
+    active_controllers: tuple[str, ...] = DEFAULT_CONTROLLERS
+    inactive_controllers: tuple[str, ...] = ()
+    gripper_joint: str | None = "robotiq_85_left_knuckle_joint"
+    tolerances: ToleranceDefaults = field(default_factory=ToleranceDefaults)
+    gripper: GripperSettings = field(default_factory=GripperSettings)
+    config: str = ""
+
+    def with_changes(self, **changes: Any) -> MujocoDriverSettings:
+        """A copy with some fields replaced."""
+        return replace(self, **changes)
+
+    @classmethod
+    def from_config(
+        cls,
+        config: str | ResolvedConfig,
+        workspace: Workspace | None = None,
+        **overrides: Any,
+    ) -> MujocoDriverSettings:
+        """Settings for config package ``config`` (a name, resolved in ``workspace``, or a resolved config).
+
+        Raises:
+            ConfigError: the config cannot be resolved or has no ``hardware.simulation.mujoco_model``.
+        """
+        from kinema.config import resolve_config
+
+        resolved = resolve_config(config, workspace, check_files=False) if isinstance(config, str) else config
+        model_path = resolved.mujoco_model_path
+        if model_path is None:
+            raise ConfigError(
+                f"config {resolved.name!r} has no MuJoCo scene: set hardware.simulation.mujoco_model "
+                "({package, path}) to simulate it",
+                location=resolved.location_of("hardware"),
+            )
+        keyframe = resolved.get("hardware.simulation.mujoco_keyframe")
+        active = resolved.get("ros2_control.controllers_active_at_startup")
+        inactive = resolved.get("ros2_control.controllers_inactive_at_startup")
+        settings = cls(
+            model_path=model_path,
+            keyframe=str(keyframe) if keyframe else None,
+            active_controllers=tuple(str(n) for n in active) if active is not None else DEFAULT_CONTROLLERS,
+            inactive_controllers=tuple(str(n) for n in inactive or ()),
+            config=resolved.name,
+        )
+        return settings.with_changes(**overrides) if overrides else settings

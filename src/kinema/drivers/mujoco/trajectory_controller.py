@@ -1,0 +1,301 @@
+"""A joint trajectory controller, as ros2_control's ``joint_trajectory_controller`` behaves.
+
+It commands position actuators: every control period (one physics step) it looks up the desired
+position and velocity of the running trajectory and sets ``ctrl = q_des + (kv/kp)·qd_des`` — the
+velocity feed-forward that keeps a position servo from lagging by ``kv·v/kp``. While the trajectory
+runs it checks the path tolerances; after its last point it waits up to the goal time tolerance for the
+goal tolerances to hold. A failed check, a cancel or a deactivation holds the joints where they are.
+
+All methods run on the physics thread.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from kinema.drivers.mujoco.execution import Execution
+from kinema.drivers.mujoco.model_index import JointInfo
+from kinema.drivers.mujoco.trajectory_goal import (
+    GOAL_TOLERANCE_VIOLATED,
+    INVALID_GOAL,
+    OLD_HEADER_TIMESTAMP,
+    PATH_TOLERANCE_VIOLATED,
+    SUCCESSFUL,
+    TrajectoryGoal,
+)
+from kinema.drivers.mujoco.trajectory_sampling import SampledTrajectory, sample_trajectory
+
+log = logging.getLogger(__name__)
+
+
+@dataclass
+class _Running:
+    execution: Execution
+    goal: TrajectoryGoal
+    table: SampledTrajectory
+    start: float
+    qpos: np.ndarray
+    qvel: np.ndarray
+    ctrl: np.ndarray
+    feedforward: np.ndarray
+
+
+def _result(code: int, message: str) -> dict[str, Any]:
+    return {"error_code": code, "error_string": message}
+
+
+def _violations(
+    names: tuple[str, ...], values: np.ndarray | None, tolerance: np.ndarray, what: str
+) -> list[str]:
+    if values is None:
+        return []
+    return [
+        f"{names[i]} {what} {values[i]:+.4f} (tolerance {tolerance[i]:.4g})"
+        for i in np.flatnonzero(np.abs(values) > tolerance)
+    ]
+
+
+class JointTrajectoryController:
+    """Tracks ``FollowJointTrajectory`` goals on a set of position-actuated joints.
+
+    Args:
+        name: the controller's name (``joint_trajectory_controller``).
+        joints: the joints it commands (each with an actuator).
+        feedforward: ``kv/kp`` of each joint's position actuator, s.
+        dt: the control period (the physics step), s.
+    """
+
+    type_name = "joint_trajectory_controller/JointTrajectoryController"
+
+    def __init__(self, name: str, joints: list[JointInfo], feedforward: np.ndarray, dt: float) -> None:
+        self.name = name
+        self.dt = dt
+        self.joints = joints
+        self.joint_names = [joint.name for joint in joints]
+        self.active = False
+        self._qpos = np.array([joint.qpos_address for joint in joints], dtype=int)
+        self._qvel = np.array([joint.dof_address for joint in joints], dtype=int)
+        self._ctrl = np.array([joint.actuator for joint in joints], dtype=int)
+        self._feedforward = np.asarray(feedforward, dtype=float)
+        # What the controller last commanded (the start state of the next trajectory).
+        self._command = np.zeros(len(joints))
+        self._command_velocity = np.zeros(len(joints))
+        self._running: _Running | None = None
+
+    @property
+    def command_interfaces(self) -> list[str]:
+        """``<joint>/position`` for each joint."""
+        return [f"{name}/position" for name in self.joint_names]
+
+    @property
+    def state_interfaces(self) -> list[str]:
+        """Position and velocity of each joint."""
+        return [f"{name}/{kind}" for name in self.joint_names for kind in ("position", "velocity")]
+
+    @property
+    def busy(self) -> bool:
+        """True while a goal runs."""
+        return self._running is not None
+
+    # -- lifecycle -------------------------------------------------------------------------------
+
+    def activate(self, data: Any) -> None:
+        """Start commanding: hold the joints where they are (no jump to a stale set point)."""
+        self.active = True
+        self._hold(data)
+
+    def deactivate(self, data: Any) -> None:
+        """Stop commanding (actuators keep their last set point); a running goal is aborted."""
+        self._end(data, "aborted", _result(INVALID_GOAL, f"{self.name} was deactivated"), hold=False)
+        self.active = False
+
+    def on_state_reset(self, data: Any) -> None:
+        """The simulation state was set from outside: abort a running goal and hold the new positions."""
+        self._end(data, "aborted", _result(INVALID_GOAL, "the simulation state was reset"), hold=False)
+        if self.active:
+            self._hold(data)
+        else:
+            self._command[:] = data.qpos[self._qpos]
+            self._command_velocity[:] = 0.0
+
+    def shutdown(self, reason: str) -> None:
+        """The driver stops: end a running goal without touching the simulation."""
+        if self._running is not None:
+            self._running.execution.finish("aborted", _result(INVALID_GOAL, reason))
+            self._running = None
+
+    # -- goals -----------------------------------------------------------------------------------
+
+    def start(self, execution: Execution, goal: TrajectoryGoal, data: Any) -> None:
+        """Begin tracking ``goal``; a goal already running is aborted (preempted)."""
+        if not self.active:
+            execution.finish(
+                "aborted",
+                _result(
+                    INVALID_GOAL,
+                    f"{self.name} is inactive; activate it with /controller_manager/switch_controller",
+                ),
+            )
+            return
+        now = float(data.time)
+        if goal.start_stamp is not None and goal.start_stamp + goal.duration < now:
+            execution.finish(
+                "aborted",
+                _result(
+                    OLD_HEADER_TIMESTAMP,
+                    f"the trajectory was stamped to start at {goal.start_stamp:.3f} s and would have ended "
+                    f"before now ({now:.3f} s sim time)",
+                ),
+            )
+            return
+        if self._running is not None:
+            self._running.execution.finish(
+                "aborted", _result(INVALID_GOAL, f"preempted by a newer goal at sim time {now:.3f} s")
+            )
+        columns = goal.joint_indices
+        table = sample_trajectory(
+            goal.times,
+            goal.positions,
+            goal.velocities,
+            goal.accelerations,
+            self._command[columns],
+            self._command_velocity[columns],
+            self.dt,
+        )
+        self._running = _Running(
+            execution=execution,
+            goal=goal,
+            table=table,
+            start=goal.start_stamp if goal.start_stamp is not None else now,
+            qpos=self._qpos[columns],
+            qvel=self._qvel[columns],
+            ctrl=self._ctrl[columns],
+            feedforward=self._feedforward[columns],
+        )
+        log.debug(
+            "%s: tracking %d points over %.3f s from sim time %.3f s",
+            self.name,
+            len(goal.times),
+            goal.duration,
+            now,
+        )
+
+    def cancel(self, execution: Execution, data: Any) -> None:
+        """Stop the goal of ``execution`` now and hold the joints where they are."""
+        running = self._running
+        if running is None or running.execution is not execution:
+            execution.finish("canceled", _result(SUCCESSFUL, "canceled before it started"))
+            return
+        now = float(data.time)
+        self._end(
+            data,
+            "canceled",
+            _result(SUCCESSFUL, f"canceled at sim time {now:.3f} s; holding position"),
+            hold=True,
+        )
+
+    def update(self, data: Any) -> None:
+        """One control period: command the desired state and check the tolerances."""
+        running = self._running
+        if running is None:
+            return
+        elapsed = float(data.time) - running.start
+        if elapsed < 0.0:
+            return  # stamped to start later: keep holding
+        table = running.table
+        row = table.index_at(elapsed)
+        desired = table.positions[row]
+        desired_velocity = table.velocities[row]
+        goal = running.goal
+        error = data.qpos[running.qpos] - desired
+        if elapsed <= table.duration:
+            velocity_error = (
+                data.qvel[running.qvel] - desired_velocity
+                if not math.isinf(goal.path_velocity_tolerance.min())
+                else None
+            )
+            if np.any(np.abs(error) > goal.path_position_tolerance) or (
+                velocity_error is not None and np.any(np.abs(velocity_error) > goal.path_velocity_tolerance)
+            ):
+                self._fail(
+                    data,
+                    PATH_TOLERANCE_VIOLATED,
+                    f"path tolerance violated {elapsed:.3f} s into the trajectory",
+                    _violations(goal.joint_names, error, goal.path_position_tolerance, "off by")
+                    + _violations(
+                        goal.joint_names, velocity_error, goal.path_velocity_tolerance, "speed off by"
+                    ),
+                )
+                return
+        else:
+            speed = data.qvel[running.qvel]
+            if np.all(np.abs(error) <= goal.goal_position_tolerance) and np.all(
+                np.abs(speed) <= goal.goal_velocity_tolerance
+            ):
+                self._end(data, "succeeded", _result(SUCCESSFUL, ""), hold=False)
+                return
+            if elapsed > table.duration + goal.goal_time_tolerance:
+                self._fail(
+                    data,
+                    GOAL_TOLERANCE_VIOLATED,
+                    f"goal tolerance still violated {elapsed - table.duration:.3f} s after the last point",
+                    _violations(goal.joint_names, error, goal.goal_position_tolerance, "off by")
+                    + _violations(goal.joint_names, speed, goal.goal_velocity_tolerance, "still moving at"),
+                )
+                return
+        self._command[goal.joint_indices] = desired
+        self._command_velocity[goal.joint_indices] = desired_velocity
+        data.ctrl[running.ctrl] = desired + running.feedforward * desired_velocity
+
+    def post_feedback(self, data: Any) -> None:
+        """Post the running goal's desired, actual and error state (called at the publish rate)."""
+        running = self._running
+        if running is None:
+            return
+        elapsed = float(data.time) - running.start
+        row = running.table.index_at(elapsed)
+        desired = running.table.positions[row]
+        desired_velocity = running.table.velocities[row]
+        actual = data.qpos[running.qpos]
+        actual_velocity = data.qvel[running.qvel]
+        stamp = float(data.time)
+        running.execution.post_feedback(
+            {
+                "header": {"stamp": {"sec": int(stamp), "nanosec": int((stamp % 1.0) * 1e9)}},
+                "joint_names": list(running.goal.joint_names),
+                "desired": {"positions": desired.tolist(), "velocities": desired_velocity.tolist()},
+                "actual": {"positions": actual.tolist(), "velocities": actual_velocity.tolist()},
+                "error": {
+                    "positions": (desired - actual).tolist(),
+                    "velocities": (desired_velocity - actual_velocity).tolist(),
+                },
+            }
+        )
+
+    # -- internals -------------------------------------------------------------------------------
+
+    def _fail(self, data: Any, code: int, what: str, violations: list[str]) -> None:
+        message = f"{what} (sim time {float(data.time):.3f} s): {'; '.join(violations)}"
+        log.warning("%s: %s", self.name, message)
+        self._end(data, "aborted", _result(code, message), hold=True)
+
+    def _end(self, data: Any, status: Any, result: dict[str, Any], *, hold: bool) -> None:
+        running = self._running
+        if running is None:
+            return
+        self._running = None
+        if hold:
+            self._hold(data)
+        else:
+            self._command_velocity[:] = 0.0
+        running.execution.finish(status, result)
+
+    def _hold(self, data: Any) -> None:
+        self._command[:] = data.qpos[self._qpos]
+        self._command_velocity[:] = 0.0
+        data.ctrl[self._ctrl] = self._command
