@@ -351,7 +351,8 @@ def service_call(
     from kinema.transport import parse_yaml_flow, to_yaml
 
     if srv_type and not values and (srv_type.lstrip().startswith("{") or ":" in srv_type):
-        srv_type, values = None, srv_type  # `kinema service call /name "{a: 1}"`: the type was left out
+        # `kinema service call /name "{a: 1}"`: the type was left out
+        values, srv_type = srv_type, None
     with _node(connect, timeout) as node:
         name = node.resolve(service_name)
         type_name = srv_type or _discover_type(

@@ -18,6 +18,7 @@ import shutil
 import sys
 from collections.abc import Iterable
 from pathlib import Path
+from typing import Any
 
 from rosbags.typesys.base import Nodetype
 
@@ -33,8 +34,8 @@ def _dependencies(package: str) -> list[str]:
     """Packages the interfaces of ``package`` reference (from the registered field definitions)."""
     found: set[str] = set()
 
-    def visit(desc: object) -> None:
-        kind, rest = desc  # type: ignore[misc]
+    def visit(desc: Any) -> None:
+        kind, rest = desc
         if kind == Nodetype.NAME:
             found.add(str(rest).split("/", 1)[0])
         elif kind in (Nodetype.ARRAY, Nodetype.SEQUENCE):

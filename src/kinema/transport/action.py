@@ -135,6 +135,19 @@ class ServerGoalHandle:
         """True until the goal succeeds, aborts or is canceled."""
         return self.status in _ACTIVE
 
+    def request_cancel(self) -> bool:
+        """Ask this goal to stop from the server side (e.g. a newer goal preempts it).
+
+        Marks the goal CANCELING and sets :attr:`cancel_requested_event`, exactly as a client's cancel
+        request would; the execute callback then ends it (usually with :meth:`canceled` or
+        :meth:`abort`). Returns False when the goal had already ended.
+        """
+        if not self.is_active:
+            return False
+        self.cancel_requested_event.set()
+        self._set_status(STATUS_CANCELING)
+        return True
+
     def publish_feedback(self, feedback: Any) -> None:
         """Send feedback (a message or a dict of its fields) to the clients."""
         action = self.server.action

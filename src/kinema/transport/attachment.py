@@ -61,7 +61,8 @@ class Attachment:
         # "source_gid", [u8; 16]):
         # strings and byte arrays are prefixed with a LEB128 length, integers are fixed little endian.
         pos = 0
-        values: dict[str, object] = {}
+        integers: dict[str, int] = {}
+        gid = b""
 
         def leb128() -> int:
             nonlocal pos
@@ -83,13 +84,11 @@ class Attachment:
                 pos += length
                 if key == "source_gid":
                     count = GID_SIZE if len(raw) - pos == GID_SIZE else leb128()
-                    values[key] = raw[pos : pos + count]
+                    gid = raw[pos : pos + count]
                     pos += count
                 else:
-                    values[key] = struct.unpack_from("<q", raw, pos)[0]
+                    integers[key] = struct.unpack_from("<q", raw, pos)[0]
                     pos += 8
-            return cls(
-                int(values["sequence_number"]), int(values["source_timestamp"]), bytes(values["source_gid"])
-            )  # type: ignore[arg-type, call-overload]
+            return cls(integers["sequence_number"], integers["source_timestamp"], gid)
         except (KeyError, UnicodeDecodeError, struct.error) as error:
             raise TransportError(f"cannot parse a {len(raw)}-byte rmw_zenoh attachment: {error}") from error

@@ -117,6 +117,7 @@ class Publisher(Entity):
         congestion = zenoh.CongestionControl.BLOCK if qos.keep_all else zenoh.CongestionControl.DROP
         reliability = zenoh.Reliability.RELIABLE if qos.reliable else zenoh.Reliability.BEST_EFFORT
         session = node.session.zenoh
+        self._publisher: Any
         if qos.transient_local:
             self._publisher = ext.declare_advanced_publisher(
                 session,
@@ -189,6 +190,7 @@ class Subscription(Entity):
         self._with_info = with_info
         self.received = 0
         session = node.session.zenoh
+        self._subscriber: Any
         if qos.transient_local:
             self._subscriber = ext.declare_advanced_subscriber(
                 session,

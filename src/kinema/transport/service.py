@@ -275,7 +275,7 @@ class ServiceClient(Entity):
                         )
                 response = self.registry.deserialize(sample.payload.to_bytes(), self.service.response)
                 answered = True
-            else:
+            elif reply.err is not None:
                 errors.append(reply.err.payload.to_string())
         if errors:
             message = errors[0]

@@ -174,3 +174,27 @@ def test_closing_the_server_cancels_running_goals(connect: Callable[[], Session]
     time.sleep(0.1)
     server_session.close()
     assert handle.result(timeout=10).status == STATUS_CANCELED
+
+
+def test_a_new_goal_can_preempt_the_running_one(connect: Callable[[], Session]) -> None:
+    running: list[ServerGoalHandle] = []
+    lock = threading.Lock()
+
+    def one_at_a_time(handle: ServerGoalHandle) -> dict[str, list[int]]:
+        with lock:
+            for older in running:
+                older.request_cancel()
+            running.append(handle)
+        if handle.cancel_requested_event.wait(0.5):
+            handle.canceled({"sequence": [-7]})
+            return {}
+        return {"sequence": [handle.goal.order]}
+
+    Node(connect(), "server").create_action_server(FIB, "/preempting", one_at_a_time)
+    client = _client(connect, "/preempting")
+    first = client.send_goal({"order": 1})
+    time.sleep(0.1)
+    second = client.send_goal({"order": 2})
+    assert first.result(timeout=5).status == STATUS_CANCELED
+    outcome = second.result(timeout=5)
+    assert outcome.succeeded and outcome.result.sequence.tolist() == [2]
