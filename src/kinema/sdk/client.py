@@ -1,0 +1,319 @@
+"""``ObjectiveClient``: start, cancel and watch objectives of a running Kinema (or MoveIt Pro) agent.
+
+::
+
+    from kinema.sdk import ObjectiveClient
+
+    with ObjectiveClient() as client:                  # joins the router at tcp/127.0.0.1:7447
+        result = client.execute("Close Gripper")       # blocks; an ObjectiveResult, never None
+        handle = client.start("3 Waypoints Pick and Place")
+        ...
+        handle.cancel()
+        print(handle.result())                         # cancelled: error code PREEMPTED (-7)
+        for status in client.statuses(timeout=5):      # the 10 Hz heartbeat
+            print(status)
+
+Every call that needs the agent raises :class:`~kinema.errors.TransportError` with one clear sentence when
+no runtime answers within the client's ``timeout``.
+"""
+
+from __future__ import annotations
+
+import threading
+from collections.abc import Iterable, Mapping
+from typing import TYPE_CHECKING, Any
+
+from kinema.errors import TransportError
+from kinema.runtime import names
+from kinema.runtime.overrides import ParameterOverride
+from kinema.runtime.result import ObjectiveResult
+from kinema.sdk.streams import BlackboardSnapshot, LogEntry, MessageStream, ServerStatus
+
+if TYPE_CHECKING:
+    from kinema.transport import ActionClient, ClientGoalHandle, Node, ServiceClient, Session
+
+Overrides = Mapping[str, Any] | Iterable[ParameterOverride] | None
+
+DEFAULT_TIMEOUT = 5.0
+
+
+def parameter_messages(overrides: Overrides) -> list[dict[str, Any]]:
+    """``BehaviorParameter`` dicts for overrides.
+
+    A mapping value that is a string is sent as YAML text (TYPE_STRING: the server parses it into the
+    port's type); a bool, int or float is sent typed; anything else (a list, a dict) is sent as YAML.
+    :class:`ParameterOverride` items keep their ``behavior_namespaces``.
+    """
+    import yaml
+
+    if overrides is None:
+        return []
+    items: list[ParameterOverride]
+    if isinstance(overrides, Mapping):
+        items = [ParameterOverride(str(k), v, (), True) for k, v in overrides.items()]
+    else:
+        items = list(overrides)
+    messages = []
+    for item in items:
+        value = item.value
+        base: dict[str, Any] = {"behavior_namespaces": list(item.behavior_namespaces)}
+        if isinstance(value, bool):
+            messages.append({**base, "description": {"name": item.name, "type": 4}, "bool_value": value})
+        elif isinstance(value, int):
+            messages.append({**base, "description": {"name": item.name, "type": 3}, "int_value": value})
+        elif isinstance(value, float):
+            messages.append({**base, "description": {"name": item.name, "type": 2}, "double_value": value})
+        else:
+            text = value if isinstance(value, str) else yaml.safe_dump(value, default_flow_style=True).strip()
+            messages.append({**base, "description": {"name": item.name, "type": 0}, "string_value": text})
+    return messages
+
+
+def _result_from(error_code: Any, error_message: str, objective_name: str) -> ObjectiveResult:
+    message = error_message or getattr(error_code, "message", "") or ""
+    return ObjectiveResult(int(error_code.val), message, objective_name)
+
+
+class ObjectiveHandle:
+    """An objective started with :meth:`ObjectiveClient.start`: cancel it, wait for its result."""
+
+    def __init__(self, goal: ClientGoalHandle, objective_name: str) -> None:
+        self._goal = goal
+        self.objective_name = objective_name
+
+    @property
+    def status(self) -> str:
+        """The goal's status: ACCEPTED, EXECUTING, CANCELING, SUCCEEDED, CANCELED or ABORTED."""
+        return self._goal.status_name
+
+    @property
+    def done(self) -> bool:
+        """True once the objective ended."""
+        return self._goal.done()
+
+    def cancel(self, timeout: float = DEFAULT_TIMEOUT) -> bool:
+        """Ask the agent to halt this objective; True if it was still running."""
+        if self._goal.done():
+            return False
+        return self._goal.cancel(timeout=timeout)
+
+    def result(self, timeout: float | None = None) -> ObjectiveResult:
+        """Wait until the objective ends and return how it ended (cancelled runs are PREEMPTED).
+
+        Raises:
+            TransportError: ``timeout`` passed, or the agent went away before answering.
+        """
+        outcome = self._goal.result(timeout)
+        result = outcome.result
+        return _result_from(result.error_code, result.error_message, self.objective_name)
+
+    def __repr__(self) -> str:
+        return f"<ObjectiveHandle {self.objective_name!r} {self.status}>"
+
+
+class ObjectiveClient:
+    """A connection to the agent (the objective server). Use it as a context manager, or call :meth:`close`.
+
+    Args:
+        connect: router endpoint(s); default ``KINEMA_ZENOH_CONNECT`` or ``tcp/127.0.0.1:7447``.
+        timeout: how long to wait for the router and the agent before raising TransportError.
+        session: an open transport session to use instead (not closed by :meth:`close`).
+        domain_id: ROS domain id (default ``ROS_DOMAIN_ID`` or 0).
+    """
+
+    def __init__(
+        self,
+        connect: str | None = None,
+        *,
+        timeout: float = DEFAULT_TIMEOUT,
+        session: Session | None = None,
+        domain_id: int | None = None,
+    ) -> None:
+        from kinema.transport import Node, open_session
+
+        self.timeout = timeout
+        self._owns_session = session is None
+        self.session = (
+            session if session is not None else open_session(connect, domain_id, connect_timeout=timeout)
+        )
+        try:
+            self.node: Node = Node(self.session, f"kinema_sdk_{id(self):x}")
+        except Exception:
+            if self._owns_session:
+                self.session.close()
+            raise
+        self._lock = threading.Lock()
+        self._clients: dict[str, ServiceClient] = {}
+        self._action: ActionClient | None = None
+        self._ready = False
+
+    # -- plumbing ------------------------------------------------------------------------------------
+
+    def _client(self, srv_type: str, name: str) -> ServiceClient:
+        with self._lock:
+            client = self._clients.get(name)
+            if client is None:
+                client = self.node.create_client(srv_type, name)
+                self._clients[name] = client
+            return client
+
+    def _do_objective(self) -> ActionClient:
+        with self._lock:
+            if self._action is None:
+                self._action = self.node.create_action_client(names.DO_OBJECTIVE_TYPE, names.DO_OBJECTIVE)
+            return self._action
+
+    def wait_for_runtime(self, timeout: float | None = None) -> None:
+        """Block until the agent's services are on the network.
+
+        Raises:
+            TransportError: no agent answered within ``timeout`` (default: the client's timeout).
+        """
+        if self._ready:
+            return
+        limit = self.timeout if timeout is None else timeout
+        client = self._client(names.EXECUTE_OBJECTIVE_TYPE, names.EXECUTE_OBJECTIVE)
+        if not client.wait_for_service(limit):
+            where = ", ".join(self.session.endpoints) or "this process"
+            raise TransportError(
+                f"no Kinema runtime answers at {where} within {limit:g} s (start one with `kinema run`)"
+            )
+        self._ready = True
+
+    # -- objectives ----------------------------------------------------------------------------------
+
+    def execute(
+        self, name: str, overrides: Overrides = None, *, wait: bool = True, timeout: float | None = None
+    ) -> ObjectiveResult | ObjectiveHandle:
+        """Run the objective ``name`` (a new objective preempts the running one).
+
+        Args:
+            name: the objective's ID.
+            overrides: parameter overrides (see :func:`parameter_messages`).
+            wait: True blocks until it ends and returns its :class:`ObjectiveResult`; False returns an
+                :class:`ObjectiveHandle` at once (as :meth:`start`).
+            timeout: with ``wait``, how long the objective may take (None: as long as it runs).
+        """
+        if not wait:
+            return self.start(name, overrides)
+        self.wait_for_runtime()
+        client = self._client(names.EXECUTE_OBJECTIVE_TYPE, names.EXECUTE_OBJECTIVE)
+        request = {"objective_name": name, "parameter_overrides": parameter_messages(overrides)}
+        response = client.call(request, timeout=1e9 if timeout is None else timeout)
+        return _result_from(response.error_code, "", name)
+
+    def start(self, name: str = "", overrides: Overrides = None, *, xml: str = "") -> ObjectiveHandle:
+        """Start an objective through ``/do_objective`` and return its handle (name wins over ``xml``)."""
+        if not name and not xml:
+            raise TransportError("start() needs an objective name or an objective XML string")
+        self.wait_for_runtime()
+        action = self._do_objective()
+        if not action.wait_for_server(self.timeout):
+            raise TransportError(f"the agent's {names.DO_OBJECTIVE} action is not available")
+        goal = {
+            "objective_name": name,
+            "objective_xml_string": xml,
+            "parameter_overrides": parameter_messages(overrides),
+        }
+        handle = action.send_goal(goal, timeout=self.timeout)
+        if not handle.accepted:
+            raise TransportError(f"the agent rejected objective {name or '<XML>'!r}")
+        return ObjectiveHandle(handle, name or _xml_name(xml))
+
+    def do_xml(
+        self, xml: str, overrides: Overrides = None, *, wait: bool = True, timeout: float | None = None
+    ) -> ObjectiveResult | ObjectiveHandle:
+        """Run an objective given as a BT.CPP v4 XML string (its main tree); see :meth:`execute`."""
+        handle = self.start(overrides=overrides, xml=xml)
+        return handle.result(timeout) if wait else handle
+
+    def cancel(self) -> bool:
+        """Cancel whatever objective runs; False when none was running."""
+        self.wait_for_runtime()
+        client = self._client(names.CANCEL_OBJECTIVE_TYPE, names.CANCEL_OBJECTIVE)
+        response = client.call({}, timeout=self.timeout)
+        return bool(response.status.success)
+
+    def objectives(self, subcategory: str = "") -> list[Any]:
+        """The loaded objectives with their metadata (``kinema_msgs/msg/ObjectiveInfo`` messages)."""
+        self.wait_for_runtime()
+        client = self._client(names.LIST_OBJECTIVES_TYPE, names.LIST_OBJECTIVES)
+        response = client.call({"subcategory": subcategory}, timeout=self.timeout)
+        if not response.status.success:
+            raise TransportError(response.status.error_message)
+        return list(response.objectives)
+
+    # -- streams -------------------------------------------------------------------------------------
+
+    def status(self, timeout: float | None = None) -> ServerStatus:
+        """The agent's current status (its latest heartbeat).
+
+        Raises:
+            TransportError: no heartbeat within ``timeout`` (default: the client's timeout).
+        """
+        limit = self.timeout if timeout is None else timeout
+        with self.statuses(timeout=limit) as stream:
+            for status in stream:
+                return status
+        where = ", ".join(self.session.endpoints) or "this process"
+        raise TransportError(f"no Kinema runtime answers at {where} within {limit:g} s (no heartbeat)")
+
+    def statuses(self, *, timeout: float | None = None) -> MessageStream[ServerStatus]:
+        """Iterate over heartbeats (10 Hz, plus one per status change); ends after ``timeout`` of silence."""
+        return MessageStream(
+            lambda cb: self.node.create_subscription(names.HEARTBEAT_TYPE, names.HEARTBEAT, cb, latched=True),
+            ServerStatus.from_message,
+            timeout=timeout,
+        )
+
+    def blackboard(self, *, timeout: float | None = None) -> MessageStream[BlackboardSnapshot]:
+        """Iterate over blackboard snapshots (latched: the current one comes first)."""
+        return MessageStream(
+            lambda cb: self.node.create_subscription(
+                names.BLACKBOARD_TYPE, names.BLACKBOARD, cb, latched=True
+            ),
+            BlackboardSnapshot.from_message,
+            timeout=timeout,
+        )
+
+    def logs(self, *, timeout: float | None = None) -> MessageStream[LogEntry]:
+        """Iterate over the agent's log messages (behavior toasts, reload events, failures)."""
+        return MessageStream(
+            lambda cb: self.node.create_subscription(names.LOG_TYPE, names.LOG, cb),
+            LogEntry.from_message,
+            timeout=timeout,
+        )
+
+    def node_statuses(self, *, timeout: float | None = None) -> MessageStream[Any]:
+        """Iterate over batches of node status changes (``kinema_msgs/msg/NodeStatusChanges``)."""
+        return MessageStream(
+            lambda cb: self.node.create_subscription(names.NODE_STATUS_TYPE, names.NODE_STATUS, cb),
+            lambda message: message,
+            timeout=timeout,
+        )
+
+    # -- lifecycle -----------------------------------------------------------------------------------
+
+    def close(self) -> None:
+        """Close the node and, if this client opened it, the session."""
+        self.node.close()
+        if self._owns_session:
+            self.session.close()
+
+    def __enter__(self) -> ObjectiveClient:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+    def __repr__(self) -> str:
+        return f"<ObjectiveClient {self.session!r}>"
+
+
+def _xml_name(xml: str) -> str:
+    try:
+        from kinema.runtime.objective_server import main_tree_id
+
+        return main_tree_id(xml)
+    except Exception:
+        return "<objective XML>"
