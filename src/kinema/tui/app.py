@@ -13,6 +13,7 @@ import time
 from collections import deque
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from pathlib import Path
 
 from textual.app import App, SystemCommand
 from textual.binding import Binding
@@ -59,6 +60,7 @@ class EventInbox:
     lock: threading.Lock = field(default_factory=threading.Lock)
     ordered: list[RuntimeEvent] = field(default_factory=list)
     heartbeat: Heartbeat | None = None
+    heartbeat_key: tuple[str, str] = ("", "")
     clock: ClockSample | None = None
     blackboard: BlackboardSnapshot | None = None
     signalled: bool = False
@@ -67,10 +69,15 @@ class EventInbox:
         """Queue ``event``; returns True when the UI thread must be woken (the inbox was idle)."""
         with self.lock:
             if isinstance(event, Heartbeat):
-                # Heartbeats matter in order only around status changes; keep every change, the last beat.
-                if self.heartbeat is not None and self.heartbeat.status != event.status:
-                    self.ordered.append(self.heartbeat)
-                self.heartbeat = event
+                # A heartbeat that changes the status or objective is ordered with the node statuses
+                # around it (a new run resets the tree before its first statuses); the rest coalesce.
+                key = (event.objective_name, event.status)
+                if key != self.heartbeat_key:
+                    self.heartbeat_key = key
+                    self.ordered.append(event)
+                    self.heartbeat = None
+                else:
+                    self.heartbeat = event
             elif isinstance(event, ClockSample):
                 self.clock = event
             elif isinstance(event, BlackboardSnapshot):
@@ -105,7 +112,8 @@ class KinemaApp(App[None]):
     """
 
     TITLE = "Kinema"
-    CSS_PATH = "app.tcss"
+    # Absolute, so subclasses defined elsewhere (tests, embedding apps) find the stylesheet too.
+    CSS_PATH = Path(__file__).with_name("app.tcss")
     MODES = {
         "configs": ConfigsScreen,
         "objectives": ObjectivesScreen,

@@ -1,0 +1,163 @@
+"""The TUI's UI-free logic: tree outlines numbered like the engine, blackboard diffs, config rows, status."""
+
+from __future__ import annotations
+
+import pytest
+
+from kinema.bt import BehaviorTreeFactory
+from kinema.config import Workspace, resolve_config
+from kinema.errors import ObjectiveError
+from kinema.tui.blackboard_model import BlackboardDiff, BlackboardModel, row_key
+from kinema.tui.config_view import config_rows, package_files
+from kinema.tui.connection import BlackboardEntry, ClockSample, ConnectionChanged, ConnectionState, Heartbeat
+from kinema.tui.runtime_status import RuntimeStatus
+from kinema.tui.tree_outline import build_outline
+
+NESTED_XML = """
+<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main">
+    <Sequence name="top">
+      <AlwaysSuccess/>
+      <SubTree ID="Inner" name="first"/>
+      <Fallback>
+        <AlwaysFailure name="nope"/>
+        <SubTree ID="Inner"/>
+      </Fallback>
+      <Action ID="AlwaysSuccess" name="done"/>
+    </Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Inner">
+    <Sequence>
+      <Sleep msec="1"/>
+      <Inverter><AlwaysFailure/></Inverter>
+    </Sequence>
+  </BehaviorTree>
+</root>
+"""
+
+
+def test_outline_numbers_nodes_exactly_as_the_engine_builds_them() -> None:
+    factory = BehaviorTreeFactory()
+    factory.register_behavior_tree_from_text(NESTED_XML)
+    tree = factory.create_tree("Main")
+    engine = sorted((node.uid, node.full_path, node.registration_id) for node in tree.nodes())
+
+    outline = build_outline(NESTED_XML)
+    ours = sorted(
+        (node.uid, node.path, "SubTree" if node.is_subtree else node.type_id) for node in outline.nodes()
+    )
+
+    assert outline.exact_uids
+    assert ours == engine
+
+
+def test_outline_loads_subtrees_from_other_documents_and_reports_missing_ones() -> None:
+    main = (
+        '<root BTCPP_format="4"><BehaviorTree ID="M"><Sequence><SubTree ID="A"/><SubTree ID="B"/>'
+        "<AlwaysSuccess/></Sequence></BehaviorTree></root>"
+    )
+    other = '<root BTCPP_format="4"><BehaviorTree ID="A"><AlwaysSuccess name="in_a"/></BehaviorTree></root>'
+    asked: list[str] = []
+
+    def load(subtree_id: str) -> str | None:
+        asked.append(subtree_id)
+        return other if subtree_id == "A" else None
+
+    outline = build_outline(main, "M", load_subtree=load)
+
+    assert asked == ["A", "B"]
+    assert [n.path for n in outline.nodes()] == [
+        "Sequence::1",
+        "A::2",
+        "A::2/in_a",
+        "B::4",
+        "AlwaysSuccess::5",
+    ]
+    assert not outline.exact_uids and outline.missing_subtrees == ["B"]
+    # With inexact numbering, a status change is matched by path only.
+    assert outline.find(99, "A::2/in_a") is not None
+    assert outline.find(3, "") is None
+
+
+def test_outline_of_an_unknown_tree_names_the_known_ones() -> None:
+    with pytest.raises(ObjectiveError, match="'Main'"):
+        build_outline(NESTED_XML, "Mian")
+
+
+def _entry(key: str, value: str, scope: str = "", type_name: str = "int") -> BlackboardEntry:
+    return BlackboardEntry(scope, key, type_name, value)
+
+
+def test_blackboard_model_reports_only_what_changed_and_keeps_history() -> None:
+    model = BlackboardModel()
+    first = model.apply("Obj", 1.0, [_entry("a", "1"), _entry("b", "2"), _entry("c", "3", scope="Sub::2")])
+    assert [e.key for e in first.added] == ["a", "b", "c"] and not first.changed and not first.removed
+
+    second = model.apply("Obj", 2.0, [_entry("a", "1"), _entry("b", "5"), _entry("d", "4")])
+    assert [e.key for e in second.changed] == ["b"]
+    assert [e.key for e in second.added] == ["d"]
+    assert second.removed == [("Sub::2", "c")]
+    assert list(model.history[("", "b")]) == [(1.0, "2"), (2.0, "5")]
+    assert ("Sub::2", "c") not in model.history
+
+    assert not model.apply("Obj", 3.0, [_entry("a", "1"), _entry("b", "5"), _entry("d", "4")])
+    assert [e.key for e in model.matching("D")] == ["d"]
+
+
+def test_merged_diffs_equal_the_diff_between_first_and_last_snapshot() -> None:
+    snapshots = [
+        [_entry("a", "1"), _entry("b", "1")],
+        [_entry("a", "2"), _entry("c", "1")],
+        [_entry("b", "9"), _entry("c", "1")],
+        [_entry("b", "9"), _entry("c", "2"), _entry("a", "7")],
+    ]
+    model = BlackboardModel()
+    model.apply("O", 0, snapshots[0])
+    merged = BlackboardDiff()
+    for snapshot in snapshots[1:]:
+        merged = merged.merge(model.apply("O", 0, snapshot))
+
+    # Applying the merged diff to the first snapshot gives the last one.
+    table = {row_key(e): e.value for e in snapshots[0]}
+    for key in merged.removed:
+        del table[key]
+    for entry in [*merged.added, *merged.changed]:
+        table[row_key(entry)] = entry.value
+    assert table == {row_key(e): e.value for e in snapshots[-1]}
+
+
+def test_config_rows_name_the_package_that_set_each_value() -> None:
+    resolved = resolve_config("example_config", Workspace.bundled_only(), check_files=False)
+    rows = {row.key: row for row in config_rows(resolved)}
+
+    assert rows["based_on_package"].package == "example_config"
+    assert rows["objectives.objective_library_paths.example_objectives"].package == "example_config"
+    inherited = [row for row in rows.values() if row.key.startswith("hardware.")]
+    assert inherited and all(row.package == "lab_sim" for row in inherited)
+    assert rows["objectives.objective_library_paths.example_objectives"].value == "example_config: objectives"
+
+
+def test_package_files_are_relative_and_cut_at_the_limit(tmp_path) -> None:  # type: ignore[no-untyped-def]
+    (tmp_path / "config").mkdir()
+    (tmp_path / "config" / "config.yaml").write_text("a: 1\n")
+    (tmp_path / ".git").mkdir()
+    (tmp_path / ".git" / "HEAD").write_text("x")
+    (tmp_path / "z.txt").write_text("")
+    assert package_files(tmp_path) == (["z.txt", "config/config.yaml"], False)
+    assert package_files(tmp_path, limit=1) == (["z.txt"], True)
+
+
+def test_status_measures_elapsed_on_the_runtime_clock_and_forgets_a_lost_runtime() -> None:
+    status = RuntimeStatus()
+    status.apply_connection(ConnectionChanged(ConnectionState.CONNECTED, "tcp/127.0.0.1:7447"))
+    assert not status.apply_heartbeat(Heartbeat(10.0, "", "Idle"))
+    assert status.apply_heartbeat(Heartbeat(11.0, "Pick", "Running"))
+    assert not status.apply_heartbeat(Heartbeat(13.5, "Pick", "Running"))
+    assert status.elapsed == pytest.approx(2.5)
+    status.apply_heartbeat(Heartbeat(14.0, "Pick", "Success"))
+    status.apply_heartbeat(Heartbeat(20.0, "Pick", "Success"))
+    assert status.elapsed == pytest.approx(3.0)
+    assert status.apply_heartbeat(Heartbeat(21.0, "Place", "Running"))  # a new run
+    status.apply_clock(ClockSample(4.0, 0.98))
+    status.apply_connection(ConnectionChanged(ConnectionState.DISCONNECTED, "tcp/127.0.0.1:7447", "gone"))
+    assert status.status == "Unknown" and status.sim_time is None

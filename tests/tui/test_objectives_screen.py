@@ -1,0 +1,142 @@
+"""The Objectives screen against the scripted runtime: browse, filter, inspect, run, cancel, live status."""
+
+from __future__ import annotations
+
+from textual.widgets import Checkbox, Input, OptionList, Select, TabbedContent, TextArea
+
+from kinema.errors import TransportError
+from kinema.tui.connection import Heartbeat, NodeStatus, NodeStatusBatch, NodeStatusUpdate
+from kinema.tui.fake_connection import FakeConnection
+from kinema.tui.screens.objectives import ObjectivesScreen
+from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
+from kinema.tui.widgets.override_form import OverrideForm
+
+from pilot_harness import drive, settle
+
+
+def listed(app) -> list[str]:  # type: ignore[no-untyped-def]
+    options = app.screen.query_one("#objective-list", OptionList)
+    return [str(options.get_option_at_index(i).id) for i in range(options.option_count)]
+
+
+def test_library_is_listed_favorites_first_and_the_first_is_shown(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        assert isinstance(app.screen, ObjectivesScreen)
+        assert listed(app) == ["Pick Object", "Open Gripper", "Wait and Log"]
+        tree = app.screen.query_one(BehaviorTreeView)
+        assert tree.outline is not None and tree.outline.tree_id == "Pick Object"
+        # The subtree was expanded from its own document.
+        assert any(node.path == "Wait and Log::3/Sleep::5" for node in tree.outline.nodes())
+        assert '<BehaviorTree ID="Pick Object"' in app.screen.query_one("#objective-xml", TextArea).text
+
+    drive(fake, scenario)
+
+
+def test_search_and_filters_narrow_the_list(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        await pilot.press("slash")
+        await pilot.press(*"grip")
+        await settle(pilot)
+        assert listed(app) == ["Open Gripper"]
+        app.screen.query_one("#objective-search", Input).value = ""
+        await pilot.press("escape")  # leave the search box; the list has the focus for the keys below
+        app.screen.query_one("#objective-list", OptionList).focus()
+        await pilot.press("f")
+        await settle(pilot)
+        assert listed(app) == ["Pick Object"]
+        await pilot.press("f", "u")
+        await settle(pilot)
+        assert listed(app) == ["Pick Object", "Open Gripper"]
+        assert app.screen.query_one("#runnable", Checkbox).value
+        app.screen.query_one("#runnable", Checkbox).value = False
+        app.screen.query_one("#subcategory", Select).value = "Utilities"
+        await settle(pilot)
+        assert listed(app) == ["Wait and Log"]
+
+    drive(fake, scenario)
+
+
+def test_run_sends_the_filled_in_parameters_and_cancel_cancels(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        await pilot.press("p")
+        await settle(pilot)
+        assert app.screen.query_one(TabbedContent).active == "parameters"
+        form = app.screen.query_one(OverrideForm)
+        inputs = {field.name: field for field in form.query(Input)}
+        assert set(inputs) == {"waypoint_name", "speed"}  # output ports get no input
+        inputs["speed"].value = "0.25"
+        app.screen.query_one("#objective-list", OptionList).focus()
+        await pilot.press("r")
+        await settle(pilot)
+        assert fake.called("start_objective") == [("Pick Object", {"speed": "0.25"})]
+        assert app.screen.query_one(TabbedContent).active == "tree"
+        await pilot.press("x")
+        await settle(pilot)
+        assert fake.called("cancel_objective") == [()]
+        assert any("Cancel the objective" in text for text in app.shown)
+
+    drive(fake, scenario)
+
+
+def test_a_subtree_only_objective_is_not_run(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        await pilot.press("down", "down")
+        await settle(pilot)
+        assert app.screen.selected.name == "Wait and Log"
+        await pilot.press("r")
+        await settle(pilot)
+        assert fake.called("start_objective") == []
+        assert any("subtree only" in text for text in app.shown)
+
+    drive(fake, scenario)
+
+
+def test_node_statuses_show_live_on_the_tree_and_reset_on_a_new_run(fake: FakeConnection) -> None:
+    def update(uid: int, path: str, status: NodeStatus) -> NodeStatusUpdate:
+        return NodeStatusUpdate(uid, path, "", "", status)
+
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        view = app.screen.query_one(BehaviorTreeView)
+        fake.emit(Heartbeat(1.0, "Pick Object", "Running"))
+        fake.emit(
+            NodeStatusBatch(
+                "Pick Object",
+                (
+                    update(1, "TopLevelSequence", NodeStatus.RUNNING),
+                    update(2, "MoveToWaypoint::2", NodeStatus.SUCCESS),
+                    update(5, "Wait and Log::3/Sleep::5", NodeStatus.RUNNING),
+                ),
+            )
+        )
+        await settle(pilot)
+        assert view.status_of("TopLevelSequence") is NodeStatus.RUNNING
+        assert view.status_of("MoveToWaypoint::2") is NodeStatus.SUCCESS
+        assert view.status_of("Wait and Log::3/Sleep::5") is NodeStatus.RUNNING
+        labels = [str(node.label) for node in view._by_uid.values()]
+        assert any(label.startswith("✔ MoveToWaypoint") and "SUCCESS" in label for label in labels)
+        # Another objective's statuses do not paint this tree.
+        fake.emit(NodeStatusBatch("Open Gripper", (update(1, "OpenGripper", NodeStatus.FAILURE),)))
+        await settle(pilot)
+        assert view.status_of("TopLevelSequence") is NodeStatus.RUNNING
+        # The run ends, then a new one starts: everything is idle again.
+        fake.emit(Heartbeat(2.0, "Pick Object", "Success"))
+        fake.emit(Heartbeat(3.0, "Pick Object", "Running"))
+        await settle(pilot)
+        assert view.status_of("MoveToWaypoint::2") is NodeStatus.IDLE
+
+    drive(fake, scenario)
+
+
+def test_a_failing_runtime_call_is_shown_and_the_app_keeps_running(fake: FakeConnection) -> None:
+    fake.failures["start_objective"] = TransportError("no runtime answered on tcp/127.0.0.1:7447 within 2 s")
+
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        await pilot.press("r")
+        await settle(pilot)
+        assert any("Run 'Pick Object' failed: no runtime answered" in text for text in app.shown)
+        assert any("no runtime answered" in entry.message for entry in app.logs)
+        await pilot.press("down")
+        await settle(pilot)
+        assert app.screen.selected.name == "Open Gripper"  # still responsive
+
+    drive(fake, scenario)

@@ -1,0 +1,287 @@
+"""Configs, Blackboard, Behaviors, Logs and Waypoints screens, the status bar and reconnection (Pilot)."""
+
+from __future__ import annotations
+
+from textual.widgets import DataTable, Input, OptionList, RichLog, Select, Tree
+
+from kinema.errors import TransportError
+from kinema.tui.connection import (
+    BlackboardEntry,
+    BlackboardSnapshot,
+    ClockSample,
+    ConnectionChanged,
+    ConnectionState,
+    Heartbeat,
+    LogEntry,
+    LogLevel,
+    ReloadNotice,
+)
+from kinema.tui.fake_connection import FakeConnection
+from kinema.tui.screens.blackboard import BlackboardScreen
+from kinema.tui.widgets.blackboard_table import BlackboardTable
+from kinema.tui.widgets.status_bar import StatusBar
+from pilot_harness import drive, settle
+
+
+def table_rows(table: DataTable) -> list[list[str]]:  # type: ignore[type-arg]
+    return [[str(cell) for cell in table.get_row_at(i)] for i in range(table.row_count)]
+
+
+def tree_labels(tree: Tree) -> list[str]:  # type: ignore[type-arg]
+    out: list[str] = []
+    stack = [tree.root]
+    while stack:
+        node = stack.pop()
+        out.append(str(node.label))
+        stack.extend(reversed(node.children))
+    return out
+
+
+# -- Configs -------------------------------------------------------------------------------------
+
+
+def test_configs_show_packages_chain_provenance_and_files(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        options = app.screen.query_one("#config-list", OptionList)
+        names = [options.get_option_at_index(i).id for i in range(options.option_count)]
+        assert names == ["example_config", "lab_sim"]
+        assert app.screen.details.name == "lab_sim"  # the runtime's config is preselected
+        options.focus()
+        await pilot.press("up")
+        await settle(pilot)
+        details = app.screen.details
+        assert details.name == "example_config" and not details.error
+        chain = tree_labels(app.screen.query_one("#chain-tree", Tree))
+        assert [label.split()[0] for label in chain[1:]] == ["lab_sim", "example_config"]
+        rows = table_rows(app.screen.query_one("#resolved-table", DataTable))
+        by_key = {row[0]: row for row in rows}
+        assert by_key["based_on_package"][2] == "example_config"
+        assert by_key["hardware.type"][2] == "lab_sim" if "hardware.type" in by_key else True
+        assert any(row[2] == "lab_sim" for row in rows) and any(row[2] == "example_config" for row in rows)
+        await pilot.press("i")
+        await settle(pilot)
+        files = tree_labels(app.screen.query_one("#file-tree", Tree))
+        assert "config/" in files and "config.yaml" in files and "package.xml" in files
+
+    drive(fake, scenario, mode="configs")
+
+
+# -- Blackboard ----------------------------------------------------------------------------------
+
+
+def snapshot(stamp: float, values: dict[str, str], scope: str = "") -> BlackboardSnapshot:
+    entries = tuple(BlackboardEntry(scope, key, "int", value) for key, value in values.items())
+    return BlackboardSnapshot("Pick Object", stamp, entries)
+
+
+def test_blackboard_rows_update_in_place_filter_and_show_history(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        table = app.screen.query_one(BlackboardTable)
+        rebuilds = 0
+        original = table.rebuild
+
+        def counting_rebuild(*args, **kwargs):  # type: ignore[no-untyped-def]
+            nonlocal rebuilds
+            rebuilds += 1
+            original(*args, **kwargs)
+
+        table.rebuild = counting_rebuild  # type: ignore[method-assign]
+        fake.emit(snapshot(1.0, {"count": "1", "goal": "[1, 2]", "name": "'a'"}))
+        fake.emit(
+            BlackboardSnapshot(
+                "Pick Object",
+                1.0,
+                (
+                    BlackboardEntry("", "count", "int", "1"),
+                    BlackboardEntry("", "goal", "int", "[1, 2]"),
+                    BlackboardEntry("", "name", "int", "'a'"),
+                    BlackboardEntry("Wait and Log::3", "seconds", "double", "0.5"),
+                ),
+            )
+        )
+        await pilot.pause(0.3)
+        await settle(pilot)
+        assert sorted(r[1] for r in table_rows(table)) == ["count", "goal", "name", "seconds"]
+        assert ["Wait and Log::3", "seconds", "double", "0.5"] in table_rows(table)
+        for i in range(2, 6):
+            fake.emit(
+                BlackboardSnapshot(
+                    "Pick Object",
+                    float(i),
+                    (
+                        BlackboardEntry("", "count", "int", str(i)),
+                        BlackboardEntry("", "goal", "int", "[1, 2]"),
+                        BlackboardEntry("Wait and Log::3", "seconds", "double", "0.5"),
+                    ),
+                )
+            )
+            await pilot.pause(0.25)
+        await settle(pilot)
+        rows = table_rows(table)
+        assert ["(root)", "count", "int", "5"] in rows
+        assert "name" not in [r[1] for r in rows]  # removed from the blackboard, removed from the table
+        assert rebuilds == 0  # live updates never rebuilt the table
+        table.move_cursor(row=[r[1] for r in rows].index("count"))
+        await settle(pilot)
+        history = table_rows(app.screen.query_one("#history-table", DataTable))
+        assert [row[1] for row in history][:3] == ["5", "4", "3"]
+        await pilot.press("slash", *"seco")
+        await pilot.pause(0.3)
+        await settle(pilot)
+        assert [r[1] for r in table_rows(table)] == ["seconds"]
+        assert "1 of 3 entries" in str(app.screen.query_one("#blackboard-summary").render())
+
+    drive(fake, scenario, mode="blackboard")
+
+
+def test_blackboard_updates_wait_while_the_screen_is_hidden(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        screen = app.screen
+        assert isinstance(screen, BlackboardScreen)
+        await pilot.press("2")
+        await settle(pilot)
+        fake.emit(snapshot(1.0, {f"k{i}": str(i) for i in range(50)}))
+        await pilot.pause(0.3)
+        assert screen.query_one(BlackboardTable).row_count == 0
+        await pilot.press("3")
+        await settle(pilot)
+        assert screen.query_one(BlackboardTable).row_count == 50
+
+    drive(fake, scenario, mode="blackboard")
+
+
+# -- Behaviors -----------------------------------------------------------------------------------
+
+
+def test_behaviors_catalog_and_reload_events(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        table = app.screen.query_one("#behavior-table", DataTable)
+        assert [row[0] for row in table_rows(table)] == ["MoveToWaypoint", "MyBehavior"]
+        await pilot.press("down")
+        await settle(pilot)
+        ports = table_rows(app.screen.query_one("#behavior-ports", DataTable))
+        assert [p[0] for p in ports] == ["int_1", "int_2", "int_out"]
+        details = str(app.screen.query_one("#behavior-details").render())
+        assert "Adds two integers." in details and "workspace: src/my_behaviors" in details
+        assert "src/my_behaviors/my_behavior.py:12" in details
+        fake.emit(
+            ReloadNotice(
+                False,
+                "reload_failed",
+                "my_behaviors",
+                "SyntaxError: invalid syntax",
+                "src/my_behaviors/my_behavior.py:7",
+            )
+        )
+        fake.emit(ReloadNotice(True, "behaviors_reloaded", "my_behaviors", "reloaded 1 behavior"))
+        await settle(pilot)
+        reloads = table_rows(app.screen.query_one("#reload-table", DataTable))
+        assert reloads[0][1] == "✘" and "src/my_behaviors/my_behavior.py:7: SyntaxError" in reloads[0][3]
+        assert reloads[1][1] == "✔"
+        assert any("my_behavior.py:7: SyntaxError" in text for text in app.shown)
+        assert len(fake.called("list_behaviors")) == 2  # a good reload lists the behaviors again
+
+    drive(fake, scenario, mode="behaviors")
+
+
+# -- Logs ----------------------------------------------------------------------------------------
+
+
+def test_toasts_notify_and_the_log_panel_filters_by_level(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        fake.emit(LogEntry("Sum: 5", LogLevel.INFO, 0.0, "MyServiceClient"))
+        fake.emit(LogEntry("gripper slow", LogLevel.WARN))
+        fake.emit(LogEntry("planning failed", LogLevel.ERROR))
+        await settle(pilot)
+        assert {"Sum: 5", "gripper slow", "planning failed"} <= set(app.shown)
+        panel = app.screen.query_one(RichLog)
+        assert len(panel.lines) == 3
+        await pilot.press("e")
+        await settle(pilot)
+        assert app.screen.query_one("#log-level", Select).value == int(LogLevel.ERROR)
+        assert [line.text for line in panel.lines] == ["ERROR planning failed"]
+        await pilot.press("l")
+        await settle(pilot)
+        assert len(panel.lines) == 2
+        assert "2 of 3 messages" in str(app.screen.query_one("#log-count").render())
+
+    drive(fake, scenario, mode="logs")
+
+
+# -- Waypoints -----------------------------------------------------------------------------------
+
+
+def test_waypoints_move_save_rename_delete(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        table = app.screen.query_one("#waypoint-table", DataTable)
+        assert [row[1] for row in table_rows(table)] == ["Home", "Look at Table"]
+        joints = table_rows(app.screen.query_one("#joint-table", DataTable))
+        assert joints == [["joint_1", "+0.0000"], ["joint_2", "+0.0000"]]
+        await pilot.press("down", "enter")
+        await settle(pilot)
+        assert fake.called("move_to_waypoint") == [("Look at Table",)]
+        await pilot.press("s")
+        await settle(pilot)
+        await pilot.press(*"Above Tray", "enter")
+        await settle(pilot)
+        assert fake.called("save_waypoint") == [("Above Tray",)]
+        assert "Above Tray" in [row[1] for row in table_rows(table)]
+        await pilot.press("n")
+        await settle(pilot)
+        app.screen.query_one(Input).value = "Tray"
+        await pilot.press("enter")
+        await settle(pilot)
+        assert fake.called("rename_waypoint")[0][1] == "Tray"
+        renamed = fake.called("rename_waypoint")[0][0]
+        await pilot.press("d")
+        await settle(pilot)
+        await pilot.press("n")  # declined: nothing deleted
+        await settle(pilot)
+        assert fake.called("erase_waypoint") == []
+        await pilot.press("d")
+        await settle(pilot)
+        await pilot.press("y")
+        await settle(pilot)
+        erased = fake.called("erase_waypoint")[0][0]
+        assert erased not in [row[1] for row in table_rows(table)]
+        assert renamed not in [row[1] for row in table_rows(table)]
+
+    drive(fake, scenario, mode="waypoints")
+
+
+# -- status bar, connection ----------------------------------------------------------------------
+
+
+def test_status_bar_shows_heartbeat_sim_time_and_a_lost_runtime_then_reloads_on_return(
+    fake: FakeConnection,
+) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        bar = app.screen.query_one(StatusBar)
+        fake.emit(Heartbeat(5.0, "Pick Object", "Running"))
+        fake.emit(Heartbeat(7.5, "Pick Object", "Running"))
+        fake.emit(ClockSample(12.25, 0.97))
+        await settle(pilot)
+        text = str(bar.render())
+        assert "connected" in text and "Pick Object Running 2.5 s" in text and "sim 12.25 s" in text
+        assert "RTF 0.97x" in text
+        listed_before = len(fake.called("list_objectives"))
+        fake.failures["list_objectives"] = TransportError("no runtime")
+        fake.emit(ConnectionChanged(ConnectionState.DISCONNECTED, "fake://runtime", "no heartbeat for 3 s"))
+        await settle(pilot)
+        assert "disconnected" in str(bar.render()) and "no heartbeat for 3 s" in str(bar.render())
+        assert any("no heartbeat for 3 s" in text for text in app.shown)
+        del fake.failures["list_objectives"]
+        fake.emit(ConnectionChanged(ConnectionState.CONNECTED, "fake://runtime"))
+        await settle(pilot)
+        assert "● connected" in str(bar.render())
+        assert len(fake.called("list_objectives")) == listed_before + 1
+
+    drive(fake, scenario)
+
+
+def test_every_binding_has_an_id_and_a_tooltip() -> None:
+    from kinema.tui.app import KinemaApp
+
+    for screen in KinemaApp.MODES.values():
+        for binding in [*KinemaApp.BINDINGS, *screen.BINDINGS]:  # type: ignore[union-attr]
+            assert binding.id and binding.tooltip, binding
