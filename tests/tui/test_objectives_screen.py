@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from pilot_harness import drive, settle
 from textual.widgets import Checkbox, Input, OptionList, Select, TabbedContent, TextArea
 
 from kinema.errors import TransportError
@@ -10,8 +11,6 @@ from kinema.tui.fake_connection import FakeConnection
 from kinema.tui.screens.objectives import ObjectivesScreen
 from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
 from kinema.tui.widgets.override_form import OverrideForm
-
-from pilot_harness import drive, settle
 
 
 def listed(app) -> list[str]:  # type: ignore[no-untyped-def]

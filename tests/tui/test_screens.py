@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from pilot_harness import drive, settle
 from textual.widgets import DataTable, Input, OptionList, RichLog, Select, Tree
 
 from kinema.errors import TransportError
@@ -20,7 +21,6 @@ from kinema.tui.fake_connection import FakeConnection
 from kinema.tui.screens.blackboard import BlackboardScreen
 from kinema.tui.widgets.blackboard_table import BlackboardTable
 from kinema.tui.widgets.status_bar import StatusBar
-from pilot_harness import drive, settle
 
 
 def table_rows(table: DataTable) -> list[list[str]]:  # type: ignore[type-arg]
