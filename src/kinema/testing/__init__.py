@@ -8,24 +8,28 @@ from __future__ import annotations
 
 from kinema.testing.harness import (
     BehaviorRun,
+    InProcessRuntime,
     ObjectiveRunResult,
     build_tree,
     load_behavior_package,
     publish_repeatedly,
     registry_of,
     run_objective,
+    runtime_in_process,
     tick_behavior,
     tick_until_done,
 )
 
 __all__ = [
     "BehaviorRun",
+    "InProcessRuntime",
     "ObjectiveRunResult",
     "build_tree",
     "load_behavior_package",
     "publish_repeatedly",
     "registry_of",
     "run_objective",
+    "runtime_in_process",
     "tick_behavior",
     "tick_until_done",
 ]

@@ -241,6 +241,67 @@ def _message(message_type: str, message: Any) -> Any:
     return message
 
 
+@dataclass
+class InProcessRuntime:
+    """A Kinema runtime (the agent) serving in this process, and an SDK client connected to it.
+
+    Attributes:
+        client: a :class:`kinema.sdk.ObjectiveClient` on the runtime's private network.
+        agent: the running :class:`kinema.runtime.agent.Agent`.
+        session: the private transport session both use (make more nodes on it for test servers).
+    """
+
+    client: Any
+    agent: Any
+    session: Any
+
+
+@contextlib.contextmanager
+def runtime_in_process(
+    config: str | None = None,
+    *,
+    workspace: Path | None = None,
+    objective_dirs: Iterable[Path] = (),
+    clock: str = "wall",
+    hot_reload: bool = False,
+) -> Iterator[InProcessRuntime]:
+    """Run the agent for ``config`` in this process on a private network; yield it with a client.
+
+    Args:
+        config: the config package (None: only ``objective_dirs`` and the engine's built-in nodes).
+        workspace: where to resolve ``config`` (default: the active workspace).
+        objective_dirs: extra objective folders.
+        clock: ``wall`` (default; no simulator is needed to advance time) or ``sim`` / ``auto``.
+        hot_reload: watch behavior packages and objective folders, as ``kinema run`` does.
+    """
+    from kinema.runtime.agent_process import AgentOptions, build_agent
+    from kinema.sdk import ObjectiveClient
+    from kinema.transport import open_session
+
+    session = open_session([])
+    agent = None
+    client = None
+    try:
+        options = AgentOptions(
+            config=config,
+            workspace=workspace,
+            objective_dirs=[Path(folder) for folder in objective_dirs],
+            clock=clock,  # type: ignore[arg-type]
+            hot_reload=hot_reload,
+        )
+        agent = build_agent(options, session)
+        agent.start()
+        client = ObjectiveClient(session=session)
+        client.wait_for_runtime()
+        yield InProcessRuntime(client, agent, session)
+    finally:
+        if client is not None:
+            client.close()
+        if agent is not None:
+            agent.close()
+        session.close()
+
+
 def load_behavior_package(folder: Path) -> BehaviorRegistry:
     """Load the behavior package at ``folder`` by path, as the runtime does, and return its registry.
 

@@ -5,6 +5,8 @@
 * ``run_objective(xml_or_path, registry=..., node=...)`` → status, blackboard values and toasts;
 * ``kinema_node``: a transport node on a private in-process network (no router, no other process);
 * ``publish_repeatedly(node, type, topic, message)``: a context manager publishing in the background;
+* ``kinema_runtime(config, workspace=..., objective_dirs=[...])``: the agent running in this process on a
+  private network, with an SDK client (``.client.execute("My Objective")``); stopped after the test;
 * ``package_registry``: the behaviors of the behavior package under test, loaded by path as the runtime
   loads them (the package is the folder holding the ``pyproject.toml`` pytest runs from).
 """
@@ -87,3 +89,20 @@ def package_registry(request: pytest.FixtureRequest) -> Any:
 
     root = Path(request.config.rootpath)
     return harness.load_behavior_package(root)
+
+
+@pytest.fixture
+def kinema_runtime() -> Iterator[Callable[..., Any]]:
+    """Start a runtime in-process: ``runtime = kinema_runtime("my_config", workspace=ws)``; see
+    :func:`kinema.testing.runtime_in_process` for the arguments. Every runtime started is stopped after
+    the test."""
+    import contextlib
+
+    from kinema.testing import harness
+
+    with contextlib.ExitStack() as stack:
+
+        def start(*args: Any, **kwargs: Any) -> Any:
+            return stack.enter_context(harness.runtime_in_process(*args, **kwargs))
+
+        yield start
