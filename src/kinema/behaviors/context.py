@@ -29,6 +29,8 @@ class BehaviorContext:
         log_sink: where ``publish_info/warn/failure`` messages go; a new private sink by default.
         robot_model: a robot model object, or a zero-argument callable that builds it on first use
             (so a behavior that never asks for it never pays for loading it).
+        config: the resolved config package the runtime runs (``kinema.config.ResolvedConfig``), for
+            behaviors that need its files (the MuJoCo scene as planning scene, say); None without one.
     """
 
     def __init__(
@@ -38,12 +40,14 @@ class BehaviorContext:
         clock: Clock | None = None,
         log_sink: LogSink | None = None,
         robot_model: Any = None,
+        config: Any = None,
     ) -> None:
         if clock is None:
             from kinema.bt import WallClock
 
             clock = WallClock()
         self.node = node
+        self.config = config
         self.clock = clock
         self.log_sink = log_sink if log_sink is not None else LogSink()
         self._robot_model = robot_model
