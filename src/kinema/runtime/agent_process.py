@@ -79,7 +79,9 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
         node.create_subscription(names.CLOCK_TYPE, names.CLOCK, clock.on_clock_message)
         log.info("time follows %s (simulation time)", names.CLOCK)
     sink = LogSink()
-    context = BehaviorContext(node, clock=clock, log_sink=sink, robot_model=_robot_model_provider(resolved))
+    context = BehaviorContext(
+        node, clock=clock, log_sink=sink, robot_model=_robot_model_provider(resolved), config=resolved
+    )
     host = build_host(resolved) if resolved is not None else None
     extra = [Path(folder) for folder in options.objective_dirs]
 
