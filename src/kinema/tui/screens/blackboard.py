@@ -7,6 +7,8 @@ costs the terminal a handful of cell updates per refresh instead of a rebuilt ta
 
 from __future__ import annotations
 
+import time
+
 from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
@@ -20,6 +22,13 @@ from kinema.tui.widgets.blackboard_table import BlackboardTable
 REFRESH_PERIOD_S = 0.2
 # A pending diff touching more rows than this is cheaper to show by rebuilding the (filtered) table.
 REBUILD_THRESHOLD = 2000
+
+
+def format_stamp(stamp: float) -> str:
+    """Wall-clock stamps as local ``HH:MM:SS.mmm``; small ones (sim time, tests) as seconds."""
+    if stamp > 1e9:
+        return time.strftime("%H:%M:%S", time.localtime(stamp)) + f".{int(stamp % 1 * 1000):03d}"
+    return f"{stamp:.2f}"
 
 
 class BlackboardScreen(KinemaScreen):
@@ -53,7 +62,7 @@ class BlackboardScreen(KinemaScreen):
     def on_mount(self) -> None:
         super().on_mount()
         history = self.query_one("#history-table", DataTable)
-        history.add_column("Time", key="time", width=10)
+        history.add_column("Time", key="time", width=12)
         history.add_column("Value", key="value")
         self.set_interval(REFRESH_PERIOD_S, self.flush)
         self.query_one(BlackboardTable).focus()
@@ -119,7 +128,7 @@ class BlackboardScreen(KinemaScreen):
         scope, name = key
         title.update(Text.assemble((name, "bold"), (f"  {scope or '(root)'}", "dim")))
         for stamp, value in reversed(self.kinema.blackboard.history.get(key, ())):
-            table.add_row(f"{stamp:.2f}", value)
+            table.add_row(format_stamp(stamp), value)
 
     def action_filter(self) -> None:
         self.query_one("#blackboard-filter", Input).focus()

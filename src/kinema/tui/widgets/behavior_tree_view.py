@@ -18,10 +18,15 @@ STATUS_MARK: dict[NodeStatus, tuple[str, str]] = {
     NodeStatus.FAILURE: ("✘", "bold red"),
     NodeStatus.SKIPPED: ("⊘", "dim cyan"),
 }
+_RESULTS = frozenset({NodeStatus.SUCCESS, NodeStatus.FAILURE, NodeStatus.SKIPPED})
 
 
 class BehaviorTreeView(Tree[OutlineNode]):
-    """Shows a :class:`TreeOutline`; :meth:`apply_statuses` marks nodes as the runtime reports them."""
+    """Shows a :class:`TreeOutline`; :meth:`apply_statuses` marks nodes as the runtime reports them.
+
+    A node keeps showing its last result (SUCCESS, FAILURE, SKIPPED) when its parent resets it to IDLE,
+    so a finished run stays readable; a new run (:meth:`reset_statuses`) clears the marks.
+    """
 
     def __init__(self, *, id: str | None = None) -> None:
         super().__init__("(no objective selected)", id=id)
@@ -69,6 +74,9 @@ class BehaviorTreeView(Tree[OutlineNode]):
             if node is None:
                 continue
             found += 1
+            previous = self.statuses.get(node.uid, NodeStatus.IDLE)
+            if update.status is NodeStatus.IDLE and previous in _RESULTS:
+                continue  # parents reset finished children to IDLE; keep showing how they ended
             self.statuses[node.uid] = update.status
             item = self._by_uid.get(node.uid)
             if item is not None:

@@ -1,0 +1,502 @@
+"""The TUI's connection to a real runtime, through :class:`kinema.sdk.ObjectiveClient` and its transport node.
+
+It subscribes to what any SDK client can see (heartbeat, node status changes, blackboard snapshots, logs,
+``/clock``) and calls the agent's public services; nothing here is private to the TUI. A supervisor thread
+keeps it connected: it joins the router (retrying while there is none), declares the subscriptions,
+reports the runtime as disconnected when heartbeats stop, and starts over with a fresh session when they
+stay away, so a restarted runtime is picked up without restarting the app.
+"""
+
+from __future__ import annotations
+
+import logging
+import re
+import threading
+import time
+from collections import deque
+from collections.abc import Mapping
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from kinema.errors import KinemaError, ObjectiveError, TransportError
+from kinema.tui.connection import (
+    BehaviorSummary,
+    BlackboardEntry,
+    BlackboardSnapshot,
+    ClockSample,
+    ConnectionChanged,
+    ConnectionState,
+    EventListener,
+    Heartbeat,
+    LogEntry,
+    LogLevel,
+    NodeStatus,
+    NodeStatusBatch,
+    NodeStatusUpdate,
+    ObjectivesChanged,
+    ObjectiveSummary,
+    PortSummary,
+    ReloadNotice,
+    RuntimeEvent,
+    WaypointSummary,
+)
+
+if TYPE_CHECKING:
+    from kinema.config import ResolvedConfig, Workspace
+    from kinema.sdk import ObjectiveClient
+
+log = logging.getLogger("kinema.tui")
+
+#: The runtime counts as gone when no heartbeat (10 Hz) arrived for this long.
+HEARTBEAT_TIMEOUT_S = 1.5
+#: After this long without heartbeats the session is dropped and a new one is opened.
+RECONNECT_AFTER_S = 4.0
+RETRY_PERIOD_S = 1.0
+CALL_TIMEOUT_S = 5.0
+#: The objective MoveIt Pro (and Kinema's core library) moves to a waypoint with.
+MOVE_TO_WAYPOINT_OBJECTIVE = "Move to Waypoint"
+_DIRECTIONS = {0: "input", 1: "output", 2: "inout"}
+# The runtime publishes hot-reload outcomes on its log stream (kinema.plugins.host wording).
+_RELOADED = re.compile(r"^Reloaded (?P<subject>\S+): (?P<ids>.*)$")
+_RELOAD_FAILED = re.compile(
+    r"^(?:(?P<location>.+?:\d+): )?(?P<subject>.+?) not reloaded, keeping the last good"
+)
+_OBJECTIVES_CHANGED = re.compile(r"^Objectives changed: (?P<names>.*)$")
+
+
+def reload_notice_from_log(text: str, level: int, stamp: float = 0.0) -> ReloadNotice | None:
+    """Recognise a hot-reload outcome among the runtime's log messages, or return None."""
+    found = _RELOADED.match(text)
+    if found:
+        ids = tuple(i.strip() for i in found["ids"].split(",") if i.strip() and i.strip() != "no behaviors")
+        return ReloadNotice(True, "behaviors_reloaded", found["subject"], text, "", ids, stamp)
+    found = _OBJECTIVES_CHANGED.match(text)
+    if found:
+        return ReloadNotice(True, "objectives_changed", "objectives", text, "", (), stamp)
+    found = _RELOAD_FAILED.match(text)
+    if found and level == int(LogLevel.ERROR):
+        location = found["location"] or ""
+        message = text[len(location) + 2 :] if location else text
+        return ReloadNotice(False, "reload_failed", found["subject"], message, location, (), stamp)
+    return None
+
+
+class SdkConnection:
+    """A :class:`~kinema.tui.connection.RuntimeConnection` to a runtime on the zenoh network.
+
+    Args:
+        endpoint: the router to join (default ``KINEMA_ZENOH_CONNECT`` or ``tcp/127.0.0.1:7447``).
+        workspace: the workspace the Configs and Behaviors screens read (default: the active one).
+        config: the config package the runtime runs (default: the active one), for the behavior catalog.
+        heartbeat_timeout: seconds without a heartbeat before the runtime is shown as disconnected.
+    """
+
+    def __init__(
+        self,
+        endpoint: str | None = None,
+        *,
+        workspace: Path | None = None,
+        config: str | None = None,
+        heartbeat_timeout: float = HEARTBEAT_TIMEOUT_S,
+    ) -> None:
+        self._endpoint = endpoint
+        self._workspace_path = workspace
+        self._config = config
+        self._heartbeat_timeout = heartbeat_timeout
+        self._listener: EventListener | None = None
+        self._client: ObjectiveClient | None = None
+        self._service_clients: dict[str, Any] = {}
+        self._lock = threading.Lock()
+        self._state_lock = threading.Lock()
+        self._stop = threading.Event()
+        self._thread: threading.Thread | None = None
+        self._last_heartbeat = 0.0
+        self._state = ConnectionState.CONNECTING
+        self._clock_window: deque[tuple[float, float]] = deque(maxlen=50)
+        self._last_clock_event = 0.0
+        self._selection_cache: tuple[Workspace, str | None] | None = None
+
+    # -- identity -------------------------------------------------------------------------------
+
+    @property
+    def endpoint(self) -> str:
+        if self._endpoint:
+            return self._endpoint
+        from kinema.transport import resolve_endpoints
+
+        return ", ".join(resolve_endpoints(None))
+
+    @property
+    def config_name(self) -> str | None:
+        if self._config:
+            return self._config
+        from kinema.config import active_selection
+
+        try:
+            return active_selection().config
+        except KinemaError:
+            return None
+
+    # -- lifecycle ------------------------------------------------------------------------------
+
+    def open(self, listener: EventListener) -> None:
+        self._listener = listener
+        self._stop.clear()
+        self._thread = threading.Thread(target=self._supervise, name="kinema-tui-connection", daemon=True)
+        self._thread.start()
+
+    def close(self) -> None:
+        self._stop.set()
+        if self._thread is not None:
+            self._thread.join(timeout=5.0)
+            self._thread = None
+        self._drop_client()
+        self._listener = None
+
+    def _emit(self, event: RuntimeEvent) -> None:
+        listener = self._listener
+        if listener is not None:
+            listener(event)
+
+    def _set_state(self, state: ConnectionState, detail: str = "") -> None:
+        with self._state_lock:  # heartbeats (transport thread) and the supervisor both change it
+            if state is self._state:
+                return
+            self._state = state
+        self._emit(ConnectionChanged(state, self.endpoint, detail))
+
+    def _supervise(self) -> None:
+        """Keep a session with live subscriptions while open (runs on its own thread)."""
+        while not self._stop.is_set():
+            if self._client is None:
+                try:
+                    self._connect()
+                except KinemaError as error:
+                    self._set_state(ConnectionState.DISCONNECTED, str(error))
+                    self._stop.wait(RETRY_PERIOD_S)
+                    continue
+                except Exception as error:  # keep retrying; the app shows why
+                    log.exception("connecting to the runtime failed")
+                    self._set_state(ConnectionState.DISCONNECTED, f"{type(error).__name__}: {error}")
+                    self._stop.wait(RETRY_PERIOD_S)
+                    continue
+            silent = time.monotonic() - self._last_heartbeat
+            if self._state is ConnectionState.CONNECTED and silent > self._heartbeat_timeout:
+                self._set_state(
+                    ConnectionState.DISCONNECTED, f"no heartbeat from the runtime for {silent:.1f} s"
+                )
+            elif self._state is not ConnectionState.CONNECTED and silent > RECONNECT_AFTER_S:
+                self._drop_client()  # start over with a fresh session: the router may have restarted
+                continue
+            self._stop.wait(0.2)
+
+    def _connect(self) -> None:
+        from kinema.runtime import names
+        from kinema.sdk import ObjectiveClient
+
+        client = ObjectiveClient(self._endpoint, timeout=2.0)
+        node = client.node
+        try:
+            node.create_subscription(names.HEARTBEAT_TYPE, names.HEARTBEAT, self._on_heartbeat, latched=True)
+            node.create_subscription(names.NODE_STATUS_TYPE, names.NODE_STATUS, self._on_node_status)
+            node.create_subscription(
+                names.BLACKBOARD_TYPE, names.BLACKBOARD, self._on_blackboard, latched=True
+            )
+            node.create_subscription(names.LOG_TYPE, names.LOG, self._on_log)
+            node.create_subscription(names.CLOCK_TYPE, names.CLOCK, self._on_clock)
+        except Exception:
+            client.close()
+            raise
+        with self._lock:
+            self._client = client
+            self._service_clients = {}
+        self._last_heartbeat = time.monotonic()  # give the latched heartbeat a moment to arrive
+        if self._state is ConnectionState.DISCONNECTED:
+            self._set_state(ConnectionState.CONNECTING, "joined the router, waiting for a heartbeat")
+
+    def _drop_client(self) -> None:
+        with self._lock:
+            client, self._client = self._client, None
+            self._service_clients = {}
+        if client is not None:
+            try:
+                client.close()
+            except Exception:  # a dead session may fail to close; it is gone either way
+                log.debug("closing the SDK client failed", exc_info=True)
+
+    # -- stream callbacks (transport threads) --------------------------------------------------
+
+    def _on_heartbeat(self, message: Any) -> None:
+        self._last_heartbeat = time.monotonic()
+        self._set_state(ConnectionState.CONNECTED)
+        stamp = message.process_timestamp
+        self._emit(
+            Heartbeat(
+                float(stamp.sec) + float(stamp.nanosec) * 1e-9,
+                str(message.objective_name),
+                str(message.objective_status),
+            )
+        )
+
+    def _on_node_status(self, message: Any) -> None:
+        by_objective: dict[str, list[NodeStatusUpdate]] = {}
+        for change in message.changes:
+            by_objective.setdefault(str(change.objective_name), []).append(
+                NodeStatusUpdate(
+                    int(change.uid),
+                    str(change.node_path),
+                    str(change.node_id),
+                    str(change.node_name),
+                    _status(change.status),
+                    _status(change.previous_status),
+                )
+            )
+        for objective, updates in by_objective.items():
+            self._emit(NodeStatusBatch(objective, tuple(updates)))
+
+    def _on_blackboard(self, message: Any) -> None:
+        stamp = message.stamp
+        entries = tuple(
+            BlackboardEntry(str(e.scope), str(e.key), str(e.type_name), str(e.value_yaml))
+            for e in message.entries
+        )
+        self._emit(
+            BlackboardSnapshot(
+                str(message.objective_name), float(stamp.sec) + float(stamp.nanosec) * 1e-9, entries
+            )
+        )
+
+    def _on_log(self, message: Any) -> None:
+        level = int(message.log_level)
+        text = str(message.message)
+        now = time.time()
+        notice = reload_notice_from_log(text, level, now)
+        if notice is not None:
+            self._emit(notice)
+            if notice.kind == "objectives_changed":
+                self._emit(ObjectivesChanged())
+            if notice.ok:
+                return  # shown in the Behaviors screen; a good reload is not worth a toast
+        known = level if level in (1, 2, 3) else int(LogLevel.INFO)
+        self._emit(LogEntry(text, LogLevel(known), now, "runtime"))
+
+    def _on_clock(self, message: Any) -> None:
+        stamp = message.clock
+        sim = float(stamp.sec) + float(stamp.nanosec) * 1e-9
+        wall = time.monotonic()
+        window = self._clock_window
+        if window and sim < window[-1][0]:
+            window.clear()  # the simulation was reset
+        window.append((sim, wall))
+        if wall - self._last_clock_event < 0.1:
+            return  # /clock may tick at 1 kHz; the status bar needs a few updates a second
+        self._last_clock_event = wall
+        factor = None
+        if len(window) >= 2 and window[-1][1] - window[0][1] > 0.05:
+            factor = (window[-1][0] - window[0][0]) / (window[-1][1] - window[0][1])
+        self._emit(ClockSample(sim, factor))
+
+    # -- calls (worker threads) -----------------------------------------------------------------
+
+    def _require_client(self) -> ObjectiveClient:
+        client = self._client
+        if client is None or self._state is not ConnectionState.CONNECTED:
+            raise TransportError(f"not connected to a runtime at {self.endpoint} (is `kinema run` running?)")
+        return client
+
+    def _call(self, srv_type: str, name: str, request: dict[str, Any]) -> Any:
+        client = self._require_client()
+        with self._lock:
+            service = self._service_clients.get(name)
+            if service is None:
+                service = client.node.create_client(srv_type, name)
+                self._service_clients[name] = service
+        response = service.call(request, timeout=CALL_TIMEOUT_S)
+        status = getattr(response, "status", None)
+        if status is not None and not status.success:
+            raise ObjectiveError(str(status.error_message) or f"{name} refused the request")
+        return response
+
+    def workspace(self) -> Workspace:
+        return self._selection()[0]
+
+    def list_objectives(self) -> list[ObjectiveSummary]:
+        return [_objective_summary(info) for info in self._require_client().objectives()]
+
+    def objective_xml(self, name: str) -> str:
+        from kinema.runtime import names
+
+        response = self._call(names.GET_OBJECTIVE_XML_TYPE, names.GET_OBJECTIVE_XML, {"objective_name": name})
+        return str(response.xml)
+
+    def start_objective(self, name: str, overrides: Mapping[str, str]) -> None:
+        self._require_client().start(name, dict(overrides) or None)
+
+    def cancel_objective(self) -> None:
+        self._require_client().cancel()
+
+    def list_waypoints(self) -> list[WaypointSummary]:
+        from kinema.runtime import names
+
+        response = self._call(names.GET_WAYPOINTS_TYPE, names.GET_WAYPOINTS, {})
+        return [_waypoint_summary(w) for w in response.waypoints]
+
+    def move_to_waypoint(self, name: str) -> None:
+        client = self._require_client()
+        known = {str(info.name) for info in client.objectives()}
+        if MOVE_TO_WAYPOINT_OBJECTIVE not in known:
+            raise ObjectiveError(
+                f"the runtime has no {MOVE_TO_WAYPOINT_OBJECTIVE!r} objective to move with; "
+                "run a config whose objective library includes Kinema's core objectives"
+            )
+        client.start(MOVE_TO_WAYPOINT_OBJECTIVE, {"waypoint_name": name})
+
+    def save_waypoint(self, name: str, joint_group_names: tuple[str, ...] = ()) -> WaypointSummary:
+        from kinema.runtime import names
+
+        response = self._call(
+            names.EDIT_WAYPOINTS_TYPE,
+            names.EDIT_WAYPOINTS,
+            {"operation": 0, "waypoint_name": name, "joint_group_names": list(joint_group_names)},
+        )
+        return _waypoint_summary(response.new_waypoint)
+
+    def rename_waypoint(self, name: str, new_name: str) -> None:
+        from kinema.runtime import names
+
+        self._call(
+            names.EDIT_WAYPOINTS_TYPE,
+            names.EDIT_WAYPOINTS,
+            {"operation": 1, "waypoint_name": name, "existing_waypoint_new_name": new_name},
+        )
+
+    def erase_waypoint(self, name: str) -> None:
+        from kinema.runtime import names
+
+        self._call(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, {"operation": 2, "waypoint_name": name})
+
+    def list_behaviors(self) -> list[BehaviorSummary]:
+        """The engine's built-in nodes plus the behaviors the runtime's config loads.
+
+        The runtime serves no behavior list, so the plugins are loaded here, from the same workspace and
+        config, exactly as the runtime loads them (a reload event makes the screen list them again).
+        """
+        from kinema.config import resolve_config
+
+        workspace, config = self._selection()
+        catalog = builtin_behaviors()
+        if config:
+            catalog += plugin_behaviors(resolve_config(config, workspace, check_files=False))
+        return catalog
+
+    def _selection(self) -> tuple[Workspace, str | None]:
+        if self._selection_cache is None:
+            from kinema.config import Workspace, active_selection
+
+            selection = active_selection(self._workspace_path, self._config)
+            workspace = (
+                Workspace.discover(selection.workspace) if selection.workspace else Workspace.bundled_only()
+            )
+            self._selection_cache = (workspace, selection.config)
+        return self._selection_cache
+
+
+def builtin_behaviors() -> list[BehaviorSummary]:
+    """The engine's built-in nodes (Sequence, Sleep, Script, ...)."""
+    from kinema.bt import BehaviorTreeFactory
+
+    manifests = BehaviorTreeFactory().manifests()
+    return [
+        BehaviorSummary(
+            manifest.id,
+            "kinema.bt",
+            "built-in node",
+            "",
+            tuple(_port_summary(port) for port in manifest.ports.values()),
+            {
+                "subcategory": str(manifest.category),
+                **dict(manifest.metadata),
+                **({"description": manifest.description} if manifest.description else {}),
+            },
+        )
+        for manifest in manifests.values()
+        if manifest.builtin
+    ]
+
+
+def plugin_behaviors(resolved: ResolvedConfig) -> list[BehaviorSummary]:
+    """The behaviors registered by the plugins ``resolved`` activates; a failed plugin is one error row."""
+    from kinema.plugins import BehaviorHost
+
+    host = BehaviorHost.for_config(resolved)
+    report = host.load()
+    registry = host.registry
+    out: list[BehaviorSummary] = []
+    for behavior_id in registry:
+        record = registry[behavior_id]
+        spec = registry.plugins[record.plugin].spec if record.plugin in registry.plugins else None
+        source = f"{spec.source.value}: {spec.where}" if spec is not None else ""
+        out.append(
+            BehaviorSummary(
+                behavior_id,
+                record.plugin,
+                source,
+                str(record.location),
+                tuple(_port_summary(port) for port in record.ports),
+                dict(record.metadata),
+            )
+        )
+    for error in report.errors:
+        log.warning("plugins: %s", error)
+    return out
+
+
+def _port_summary(port: Any) -> PortSummary:
+    direction = getattr(port.direction, "name", str(port.direction)).lower()
+    return PortSummary(
+        port.name,
+        direction,
+        port.default_str or "",
+        port.description or "",
+        port.type_name,
+    )
+
+
+def _status(value: Any) -> NodeStatus:
+    try:
+        return NodeStatus(int(value))
+    except ValueError:
+        return NodeStatus.IDLE
+
+
+def _objective_summary(info: Any) -> ObjectiveSummary:
+    return ObjectiveSummary(
+        name=str(info.name),
+        description=str(info.description),
+        subcategory=str(info.subcategory),
+        runnable=bool(info.runnable),
+        favorite=bool(info.favorite),
+        package=str(info.package),
+        file_path=str(info.file_path),
+        ports=tuple(
+            PortSummary(
+                str(port.name),
+                _DIRECTIONS.get(int(port.direction), "input"),
+                str(port.default_value),
+                str(port.description),
+            )
+            for port in info.ports
+        ),
+    )
+
+
+def _waypoint_summary(message: Any) -> WaypointSummary:
+    state = message.joint_state
+    return WaypointSummary(
+        name=str(message.name),
+        description=str(message.description),
+        favorite=bool(message.favorite),
+        joint_names=tuple(str(n) for n in state.name),
+        positions=tuple(float(p) for p in state.position),
+        joint_group_names=tuple(str(g) for g in message.joint_group_names),
+    )
