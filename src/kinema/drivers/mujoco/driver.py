@@ -30,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from kinema.drivers.mujoco import names
+from kinema.drivers.mujoco.cdr_templates import ClockEncoder, JointStateEncoder, generic_serializers
 from kinema.drivers.mujoco.controller_manager import Controller, ControllerManager, JointStateBroadcaster
 from kinema.drivers.mujoco.execution import Execution
 from kinema.drivers.mujoco.gripper_controller import GripperController
@@ -111,12 +112,10 @@ class MujocoDriver:
             before_step=self._before_step,
             on_publish=self._on_publish,
         )
-        types = session.registry.typestore.types
-        self._time_type = types["builtin_interfaces/msg/Time"]
-        self._clock_type = types[names.CLOCK_TYPE]
-        self._joint_state_type = types[names.JOINT_STATES_TYPE]
-        self._header_type = types["std_msgs/msg/Header"]
         self._joint_names = self.index.joint_names
+        generic_clock, generic_joint_state = generic_serializers(session.registry)
+        self._clock_encoder = ClockEncoder(generic_clock)
+        self._joint_state_encoder = JointStateEncoder(self._joint_names, generic_joint_state)
         self._joint_qpos = np.array([j.qpos_address for j in self.index.joints], dtype=int)
         self._joint_dofs = np.array([j.dof_address for j in self.index.joints], dtype=int)
         self._nodes: list[Node] = []
@@ -342,17 +341,15 @@ class MujocoDriver:
     def _on_publish(self) -> None:
         data = self.data
         now = float(data.time)
-        stamp = self._time_type(**_stamp(now))
-        self._publishers["clock"].publish(self._clock_type(clock=stamp))
+        self._publishers["clock"].publish_raw(self._clock_encoder.encode(now))
         broadcaster = self._controllers.get(names.JOINT_STATE_BROADCASTER)
         if broadcaster is not None and broadcaster.active:
-            self._publishers["joint_states"].publish(
-                self._joint_state_type(
-                    header=self._header_type(stamp=stamp, frame_id=""),
-                    name=self._joint_names,
-                    position=data.qpos[self._joint_qpos],
-                    velocity=data.qvel[self._joint_dofs],
-                    effort=data.qfrc_actuator[self._joint_dofs],
+            self._publishers["joint_states"].publish_raw(
+                self._joint_state_encoder.encode(
+                    now,
+                    data.qpos[self._joint_qpos],
+                    data.qvel[self._joint_dofs],
+                    data.qfrc_actuator[self._joint_dofs],
                 )
             )
         for controller in self._controllers.values():

@@ -1,0 +1,105 @@
+"""The controller manager: list, switch (strict and best effort), and goals to inactive controllers."""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+
+import numpy as np
+
+from conftest import ARM, GRIPPER, Sim, trajectory, wait_for
+from kinema.drivers.mujoco import names as n
+from kinema.transport import STATUS_ABORTED
+
+STRICT, BEST_EFFORT = 2, 1
+
+
+def test_list_controllers_reports_the_config_controllers_active(sim: Sim) -> None:
+    controllers = sim.controllers()
+    assert set(controllers) == {
+        n.JOINT_STATE_BROADCASTER,
+        n.JOINT_TRAJECTORY_CONTROLLER,
+        n.GRIPPER_CONTROLLER,
+    }
+    assert all(c.state == "active" for c in controllers.values())
+    trajectory_controller = controllers[n.JOINT_TRAJECTORY_CONTROLLER]
+    assert trajectory_controller.type == "joint_trajectory_controller/JointTrajectoryController"
+    assert list(trajectory_controller.claimed_interfaces) == [f"{j}/position" for j in ARM]
+    assert list(controllers[n.GRIPPER_CONTROLLER].claimed_interfaces) == [f"{GRIPPER}/position"]
+    assert list(controllers[n.JOINT_STATE_BROADCASTER].claimed_interfaces) == []
+
+
+def test_switching_off_and_on_again(sim: Sim) -> None:
+    response = sim.switch(deactivate=[n.JOINT_TRAJECTORY_CONTROLLER, n.GRIPPER_CONTROLLER])
+    assert response.ok, response.message
+    controllers = sim.controllers()
+    assert controllers[n.JOINT_TRAJECTORY_CONTROLLER].state == "inactive"
+    assert list(controllers[n.JOINT_TRAJECTORY_CONTROLLER].claimed_interfaces) == []
+    assert controllers[n.GRIPPER_CONTROLLER].state == "inactive"
+    assert controllers[n.JOINT_STATE_BROADCASTER].state == "active"
+    # MoveIt Pro's objectives name controllers with a leading slash.
+    response = sim.switch(activate=["/joint_trajectory_controller", n.GRIPPER_CONTROLLER])
+    assert response.ok, response.message
+    assert all(c.state == "active" for c in sim.controllers().values())
+
+
+def test_a_goal_to_an_inactive_controller_is_rejected(sim: Sim) -> None:
+    assert sim.switch(deactivate=[n.JOINT_TRAJECTORY_CONTROLLER]).ok
+    start = sim.joint_states.latest()
+    result = sim.follow(trajectory(start, start + 0.3, 0.5)).result(10.0)
+    assert result.status == STATUS_ABORTED
+    assert "inactive" in result.result.error_string
+    sim.settle(0.3)
+    np.testing.assert_allclose(sim.joint_states.latest(), start, atol=1e-3)
+    assert sim.switch(activate=[n.JOINT_TRAJECTORY_CONTROLLER]).ok
+    assert sim.follow(trajectory(start, start + 0.3, 0.5)).result(30.0).succeeded
+
+
+def test_a_gripper_goal_to_an_inactive_controller_is_aborted(sim: Sim) -> None:
+    assert sim.switch(deactivate=[n.GRIPPER_CONTROLLER]).ok
+    assert sim.gripper(0.7929).status == STATUS_ABORTED
+    sim.settle(0.3)
+    assert sim.joint_states.latest((GRIPPER,))[0] < 0.01
+
+
+def test_a_strict_switch_with_an_unknown_name_changes_nothing(sim: Sim) -> None:
+    response = sim.switch(
+        deactivate=[n.JOINT_TRAJECTORY_CONTROLLER, "velocity_force_controller"], strictness=STRICT
+    )
+    assert not response.ok
+    assert "velocity_force_controller" in response.message
+    assert n.JOINT_TRAJECTORY_CONTROLLER in response.message  # the known controllers are listed
+    assert sim.controllers()[n.JOINT_TRAJECTORY_CONTROLLER].state == "active"
+
+
+def test_a_best_effort_switch_skips_unknown_names(sim: Sim) -> None:
+    response = sim.switch(
+        deactivate=[n.JOINT_TRAJECTORY_CONTROLLER, "velocity_force_controller"], strictness=BEST_EFFORT
+    )
+    assert response.ok
+    assert "velocity_force_controller" in response.message
+    assert sim.controllers()[n.JOINT_TRAJECTORY_CONTROLLER].state == "inactive"
+
+
+def test_the_broadcaster_can_be_switched_off(sim: Sim) -> None:
+    assert sim.switch(deactivate=[n.JOINT_STATE_BROADCASTER]).ok
+    received = len(sim.joint_states.stamps)
+    before = sim.driver.sim_time
+    wait_for(lambda: sim.driver.sim_time > before + 0.5, what="0.5 s of sim time")
+    time.sleep(0.05)  # messages already on their way may still arrive
+    assert len(sim.joint_states.stamps) - received <= 3
+    assert sim.switch(activate=[n.JOINT_STATE_BROADCASTER]).ok
+    sim.joint_states.wait_until(sim.driver.sim_time)
+
+
+def test_the_controllers_can_start_inactive(start_sim: Callable[..., Sim]) -> None:
+    sim = start_sim(
+        active_controllers=(n.JOINT_STATE_BROADCASTER, n.GRIPPER_CONTROLLER),
+        inactive_controllers=(n.JOINT_TRAJECTORY_CONTROLLER,),
+    )
+    states = {name: c.state for name, c in sim.controllers().items()}
+    assert states == {
+        n.JOINT_STATE_BROADCASTER: "active",
+        n.GRIPPER_CONTROLLER: "active",
+        n.JOINT_TRAJECTORY_CONTROLLER: "inactive",
+    }
