@@ -149,14 +149,27 @@ class GraphCache:
 
 
 def query_graph(session: Session, timeout: float = 2.0) -> Graph:
-    """Ask the network for every liveliness token of the session's domain (one round trip)."""
-    replies = session.zenoh.liveliness().get(f"{LIVELINESS_PREFIX}/{session.domain_id}/**", timeout=timeout)
-    entities: dict[str, GraphEntity] = {}
-    for reply in replies:
-        if reply.ok is None:
-            continue
-        key = str(reply.ok.key_expr)
-        entity = parse_token(key)
-        if entity is not None:
-            entities[key] = entity
-    return Graph(tuple(entities.values()))
+    """Ask the network for every liveliness token of the session's domain.
+
+    A liveliness query occasionally comes back empty right after links change; when this session has
+    nodes of its own (whose tokens must be in the answer) the query is repeated until they are.
+    """
+    deadline = time.monotonic() + timeout
+    expect_own = session.node_count() > 0
+    while True:
+        replies = session.zenoh.liveliness().get(
+            f"{LIVELINESS_PREFIX}/{session.domain_id}/**", timeout=max(deadline - time.monotonic(), 0.01)
+        )
+        entities: dict[str, GraphEntity] = {}
+        for reply in replies:
+            if reply.ok is None:
+                continue
+            key = str(reply.ok.key_expr)
+            entity = parse_token(key)
+            if entity is not None:
+                entities[key] = entity
+        graph = Graph(tuple(entities.values()))
+        complete = not expect_own or any(entity.zid == session.zid for entity in graph.entities)
+        if complete or time.monotonic() >= deadline:
+            return graph
+        time.sleep(0.005)

@@ -214,6 +214,13 @@ class Session:
             if closer in self._closers:
                 self._closers.remove(closer)
 
+    def node_count(self) -> int:
+        """Open nodes on this session."""
+        from kinema.transport.node import Node
+
+        with self._lock:
+            return sum(isinstance(closer, Node) for closer in self._closers)
+
     def connected_routers(self) -> list[str]:
         """Zenoh ids of the routers this session is linked to."""
         return [str(zid) for zid in self.zenoh.info.routers_zid()]
