@@ -1,0 +1,159 @@
+"""The real app against a real runtime subprocess: run an objective, watch its nodes, survive a restart.
+
+Only built-in BT nodes are used, so no robot, simulator or behavior plugin is needed.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import os
+import socket
+import subprocess
+import sys
+import time
+from collections.abc import Callable, Iterator
+from pathlib import Path
+
+import pytest
+
+from kinema.tui.app import KinemaApp
+from kinema.tui.connection import ConnectionState, NodeStatus
+from kinema.tui.screens.objectives import ObjectivesScreen
+from kinema.tui.sdk_connection import SdkConnection
+from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
+
+pytestmark = pytest.mark.slow
+
+COUNT_UP = """<?xml version="1.0" encoding="UTF-8"?>
+<root BTCPP_format="4" main_tree_to_execute="Count Up">
+  <BehaviorTree ID="Count Up" _description="Counts to three." _favorite="true">
+    <Sequence name="Main">
+      <Script code="count := 0"/>
+      <Repeat num_cycles="3">
+        <Sequence name="Step">
+          <Sleep msec="300"/>
+          <Script code="count += 1"/>
+        </Sequence>
+      </Repeat>
+    </Sequence>
+  </BehaviorTree>
+</root>
+"""
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+def start_agent(endpoint: str, objectives: Path) -> subprocess.Popen[bytes]:
+    env = {**os.environ, "KINEMA_CONFIG": "", "KINEMA_WORKSPACE": ""}
+    return subprocess.Popen(
+        [
+            sys.executable,
+            "-m",
+            "kinema.runtime.agent_process",
+            "--host-router",
+            endpoint,
+            "--objectives",
+            str(objectives),
+            "--clock",
+            "wall",
+            "--no-hot-reload",
+        ],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+    )
+
+
+def stop(process: subprocess.Popen[bytes]) -> None:
+    if process.poll() is None:
+        process.terminate()
+        try:
+            process.wait(10)
+        except subprocess.TimeoutExpired:
+            process.kill()
+            process.wait(5)
+
+
+class Agent:
+    """An agent process on a fixed endpoint that can be stopped and started again."""
+
+    def __init__(self, endpoint: str, objectives: Path) -> None:
+        self.endpoint = endpoint
+        self.objectives = objectives
+        self.process: subprocess.Popen[bytes] | None = None
+
+    def start(self) -> None:
+        self.process = start_agent(self.endpoint, self.objectives)
+
+    def stop(self) -> None:
+        if self.process is not None:
+            stop(self.process)
+
+
+@pytest.fixture
+def agent(tmp_path: Path) -> Iterator[Agent]:
+    """A fresh agent serving the Count Up objective on a free loopback port."""
+    (tmp_path / "count_up.xml").write_text(COUNT_UP)
+    runner = Agent(f"tcp/127.0.0.1:{free_port()}", tmp_path)
+    runner.start()
+    try:
+        yield runner
+    finally:
+        runner.stop()
+
+
+async def wait_for(pilot, condition: Callable[[], bool], what: str, timeout: float = 20.0) -> None:  # type: ignore[no-untyped-def]
+    deadline = time.monotonic() + timeout
+    while not condition():
+        if time.monotonic() > deadline:
+            raise AssertionError(f"timed out after {timeout} s waiting for {what}")
+        await pilot.pause(0.05)
+
+
+def test_the_app_runs_an_objective_on_a_real_runtime_and_follows_a_restart(agent: Agent) -> None:
+    app = KinemaApp(SdkConnection(agent.endpoint))
+    seen: dict[str, set[NodeStatus]] = {}
+
+    async def main() -> None:
+        async with app.run_test(size=(140, 40)) as pilot:
+            await wait_for(
+                pilot, lambda: app.status.state is ConnectionState.CONNECTED, "the first heartbeat"
+            )
+            screen = app.screen
+            assert isinstance(screen, ObjectivesScreen)
+            await wait_for(
+                pilot,
+                lambda: screen.selected is not None and screen.selected.name == "Count Up",
+                "the objective list",
+            )
+            view = screen.query_one(BehaviorTreeView)
+            await wait_for(pilot, lambda: view.outline is not None, "the objective's tree")
+
+            await pilot.press("r")
+
+            def record() -> bool:
+                for node in view.outline.nodes():  # type: ignore[union-attr]
+                    seen.setdefault(node.path, set()).add(view.statuses.get(node.uid, NodeStatus.IDLE))
+                return app.status.status == "Success" and view.status_of("Main") is NodeStatus.SUCCESS
+
+            await wait_for(pilot, record, "the objective to succeed")
+            assert NodeStatus.RUNNING in seen["Main"]
+            assert NodeStatus.RUNNING in seen["Step"]
+            assert view.status_of("Step") is NodeStatus.SUCCESS
+            assert app.status.objective == "Count Up" and app.status.elapsed is not None
+            assert app.status.elapsed >= 0.8  # three 300 ms sleeps, measured on the runtime's clock
+            assert any(e.key == "count" and e.value == "3" for e in app.blackboard.entries.values())
+
+            # The runtime goes away: shown as disconnected; it comes back: reconnected by itself.
+            agent.stop()
+            await wait_for(pilot, lambda: app.status.state is ConnectionState.DISCONNECTED, "the disconnect")
+            agent.start()
+            await wait_for(pilot, lambda: app.status.state is ConnectionState.CONNECTED, "the reconnect", 30)
+            await pilot.press("r")
+            await wait_for(pilot, lambda: app.status.status == "Running", "a run after the restart")
+
+    asyncio.run(main())
