@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import asyncio
+import concurrent.futures
 from typing import Any, ClassVar
 
 from kinema.behaviors.asynchronous import AsyncBehavior
@@ -85,8 +86,13 @@ class ActionClientBehavior(AsyncBehavior):
             except Exception as error:
                 feedback_errors.append(error)
 
+        sending = RUNNER.run_function(lambda: client.send_goal(goal, on_feedback, timeout=10.0))
         try:
-            handle = await asyncio.to_thread(client.send_goal, goal, on_feedback, timeout=10.0)
+            handle = await asyncio.shield(asyncio.wrap_future(sending))
+        except asyncio.CancelledError:
+            # Halted while the goal was on its way: cancel it as soon as the server has accepted it.
+            sending.add_done_callback(_cancel_when_accepted)
+            raise
         except TransportError as error:
             self.logger.publish_failure(f"Failed to send a goal to {name}: {error}")
             return False
@@ -120,6 +126,14 @@ class ActionClientBehavior(AsyncBehavior):
             return self.process_result(outcome)
         except Exception as error:
             raise behavior_fault(self, error, "process_result") from error
+
+
+def _cancel_when_accepted(sending: concurrent.futures.Future[Any]) -> None:
+    if sending.cancelled() or sending.exception() is not None:
+        return
+    handle = sending.result()
+    if handle.accepted and not handle.done():
+        RUNNER.run_function(handle.cancel)
 
 
 def _resolve(future: asyncio.Future[None]) -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import concurrent.futures
 import inspect
 import threading
+from collections.abc import Awaitable
 from typing import Any
 
 from kinema.behaviors.base import Behavior
@@ -31,7 +32,7 @@ class AsyncBehavior(Behavior, StatefulActionNode):
         self._tick_thread = 0
         self._pending_outputs: list[tuple[str, Any]] = []
 
-    def do_work(self) -> bool:
+    def do_work(self) -> bool | Awaitable[bool]:
         """Do the work; return True for SUCCESS, False for FAILURE.
 
         Called once per start of the node, on a worker thread (plain function) or on Kinema's asyncio

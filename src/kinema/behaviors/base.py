@@ -41,8 +41,6 @@ class Behavior:
     kinema_context: ClassVar[BehaviorContext | None] = None
     kinema_plugin: ClassVar[str] = ""
 
-    _logger: BehaviorLogger | None = None
-
     @classmethod
     def metadata(cls) -> dict[str, str]:
         """The behavior's metadata as MoveIt Pro names it (``subcategory``, ``description``).
@@ -65,14 +63,17 @@ class Behavior:
     @property
     def logger(self) -> BehaviorLogger:
         """This node's logger: ``publish_info/publish_warn/publish_failure`` become toasts."""
-        if self._logger is None:
-            self._logger = self.context.logger_for(
+        # Kept in the instance dict (TreeNode has one) because a mixin combined with a slotted node
+        # class cannot declare slots of its own.
+        logger: BehaviorLogger | None = self.__dict__.get("_kinema_logger")
+        if logger is None:
+            logger = self.__dict__["_kinema_logger"] = self.context.logger_for(
                 behavior_id=str(getattr(self, "registration_id", type(self).__name__)),
                 node_name=str(getattr(self, "name", "")),
                 node_path=str(getattr(self, "full_path", "")),
                 plugin=type(self).kinema_plugin,
             )
-        return self._logger
+        return logger
 
     def get_required_inputs(self, *names: str) -> tuple[Any, ...]:
         """Return the values of the input ports ``names``, or raise one error naming every missing one.

@@ -125,6 +125,11 @@ class BehaviorContext:
         for endpoint in endpoints:
             endpoint.close()
 
+    @property
+    def logger(self) -> BehaviorLogger:
+        """A logger to this context's sink without a behavior identity (behaviors use ``self.logger``)."""
+        return BehaviorLogger(self.log_sink)
+
     def logger_for(
         self, *, behavior_id: str = "", node_name: str = "", node_path: str = "", plugin: str = ""
     ) -> BehaviorLogger:

@@ -265,7 +265,12 @@ class BehaviorHost:
 
     def _import(self, spec: PluginSpec) -> object:
         if spec.root is not None:
-            module: object = import_fresh(spec.root, spec.module, spec.package)
+            try:
+                module: object = import_fresh(spec.root, spec.module, spec.package)
+            except PluginError as error:
+                raise PluginError(
+                    f"plugin '{spec.name}': {error.message}", location=error.location
+                ) from error
         else:
             try:
                 module = importlib.import_module(spec.module)

@@ -17,6 +17,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 
 from watchdog.events import FileSystemEvent, FileSystemEventHandler
+from watchdog.observers.api import BaseObserver
 
 OnChange = Callable[[Path, tuple[Path, ...], float], None]
 """``on_change(folder, changed_paths, first_event_time)``; first_event_time is ``time.monotonic()``."""
@@ -88,7 +89,7 @@ class DirectoryWatcher:
         self.poll_interval = poll_interval
         self._watched: dict[Path, _Watched] = {}
         self._lock = threading.Condition()
-        self._observer: object | None = None
+        self._observer: BaseObserver | None = None
         self._worker: threading.Thread | None = None
         self._stopping = False
 
@@ -139,8 +140,8 @@ class DirectoryWatcher:
             observer, self._observer = self._observer, None
             self._lock.notify_all()
         if observer is not None:
-            observer.stop()  # type: ignore[attr-defined]
-            observer.join(timeout=5)  # type: ignore[attr-defined]
+            observer.stop()
+            observer.join(timeout=5)
         if self._worker is not None:
             self._worker.join(timeout=5)
             self._worker = None
@@ -152,7 +153,7 @@ class DirectoryWatcher:
     def __exit__(self, *exc_info: object) -> None:
         self.stop()
 
-    def _start_observer(self) -> object:
+    def _start_observer(self) -> BaseObserver:
         from watchdog.observers import Observer
         from watchdog.observers.polling import PollingObserver
 
@@ -173,8 +174,8 @@ class DirectoryWatcher:
         return observer
 
     def _schedule(self, folder: Path) -> None:
-        if folder.is_dir():
-            self._observer.schedule(_Forwarder(self, folder), str(folder), recursive=True)  # type: ignore[attr-defined]
+        if folder.is_dir() and self._observer is not None:
+            self._observer.schedule(_Forwarder(self, folder), str(folder), recursive=True)
 
     def _run(self) -> None:
         while True:

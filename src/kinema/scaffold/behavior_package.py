@@ -184,6 +184,7 @@ def _behavior_package_dir(workspace: Workspace, package: str) -> Path:
         for p in workspace.packages.values()
         if p.origin == "workspace" and (p.path / "pyproject.toml").is_file()
     }
+    assert workspace.root is not None  # checked by new_behavior
     behavior_packages = [
         n for n, path in candidates.items() if read_behavior_package(path, PluginSource.WORKSPACE)
     ]
