@@ -14,14 +14,14 @@ from kinema.errors import ConfigError
 @click.option(
     "-w",
     "--workspace",
-    type=click.Path(file_okay=False, path_type=Path),
     default=None,
+    metavar="PATH",
     help="Workspace folder (one with src/). Asked for when missing; empty means none (bundled configs only).",
 )
 @click.option(
     "-c", "--config", default=None, metavar="NAME", help="Config package to use. Asked for when missing."
 )
-def configure(workspace: Path | None, config: str | None) -> None:
+def configure(workspace: str | None, config: str | None) -> None:
     """Set the active workspace and config package for later commands.
 
     The choice is stored in the user's config folder (~/.config/kinema/selection.yaml on Linux);
@@ -34,13 +34,12 @@ def configure(workspace: Path | None, config: str | None) -> None:
 
     current = active_selection()
     if workspace is None:
-        answer = click.prompt(
+        workspace = click.prompt(
             "Workspace folder (empty: none, bundled configs only)",
             default=str(current.workspace) if current.workspace else "",
             show_default=bool(current.workspace),
         )
-        workspace = Path(answer) if answer.strip() else None
-    root = find_workspace_root(workspace) if workspace is not None and str(workspace) else None
+    root = find_workspace_root(Path(workspace)) if workspace.strip() else None
     found = Workspace.discover(root) if root is not None else Workspace.bundled_only()
     names = [package.name for package in found.config_packages()]
     if config is None:

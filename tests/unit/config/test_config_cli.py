@@ -156,3 +156,12 @@ def test_configure_prompts_for_missing_values(capsys, monkeypatch: pytest.Monkey
 
     assert active_selection().config == "example_config"
     assert active_selection().workspace == (tmp_path / "w").resolve()
+
+
+def test_configure_with_an_empty_workspace_selects_bundled_configs_only(capsys):
+    from kinema.config import active_selection
+
+    code, out, _ = run(capsys, "configure", "-w", "", "-c", "example_config")
+    assert code == 0 and "(none, bundled configs only)" in out
+    assert active_selection().workspace is None
+    assert active_selection().config == "example_config"

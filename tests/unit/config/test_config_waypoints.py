@@ -176,3 +176,16 @@ def test_concurrent_processes_never_lose_a_waypoint(tmp_path: Path):
     assert names == expected
     # readers never saw, and nothing left behind, a temporary file
     assert sorted(p.name for p in tmp_path.iterdir()) == ["waypoints.yaml", "waypoints.yaml.lock"]
+
+
+def test_bundled_lab_sim_waypoints_parse_with_the_robot_joint_names():
+    from kinema.config import Workspace, resolve_config
+
+    resolved = resolve_config("lab_sim", Workspace.bundled_only())
+    assert resolved.waypoints_path is not None
+    store = WaypointStore(resolved.waypoints_path)
+    names = store.names()
+    assert names and len(names) == len(set(names))
+    for waypoint in store.all():
+        assert "linear_rail_joint" in waypoint.joint_names
+        assert len(waypoint.positions) == len(waypoint.joint_names)
