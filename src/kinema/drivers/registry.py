@@ -46,6 +46,7 @@ class DriverSpec:
         workspace: str | Path | None = None,
         sim_speed: str | float | None = None,
         log_file: str | Path | None = None,
+        ready_fd: int | None = None,
         verbose: bool = False,
     ) -> list[str]:
         """The command line that runs this driver as a process of its own.
@@ -56,6 +57,7 @@ class DriverSpec:
             workspace: the workspace to resolve ``config`` in.
             sim_speed: for simulators, ``1`` (real time), a factor such as ``4``, or ``max``.
             log_file: write the log there in the run format (else to stderr).
+            ready_fd: a file descriptor (inherited by the child) it writes ``ready`` to once serving.
             verbose: log at DEBUG level.
         """
         argv = [sys.executable, "-m", self.module, "--config", config]
@@ -67,6 +69,8 @@ class DriverSpec:
             argv += ["--sim-speed", str(sim_speed)]
         if log_file is not None:
             argv += ["--log-file", str(log_file)]
+        if ready_fd is not None:
+            argv += ["--ready-fd", str(ready_fd)]
         if verbose:
             argv.append("--verbose")
         return argv

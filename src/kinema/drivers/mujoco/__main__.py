@@ -1,14 +1,17 @@
 """Run the MuJoCo driver as a process: ``python -m kinema.drivers.mujoco --config lab_sim``.
 
-``kinema run`` starts it this way (see :meth:`kinema.drivers.DriverSpec.command`). It runs until
-SIGINT or SIGTERM and exits 0, or exits 1 with one ``error:`` line when it cannot start or the physics
-thread fails.
+``kinema run`` starts it this way (see :meth:`kinema.drivers.DriverSpec.command`), like the agent
+(``kinema.runtime.agent_process``): it prints nothing on stdout; with ``--ready-fd N`` it writes
+``ready`` to that file descriptor once every topic, service and action is served. It runs until SIGINT
+or SIGTERM and exits 0, or exits 1 with one ``error:`` line when it cannot start or the physics thread
+fails.
 """
 
 from __future__ import annotations
 
 import argparse
 import logging
+import os
 import signal
 import sys
 import threading
@@ -42,6 +45,9 @@ def _parser() -> argparse.ArgumentParser:
         help="router endpoint to join (default: $KINEMA_ZENOH_CONNECT or tcp/127.0.0.1:7447)",
     )
     parser.add_argument(
+        "--host-router", metavar="ENDPOINT", default=None, help="host the router here instead of joining one"
+    )
+    parser.add_argument(
         "--sim-speed",
         default="1",
         metavar="FACTOR|max",
@@ -57,6 +63,9 @@ def _parser() -> argparse.ArgumentParser:
         help="Hz of sim time for /clock and /joint_states (default 100)",
     )
     parser.add_argument("--log-file", type=Path, default=None, help="write the log there (default: stderr)")
+    parser.add_argument(
+        "--ready-fd", type=int, default=None, help="write 'ready' to this file descriptor when serving"
+    )
     parser.add_argument("-v", "--verbose", action="store_true", help="log at DEBUG level")
     return parser
 
@@ -88,7 +97,7 @@ def _run(args: argparse.Namespace, stop: threading.Event) -> int:
     from kinema.drivers.mujoco.driver import MujocoDriver
     from kinema.drivers.mujoco.settings import MujocoDriverSettings
     from kinema.drivers.mujoco.sim_speed import parse_sim_speed
-    from kinema.transport import open_session
+    from kinema.transport import host_router, open_session
 
     overrides: dict[str, object] = {
         "sim_speed": parse_sim_speed(args.sim_speed),
@@ -98,9 +107,13 @@ def _run(args: argparse.Namespace, stop: threading.Event) -> int:
         overrides["keyframe"] = args.keyframe
     workspace = Workspace.discover(args.workspace) if args.workspace is not None else None
     settings = MujocoDriverSettings.from_config(args.config, workspace, **overrides)
-    with open_session(args.connect) as session:
+    session = host_router(args.host_router) if args.host_router else open_session(args.connect)
+    with session:
         driver = MujocoDriver(session, settings)
         driver.start()
+        if args.ready_fd is not None:
+            with os.fdopen(args.ready_fd, "w") as ready:
+                ready.write("ready\n")
         try:
             while not stop.wait(0.2):
                 if driver.failure is not None:
