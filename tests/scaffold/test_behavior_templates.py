@@ -142,3 +142,11 @@ def test_the_template_refuses_bad_input_when_cookiecutter_runs_it_directly(tmp_p
             default_config=True,
         )
     assert list(tmp_path.iterdir()) == []
+
+
+def test_an_id_the_config_already_loads_is_refused(workspace: Path) -> None:
+    found = Workspace.discover(workspace)
+    # example_config loads the tutorial's bundled MyBehavior.
+    with pytest.raises(ScaffoldError, match=r"'MyBehavior' is already registered by plugin 'kinema::Example"):
+        new_behavior("my_behavior", "async", workspace=found, config="example_config")
+    assert list((workspace / "src").iterdir()) == []

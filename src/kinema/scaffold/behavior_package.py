@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from kinema.config.workspace import Workspace
+from kinema.config.workspace import Package, Workspace
 from kinema.errors import ConfigError, ScaffoldError, did_you_mean
 from kinema.scaffold.generate import generate
 from kinema.scaffold.names import package_name_problem
@@ -112,6 +112,8 @@ def new_behavior(
     behavior_id = behavior_id_for(name)
     context = {"behavior_name": name, "behavior_id": behavior_id, "behavior_type": behavior_type}
     config_package = _workspace_config(workspace, config)
+    if config:
+        _check_id_is_free(behavior_id, workspace, config)
 
     if package is None:
         if workspace.has_package(name):
@@ -167,7 +169,29 @@ def new_behavior(
     return result
 
 
-def _workspace_config(workspace: Workspace, config: str | None):  # type: ignore[no-untyped-def]
+def _check_id_is_free(behavior_id: str, workspace: Workspace, config: str) -> None:
+    """Refuse an ID that a behavior the config already loads has: the two would collide at load time."""
+    from kinema.config import resolve_config
+    from kinema.errors import KinemaError
+    from kinema.plugins.host import BehaviorHost
+
+    try:
+        resolved = resolve_config(config, workspace, check_files=False)
+    except KinemaError:
+        # A config that does not resolve loads no behaviors, so nothing can collide; `kinema build`
+        # reports what is wrong with it.
+        return
+    host = BehaviorHost.for_config(resolved)
+    host.load()
+    existing = host.registry.get(behavior_id)
+    if existing is not None:
+        raise ScaffoldError(
+            f"behavior ID {behavior_id!r} is already registered by plugin '{existing.plugin}' "
+            f"({existing.location}), which config {resolved.name!r} loads; choose another name"
+        )
+
+
+def _workspace_config(workspace: Workspace, config: str | None) -> Package | None:
     if not config or not workspace.has_package(config):
         return None
     package = workspace.package(config)
