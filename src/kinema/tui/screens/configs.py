@@ -152,7 +152,7 @@ class ConfigsScreen(KinemaScreen):
         for name in resolved.chain:
             package = resolved.workspace.package(name)
             label = Text(name, style="bold" if name == details.name else "")
-            label.append(f"  {package.origin}  {package.path}", style="dim")
+            label.append(f"  {_where(package, resolved.workspace)}", style="dim")
             node = node.add(label, expand=True)
         node.allow_expand = False
         tree.root.expand_all()
@@ -175,6 +175,16 @@ class ConfigsScreen(KinemaScreen):
         if details.files_cut:
             tree.root.add_leaf(Text(f"… (only the first {len(details.files)} files are listed)", style="dim"))
         tree.root.expand()
+
+
+def _where(package: Package, workspace: Workspace) -> str:
+    """Where a package lives: ``bundled``, or its folder relative to the workspace."""
+    if package.origin == "bundled" or workspace.root is None:
+        return package.origin
+    try:
+        return f"workspace: {package.path.relative_to(workspace.root)}"
+    except ValueError:
+        return f"workspace: {package.path}"
 
 
 def _package_label(package: Package) -> Text:

@@ -1,0 +1,160 @@
+"""Snapshot tests: each screen on the demo runtime at a fixed size, with no clocks and no toasts.
+
+Update after an intended change with ``pytest tests/tui/test_snapshots.py --snapshot-update`` and look at
+the SVGs (``__snapshots__/``) before committing them.
+"""
+
+from __future__ import annotations
+
+from pilot_harness import settle
+from textual.pilot import Pilot
+
+from kinema.tui.app import KinemaApp
+from kinema.tui.connection import (
+    BlackboardEntry,
+    BlackboardSnapshot,
+    Heartbeat,
+    LogEntry,
+    LogLevel,
+    NodeStatus,
+    NodeStatusBatch,
+    NodeStatusUpdate,
+    ReloadNotice,
+)
+from kinema.tui.fake_connection import FakeConnection
+
+SIZE = (120, 34)
+
+
+class QuietApp(KinemaApp):
+    """The app without toasts (they time out on the wall clock, which snapshots must not depend on)."""
+
+    def notify(self, *args: object, **kwargs: object) -> None:  # type: ignore[override]
+        return None
+
+
+def app_on(mode: str, fake: FakeConnection | None = None) -> tuple[QuietApp, FakeConnection]:
+    fake = fake or FakeConnection.demo()
+    return QuietApp(fake, initial_mode=mode), fake
+
+
+def test_objectives_screen_with_a_running_tree(snap_compare) -> None:  # type: ignore[no-untyped-def]
+    app, fake = app_on("objectives")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
+        fake.emit(Heartbeat(12.5, "Pick Object", "Running"))
+        fake.emit(
+            NodeStatusBatch(
+                "Pick Object",
+                (
+                    NodeStatusUpdate(
+                        1, "TopLevelSequence", "Sequence", "TopLevelSequence", NodeStatus.RUNNING
+                    ),
+                    NodeStatusUpdate(2, "MoveToWaypoint::2", "MoveToWaypoint", "", NodeStatus.SUCCESS),
+                    NodeStatusUpdate(3, "Wait and Log::3", "SubTree", "", NodeStatus.RUNNING),
+                    NodeStatusUpdate(5, "Wait and Log::3/Sleep::5", "Sleep", "", NodeStatus.RUNNING),
+                ),
+            )
+        )
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+
+
+def test_objectives_parameters_tab(snap_compare) -> None:  # type: ignore[no-untyped-def]
+    app, _ = app_on("objectives")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        await pilot.press("p")
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+
+
+def test_configs_screen_resolved_values(snap_compare) -> None:  # type: ignore[no-untyped-def]
+    app, _ = app_on("configs")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        await pilot.press("up")
+        await settle(pilot)
+        await pilot.press("v")
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+
+
+def test_blackboard_screen(snap_compare) -> None:  # type: ignore[no-untyped-def]
+    app, fake = app_on("blackboard")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        for stamp, count in ((1.0, "1"), (2.0, "2"), (3.0, "3")):
+            fake.emit(
+                BlackboardSnapshot(
+                    "Pick Object",
+                    stamp,
+                    (
+                        BlackboardEntry("Pick Object", "count", "int", count),
+                        BlackboardEntry(
+                            "Pick Object",
+                            "grasp_pose",
+                            "PoseStamped",
+                            "{header: {frame_id: world}, pose: {position: {x: 0.4, y: 0, z: 0.1}}}",
+                        ),
+                        BlackboardEntry("Pick Object/Wait and Log::3", "seconds", "double", "0.5"),
+                    ),
+                )
+            )
+            await pilot.pause(0.25)
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+
+
+def test_behaviors_screen_with_a_failed_reload(snap_compare) -> None:  # type: ignore[no-untyped-def]
+    app, fake = app_on("behaviors")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        fake.emit(
+            ReloadNotice(
+                False,
+                "reload_failed",
+                "my_behaviors",
+                "my_behaviors not reloaded, keeping the last good version: invalid syntax",
+                "src/my_behaviors/my_behavior.py:7",
+            )
+        )
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+
+
+def test_logs_screen(snap_compare) -> None:  # type: ignore[no-untyped-def]
+    app, fake = app_on("logs")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        fake.emit(LogEntry("[MyServiceClient] Sum: 5", LogLevel.INFO, 0.0, "runtime"))
+        fake.emit(LogEntry("gripper is slow to open", LogLevel.WARN, 0.0, "runtime"))
+        fake.emit(
+            LogEntry(
+                "Objective 'Pick Object' failed: MoveToWaypoint: no path", LogLevel.ERROR, 0.0, "runtime"
+            )
+        )
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+
+
+def test_waypoints_screen(snap_compare) -> None:  # type: ignore[no-untyped-def]
+    app, _ = app_on("waypoints")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
