@@ -7,7 +7,10 @@ from __future__ import annotations
 
 from kinema.plugins import RegisterBehavior, hookimpl
 
+from .set_mujoco_state import SetMujocoState
+
 
 @hookimpl
 def register_behaviors(register: RegisterBehavior) -> None:
-    """Register the mujoco behaviors."""
+    """Register the MuJoCo behaviors."""
+    register(SetMujocoState)

@@ -1,0 +1,140 @@
+"""SwitchController: activate and deactivate controllers of the controller manager."""
+
+from __future__ import annotations
+
+import asyncio
+
+from kinema.behaviors import AsyncBehavior, PortInfo, input_port
+from kinema.errors import TransportError
+
+BEST_EFFORT = 1
+STRICT = 2
+_LIST_TYPE = "controller_manager_msgs/srv/ListControllers"
+_SWITCH_TYPE = "controller_manager_msgs/srv/SwitchController"
+
+
+def _names(values: list[str]) -> list[str]:
+    """Controller names without blanks or the leading '/' MoveIt Pro objectives sometimes give."""
+    return [name.strip().lstrip("/") for name in values if name.strip().lstrip("/")]
+
+
+class SwitchController(AsyncBehavior):
+    """Activates ``activate_controllers`` and deactivates ``deactivate_controllers`` in one switch.
+
+    With ``automatic_deactivation`` (default), active controllers that command the same joints as a
+    controller being activated are deactivated in the same switch. With ``automatic_activation``,
+    deactivating a controller activates the inactive ones that command the same joints. Activating an
+    active controller, or deactivating an inactive one, changes nothing and succeeds.
+    """
+
+    subcategory = "Controllers"
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            input_port(
+                "controller_switch_action_name",
+                str,
+                "/controller_manager/switch_controller",
+                "The controller manager's SwitchController service.",
+            ),
+            input_port(
+                "controller_list_action_name",
+                str,
+                "/controller_manager/list_controllers",
+                "The controller manager's ListControllers service (for automatic (de)activation).",
+            ),
+            input_port("activate_controllers", list[str], "", "Controllers to activate (';'-separated)."),
+            input_port("deactivate_controllers", list[str], "", "Controllers to deactivate (';'-separated)."),
+            input_port(
+                "automatic_deactivation",
+                bool,
+                True,
+                "Also deactivate active controllers that command the joints of an activated one.",
+            ),
+            input_port(
+                "automatic_activation",
+                bool,
+                False,
+                "Also activate inactive controllers that command the joints of a deactivated one.",
+            ),
+            input_port("activate_asap", bool, True, "Start the activated controllers at once."),
+            input_port("strictness", int, STRICT, "1: best effort, 2: strict (fail on any problem)."),
+            input_port("timeout", float, 3.0, "Seconds to wait for the controller manager."),
+        ]
+
+    async def do_work(self) -> bool:
+        node = self.context.require_node(self.registration_id)
+        activate = _names(self.get_input_or("activate_controllers", []))
+        deactivate = _names(self.get_input_or("deactivate_controllers", []))
+        strictness = int(self.get_input("strictness"))
+        timeout = float(self.get_input("timeout"))
+        if strictness not in (BEST_EFFORT, STRICT):
+            self.logger.publish_failure(
+                f"SwitchController: strictness must be 1 (best effort) or 2 (strict), got {strictness}"
+            )
+            return False
+        if not activate and not deactivate:
+            self.logger.publish_info("SwitchController: no controller to activate or deactivate")
+            return True
+        automatic_deactivation = bool(self.get_input("automatic_deactivation"))
+        automatic_activation = bool(self.get_input("automatic_activation"))
+        if (automatic_deactivation and activate) or (automatic_activation and deactivate):
+            list_name = str(self.get_input("controller_list_action_name"))
+            client = self.context.service_client(node, _LIST_TYPE, list_name)
+            try:
+                listing = await asyncio.wrap_future(client.call_async({}, timeout))
+            except TransportError as error:
+                self.logger.publish_failure(
+                    f"SwitchController: cannot list the controllers ({list_name}): {error}"
+                )
+                return False
+            controllers = {str(c.name): c for c in listing.controller}
+            if automatic_deactivation:
+                wanted = {
+                    i
+                    for n in activate
+                    if n in controllers
+                    for i in controllers[n].required_command_interfaces
+                }
+                for name, controller in controllers.items():
+                    conflicts = wanted.intersection(controller.required_command_interfaces)
+                    if controller.state == "active" and name not in activate and conflicts:
+                        deactivate.append(name)
+            if automatic_activation:
+                freed = {
+                    i
+                    for n in deactivate
+                    if n in controllers
+                    for i in controllers[n].required_command_interfaces
+                }
+                for name, controller in controllers.items():
+                    if (
+                        controller.state != "active"
+                        and name not in deactivate
+                        and freed.intersection(controller.required_command_interfaces)
+                    ):
+                        activate.append(name)
+        switch_name = str(self.get_input("controller_switch_action_name"))
+        client = self.context.service_client(node, _SWITCH_TYPE, switch_name)
+        request = {
+            "activate_controllers": activate,
+            "deactivate_controllers": deactivate,
+            "strictness": strictness,
+            "activate_asap": bool(self.get_input("activate_asap")),
+            "timeout": {"sec": int(timeout), "nanosec": int((timeout % 1.0) * 1e9)},
+        }
+        try:
+            response = await asyncio.wrap_future(client.call_async(request, timeout))
+        except TransportError as error:
+            self.logger.publish_failure(
+                f"SwitchController: cannot reach the controller manager ({switch_name}): {error}"
+            )
+            return False
+        if not response.ok:
+            self.logger.publish_failure(
+                f"SwitchController: the switch (activate {activate or '-'}, deactivate {deactivate or '-'}) "
+                f"was refused: {response.message}"
+            )
+            return False
+        return True
