@@ -99,3 +99,18 @@ def test_process_exits_without_closing_its_session(endpoints: Callable[[], str])
     )
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "1"
+
+
+def test_standalone_session_serves_in_process() -> None:
+    with open_session([]) as session:
+        node = Node(session, "solo")
+        node.create_service("example_interfaces/srv/AddTwoInts", "/add", lambda r: {"sum": r.a + r.b})
+        node.create_action_server(
+            "example_interfaces/action/Fibonacci", "/fib", lambda h: {"sequence": [1, 1]}
+        )
+        assert node.create_client("example_interfaces/srv/AddTwoInts", "/add").call({"a": 1, "b": 2}).sum == 3
+        handle = node.create_action_client("example_interfaces/action/Fibonacci", "/fib").send_goal(
+            {"order": 2}
+        )
+        assert handle.result(timeout=5).result.sequence.tolist() == [1, 1]
+    assert session.closed
