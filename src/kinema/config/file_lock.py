@@ -3,12 +3,14 @@
 ``fcntl.flock`` on a sidecar ``<file>.lock`` (never on the data file itself, which is replaced by
 ``os.replace`` and so changes inode on every write). flock locks belong to an open file description, so
 two threads of one process that each open the lock file exclude each other just as two processes do.
+On Windows, where there is no flock, ``msvcrt.locking`` on the first byte of the sidecar does the same.
 """
 
 from __future__ import annotations
 
-import fcntl
 import os
+import sys
+import time
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
@@ -25,10 +27,35 @@ def locked(path: str | Path) -> Iterator[None]:
     lock_file = lock_path_for(Path(path))
     descriptor = os.open(lock_file, os.O_RDWR | os.O_CREAT, 0o666)
     try:
-        fcntl.flock(descriptor, fcntl.LOCK_EX)
+        _acquire(descriptor)
         try:
             yield
         finally:
-            fcntl.flock(descriptor, fcntl.LOCK_UN)
+            _release(descriptor)
     finally:
         os.close(descriptor)
+
+
+if sys.platform == "win32":  # pragma: no cover - exercised on Windows only
+    import msvcrt
+
+    def _acquire(descriptor: int) -> None:
+        while True:
+            try:
+                msvcrt.locking(descriptor, msvcrt.LK_NBLCK, 1)
+                return
+            except OSError:
+                time.sleep(0.005)
+
+    def _release(descriptor: int) -> None:
+        os.lseek(descriptor, 0, os.SEEK_SET)
+        msvcrt.locking(descriptor, msvcrt.LK_UNLCK, 1)
+
+else:
+    import fcntl
+
+    def _acquire(descriptor: int) -> None:
+        fcntl.flock(descriptor, fcntl.LOCK_EX)
+
+    def _release(descriptor: int) -> None:
+        fcntl.flock(descriptor, fcntl.LOCK_UN)

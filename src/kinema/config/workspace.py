@@ -196,19 +196,25 @@ class Workspace:
 
 
 def find_workspace_root(path: Path) -> Path:
-    """Return ``path`` or its nearest ancestor that has a ``src/`` folder.
+    """Return the workspace ``path`` names: ``path`` itself when it has ``src/``, or the workspace whose
+    ``src/`` contains ``path`` (e.g. a package folder).
+
+    An unrelated ancestor with a ``src/`` (such as a home folder with ``~/src``) is not taken for a
+    workspace.
 
     Raises:
-        ConfigError: no such folder (the message suggests ``kinema init``).
+        ConfigError: ``path`` is not a workspace (the message suggests ``kinema init``).
     """
     start = path.expanduser().resolve()
     if not start.exists():
         raise ConfigError(f"the workspace folder {start} does not exist; create it with `kinema init {path}`")
-    for candidate in (start, *start.parents):
-        if (candidate / "src").is_dir():
+    if (start / "src").is_dir():
+        return start
+    for candidate in start.parents:
+        if (candidate / "src").is_dir() and start.is_relative_to(candidate / "src"):
             return candidate
     raise ConfigError(
-        f"{start} is not a workspace (no src/ folder in it or above it); create one with `kinema init`"
+        f"{start} is not a workspace (it has no src/ folder); create one with `kinema init {path}`"
     )
 
 

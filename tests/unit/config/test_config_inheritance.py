@@ -276,9 +276,9 @@ def test_bundled_lab_sim_and_example_config_resolve():
     assert resolved.mujoco_model_path is not None and resolved.mujoco_model_path.name == "lab_sim_scene.xml"
     assert resolved.joint_limits_path is not None and resolved.joint_limits_path.name == "joint_limits.yaml"
     assert resolved.waypoints_path is not None and resolved.waypoints_path.name == "lab_sim_waypoints.yaml"
-    assert resolved.behavior_loader_plugins == {
-        "core": ["kinema::CoreBehaviorsLoader", "kinema::MujocoBehaviorsLoader"]
-    }
+    loaders = resolved.behavior_loader_plugins
+    assert loaders["core"] == ["kinema::CoreBehaviorsLoader", "kinema::MujocoBehaviorsLoader"]  # from lab_sim
+    assert resolved.provenance["objectives.behavior_loader_plugins.core[0]"] == "lab_sim"
     assert resolved.get("ros2_control.controllers_active_at_startup") == [
         "joint_state_broadcaster",
         "joint_trajectory_controller",

@@ -32,6 +32,12 @@ def test_discover_from_a_folder_inside_the_workspace(ws):
     assert Workspace.discover(package / "config").root == ws.root.resolve()
 
 
+def test_a_folder_beside_src_is_not_inside_the_workspace(ws):
+    (ws.root / "notes").mkdir()
+    with pytest.raises(ConfigError, match="is not a workspace"):
+        Workspace.discover(ws.root / "notes")
+
+
 def test_a_folder_without_src_is_not_a_workspace(tmp_path: Path):
     with pytest.raises(ConfigError, match=r"not a workspace.*kinema init"):
         Workspace.discover(tmp_path)
