@@ -30,6 +30,10 @@ if TYPE_CHECKING:
 
 ReloadSubscriber = Callable[[ReloadEvent], None]
 
+# Bundled plugins never reload, so every host in the process shares one import of each (the same
+# classes everywhere, and no new module generation per host).
+_STATIC_MODULES: dict[tuple[Path, str], object] = {}
+
 
 @dataclass
 class LoadReport:
@@ -242,7 +246,7 @@ class BehaviorHost:
         except PluginError as error:
             self._registry = self._registry.with_failure(PluginRecord(spec, (), error))
             return error
-        new_top = getattr(plugin, "__name__", "").split(".")[0] if spec.root is not None else ""
+        new_top = getattr(plugin, "__name__", "").split(".")[0] if spec.hot_reloadable else ""
         scratch = KinemaPluginManager()
         try:
             scratch.add(spec.name, plugin)
@@ -265,12 +269,19 @@ class BehaviorHost:
 
     def _import(self, spec: PluginSpec) -> object:
         if spec.root is not None:
-            try:
-                module: object = import_fresh(spec.root, spec.module, spec.package)
-            except PluginError as error:
-                raise PluginError(
-                    f"plugin '{spec.name}': {error.message}", location=error.location
-                ) from error
+            key = (spec.root, spec.module)
+            cached = None if spec.hot_reloadable else _STATIC_MODULES.get(key)
+            if cached is not None:
+                module: object = cached
+            else:
+                try:
+                    module = import_fresh(spec.root, spec.module, spec.package)
+                except PluginError as error:
+                    raise PluginError(
+                        f"plugin '{spec.name}': {error.message}", location=error.location
+                    ) from error
+                if not spec.hot_reloadable:
+                    _STATIC_MODULES[key] = module
         else:
             try:
                 module = importlib.import_module(spec.module)
