@@ -4,10 +4,14 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import click
 
 from kinema.cli.options import print_notices, resolve_selection, selection_options, verbose_option
+
+if TYPE_CHECKING:
+    from kinema.config import ObjectiveLibrary
 
 
 @click.group()
@@ -15,7 +19,7 @@ def objective() -> None:
     """List, inspect and run the objectives of a config package."""
 
 
-def _load_library(workspace: Path | None, config: str | None, verbose: bool):  # type: ignore[no-untyped-def]
+def _load_library(workspace: Path | None, config: str | None, verbose: bool) -> ObjectiveLibrary:
     from kinema.config import ObjectiveLibrary, resolve_config
 
     found, name = resolve_selection(workspace, config)
@@ -98,3 +102,132 @@ def show(
         click.echo("  ports:       none")
     click.echo("")
     click.echo(info.read_xml(), nl=False)
+
+
+# -- running objectives on a live runtime (run, cancel, do, status) ------------------------------------
+
+connect_option = click.option(
+    "--connect",
+    default=None,
+    metavar="ENDPOINT",
+    help="Router to join (default: $KINEMA_ZENOH_CONNECT, else tcp/127.0.0.1:7447).",
+)
+timeout_option = click.option(
+    "--timeout",
+    type=float,
+    default=5.0,
+    show_default=True,
+    metavar="SECONDS",
+    help="How long to wait for a runtime to answer before giving up.",
+)
+
+
+def _client(connect: str | None, timeout: float):  # type: ignore[no-untyped-def]
+    from kinema.sdk import ObjectiveClient
+
+    return ObjectiveClient(connect, timeout=timeout)
+
+
+def _finish(handle, wait: bool) -> None:  # type: ignore[no-untyped-def]
+    """Wait for a started objective (Ctrl-C cancels it) and exit 0 only when it succeeded."""
+    if not wait:
+        click.echo(f"started {handle.objective_name!r}")
+        return
+    try:
+        result = handle.result()
+    except KeyboardInterrupt:
+        click.echo(f"cancelling {handle.objective_name!r} ...", err=True)
+        handle.cancel()
+        result = handle.result(10.0)
+    if result.succeeded:
+        click.echo(str(result))
+        return
+    click.secho(str(result), err=True, fg="yellow" if result.cancelled else "red")
+    raise click.exceptions.Exit(1)
+
+
+@objective.command("run")
+@click.argument("name")
+@click.option(
+    "-p",
+    "--param",
+    "params",
+    multiple=True,
+    metavar="NAME=VALUE",
+    help="Override a parameter (VALUE is YAML, parsed into the port's type); repeatable.",
+)
+@click.option("--no-wait", is_flag=True, help="Return once the objective started instead of when it ends.")
+@connect_option
+@timeout_option
+def run_(name: str, params: tuple[str, ...], no_wait: bool, connect: str | None, timeout: float) -> None:
+    """Run objective NAME on the running Kinema (a running objective is preempted).
+
+    Exits 0 when the objective succeeds, 1 when it fails or is cancelled; Ctrl-C cancels it.
+    """
+    from kinema.sdk import ParameterOverride
+
+    overrides = [ParameterOverride.parse(param) for param in params]
+    with _client(connect, timeout) as client:
+        _finish(client.start(name, overrides), not no_wait)
+
+
+@objective.command("do")
+@click.argument("file", type=click.File("r"))
+@click.option("--no-wait", is_flag=True, help="Return once the objective started instead of when it ends.")
+@connect_option
+@timeout_option
+def do_(file, no_wait: bool, connect: str | None, timeout: float) -> None:  # type: ignore[no-untyped-def]
+    """Run the BT.CPP v4 XML in FILE (`-` reads stdin) as an ad-hoc objective (its main tree)."""
+    xml = file.read()
+    with _client(connect, timeout) as client:
+        _finish(client.start(xml=xml), not no_wait)
+
+
+@objective.command("cancel")
+@connect_option
+@timeout_option
+def cancel_(connect: str | None, timeout: float) -> None:
+    """Cancel the objective that is running (its result is PREEMPTED)."""
+    with _client(connect, timeout) as client:
+        status = client.status()
+        if client.cancel():
+            click.echo(f"cancelled {status.objective_name!r}")
+        else:
+            click.echo("no objective was running")
+
+
+@objective.command("status")
+@click.option("-f", "--follow", is_flag=True, help="Keep printing every status change (Ctrl-C stops).")
+@click.option(
+    "--json", "as_json", is_flag=True, help='Print {"status", "objective_name", "process_time", ...}.'
+)
+@connect_option
+@timeout_option
+def status_(follow: bool, as_json: bool, connect: str | None, timeout: float) -> None:
+    """Print the objective server's status: Idle, Loading, Running, Success, Failure or Cancelled."""
+    import dataclasses
+
+    def show(status) -> None:  # type: ignore[no-untyped-def]
+        if as_json:
+            click.echo(
+                json.dumps({k: str(v) if k == "status" else v for k, v in dataclasses.asdict(status).items()})
+            )
+        else:
+            click.echo(str(status))
+
+    with _client(connect, timeout) as client:
+        current = client.status()
+        show(current)
+        if not follow:
+            return
+        last = (current.status, current.objective_name)
+        try:
+            # Heartbeats stop when the runtime goes away; say so instead of waiting forever.
+            for status in client.statuses(timeout=max(timeout, 2.0)):
+                if (status.status, status.objective_name) != last:
+                    last = (status.status, status.objective_name)
+                    show(status)
+        except KeyboardInterrupt:
+            return
+        click.secho("the runtime stopped sending heartbeats", err=True, fg="red")
+        raise click.exceptions.Exit(1)

@@ -165,3 +165,33 @@ def test_configure_with_an_empty_workspace_selects_bundled_configs_only(capsys):
     assert code == 0 and "(none, bundled configs only)" in out
     assert active_selection().workspace is None
     assert active_selection().config == "example_config"
+
+
+@pytest.mark.parametrize(
+    ("setup", "words"),
+    [
+        ("cycle", "inheritance cycle: a → b → a"),
+        ("missing_file", "description/robot.urdf does not exist"),
+        ("wrong_type", "hardware must be a mapping, not a list"),
+        ("missing_parent", "which is not a known package"),
+        ("huge", "larger than the limit"),
+    ],
+)
+def test_bad_configs_through_the_cli(capsys, ws, setup: str, words: str):
+    if setup == "cycle":
+        ws.child("a", "b")
+        ws.child("b", "a")
+    elif setup == "missing_file":
+        package = ws.config("a")
+        (package / "description" / "robot.urdf").unlink()
+    elif setup == "wrong_type":
+        ws.config("a", "hardware: [1]\n")
+    elif setup == "missing_parent":
+        ws.child("a", "nobody")
+    else:
+        ws.config("a", "# " + "x" * (3 * 1024 * 1024) + "\n")
+    for verb in (("config", "show"), ("objective", "list")):
+        code, _, err = run(capsys, *verb, "-w", str(ws.root), "-c", "a")
+        assert code == 1, verb
+        assert err.startswith("error: ") and words in err, err
+        assert "Traceback" not in err
