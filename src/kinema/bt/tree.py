@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import sys
 import threading
 from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING, Any
@@ -91,6 +92,14 @@ class Subtree:
 
     def __repr__(self) -> str:
         return f"Subtree({self.tree_id!r}, {self.instance_name!r}, {len(self.nodes)} nodes)"
+
+
+# Ticking recurses through the tree (about three frames per level) and BT.CPP allows 256 levels of
+# nesting, which is close to CPython's default limit of 1000 frames once the caller's own frames
+# are counted.
+_MIN_RECURSION_LIMIT = 4000
+if sys.getrecursionlimit() < _MIN_RECURSION_LIMIT:
+    sys.setrecursionlimit(_MIN_RECURSION_LIMIT)
 
 
 class Tree:

@@ -121,6 +121,9 @@ def parse_xml(text: str | bytes, filename: str = "<string>") -> etree._Element:
     except etree.XMLSyntaxError as error:
         line = error.lineno or 0
         message = str(error.msg or error).split(", line")[0]
+        if "Excessive depth" in message:
+            # libxml2's own nesting guard fires first; say what BT.CPP would say.
+            message = f"elements nest deeper than {MAX_DEPTH} levels"
         raise ObjectiveError(
             f"XML syntax error: {message}", location=SourceLocation(filename, line)
         ) from None

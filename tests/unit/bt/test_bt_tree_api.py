@@ -1,0 +1,230 @@
+"""The Tree and factory API other parts of Kinema build on."""
+
+from __future__ import annotations
+
+import threading
+import time
+
+import pytest
+from lxml import etree
+
+from kinema.bt import (
+    BehaviorTreeFactory,
+    BTError,
+    BTLogicError,
+    ConditionNode,
+    ManualClock,
+    NodeExecutionError,
+    NodeStatus,
+    NodeType,
+    StatefulActionNode,
+    SyncActionNode,
+    TreeObserver,
+    bidirectional_port,
+    input_port,
+    output_port,
+    write_tree_nodes_model_xml,
+)
+
+S, F, R, IDLE = NodeStatus.SUCCESS, NodeStatus.FAILURE, NodeStatus.RUNNING, NodeStatus.IDLE
+
+
+def test_status_observer_sees_every_change_including_resets(bench) -> None:
+    tree = bench.tree('<Sequence name="seq"><AlwaysSuccess name="a"/></Sequence>')
+    changes = []
+    handle = tree.add_status_observer(lambda t, node, prev, new: changes.append((node.full_path, prev, new)))
+    tree.tick_once()
+    assert changes == [("seq", IDLE, R), ("a", IDLE, S), ("a", S, IDLE), ("seq", R, S), ("seq", S, IDLE)]
+    tree.remove_status_observer(handle)
+    tree.tick_once()
+    assert len(changes) == 5
+
+
+def test_tree_observer_statistics(bench) -> None:
+    bench.condition("Check", F, F, S)
+    tree = bench.tree('<RetryUntilSuccessful num_attempts="5"><Check name="check"/></RetryUntilSuccessful>')
+    observer = TreeObserver(tree)
+    assert tree.tick_once() is S
+    stats = observer.statistics("check")
+    assert (stats.failure_count, stats.success_count, stats.transitions_count) == (2, 1, 3)
+    assert stats.last_result is S
+    assert observer.statistics(tree.node_by_path("check").uid) is stats
+    with pytest.raises(BTError, match="no node with path"):
+        observer.statistics("nope")
+
+
+def test_halt_tree_runs_on_halted_everywhere_and_halts_running_nodes(bench) -> None:
+    bench.stateful("Work", running_ticks=-1)
+    tree = bench.tree(
+        '<Sequence><Script code="h := 0"/><AlwaysSuccess _onHalted="h += 1"/><Work _onHalted="h += 10"/></Sequence>'  # noqa: E501
+    )
+    assert tree.tick_once() is R
+    tree.halt_tree()
+    assert bench.halts["Work"] == 1
+    assert tree.root_blackboard.get("h") == 21  # halted twice counts as in BT.CPP: root halt, then every node
+    assert all(node.status is IDLE for node in tree.nodes())
+
+
+def test_exceptions_are_wrapped_once_with_the_innermost_node(bench) -> None:
+    class Broken(SyncActionNode):
+        def tick(self) -> NodeStatus:
+            raise ValueError("sensor unplugged")
+
+    bench.factory.register_node_type(Broken, "Broken")
+    tree = bench.tree('<Sequence><Inverter><Broken name="camera"/></Inverter></Sequence>')
+    with pytest.raises(NodeExecutionError) as info:
+        tree.tick_once()
+    assert info.value.node_path == "camera"
+    assert str(info.value).endswith("Exception in node 'camera' [Broken]: ValueError: sensor unplugged")
+
+
+def test_sync_action_may_not_return_running(bench) -> None:
+    class Liar(SyncActionNode):
+        def tick(self) -> NodeStatus:
+            return R
+
+    bench.factory.register_node_type(Liar, "Liar")
+    with pytest.raises(BTLogicError, match="never return RUNNING"):
+        bench.tree("<Liar/>").tick_once()
+    bench.factory.register_simple_action("Simple", lambda node: R)
+    with pytest.raises(BTLogicError):
+        bench.tree("<Simple/>").tick_once()
+
+
+def test_stateful_action_lifecycle(bench) -> None:
+    calls = []
+
+    class Move(StatefulActionNode):
+        @classmethod
+        def provided_ports(cls) -> list:
+            return [input_port("steps", int, 2), output_port("done", bool)]
+
+        def on_start(self) -> NodeStatus:
+            calls.append("start")
+            self.left = self.get_input("steps")
+            return R
+
+        def on_running(self) -> NodeStatus:
+            calls.append("running")
+            self.left -= 1
+            if self.left == 0:
+                self.set_output("done", True)
+                return S
+            return R
+
+        def on_halted(self) -> None:
+            calls.append("halted")
+
+    bench.factory.register_node_type(Move, "Move")
+    tree = bench.tree('<Move done="{finished}"/>')
+    assert [tree.tick_once() for _ in range(3)] == [R, R, S]
+    assert calls == ["start", "running", "running"]
+    assert tree.root_blackboard.get("finished") is True
+    tree.tick_once()
+    tree.halt_tree()
+    assert calls[-1] == "halted"
+
+
+def test_registration_rules() -> None:
+    factory = BehaviorTreeFactory()
+
+    class Bad(ConditionNode):
+        @classmethod
+        def provided_ports(cls) -> list:
+            return [input_port("name")]
+
+    with pytest.raises(BTLogicError, match="reserved"):
+        factory.register_node_type(Bad, "Bad")
+    with pytest.raises(BTLogicError, match="already registered"):
+        factory.register_simple_action("Sequence", lambda n: S)
+    with pytest.raises(BTLogicError, match="forbidden character"):
+        factory.register_simple_action("has space", lambda n: S)
+    factory.register_simple_condition("Ok", lambda n: S)
+    assert factory.manifests()["Ok"].category is NodeType.CONDITION
+    assert factory.unregister("Ok") and not factory.is_registered("Ok")
+
+
+def test_builtin_ids_match_btcpp_4_10() -> None:
+    builtin = set(BehaviorTreeFactory().builtin_nodes())
+    assert len(builtin) == 42
+    assert {"TryCatch", "Switch6", "LoopString", "WaitValueUpdate", "WasEntryUpdated", "SubTree"} <= builtin
+    assert "ManualSelector" not in builtin and "SequenceStar" not in builtin
+
+
+def test_tree_nodes_model_export() -> None:
+    factory = BehaviorTreeFactory()
+
+    class Gripper(StatefulActionNode):
+        """Open or close the gripper."""
+
+        @classmethod
+        def provided_ports(cls) -> list:
+            return [
+                input_port("position", float, 0.5, "target opening"),
+                output_port("reached", bool),
+                bidirectional_port("queue"),
+            ]
+
+        @classmethod
+        def metadata(cls) -> dict[str, str]:
+            return {"subcategory": "Grasping"}
+
+    factory.register_node_type(Gripper, "MoveGripper")
+    root = etree.fromstring(write_tree_nodes_model_xml(factory).encode())
+    (model,) = root.find("TreeNodesModel")
+    assert (model.tag, model.get("ID")) == ("Action", "MoveGripper")
+    ports = {p.get("name"): p for p in model if p.tag.endswith("_port")}
+    assert ports["position"].attrib == {"name": "position", "type": "double", "default": "0.500000"}
+    assert ports["position"].text == "target opening"
+    assert ports["reached"].tag == "output_port" and ports["queue"].get("type") == "BT::AnyTypeAllowed"
+    assert model.find("MetadataFields/Metadata").attrib == {"subcategory": "Grasping"}
+    full = etree.fromstring(write_tree_nodes_model_xml(factory, include_builtin=True).encode())
+    ids = [m.get("ID") for m in full.find("TreeNodesModel")]
+    assert ids == sorted(ids) and "Sequence" in ids
+
+
+def test_tree_sleep_returns_early_on_wake_up(bench) -> None:
+    tree = bench.tree("<AlwaysSuccess/>")
+    threading.Timer(0.05, tree.wake_up.emit).start()
+    start = time.monotonic()
+    assert tree.sleep(5.0) is True
+    assert time.monotonic() - start < 4.0
+    assert tree.sleep(0.01) is False
+
+
+def test_sleep_on_a_manual_clock_waits_for_simulated_time() -> None:
+    clock = ManualClock()
+    tree = BehaviorTreeFactory(clock=clock).create_tree_from_text(
+        '<root><BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree></root>'
+    )
+    done = threading.Event()
+    threading.Thread(target=lambda: (tree.sleep(2.0), done.set()), daemon=True).start()
+    time.sleep(0.05)
+    assert not done.is_set()
+    clock.advance(2.0)
+    assert done.wait(5.0)
+
+
+def test_tick_while_running_skipped_root_stays_idle(bench) -> None:
+    tree = bench.tree('<AlwaysSuccess _skipIf="true"/>')
+    assert tree.tick_while_running() is NodeStatus.SKIPPED
+    assert tree.root_node.status is IDLE  # type: ignore[union-attr]
+
+
+def test_blackboard_snapshot_and_tree_observer_of_writes(bench) -> None:
+    bench.factory.register_behavior_tree_from_text(
+        '<root><BehaviorTree ID="Main"><Sequence><Script code="x := 1"/><SubTree ID="S" name="sub"/></Sequence>'  # noqa: E501
+        '</BehaviorTree><BehaviorTree ID="S"><Script code="y := 2.5"/></BehaviorTree></root>'
+    )
+    tree = bench.factory.create_tree("Main")
+    writes = []
+    tree.add_blackboard_observer(lambda scope, key, entry: writes.append((scope, key, entry.value)))
+    tree.tick_once()
+    assert writes == [("Main", "x", 1), ("sub", "y", 2.5)]
+    assert tree.blackboard_snapshot() == {"Main": {"x": ("int", 1)}, "sub": {"y": ("double", 2.5)}}
+
+
+def test_walk_visits_nodes_depth_first_with_depth(bench) -> None:
+    tree = bench.tree('<Sequence name="s"><Inverter name="i"><AlwaysFailure name="f"/></Inverter></Sequence>')
+    assert [(n.name, d) for n, d in tree.walk()] == [("s", 0), ("i", 1), ("f", 2)]
+    assert len(tree) == 3 and [n.name for n in tree] == ["s", "i", "f"]

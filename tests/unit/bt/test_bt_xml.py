@@ -1,0 +1,190 @@
+"""Loading XML: document rules, errors with file:line, main-tree choice, includes, metadata."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from kinema.bt import BehaviorTreeFactory, BTError, NodeStatus
+from kinema.errors import ObjectiveError
+
+S = NodeStatus.SUCCESS
+COMPAT = Path(__file__).resolve().parents[4] / "shared" / "compat" / "moveit_pro" / "objectives"
+
+
+@pytest.mark.parametrize(
+    ("xml", "message"),
+    [
+        ('<tree><BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree></tree>', "root node called <root>"),
+        ('<root><BehaviorTree ID="M"><Unknown/></BehaviorTree></root>', "Node not recognized: Unknown"),
+        (
+            '<root><BehaviorTree ID="M"><AlwaysSuccess/><AlwaysFailure/></BehaviorTree></root>',
+            "exactly 1 child",
+        ),
+        ('<root><BehaviorTree ID="M"><Inverter/></BehaviorTree></root>', "must have exactly 1 child"),
+        ('<root><BehaviorTree ID="M"><Sequence/></BehaviorTree></root>', "1 or more children"),
+        (
+            '<root><BehaviorTree ID="M"><AlwaysSuccess><AlwaysSuccess/></AlwaysSuccess></BehaviorTree></root>',  # noqa: E501
+            "must not have any child",
+        ),
+        (
+            '<root><BehaviorTree ID="M"><TryCatch><AlwaysSuccess/></TryCatch></BehaviorTree></root>',
+            "at least 2",
+        ),
+        ('<root><BehaviorTree ID="M"><AlwaysSuccess ID="x"/></BehaviorTree></root>', "not allowed in"),
+        ('<root><BehaviorTree ID="M"><Action/></BehaviorTree></root>', "must have the attribute [ID]"),
+        ('<root><BehaviorTree ID="Sequence"><AlwaysSuccess/></BehaviorTree></root>', "registered Node"),
+        ('<root><BehaviorTree ID="M"><AlwaysSuccess da_port="1"/></BehaviorTree></root>', "providedPorts"),
+        (
+            '<root><BehaviorTree ID="M"><AlwaysSuccess _skipIf="1 +"/></BehaviorTree></root>',
+            "Error in the script",
+        ),
+        ('<root><BehaviorTree ID="M"><Script code="a :="/></BehaviorTree></root>', "Error in the script"),
+        (
+            '<root><TreeNodesModel/><TreeNodesModel/><BehaviorTree ID="M"><AlwaysSuccess/></BehaviorTree></root>',  # noqa: E501
+            "single node <TreeNodesModel>",
+        ),
+        ("<root><BehaviorTree><AlwaysSuccess/></BehaviorTree><TreeNodesModel/></root>", "attribute [ID]"),
+        (
+            '<root><BehaviorTree ID="M"><ReactiveSequence><AsyncSequence><AlwaysSuccess/></AsyncSequence>'
+            "<AsyncSequence><AlwaysSuccess/></AsyncSequence></ReactiveSequence></BehaviorTree></root>",
+            "more than one async child",
+        ),
+        (
+            '<root><BehaviorTree ID="M"><ReactiveSequence><Action ID="AlwaysSuccess"/></ReactiveSequence>'
+            "</BehaviorTree></root>",
+            "Unknown node type: Action",
+        ),
+        ('<root><BehaviorTree ID="M"><SubTree ID="Nowhere"/></BehaviorTree></root>', "Nowhere"),
+        ("<root><BehaviorTree ID=\"M\"><AlwaysSuccess name='x\x01'/></BehaviorTree></root>", ""),
+    ],
+)
+def test_document_errors(xml: str, message: str) -> None:
+    with pytest.raises(ObjectiveError) as info:
+        BehaviorTreeFactory().create_tree_from_text(xml)
+    assert message in str(info.value)
+
+
+def test_errors_carry_file_and_line(tmp_path: Path) -> None:
+    path = tmp_path / "bad.xml"
+    path.write_text(
+        '<root BTCPP_format="4">\n  <BehaviorTree ID="M">\n    <Nope/>\n  </BehaviorTree>\n</root>\n'
+    )
+    with pytest.raises(BTError) as info:
+        BehaviorTreeFactory().create_tree_from_file(path)
+    assert str(info.value).startswith(f"{path}:3: ")
+
+
+def test_lenient_attribute_values() -> None:
+    xml = (
+        '<root BTCPP_format="4"><BehaviorTree ID="M"><Sequence><Script code="A := 1; B := 2"/>'
+        '<ScriptCondition code="A<2 && B>1"/><Script code="C := 3;\n D := 4"/></Sequence></BehaviorTree></root>'  # noqa: E501
+    )
+    tree = BehaviorTreeFactory().create_tree_from_text(xml)
+    assert tree.tick_once() is S
+    assert tree.root_blackboard.get("D") == 4
+
+
+def test_explicit_and_compact_forms_are_equivalent_and_the_tag_is_not_checked() -> None:
+    xml = (
+        '<root BTCPP_format="4"><BehaviorTree ID="M"><Control ID="Sequence">'
+        '<Condition ID="AlwaysSuccess"/><Decorator ID="Inverter"><Action ID="AlwaysFailure"/></Decorator>'
+        "</Control></BehaviorTree></root>"
+    )
+    assert BehaviorTreeFactory().create_tree_from_text(xml).tick_once() is S
+
+
+def test_main_tree_choice() -> None:
+    factory = BehaviorTreeFactory()
+    two = (
+        '<root main_tree_to_execute="B"><BehaviorTree ID="A"><AlwaysFailure/></BehaviorTree>'
+        '<BehaviorTree ID="B"><AlwaysSuccess/></BehaviorTree></root>'
+    )
+    assert factory.create_tree_from_text(two).tick_once() is S
+    anonymous = "<root><BehaviorTree><AlwaysSuccess/></BehaviorTree></root>"
+    tree = factory.create_tree_from_text(anonymous)
+    assert tree.subtrees[0].tree_id == "BehaviorTree_0"
+    assert sorted(factory.registered_behavior_trees()) == ["A", "B", "BehaviorTree_0"]
+
+
+def test_trees_registered_earlier_are_visible_to_later_documents() -> None:
+    factory = BehaviorTreeFactory()
+    factory.register_behavior_tree_from_text(
+        '<root><BehaviorTree ID="Lib"><AlwaysSuccess/></BehaviorTree></root>'
+    )
+    tree = factory.create_tree_from_text(
+        '<root><BehaviorTree ID="M"><SubTree ID="Lib"/></BehaviorTree></root>'
+    )
+    assert tree.tick_once() is S
+    factory.register_behavior_tree_from_text(
+        '<root><BehaviorTree ID="Lib"><AlwaysFailure/></BehaviorTree></root>'
+    )
+    assert factory.create_tree("M").tick_once() is NodeStatus.FAILURE  # reloading replaces
+    factory.clear_registered_behavior_trees()
+    assert factory.registered_behavior_trees() == []
+
+
+def test_includes_resolve_relative_to_the_including_file(tmp_path: Path) -> None:
+    (tmp_path / "lib").mkdir()
+    (tmp_path / "lib" / "inner.xml").write_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Inner"><AlwaysSuccess/></BehaviorTree></root>'
+    )
+    (tmp_path / "lib" / "middle.xml").write_text(
+        '<root BTCPP_format="4"><include path="inner.xml"/>'
+        '<BehaviorTree ID="Middle"><SubTree ID="Inner"/></BehaviorTree></root>'
+    )
+    main = tmp_path / "main.xml"
+    main.write_text(
+        '<root BTCPP_format="4" main_tree_to_execute="Main"><include path="lib/middle.xml"/>'
+        '<BehaviorTree ID="Main"><SubTree ID="Middle"/></BehaviorTree></root>'
+    )
+    assert BehaviorTreeFactory().create_tree_from_file(main).tick_once() is S
+
+
+def test_an_include_cycle_is_reported(tmp_path: Path) -> None:
+    (tmp_path / "a.xml").write_text('<root><include path="b.xml"/></root>')
+    (tmp_path / "b.xml").write_text('<root><include path="a.xml"/></root>')
+    with pytest.raises(BTError, match="cycle"):
+        BehaviorTreeFactory().register_behavior_tree_from_file(tmp_path / "a.xml")
+
+
+def test_metadata_is_kept_for_writing_objectives_back() -> None:
+    factory = BehaviorTreeFactory()
+    factory.register_behavior_tree_from_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Pick" _description="Pick it" _favorite="true">'
+        '<Sequence _collapsed="true"><AlwaysSuccess/></Sequence></BehaviorTree>'
+        '<TreeNodesModel><SubTree ID="Pick"><input_port name="speed" default="1.0" description="how fast"/>'
+        '<MetadataFields><Metadata subcategory="Grasping"/><Metadata runnable="true"/></MetadataFields>'
+        "</SubTree></TreeNodesModel></root>"
+    )
+    definition = factory.tree_definition("Pick")
+    assert definition.attributes == {"ID": "Pick", "_description": "Pick it", "_favorite": "true"}
+    assert 'Sequence _collapsed="true"' in definition.to_xml()
+    model = factory.library.subtree_models["Pick"]
+    assert model.metadata == [("subcategory", "Grasping"), ("runnable", "true")]
+    assert model.ports["speed"].default_str == "1.0" and model.ports["speed"].description == "how fast"
+    tree = factory.create_tree("Pick")
+    assert tree.root_node.config.other_attributes == {"_collapsed": "true"}  # type: ignore[union-attr]
+
+
+def test_deep_nesting_is_reported_not_crashed() -> None:
+    depth = 300
+    body = "<Inverter>" * depth + "<AlwaysFailure/>" + "</Inverter>" * depth
+    with pytest.raises(ObjectiveError, match=r"deeper than 256|nesting depth"):
+        BehaviorTreeFactory().create_tree_from_text(
+            f'<root><BehaviorTree ID="M">{body}</BehaviorTree></root>'
+        )
+
+
+@pytest.mark.skipif(
+    not COMPAT.is_dir(), reason="the MoveIt Pro compatibility files are not beside the checkout"
+)
+def test_moveit_pro_objectives_load_into_the_library() -> None:
+    factory = BehaviorTreeFactory()
+    for path in sorted(COMPAT.glob("*.xml")):
+        factory.library.load_file(path, factory.manifests(), verify=False)
+    assert {"Move to Waypoint", "Move to Joint State", "3 Waypoints Pick and Place"} <= set(
+        factory.registered_behavior_trees()
+    )
+    assert factory.tree_definition("Open Gripper").attributes["_description"] == "Open the gripper"
