@@ -101,6 +101,13 @@ class MujocoDriver:
         else:
             mujoco.mj_forward(self.model, self.data)
         self._controllers = self._build_controllers()
+        # Called before every step / at every publish; each returns at once when no goal runs.
+        self._updates = [c.update for c in self._controllers.values() if hasattr(c, "update")]  # type: ignore[attr-defined]
+        self._feedback_posters = [
+            c.post_feedback  # type: ignore[attr-defined]
+            for c in self._controllers.values()
+            if hasattr(c, "post_feedback")
+        ]
         self.controller_manager = ControllerManager(
             list(self._controllers.values()), update_rate=round(1.0 / self.index.timestep)
         )
@@ -334,9 +341,9 @@ class MujocoDriver:
     # -- the physics thread ------------------------------------------------------------------------
 
     def _before_step(self) -> None:
-        for controller in self._controllers.values():
-            if getattr(controller, "busy", False):
-                controller.update(self.data)  # type: ignore[attr-defined]
+        data = self.data
+        for update in self._updates:
+            update(data)
 
     def _on_publish(self) -> None:
         data = self.data
@@ -352,9 +359,8 @@ class MujocoDriver:
                     data.qfrc_actuator[self._joint_dofs],
                 )
             )
-        for controller in self._controllers.values():
-            if getattr(controller, "busy", False):
-                controller.post_feedback(data)  # type: ignore[attr-defined]
+        for post_feedback in self._feedback_posters:
+            post_feedback(data)
         wall = time.perf_counter()
         if wall - self._last_scene_publish >= 1.0 / self.settings.scene_state_rate:
             self._publish_scene_state(wall)

@@ -33,16 +33,29 @@ from kinema.drivers.mujoco.trajectory_sampling import SampledTrajectory, sample_
 log = logging.getLogger(__name__)
 
 
+Index = np.ndarray | slice
+
+
+def _index(addresses: np.ndarray) -> Index:
+    """A slice when the addresses are consecutive (a view: much cheaper per step), else the array."""
+    if len(addresses) and np.array_equal(addresses, np.arange(addresses[0], addresses[0] + len(addresses))):
+        return slice(int(addresses[0]), int(addresses[0]) + len(addresses))
+    return addresses
+
+
 @dataclass
 class _Running:
     execution: Execution
     goal: TrajectoryGoal
     table: SampledTrajectory
     start: float
-    qpos: np.ndarray
-    qvel: np.ndarray
-    ctrl: np.ndarray
-    feedforward: np.ndarray
+    qpos: Index
+    qvel: Index
+    ctrl: Index
+    # ctrl per table row: position plus the velocity feed-forward, computed once per goal.
+    commands: np.ndarray
+    check_path_velocity: bool
+    row: int = 0
 
 
 def _result(code: int, message: str) -> dict[str, Any]:
@@ -157,6 +170,7 @@ class JointTrajectoryController:
             self._running.execution.finish(
                 "aborted", _result(INVALID_GOAL, f"preempted by a newer goal at sim time {now:.3f} s")
             )
+        self._settle_command()
         columns = goal.joint_indices
         table = sample_trajectory(
             goal.times,
@@ -172,10 +186,11 @@ class JointTrajectoryController:
             goal=goal,
             table=table,
             start=goal.start_stamp if goal.start_stamp is not None else now,
-            qpos=self._qpos[columns],
-            qvel=self._qvel[columns],
-            ctrl=self._ctrl[columns],
-            feedforward=self._feedforward[columns],
+            qpos=_index(self._qpos[columns]),
+            qvel=_index(self._qvel[columns]),
+            ctrl=_index(self._ctrl[columns]),
+            commands=table.positions + self._feedforward[columns] * table.velocities,
+            check_path_velocity=not math.isinf(goal.path_velocity_tolerance.min()),
         )
         log.debug(
             "%s: tracking %d points over %.3f s from sim time %.3f s",
@@ -208,19 +223,17 @@ class JointTrajectoryController:
         if elapsed < 0.0:
             return  # stamped to start later: keep holding
         table = running.table
-        row = table.index_at(elapsed)
+        row = running.row = table.index_at(elapsed)
         desired = table.positions[row]
-        desired_velocity = table.velocities[row]
         goal = running.goal
         error = data.qpos[running.qpos] - desired
         if elapsed <= table.duration:
             velocity_error = (
-                data.qvel[running.qvel] - desired_velocity
-                if not math.isinf(goal.path_velocity_tolerance.min())
-                else None
+                data.qvel[running.qvel] - table.velocities[row] if running.check_path_velocity else None
             )
-            if np.any(np.abs(error) > goal.path_position_tolerance) or (
-                velocity_error is not None and np.any(np.abs(velocity_error) > goal.path_velocity_tolerance)
+            # ndarray.any() rather than np.any(): this runs every physics step.
+            if (np.abs(error) > goal.path_position_tolerance).any() or (
+                velocity_error is not None and (np.abs(velocity_error) > goal.path_velocity_tolerance).any()
             ):
                 self._fail(
                     data,
@@ -248,9 +261,7 @@ class JointTrajectoryController:
                     + _violations(goal.joint_names, speed, goal.goal_velocity_tolerance, "still moving at"),
                 )
                 return
-        self._command[goal.joint_indices] = desired
-        self._command_velocity[goal.joint_indices] = desired_velocity
-        data.ctrl[running.ctrl] = desired + running.feedforward * desired_velocity
+        data.ctrl[running.ctrl] = running.commands[row]
 
     def post_feedback(self, data: Any) -> None:
         """Post the running goal's desired, actual and error state (called at the publish rate)."""
@@ -288,12 +299,21 @@ class JointTrajectoryController:
         running = self._running
         if running is None:
             return
+        self._settle_command()
         self._running = None
         if hold:
             self._hold(data)
         else:
             self._command_velocity[:] = 0.0
         running.execution.finish(status, result)
+
+    def _settle_command(self) -> None:
+        """Record what the running goal commands now (kept lazily: the per-step path only writes ctrl)."""
+        running = self._running
+        if running is not None:
+            columns = running.goal.joint_indices
+            self._command[columns] = running.table.positions[running.row]
+            self._command_velocity[columns] = running.table.velocities[running.row]
 
     def _hold(self, data: Any) -> None:
         self._command[:] = data.qpos[self._qpos]
