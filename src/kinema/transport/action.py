@@ -550,14 +550,16 @@ class ActionClient:
         handle = ClientGoalHandle(self, goal_id, feedback_callback)
         with self._lock:
             self._handles[goal_id] = handle
+        request = from_dict(action.send_goal.request, {"goal_id": _uuid_dict(goal_id), "goal": goal_msg})
         try:
-            response = self._send_goal.call(
-                from_dict(action.send_goal.request, {"goal_id": _uuid_dict(goal_id), "goal": goal_msg}),
-                timeout=timeout,
-            )
-        except TransportError:
+            response = self._send_goal.call(request, timeout=timeout)
+        except TransportError as error:
             with self._lock:
                 self._handles.pop(goal_id, None)
+            if str(error).startswith("no server for service"):
+                raise TransportError(
+                    f"no action server {self.name} [{self.type_name}] answered within {timeout:g} s"
+                ) from error
             raise
         handle.accepted = bool(response.accepted)
         handle.stamp = response.stamp

@@ -237,8 +237,24 @@ class ServiceClient(Entity):
             if time.monotonic() + _RETRY_PAUSE >= deadline:
                 raise TransportError(
                     f"no server for service {self.name} [{self.type_name}] answered within {timeout:g} s"
+                    f"{self._mismatch_hint()}"
                 )
             time.sleep(_RETRY_PAUSE)
+
+    def _mismatch_hint(self) -> str:
+        """Explain a server that exists under this name but with another type or definition."""
+        name = self.name
+        cache = self.node.session.graph_cache()
+        cache.wait_for(lambda graph: bool(graph.service_servers(name)), 0.1)
+        others = {(s.type_name, s.type_hash) for s in cache.snapshot().service_servers(name)}
+        others.discard((self.type_name, self.type_hash))
+        if not others:
+            return ""
+        found = ", ".join(f"{type_name} ({type_hash})" for type_name, type_hash in sorted(others))
+        return (
+            f"; a server with another type or interface definition is there: {found}, "
+            f"this client uses {self.type_name} ({self.type_hash})"
+        )
 
     def _call_once(self, payload: bytes, timeout: float) -> Any | None:
         import zenoh

@@ -198,3 +198,9 @@ def test_a_new_goal_can_preempt_the_running_one(connect: Callable[[], Session]) 
     assert first.result(timeout=5).status == STATUS_CANCELED
     outcome = second.result(timeout=5)
     assert outcome.succeeded and outcome.result.sequence.tolist() == [2]
+
+
+def test_missing_action_server_is_named(connect: Callable[[], Session]) -> None:
+    client = Node(connect(), "client").create_action_client(FIB, "/nobody")
+    with pytest.raises(TransportError, match="no action server /nobody"):
+        client.send_goal({"order": 1}, timeout=0.3)

@@ -114,3 +114,13 @@ def test_closed_node_stops_serving(connect: Callable[[], Session]) -> None:
 def test_unknown_service_type_names_the_alternatives(connect: Callable[[], Session]) -> None:
     with pytest.raises(TransportError, match="did you mean 'example_interfaces/srv/AddTwoInts'"):
         Node(connect(), "n").create_client("example_interfaces/srv/AddTwoInt", "/x")
+
+
+def test_a_server_with_another_definition_is_pointed_out(connect: Callable[[], Session]) -> None:
+    # Same name, another type: what a ROS side built from different .srv text looks like.
+    Node(connect(), "server").create_service(
+        "controller_manager_msgs/srv/ListControllers", "/mismatched", lambda request: {}
+    )
+    client = Node(connect(), "caller").create_client(ADD, "/mismatched")
+    with pytest.raises(TransportError, match="a server with another type or interface definition is there"):
+        client.call({}, timeout=0.5)
