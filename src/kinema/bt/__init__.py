@@ -21,7 +21,7 @@ from kinema.bt.errors import (
 )
 from kinema.bt.factory import BehaviorTreeFactory
 from kinema.bt.manifest import NodeManifest, NodeType
-from kinema.bt.model_xml import write_tree_nodes_model_xml
+from kinema.bt.model_xml import write_objective_xml, write_tree_nodes_model_xml
 from kinema.bt.node import (
     ActionNode,
     ConditionNode,
@@ -75,5 +75,6 @@ __all__ = [
     "bidirectional_port",
     "input_port",
     "output_port",
+    "write_objective_xml",
     "write_tree_nodes_model_xml",
 ]

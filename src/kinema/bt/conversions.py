@@ -346,7 +346,7 @@ def python_type_of(value: Any) -> Any:
     if isinstance(value, list):
         for candidate in (bool, int, float, str):
             if value and all(type(v) is candidate for v in value):
-                return list[candidate]
+                return list[candidate]  # type: ignore[valid-type]
         return list
     return type(value)
 

@@ -461,7 +461,7 @@ class LoopNode(DecoratorNode):
         raw = self.config.input_ports.get("queue")
         self._static: list[Any] | None = None
         if isinstance(raw, str) and blackboard_pointer(raw, "queue") is None:
-            self._static = convert_from_string(list[self.item_type], raw, self.config.enums)
+            self._static = convert_from_string(self._list_type(), raw, self.config.enums)
 
     def tick(self) -> NodeStatus:
         popped = False
@@ -488,6 +488,10 @@ class LoopNode(DecoratorNode):
             return FAILURE
         return RUNNING
 
+    @classmethod
+    def _list_type(cls) -> Any:
+        return list[cls.item_type]  # type: ignore[name-defined]
+
     def _read_queue(self) -> None:
         key = self.port_blackboard_key("queue")
         if key is None:
@@ -502,7 +506,7 @@ class LoopNode(DecoratorNode):
             if isinstance(value, list | tuple):
                 self._queue = deque(value)
             elif isinstance(value, str):
-                self._queue = deque(convert_from_string(list[self.item_type], value, self.config.enums))
+                self._queue = deque(convert_from_string(self._list_type(), value, self.config.enums))
             else:
                 raise BTRuntimeError(
                     "LoopNode: port 'queue' must contain either a queue, a list, or a string"

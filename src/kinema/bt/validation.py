@@ -142,10 +142,10 @@ def _node_problems(root: etree._Element, filename: str, factory: BehaviorTreeFac
             script_port = _SCRIPT_PORTS.get(node_id or "")
             code = element.get(script_port) if script_port else None
             if code and not strict_blackboard_pointer(code.strip()):
-                error = validate_script(code)
-                if error is not None:
+                parse_error = validate_script(code)
+                if parse_error is not None:
                     problems.append(
-                        Problem(where, f'{node_id} {script_port}="{code}" does not parse: {error}')
+                        Problem(where, f'{node_id} {script_port}="{code}" does not parse: {parse_error}')
                     )
     return problems
 

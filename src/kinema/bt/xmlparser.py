@@ -259,7 +259,7 @@ class TreeLibrary:
 
     # -- main tree -------------------------------------------------------------------------------
 
-    def main_tree_of(self, root: etree._Element, before: set[str]) -> str | None:
+    def main_tree_of(self, root: etree._Element, before: set[str]) -> str:
         """The tree ``createTreeFromText`` instantiates for document ``root`` (BT.CPP's rules)."""
         main = root.get("main_tree_to_execute")
         if main:

@@ -188,3 +188,30 @@ def test_moveit_pro_objectives_load_into_the_library() -> None:
         factory.registered_behavior_trees()
     )
     assert factory.tree_definition("Open Gripper").attributes["_description"] == "Open the gripper"
+
+
+def test_objectives_are_written_back_with_their_metadata() -> None:
+    from kinema.bt import write_objective_xml
+
+    source = (
+        '<root BTCPP_format="4" main_tree_to_execute="Pick">'
+        '<BehaviorTree ID="Pick" _description="Pick &amp; place" _favorite="true">'
+        '<Sequence _collapsed="true"><!-- keep me --><Script code="a := 1&#10;b := a &lt; 2"/>'
+        '<SubTree ID="Helper" speed="{s}"/></Sequence></BehaviorTree>'
+        '<BehaviorTree ID="Helper"><AlwaysSuccess/></BehaviorTree>'
+        '<TreeNodesModel><SubTree ID="Helper"><input_port name="speed" default="1.0" description="how fast"/>'
+        '<MetadataFields><Metadata subcategory="Motion"/></MetadataFields></SubTree></TreeNodesModel></root>'
+    )
+    factory = BehaviorTreeFactory()
+    factory.register_behavior_tree_from_text(source)
+    written = write_objective_xml(factory, ["Pick", "Helper"], main_tree="Pick")
+    again = BehaviorTreeFactory()
+    again.register_behavior_tree_from_text(written)
+    assert again.tree_definition("Pick").attributes == factory.tree_definition("Pick").attributes
+    assert "keep me" in written and '_collapsed="true"' in written
+    script = again.tree_definition("Pick").element.find(".//Script")
+    assert script is not None and script.get("code") == "a := 1\nb := a < 2"
+    model = again.library.subtree_models["Helper"]
+    assert model.metadata == [("subcategory", "Motion")] and model.ports["speed"].description == "how fast"
+    tree = again.create_tree_from_text(written)
+    assert tree.tick_once() is S
