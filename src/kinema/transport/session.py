@@ -68,7 +68,10 @@ def _install_exit_hook() -> None:
             return
         register = getattr(threading, "_register_atexit", None)
         if register is not None:
-            register(_close_all_at_exit)
+            try:
+                register(_close_all_at_exit)
+            except RuntimeError:
+                return  # the interpreter is already shutting down; nothing left to hook into
         _exit_hook_installed = True
 
 
