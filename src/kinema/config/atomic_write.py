@@ -12,6 +12,8 @@ import os
 import tempfile
 from pathlib import Path
 
+from kinema.errors import ConfigError, KinemaError, SourceLocation
+
 
 def _read_umask() -> int:
     # os.umask can only be read by setting it; done once at import, before threads write files.
@@ -23,9 +25,22 @@ def _read_umask() -> int:
 _UMASK = _read_umask()
 
 
-def atomic_write_bytes(path: str | Path, data: bytes) -> None:
-    """Replace ``path`` with ``data`` atomically (creating it when it does not exist)."""
+def atomic_write_bytes(path: str | Path, data: bytes, *, error: type[KinemaError] = ConfigError) -> None:
+    """Replace ``path`` with ``data`` atomically (creating it when it does not exist).
+
+    Raises:
+        KinemaError: (of class ``error``) the folder is missing or not writable, the disk is full, ...
+    """
     path = Path(path)
+    try:
+        _replace(path, data)
+    except OSError as exc:
+        raise error(
+            f"cannot write the file: {exc.strerror or exc}", location=SourceLocation(str(path))
+        ) from None
+
+
+def _replace(path: Path, data: bytes) -> None:
     try:
         mode: int | None = path.stat().st_mode & 0o7777
     except FileNotFoundError:
@@ -47,6 +62,6 @@ def atomic_write_bytes(path: str | Path, data: bytes) -> None:
         raise
 
 
-def atomic_write_text(path: str | Path, text: str) -> None:
-    """Replace ``path`` with UTF-8 ``text`` atomically."""
-    atomic_write_bytes(path, text.encode("utf-8"))
+def atomic_write_text(path: str | Path, text: str, *, error: type[KinemaError] = ConfigError) -> None:
+    """Replace ``path`` with UTF-8 ``text`` atomically (see :func:`atomic_write_bytes`)."""
+    atomic_write_bytes(path, text.encode("utf-8"), error=error)

@@ -15,6 +15,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
+from kinema.errors import ConfigError, SourceLocation
+
 
 def lock_path_for(path: Path) -> Path:
     """The sidecar lock file of ``path``."""
@@ -25,7 +27,12 @@ def lock_path_for(path: Path) -> Path:
 def locked(path: str | Path) -> Iterator[None]:
     """Hold the exclusive lock of ``path`` (blocking until it is free) for the ``with`` body."""
     lock_file = lock_path_for(Path(path))
-    descriptor = os.open(lock_file, os.O_RDWR | os.O_CREAT, 0o666)
+    try:
+        descriptor = os.open(lock_file, os.O_RDWR | os.O_CREAT, 0o666)
+    except OSError as error:
+        raise ConfigError(
+            f"cannot create the lock file: {error.strerror}", location=SourceLocation(str(lock_file))
+        ) from None
     try:
         _acquire(descriptor)
         try:

@@ -187,8 +187,14 @@ class ObjectiveLibrary:
             destination = previous.file
         else:
             destination = self._free_file_name(target_library.path, objective_id)
-        destination.parent.mkdir(parents=True, exist_ok=True)
-        atomic_write_text(destination, text)
+        try:
+            destination.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as error:
+            raise ObjectiveError(
+                f"cannot create the folder: {error.strerror}",
+                location=SourceLocation(str(destination.parent)),
+            ) from None
+        atomic_write_text(destination, text, error=ObjectiveError)
         for info in self._add_file(destination, target_library.package, replace=True):
             if info.id == objective_id:
                 return info

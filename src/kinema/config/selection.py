@@ -88,7 +88,13 @@ def store_selection(workspace: Path | None, config: str | None) -> Path:
     """Write the active workspace and config for later commands; return the file written."""
     data = {"workspace": str(workspace) if workspace is not None else None, "config": config}
     path = selection_file()
-    path.parent.mkdir(parents=True, exist_ok=True)
+    try:
+        path.parent.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise ConfigError(
+            f"cannot create Kinema's config folder: {error.strerror}",
+            location=SourceLocation(str(path.parent)),
+        ) from None
     atomic_write_text(path, "# Written by `kinema configure`.\n" + yaml.safe_dump(data, sort_keys=False))
     return path
 

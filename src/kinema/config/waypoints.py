@@ -20,6 +20,7 @@ half-written file.
 from __future__ import annotations
 
 import copy
+from contextlib import AbstractContextManager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -236,8 +237,14 @@ class WaypointStore:
             del waypoints[names.index(name)]
             self._write(waypoints)
 
-    def _locked(self):  # type: ignore[no-untyped-def]
-        self.path.parent.mkdir(parents=True, exist_ok=True)
+    def _locked(self) -> AbstractContextManager[None]:
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+        except OSError as error:
+            raise ConfigError(
+                f"cannot create the folder of the waypoints file: {error.strerror}",
+                location=SourceLocation(str(self.path.parent)),
+            ) from None
         return locked(self.path)
 
     def _read(self) -> list[Waypoint]:
@@ -272,5 +279,4 @@ class WaypointStore:
             sort_keys=True,
             allow_unicode=True,
         )
-        self.path.parent.mkdir(parents=True, exist_ok=True)
         atomic_write_text(self.path, text)

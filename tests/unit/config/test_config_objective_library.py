@@ -272,3 +272,19 @@ def test_core_library_folder_listed_twice_loads_once(shared_dir: Path, ws):
     assert len(core_entries) == 4
     library = ObjectiveLibrary.from_libraries(core_entries, resolved.chain)
     assert len(library.libraries) == 1
+
+
+def test_saving_where_the_library_cannot_be_written_is_a_clear_error(ws, monkeypatch: pytest.MonkeyPatch):
+    import os
+
+    ws.config("base")
+    ws.child("site", "base")
+    library = ObjectiveLibrary.load(resolve_config("site", Workspace.discover(ws.root)))
+
+    def refuse(source: str, destination: str) -> None:
+        raise PermissionError(13, "Permission denied")
+
+    monkeypatch.setattr(os, "replace", refuse)
+    with pytest.raises(ObjectiveError, match=r"a\.xml: cannot write the file: Permission denied"):
+        library.save("A", '<BehaviorTree ID="A"><AlwaysSuccess/></BehaviorTree>')
+    assert list((ws.root / "src" / "site" / "objectives").iterdir()) == []  # the temporary file is gone

@@ -189,3 +189,10 @@ def test_bundled_lab_sim_waypoints_parse_with_the_robot_joint_names():
     for waypoint in store.all():
         assert "linear_rail_joint" in waypoint.joint_names
         assert len(waypoint.positions) == len(waypoint.joint_names)
+
+
+def test_an_unwritable_location_is_a_clear_error(tmp_path: Path):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("not a folder")
+    with pytest.raises(ConfigError, match="cannot create the folder of the waypoints file"):
+        WaypointStore(blocker / "waypoints.yaml").save(_waypoint("A"))
