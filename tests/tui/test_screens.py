@@ -55,9 +55,11 @@ def test_configs_show_packages_chain_provenance_and_files(fake: FakeConnection) 
         assert [label.split()[0] for label in chain[1:]] == ["lab_sim", "example_config"]
         rows = table_rows(app.screen.query_one("#resolved-table", DataTable))
         by_key = {row[0]: row for row in rows}
-        assert by_key["based_on_package"][2] == "example_config"
-        assert by_key["hardware.type"][2] == "lab_sim" if "hardware.type" in by_key else True
-        assert any(row[2] == "lab_sim" for row in rows) and any(row[2] == "example_config" for row in rows)
+        assert by_key["based_on_package"][1:] == ["example_config", "lab_sim"]
+        assert by_key["hardware.robot_description.urdf"][1] == "lab_sim"  # inherited
+        # Lists show as written (not swallowed as markup).
+        started = by_key["ros2_control.controllers_active_at_startup"][2]
+        assert started.startswith("[") and started.endswith("]") and len(started) > 2
         await pilot.press("i")
         await settle(pilot)
         files = tree_labels(app.screen.query_one("#file-tree", Tree))
@@ -103,6 +105,7 @@ def test_blackboard_rows_update_in_place_filter_and_show_history(fake: FakeConne
         await settle(pilot)
         assert sorted(r[1] for r in table_rows(table)) == ["count", "goal", "name", "seconds"]
         assert ["Wait and Log::3", "seconds", "double", "0.5"] in table_rows(table)
+        assert ["(root)", "goal", "int", "[1, 2]"] in table_rows(table)  # shown as written, not as markup
         for i in range(2, 6):
             fake.emit(
                 BlackboardSnapshot(

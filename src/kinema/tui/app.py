@@ -17,6 +17,7 @@ from pathlib import Path
 
 from textual.app import App, SystemCommand
 from textual.binding import Binding
+from textual.notifications import SeverityLevel
 from textual.screen import Screen
 
 from kinema.tui.blackboard_model import BlackboardModel
@@ -262,6 +263,18 @@ class KinemaApp(App[None]):
                 self.logs.append(
                     LogEntry(f"{type(view).__name__}: {error}", LogLevel.ERROR, time.time(), "ui")
                 )
+
+    def notify(
+        self,
+        message: str,
+        *,
+        title: str = "",
+        severity: SeverityLevel = "information",
+        timeout: float | None = None,
+        markup: bool = False,
+    ) -> None:
+        """Show a toast. Markup is off by default: runtime messages contain ``[node/path]`` and file names."""
+        super().notify(message, title=title, severity=severity, timeout=timeout, markup=markup)
 
     # -- messages from screens ----------------------------------------------------------------------
 

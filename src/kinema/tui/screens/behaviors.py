@@ -85,9 +85,8 @@ class BehaviorsScreen(KinemaScreen):
         table = self.query_one("#behavior-table", DataTable)
         table.clear()
         for behavior in self.shown_behaviors:
-            table.add_row(
-                behavior.id, behavior.plugin, behavior.metadata.get("subcategory", ""), key=behavior.id
-            )
+            cells = (behavior.id, behavior.plugin, behavior.metadata.get("subcategory", ""))
+            table.add_row(*(Text(cell) for cell in cells), key=behavior.id)
         if self.shown_behaviors:
             self._show(self.shown_behaviors[0])
 
@@ -121,7 +120,12 @@ class BehaviorsScreen(KinemaScreen):
         ports = self.query_one("#behavior-ports", DataTable)
         ports.clear()
         for port in behavior.ports:
-            ports.add_row(port.name, port.direction, port.type_name, port.default, port.description)
+            ports.add_row(
+                *(
+                    Text(v)
+                    for v in (port.name, port.direction, port.type_name, port.default, port.description)
+                )
+            )
 
     def runtime_reload(self, notice: ReloadNotice) -> None:
         self._add_reload(notice)
@@ -135,7 +139,7 @@ class BehaviorsScreen(KinemaScreen):
         message = Text(notice.message)
         if notice.location:
             message = Text.assemble((f"{notice.location}: ", "bold"), notice.message)
-        table.add_row(stamp, mark, notice.subject, message)
+        table.add_row(stamp, mark, Text(notice.subject), message)
         table.move_cursor(row=table.row_count - 1)
 
     def action_search(self) -> None:

@@ -128,7 +128,7 @@ class BlackboardScreen(KinemaScreen):
         scope, name = key
         title.update(Text.assemble((name, "bold"), (f"  {scope or '(root)'}", "dim")))
         for stamp, value in reversed(self.kinema.blackboard.history.get(key, ())):
-            table.add_row(format_stamp(stamp), value)
+            table.add_row(format_stamp(stamp), Text(value))
 
     def action_filter(self) -> None:
         self.query_one("#blackboard-filter", Input).focus()

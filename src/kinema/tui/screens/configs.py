@@ -83,8 +83,8 @@ class ConfigsScreen(KinemaScreen):
         super().on_mount()
         table = self.query_one("#resolved-table", DataTable)
         table.add_column("Key", key="key")
-        table.add_column("Value", key="value")
         table.add_column("Set by", key="package")
+        table.add_column("Value", key="value")
         self.action_reload()
 
     def action_reload(self) -> None:
@@ -106,7 +106,7 @@ class ConfigsScreen(KinemaScreen):
         for package in packages:
             options.add_option(Option(_package_label(package), id=package.name))
         info = message.workspace.describe()
-        self.query_one("#workspace-info", Static).update(f"{len(packages)} config packages in {info}")
+        self.query_one("#workspace-info", Static).update(Text(f"{len(packages)} config packages in {info}"))
         preferred = self.kinema.connection.config_name
         names = [p.name for p in packages]
         if names:
@@ -137,7 +137,7 @@ class ConfigsScreen(KinemaScreen):
         table.clear()
         for row in details.rows:
             own = row.package == details.name
-            table.add_row(row.key, row.value, Text(row.package, style="bold" if own else "dim"))
+            table.add_row(Text(row.key), Text(row.package, style="bold" if own else "dim"), Text(row.value))
         self._show_files(details)
 
     def _show_chain(self, details: ConfigDetails) -> None:
@@ -160,7 +160,7 @@ class ConfigsScreen(KinemaScreen):
     def _show_files(self, details: ConfigDetails) -> None:
         tree = self.query_one("#file-tree", Tree)
         tree.clear()
-        tree.root.set_label(f"{details.name}/")
+        tree.root.set_label(Text(f"{details.name}/"))
         folders: dict[str, object] = {"": tree.root}
         for path in details.files:
             parent_key = ""
@@ -169,9 +169,9 @@ class ConfigsScreen(KinemaScreen):
             for part in parts[:-1]:
                 parent_key = f"{parent_key}/{part}"
                 if parent_key not in folders:
-                    folders[parent_key] = parent.add(f"{part}/", expand=parent is tree.root)
+                    folders[parent_key] = parent.add(Text(f"{part}/"), expand=parent is tree.root)
                 parent = folders[parent_key]  # type: ignore[assignment]
-            parent.add_leaf(parts[-1])
+            parent.add_leaf(Text(parts[-1]))
         if details.files_cut:
             tree.root.add_leaf(Text(f"… (only the first {len(details.files)} files are listed)", style="dim"))
         tree.root.expand()

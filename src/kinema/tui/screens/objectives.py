@@ -197,7 +197,7 @@ class ObjectivesScreen(KinemaScreen):
         ports = self.query_one("#port-table", DataTable)
         ports.clear()
         for port in objective.ports:
-            ports.add_row(port.name, port.direction, port.default, port.description)
+            ports.add_row(*(Text(v) for v in (port.name, port.direction, port.default, port.description)))
         self.run_worker(self.query_one(OverrideForm).show_objective(objective), group="override-form")
         self.query_one(BehaviorTreeView).show_outline(None, "loading …")
         connection = self.kinema.connection
@@ -224,7 +224,7 @@ class ObjectivesScreen(KinemaScreen):
             self.notify("Select an objective first.", severity="warning")
             return
         if not self.selected.runnable:
-            self.notify(
+            self.app.notify(
                 f"{self.selected.name!r} is a subtree only; run an objective that uses it.",
                 severity="warning",
             )

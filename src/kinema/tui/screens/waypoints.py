@@ -69,9 +69,9 @@ class WaypointsScreen(KinemaScreen):
         for waypoint in self.waypoints:
             table.add_row(
                 Text("★", style="yellow") if waypoint.favorite else "",
-                waypoint.name,
-                ", ".join(waypoint.joint_group_names),
-                waypoint.description,
+                Text(waypoint.name),
+                Text(", ".join(waypoint.joint_group_names)),
+                Text(waypoint.description),
                 key=waypoint.name,
             )
         names = [w.name for w in self.waypoints]
@@ -104,7 +104,7 @@ class WaypointsScreen(KinemaScreen):
             return
         title.update(Text(waypoint.name, style="bold"))
         for name, position in zip(waypoint.joint_names, waypoint.positions, strict=False):
-            joints.add_row(name, f"{position:+.4f}")
+            joints.add_row(Text(name), f"{position:+.4f}")
 
     def action_move(self) -> None:
         waypoint = self.selected()

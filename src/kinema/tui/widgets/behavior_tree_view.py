@@ -41,7 +41,7 @@ class BehaviorTreeView(Tree[OutlineNode]):
         self._by_uid = {}
         self.clear()
         if outline is None or outline.root is None:
-            self.root.set_label(message or "(empty tree)")
+            self.root.set_label(Text(message or "(empty tree)"))
             return
         self.root.set_label(Text(outline.tree_id, style="bold"))
         self.root.data = None

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from rich.text import Text
 from textual.widgets import DataTable
 
 from kinema.tui.blackboard_model import BlackboardDiff, BlackboardModel, RowKey, matches, row_id, row_key
@@ -47,8 +48,8 @@ class BlackboardTable(DataTable[str]):
             wanted = self._wanted(entry)
             if key in self.shown and wanted:
                 rid = row_id(key)
-                self.update_cell(rid, "type", entry.type_name)
-                self.update_cell(rid, "value", _cell(entry.value))
+                self.update_cell(rid, "type", Text(entry.type_name))
+                self.update_cell(rid, "value", Text(_cell(entry.value)))
             elif key in self.shown:
                 self.shown.discard(key)
                 self.remove_row(row_id(key))
@@ -75,7 +76,13 @@ class BlackboardTable(DataTable[str]):
     def _add(self, entry: BlackboardEntry) -> None:
         key = row_key(entry)
         self.shown.add(key)
-        self.add_row(entry.scope or "(root)", entry.key, entry.type_name, _cell(entry.value), key=row_id(key))
+        self.add_row(
+            Text(entry.scope or "(root)"),
+            Text(entry.key),
+            Text(entry.type_name),
+            Text(_cell(entry.value)),
+            key=row_id(key),
+        )
 
 
 def _cell(value: str) -> str:
