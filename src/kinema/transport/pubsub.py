@@ -15,7 +15,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
 
+import zenoh
+from zenoh import ext
+
 from kinema.errors import TransportError
+from kinema.interfaces import dds_type_name
 from kinema.transport.attachment import Attachment, new_gid
 from kinema.transport.keys import EntityKind, QoS, data_key, entity_token
 from kinema.transport.messages import from_dict, type_of
@@ -103,13 +107,8 @@ class Publisher(Entity):
     kind = EntityKind.PUBLISHER
 
     def __init__(self, node: Node, msg_type: str, topic: str, qos: QoS) -> None:
-        import zenoh
-        from zenoh import ext
-
         registry = node.session.registry
         msg_type = registry.message_type(msg_type)
-        from kinema.interfaces import dds_type_name
-
         super().__init__(node, topic, msg_type, dds_type_name(msg_type), registry.type_hash(msg_type), qos)
         self._registry = registry
         self._sequence = itertools.count(1)
@@ -177,10 +176,6 @@ class Subscription(Entity):
         raw: bool = False,
         with_info: bool = False,
     ) -> None:
-        from zenoh import ext
-
-        from kinema.interfaces import dds_type_name
-
         registry = node.session.registry
         msg_type = registry.message_type(msg_type)
         super().__init__(node, topic, msg_type, dds_type_name(msg_type), registry.type_hash(msg_type), qos)

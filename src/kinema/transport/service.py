@@ -16,6 +16,8 @@ import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
+import zenoh
+
 from kinema.errors import TransportError
 from kinema.interfaces import ServiceType
 from kinema.transport.attachment import Attachment
@@ -257,8 +259,6 @@ class ServiceClient(Entity):
         )
 
     def _call_once(self, payload: bytes, timeout: float) -> Any | None:
-        import zenoh
-
         if self._closed:
             raise TransportError(f"client of {self.name} is closed")
         with self._lock:
