@@ -1,0 +1,79 @@
+"""Kinema's own lab_sim and core objectives (same names as MoveIt Pro's) run on lab_sim."""
+
+from __future__ import annotations
+
+import pytest
+from compat_cell import Cell, wait_for
+from objective_checks import (
+    _joint_state,
+    arm_at_waypoint,
+    run_and_expect_success,
+    run_pick_and_place_two_placements,
+)
+
+pytestmark = pytest.mark.slow
+
+
+@pytest.fixture(scope="module")
+def cell(start_cell) -> Cell:
+    return start_cell(objectives=None)
+
+
+def test_kinemas_libraries_provide_the_moveit_pro_names(cell: Cell) -> None:
+    infos = {info.name: info for info in cell.client.objectives()}
+    for expected in (
+        "3 Waypoints Pick and Place",
+        "Close Gripper",
+        "Open Gripper",
+        "Look at Table",
+        "Reset MuJoCo Robot",
+        "Move to Waypoint",
+        "Move to Joint State",
+    ):
+        assert expected in infos
+    # The subtrees MoveIt Pro objectives call have MoveIt Pro's ports.
+    ports = {port.name for port in infos["Move to Waypoint"].ports}
+    assert ports == {
+        "waypoint_name",
+        "joint_group_name",
+        "link_padding",
+        "keep_orientation_tolerance",
+        "keep_orientation",
+        "velocity_scale_factor",
+        "acceleration_scale_factor",
+        "controller_names",
+        "controller_action_server",
+    }
+    ports = {port.name for port in infos["Move to Joint State"].ports}
+    assert ports == {
+        "target_joint_state",
+        "joint_group_name",
+        "link_padding",
+        "orientation_constraint",
+        "velocity_scale_factor",
+        "acceleration_scale_factor",
+        "controller_names",
+        "controller_action_server",
+    }
+
+
+def test_close_and_open_gripper_succeed(cell: Cell) -> None:
+    run_and_expect_success(cell, "Close Gripper")
+    run_and_expect_success(cell, "Open Gripper")
+
+
+def test_look_at_table_moves_the_arm_to_its_waypoint(cell: Cell) -> None:
+    run_and_expect_success(cell, "Look at Table")
+    arm_at_waypoint(cell, "Look at Table")
+
+
+def test_reset_mujoco_robot_puts_the_arm_upright(cell: Cell) -> None:
+    run_and_expect_success(cell, "Reset MuJoCo Robot")
+    message = wait_for(lambda: _joint_state(cell), 10.0, "the arm state")
+    state = dict(zip(message.name, message.position, strict=True))
+    assert abs(state["shoulder_lift_joint"] + 1.57) < 0.02
+    run_and_expect_success(cell, "Look at Table")
+
+
+def test_pick_and_place_moves_the_cube_to_the_tray_and_back_and_loops(cell: Cell) -> None:
+    run_pick_and_place_two_placements(cell)
