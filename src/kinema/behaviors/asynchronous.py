@@ -109,6 +109,10 @@ class AsyncBehavior(Behavior, StatefulActionNode):
         future, self._future = self._future, None
         try:
             self.do_halt()
+        except Exception as error:
+            # Halting must always complete (a cancel has to stop the tree), so a faulty do_halt is
+            # reported as a failure toast naming the behavior, plugin and line, not raised.
+            self.logger.publish_failure(str(behavior_fault(self, error, "do_halt")))
         finally:
             if future is not None:
                 future.cancel()

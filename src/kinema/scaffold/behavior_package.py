@@ -165,7 +165,12 @@ def new_behavior(
 
     if config_package is not None:
         result.config_file = config_package.config_file
-        result.config_changes = add_to_config(config_package.config_file, result.package, loader)
+        result.config_changes = add_to_config(
+            config_package.config_file,
+            result.package,
+            loader,
+            objectives=(result.package_dir / "objectives").is_dir(),
+        )
     return result
 
 
@@ -244,8 +249,10 @@ def _register_in_init(text: str, name: str, behavior_id: str, path: Path) -> str
     return "\n".join(lines) + "\n"
 
 
-def add_to_config(config_file: Path, package: str, loader: str) -> list[str]:
-    """Add ``loader`` and the package's ``objectives/`` library to a config.yaml; return what changed.
+def add_to_config(config_file: Path, package: str, loader: str, *, objectives: bool = True) -> list[str]:
+    """Add ``loader`` (and, with ``objectives``, the package's ``objectives/`` library) to a config.yaml.
+
+    Returns what changed, one line per change.
 
     The file is edited as a round trip (comments, order and quoting kept) and replaced atomically.
 
@@ -267,11 +274,11 @@ def add_to_config(config_file: Path, package: str, loader: str) -> list[str]:
         raise ConfigError(f"{config_file}: cannot update it, it does not parse: {error}") from None
     if data is None:
         data = CommentedMap()
-    objectives = data.setdefault("objectives", CommentedMap())
-    if not isinstance(objectives, dict):
+    section = data.setdefault("objectives", CommentedMap())
+    if not isinstance(section, dict):
         raise ConfigError(f"{config_file}: 'objectives' must be a mapping to add a behavior loader to it")
     changes: list[str] = []
-    loaders = objectives.setdefault("behavior_loader_plugins", CommentedMap())
+    loaders = section.setdefault("behavior_loader_plugins", CommentedMap())
     already = any(loader in (names or []) for names in loaders.values())
     if not already:
         comment = _take_trailing_comment(loaders)
@@ -279,9 +286,9 @@ def add_to_config(config_file: Path, package: str, loader: str) -> list[str]:
         entry.append(loader)
         _put_trailing_comment(loaders, comment)
         changes.append(f"objectives.behavior_loader_plugins.{package}: + {loader}")
-    libraries = objectives.setdefault("objective_library_paths", CommentedMap())
+    libraries = section.setdefault("objective_library_paths", CommentedMap())
     key = f"{package}_objectives"
-    if key not in libraries:
+    if objectives and key not in libraries:
         comment = _take_trailing_comment(libraries)
         libraries[key] = CommentedMap([("package_name", package), ("relative_path", "objectives")])
         _put_trailing_comment(libraries, comment)

@@ -52,3 +52,49 @@ def test_a_new_behavior_runs_in_the_runtime_and_an_edit_is_used_by_the_next_run(
     while not (result := client.execute("Check Sum")).succeeded and time.monotonic() < deadline:
         time.sleep(0.1)
     assert result.succeeded, result.error_message
+
+
+FAULTY = """
+from kinema.behaviors import AsyncBehavior, NodeStatus, SyncBehavior
+
+
+class Crash(SyncBehavior):
+    def tick(self):
+        return 1 / 0
+
+
+class CrashLater(AsyncBehavior):
+    async def do_work(self):
+        raise RuntimeError("lost the robot")
+"""
+FAULT_OBJECTIVES = """
+<root BTCPP_format="4">
+  <BehaviorTree ID="Crash Now"><Sequence name="steps"><Crash name="culprit"/></Sequence></BehaviorTree>
+  <BehaviorTree ID="Crash Later"><Sequence name="steps"><CrashLater name="culprit"/></Sequence></BehaviorTree>
+</root>
+"""
+
+
+def test_a_faulty_behavior_fails_its_objective_with_a_named_cause_and_the_runtime_keeps_serving(
+    workspace: Path, write_package, kinema_runtime
+) -> None:
+    from kinema.scaffold.behavior_package import add_to_config
+
+    _workspace(workspace)
+    write_package("faulty", FAULTY, ["Crash", "CrashLater"])
+    config_file = workspace / "src" / "my_config" / "config" / "config.yaml"
+    add_to_config(config_file, "faulty", "faulty::TestLoader", objectives=False)
+    checks = workspace / "checks"
+    checks.mkdir()
+    (checks / "faults.xml").write_text(FAULT_OBJECTIVES)
+    client = kinema_runtime("my_config", workspace=workspace, objective_dirs=[checks]).client
+    for objective, behavior, cause in (
+        ("Crash Now", "Crash", "ZeroDivisionError"),
+        ("Crash Later", "CrashLater", "lost the robot"),
+    ):
+        result = client.execute(objective)
+        assert result.failed
+        message = result.error_message
+        assert f"behavior '{behavior}' of plugin 'faulty::TestLoader'" in message, message
+        assert "culprit" in message and cause in message and "behaviors.py:" in message
+        assert client.execute("MyAdder Example").succeeded

@@ -119,3 +119,28 @@ def test_the_tree_can_run_the_same_behavior_again() -> None:
         tree.root_blackboard.set("a", a)
         assert tree.tick_while_running() == NodeStatus.SUCCESS
         assert tree.root_blackboard.get("sum") == a + 3
+
+
+class BadHalt(Forever):
+    def do_halt(self) -> None:
+        raise RuntimeError("cannot let go")
+
+
+def test_a_raising_do_halt_is_reported_and_the_work_still_stops() -> None:
+    from kinema.behaviors import BehaviorContext
+
+    context = BehaviorContext()
+    messages = []
+    context.log_sink.subscribe(messages.append)
+    Forever.cancelled.clear()
+    tree = build_tree(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><BadHalt/></BehaviorTree></root>',
+        behaviors=[BadHalt],
+        context=context,
+    )
+    assert tree.tick_once() == NodeStatus.RUNNING
+    tree.halt_tree()
+    assert Forever.cancelled.wait(5)
+    (message,) = messages
+    assert "behavior 'BadHalt'" in message.text and "do_halt" in message.text
+    assert "cannot let go" in message.text and "test_async_behavior.py" in message.text
