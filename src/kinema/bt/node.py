@@ -14,7 +14,7 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from kinema.bt.conversions import ConversionError, cast_value, convert_from_string, list_item_type
+from kinema.bt.conversions import AnyValue, ConversionError, cast_value, convert_from_string, list_item_type
 from kinema.bt.errors import BTError, BTLogicError, BTRuntimeError, NodeExecutionError
 from kinema.bt.ports import PortInfo, blackboard_pointer
 from kinema.bt.status import FAILURE, IDLE, RUNNING, SKIPPED, SUCCESS, NodeStatus
@@ -27,7 +27,7 @@ if TYPE_CHECKING:
 
 StatusObserver = Callable[[float, "TreeNode", NodeStatus, NodeStatus], None]
 
-_PORT_TYPE: Any = object()  # "use the declared type of the port"
+_MISSING: Any = object()
 
 
 class NodeConfig:
@@ -341,21 +341,25 @@ class TreeNode:
         self._bindings[name] = binding
         return binding
 
-    def get_input(self, name: str, type: Any = _PORT_TYPE) -> Any:
-        """The value of input port ``name``, converted to ``type`` (default: the declared type).
+    def get_input(self, name: str, type: Any = None) -> Any:
+        """The value of input port ``name``, converted to ``type`` (None: the port's declared type).
+
+        Pass ``AnyValue`` to get the stored value or the literal text without any conversion.
 
         Raises:
             PortError: the port is missing, its blackboard entry is missing or empty, or the value
                 cannot be converted; the message names the node path and the port.
         """
         key, raw, port_type = self._binding(name)
-        target = port_type if type is _PORT_TYPE else type
+        target = port_type if type is None else type
+        if target is AnyValue:
+            target = None
         if key is None:
             if raw.__class__ is not str or target is str or target is None:
                 return raw
             cache_key = (name, target)
-            cached = self._literal_cache.get(cache_key, _PORT_TYPE)
-            if cached is not _PORT_TYPE:
+            cached = self._literal_cache.get(cache_key, _MISSING)
+            if cached is not _MISSING:
                 return list(cached) if cached.__class__ is list else cached
             try:
                 value = convert_from_string(target, raw, self.config.enums)
@@ -383,14 +387,14 @@ class TreeNode:
                 f"the requested type: {error.message}"
             ) from None
 
-    def try_get_input(self, name: str, type: Any = _PORT_TYPE) -> PortResult:
+    def try_get_input(self, name: str, type: Any = None) -> PortResult:
         """Like :meth:`get_input` but never raises: check ``result.ok`` / ``result.error``."""
         try:
             return PortResult(self.get_input(name, type))
         except BTError as error:
             return PortResult(None, error.message)
 
-    def get_input_or(self, name: str, default: Any, type: Any = _PORT_TYPE) -> Any:
+    def get_input_or(self, name: str, default: Any, type: Any = None) -> Any:
         """The value of input port ``name``, or ``default`` if it cannot be read."""
         result = self.try_get_input(name, type)
         return result.value if result.error is None else default

@@ -19,12 +19,25 @@ from kinema.errors import ObjectiveError, SourceLocation
 # Marks a newline inside an attribute value during parsing (a private-use code point, so it never
 # occurs in real files); the newline itself stays in the text so line numbers do not shift.
 _NEWLINE_MARK = "\ue000"
-_KNOWN_ENTITY = re.compile(r"&(?:amp|lt|gt|quot|apos|#[0-9]+|#x[0-9a-fA-F]+);")
+_ENTITY = r"(?:amp|lt|gt|quot|apos|#[0-9]+|#x[0-9a-fA-F]+);"
 MAX_DEPTH = 256
 
-
-def _escape_ampersand(text: str, index: int) -> str:
-    return "&" if _KNOWN_ENTITY.match(text, index) else "&amp;"
+# The pre-pass works on runs, not characters: most of a file is text, comments and tags whose quoted
+# values need no escaping, and one regex match copies such a run unchanged. Possessive quantifiers keep
+# every pattern linear (no backtracking on unterminated tags or quotes).
+_UNCHANGED = re.compile(
+    r"(?:[^<&]++|&(?=" + _ENTITY + r")"
+    r"|<!--.*?(?:-->|\Z)|<!\[CDATA\[.*?(?:\]\]>|\Z)|<\?.*?(?:\?>|\Z)|<!.*?(?:>|\Z)"
+    r"""|<(?:[^"'>]++|"[^"<>&\n\t]*+"|'[^'<>&\n\t]*+')*+>)++""",
+    re.S,
+)
+# A start or end tag up to its first '>' outside quotes; an unterminated quote runs to the end of the text.
+_TAG = re.compile(r"""<(?:[^"'>]++|"[^"]*+(?:"|\Z)|'[^']*+(?:'|\Z))*+>?""")
+_QUOTED = re.compile(r""""[^"]*+(?:"|\Z)|'[^']*+(?:'|\Z)""")
+_LONE_AMPERSAND = re.compile(r"&(?!" + _ENTITY + ")")
+_SPECIAL_IN_VALUE = re.compile(r"[<>\n\t]")
+# A newline in a value would become a space; the mark before it says to restore it.
+_VALUE_ESCAPES = {"<": "&lt;", ">": "&gt;", "\n": _NEWLINE_MARK + "\n", "\t": "&#9;"}
 
 
 def make_strict(text: str) -> str:
@@ -34,60 +47,27 @@ def make_strict(text: str) -> str:
     """
     text = text.replace("\r\n", "\n").replace("\r", "\n")
     out: list[str] = []
-    i = 0
-    n = len(text)
-    while i < n:
-        c = text[i]
-        if c != "<":
-            out.append(_escape_ampersand(text, i) if c == "&" else c)
-            i += 1
-            continue
-        for opener, closer in (("<!--", "-->"), ("<![CDATA[", "]]>"), ("<?", "?>"), ("<!", ">")):
-            if text.startswith(opener, i):
-                end = text.find(closer, i + len(opener))
-                end = n if end < 0 else end + len(closer)
-                out.append(text[i:end])
-                i = end
-                break
+    position, end = 0, len(text)
+    while position < end:
+        unchanged = _UNCHANGED.match(text, position)
+        if unchanged is not None:
+            out.append(unchanged.group())
+            position = unchanged.end()
+        elif text[position] == "&":
+            out.append("&amp;")
+            position += 1
         else:
-            i = _copy_tag(text, i, out)
+            tag = _TAG.match(text, position)
+            assert tag is not None  # text[position] == "<" always starts a tag
+            out.append(_QUOTED.sub(_escape_value, tag.group()))
+            position = tag.end()
     return "".join(out)
 
 
-def _copy_tag(text: str, i: int, out: list[str]) -> int:
-    """Copy one start or end tag starting at ``text[i] == '<'``, escaping inside quoted values."""
-    n = len(text)
-    out.append("<")
-    i += 1
-    quote: str | None = None
-    while i < n:
-        c = text[i]
-        if quote is None:
-            out.append(c)
-            i += 1
-            if c in "\"'":
-                quote = c
-            elif c == ">":
-                return i
-            continue
-        if c == quote:
-            quote = None
-            out.append(c)
-        elif c == "<":
-            out.append("&lt;")
-        elif c == ">":
-            out.append("&gt;")
-        elif c == "&":
-            out.append(_escape_ampersand(text, i))
-        elif c == "\n":
-            # The parser turns this newline into a space; the mark before it says to restore it.
-            out.append(_NEWLINE_MARK + "\n")
-        elif c == "\t":
-            out.append("&#9;")
-        else:
-            out.append(c)
-        i += 1
-    return i
+def _escape_value(match: re.Match[str]) -> str:
+    value = match.group()
+    body = _LONE_AMPERSAND.sub("&amp;", value[1:])
+    return value[0] + _SPECIAL_IN_VALUE.sub(lambda special: _VALUE_ESCAPES[special.group()], body)
 
 
 def _restore_newlines(root: etree._Element) -> None:
