@@ -1,0 +1,100 @@
+"""``kinema run`` and ``kinema down``: start a Kinema instance (router, agent, drivers) and stop it."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import click
+
+from kinema.cli.options import selection_options
+
+
+@click.command()
+@selection_options
+@click.option(
+    "-n", "--no-drivers", is_flag=True, help="Start only the agent (drivers run elsewhere on the network)."
+)
+@click.option("-o", "--only-drivers", is_flag=True, help="Start only the drivers (the agent runs elsewhere).")
+@click.option(
+    "--headless",
+    is_flag=True,
+    help="No terminal UI. The TUI is not available yet, so every run is headless for now.",
+)
+@click.option("-v", "--verbose", is_flag=True, help="Log at DEBUG level and echo the supervisor's log here.")
+@click.option("--no-browser", is_flag=True, help="Do not open the 3D view in a browser.")
+@click.option("-l", "--list", "list_configs", is_flag=True, help="List the config packages and exit.")
+@click.option(
+    "--connect",
+    default=None,
+    metavar="ENDPOINT",
+    help="Router endpoint to host or join (default: $KINEMA_ZENOH_CONNECT, else tcp/127.0.0.1:7447).",
+)
+@click.option("--tick-rate", type=float, default=100.0, show_default=True, help="Objective ticks per second.")
+def run(
+    workspace: Path | None,
+    config: str | None,
+    no_drivers: bool,
+    only_drivers: bool,
+    headless: bool,
+    verbose: bool,
+    no_browser: bool,
+    list_configs: bool,
+    connect: str | None,
+    tick_rate: float,
+) -> None:
+    """Start Kinema: host the zenoh router (or join one), the agent and the config's drivers.
+
+    Prints one line once objectives can be started, writes every process's log to a per-run folder
+    (see `kinema logs`), and blocks until Ctrl-C or `kinema down`.
+    """
+    from kinema.cli.options import resolve_selection
+
+    if list_configs:
+        _list_configs(workspace)
+        return
+    if no_drivers and only_drivers:
+        raise click.UsageError("-n/--no-drivers and -o/--only-drivers exclude each other")
+    found, name = resolve_selection(workspace, config)
+    from kinema.runtime.launcher import Launcher, LaunchOptions
+
+    if not headless:
+        click.echo("the terminal UI is not available yet: running headless")
+    root = getattr(found, "root", None)
+    options = LaunchOptions(
+        config=name,
+        workspace=Path(root) if root is not None else None,
+        agent=not only_drivers,
+        drivers=not no_drivers,
+        endpoint=connect,
+        verbose=verbose,
+        tick_rate_hz=tick_rate,
+        echo=click.echo,
+    )
+    code = Launcher(options).run()
+    if code:
+        raise click.exceptions.Exit(code)
+
+
+def _list_configs(workspace: Path | None) -> None:
+    from kinema.config import Workspace, list_config_packages
+
+    packages = list_config_packages(Workspace.discover(workspace))
+    if not packages:
+        click.echo("no config packages")
+        return
+    width = max(len(package.name) for package in packages)
+    for package in packages:
+        click.echo(f"{package.name:<{width}}  {package.path}")
+
+
+@click.command()
+@click.option(
+    "--timeout", type=float, default=15.0, show_default=True, help="Seconds to wait for a clean stop."
+)
+def down(timeout: float) -> None:
+    """Stop the running Kinema instance (its agent, drivers and router), cleanly."""
+    from kinema.runtime.instance import stop_all
+
+    for record, clean in stop_all(timeout=timeout):
+        how = "stopped" if clean else "killed (it did not stop in time)"
+        click.echo(f"{how} kinema run (pid {record.pid}, config {record.config or '-'})")

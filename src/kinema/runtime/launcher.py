@@ -1,0 +1,322 @@
+"""``kinema run``'s supervisor: host (or join) the router, start the agent and the drivers, stop them all.
+
+Process layout: the supervisor (the ``kinema run`` process) hosts the zenoh router and watches its
+children; the agent and each driver run in processes of their own. The agent is a child rather than a
+thread of the supervisor so that its 100 Hz tick thread never competes for the GIL with a UI running in
+the supervisor (the TUI), so a crashing behavior cannot take the router (and every client's connection)
+down with it, and so ``kinema down`` can stop it like any other process. Children get a parent-death
+signal, so even a supervisor killed with SIGKILL leaves no orphans behind.
+
+A UI plugs in through :attr:`LaunchOptions.ui`: a callable that receives the started :class:`Launcher`
+(its ``session``, ``endpoint``, ``run_folder``) and runs in the main thread until the user quits; without
+one the supervisor blocks until Ctrl-C, SIGTERM (``kinema down``) or a child dies.
+"""
+
+from __future__ import annotations
+
+import importlib.util
+import logging
+import os
+import signal
+import subprocess
+import sys
+import threading
+import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from kinema.errors import KinemaError
+from kinema.runtime.instance import InstanceRecord
+from kinema.runtime.run_folder import RunFolder
+
+if TYPE_CHECKING:
+    from kinema.transport import Session
+
+log = logging.getLogger("kinema.supervisor")
+
+AGENT_READY_TIMEOUT_S = 120.0
+STOP_GRACE_S = 5.0
+
+
+@dataclass
+class LaunchOptions:
+    """What ``kinema run`` starts.
+
+    Attributes:
+        config: the config package name.
+        workspace: the workspace root (None: only bundled packages).
+        agent: start the agent (False with ``-o/--only-drivers``).
+        drivers: start the config's drivers (False with ``-n/--no-drivers``).
+        endpoint: the router endpoint to host or join (None: ``KINEMA_ZENOH_CONNECT`` or 7447).
+        verbose: DEBUG logs, echoed to the terminal.
+        tick_rate_hz: the agent's tick rate.
+        ui: runs in the main thread once everything started (the TUI); returns an exit code.
+        echo: print progress lines (the CLI); tests turn it off.
+    """
+
+    config: str
+    workspace: Path | None = None
+    agent: bool = True
+    drivers: bool = True
+    endpoint: str | None = None
+    verbose: bool = False
+    tick_rate_hz: float = 100.0
+    ui: Callable[[Launcher], int] | None = None
+    echo: Callable[[str], None] = field(default=print)
+
+
+@dataclass
+class Child:
+    """A process the supervisor started."""
+
+    name: str
+    process: subprocess.Popen[bytes]
+    log_file: Path
+
+
+def _die_with_parent() -> None:
+    """In the child, before exec: get SIGTERM when the supervisor dies (Linux; a no-op elsewhere)."""
+    try:
+        import ctypes
+
+        libc = ctypes.CDLL("libc.so.6", use_errno=True)
+        pr_set_pdeathsig = 1
+        libc.prctl(pr_set_pdeathsig, signal.SIGTERM)
+    except OSError:
+        pass
+
+
+class Launcher:
+    """Starts and supervises one Kinema instance (see the module docstring)."""
+
+    def __init__(self, options: LaunchOptions) -> None:
+        self.options = options
+        self.session: Session | None = None
+        self.endpoint = ""
+        self.hosting = False
+        self.run_folder: RunFolder | None = None
+        self.children: list[Child] = []
+        self.record: InstanceRecord | None = None
+        self._stop = threading.Event()
+        self._stop_reason = ""
+
+    # -- start --------------------------------------------------------------------------------------
+
+    def start(self) -> None:
+        """Start the router, the drivers and the agent; returns when objectives can be started.
+
+        Raises:
+            KinemaError: the router cannot be hosted or joined, or the agent failed to start (the message
+                carries the end of its log).
+        """
+        from kinema.runtime.log_files import configure_process_logging
+        from kinema.transport import host_or_join, resolve_endpoints
+
+        options = self.options
+        self.run_folder = RunFolder.create(options.config)
+        supervisor_log = self.run_folder.log_file("supervisor")
+        configure_process_logging(supervisor_log, verbose=options.verbose, echo=options.verbose)
+        self.endpoint = options.endpoint or resolve_endpoints(None)[0]
+        try:
+            self.session = host_or_join(self.endpoint)
+            self.hosting = self.session.is_router
+            log.info("%s the router at %s", "hosting" if self.hosting else "joined", self.endpoint)
+            self.record = InstanceRecord(
+                os.getpid(), self.endpoint, str(self.run_folder.path), options.config
+            )
+            self.record.save()
+            clock = "auto"
+            if options.drivers:
+                started = self._start_drivers()
+                if not started and options.agent:
+                    clock = "wall"  # no simulator will publish /clock: time must not freeze
+            if options.agent:
+                self._start_agent(clock)
+        except BaseException:
+            self.stop()
+            raise
+
+    def _resolved(self) -> Any:
+        from kinema.config import Workspace, resolve_config
+
+        workspace = Workspace.discover(self.options.workspace) if self.options.workspace else None
+        return resolve_config(self.options.config, workspace)
+
+    def _start_drivers(self) -> bool:
+        from kinema.drivers.registry import drivers_for_config
+
+        specs = drivers_for_config(self._resolved())
+        if not specs:
+            self.options.echo(f"config {self.options.config!r} needs no driver")
+            return False
+        started = False
+        for spec in specs:
+            if not _runnable_module(spec.module):
+                self.options.echo(
+                    f"driver {spec.name!r} ({spec.description}) is not available yet: not started"
+                )
+                log.warning("driver %s: module %s has no __main__; not started", spec.name, spec.module)
+                continue
+            assert self.run_folder is not None
+            log_file = self.run_folder.log_file(spec.name)
+            argv = spec.command(
+                config=self.options.config,
+                connect=self.endpoint,
+                workspace=self.options.workspace,
+                log_file=log_file,
+                verbose=self.options.verbose,
+            )
+            self._spawn(spec.name, argv, log_file)
+            self.options.echo(f"driver {spec.name!r} started ({spec.description})")
+            started = True
+        return started
+
+    def _start_agent(self, clock: str) -> None:
+        assert self.run_folder is not None
+        log_file = self.run_folder.log_file("agent")
+        read_fd, write_fd = os.pipe()
+        argv = [
+            sys.executable,
+            "-m",
+            "kinema.runtime.agent_process",
+            "--config",
+            self.options.config,
+            "--connect",
+            self.endpoint,
+            "--log-file",
+            str(log_file),
+            "--ready-fd",
+            str(write_fd),
+            "--tick-rate",
+            str(self.options.tick_rate_hz),
+            "--clock",
+            clock,
+        ]
+        if self.options.workspace is not None:
+            argv += ["--workspace", str(self.options.workspace)]
+        if self.options.verbose:
+            argv.append("--verbose")
+        try:
+            child = self._spawn("agent", argv, log_file, pass_fds=(write_fd,))
+        finally:
+            os.close(write_fd)
+        with os.fdopen(read_fd, "r") as ready:
+            if not _wait_ready(ready, child.process, AGENT_READY_TIMEOUT_S, self._stop):
+                if self._stop.is_set():
+                    raise KinemaError(f"interrupted ({self._stop_reason}) while the agent was starting")
+                tail = _tail(log_file, 8)
+                raise KinemaError(
+                    f"the agent did not start (exit code {child.process.poll()}); end of {log_file}:\n{tail}"
+                )
+
+    def _spawn(self, name: str, argv: list[str], log_file: Path, pass_fds: tuple[int, ...] = ()) -> Child:
+        log.info("starting %s: %s", name, " ".join(argv))
+        with open(log_file, "ab") as output:
+            process = subprocess.Popen(
+                argv,
+                stdin=subprocess.DEVNULL,
+                stdout=output,
+                stderr=subprocess.STDOUT,
+                pass_fds=pass_fds,
+                preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
+            )
+        child = Child(name, process, log_file)
+        self.children.append(child)
+        if self.record is not None:
+            self.record.children.append(process.pid)
+            self.record.save()
+        return child
+
+    # -- run and stop -----------------------------------------------------------------------------------
+
+    def request_stop(self, reason: str = "") -> None:
+        """Ask :meth:`wait` to return (signal handlers call this)."""
+        self._stop_reason = self._stop_reason or reason
+        self._stop.set()
+
+    def wait(self) -> int:
+        """Block until a stop is requested or a child exits; return the exit code for the CLI."""
+        while not self._stop.wait(0.2):
+            for child in self.children:
+                code = child.process.poll()
+                if code is not None:
+                    log.error("%s exited with code %s", child.name, code)
+                    self.options.echo(
+                        f"{child.name} exited unexpectedly (code {code}); see {child.log_file}; stopping"
+                    )
+                    return 1
+        log.info("stopping (%s)", self._stop_reason or "requested")
+        return 0
+
+    def stop(self) -> None:
+        """Stop the children (SIGTERM, SIGKILL after a grace period), close the router, drop the record."""
+        for child in reversed(self.children):
+            if child.process.poll() is None:
+                child.process.terminate()
+        deadline = time.monotonic() + STOP_GRACE_S
+        for child in reversed(self.children):
+            try:
+                child.process.wait(max(0.0, deadline - time.monotonic()))
+            except subprocess.TimeoutExpired:
+                log.warning("%s did not stop within %.0f s; killing it", child.name, STOP_GRACE_S)
+                child.process.kill()
+                child.process.wait(2.0)
+        self.children.clear()
+        if self.session is not None:
+            self.session.close()
+            self.session = None
+        if self.record is not None:
+            self.record.remove()
+            self.record = None
+
+    def run(self) -> int:
+        """Start, block (or run the UI), stop; SIGINT and SIGTERM stop cleanly. Returns the exit code."""
+        previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
+        signal.signal(signal.SIGTERM, lambda *_: self.request_stop("SIGTERM"))
+        signal.signal(signal.SIGINT, lambda *_: self.request_stop("Ctrl-C"))
+        try:
+            self.start()
+            assert self.run_folder is not None
+            role = "hosting the router" if self.hosting else "joined the router"
+            self.options.echo(
+                f"Kinema is running: objectives can be started (config {self.options.config}, {role} at "
+                f"{self.endpoint}, logs in {self.run_folder.path}). Stop with Ctrl-C or `kinema down`."
+            )
+            if self.options.ui is not None:
+                return self.options.ui(self)
+            return self.wait()
+        finally:
+            self.stop()
+            for sig, handler in previous.items():
+                signal.signal(sig, handler)
+
+
+def _runnable_module(module: str) -> bool:
+    """True when ``python -m module`` would run (the package exists and has a ``__main__``)."""
+    try:
+        return importlib.util.find_spec(f"{module}.__main__") is not None
+    except ModuleNotFoundError:
+        return False
+
+
+def _wait_ready(stream: Any, process: subprocess.Popen[bytes], timeout: float, stop: threading.Event) -> bool:
+    """Wait for the child's ``ready`` line; False when it exits, times out or a stop is requested."""
+    import select
+
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and not stop.is_set():
+        readable, _, _ = select.select([stream], [], [], 0.1)
+        if readable:
+            return stream.readline().strip() == "ready"
+        if process.poll() is not None:
+            return False
+    return False
+
+
+def _tail(path: Path, lines: int) -> str:
+    try:
+        return "\n".join(path.read_text(encoding="utf-8", errors="replace").splitlines()[-lines:])
+    except OSError:
+        return "(no log)"
