@@ -18,32 +18,58 @@ from kinema.scaffold.behavior_package import BEHAVIOR_TYPES, behavior_id_for, ne
 from kinema.testing import load_behavior_package
 
 
-def _run_package_tests(package_dir: Path) -> subprocess.CompletedProcess[str]:
+def _start_package_tests(package_dir: Path) -> subprocess.Popen[str]:
     env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
-    return subprocess.run(
+    return subprocess.Popen(
         [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:randomly"],
         cwd=package_dir,
-        capture_output=True,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
         text=True,
-        timeout=180,
         env=env,
     )
 
 
+def _run_package_tests(package_dir: Path) -> tuple[int, str]:
+    process = _start_package_tests(package_dir)
+    output, _ = process.communicate(timeout=180)
+    return process.returncode, output
+
+
+@pytest.fixture(scope="module")
+def baked(tmp_path_factory: pytest.TempPathFactory) -> dict[str, tuple[Path, str, int, str]]:
+    """Every type baked into one workspace; their test runs started together (they mostly wait on I/O)."""
+    workspace = tmp_path_factory.mktemp("templates") / "ws"
+    (workspace / "src").mkdir(parents=True)
+    packages = {}
+    for behavior_type in BEHAVIOR_TYPES:
+        name = f"my_{behavior_type}"
+        result = new_behavior(name, behavior_type, workspace=Workspace.discover(workspace))
+        packages[behavior_type] = (result.package_dir, result.behavior_id)
+    processes = {kind: _start_package_tests(folder) for kind, (folder, _) in packages.items()}
+    outcomes = {}
+    try:
+        for kind, process in processes.items():
+            output, _ = process.communicate(timeout=300)
+            outcomes[kind] = (*packages[kind], process.returncode, output)
+    finally:
+        for process in processes.values():
+            if process.poll() is None:
+                process.kill()
+    return outcomes
+
+
 @pytest.mark.parametrize("behavior_type", BEHAVIOR_TYPES)
-def test_each_type_bakes_into_a_package_whose_tests_pass(workspace: Path, behavior_type: str) -> None:
+def test_each_type_bakes_into_a_package_whose_tests_pass(baked, behavior_type: str) -> None:
+    package_dir, behavior_id, returncode, output = baked[behavior_type]
     name = f"my_{behavior_type}"
-    result = new_behavior(name, behavior_type, workspace=Workspace.discover(workspace))
-    package_dir = workspace / "src" / name
-    assert result.created_package and result.package_dir == package_dir
-    assert result.behavior_id == behavior_id_for(name)
+    assert package_dir.name == name and behavior_id == behavior_id_for(name)
     for relative in ("pyproject.toml", f"{name}/__init__.py", f"{name}/{name}.py", f"objectives/{name}.xml"):
         assert (package_dir / relative).is_file(), relative
-    assert list(load_behavior_package(package_dir)) == [result.behavior_id]
+    assert list(load_behavior_package(package_dir)) == [behavior_id]
 
-    outcome = _run_package_tests(package_dir)
-    assert outcome.returncode == 0, outcome.stdout + outcome.stderr
-    assert " passed" in outcome.stdout and "failed" not in outcome.stdout
+    assert returncode == 0, output
+    assert " passed" in output and "failed" not in output
 
     if shutil.which("ruff"):
         lint = subprocess.run(
@@ -65,9 +91,9 @@ def test_a_behavior_added_to_a_package_is_registered_and_tested(workspace: Path)
     assert added.loader_name == "adders::AddersBehaviorsLoader"
     assert (package_dir / "adders" / "add_client.py").is_file()
     assert sorted(load_behavior_package(package_dir)) == ["AddClient", "Adders"]
-    outcome = _run_package_tests(package_dir)
-    assert outcome.returncode == 0, outcome.stdout + outcome.stderr
-    assert "6 passed" in outcome.stdout
+    returncode, output = _run_package_tests(package_dir)
+    assert returncode == 0, output
+    assert "6 passed" in output
 
 
 @pytest.mark.parametrize(
