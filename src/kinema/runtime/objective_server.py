@@ -38,6 +38,9 @@ DEFAULT_TICK_RATE_HZ = 100.0
 # An objective sent as a string larger than this is refused before parsing: a tree this large is a
 # mistake or an attack, and parsing it would stall the tick thread.
 MAX_OBJECTIVE_XML_BYTES = 2 * 1024 * 1024
+# How long the status stays Success/Failure/Cancelled after a run before it returns to Idle, so that
+# pollers of the heartbeat see how the run ended.
+RESULT_HOLD_S = 2.0
 # Blackboard snapshots are taken at most this often while a tree runs.
 BLACKBOARD_SNAPSHOT_PERIOD_S = 0.1
 
@@ -208,6 +211,7 @@ class ObjectiveServer:
         tick_rate_hz: ticks per second while an objective runs (100 Hz, as MoveIt Pro's server).
         listeners: receive status, node status changes, blackboard snapshots and results.
         blackboard_period_s: the minimum time between two blackboard snapshots (0 disables them).
+        result_hold_s: how long a run's final status is shown before the server reports Idle again.
     """
 
     def __init__(
@@ -217,6 +221,7 @@ class ObjectiveServer:
         tick_rate_hz: float = DEFAULT_TICK_RATE_HZ,
         listeners: Sequence[ServerListener] = (),
         blackboard_period_s: float = BLACKBOARD_SNAPSHOT_PERIOD_S,
+        result_hold_s: float = RESULT_HOLD_S,
     ) -> None:
         if tick_rate_hz <= 0:
             raise KinemaError(f"the tick rate must be positive, got {tick_rate_hz} Hz")
@@ -241,6 +246,8 @@ class ObjectiveServer:
         self._notes_lock = threading.Lock()
         # Read by any thread (a consistent pair, replaced atomically):
         self._status: tuple[ObjectiveStatus, str] = (ObjectiveStatus.IDLE, "")
+        self._result_hold = result_hold_s
+        self._ended_at: float | None = None
 
     # -- lifecycle --------------------------------------------------------------------------------
 
@@ -350,7 +357,12 @@ class ObjectiveServer:
         next_tick = time.monotonic()
         while True:
             with self._wake:
-                timeout = None if self._tree is None else max(0.0, next_tick - time.monotonic())
+                if self._tree is not None:
+                    timeout: float | None = max(0.0, next_tick - time.monotonic())
+                elif self._ended_at is not None:
+                    timeout = max(0.0, self._ended_at + self._result_hold - time.monotonic())
+                else:
+                    timeout = None
                 if not self._woken and not self._stopping and (timeout is None or timeout > 0):
                     self._wake.wait(timeout)
                 self._woken = False
@@ -367,6 +379,13 @@ class ObjectiveServer:
             if start is not None:
                 self._load(start)
                 next_tick = time.monotonic()
+            elif (
+                self._tree is None
+                and self._ended_at is not None
+                and time.monotonic() >= self._ended_at + self._result_hold
+            ):
+                self._ended_at = None
+                self._set_status(ObjectiveStatus.IDLE, self._status[1])
             if self._tree is not None and (tick_now or time.monotonic() >= next_tick - 1e-4):
                 next_tick += self._period
                 now = time.monotonic()
@@ -521,6 +540,7 @@ class ObjectiveServer:
     def _end(self, run: ObjectiveRun, result: ObjectiveResult, status: ObjectiveStatus) -> None:
         self._tree = None
         self._run = None
+        self._ended_at = time.monotonic()
         self._set_status(status, run.objective_name)
         if run._finish(result):
             for listener in self._listeners:

@@ -257,3 +257,18 @@ def test_stopping_preempts_the_running_objective(recorder: Recorder) -> None:
     server.stop()
     result = run.result
     assert result is not None and result.cancelled
+
+
+def test_the_final_status_is_held_then_the_server_reports_idle(recorder: Recorder) -> None:
+    factory = BehaviorTreeFactory()
+    factory.register_behavior_tree_from_text(LIBRARY)
+    with ObjectiveServer(FactoryTreeSource(factory), listeners=[recorder], result_hold_s=0.05) as server:
+        server.submit(ObjectiveRequest("Quick")).wait(5)
+        _wait_status(server, ObjectiveStatus.IDLE)
+    assert [s for s, _ in recorder.statuses] == [
+        ObjectiveStatus.LOADING,
+        ObjectiveStatus.RUNNING,
+        ObjectiveStatus.SUCCESS,
+        ObjectiveStatus.IDLE,
+    ]
+    assert recorder.statuses[-1] == (ObjectiveStatus.IDLE, "Quick")
