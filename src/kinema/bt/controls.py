@@ -194,8 +194,13 @@ class ReactiveSequenceNode(ControlNode):
         children = self.children
         for index, child in enumerate(children):
             status = child.execute_tick()
-            if status is not SKIPPED:
+            if status is SUCCESS:
                 all_skipped = False
+                continue
+            if status is SKIPPED:
+                self.halt_child(index)
+                continue
+            all_skipped = False
             if status is RUNNING:
                 for i in range(len(children)):
                     if i != index:
@@ -206,10 +211,7 @@ class ReactiveSequenceNode(ControlNode):
             if status is FAILURE:
                 self.reset_children()
                 return FAILURE
-            if status is SKIPPED:
-                self.halt_child(index)
-            elif status is not SUCCESS:
-                raise _idle_child(self)
+            raise _idle_child(self)
         self.reset_children()
         return SKIPPED if all_skipped else SUCCESS
 

@@ -246,6 +246,13 @@ class Tree:
 
     halt = halt_tree
 
+    def __enter__(self) -> Tree:
+        return self
+
+    def __exit__(self, *exc_info: object) -> None:
+        # BT.CPP's Tree destructor halts the tree; a with-block gives Python code the same guarantee.
+        self.halt_tree()
+
     # -- observers -------------------------------------------------------------------------------
 
     def add_status_observer(self, callback: StatusObserver) -> int:

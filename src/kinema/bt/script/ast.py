@@ -386,7 +386,13 @@ class Assignment(Expr):
                 temp = dst + value
             else:
                 raise EvalError("Operation not permitted")
-            new = temp if type(temp) is type(dst) else copy_into(temp, dst)
+            dst_type = type(dst)
+            if dst_type is type(temp):
+                new = temp
+            elif dst_type is int and temp.__class__ is float and temp.is_integer():
+                new = int(temp)  # the common `counter += 1` on an int entry
+            else:
+                new = copy_into(temp, dst)
         entry.value = new
         bb.notify_written(key, entry)
         return new

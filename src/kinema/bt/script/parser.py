@@ -189,8 +189,11 @@ class Script:
             ScriptError: "Error in script [<code>]" followed by what went wrong.
         """
         try:
+            statements = self.statements
+            if len(statements) == 1:
+                return statements[0].evaluate(blackboard, enums)
             value = None
-            for statement in self.statements:
+            for statement in statements:
                 value = statement.evaluate(blackboard, enums)
             return value
         except ScriptError:
