@@ -41,7 +41,9 @@ def _dependencies(package: str) -> list[str]:
         elif kind in (Nodetype.ARRAY, Nodetype.SEQUENCE):
             visit(rest[0])
 
-    for name, (_, fields) in load_interfaces().typestore.fielddefs.items():
+    registry = load_interfaces()
+    registry.load_all()
+    for name, (_, fields) in registry.typestore.fielddefs.items():
         if name.split("/", 1)[0] == package:
             for _, desc in fields:
                 visit(desc)

@@ -108,10 +108,102 @@ def _parse_struct(text: str, package: str, name: str, path: str) -> tuple[list[A
     return constants, fields
 
 
-class TypeRegistry:
-    """All interface types Kinema knows, registered once in a rosbags Typestore.
+@dataclass
+class _Parsed:
+    """Message definitions parsed from interface files, before registration."""
 
-    Thread-safe for lookups; ``add_directory`` may be called while nodes run (it only adds types).
+    pending: dict[str, tuple[list[Any], list[Any]]]
+    services: list[tuple[str, str]]
+    actions: list[tuple[str, str]]
+
+    def packages_used(self) -> set[str]:
+        """Packages the parsed definitions refer to (actions also need action_msgs' CancelGoal)."""
+        used: set[str] = set()
+
+        def visit(desc: Any) -> None:
+            kind, rest = desc
+            if kind == Nodetype.NAME:
+                used.add(rest.split("/", 1)[0])
+            elif kind in (Nodetype.ARRAY, Nodetype.SEQUENCE):
+                visit(rest[0])
+
+        for _, fields in self.pending.values():
+            for _, desc in fields:
+                visit(desc)
+        if self.actions:
+            used.add("action_msgs")
+        return used
+
+
+def _parse_files(files: Iterable[Path]) -> _Parsed:
+    pending: dict[str, tuple[list[Any], list[Any]]] = {}
+    services: list[tuple[str, str]] = []
+    actions: list[tuple[str, str]] = []
+    for path in files:
+        package, kind, name = path.parent.parent.name, path.parent.name, path.stem
+        text = path.read_text(encoding="utf-8")
+        if kind == "msg":
+            pending[f"{package}/msg/{name}"] = _parse_struct(text, package, name, str(path))
+        elif kind == "srv":
+            request, response = _split_sections(text, 2, str(path))
+            pending[f"{package}/srv/{name}_Request"] = _parse_struct(
+                request, package, f"{name}_Request", str(path)
+            )
+            pending[f"{package}/srv/{name}_Response"] = _parse_struct(
+                response, package, f"{name}_Response", str(path)
+            )
+            services.append((package, name))
+        else:
+            goal, result, feedback = _split_sections(text, 3, str(path))
+            base = f"{package}/action/{name}"
+            pending[f"{base}_Goal"] = _parse_struct(goal, package, f"{name}_Goal", str(path))
+            pending[f"{base}_Result"] = _parse_struct(result, package, f"{name}_Result", str(path))
+            pending[f"{base}_Feedback"] = _parse_struct(feedback, package, f"{name}_Feedback", str(path))
+            pending[f"{base}_SendGoal_Request"] = (
+                [],
+                [("goal_id", (Nodetype.NAME, _UUID)), ("goal", (Nodetype.NAME, f"{base}_Goal"))],
+            )
+            pending[f"{base}_SendGoal_Response"] = (
+                [],
+                [("accepted", (Nodetype.BASE, ("bool", 0))), ("stamp", (Nodetype.NAME, _TIME))],
+            )
+            pending[f"{base}_GetResult_Request"] = ([], [("goal_id", (Nodetype.NAME, _UUID))])
+            pending[f"{base}_GetResult_Response"] = (
+                [],
+                [("status", (Nodetype.BASE, ("int8", 0))), ("result", (Nodetype.NAME, f"{base}_Result"))],
+            )
+            pending[f"{base}_FeedbackMessage"] = (
+                [],
+                [("goal_id", (Nodetype.NAME, _UUID)), ("feedback", (Nodetype.NAME, f"{base}_Feedback"))],
+            )
+            actions.append((package, name))
+    # A bare reference inside a .srv/.action (``GripperCommand command``) was resolved to pkg/msg/*;
+    # the parts of the service or action itself live under pkg/srv/* and pkg/action/*.
+    renames = {
+        f"{p}/msg/{n}{suffix}": f"{p}/action/{n}{suffix}"
+        for p, n in actions
+        for suffix in ("_Goal", "_Result", "_Feedback")
+    }
+    renames.update(
+        {
+            f"{p}/msg/{n}{suffix}": f"{p}/srv/{n}{suffix}"
+            for p, n in services
+            for suffix in ("_Request", "_Response")
+        }
+    )
+    renamed = {
+        name: (constants, [(field, _rename(desc, renames)) for field, desc in fields])
+        for name, (constants, fields) in pending.items()
+    }
+    return _Parsed(renamed, services, actions)
+
+
+class TypeRegistry:
+    """All interface types Kinema knows, registered in a rosbags Typestore.
+
+    Packages added with :meth:`add_directory` are parsed and registered the first time one of their
+    types (or a type that refers to them) is looked up, so a process pays only for what it uses.
+    Thread-safe; packages may be added while nodes run.
     """
 
     def __init__(self) -> None:
@@ -122,85 +214,80 @@ class TypeRegistry:
         # Synthetic wrappers used only for hashing (service and action description structs).
         self._hash_only: dict[str, tuple[list[Any], list[Any]]] = {}
         self._hashes: dict[str, str] = {}
+        # package -> interface files not parsed yet
+        self._unloaded: dict[str, list[Path]] = {}
 
     # -- loading ---------------------------------------------------------------------------------
 
     def add_directory(self, root: Path) -> None:
-        """Register every ``<pkg>/{msg,srv,action}/*.{msg,srv,action}`` file below ``root``."""
+        """Make every ``<pkg>/{msg,srv,action}/*.{msg,srv,action}`` below ``root`` available.
+
+        Files are parsed when a type of their package is first needed; :meth:`load_all` forces it.
+        """
         files = sorted(
             p for p in root.glob("*/*/*") if p.parent.name in _KINDS and p.suffix[1:] == p.parent.name
         )
-        self.add_files(files)
+        with self._lock:
+            for path in files:
+                self._unloaded.setdefault(path.parent.parent.name, []).append(path)
 
     def add_files(self, files: Iterable[Path]) -> None:
-        """Register interface files (package = the folder above ``msg``/``srv``/``action``)."""
-        pending: dict[str, tuple[list[Any], list[Any]]] = {}
-        services: list[tuple[str, str]] = []
-        actions: list[tuple[str, str]] = []
-        for path in files:
-            package, kind, name = path.parent.parent.name, path.parent.name, path.stem
-            text = path.read_text(encoding="utf-8")
-            if kind == "msg":
-                pending[f"{package}/msg/{name}"] = _parse_struct(text, package, name, str(path))
-            elif kind == "srv":
-                request, response = _split_sections(text, 2, str(path))
-                pending[f"{package}/srv/{name}_Request"] = _parse_struct(
-                    request, package, f"{name}_Request", str(path)
-                )
-                pending[f"{package}/srv/{name}_Response"] = _parse_struct(
-                    response, package, f"{name}_Response", str(path)
-                )
-                services.append((package, name))
-            else:
-                goal, result, feedback = _split_sections(text, 3, str(path))
-                base = f"{package}/action/{name}"
-                pending[f"{base}_Goal"] = _parse_struct(goal, package, f"{name}_Goal", str(path))
-                pending[f"{base}_Result"] = _parse_struct(result, package, f"{name}_Result", str(path))
-                pending[f"{base}_Feedback"] = _parse_struct(feedback, package, f"{name}_Feedback", str(path))
-                pending[f"{base}_SendGoal_Request"] = (
-                    [],
-                    [("goal_id", (Nodetype.NAME, _UUID)), ("goal", (Nodetype.NAME, f"{base}_Goal"))],
-                )
-                pending[f"{base}_SendGoal_Response"] = (
-                    [],
-                    [("accepted", (Nodetype.BASE, ("bool", 0))), ("stamp", (Nodetype.NAME, _TIME))],
-                )
-                pending[f"{base}_GetResult_Request"] = ([], [("goal_id", (Nodetype.NAME, _UUID))])
-                pending[f"{base}_GetResult_Response"] = (
-                    [],
-                    [("status", (Nodetype.BASE, ("int8", 0))), ("result", (Nodetype.NAME, f"{base}_Result"))],
-                )
-                pending[f"{base}_FeedbackMessage"] = (
-                    [],
-                    [("goal_id", (Nodetype.NAME, _UUID)), ("feedback", (Nodetype.NAME, f"{base}_Feedback"))],
-                )
-                actions.append((package, name))
+        """Parse and register interface files now (package = the folder above ``msg``/``srv``/``action``)."""
         with self._lock:
-            # A bare reference inside an action (``GripperCommand command``) was resolved to
-            # pkg/msg/*; the parts of the action itself live under pkg/action/*.
-            renames = {
-                f"{p}/msg/{n}{suffix}": f"{p}/action/{n}{suffix}"
-                for p, n in actions
-                for suffix in ("_Goal", "_Result", "_Feedback")
+            parsed = _parse_files(files)
+            for package in parsed.packages_used():
+                self._ensure_package(package)
+            self._register(parsed)
+
+    def load_all(self) -> None:
+        """Parse and register every package added so far."""
+        with self._lock:
+            for package in list(self._unloaded):
+                self._ensure_package(package)
+
+    def packages(self) -> list[str]:
+        """Interface packages Kinema added (loaded or not), without the standard ones of the store."""
+        with self._lock:
+            added = set(self._unloaded) | {n.split("/", 1)[0] for n in (*self._services, *self._actions)}
+        return sorted(added)
+
+    def _ensure_package(self, package: str) -> None:
+        """Load ``package`` and the not-yet-loaded packages it refers to, in one registration."""
+        if package not in self._unloaded:
+            return
+        with self._lock:
+            todo, batch = [package], []
+            while todo:
+                name = todo.pop()
+                files = self._unloaded.pop(name, None)
+                if files is None:
+                    continue
+                parsed = _parse_files(files)
+                batch.append(parsed)
+                todo.extend(parsed.packages_used())
+            merged = _Parsed({}, [], [])
+            for parsed in batch:
+                merged.pending.update(parsed.pending)
+                merged.services.extend(parsed.services)
+                merged.actions.extend(parsed.actions)
+            self._register(merged)
+
+    def _ensure_for(self, type_name: str) -> None:
+        if self._unloaded:
+            self._ensure_package(type_name.strip("/").split("/", 1)[0])
+
+    def _register(self, parsed: _Parsed) -> None:
+        with self._lock:
+            fresh = {
+                name: defs for name, defs in parsed.pending.items() if name not in self.typestore.fielddefs
             }
-            renames.update(
-                {
-                    f"{p}/msg/{n}{suffix}": f"{p}/srv/{n}{suffix}"
-                    for p, n in services
-                    for suffix in ("_Request", "_Response")
-                }
-            )
-            typesdict = {
-                name: (constants, [(field, _rename(desc, renames)) for field, desc in fields])
-                for name, (constants, fields) in pending.items()
-            }
-            fresh = {name: defs for name, defs in typesdict.items() if name not in self.typestore.fielddefs}
             self._check_references(fresh)
             if fresh:
                 self.typestore.register(fresh)  # type: ignore[arg-type]
-            for package, name in services:
+            # CancelGoal (in action_msgs) must be known before any action refers to it.
+            for package, name in sorted(parsed.services, key=lambda item: item[0] != "action_msgs"):
                 self._add_service(f"{package}/srv/{name}")
-            for package, name in actions:
+            for package, name in parsed.actions:
                 self._add_action(f"{package}/action/{name}")
 
     def _check_references(self, typesdict: dict[str, tuple[list[Any], list[Any]]]) -> None:
@@ -289,6 +376,7 @@ class TypeRegistry:
 
     def type_hash(self, type_name: str) -> str:
         """RIHS01 hash of a message, or of a service/action (their wrapper description)."""
+        self._ensure_for(type_name)
         with self._lock:
             cached = self._hashes.get(type_name)
             if cached is None:
@@ -302,6 +390,7 @@ class TypeRegistry:
 
     def names(self, kind: str | None = None) -> list[str]:
         """Names of the known interfaces, optionally only one kind (``msg``, ``srv``, ``action``)."""
+        self.load_all()
         with self._lock:
             messages = [n for n in self.typestore.fielddefs if "/msg/" in n]
             by_kind = {"msg": messages, "srv": list(self._services), "action": list(self._actions)}
@@ -313,6 +402,7 @@ class TypeRegistry:
         """Normalise and check a message type name (``pkg/Name`` → ``pkg/msg/Name``)."""
         package, kind, name = split_type_name(type_name)
         full = f"{package}/{kind}/{name}"
+        self._ensure_for(full)
         if full not in self.typestore.fielddefs:
             raise TransportError(
                 f"unknown message type {type_name!r} ({did_you_mean(full, self.names('msg'))})"
@@ -327,6 +417,7 @@ class TypeRegistry:
         """Look up a service type (``pkg/srv/Name``)."""
         package, kind, name = split_type_name(type_name)
         full = f"{package}/{kind}/{name}"
+        self._ensure_for(full)
         with self._lock:
             found = self._services.get(full)
         if found is None:
@@ -339,6 +430,7 @@ class TypeRegistry:
         """Look up an action type (``pkg/action/Name``)."""
         package, kind, name = split_type_name(type_name)
         full = f"{package}/{kind}/{name}"
+        self._ensure_for(full)
         with self._lock:
             found = self._actions.get(full)
         if found is None:
@@ -346,6 +438,10 @@ class TypeRegistry:
                 f"unknown action type {type_name!r} ({did_you_mean(full, self.names('action'))})"
             )
         return found
+
+    def fields(self, type_name: str) -> list[tuple[str, Any]]:
+        """Field definitions of a message type: ``[(name, rosbags field descriptor)]``."""
+        return list(self.typestore.fielddefs[self.message_type(type_name)][1])
 
     def constants(self, type_name: str) -> list[tuple[str, str, Any]]:
         """Constants declared by a message type: ``[(name, base type, value)]``."""
@@ -355,6 +451,7 @@ class TypeRegistry:
 
     def serialize(self, message: object, type_name: str) -> bytes:
         """CDR (little endian, with the 4-byte encapsulation header) of ``message``."""
+        self._ensure_for(type_name)
         try:
             return bytes(self.typestore.serialize_cdr(message, type_name, little_endian=True))
         except Exception as error:
@@ -364,6 +461,7 @@ class TypeRegistry:
 
     def deserialize(self, data: bytes | memoryview, type_name: str) -> Any:
         """Decode CDR bytes of ``type_name`` into its rosbags dataclass."""
+        self._ensure_for(type_name)
         try:
             return self.typestore.deserialize_cdr(data, type_name)
         except Exception as error:

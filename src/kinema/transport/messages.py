@@ -59,11 +59,7 @@ def _registry(registry: TypeRegistry | None) -> TypeRegistry:
 
 
 def _fields(registry: TypeRegistry, type_name: str) -> list[tuple[str, Any]]:
-    defs = registry.typestore.fielddefs.get(type_name)
-    if defs is None:
-        registry.message_type(type_name)  # raises with the valid alternatives
-        raise AssertionError("unreachable")
-    return list(defs[1])
+    return registry.fields(type_name)
 
 
 def _base_default(base: str) -> Any:

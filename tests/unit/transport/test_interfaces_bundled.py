@@ -2,11 +2,11 @@
 
 from __future__ import annotations
 
-from kinema.interfaces import interfaces_dir, load_interfaces
+from kinema.interfaces import TypeRegistry, interfaces_dir, load_interfaces
 
 
 def _fields(type_name: str) -> list[str]:
-    return [name for name, _ in load_interfaces().typestore.fielddefs[type_name][1]]
+    return [name for name, _ in load_interfaces().fields(type_name)]
 
 
 def test_sdk_interfaces_have_moveit_pro_fields() -> None:
@@ -79,3 +79,14 @@ def test_files_ship_inside_the_package() -> None:
     root = interfaces_dir()
     assert (root / "moveit_studio_sdk_msgs" / "action" / "DoObjectiveSequence.action").is_file()
     assert root.parent.name == "kinema"
+
+
+def test_packages_load_on_first_use() -> None:
+    registry = TypeRegistry()
+    registry.add_directory(interfaces_dir())
+    assert "moveit_studio_sdk_msgs/msg/RequestStatus" not in registry.typestore.fielddefs
+    execute = registry.service("moveit_studio_sdk_msgs/srv/ExecuteObjective")
+    assert execute.request in registry.typestore.fielddefs
+    assert "moveit_msgs/msg/MoveItErrorCodes" in registry.typestore.fielddefs  # a dependency
+    assert "kinema_msgs/msg/ObjectiveInfo" not in registry.typestore.fielddefs
+    assert "kinema_msgs/srv/ListObjectives" in registry.names("srv")  # listing loads everything
