@@ -253,3 +253,69 @@ def test_a_child_returning_idle_is_a_logic_error(bench) -> None:
     tree = bench.tree("<Sequence><Bad/></Sequence>")
     with pytest.raises(BTError):
         tree.tick_once()
+
+
+def test_navigation_with_recovery(bench) -> None:
+    """A realistic recovery tree (after BT.CPP's navigation_test), with tick-based nodes."""
+    from collections import Counter
+
+    from kinema.bt import ConditionNode, StatefulActionNode, SyncActionNode
+
+    stuck = {"value": False}
+    ticks: Counter[str] = Counter()
+    halted: list[str] = []
+
+    class IsStuck(ConditionNode):
+        def tick(self) -> NodeStatus:
+            ticks[self.name] += 1
+            return S if stuck["value"] else F
+
+    class Instant(SyncActionNode):
+        def tick(self) -> NodeStatus:
+            ticks[self.name] += 1
+            return S
+
+    class FollowPath(StatefulActionNode):
+        def on_start(self) -> NodeStatus:
+            ticks[self.name] += 1
+            self.left = 3
+            return R
+
+        def on_running(self) -> NodeStatus:
+            self.left -= 1
+            return S if self.left == 0 else R
+
+        def on_halted(self) -> None:
+            halted.append(self.name)
+
+    for cls in (IsStuck, FollowPath):
+        bench.factory.register_node_type(cls, cls.__name__)
+    bench.factory.register_node_type(Instant, "ComputePathToPose")
+    bench.factory.register_node_type(Instant, "BackUpAndSpin")
+    xml = """
+        <Fallback name="root">
+            <ReactiveSequence name="navigation_subtree">
+                <Inverter><Condition ID="IsStuck" name="stuck_1"/></Inverter>
+                <SequenceWithMemory name="navigate">
+                    <Action ID="ComputePathToPose" name="compute"/>
+                    <Action ID="FollowPath" name="follow"/>
+                </SequenceWithMemory>
+            </ReactiveSequence>
+            <SequenceWithMemory name="stuck_recovery">
+                <Condition ID="IsStuck" name="stuck_2"/>
+                <Action ID="BackUpAndSpin" name="backup"/>
+            </SequenceWithMemory>
+        </Fallback>"""
+    tree = bench.tree(xml)
+    statuses = [tree.tick_once() for _ in range(4)]
+    assert statuses == [R, R, R, S]
+    # SequenceWithMemory yields after "compute", so the first tick_once re-ticks the reactive condition
+    assert ticks == Counter({"stuck_1": 5, "compute": 1, "follow": 1})
+    assert halted == []
+
+    ticks.clear()
+    assert tree.tick_once() is R
+    stuck["value"] = True
+    assert tree.tick_once() is S
+    assert ticks == Counter({"stuck_1": 3, "compute": 1, "follow": 1, "stuck_2": 1, "backup": 1})
+    assert halted == ["follow"]
