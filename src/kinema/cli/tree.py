@@ -10,13 +10,37 @@ from typing import TYPE_CHECKING, Any
 import click
 
 if TYPE_CHECKING:
-    from kinema.bt import NodeStatus, TreeNode
+    from kinema.bt import BehaviorTreeFactory, NodeStatus, TreeNode
 
 _COLORS = {"SUCCESS": "green", "FAILURE": "red", "RUNNING": "yellow", "SKIPPED": "blue", "IDLE": "cyan"}
 
 
 def _styled(status: NodeStatus, color: bool) -> str:
     return click.style(status.name, fg=_COLORS[status.name]) if color else status.name
+
+
+behaviors_option = click.option(
+    "--behaviors",
+    is_flag=True,
+    help="Also register the bundled behavior plugins (core, mujoco, examples), offline: no robot.",
+)
+
+
+def _factory(with_behaviors: bool) -> BehaviorTreeFactory:
+    """The built-in nodes, plus the bundled behaviors when asked (their load errors are printed)."""
+    from kinema.bt import BehaviorTreeFactory
+
+    if not with_behaviors:
+        return BehaviorTreeFactory()
+    from kinema.plugins.discovery import bundled_plugins
+    from kinema.plugins.host import BehaviorHost
+
+    specs = bundled_plugins()
+    host = BehaviorHost([spec.name for spec in specs])
+    report = host.load_specs(specs)
+    for error in report.errors:
+        click.echo(f"warning: {error}", err=True)
+    return host.registry.create_factory()
 
 
 @click.group()
@@ -33,16 +57,24 @@ def tree() -> None:
 @click.option("--timeout", type=click.FloatRange(min=0.0), help="Halt the tree after this many seconds.")
 @click.option("-q", "--quiet", is_flag=True, help="Print only the final status, not every status change.")
 @click.option("-b", "--blackboard", "show_blackboard", is_flag=True, help="Print the blackboard at the end.")
+@behaviors_option
 def run(
-    file: Path, tree_id: str | None, rate: float, timeout: float | None, quiet: bool, show_blackboard: bool
+    file: Path,
+    tree_id: str | None,
+    rate: float,
+    timeout: float | None,
+    quiet: bool,
+    show_blackboard: bool,
+    behaviors: bool,
 ) -> None:
     """Tick the objective in FILE until it finishes; print status changes and the final status.
 
-    Uses the built-in nodes. Exits 0 only if the tree ends in SUCCESS; Ctrl-C halts the tree.
+    Uses the built-in nodes (and the bundled behaviors with --behaviors). Exits 0 only if the tree
+    ends in SUCCESS; Ctrl-C halts the tree.
     """
-    from kinema.bt import BehaviorTreeFactory, NodeStatus
+    from kinema.bt import NodeStatus
 
-    factory = BehaviorTreeFactory()
+    factory = _factory(behaviors)
     if tree_id is None:
         behavior_tree = factory.create_tree_from_file(file)
     else:
@@ -88,7 +120,8 @@ def run(
     "files", nargs=-1, required=True, type=click.Path(exists=True, dir_okay=False, path_type=Path)
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the problems as a JSON list.")
-def validate(files: tuple[Path, ...], as_json: bool) -> None:
+@behaviors_option
+def validate(files: tuple[Path, ...], as_json: bool, behaviors: bool) -> None:
     """Check objective FILES together: node IDs, ports, scripts, subtrees.
 
     Every problem is printed as file:line: message. A SubTree may call a tree defined in another of
@@ -96,7 +129,7 @@ def validate(files: tuple[Path, ...], as_json: bool) -> None:
     """
     from kinema.bt.validation import count_trees, validate_files
 
-    problems = validate_files(list(files))
+    problems = validate_files(list(files), _factory(behaviors))
     if as_json:
         rows: list[dict[str, Any]] = [
             {"file": p.location.file, "line": p.location.line, "message": p.message} for p in problems
@@ -115,8 +148,9 @@ def validate(files: tuple[Path, ...], as_json: bool) -> None:
 
 @tree.command()
 @click.option("--builtin", is_flag=True, help="Include the built-in nodes (Sequence, Retry, ...).")
-def nodes(builtin: bool) -> None:
+@behaviors_option
+def nodes(builtin: bool, behaviors: bool) -> None:
     """Print the TreeNodesModel XML (Groot2 format) of the registered node types."""
-    from kinema.bt import BehaviorTreeFactory, write_tree_nodes_model_xml
+    from kinema.bt import write_tree_nodes_model_xml
 
-    click.echo(write_tree_nodes_model_xml(BehaviorTreeFactory(), include_builtin=builtin), nl=False)
+    click.echo(write_tree_nodes_model_xml(_factory(behaviors), include_builtin=builtin), nl=False)

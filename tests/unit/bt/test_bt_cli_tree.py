@@ -121,3 +121,13 @@ def test_nodes_prints_the_model() -> None:
     assert code == 0 and "<TreeNodesModel" in out and "Sequence" not in out
     code, out = run_cli("tree", "nodes", "--builtin")
     assert code == 0 and '<Control ID="Sequence"/>' in out
+
+
+@pytest.mark.skipif(
+    not COMPAT.is_dir(), reason="the MoveIt Pro compatibility files are not beside the checkout"
+)
+def test_validate_moveit_pro_objectives_against_the_bundled_behaviors() -> None:
+    files = sorted(str(p) for p in COMPAT.glob("*.xml"))
+    code, out = run_cli("tree", "validate", "--behaviors", *files)
+    assert "Node not recognized" not in out
+    assert code == 0, out
