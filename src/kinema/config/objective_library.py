@@ -177,16 +177,18 @@ class ObjectiveLibrary:
         if root.get("main_tree_to_execute") is None:
             root.set("main_tree_to_execute", objective_id)
         objectives_of(root, Path(f"<objective {objective_id!r}>"))  # same checks as loading, before writing
-        etree.indent(root, space="  ")
-        text = '<?xml version="1.0" encoding="UTF-8" ?>\n' + etree.tostring(root, encoding="unicode") + "\n"
         if (
             previous is not None
             and previous.package == target_library.package
             and _inside(previous.file, target_library.path)
         ):
             destination = previous.file
+            # A file holding other objectives too keeps them: only this objective's trees are replaced.
+            root = _merged_into_file(previous, root)
         else:
             destination = self._free_file_name(target_library.path, objective_id)
+        etree.indent(root, space="  ")
+        text = '<?xml version="1.0" encoding="UTF-8" ?>\n' + etree.tostring(root, encoding="unicode") + "\n"
         try:
             destination.parent.mkdir(parents=True, exist_ok=True)
         except OSError as error:
@@ -260,6 +262,44 @@ def _inside(path: Path, folder: Path) -> bool:
     except ValueError:
         return False
     return True
+
+
+def _merged_into_file(previous: ObjectiveInfo, new_root: etree._Element) -> etree._Element:
+    """Return the document of ``previous.file`` with the trees and models of ``new_root`` put in place
+    of those with the same IDs; ``new_root`` itself when that file holds nothing else."""
+    try:
+        old_root = parse_xml(previous.read_xml(), str(previous.file))
+    except ObjectiveError:
+        return new_root  # the old file is unreadable: the new document replaces it
+    new_trees = {e.get("ID"): e for e in new_root if e.tag == "BehaviorTree"}
+    if all(e.get("ID") in new_trees for e in old_root if e.tag == "BehaviorTree"):
+        return new_root
+    for tree_id, tree in new_trees.items():
+        old = next((e for e in old_root if e.tag == "BehaviorTree" and e.get("ID") == tree_id), None)
+        if old is None:
+            old_root.append(tree)
+        else:
+            old_root.replace(old, tree)
+    new_models = [s for m in new_root.iter("TreeNodesModel") for s in m if s.tag == "SubTree"]
+    if new_models:
+        models = next(iter(old_root.iter("TreeNodesModel")), None)
+        if models is None:
+            models = etree.SubElement(old_root, "TreeNodesModel")
+        for model in new_models:
+            old = next(
+                (
+                    s
+                    for m in old_root.iter("TreeNodesModel")
+                    for s in m
+                    if s.tag == "SubTree" and s.get("ID") == model.get("ID")
+                ),
+                None,
+            )
+            if old is None:
+                models.append(model)
+            else:
+                old.getparent().replace(old, model)
+    return old_root
 
 
 def _carry_metadata(

@@ -288,3 +288,24 @@ def test_saving_where_the_library_cannot_be_written_is_a_clear_error(ws, monkeyp
     with pytest.raises(ObjectiveError, match=r"a\.xml: cannot write the file: Permission denied"):
         library.save("A", '<BehaviorTree ID="A"><AlwaysSuccess/></BehaviorTree>')
     assert list((ws.root / "src" / "site" / "objectives").iterdir()) == []  # the temporary file is gone
+
+
+def test_saving_one_objective_of_a_multi_objective_file_keeps_the_others(ws):
+    ws.config("base")
+    ws.child("site", "base")
+    path = ws.root / "src" / "site" / "objectives" / "pair.xml"
+    path.write_text(
+        '<root BTCPP_format="4" main_tree_to_execute="First">\n'
+        '  <BehaviorTree ID="First" _description="one"><AlwaysSuccess/></BehaviorTree>\n'
+        '  <BehaviorTree ID="Second" _description="two"><AlwaysSuccess/></BehaviorTree>\n'
+        '  <TreeNodesModel><SubTree ID="Second"><input_port name="x"/></SubTree></TreeNodesModel>\n'
+        "</root>\n"
+    )
+    library = ObjectiveLibrary.load(resolve_config("site", Workspace.discover(ws.root)))
+    saved = library.save("Second", '<BehaviorTree ID="Second"><AlwaysFailure/></BehaviorTree>')
+    assert saved.file == path
+    assert saved.description == "two" and [p.name for p in saved.ports] == ["x"]
+    reloaded = ObjectiveLibrary.load(resolve_config("site", Workspace.discover(ws.root)))
+    assert reloaded.get("First").description == "one"
+    assert reloaded.get("First").file == path
+    assert "AlwaysFailure" in path.read_text() and path.read_text().count("<BehaviorTree") == 2
