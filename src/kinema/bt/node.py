@@ -123,6 +123,8 @@ class TreeNode:
         "_hooked",
         "_literal_cache",
         "_observers",
+        "_post_tick",
+        "_pre_tick",
         "_status",
         "config",
         "name",
@@ -141,7 +143,30 @@ class TreeNode:
         self._literal_cache: dict[tuple[str, Any], Any] = {}
         manifest = self.config.manifest
         self.registration_id: str = manifest.id if manifest is not None else type(self).__name__
-        self._hooked = bool(self.config.pre_conditions or self.config.post_conditions)
+        self._pre_tick: Callable[[TreeNode], NodeStatus] | None = None
+        self._post_tick: Callable[[TreeNode, NodeStatus], NodeStatus] | None = None
+        self._refresh_hooked()
+
+    def _refresh_hooked(self) -> None:
+        # The plain tick path is taken unless the node has conditions or injected callbacks.
+        config = self.config
+        self._hooked = bool(
+            config.pre_conditions or config.post_conditions or self._pre_tick or self._post_tick
+        )
+
+    def set_pre_tick_callback(self, callback: Callable[[TreeNode], NodeStatus] | None) -> None:
+        """Call ``callback(node)`` before ``tick()`` while the node is not completed.
+
+        If it returns SUCCESS or FAILURE, ``tick()`` is skipped and that is the result (BT.CPP's
+        ``setPreTickFunction``, used for breakpoints and substitutions). None removes it.
+        """
+        self._pre_tick = callback
+        self._refresh_hooked()
+
+    def set_post_tick_callback(self, callback: Callable[[TreeNode, NodeStatus], NodeStatus] | None) -> None:
+        """Call ``callback(node, status)`` after every tick; SUCCESS/FAILURE returned replace the status."""
+        self._post_tick = callback
+        self._refresh_hooked()
 
     # -- identity --------------------------------------------------------------------------------
 
@@ -222,12 +247,18 @@ class TreeNode:
         config = self.config
         status = self._check_pre_conditions() if config.pre_conditions else None
         if status is None:
-            try:
-                status = self.tick()
-            except NodeExecutionError:
-                raise
-            except Exception as error:
-                raise self._wrap_exception(error) from error
+            pre_tick = self._pre_tick
+            if pre_tick is not None and self._status is not SUCCESS and self._status is not FAILURE:
+                override = pre_tick(self)
+                if override is SUCCESS or override is FAILURE:
+                    status = override
+            if status is None:
+                try:
+                    status = self.tick()
+                except NodeExecutionError:
+                    raise
+                except Exception as error:
+                    raise self._wrap_exception(error) from error
         if (status is SUCCESS or status is FAILURE) and config.post_conditions:
             post = config.post_conditions
             script = post.get("_onSuccess" if status is SUCCESS else "_onFailure")
@@ -236,6 +267,11 @@ class TreeNode:
             script = post.get("_post")
             if script is not None:
                 script.run(config.blackboard, config.enums)
+        post_tick = self._post_tick
+        if post_tick is not None:
+            override = post_tick(self, status)
+            if override is SUCCESS or override is FAILURE:
+                status = override
         if status is not SKIPPED:
             self._set_status(status)
         return status

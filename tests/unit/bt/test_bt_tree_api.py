@@ -228,3 +228,18 @@ def test_walk_visits_nodes_depth_first_with_depth(bench) -> None:
     tree = bench.tree('<Sequence name="s"><Inverter name="i"><AlwaysFailure name="f"/></Inverter></Sequence>')
     assert [(n.name, d) for n, d in tree.walk()] == [("s", 0), ("i", 1), ("f", 2)]
     assert len(tree) == 3 and [n.name for n in tree] == ["s", "i", "f"]
+
+
+def test_pre_and_post_tick_callbacks_substitute_results(bench) -> None:
+    bench.action("Real", F)
+    tree = bench.tree('<Sequence><Real name="real"/><AlwaysSuccess name="after"/></Sequence>')
+    real = tree.node_by_path("real")
+    real.set_pre_tick_callback(lambda node: S)
+    assert tree.tick_once() is S
+    assert bench.ticks["Real"] == 0  # the substitution skipped tick()
+    real.set_pre_tick_callback(None)
+    real.set_post_tick_callback(lambda node, status: S if status is F else status)
+    assert tree.tick_once() is S
+    assert bench.ticks["Real"] == 1
+    real.set_post_tick_callback(None)
+    assert tree.tick_once() is F
