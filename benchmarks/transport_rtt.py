@@ -16,7 +16,6 @@ The helpers (``time_calls``, ``percentiles``, ``serve``) are meant for reuse by 
 from __future__ import annotations
 
 import argparse
-import socket
 import statistics
 import subprocess
 import sys
@@ -24,13 +23,6 @@ import time
 from collections.abc import Callable
 
 RAW_KEY = "kinema_bench/raw_echo"
-
-
-def free_endpoint() -> str:
-    """A loopback endpoint on a port the OS reports free."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return f"tcp/127.0.0.1:{probe.getsockname()[1]}"
 
 
 def percentiles(samples_ns: list[int]) -> tuple[float, float]:
@@ -85,7 +77,7 @@ def main() -> None:
 
     import zenoh
 
-    from kinema.transport import Node, open_session
+    from kinema.transport import Node, free_endpoint, open_session
 
     endpoint = free_endpoint()
     server = subprocess.Popen(

@@ -42,6 +42,7 @@ from kinema.transport.service import Responder, ServiceClient, ServiceServer
 from kinema.transport.session import (
     DEFAULT_ENDPOINT,
     Session,
+    free_endpoint,
     host_or_join,
     host_router,
     open_session,
@@ -77,6 +78,7 @@ __all__ = [
     "ServiceServer",
     "Session",
     "Subscription",
+    "free_endpoint",
     "from_dict",
     "host_or_join",
     "host_router",

@@ -75,6 +75,15 @@ def _install_exit_hook() -> None:
         _exit_hook_installed = True
 
 
+def free_endpoint(host: str = "127.0.0.1") -> str:
+    """``tcp/<host>:<port>`` on a port the OS reports free now (for tests and side-by-side runtimes)."""
+    import socket
+
+    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+        probe.bind((host, 0))
+        return f"tcp/{host}:{probe.getsockname()[1]}"
+
+
 def resolve_endpoints(connect: str | Sequence[str] | None) -> list[str]:
     """Endpoints to connect to: the argument, else ``KINEMA_ZENOH_CONNECT``, else the default router."""
     if connect is None:

@@ -2,20 +2,11 @@
 
 from __future__ import annotations
 
-import socket
 from collections.abc import Callable, Iterator
 
 import pytest
 
-from kinema.transport import Session, host_router, open_session
-
-
-def free_endpoint() -> str:
-    """A ``tcp/127.0.0.1:<port>`` endpoint on a port the OS just reported free."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
-    return f"tcp/127.0.0.1:{port}"
+from kinema.transport import Session, free_endpoint, host_router, open_session
 
 
 @pytest.fixture
