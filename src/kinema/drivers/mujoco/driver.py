@@ -101,12 +101,12 @@ class MujocoDriver:
         else:
             mujoco.mj_forward(self.model, self.data)
         self._controllers = self._build_controllers()
-        # Called before every step / at every publish; each returns at once when no goal runs.
-        self._updates = [c.update for c in self._controllers.values() if hasattr(c, "update")]  # type: ignore[attr-defined]
-        self._feedback_posters = [
-            c.post_feedback  # type: ignore[attr-defined]
+        # The controllers that run goals: updated before every step, asked for feedback at every
+        # publish (each returns at once when no goal runs), told about resets and shutdown.
+        self._goal_controllers: list[JointTrajectoryController | GripperController] = [
+            c
             for c in self._controllers.values()
-            if hasattr(c, "post_feedback")
+            if isinstance(c, JointTrajectoryController | GripperController)
         ]
         self.controller_manager = ControllerManager(
             list(self._controllers.values()), update_rate=round(1.0 / self.index.timestep)
@@ -185,10 +185,8 @@ class MujocoDriver:
             return
         self._stopped = True
         self.simulation.stop()
-        for controller in self._controllers.values():
-            shutdown = getattr(controller, "shutdown", None)
-            if shutdown is not None:
-                shutdown("the MuJoCo driver stopped")
+        for controller in self._goal_controllers:
+            controller.shutdown("the MuJoCo driver stopped")
         with self._goals_lock:
             self._goals_lock.wait_for(lambda: self._goals_running == 0, RESULT_GRACE)
         for node in reversed(self._nodes):
@@ -342,8 +340,8 @@ class MujocoDriver:
 
     def _before_step(self) -> None:
         data = self.data
-        for update in self._updates:
-            update(data)
+        for controller in self._goal_controllers:
+            controller.update(data)
 
     def _on_publish(self) -> None:
         data = self.data
@@ -359,8 +357,8 @@ class MujocoDriver:
                     data.qfrc_actuator[self._joint_dofs],
                 )
             )
-        for post_feedback in self._feedback_posters:
-            post_feedback(data)
+        for controller in self._goal_controllers:
+            controller.post_feedback(data)
         wall = time.perf_counter()
         if wall - self._last_scene_publish >= 1.0 / self.settings.scene_state_rate:
             self._publish_scene_state(wall)
@@ -393,10 +391,8 @@ class MujocoDriver:
         moved = (
             apply_joint_state(self.model, self.data, self.index, positions, velocities) if positions else []
         )
-        for controller in self._controllers.values():
-            on_reset = getattr(controller, "on_state_reset", None)
-            if on_reset is not None:
-                on_reset(self.data)
+        for controller in self._goal_controllers:
+            controller.on_state_reset(self.data)
         self._publish_scene_state()
         parts = []
         if keyframe:
