@@ -32,6 +32,8 @@ from kinema.errors import ObjectiveError, SourceLocation, did_you_mean
 __all__ = ["ObjectiveInfo", "ObjectiveLibrary", "ObjectivePort", "objective_file_name"]
 
 _UNSAFE_IN_FILE_NAME = re.compile(r"[^\w\-.]+")
+#: MoveIt Pro's example workspace lint: "if everything is favorited, nothing is favorited".
+MAX_FAVORITES_PER_PACKAGE = 8
 _KEPT_TREE_ATTRIBUTES = ("_description", "_favorite", "_subtreeOnly", "_hardcoded")
 
 
@@ -83,7 +85,23 @@ class ObjectiveLibrary:
         for library_path in library.libraries:
             for xml_file in _xml_files(library_path.path):
                 library._add_file(xml_file, library_path.package)
+        library._note_favorites()
         return library
+
+    def _note_favorites(self) -> None:
+        """Note MoveIt Pro's favorite rules: never on a subtree-only objective, at most 8 per package."""
+        per_package: dict[str, int] = {}
+        for info in self.objectives.values():
+            if info.favorite:
+                per_package[info.package] = per_package.get(info.package, 0) + 1
+                if not info.runnable:
+                    self.notices.append(f"{info.location}: {info.id!r} is a favorite but not runnable")
+        for package, count in sorted(per_package.items()):
+            if count > MAX_FAVORITES_PER_PACKAGE:
+                self.notices.append(
+                    f"package {package} has {count} favorite objectives; "
+                    f"more than {MAX_FAVORITES_PER_PACKAGE} makes favorites meaningless"
+                )
 
     def get(self, objective_id: str) -> ObjectiveInfo:
         """Return the objective ``objective_id``.

@@ -309,3 +309,13 @@ def test_saving_one_objective_of_a_multi_objective_file_keeps_the_others(ws):
     assert reloaded.get("First").description == "one"
     assert reloaded.get("First").file == path
     assert "AlwaysFailure" in path.read_text() and path.read_text().count("<BehaviorTree") == 2
+
+
+def test_favorite_rules_are_noted(ws):
+    ws.config("robot")
+    ws.objective("robot", "Hidden Helper", _favorite="true", _subtreeOnly="true")
+    for n in range(9):
+        ws.objective("robot", f"Fav {n}", _favorite="true")
+    library = ObjectiveLibrary.load(resolve_config("robot", Workspace.discover(ws.root)))
+    assert any("'Hidden Helper' is a favorite but not runnable" in n for n in library.notices)
+    assert any("package robot has 10 favorite objectives" in n for n in library.notices)
