@@ -35,13 +35,14 @@ class AsyncBehavior(Behavior, StatefulActionNode):
     def do_work(self) -> bool | Awaitable[bool]:
         """Do the work; return True for SUCCESS, False for FAILURE.
 
-        Called once per start of the node, on a worker thread (plain function) or on Kinema's asyncio
-        loop (``async def``), never on the tick thread: it may block or await as long as it needs. It must
-        not touch other nodes or the tree; read inputs with ``get_input`` and write outputs with
-        ``set_output`` (outputs written here reach the blackboard on the tick thread when the work
-        finishes, so a running tree is only ever changed by its tick thread). For an expected failure call
-        ``self.logger.publish_failure(...)`` and return False; an exception is treated as a bug and fails
-        the objective with the line that raised.
+        Called once per start of the node, never on the tick thread: a plain function runs on a worker
+        thread and may block as long as it needs; an ``async def`` runs on Kinema's asyncio loop and must
+        ``await`` rather than block (a blocking call there stalls every other async behavior; wrap one in
+        ``await asyncio.to_thread(...)``). It must not touch other nodes or the tree. Read inputs with
+        ``get_input`` and write outputs with ``set_output`` (outputs written here reach the blackboard on
+        the tick thread when the work finishes, so a running tree is only ever changed by its tick
+        thread). For an expected failure call ``self.logger.publish_failure(...)`` and return False; an
+        exception is treated as a bug and fails the objective with the line that raised.
         """
         raise NotImplementedError(f"{type(self).__name__}.do_work() is not implemented")
 

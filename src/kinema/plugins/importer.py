@@ -117,8 +117,14 @@ def import_fresh(root: Path, module: str, package: str) -> ModuleType:
         purge_modules(fresh_top)
         if isinstance(error, KeyboardInterrupt):
             raise
+        hint = ""
+        if isinstance(error, ModuleNotFoundError) and (error.name or "").split(".")[0] == top:
+            hint = (
+                f"; import the package's own modules relatively (from .module import X): '{top}' is "
+                "loaded from its folder, not installed"
+            )
         raise PluginError(
-            f"behavior package '{package}' failed to import: {describe_exception(error)}",
+            f"behavior package '{package}' failed to import: {describe_exception(error)}{hint}",
             location=user_location(error, Path(root)),
         ) from error
     return result

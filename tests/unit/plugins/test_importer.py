@@ -69,3 +69,13 @@ def test_an_exception_at_import_points_at_the_raising_line_in_the_users_file(tmp
         import_fresh(root, "pkg", "pkg")
     assert caught.value.location is not None
     assert (Path(caught.value.location.file).name, caught.value.location.line) == ("helper.py", 2)
+
+
+def test_an_absolute_import_of_the_package_itself_gets_a_hint(tmp_path: Path) -> None:
+    root = _package(
+        tmp_path,
+        {"own_pkg/__init__.py": "from own_pkg.helper import X\n", "own_pkg/helper.py": "X = 1\n"},
+    )
+    with pytest.raises(PluginError, match=r"import the package's own modules relatively") as caught:
+        import_fresh(root, "own_pkg", "own_pkg")
+    assert caught.value.location is not None and caught.value.location.line == 1
