@@ -11,6 +11,7 @@ from __future__ import annotations
 import concurrent.futures
 import itertools
 import logging
+import queue
 import threading
 import time
 from collections.abc import Callable
@@ -40,6 +41,40 @@ def _as_message(value: Any, type_name: str, what: str) -> Any:
     if type_of(value) != type_name:
         raise TransportError(f"{what} must be {type_name}, got {type_of(value)}")
     return value
+
+
+class _HandlerPool:
+    """Up to ``size`` daemon threads running requests; unlike a ThreadPoolExecutor, a handler still
+    blocked (say, waiting for an Objective) never keeps the interpreter from exiting."""
+
+    def __init__(self, size: int, name: str) -> None:
+        self._jobs: queue.SimpleQueue[tuple[Callable[..., None], tuple[Any, ...]] | None] = (
+            queue.SimpleQueue()
+        )
+        self._threads = [
+            threading.Thread(target=self._work, name=f"{name}-{index}", daemon=True) for index in range(size)
+        ]
+        self._closed = False
+        for thread in self._threads:
+            thread.start()
+
+    def _work(self) -> None:
+        while (job := self._jobs.get()) is not None:
+            function, args = job
+            try:
+                function(*args)
+            except Exception:
+                log.exception("service handler thread failed")
+
+    def submit(self, function: Callable[..., None], *args: Any) -> None:
+        if self._closed:
+            raise RuntimeError("pool is shut down")
+        self._jobs.put((function, args))
+
+    def shutdown(self) -> None:
+        self._closed = True
+        for _ in self._threads:
+            self._jobs.put(None)
 
 
 class Responder:
@@ -134,11 +169,7 @@ class ServiceServer(Entity):
         self._handler = handler
         self._deferred = deferred
         self._after_reply = after_reply
-        self._pool = (
-            concurrent.futures.ThreadPoolExecutor(max_concurrent, thread_name_prefix=f"kinema-srv{name}")
-            if max_concurrent > 1
-            else None
-        )
+        self._pool = _HandlerPool(max_concurrent, f"kinema-srv{name}") if max_concurrent > 1 else None
         self._queryable = node.session.zenoh.declare_queryable(self.key, self._on_query, complete=True)
         self._announce()
 
@@ -188,7 +219,7 @@ class ServiceServer(Entity):
     def _undeclare(self) -> None:
         self._queryable.undeclare()
         if self._pool is not None:
-            self._pool.shutdown(wait=False, cancel_futures=True)
+            self._pool.shutdown()
 
 
 class ServiceClient(Entity):

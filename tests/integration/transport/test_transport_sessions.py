@@ -114,3 +114,27 @@ def test_standalone_session_serves_in_process() -> None:
         )
         assert handle.result(timeout=5).result.sequence.tolist() == [1, 1]
     assert session.closed
+
+
+_STUCK_HANDLER = textwrap.dedent(
+    """
+    import sys, threading
+    from kinema.transport import Node, open_session
+    session = open_session([])
+    node = Node(session, "stuck")
+    entered = threading.Event()
+    def forever(request):
+        entered.set()
+        threading.Event().wait()  # a handler that never returns (an Objective that never ends)
+    node.create_service("example_interfaces/srv/AddTwoInts", "/stuck", forever, max_concurrent=2)
+    future = node.create_client("example_interfaces/srv/AddTwoInts", "/stuck").call_async({}, timeout=0.5)
+    entered.wait(5)
+    print("in handler", flush=True)
+    """
+)
+
+
+def test_process_exits_while_a_concurrent_handler_is_stuck() -> None:
+    done = subprocess.run([sys.executable, "-c", _STUCK_HANDLER], capture_output=True, text=True, timeout=60)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "in handler"
