@@ -1,0 +1,280 @@
+"""PlanToJointGoal, PlanCartesianPath, ExecuteTrajectory: lab_sim model, fake joint states and controllers."""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any
+
+import numpy as np
+import pytest
+
+from kinema.behaviors import BehaviorContext
+from kinema.bt import NodeStatus
+from kinema.testing import build_tree, publish_repeatedly, tick_behavior
+
+ARM = [
+    "linear_rail_joint",
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "elbow_joint",
+    "wrist_1_joint",
+    "wrist_2_joint",
+    "wrist_3_joint",
+]
+GRIPPER = "robotiq_85_left_knuckle_joint"
+HOME = [0.0, 0.0, -2.0, 2.0, -1.5708, -1.5708, 0.0]
+MID = [-0.1333, 0.0, -1.25758, 1.37827, -1.69149, -1.5708, 0.0]
+THROUGH_TABLE = [0.0, 0.0, -0.3, 1.9, -1.6, -1.5708, 0.0]
+
+
+@pytest.fixture
+def at_home(context: BehaviorContext) -> Any:
+    """The fake driver reports the arm at Home, gripper open."""
+    state = {"name": [*ARM, GRIPPER], "position": [*HOME, 0.0]}
+    with publish_repeatedly(context.node, "sensor_msgs/msg/JointState", "/joint_states", state):
+        yield
+
+
+def _goal(positions: list[float]) -> Any:
+    from kinema.transport import from_dict
+
+    return from_dict("sensor_msgs/msg/JointState", {"name": ARM, "position": positions})
+
+
+def test_plan_to_joint_goal_times_a_path_from_the_current_state(
+    behavior: Any, context: BehaviorContext, at_home: Any
+) -> None:
+    run = tick_behavior(
+        behavior("PlanToJointGoal"),
+        {"joint_goal": _goal(MID), "velocity_scale_factor": 0.5},
+        context=context,
+        timeout=30.0,
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    trajectory = run.outputs["joint_trajectory_msg"]
+    assert list(trajectory.joint_names) == ARM
+    np.testing.assert_allclose(trajectory.points[0].positions, HOME, atol=1e-6)
+    np.testing.assert_allclose(trajectory.points[-1].positions, MID, atol=1e-6)
+    last = trajectory.points[-1].time_from_start
+    assert last.sec + last.nanosec * 1e-9 > 0.2
+    # velocity_scale_factor 0.5 keeps every joint at half its limit or below
+    limits = np.array([context.robot_model.limits[j].max_velocity for j in ARM])
+    speeds = np.abs(np.array([p.velocities for p in trajectory.points]))
+    assert (speeds <= 0.5 * limits + 1e-6).all()
+
+
+def test_a_goal_in_collision_fails_naming_the_links(
+    behavior: Any, context: BehaviorContext, at_home: Any
+) -> None:
+    run = tick_behavior(behavior("PlanToJointGoal"), {"joint_goal": _goal(THROUGH_TABLE)}, context=context)
+    assert run.status == NodeStatus.FAILURE
+    assert run.toasts[-1].startswith("PlanToJointGoal: planning failed: goal state is in collision")
+    assert "table" in run.toasts[-1]
+
+
+def test_a_goal_outside_the_limits_or_group_fails(
+    behavior: Any, context: BehaviorContext, at_home: Any
+) -> None:
+    beyond = list(MID)
+    beyond[2] = 1.0  # shoulder_lift_joint's upper limit is 0
+    run = tick_behavior(behavior("PlanToJointGoal"), {"joint_goal": _goal(beyond)}, context=context)
+    assert run.status == NodeStatus.FAILURE and "outside its limits" in run.toasts[-1]
+    group = tick_behavior(
+        behavior("PlanToJointGoal"),
+        {"joint_goal": _goal(MID), "planning_group_name": "manipulatr"},
+        context=context,
+    )
+    assert group.status == NodeStatus.FAILURE and "unknown planning group 'manipulatr'" in group.toasts[-1]
+
+
+def test_planning_without_a_driver_says_so(behavior: Any, context: BehaviorContext) -> None:
+    run = tick_behavior(
+        behavior("PlanToJointGoal"), {"joint_goal": _goal(MID)}, context=context, timeout=30.0
+    )
+    assert run.status == NodeStatus.FAILURE
+    assert "no joint state received on /joint_states" in run.toasts[-1]
+
+
+def test_an_orientation_constraint_is_refused_not_ignored(
+    behavior: Any, context: BehaviorContext, at_home: Any
+) -> None:
+    run = tick_behavior(
+        behavior("PlanToJointGoal"),
+        {"joint_goal": _goal(MID), "orientation_constraint": "[0, 0, 0, 1]"},
+        context=context,
+    )
+    assert run.status == NodeStatus.FAILURE and "orientation constraints are not supported" in run.toasts[-1]
+
+
+def test_plan_cartesian_path_moves_the_tool_straight_down(
+    behavior: Any, context: BehaviorContext, at_home: Any
+) -> None:
+    from kinema.motion import fk
+
+    model = context.robot_model
+    q = model.neutral().copy()
+    q[: len(HOME)] = HOME
+    start = fk(model, q, "grasp_link")
+    pose = tick_behavior(
+        behavior("CreatePoseStamped"),
+        {
+            "reference_frame": "grasp_link",
+            "position_xyz": [0.0, 0.0, 0.05],  # 5 cm along the tool's own z axis
+            "orientation_xyzw": [0.0, 0.0, 0.0, 1.0],
+        },
+        context=context,
+    ).outputs["pose_stamped"]
+    run = tick_behavior(behavior("PlanCartesianPath"), {"path": [pose]}, context=context, timeout=30.0)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    end = list(run.outputs["joint_trajectory_msg"].points[-1].positions)
+    q_end = q.copy()
+    q_end[: len(ARM)] = end
+    moved = fk(model, q_end, "grasp_link")[:3, 3] - start[:3, 3]
+    np.testing.assert_allclose(moved, start[:3, 2] * 0.05, atol=2e-3)
+
+
+class Controller:
+    """A fake FollowJointTrajectory server."""
+
+    def __init__(
+        self, node: Any, *, error_code: int = 0, error: str = "", hold: bool = False, hang: bool = False
+    ) -> None:
+        self.goals: list[Any] = []
+        self.hang = threading.Event() if hang else None
+        self.cancelled = threading.Event()
+        self.started = threading.Event()
+        self.error_code, self.error, self.hold = error_code, error, hold
+        self.server = node.create_action_server(
+            "control_msgs/action/FollowJointTrajectory",
+            "/joint_trajectory_controller/follow_joint_trajectory",
+            self._execute,
+        )
+
+    def _execute(self, handle: Any) -> Any:
+        self.goals.append(handle.goal)
+        self.started.set()
+        if self.hang is not None:  # a crashed driver: never answers again
+            self.hang.wait(30.0)
+            return None
+        if self.hold:
+            if handle.cancel_requested_event.wait(30.0):
+                self.cancelled.set()
+                handle.canceled({"error_code": 0, "error_string": "canceled; holding position"})
+            return None
+        result = {"error_code": self.error_code, "error_string": self.error}
+        if self.error_code:
+            handle.abort(result)
+            return None
+        return result
+
+
+def _trajectory(names: list[str] = ARM) -> Any:
+    from kinema.transport import from_dict
+
+    points = [
+        {"positions": [0.0] * len(names), "time_from_start": {"sec": 0, "nanosec": 0}},
+        {"positions": [0.1] * len(names), "time_from_start": {"sec": 1, "nanosec": 0}},
+    ]
+    return from_dict("trajectory_msgs/msg/JointTrajectory", {"joint_names": names, "points": points})
+
+
+def test_execute_trajectory_sends_the_trajectory_and_tolerances(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    controller = Controller(context.node)
+    run = tick_behavior(
+        behavior("ExecuteTrajectory"),
+        {
+            "joint_trajectory_msg": _trajectory(),
+            "goal_position_tolerance": 0.01,
+            "goal_duration_tolerance": 0.5,
+        },
+        context=context,
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    goal = controller.goals[0]
+    assert list(goal.trajectory.joint_names) == ARM
+    assert [t.position for t in goal.goal_tolerance] == [0.01] * len(ARM)
+    assert goal.goal_time_tolerance.nanosec == 500_000_000
+    assert len(goal.path_tolerance) == 0
+
+
+def test_a_rejected_trajectory_fails_with_the_controllers_error(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    Controller(context.node, error_code=-2, error="unknown joint 'elbow_jiont' (joints: elbow_joint, ...)")
+    names = [*ARM[:3], "elbow_jiont"]
+    run = tick_behavior(
+        behavior("ExecuteTrajectory"), {"joint_trajectory_msg": _trajectory(names)}, context=context
+    )
+    assert run.status == NodeStatus.FAILURE
+    assert "ABORTED" in run.toasts[-1] and "elbow_jiont" in run.toasts[-1]
+
+
+def test_a_malformed_trajectory_is_refused_before_sending(behavior: Any, context: BehaviorContext) -> None:
+    controller = Controller(context.node)
+    empty = _trajectory()
+    empty.points = []
+    run = tick_behavior(behavior("ExecuteTrajectory"), {"joint_trajectory_msg": empty}, context=context)
+    assert run.status == NodeStatus.FAILURE and "has no points" in run.toasts[-1]
+    assert controller.goals == []
+
+
+def test_halting_execute_trajectory_cancels_the_controller_goal(
+    behavior: Any, registry: Any, context: BehaviorContext
+) -> None:
+    controller = Controller(context.node, hold=True)
+    context.log_sink  # noqa: B018 - the tree shares the context's sink
+    from kinema.bt import Blackboard
+
+    blackboard = Blackboard.create()
+    blackboard.set("joint_trajectory_msg", _trajectory())
+    tree = build_tree(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Action ID="ExecuteTrajectory" /></BehaviorTree></root>',
+        registry=registry,
+        context=context,
+        blackboard=blackboard,
+    )
+    deadline = time.monotonic() + 10
+    while not controller.started.is_set() and time.monotonic() < deadline:
+        assert tree.tick_once() == NodeStatus.RUNNING
+        tree.sleep(0.01)
+    halted = time.monotonic()
+    tree.halt_tree()
+    assert controller.cancelled.wait(5.0)
+    assert time.monotonic() - halted < 1.0
+
+
+def test_a_controller_that_goes_away_fails_the_run_within_a_second(
+    behavior: Any, registry: Any, context: BehaviorContext
+) -> None:
+    from kinema.transport import Node
+
+    server_node = Node(context.node.session, "fake_driver")
+    controller = Controller(server_node, hang=True)
+    messages: list[Any] = []
+    context.log_sink.subscribe(messages.append)
+    from kinema.bt import Blackboard
+
+    blackboard = Blackboard.create()
+    blackboard.set("joint_trajectory_msg", _trajectory())
+    tree = build_tree(
+        '<root BTCPP_format="4"><BehaviorTree ID="T"><Action ID="ExecuteTrajectory" /></BehaviorTree></root>',
+        registry=registry,
+        context=context,
+        blackboard=blackboard,
+    )
+    status = tree.tick_once()
+    while not controller.started.is_set():
+        status = tree.tick_once()
+        tree.sleep(0.01)
+    server_node.close()
+    gone = time.monotonic()
+    while status == NodeStatus.RUNNING and time.monotonic() - gone < 5.0:
+        tree.sleep(0.01)
+        status = tree.tick_once()
+    assert status == NodeStatus.FAILURE
+    assert time.monotonic() - gone < 1.0
+    assert "lost the controller" in messages[-1].text
+    controller.hang.set()
