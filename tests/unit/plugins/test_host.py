@@ -134,3 +134,29 @@ def test_a_broken_reload_keeps_the_last_good_version_and_reports_the_line(
     assert host.registry["Answer"] is good["Answer"]
     assert _run(host.registry, "Answer") == 42
     assert host.registry.plugins["answers::TestLoader"].error is not None
+
+
+def test_an_installed_entry_point_loads_like_any_plugin_and_a_workspace_package_overlays_it(
+    workspace: Path, make_package, tmp_path: Path, monkeypatch
+) -> None:
+    from importlib import metadata
+
+    from kinema.plugins import discovery
+
+    site = tmp_path / "site"
+    installed = make_package("installed_pkg", classes={"Installed": 5}).rename(site)
+    monkeypatch.syspath_prepend(str(installed))
+    entry = metadata.EntryPoint("installed::Loader", "installed_pkg", discovery.ENTRY_POINT_GROUP)
+    monkeypatch.setattr(discovery.metadata, "entry_points", lambda group: [entry])
+
+    host = BehaviorHost(["installed::Loader"], workspace)
+    assert host.load().ok
+    record = host.registry.plugins["installed::Loader"]
+    assert record.spec.source is PluginSource.ENTRY_POINT and record.spec.root is None
+    assert _run(host.registry, "Installed") == 5
+
+    make_package("local_pkg", classes={"Local": 6}, loader="installed::Loader")
+    host = BehaviorHost(["installed::Loader"], workspace)
+    assert host.load().ok
+    assert host.registry.plugins["installed::Loader"].spec.source is PluginSource.WORKSPACE
+    assert list(host.registry) == ["Local"]
