@@ -1,0 +1,121 @@
+"""Fixtures: an agent process on a free loopback port, serving objectives made of BT.CPP built-ins."""
+
+from __future__ import annotations
+
+import os
+import socket
+import subprocess
+import sys
+from collections.abc import Iterator
+from dataclasses import dataclass
+from pathlib import Path
+
+import pytest
+
+OBJECTIVES = """<root BTCPP_format="4">
+  <BehaviorTree ID="Quick">
+    <Sequence><Script code="answer := 42"/></Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Forever">
+    <KeepRunningUntilFailure><Sleep msec="20"/></KeepRunningUntilFailure>
+  </BehaviorTree>
+  <BehaviorTree ID="Short Sleep">
+    <Sequence><Sleep msec="200"/></Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Fails">
+    <Sequence name="main"><AlwaysSuccess/><AlwaysFailure name="broken"/></Sequence>
+  </BehaviorTree>
+  <BehaviorTree ID="Typed">
+    <Sequence>
+      <Sleep msec="{delay}"/>
+      <SetBlackboard value="{greeting}" output_key="echo"/>
+    </Sequence>
+  </BehaviorTree>
+</root>
+"""
+
+
+def free_port() -> int:
+    """A TCP port on 127.0.0.1 nobody listens on right now."""
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+@dataclass
+class AgentProcess:
+    """A running agent: its router endpoint and process."""
+
+    endpoint: str
+    process: subprocess.Popen[bytes]
+    log_file: Path
+
+
+def start_agent(tmp_path: Path, *extra: str) -> AgentProcess:
+    """Start ``python -m kinema.runtime.agent_process`` hosting a router on a free port; wait until ready."""
+    folder = tmp_path / "objectives"
+    folder.mkdir(exist_ok=True)
+    (folder / "builtins.xml").write_text(OBJECTIVES)
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    log_file = tmp_path / "agent.log"
+    read_fd, write_fd = os.pipe()
+    argv = [
+        sys.executable,
+        "-m",
+        "kinema.runtime.agent_process",
+        "--host-router",
+        endpoint,
+        "--objectives",
+        str(folder),
+        "--no-hot-reload",
+        "--log-file",
+        str(log_file),
+        "--ready-fd",
+        str(write_fd),
+        *extra,
+    ]
+    process = subprocess.Popen(argv, pass_fds=(write_fd,), stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+    os.close(write_fd)
+    with os.fdopen(read_fd) as ready:
+        line = ready.readline().strip()
+    if line != "ready":
+        process.kill()
+        _, err = process.communicate(timeout=10)
+        log = log_file.read_text() if log_file.exists() else ""
+        raise RuntimeError(f"agent did not start: {err.decode()}\n{log}")
+    return AgentProcess(endpoint, process, log_file)
+
+
+def stop_agent(agent: AgentProcess) -> None:
+    """SIGTERM the agent and wait; kill it if it hangs."""
+    agent.process.terminate()
+    try:
+        agent.process.wait(10)
+    except subprocess.TimeoutExpired:
+        agent.process.kill()
+        agent.process.wait(5)
+
+
+@pytest.fixture(scope="module")
+def agent(tmp_path_factory: pytest.TempPathFactory) -> Iterator[AgentProcess]:
+    """One agent per test module: every test starts from whatever the previous one left running, which
+    is itself part of what is tested (the server keeps serving)."""
+    running = start_agent(tmp_path_factory.mktemp("agent"))
+    try:
+        yield running
+    finally:
+        stop_agent(running)
+
+
+@pytest.fixture
+def client(agent: AgentProcess) -> Iterator[object]:
+    from kinema.sdk import ObjectiveClient
+
+    with ObjectiveClient(agent.endpoint, timeout=10) as connected:
+        yield connected
+
+
+@pytest.fixture
+def free_endpoint() -> str:
+    """A loopback endpoint nothing listens on."""
+    return f"tcp/127.0.0.1:{free_port()}"

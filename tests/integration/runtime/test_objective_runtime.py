@@ -1,0 +1,280 @@
+"""The objective server in its own process, driven through the SDK over zenoh."""
+
+from __future__ import annotations
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from typing import Any
+
+import pytest
+
+from kinema.errors import TransportError
+from kinema.sdk import MoveItErrorCode, ObjectiveClient, ObjectiveResult, ObjectiveStatus, ParameterOverride
+
+TEST_SIMPLE = """<root BTCPP_format="4" main_tree_to_execute="test simple">
+  <BehaviorTree ID="test simple">
+    <Control ID="Sequence" name="TopLevelSequence">
+      <Action ID="AlwaysSuccess"/>
+    </Control>
+  </BehaviorTree>
+</root>"""
+
+
+def _wait_for(
+    client: ObjectiveClient, status: ObjectiveStatus, name: str | None = None, timeout: float = 10
+) -> None:
+    deadline = time.monotonic() + timeout
+    with client.statuses(timeout=timeout) as stream:
+        for heartbeat in stream:
+            if heartbeat.status is status and (name is None or heartbeat.objective_name == name):
+                return
+            assert time.monotonic() < deadline, f"never saw {status}"
+    raise AssertionError(f"never saw {status} {name or ''}")
+
+
+def test_the_tutorial_xml_sent_to_do_objective_succeeds_with_code_1(client: ObjectiveClient) -> None:
+    handle = client.start(xml=TEST_SIMPLE)
+    result = handle.result(10)
+    assert result == ObjectiveResult(1, "", "test simple")
+    assert handle.status == "SUCCEEDED"
+
+
+def test_cancel_stops_a_looping_objective(client: ObjectiveClient) -> None:
+    handle = client.start("Forever")
+    _wait_for(client, ObjectiveStatus.RUNNING, "Forever")
+    assert handle.cancel()
+    result = handle.result(5)
+    assert result.cancelled and result.error_code == MoveItErrorCode.PREEMPTED
+    assert handle.status == "CANCELED"
+    assert client.status().status in (ObjectiveStatus.CANCELLED, ObjectiveStatus.IDLE)
+
+
+def test_cancel_objective_service_halts_what_runs(client: ObjectiveClient) -> None:
+    handle = client.start("Forever")
+    _wait_for(client, ObjectiveStatus.RUNNING, "Forever")
+    assert client.cancel()
+    assert handle.result(5).cancelled
+    assert not client.cancel()
+
+
+def test_a_new_goal_preempts_the_old_one(client: ObjectiveClient) -> None:
+    first = client.start("Forever")
+    _wait_for(client, ObjectiveStatus.RUNNING, "Forever")
+    second = client.execute("Quick")
+    assert second == ObjectiveResult.success("Quick")
+    preempted = first.result(5)
+    assert preempted.cancelled and "newer" in preempted.error_message
+
+
+def test_valid_overrides_apply(client: ObjectiveClient) -> None:
+    result = client.execute("Typed", {"delay": "10", "greeting": "hello"})
+    assert result == ObjectiveResult.success("Typed")
+    typed = client.execute("Typed", {"delay": 5, "greeting": "[1, 2]"})
+    assert typed.succeeded
+
+
+@pytest.mark.parametrize(
+    ("overrides", "reason"),
+    [
+        ({"delay": "soon", "greeting": "x"}, "'soon' is not a valid int"),
+        ({"delay": 1.5, "greeting": "x"}, "1.5 is not an int"),
+        ({"dealy": "5"}, "did you mean 'delay'"),
+        ([ParameterOverride("delay", "5", ("nowhere",))], "no subtree is named 'nowhere'"),
+    ],
+)
+def test_invalid_overrides_fail_before_the_objective_runs(
+    client: ObjectiveClient, overrides: object, reason: str
+) -> None:
+    result = client.execute("Typed", overrides)  # type: ignore[arg-type]
+    assert result.failed and reason in result.error_message
+    assert "Typed" in result.error_message
+
+
+def test_heartbeat_walks_through_the_states(client: ObjectiveClient) -> None:
+    seen: list[ObjectiveStatus] = []
+    with client.statuses(timeout=10) as stream:
+        handle = client.start("Short Sleep")
+        for heartbeat in stream:
+            if not seen or seen[-1] is not heartbeat.status:
+                seen.append(heartbeat.status)
+            if heartbeat.status is ObjectiveStatus.IDLE and ObjectiveStatus.SUCCESS in seen:
+                break
+    assert handle.result(5).succeeded
+    start = seen.index(ObjectiveStatus.LOADING)
+    assert seen[start:] == [
+        ObjectiveStatus.LOADING,
+        ObjectiveStatus.RUNNING,
+        ObjectiveStatus.SUCCESS,
+        ObjectiveStatus.IDLE,
+    ]
+
+
+def test_heartbeat_comes_at_10_hz(client: ObjectiveClient) -> None:
+    stamps = []
+    with client.statuses(timeout=5) as stream:
+        for heartbeat in stream:
+            stamps.append(heartbeat.process_time)
+            if len(stamps) == 11:
+                break
+    assert 0.5 < stamps[-1] - stamps[1] < 2.0  # nine periods of 0.1 s, loosely
+
+
+def test_failure_names_the_node_and_reaches_the_log_stream(client: ObjectiveClient) -> None:
+    with client.logs(timeout=5) as logs:
+        result = client.execute("Fails")
+        assert result.error_code == MoveItErrorCode.FAILURE
+        assert "node 'broken' [AlwaysFailure]" in result.error_message
+        entry = next(iter(logs))
+    assert entry.level == "error" and "broken" in entry.text
+
+
+def test_the_blackboard_snapshot_is_latched(client: ObjectiveClient) -> None:
+    assert client.execute("Quick").succeeded
+    with client.blackboard(timeout=5) as stream:
+        snapshot = next(iter(stream))
+    assert snapshot.objective_name == "Quick"
+    assert snapshot.as_dict()["Quick"]["answer"] == "42"
+
+
+def test_node_status_changes_are_streamed(client: ObjectiveClient) -> None:
+    with client.node_statuses(timeout=5) as stream:
+        assert client.execute("Fails").failed
+        paths = set()
+        for batch in stream:
+            paths.update(change.node_path for change in batch.changes)
+            if "broken" in paths:
+                break
+    assert {"main", "broken"} <= paths
+
+
+def test_the_objective_list_carries_metadata(client: ObjectiveClient) -> None:
+    names = {info.name: info for info in client.objectives()}
+    assert {"Quick", "Forever", "Fails", "Typed", "Short Sleep"} <= set(names)
+    assert names["Quick"].file_path.endswith("builtins.xml")
+
+
+def test_a_client_killed_mid_goal_does_not_wedge_the_server(agent: Any, client: ObjectiveClient) -> None:
+    script = textwrap.dedent(
+        f"""
+        import sys, time
+        from kinema.sdk import ObjectiveClient
+        client = ObjectiveClient({agent.endpoint!r}, timeout=10)
+        handle = client.start("Forever")
+        print("started", flush=True)
+        handle.result()
+        """
+    )
+    victim = subprocess.Popen([sys.executable, "-c", script], stdout=subprocess.PIPE, text=True)
+    try:
+        assert victim.stdout is not None and victim.stdout.readline().strip() == "started"
+        _wait_for(client, ObjectiveStatus.RUNNING, "Forever")
+        os.kill(victim.pid, signal.SIGKILL)
+        victim.wait(5)
+    finally:
+        if victim.poll() is None:
+            victim.kill()
+    assert client.execute("Quick") == ObjectiveResult.success("Quick")
+    handle = client.start("Forever")
+    _wait_for(client, ObjectiveStatus.RUNNING, "Forever")
+    assert handle.cancel() and handle.result(5).cancelled
+
+
+def test_a_burst_of_200_execute_and_cancel_requests_leaves_the_server_idle(client: ObjectiveClient) -> None:
+    from kinema.runtime import names
+
+    execute = client.node.create_client(names.EXECUTE_OBJECTIVE_TYPE, names.EXECUTE_OBJECTIVE)
+    cancel = client.node.create_client(names.CANCEL_OBJECTIVE_TYPE, names.CANCEL_OBJECTIVE)
+    futures = []
+    for index in range(100):
+        name = "Forever" if index % 3 else "Quick"
+        futures.append(execute.call_async({"objective_name": name}, timeout=60))
+        futures.append(cancel.call_async({}, timeout=60))
+    responses = [future.result(60) for future in futures]
+    codes = {int(r.error_code.val) for r in responses[0::2]}
+    assert codes <= {MoveItErrorCode.SUCCESS, MoveItErrorCode.PREEMPTED}
+    client.cancel()
+    _wait_for(client, ObjectiveStatus.IDLE, timeout=15)
+    assert client.execute("Quick") == ObjectiveResult.success("Quick")
+
+
+@pytest.mark.parametrize(
+    ("xml", "reason"),
+    [
+        ("<root BTCPP_format='4'><BehaviorTree ID='X'><NoSuchNode/></BehaviorTree></root>", "NoSuchNode"),
+        ("<root><BehaviorTree ID='X'><Sequence>", "XML"),
+        ("x" * (10 * 1024 * 1024), "limit is"),
+    ],
+    ids=["unknown node", "broken XML", "10 MB"],
+)
+def test_malformed_xml_gets_an_error_result_and_the_server_keeps_serving(
+    client: ObjectiveClient, xml: str, reason: str
+) -> None:
+    result = client.do_xml(xml, timeout=30)
+    assert isinstance(result, ObjectiveResult) and result.failed
+    assert reason in result.error_message
+    assert client.execute("Quick").succeeded
+
+
+def test_unknown_objectives_and_wrong_types_get_error_results(client: ObjectiveClient) -> None:
+    from kinema.runtime import names
+
+    unknown = client.execute("Quik")
+    assert unknown.failed and "did you mean 'Quick'" in unknown.error_message
+    execute = client.node.create_client(names.EXECUTE_OBJECTIVE_TYPE, names.EXECUTE_OBJECTIVE)
+    bad_type = execute.call(
+        {"objective_name": "Typed", "parameter_overrides": [{"description": {"name": "delay", "type": 9}}]},
+        timeout=10,
+    )
+    assert bad_type.error_code.val == MoveItErrorCode.FAILURE and "type 9" in bad_type.error_code.message
+    garbage = client.node.session.zenoh.get(
+        f"{client.node.session.domain_id}/execute_objective/**", payload=b"\x00\x01\x02", timeout=5
+    )
+    replies = list(garbage)
+    assert replies and all(reply.err is not None for reply in replies)
+    assert client.execute("Quick").succeeded
+
+
+def test_no_runtime_gives_a_clear_transport_error(free_endpoint: str) -> None:
+    with pytest.raises(TransportError, match="no Kinema router answers"):
+        ObjectiveClient(free_endpoint, timeout=0.5)
+
+
+def test_the_cli_exits_non_zero_with_one_line_when_no_runtime_answers(free_endpoint: str) -> None:
+    endpoint = free_endpoint
+    for verb in (["status"], ["run", "Quick"], ["cancel"]):
+        done = subprocess.run(
+            [sys.executable, "-m", "kinema", "objective", *verb, "--connect", endpoint, "--timeout", "0.5"],
+            capture_output=True,
+            text=True,
+            timeout=30,
+        )
+        assert done.returncode == 1
+        assert done.stderr.count("\n") == 1 and done.stderr.startswith("error: no Kinema router answers")
+
+
+def test_the_cli_runs_and_reports_objectives(agent: Any, tmp_path: object) -> None:
+    def kinema(*args: str, stdin: str | None = None) -> subprocess.CompletedProcess[str]:
+        return subprocess.run(
+            [sys.executable, "-m", "kinema", "objective", *args, "--connect", agent.endpoint],
+            capture_output=True,
+            text=True,
+            input=stdin,
+            timeout=60,
+        )
+
+    ok = kinema("run", "Typed", "--param", "delay=5", "--param", "greeting=hi")
+    assert ok.returncode == 0 and "succeeded" in ok.stdout
+    failed = kinema("run", "Fails")
+    assert failed.returncode == 1 and "node 'broken'" in failed.stderr
+    adhoc = kinema("do", "-", stdin=TEST_SIMPLE)
+    assert adhoc.returncode == 0 and "'test simple' succeeded" in adhoc.stdout
+    started = kinema("run", "Forever", "--no-wait")
+    assert started.returncode == 0
+    status = kinema("status")
+    assert status.stdout.strip() in ("Running: Forever", "Loading: Forever")
+    cancelled = kinema("cancel")
+    assert cancelled.returncode == 0 and "cancelled 'Forever'" in cancelled.stdout
