@@ -19,6 +19,7 @@ class BehaviorsScreen(KinemaScreen):
     """The behavior catalog and the hot-reload event list."""
 
     MODE = "behaviors"
+    AUTO_FOCUS = "#behavior-table"
     BINDINGS = [
         Binding("slash", "search", "Search", id="behaviors.search", tooltip="Search behaviors"),
         Binding("f5", "reload", "Reload", id="behaviors.reload", tooltip="List the behaviors again"),

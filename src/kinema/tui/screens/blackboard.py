@@ -35,6 +35,7 @@ class BlackboardScreen(KinemaScreen):
     """The live blackboard of the running (or last) objective."""
 
     MODE = "blackboard"
+    AUTO_FOCUS = "#blackboard-table"
     BINDINGS = [
         Binding("slash", "filter", "Filter", id="blackboard.filter", tooltip="Filter keys, types and values"),
         Binding("escape", "clear_filter", "Clear filter", id="blackboard.clear", tooltip="Show every entry"),

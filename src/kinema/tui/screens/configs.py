@@ -51,6 +51,7 @@ class ConfigsScreen(KinemaScreen):
     """Browse config packages: chain, resolved values with provenance, files."""
 
     MODE = "configs"
+    AUTO_FOCUS = "#config-list"
     BINDINGS = [
         Binding("f5", "reload", "Rescan", id="configs.reload", tooltip="Scan the workspace again"),
         Binding("c", "tab('chain')", "Chain", id="configs.chain", tooltip="The inheritance chain"),

@@ -44,6 +44,7 @@ class LogsScreen(KinemaScreen):
     """The log panel."""
 
     MODE = "logs"
+    AUTO_FOCUS = "#log-panel"
     BINDINGS = [
         Binding("l", "cycle_level", "Level", id="logs.level", tooltip="Cycle the minimum level shown"),
         Binding("ctrl+l", "clear", "Clear", id="logs.clear", tooltip="Clear the log panel"),

@@ -54,6 +54,7 @@ class ObjectivesScreen(KinemaScreen):
     """Browse, inspect and run objectives."""
 
     MODE = "objectives"
+    AUTO_FOCUS = "#objective-list"
     BINDINGS = [
         Binding(
             "r", "run", "Run", id="objectives.run", tooltip="Run the selected objective with the parameters"

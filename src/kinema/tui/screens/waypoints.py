@@ -19,6 +19,7 @@ class WaypointsScreen(KinemaScreen):
     """The saved waypoints of the runtime's config."""
 
     MODE = "waypoints"
+    AUTO_FOCUS = "#waypoint-table"
     BINDINGS = [
         Binding("enter", "move", "Move to", id="waypoints.move", tooltip="Move the robot to the waypoint"),
         Binding(

@@ -1,0 +1,110 @@
+"""Run ``kinema ui`` in a real terminal (tmux) as a person would, and read the screen with ``capture-pane``.
+
+CI needs tmux installed (``apt-get install -y tmux``); without it this test is skipped, saying so.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import subprocess
+import sys
+import time
+import uuid
+from collections.abc import Callable, Iterator
+
+import pytest
+
+pytestmark = pytest.mark.skipif(
+    shutil.which("tmux") is None,
+    reason="tmux is not installed (apt-get install -y tmux); CI should install it",
+)
+
+
+class Terminal:
+    """A detached tmux session on its own server socket, running one command."""
+
+    def __init__(self, command: list[str], width: int = 120, height: int = 34) -> None:
+        self.socket = f"kinema-test-{uuid.uuid4().hex[:8]}"
+        env = {**os.environ, "TERM": "xterm-256color", "KINEMA_WORKSPACE": "", "KINEMA_CONFIG": ""}
+        shell_command = " ".join(_quote(part) for part in command)
+        self._tmux(
+            "new-session", "-d", "-s", "ui", "-x", str(width), "-y", str(height), shell_command, env=env
+        )
+
+    def _tmux(self, *args: str, env: dict[str, str] | None = None) -> str:
+        done = subprocess.run(
+            ["tmux", "-L", self.socket, *args],
+            capture_output=True,
+            text=True,
+            timeout=10,
+            env=env,
+            check=False,
+        )
+        return done.stdout
+
+    def screen(self) -> str:
+        """The visible screen as text."""
+        return self._tmux("capture-pane", "-p", "-t", "ui")
+
+    def press(self, *keys: str) -> None:
+        for key in keys:
+            self._tmux("send-keys", "-t", "ui", key)
+
+    def wait_for(self, check: Callable[[str], bool], what: str, timeout: float = 20.0) -> str:
+        deadline = time.monotonic() + timeout
+        text = ""
+        while time.monotonic() < deadline:
+            text = self.screen()
+            if check(text):
+                return text
+            time.sleep(0.1)
+        raise AssertionError(f"timed out waiting for {what}; the screen shows:\n{text}")
+
+    def alive(self) -> bool:
+        return "ui" in self._tmux("list-sessions", "-F", "#{session_name}")
+
+    def close(self) -> None:
+        self._tmux("kill-server")
+
+
+def _quote(part: str) -> str:
+    return "'" + part.replace("'", "'\"'\"'") + "'"
+
+
+@pytest.fixture
+def terminal() -> Iterator[Terminal]:
+    term = Terminal([sys.executable, "-m", "kinema.cli.main", "ui", "--demo"])
+    try:
+        yield term
+    finally:
+        term.close()
+
+
+def test_a_person_browses_runs_and_quits_in_a_real_terminal(terminal: Terminal) -> None:
+    terminal.wait_for(lambda s: "Pick Object" in s and "connected" in s, "the first paint")
+    first = terminal.wait_for(lambda s: "○ Sleep" in s, "the objective's tree")
+    lines = first.splitlines()
+    assert "1 Configs" in lines[0] and "6 Waypoints" in lines[0]  # every screen is named, with its key
+    assert "● connected fake://runtime" in first  # the status bar
+    assert "r Run" in lines[-1] and "^p palette" in lines[-1]  # the footer lists the bindings
+    assert "○ MoveToWaypoint" in first and "○ Sleep" in first  # the tree, subtree expanded
+
+    terminal.press("r")
+    terminal.wait_for(lambda s: "Run 'Pick Object'" in s, "the run notification")
+
+    terminal.press("3")
+    terminal.wait_for(lambda s: "filter by key" in s and "History" in s, "the Blackboard screen")
+
+    terminal.press("6")
+    waypoints = terminal.wait_for(lambda s: "Look at Table" in s, "the Waypoints screen")
+    assert "★" in waypoints and "Home" in waypoints
+
+    terminal.press("1")
+    terminal.wait_for(lambda s: "example_config" in s and "lab_sim" in s, "the Configs screen")
+
+    terminal.press("q")
+    deadline = time.monotonic() + 10
+    while terminal.alive() and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not terminal.alive(), "q did not close the app"
