@@ -155,3 +155,24 @@ def test_clock_never_runs_ahead_of_wall_time_at_real_time(start_sim: Callable[..
     wall_start = time.monotonic()
     time.sleep(0.5)
     assert sim.joint_states.latest_stamp() - first <= (time.monotonic() - wall_start) + 0.05
+
+
+def test_everything_the_driver_says_it_serves_is_on_the_graph(sim: Sim) -> None:
+    served = sim.driver.interfaces()
+    assert {(i.kind, i.name) for i in served} >= {
+        ("topic", n.CLOCK_TOPIC),
+        ("topic", n.JOINT_STATES_TOPIC),
+        ("action", n.FOLLOW_JOINT_TRAJECTORY_ACTION),
+        ("action", n.GRIPPER_COMMAND_ACTION),
+        ("service", n.LIST_CONTROLLERS_SERVICE),
+        ("service", n.SWITCH_CONTROLLERS_SERVICE),
+        ("service", n.SET_STATE_SERVICE),
+    }
+
+    def all_there() -> bool:
+        graph = sim.node.graph()
+        topics, services, actions = graph.topics(), graph.services(), graph.actions()
+        found = {"topic": topics, "service": services, "action": actions}
+        return all(i.type_name in found[i.kind].get(i.name, []) for i in served)
+
+    wait_for(all_there, what="every served interface on the graph")
