@@ -1,0 +1,114 @@
+"""``kinema run`` starts the agent as a child and ``kinema down`` stops everything; logs land per run."""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+import zipfile
+from collections.abc import Iterator
+from pathlib import Path
+
+import pytest
+
+from kinema.runtime.instance import pid_alive
+from kinema.sdk import ObjectiveClient, ObjectiveStatus
+
+READY = "objectives can be started"
+
+
+@pytest.fixture
+def env(tmp_path: Path, free_endpoint: str) -> dict[str, str]:
+    return {
+        **os.environ,
+        "XDG_STATE_HOME": str(tmp_path / "state"),
+        "KINEMA_ZENOH_CONNECT": free_endpoint,
+        "KINEMA_CONFIG": "lab_sim",
+    }
+
+
+@pytest.fixture
+def kinema_run(env: dict[str, str]) -> Iterator[subprocess.Popen[str]]:
+    process = subprocess.Popen(
+        [sys.executable, "-m", "kinema", "run", "-n", "--headless"],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.STDOUT,
+        text=True,
+        env=env,
+    )
+    try:
+        assert process.stdout is not None
+        lines = []
+        deadline = time.monotonic() + 120
+        while time.monotonic() < deadline:
+            line = process.stdout.readline()
+            if not line:
+                break
+            lines.append(line)
+            if READY in line:
+                break
+        assert READY in "".join(lines), "".join(lines)
+        yield process
+    finally:
+        if process.poll() is None:
+            process.send_signal(signal.SIGINT)
+            try:
+                process.wait(20)
+            except subprocess.TimeoutExpired:
+                process.kill()
+                process.wait(5)
+
+
+def _instance(env: dict[str, str]) -> dict[str, object]:
+    records = list((Path(env["XDG_STATE_HOME"]) / "kinema" / "instances").glob("*.json"))
+    assert len(records) == 1
+    return json.loads(records[0].read_text())  # type: ignore[no-any-return]
+
+
+def _kinema(env: dict[str, str], *args: str) -> subprocess.CompletedProcess[str]:
+    argv = [sys.executable, "-m", "kinema", *args]
+    return subprocess.run(argv, capture_output=True, text=True, env=env, timeout=60)
+
+
+def test_run_serves_objectives_and_down_stops_every_process(
+    kinema_run: subprocess.Popen[str], env: dict[str, str], tmp_path: Path
+) -> None:
+    record = _instance(env)
+    assert record["pid"] == kinema_run.pid and record["config"] == "lab_sim"
+    children = record["children"]
+    assert isinstance(children, list) and len(children) == 1  # -n: the agent only
+    with ObjectiveClient(env["KINEMA_ZENOH_CONNECT"], timeout=10) as client:
+        assert client.status().status is ObjectiveStatus.IDLE
+        assert "Look at Table" in {info.name for info in client.objectives()}
+
+    down = _kinema(env, "down")
+    assert down.returncode == 0 and f"stopped kinema run (pid {kinema_run.pid}" in down.stdout
+    assert kinema_run.wait(20) == 0
+    assert not any(pid_alive(int(pid)) for pid in children)
+    again = _kinema(env, "down")
+    assert again.returncode == 1 and "no Kinema instance is running" in again.stderr
+
+    logs = _kinema(env, "logs")
+    assert logs.returncode == 0 and "agent serving (config lab_sim" in logs.stdout
+    archive = tmp_path / "logs.zip"
+    exported = _kinema(env, "export-logs", "-o", str(archive))
+    assert exported.returncode == 0
+    with zipfile.ZipFile(archive) as zipped:
+        assert {Path(name).name for name in zipped.namelist()} >= {"agent.log", "supervisor.log"}
+
+
+def test_killing_the_supervisor_leaves_no_orphans(
+    kinema_run: subprocess.Popen[str], env: dict[str, str]
+) -> None:
+    children = [int(pid) for pid in _instance(env)["children"]]  # type: ignore[union-attr]
+    os.kill(kinema_run.pid, signal.SIGKILL)
+    kinema_run.wait(10)
+    deadline = time.monotonic() + 15
+    while any(pid_alive(pid) for pid in children) and time.monotonic() < deadline:
+        time.sleep(0.1)
+    assert not any(pid_alive(pid) for pid in children)
+    stale = _kinema(env, "down")
+    assert stale.returncode == 1  # the record of a dead supervisor is stale, not a running instance
