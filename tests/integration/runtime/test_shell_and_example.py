@@ -1,0 +1,41 @@
+"""``kinema shell`` talks to the runtime; ``kinema example add-two-ints-server`` answers AddTwoInts."""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from typing import Any
+
+
+def test_the_shell_has_a_connected_client(agent: Any) -> None:
+    done = subprocess.run(
+        [sys.executable, "-m", "kinema", "shell", "--plain", "--connect", agent.endpoint],
+        input="print('RESULT', client.execute('Quick').succeeded)\n",
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    assert "RESULT True" in done.stdout
+
+
+def test_the_add_two_ints_example_serves_and_prints_requests(agent: Any) -> None:
+    from kinema.transport import Node, open_session
+
+    server = subprocess.Popen(
+        [sys.executable, "-m", "kinema", "example", "add-two-ints-server", "--connect", agent.endpoint],
+        stdout=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        assert server.stdout is not None
+        assert "serving /add_two_ints" in server.stdout.readline()
+        with open_session(agent.endpoint) as session:
+            node = Node(session, "adder")
+            client = node.create_client("example_interfaces/srv/AddTwoInts", "/add_two_ints")
+            assert client.call({"a": 5, "b": 37}, timeout=10).sum == 42
+        assert server.stdout.readline().strip() == "request: a=5 b=37 -> sum=42"
+    finally:
+        server.terminate()
+        server.wait(10)
+    assert server.returncode == 0
