@@ -20,8 +20,13 @@ from kinema.testing import load_behavior_package
 
 def _start_package_tests(package_dir: Path) -> subprocess.Popen[str]:
     env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "1"}
+    from importlib import metadata
+
+    # As `kinema test` does: name the plugin when this environment's metadata predates its entry point.
+    installed = any(entry.name == "kinema" for entry in metadata.entry_points(group="pytest11"))
+    plugin = [] if installed else ["-p", "kinema.testing.plugin"]
     return subprocess.Popen(
-        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", "-p", "no:randomly"],
+        [sys.executable, "-m", "pytest", "-q", "-p", "no:cacheprovider", *plugin],
         cwd=package_dir,
         stdout=subprocess.PIPE,
         stderr=subprocess.STDOUT,
