@@ -36,6 +36,7 @@ from kinema.tui.connection import (
     RuntimeConnection,
     RuntimeEvent,
 )
+from kinema.tui.dialogs.confirm import ConfirmDialog
 from kinema.tui.messages import ModeSelected, RuntimeCallFailed, RuntimeCallSucceeded, RuntimeEventsArrived
 from kinema.tui.runtime_status import RuntimeStatus
 from kinema.tui.screens.base import KinemaScreen
@@ -290,6 +291,21 @@ class KinemaApp(App[None]):
         self.switch_mode(message.mode)
 
     # -- actions and commands -----------------------------------------------------------------------
+
+    async def action_quit(self) -> None:
+        """Close the app; when it owns the runtime (``kinema run``), ask first, since that stops it."""
+        if not self.owns_runtime:
+            self.exit()
+            return
+
+        def answered(stop: bool | None) -> None:
+            if stop:
+                self.exit()
+
+        self.push_screen(
+            ConfirmDialog("Close Kinema? This stops the runtime that `kinema run` started.", "Quit and stop"),
+            answered,
+        )
 
     def action_cancel_objective(self) -> None:
         screen = self.screen
