@@ -18,7 +18,7 @@ from kinema.cli.options import selection_options
 @click.option(
     "--headless",
     is_flag=True,
-    help="No terminal UI. The TUI is not available yet, so every run is headless for now.",
+    help="No terminal UI: just run until Ctrl-C or `kinema down` (the default when not in a terminal).",
 )
 @click.option("-v", "--verbose", is_flag=True, help="Log at DEBUG level and echo the supervisor's log here.")
 @click.option("--no-browser", is_flag=True, help="Do not open the 3D view in a browser.")
@@ -57,8 +57,16 @@ def run(
     found, name = resolve_selection(workspace, config)
     from kinema.runtime.launcher import Launcher, LaunchOptions
 
+    ui = None
     if not headless:
-        click.echo("the terminal UI is not available yet: running headless")
+        import sys
+
+        if sys.stdin.isatty() and sys.stdout.isatty():
+            from kinema.tui.launch import run_for_launcher
+
+            ui = run_for_launcher
+        else:
+            click.echo("not a terminal: running headless (pass --headless to say so)")
     root = getattr(found, "root", None)
     options = LaunchOptions(
         config=name,
@@ -69,6 +77,7 @@ def run(
         verbose=verbose,
         tick_rate_hz=tick_rate,
         echo=click.echo,
+        ui=ui,
     )
     code = Launcher(options).run()
     if code:
