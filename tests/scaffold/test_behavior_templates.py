@@ -181,3 +181,31 @@ def test_an_id_the_config_already_loads_is_refused(workspace: Path) -> None:
     with pytest.raises(ScaffoldError, match=r"'MyBehavior' is already registered by plugin 'kinema::Example"):
         new_behavior("my_behavior", "async", workspace=found, config="example_config")
     assert list((workspace / "src").iterdir()) == []
+
+
+@pytest.mark.parametrize(
+    "text",
+    [
+        "based_on_package: lab_sim\n",
+        "based_on_package: lab_sim\nobjectives:\n",
+        "based_on_package: lab_sim\nobjectives:\n  behavior_loader_plugins:\n"
+        '    core: ["kinema::CoreBehaviorsLoader"]\n',
+    ],
+    ids=["no-objectives", "empty-objectives", "flow-list"],
+)
+def test_add_to_config_handles_sparse_and_flow_style_files(tmp_path: Path, text: str) -> None:
+    import yaml
+
+    from kinema.scaffold.behavior_package import add_to_config
+
+    config = tmp_path / "config.yaml"
+    config.write_text(text)
+    changes = add_to_config(config, "my_pkg", "my_pkg::MyPkgBehaviorsLoader")
+    assert len(changes) == 2
+    data = yaml.safe_load(config.read_text())
+    assert data["objectives"]["behavior_loader_plugins"]["my_pkg"] == ["my_pkg::MyPkgBehaviorsLoader"]
+    assert data["objectives"]["objective_library_paths"]["my_pkg_objectives"] == {
+        "package_name": "my_pkg",
+        "relative_path": "objectives",
+    }
+    assert add_to_config(config, "my_pkg", "my_pkg::MyPkgBehaviorsLoader") == []

@@ -274,11 +274,15 @@ def add_to_config(config_file: Path, package: str, loader: str, *, objectives: b
         raise ConfigError(f"{config_file}: cannot update it, it does not parse: {error}") from None
     if data is None:
         data = CommentedMap()
-    section = data.setdefault("objectives", CommentedMap())
+    section = data.get("objectives")
+    if section is None:  # absent, or an empty `objectives:` key
+        section = data["objectives"] = CommentedMap()
     if not isinstance(section, dict):
         raise ConfigError(f"{config_file}: 'objectives' must be a mapping to add a behavior loader to it")
     changes: list[str] = []
-    loaders = section.setdefault("behavior_loader_plugins", CommentedMap())
+    loaders = section.get("behavior_loader_plugins")
+    if loaders is None:
+        loaders = section["behavior_loader_plugins"] = CommentedMap()
     already = any(loader in (names or []) for names in loaders.values())
     if not already:
         comment = _take_trailing_comment(loaders)
@@ -286,7 +290,9 @@ def add_to_config(config_file: Path, package: str, loader: str, *, objectives: b
         entry.append(loader)
         _put_trailing_comment(loaders, comment)
         changes.append(f"objectives.behavior_loader_plugins.{package}: + {loader}")
-    libraries = section.setdefault("objective_library_paths", CommentedMap())
+    libraries = section.get("objective_library_paths")
+    if libraries is None:
+        libraries = section["objective_library_paths"] = CommentedMap()
     key = f"{package}_objectives"
     if objectives and key not in libraries:
         comment = _take_trailing_comment(libraries)
