@@ -7,8 +7,8 @@ from collections.abc import Callable
 
 import numpy as np
 import pytest
+from driver_harness import ARM, Sim
 
-from conftest import ARM, Sim
 from kinema.cli.main import main
 
 

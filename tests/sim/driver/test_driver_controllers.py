@@ -6,8 +6,8 @@ import time
 from collections.abc import Callable
 
 import numpy as np
+from driver_harness import ARM, GRIPPER, Sim, trajectory, wait_for
 
-from conftest import ARM, GRIPPER, Sim, trajectory, wait_for
 from kinema.drivers.mujoco import names as n
 from kinema.transport import STATUS_ABORTED
 

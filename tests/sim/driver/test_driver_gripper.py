@@ -4,8 +4,8 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
+from driver_harness import GRIPPER, Sim
 
-from conftest import GRIPPER, Sim
 from kinema.drivers.mujoco import names as n
 from kinema.transport import STATUS_SUCCEEDED
 

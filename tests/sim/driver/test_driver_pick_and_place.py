@@ -4,8 +4,8 @@ and bring it back (joint-space moves, no planner), as "3 Waypoints Pick and Plac
 from __future__ import annotations
 
 import numpy as np
+from driver_harness import ARM, Sim, trajectory
 
-from conftest import ARM, Sim, trajectory
 from kinema.config import WaypointStore, resolve_config
 from kinema.drivers.mujoco import names as n
 

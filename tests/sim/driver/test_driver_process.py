@@ -10,8 +10,8 @@ import sys
 from collections.abc import Iterator
 
 import pytest
+from driver_harness import wait_for
 
-from conftest import wait_for
 from kinema.drivers import driver_spec
 from kinema.drivers.mujoco import names as n
 from kinema.transport import Node, open_session

@@ -8,8 +8,8 @@ from typing import Any
 
 import numpy as np
 import pytest
+from driver_harness import ARM, GRIPPER, Sim, trajectory, wait_for
 
-from conftest import ARM, GRIPPER, Sim, trajectory, wait_for
 from kinema.drivers.mujoco import names as n
 from kinema.transport import STATUS_ABORTED
 

@@ -7,8 +7,8 @@ from collections.abc import Callable
 from typing import Any
 
 import numpy as np
+from driver_harness import ARM, Sim, trajectory, wait_for
 
-from conftest import ARM, Sim, trajectory, wait_for
 from kinema.transport import STATUS_ABORTED, STATUS_CANCELED, STATUS_SUCCEEDED
 
 # A reachable, collision-free goal from the default keyframe: rail, pan, lift, elbow, wrists.
