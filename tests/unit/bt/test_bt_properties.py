@@ -186,3 +186,70 @@ def test_subtree_chains_and_cycles_are_reported(length: int) -> None:
         assert "Recursive behavior tree cycle" in error.message
     else:
         raise AssertionError("a cycle of subtrees was accepted")
+
+
+RUNNER_LEAVES = [*LEAVES, '<Work n="1"/>', '<Work n="3"/>', "<AlwaysFailure/>"]
+# SequenceWithMemory keeps its succeeded children after a FAILURE (its memory) and a two-child
+# IfThenElse returns a failed condition without resetting it, both exactly as in BT.CPP: they are
+# left out of the "everything is IDLE again" property.
+RESETTING_CONTROLS = [c for c in CONTROLS if c not in ("SequenceWithMemory", "IfThenElse")]
+
+
+def _work_factory() -> BehaviorTreeFactory:
+    from kinema.bt import StatefulActionNode, input_port
+
+    class Work(StatefulActionNode):
+        @classmethod
+        def provided_ports(cls) -> list:
+            return [input_port("n", int)]
+
+        def on_start(self) -> NodeStatus:
+            self.left = self.get_input("n")
+            return NodeStatus.RUNNING
+
+        def on_running(self) -> NodeStatus:
+            self.left -= 1
+            return NodeStatus.SUCCESS if self.left <= 0 else NodeStatus.RUNNING
+
+    factory = BehaviorTreeFactory()
+    factory.register_node_type(Work, "Work")
+    return factory
+
+
+def running_tree(depth: int) -> st.SearchStrategy[str]:
+    if depth == 0:
+        return st.sampled_from(RUNNER_LEAVES)
+    child = running_tree(depth - 1)
+    controls = st.tuples(st.sampled_from(RESETTING_CONTROLS), st.lists(child, min_size=1, max_size=3)).map(
+        lambda t: f"<{t[0]}>{''.join(t[1])}</{t[0]}>"
+    )
+    decorators = st.tuples(st.sampled_from(DECORATORS), child).map(
+        lambda t: f"<{t[0]}>{t[1]}</{t[0].split()[0]}>"
+    )
+    return st.one_of(st.sampled_from(RUNNER_LEAVES), controls, decorators)
+
+
+@PROPERTY_SETTINGS
+@given(running_tree(3), st.lists(st.sampled_from(["once", "exactly", "halt"]), min_size=1, max_size=8))
+def test_completed_or_halted_trees_leave_every_node_idle(body: str, actions: list[str]) -> None:
+    try:
+        tree = _work_factory().create_tree_from_text(
+            f'<root BTCPP_format="4"><BehaviorTree ID="M">{body}</BehaviorTree></root>'
+        )
+    except KinemaError:
+        return  # e.g. a Switch2 or IfThenElse with the wrong number of children is only checked later
+    try:
+        for action in actions:
+            if action == "halt":
+                tree.halt_tree()
+                status = None
+            else:
+                status = tree.tick_once() if action == "once" else tree.tick_exactly_once()
+            # After SKIPPED, decorators that set RUNNING before ticking keep it, exactly as in BT.CPP.
+            if status is None or status is NodeStatus.SUCCESS or status is NodeStatus.FAILURE:
+                busy = [n.full_path for n in tree.nodes() if n.status is not NodeStatus.IDLE]
+                assert not busy, f"after {action} -> {status}: {busy} not IDLE"
+    except KinemaError as error:
+        assert error.message
+    finally:
+        tree.halt_tree()
