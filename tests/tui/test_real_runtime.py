@@ -157,3 +157,6 @@ def test_the_app_runs_an_objective_on_a_real_runtime_and_follows_a_restart(agent
             await wait_for(pilot, lambda: app.status.status == "Running", "a run after the restart")
 
     asyncio.run(main())
+    assert agent.process is not None and agent.process.poll() is None, (
+        "closing an attached app stopped the runtime"
+    )

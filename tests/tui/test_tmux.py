@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import os
 import shutil
+import socket
 import subprocess
 import sys
 import time
@@ -108,3 +109,35 @@ def test_a_person_browses_runs_and_quits_in_a_real_terminal(terminal: Terminal) 
     while terminal.alive() and time.monotonic() < deadline:
         time.sleep(0.1)
     assert not terminal.alive(), "q did not close the app"
+
+
+def test_kinema_run_opens_the_app_and_closing_it_stops_the_runtime() -> None:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        port = sock.getsockname()[1]
+    command = [
+        sys.executable,
+        "-m",
+        "kinema.cli.main",
+        "run",
+        "-c",
+        "lab_sim",
+        "-n",
+        "--connect",
+        f"tcp/127.0.0.1:{port}",
+    ]
+    term = Terminal(["sh", "-c", " ".join(_quote(p) for p in command) + "; echo KINEMA-EXIT=$?; sleep 30"])
+    try:
+        screen = term.wait_for(
+            lambda s: "● connected" in s and "Hello Tree" in s, "the app on the runtime", 90
+        )
+        assert f"tcp/127.0.0.1:{port}" in screen
+        term.press("q")
+        term.wait_for(lambda s: "This stops the runtime" in s, "the quit question")
+        term.press("y")
+        term.wait_for(lambda s: "KINEMA-EXIT=0" in s, "kinema run to exit", 30)
+        with socket.socket() as probe:  # the router it hosted is gone: nothing listens on its port
+            probe.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            probe.bind(("127.0.0.1", port))
+    finally:
+        term.close()
