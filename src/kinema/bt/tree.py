@@ -151,7 +151,7 @@ class Tree:
         """The node whose ``full_path`` is ``path``.
 
         Raises:
-            KeyError-free ObjectiveError: no node has that path; the message lists some paths.
+            BTRuntimeError: no node has that path; the message suggests the closest paths.
         """
         for node in self.nodes():
             if node.full_path == path:

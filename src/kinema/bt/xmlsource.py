@@ -109,8 +109,11 @@ def parse_xml(text: str | bytes, filename: str = "<string>") -> etree._Element:
         ) from None
     if root is None:
         raise ObjectiveError("the XML document is empty", location=SourceLocation(filename))
-    _check_depth(root, filename)
-    _restore_newlines(root)
+    # Both walks visit every element in Python; skip them when they cannot find anything (most files).
+    if strict.count("<") > MAX_DEPTH:
+        _check_depth(root, filename)
+    if _NEWLINE_MARK in strict:
+        _restore_newlines(root)
     return root
 
 
