@@ -15,6 +15,7 @@ from __future__ import annotations
 import logging
 import threading
 import time
+import weakref
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -44,6 +45,7 @@ log = logging.getLogger("kinema.agent")
 
 # Blackboard values are rendered for display; longer renderings are cut.
 MAX_VALUE_CHARS = 2000
+MAX_LIST_ITEMS = 16
 LOG_ERROR, LOG_WARN, LOG_INFO = 1, 2, 3
 
 
@@ -92,7 +94,7 @@ def render_value(value: Any) -> str:
     from kinema.transport.messages import to_dict
 
     try:
-        data = to_dict(value)
+        data = _clip_lists(to_dict(value))
         if isinstance(data, str | int | float | bool | list | dict | type(None)):
             text = yaml.safe_dump(data, default_flow_style=True, width=1 << 30).strip()
             if text.endswith("\n..."):
@@ -103,6 +105,19 @@ def render_value(value: Any) -> str:
     except Exception:
         text = repr(value)
     return text if len(text) <= MAX_VALUE_CHARS else text[: MAX_VALUE_CHARS - 1] + "…"
+
+
+def _clip_lists(data: Any) -> Any:
+    """Shorten long lists before rendering: the text is cut at MAX_VALUE_CHARS anyway, and YAML-dumping a
+    whole trajectory (hundreds of points) takes a second on the tick thread."""
+    if isinstance(data, dict):
+        return {key: _clip_lists(item) for key, item in data.items()}
+    if isinstance(data, list):
+        head = [_clip_lists(item) for item in data[:MAX_LIST_ITEMS]]
+        if len(data) > MAX_LIST_ITEMS:
+            return [*head, f"... {len(data) - MAX_LIST_ITEMS} more"]
+        return head
+    return data
 
 
 class _Streams:
@@ -240,6 +255,8 @@ class Agent:
         self._streams = _Streams(self.node, clock)
         server.add_listener(self._streams)
         self._goal_runs: dict[bytes, ObjectiveRun] = {}
+        self._quick_runs: weakref.WeakValueDictionary[int, ObjectiveRun] = weakref.WeakValueDictionary()
+        self._quick: list[Any] = []
         self._goal_lock = threading.Lock()
         self._stop = threading.Event()
         self._joint_state: Any = None
@@ -269,6 +286,17 @@ class Agent:
         node.create_service(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, self._on_edit_waypoints)
         if self.waypoints is not None:
             node.create_subscription(names.JOINT_STATES_TYPE, names.JOINT_STATES, self._on_joint_states)
+        from kinema.runtime import quick_protocol as quick
+
+        domain = self.session.domain_id
+        self._quick = [
+            self.session.zenoh.declare_queryable(quick.key(domain, op), handler, complete=True)
+            for op, handler in (
+                (quick.START, self._on_quick_start),
+                (quick.CANCEL, self._on_quick_cancel),
+                (quick.STATUS, self._on_quick_status),
+            )
+        ]
 
     # -- lifecycle -----------------------------------------------------------------------------------
 
@@ -284,6 +312,8 @@ class Agent:
         for unsubscribe in self._unsubscribe:
             unsubscribe()
         self.server.stop()
+        for queryable in self._quick:
+            queryable.undeclare()
         if self._heartbeat_thread.is_alive():
             self._heartbeat_thread.join(1.0)
         self.node.close()
@@ -369,6 +399,77 @@ class Agent:
             # Non-blocking: the tick thread halts the tree right away; the execute thread reports it.
             self.server.cancel(run, reason="goal cancelled", timeout=0)
         return True
+
+    # -- the private JSON endpoints (kinema.runtime.quick_protocol) ----------------------------------------
+
+    def _on_quick_start(self, query: Any) -> None:
+        from kinema.runtime import quick_protocol as quick
+
+        try:
+            body = quick.decode(query.payload.to_bytes() if query.payload is not None else b"")
+            overrides = tuple(
+                ParameterOverride(
+                    str(item["name"]),
+                    item["value"],
+                    tuple(item.get("behavior_namespaces", ())),
+                    from_yaml=isinstance(item["value"], str),
+                )
+                for item in body.get("overrides", ())
+            )
+            request = ObjectiveRequest(
+                str(body.get("objective_name", "")), str(body.get("objective_xml", "")), overrides, "json"
+            )
+        except (ValueError, KeyError, TypeError) as error:
+            with query:
+                query.reply_err(f"bad request: {error}".encode())
+            return
+        run = self.server.submit(request)
+        query.reply(query.key_expr, quick.encode({"event": "accepted", "run_id": run.id}))
+
+        def finish(result: ObjectiveResult) -> None:
+            payload = {
+                "event": "result",
+                "run_id": run.id,
+                "error_code": int(result.error_code),
+                "error_message": result.error_message,
+                "objective_name": result.objective_name,
+            }
+            try:
+                query.reply(query.key_expr, quick.encode(payload))
+            except Exception:
+                log.debug("the JSON client of run %d is gone", run.id, exc_info=True)
+            finally:
+                query.drop()
+
+        with self._goal_lock:
+            self._quick_runs[run.id] = run
+        run.add_done_callback(finish)
+
+    def _on_quick_cancel(self, query: Any) -> None:
+        from kinema.runtime import quick_protocol as quick
+
+        with query:
+            try:
+                body = quick.decode(query.payload.to_bytes() if query.payload is not None else b"")
+            except ValueError as error:
+                query.reply_err(f"bad request: {error}".encode())
+                return
+            run_id = body.get("run_id")
+            name = self.server.status[1]
+            with self._goal_lock:
+                run = self._quick_runs.get(run_id) if run_id is not None else None
+            if run_id is not None and run is None:
+                cancelled = False
+            else:
+                cancelled = self.server.cancel(run, reason="cancelled by a client")
+            query.reply(query.key_expr, quick.encode({"cancelled": cancelled, "objective_name": name}))
+
+    def _on_quick_status(self, query: Any) -> None:
+        from kinema.runtime import quick_protocol as quick
+
+        status, name = self.server.status
+        with query:
+            query.reply(query.key_expr, quick.encode({"status": str(status), "objective_name": name}))
 
     # -- library -----------------------------------------------------------------------------------
 
