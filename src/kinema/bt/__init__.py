@@ -21,7 +21,7 @@ from kinema.bt.errors import (
 )
 from kinema.bt.factory import BehaviorTreeFactory
 from kinema.bt.manifest import NodeManifest, NodeType
-from kinema.bt.model_xml import write_objective_xml, write_tree_nodes_model_xml
+from kinema.bt.model_xml import write_objective_xml, write_tree_nodes_model_xml, write_tree_to_xml
 from kinema.bt.node import (
     ActionNode,
     ConditionNode,
@@ -77,4 +77,5 @@ __all__ = [
     "output_port",
     "write_objective_xml",
     "write_tree_nodes_model_xml",
+    "write_tree_to_xml",
 ]

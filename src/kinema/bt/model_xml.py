@@ -6,11 +6,14 @@ from typing import TYPE_CHECKING
 
 from lxml import etree
 
+from kinema.bt.decorators import SubTreeNode
 from kinema.bt.manifest import NodeManifest
+from kinema.bt.node import TreeNode, node_children
 from kinema.bt.xmlparser import SubtreeModel
 
 if TYPE_CHECKING:
     from kinema.bt.factory import BehaviorTreeFactory
+    from kinema.bt.tree import Tree
 
 
 def manifest_element(manifest: NodeManifest) -> etree._Element:
@@ -89,3 +92,64 @@ def write_objective_xml(
             element.text = None
     etree.indent(root, space="  ")
     return '<?xml version="1.0" encoding="UTF-8"?>\n' + etree.tostring(root, encoding="unicode") + "\n"
+
+
+def _node_element(node: TreeNode, subtree_paths: dict[int, str], add_metadata: bool) -> etree._Element:
+    config = node.config
+    if isinstance(node, SubTreeNode):
+        element = etree.Element("SubTree", ID=node.subtree_id)
+        element.set("_fullpath", subtree_paths.get(node.uid, ""))
+    else:
+        element = etree.Element(node.registration_id, name=node.name)
+    if add_metadata:
+        element.set("_uid", str(node.uid))
+    for port, value in config.input_ports.items():
+        if isinstance(value, str):
+            element.set(port, value)
+    for port, value in config.output_ports.items():
+        if isinstance(value, str) and port not in config.input_ports:
+            element.set(port, value)
+    for key, script in (*config.pre_conditions.items(), *config.post_conditions.items()):
+        element.set(key, script.code)
+    return element
+
+
+def write_tree_to_xml(tree: Tree, add_metadata: bool = True, add_builtin_models: bool = True) -> str:
+    """The instantiated tree as XML (BT.CPP ``WriteTreeToXML``, what Groot2 receives).
+
+    One ``<BehaviorTree ID _fullpath>`` per subtree instance, nodes in compact form with their
+    instance ``name`` (a ``<SubTree>`` gets ``ID`` and ``_fullpath``), ``_uid`` when
+    ``add_metadata``, every port value (declared defaults included) and the pre/post-condition
+    scripts, followed by the ``<TreeNodesModel>`` of the node types.
+    """
+    root = etree.Element("root", BTCPP_format="4")
+    # The subtree instance each SubTree node opened: instances are created right after their node.
+    subtree_paths: dict[int, str] = {}
+    for subtree in tree.subtrees[1:]:
+        parent_path, _, _ = subtree.instance_name.rpartition("/")
+        for candidate in tree.subtrees:
+            if candidate.instance_name != parent_path:
+                continue
+            for node in candidate.nodes:
+                if isinstance(node, SubTreeNode) and node.child is subtree.nodes[0]:
+                    subtree_paths[node.uid] = subtree.instance_name
+    for subtree in tree.subtrees:
+        tree_element = etree.SubElement(root, "BehaviorTree", ID=subtree.tree_id)
+        tree_element.set("_fullpath", subtree.instance_name)
+        if not subtree.nodes:
+            continue
+        stack: list[tuple[TreeNode, etree._Element]] = [(subtree.nodes[0], tree_element)]
+        while stack:
+            node, parent_element = stack.pop()
+            element = _node_element(node, subtree_paths, add_metadata)
+            parent_element.append(element)
+            if not isinstance(node, SubTreeNode):
+                for child in reversed(node_children(node)):
+                    stack.append((child, element))
+    models = etree.SubElement(root, "TreeNodesModel")
+    for _, manifest in sorted(tree.manifests.items()):
+        if manifest.builtin and not add_builtin_models:
+            continue
+        models.append(manifest_element(manifest))
+    etree.indent(root, space="    ")
+    return etree.tostring(root, encoding="unicode") + "\n"

@@ -243,3 +243,34 @@ def test_pre_and_post_tick_callbacks_substitute_results(bench) -> None:
     assert bench.ticks["Real"] == 1
     real.set_post_tick_callback(None)
     assert tree.tick_once() is F
+
+
+def test_write_tree_to_xml_matches_btcpp_layout(bench) -> None:
+    from kinema.bt import write_tree_to_xml
+
+    bench.factory.register_behavior_tree_from_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Main"><Sequence name="root_seq"><Script code="x := 1"/>'
+        '<SubTree ID="Sub" name="sub1" v="{x}"/><Sleep msec="20" _skipIf="x == 2"/></Sequence></BehaviorTree>'
+        '<BehaviorTree ID="Sub"><Fallback><AlwaysFailure/><AlwaysSuccess name="ok"/></Fallback></BehaviorTree>'  # noqa: E501
+        "</root>"
+    )
+    root = etree.fromstring(
+        write_tree_to_xml(bench.factory.create_tree("Main"), add_builtin_models=False).encode()
+    )
+    main, sub = root.findall("BehaviorTree")
+    assert (main.get("ID"), main.get("_fullpath"), sub.get("ID"), sub.get("_fullpath")) == (
+        "Main",
+        "",
+        "Sub",
+        "sub1",
+    )
+    assert [(e.tag, e.get("name"), e.get("_uid")) for e in main.iter() if e is not main] == [
+        ("Sequence", "root_seq", "1"),
+        ("Script", "Script", "2"),
+        ("SubTree", None, "3"),
+        ("Sleep", "Sleep", "7"),
+    ]
+    subtree_call = main.find(".//SubTree")
+    assert subtree_call.attrib == {"ID": "Sub", "_fullpath": "sub1", "_uid": "3", "v": "{x}"}
+    assert main.find(".//Sleep").attrib == {"name": "Sleep", "_uid": "7", "msec": "20", "_skipIf": "x == 2"}
+    assert [e.get("_uid") for e in sub.iter() if e is not sub] == ["4", "5", "6"]
