@@ -123,22 +123,23 @@ timeout_option = click.option(
 
 
 def _client(connect: str | None, timeout: float):  # type: ignore[no-untyped-def]
-    from kinema.sdk import ObjectiveClient
+    # The JSON client: no ROS type system to load, so one-shot commands start fast.
+    from kinema.sdk.quick import QuickClient
 
-    return ObjectiveClient(connect, timeout=timeout)
+    return QuickClient(connect, timeout=timeout)
 
 
-def _finish(handle, wait: bool) -> None:  # type: ignore[no-untyped-def]
+def _finish(run, wait: bool) -> None:  # type: ignore[no-untyped-def]
     """Wait for a started objective (Ctrl-C cancels it) and exit 0 only when it succeeded."""
     if not wait:
-        click.echo(f"started {handle.objective_name!r}")
+        click.echo(f"started {run.objective_name!r}")
         return
     try:
-        result = handle.result()
+        result = run.result()
     except KeyboardInterrupt:
-        click.echo(f"cancelling {handle.objective_name!r} ...", err=True)
-        handle.cancel()
-        result = handle.result(10.0)
+        click.echo(f"cancelling {run.objective_name!r} ...", err=True)
+        run.cancel()
+        result = run.result()
     if result.succeeded:
         click.echo(str(result))
         return
@@ -189,18 +190,13 @@ def do_(file, no_wait: bool, connect: str | None, timeout: float) -> None:  # ty
 def cancel_(connect: str | None, timeout: float) -> None:
     """Cancel the objective that is running (its result is PREEMPTED)."""
     with _client(connect, timeout) as client:
-        status = client.status()
-        if client.cancel():
-            click.echo(f"cancelled {status.objective_name!r}")
-        else:
-            click.echo("no objective was running")
+        cancelled, name = client.cancel()
+    click.echo(f"cancelled {name!r}" if cancelled else "no objective was running")
 
 
 @objective.command("status")
 @click.option("-f", "--follow", is_flag=True, help="Keep printing every status change (Ctrl-C stops).")
-@click.option(
-    "--json", "as_json", is_flag=True, help='Print {"status", "objective_name", "process_time", ...}.'
-)
+@click.option("--json", "as_json", is_flag=True, help="Print each status as one JSON object.")
 @connect_option
 @timeout_option
 def status_(follow: bool, as_json: bool, connect: str | None, timeout: float) -> None:
@@ -215,18 +211,26 @@ def status_(follow: bool, as_json: bool, connect: str | None, timeout: float) ->
         else:
             click.echo(str(status))
 
-    with _client(connect, timeout) as client:
+    if not follow:
+        with _client(connect, timeout) as quick:
+            status, name = quick.status()
+        if as_json:
+            click.echo(json.dumps({"status": str(status), "objective_name": name}))
+        else:
+            click.echo(f"{status}: {name}" if name else str(status))
+        return
+    from kinema.sdk import ObjectiveClient
+
+    with ObjectiveClient(connect, timeout=timeout) as client:
         current = client.status()
         show(current)
-        if not follow:
-            return
         last = (current.status, current.objective_name)
         try:
             # Heartbeats stop when the runtime goes away; say so instead of waiting forever.
-            for status in client.statuses(timeout=max(timeout, 2.0)):
-                if (status.status, status.objective_name) != last:
-                    last = (status.status, status.objective_name)
-                    show(status)
+            for heartbeat in client.statuses(timeout=max(timeout, 2.0)):
+                if (heartbeat.status, heartbeat.objective_name) != last:
+                    last = (heartbeat.status, heartbeat.objective_name)
+                    show(heartbeat)
         except KeyboardInterrupt:
             return
         click.secho("the runtime stopped sending heartbeats", err=True, fg="red")

@@ -11,6 +11,7 @@ from kinema.runtime.objective_status import ObjectiveStatus
 from kinema.runtime.overrides import ParameterOverride
 from kinema.runtime.result import ObjectiveResult
 from kinema.sdk.client import ObjectiveClient, ObjectiveHandle, parameter_messages
+from kinema.sdk.quick import QuickClient, QuickRun
 from kinema.sdk.streams import BlackboardSnapshot, BlackboardValue, LogEntry, MessageStream, ServerStatus
 
 __all__ = [
@@ -24,6 +25,8 @@ __all__ = [
     "ObjectiveResult",
     "ObjectiveStatus",
     "ParameterOverride",
+    "QuickClient",
+    "QuickRun",
     "ServerStatus",
     "parameter_messages",
 ]

@@ -19,6 +19,7 @@ no runtime answers within the client's ``timeout``.
 
 from __future__ import annotations
 
+import re
 import threading
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
@@ -146,6 +147,7 @@ class ObjectiveClient:
         self._clients: dict[str, ServiceClient] = {}
         self._action: ActionClient | None = None
         self._ready = False
+        self._action_ready = False
 
     # -- plumbing ------------------------------------------------------------------------------------
 
@@ -208,8 +210,10 @@ class ObjectiveClient:
             raise TransportError("start() needs an objective name or an objective XML string")
         self.wait_for_runtime()
         action = self._do_objective()
-        if not action.wait_for_server(self.timeout):
-            raise TransportError(f"the agent's {names.DO_OBJECTIVE} action is not available")
+        if not self._action_ready:
+            if not action.wait_for_server(self.timeout):
+                raise TransportError(f"the agent's {names.DO_OBJECTIVE} action is not available")
+            self._action_ready = True
         goal = {
             "objective_name": name,
             "objective_xml_string": xml,
@@ -310,10 +314,15 @@ class ObjectiveClient:
         return f"<ObjectiveClient {self.session!r}>"
 
 
-def _xml_name(xml: str) -> str:
-    try:
-        from kinema.runtime.objective_server import main_tree_id
+_MAIN_TREE = re.compile(r"""main_tree_to_execute\s*=\s*["']([^"']+)["']""")
+_TREE_IDS = re.compile(r"""<BehaviorTree\b[^>]*?\bID\s*=\s*["']([^"']+)["']""")
 
-        return main_tree_id(xml)
-    except Exception:
-        return "<objective XML>"
+
+def _xml_name(xml: str) -> str:
+    """The name the agent will report for an XML objective (without loading the BT engine here)."""
+    head = xml[:65536]
+    found = _MAIN_TREE.search(head)
+    if found:
+        return found.group(1)
+    ids = _TREE_IDS.findall(head)
+    return ids[0] if len(ids) == 1 else "<objective XML>"

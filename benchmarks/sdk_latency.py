@@ -1,0 +1,199 @@
+"""Round trip of a trivial objective through the SDK, against the raw zenoh query floor, and CLI cold start.
+
+An agent process (``python -m kinema.runtime.agent_process``) hosts the router on a free loopback port
+and serves one objective, ``Trivial`` (a single AlwaysSuccess). An echo process joins the same router
+with a raw zenoh queryable. This process then times, one after the other:
+
+* the raw zenoh query round trip to the echo process (64-byte payload): the floor;
+* ``ObjectiveClient.execute("Trivial")`` (``/execute_objective``: load, tick, reply);
+* ``ObjectiveClient.do_xml(...)`` (the ``/do_objective`` action: send_goal, then get_result);
+* the wall time of a cold ``kinema objective do FILE`` (a new interpreter each time), next to a cold
+  ``python -c pass`` measured in the same run.
+
+Targets: execute p50 under 5 ms; a cold ``kinema objective do`` under 400 ms.
+Run: ``python benchmarks/sdk_latency.py [--calls N] [--warmup N] [--cold N]``.
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import socket
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from collections.abc import Callable
+from pathlib import Path
+
+TRIVIAL = """<root BTCPP_format="4" main_tree_to_execute="Trivial">
+  <BehaviorTree ID="Trivial"><AlwaysSuccess/></BehaviorTree>
+</root>
+"""
+ECHO_KEY = "kinema_bench/echo"
+ECHO_SERVER = """
+import sys, zenoh
+from kinema.transport import open_session
+with open_session(sys.argv[1]) as session:
+    q = session.zenoh.declare_queryable(sys.argv[2], lambda query: query.reply(query.key_expr, query.payload),
+                                        complete=True)
+    print("ready", flush=True)
+    sys.stdin.read()
+"""
+
+
+def free_port() -> int:
+    with socket.socket() as sock:
+        sock.bind(("127.0.0.1", 0))
+        return int(sock.getsockname()[1])
+
+
+def percentiles(samples_ns: list[int]) -> tuple[float, float]:
+    """(p50, p99) in milliseconds."""
+    ordered = sorted(samples_ns)
+    return statistics.median(ordered) / 1e6, ordered[min(len(ordered) - 1, int(len(ordered) * 0.99))] / 1e6
+
+
+def time_calls(call: Callable[[], object], calls: int, warmup: int) -> list[int]:
+    for _ in range(warmup):
+        call()
+    samples = []
+    for _ in range(calls):
+        start = time.perf_counter_ns()
+        call()
+        samples.append(time.perf_counter_ns() - start)
+    return samples
+
+
+def start_agent(folder: Path, endpoint: str) -> subprocess.Popen[bytes]:
+    read_fd, write_fd = os.pipe()
+    argv = [
+        sys.executable,
+        "-m",
+        "kinema.runtime.agent_process",
+        "--host-router",
+        endpoint,
+        "--objectives",
+        str(folder),
+        "--no-hot-reload",
+        "--log-file",
+        str(folder / "agent.log"),
+        "--ready-fd",
+        str(write_fd),
+    ]
+    process = subprocess.Popen(argv, pass_fds=(write_fd,))
+    os.close(write_fd)
+    with os.fdopen(read_fd) as ready:
+        if ready.readline().strip() != "ready":
+            process.kill()
+            raise SystemExit(f"the agent did not start; see {folder / 'agent.log'}")
+    return process
+
+
+def cold_runs(argv: list[str], runs: int, env: dict[str, str]) -> list[float]:
+    times = []
+    for _ in range(runs):
+        start = time.perf_counter()
+        done = subprocess.run(argv, capture_output=True, env=env)
+        times.append(time.perf_counter() - start)
+        if done.returncode != 0:
+            raise SystemExit(f"{' '.join(argv)} failed: {done.stderr.decode()}")
+    return times
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(
+        description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter
+    )
+    parser.add_argument("--calls", type=int, default=1000)
+    parser.add_argument("--warmup", type=int, default=100)
+    parser.add_argument("--cold", type=int, default=5, help="cold CLI runs")
+    args = parser.parse_args()
+
+    from kinema.sdk import ObjectiveClient
+
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    with tempfile.TemporaryDirectory() as tmp:
+        folder = Path(tmp)
+        (folder / "trivial.xml").write_text(TRIVIAL)
+        agent = start_agent(folder, endpoint)
+        echo = subprocess.Popen(
+            [sys.executable, "-c", ECHO_SERVER, endpoint, ECHO_KEY],
+            stdin=subprocess.PIPE,
+            stdout=subprocess.PIPE,
+            text=True,
+        )
+        try:
+            assert echo.stdout is not None and echo.stdout.readline().strip() == "ready"
+            with ObjectiveClient(endpoint, timeout=10) as client:
+                session = client.session.zenoh
+                payload = b"x" * 64
+
+                def raw() -> None:
+                    replies = list(session.get(ECHO_KEY, payload=payload, timeout=5))
+                    assert replies and replies[0].ok is not None
+
+                deadline = time.monotonic() + 10
+                while not any(r.ok is not None for r in session.get(ECHO_KEY, payload=payload, timeout=1)):
+                    if time.monotonic() > deadline:
+                        raise SystemExit("the echo queryable never answered")
+                    time.sleep(0.05)
+
+                def execute() -> None:
+                    result = client.execute("Trivial")
+                    assert result.succeeded, result
+
+                def do_xml() -> None:
+                    result = client.do_xml(TRIVIAL)
+                    assert result.succeeded, result
+
+                rows = [
+                    ("raw zenoh query (floor)", time_calls(raw, args.calls, args.warmup)),
+                    ("SDK execute (/execute_objective)", time_calls(execute, args.calls, args.warmup)),
+                    (
+                        "SDK do_xml (/do_objective action)",
+                        time_calls(do_xml, args.calls // 4, args.warmup // 4),
+                    ),
+                ]
+            floor = percentiles(rows[0][1])[0]
+            print(f"{'case':<36} {'p50 ms':>8} {'p99 ms':>8} {'p50 / floor':>12}")
+            for name, samples in rows:
+                p50, p99 = percentiles(samples)
+                print(f"{name:<36} {p50:8.3f} {p99:8.3f} {p50 / floor:11.1f}x")
+            target = percentiles(rows[1][1])[0]
+            print(f"execute p50 target < 5 ms: {'met' if target < 5 else 'NOT met'} ({target:.2f} ms)")
+
+            env = {**os.environ, "KINEMA_ZENOH_CONNECT": endpoint}
+            xml_file = folder / "trivial_do.xml"
+            xml_file.write_text(TRIVIAL)
+            baseline = cold_runs([sys.executable, "-c", "pass"], args.cold, env)
+            sdk_import = cold_runs([sys.executable, "-c", "import kinema.sdk"], args.cold, env)
+            cli = cold_runs(
+                [sys.executable, "-m", "kinema", "objective", "do", str(xml_file)], args.cold, env
+            )
+            print()
+            print(f"{'cold start (median of ' + str(args.cold) + ')':<36} {'ms':>8} {'vs python':>12}")
+            base = statistics.median(baseline)
+            for name, times in (
+                ("python -c pass", baseline),
+                ("python -c 'import kinema.sdk'", sdk_import),
+                ("kinema objective do FILE", cli),
+            ):
+                median = statistics.median(times)
+                print(f"{name:<36} {median * 1000:8.0f} {median / base:11.1f}x")
+            cold = statistics.median(cli) * 1000
+            print(
+                f"cold `kinema objective do` target < 400 ms: {'met' if cold < 400 else 'NOT met'} "
+                f"({cold:.0f} ms)"
+            )
+        finally:
+            if echo.stdin is not None:
+                echo.stdin.close()
+            echo.wait(10)
+            agent.terminate()
+            agent.wait(10)
+
+
+if __name__ == "__main__":
+    main()
