@@ -47,6 +47,7 @@ log = logging.getLogger("kinema.agent")
 MAX_VALUE_CHARS = 2000
 MAX_LIST_ITEMS = 16
 LOG_ERROR, LOG_WARN, LOG_INFO = 1, 2, 3
+DO_OBJECTIVE_RESULT_KEEP_S = 60.0
 
 
 def _stamp(seconds: float) -> dict[str, int]:
@@ -279,6 +280,9 @@ class Agent:
             names.DO_OBJECTIVE,
             self._on_do_objective,
             cancel_callback=self._on_cancel_goal,
+            # Ended goals stay in the (latched) status array this long: long enough for a client to
+            # fetch a result, short enough that a busy server does not publish thousands of them.
+            result_timeout=DO_OBJECTIVE_RESULT_KEEP_S,
         )
         node.create_service(names.LIST_OBJECTIVES_TYPE, names.LIST_OBJECTIVES, self._on_list_objectives)
         node.create_service(names.GET_OBJECTIVE_XML_TYPE, names.GET_OBJECTIVE_XML, self._on_get_objective_xml)
