@@ -98,3 +98,20 @@ def test_a_faulty_behavior_fails_its_objective_with_a_named_cause_and_the_runtim
         assert f"behavior '{behavior}' of plugin 'faulty::TestLoader'" in message, message
         assert "culprit" in message and cause in message and "behaviors.py:" in message
         assert client.execute("MyAdder Example").succeeded
+
+
+def test_a_broken_save_is_a_toast_with_file_and_line_and_the_last_good_version_keeps_running(
+    workspace: Path, kinema_runtime
+) -> None:
+    _workspace(workspace)
+    client = kinema_runtime("my_config", workspace=workspace, hot_reload=True).client
+    logs = client.logs(timeout=10)
+    module = workspace / "src" / "my_adder" / "my_adder" / "my_adder.py"
+    text = module.read_text()
+    module.write_text(text.replace("async def do_work(self) -> bool:", "async def do_work(self) -> bool"))
+    line = text.splitlines().index("    async def do_work(self) -> bool:") + 1
+    toast = next(entry for entry in logs if "not reloaded" in entry.text)
+    logs.close()
+    assert toast.level == "error"
+    assert f"{module}:{line}" in toast.text and "SyntaxError" in toast.text
+    assert client.execute("MyAdder Example").succeeded
