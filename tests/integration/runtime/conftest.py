@@ -119,3 +119,13 @@ def client(agent: AgentProcess) -> Iterator[object]:
 def free_endpoint() -> str:
     """A loopback endpoint nothing listens on."""
     return f"tcp/127.0.0.1:{free_port()}"
+
+
+@pytest.fixture
+def sim_agent(tmp_path: Path) -> Iterator[AgentProcess]:
+    """An agent whose clock follows /clock (as with a simulator), with nothing publishing it yet."""
+    running = start_agent(tmp_path, "--clock", "sim")
+    try:
+        yield running
+    finally:
+        stop_agent(running)

@@ -1,0 +1,26 @@
+"""With a simulator, time-based nodes follow /clock: frozen sim time holds a Sleep, fast sim time ends it."""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+
+def test_sleep_follows_the_simulation_clock(sim_agent: Any) -> None:
+    from kinema.sdk import ObjectiveClient, ObjectiveStatus
+
+    with ObjectiveClient(sim_agent.endpoint, timeout=10) as client:
+        clock = client.node.create_publisher("rosgraph_msgs/msg/Clock", "/clock")
+        handle = client.start("Short Sleep")  # Sleep msec=200, in sim time
+        time.sleep(0.6)  # three times the sleep in wall time, while the simulation does not move
+        assert not handle.done
+        assert client.status().status is ObjectiveStatus.RUNNING
+        started = time.monotonic()
+        for step in range(1, 200):
+            # 50 ms of sim time per message: a simulation running 10x faster than real time
+            clock.publish({"clock": {"sec": step // 20, "nanosec": (step % 20) * 50_000_000}})
+            if handle.done:
+                break
+            time.sleep(0.005)
+        assert handle.result(5).succeeded
+        assert time.monotonic() - started < 0.6
