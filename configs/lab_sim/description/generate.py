@@ -492,11 +492,14 @@ def render_scene() -> str:
         "  </tendon>",
         "  <equality>",
         # The fingers move together; the knuckle (a light visual link) follows them, so the knuckle joint
-        # reports the real opening and no grip force has to flow through a soft coupling.
+        # reports the real opening and no grip force has to flow through a soft coupling. Both couplings
+        # are stiff: with the default solref the light knuckle rings for ~100 ms after the arm stops,
+        # which /joint_states would report as gripper motion.
         '    <joint name="finger_coupling" joint1="robotiq_85_right_finger_joint" '
         'joint2="robotiq_85_left_finger_joint" solref="0.004 1"/>',
         f'    <joint name="knuckle_follows_fingers" joint1="robotiq_85_left_knuckle_joint" '
-        f'joint2="robotiq_85_left_finger_joint" polycoef="0 {_f(1 / FINGER_PER_KNUCKLE)} 0 0 0"/>',
+        f'joint2="robotiq_85_left_finger_joint" polycoef="0 {_f(1 / FINGER_PER_KNUCKLE)} 0 0 0" '
+        'solref="0.004 1"/>',
         "  </equality>",
         "  <actuator>",
         *actuators,
