@@ -42,14 +42,27 @@ class ConversionError(BTRuntimeError):
     """A value could not be converted to the requested type."""
 
 
+def int64_from_digits(digits: str, base: int = 10) -> int | None:
+    """``int(digits, base)`` if it fits int64, else None.
+
+    Overlong inputs are rejected by length first: besides being out of range, Python refuses to
+    convert decimal strings of more than 4300 digits.
+    """
+    significant = digits.lstrip("-+").lstrip("0")
+    if len(significant) > (20 if base == 10 else 17):
+        return None
+    value = int(digits, base)
+    return value if INT64_MIN <= value <= INT64_MAX else None
+
+
 def parse_int_prefix(text: str) -> int:
     """``std::from_chars`` for int64: a leading integer (prefix is enough, no space, no '+')."""
     match = _INT_PREFIX.match(text)
     if match is None:
-        raise ConversionError(f"Can't convert string [{text}] to integer")
-    value = int(match.group())
-    if value < INT64_MIN or value > INT64_MAX:
-        raise ConversionError(f"Value out of bound when converting [{text}] to integer")
+        raise ConversionError(f"Can't convert string [{text[:80]}] to integer")
+    value = int64_from_digits(match.group())
+    if value is None:
+        raise ConversionError(f"Value out of bound when converting [{text[:80]}] to integer")
     return value
 
 
@@ -59,18 +72,21 @@ def parse_double_prefix(text: str) -> float:
     if match is None:
         raise ConversionError(f"Can't convert string [{text}] to double")
     token = match.group()
-    if token.lower().startswith(("nan", "-nan")):
+    lowered = token.lower()
+    if lowered.startswith(("nan", "-nan")):
         return math.nan
-    return float(token)
+    value = float(token)
+    if math.isinf(value) and "inf" not in lowered:
+        # from_chars reports result_out_of_range instead of rounding to infinity
+        raise ConversionError(f"Value out of bound when converting [{text[:80]}] to double")
+    return value
 
 
 def parse_int_full(text: str) -> int | None:
     """The whole text as an int64, or None (used where BT.CPP requires full consumption)."""
-    match = _INT_PREFIX.fullmatch(text)
-    if match is None:
+    if _INT_PREFIX.fullmatch(text) is None:
         return None
-    value = int(text)
-    return value if INT64_MIN <= value <= INT64_MAX else None
+    return int64_from_digits(text)
 
 
 def parse_double_full(text: str) -> float | None:

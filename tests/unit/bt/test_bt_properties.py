@@ -41,7 +41,7 @@ def test_token_soup_scripts_fail_only_with_kinema_errors(tokens: list[str]) -> N
 
 
 @PROPERTY_SETTINGS
-@given(st.text(max_size=60))
+@given(st.one_of(st.text(max_size=60), st.from_regex(r"-?(0x)?[0-9a-fA-F.e]{1,6000}", fullmatch=True)))
 def test_arbitrary_text_scripts_fail_only_with_kinema_errors(code: str) -> None:
     try:
         parse_script(code).run(Blackboard.create(), {})

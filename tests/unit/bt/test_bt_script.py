@@ -205,6 +205,28 @@ def test_logic_operators_evaluate_both_sides() -> None:
     assert bb.get("x") == 1  # no short-circuit, as in BT.CPP
 
 
+@pytest.mark.parametrize(
+    ("code", "expected"),
+    [
+        ("9" * 5000, 0),
+        ("0x" + "F" * 5000, 0),
+        ("9223372036854775807", 2**63 - 1),
+    ],
+)
+def test_overlong_numbers_behave_like_from_chars(code: str, expected: object) -> None:
+    assert run(code) == expected  # an int64 overflow leaves 0, as std::from_chars does
+
+
+def test_an_out_of_range_real_literal_is_a_parse_error() -> None:
+    with pytest.raises(ScriptParseError, match="out of bound"):
+        parse_script("1e" + "9" * 5000)
+
+
+def test_bitwise_operators_need_int64_operands() -> None:
+    with pytest.raises(ScriptError, match="Binary operators are not allowed"):
+        run("1e300 | 1")
+
+
 def test_deep_nesting_is_a_parse_error_not_a_crash() -> None:
     with pytest.raises(ScriptParseError, match="nests deeper"):
         parse_script("(" * 5000 + "1" + ")" * 5000)

@@ -55,8 +55,11 @@ def to_int64(v: Any) -> int:
     if isinstance(v, float):
         if not v.is_integer():
             raise EvalError("Floating point truncated")
-        return int(v)
-    return int(v)
+        v = int(v)
+    value = int(v)
+    if value < -(2**63) or value > 2**63 - 1:
+        raise EvalError("Value outside the int64 range")
+    return value
 
 
 def string_to_double(text: str, enums: dict[str, int] | None) -> float:

@@ -10,8 +10,8 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
-from kinema.bt.conversions import parse_double_prefix
-from kinema.bt.errors import ScriptError, ScriptParseError
+from kinema.bt.conversions import int64_from_digits, parse_double_prefix
+from kinema.bt.errors import BTError, ScriptError, ScriptParseError
 from kinema.bt.script.ast import Assignment, Binary, Comparison, Expr, Literal, Name, Ternary, Unary
 from kinema.bt.script.tokenizer import Tok, Token, tokenize
 
@@ -149,14 +149,16 @@ class _Parser:
         elif kind is Tok.INTEGER:
             self.advance()
             text = token.text
-            value = int(text[2:], 16) if text[:2] in ("0x", "0X") else int(text)
-            if value > 2**63 - 1:
-                # from_chars leaves the value untouched (0) when it overflows int64
-                value = 0
-            return Literal(value)
+            is_hex = text[:2] in ("0x", "0X")
+            value = int64_from_digits(text[2:] if is_hex else text, 16 if is_hex else 10)
+            # from_chars leaves the value untouched (0) when it overflows int64
+            return Literal(0 if value is None else value)
         elif kind is Tok.REAL:
             self.advance()
-            return Literal(parse_double_prefix(token.text))
+            try:
+                return Literal(parse_double_prefix(token.text))
+            except BTError as error:
+                raise ScriptParseError(f"Invalid number '{token.text[:40]}': {error.message}") from None
         elif kind is Tok.STRING:
             self.advance()
             return Literal(token.text)
