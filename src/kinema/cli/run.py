@@ -84,22 +84,6 @@ def run(
         raise click.exceptions.Exit(code)
 
 
-def _terminal_ui():  # type: ignore[no-untyped-def]
-    """The TUI entry point for the launcher, or None (with a note) when it cannot run here."""
-    import importlib.util
-    import sys
-
-    if not (sys.stdin.isatty() and sys.stdout.isatty()):
-        click.echo("not in a terminal: running headless")
-        return None
-    if importlib.util.find_spec("kinema.tui.launch") is None:
-        click.echo("the terminal UI is not installed: running headless")
-        return None
-    from kinema.tui.launch import run_for_launcher
-
-    return run_for_launcher
-
-
 def _list_configs(workspace: Path | None) -> None:
     from kinema.config import Workspace, list_config_packages
 
