@@ -278,3 +278,27 @@ def test_the_cli_runs_and_reports_objectives(agent: Any, tmp_path: object) -> No
     assert status.stdout.strip() in ("Running: Forever", "Loading: Forever")
     cancelled = kinema("cancel")
     assert cancelled.returncode == 0 and "cancelled 'Forever'" in cancelled.stdout
+
+
+def test_the_json_endpoints_start_cancel_and_refuse_garbage(agent: Any) -> None:
+    from kinema.runtime import quick_protocol
+    from kinema.sdk import QuickClient
+
+    with QuickClient(agent.endpoint, timeout=10) as quick:
+        run = quick.start("Typed", {"delay": "5", "greeting": "hi"})
+        assert run.result() == ObjectiveResult.success("Typed")
+        looping = quick.start("Forever")
+        deadline = time.monotonic() + 5
+        while quick.status() != (ObjectiveStatus.RUNNING, "Forever"):
+            assert time.monotonic() < deadline
+            time.sleep(0.01)
+        assert looping.cancel()
+        assert looping.result().cancelled
+        assert not looping.cancel()
+        replies = list(
+            quick._session.get(
+                quick_protocol.key(quick.domain_id, quick_protocol.START), payload=b"{nope", timeout=5
+            )
+        )
+        assert len(replies) == 1 and "bad request" in replies[0].err.payload.to_string()
+        assert quick.start("Quick").result().succeeded
