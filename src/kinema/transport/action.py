@@ -119,6 +119,10 @@ class ServerGoalHandle:
         self.cancel_requested_event = threading.Event()
         self._waiters: list[Responder] = []
         self._lock = threading.Lock()
+        # Built once: the status array repeats it for every goal on every status change.
+        self.goal_info = from_dict(
+            "action_msgs/msg/GoalInfo", {"goal_id": _uuid_dict(goal_id), "stamp": self.stamp}
+        )
 
     @property
     def goal_uuid(self) -> uuid.UUID:
@@ -156,9 +160,8 @@ class ServerGoalHandle:
             if isinstance(feedback, dict) or feedback is None
             else feedback
         )
-        self.server._feedback.publish(
-            from_dict(action.feedback_message, {"goal_id": _uuid_dict(self.goal_id), "feedback": message})
-        )
+        feedback_message = self.server._feedback_class(goal_id=self.goal_info.goal_id, feedback=message)
+        self.server._feedback.publish(feedback_message)
 
     def succeed(self, result: Any = None) -> None:
         """End the goal as SUCCEEDED with ``result`` (message, dict, or None for defaults)."""
@@ -244,15 +247,21 @@ class ActionServer:
         goal_callback: GoalCallback | None = None,
         cancel_callback: CancelCallback | None = None,
         result_timeout: float = 900.0,
+        max_finished_goals: int = 100,
     ) -> None:
         self.node = node
-        self.action: ActionType = node.session.registry.action(action_type)
+        registry = node.session.registry
+        self.action: ActionType = registry.action(action_type)
         self.name = _action_names(node, name)
         self.type_name = self.action.name
         self._execute_callback = execute_callback
         self._goal_callback = goal_callback
         self._cancel_callback = cancel_callback
         self._result_timeout = result_timeout
+        self._max_finished = max_finished_goals
+        self._feedback_class = registry.message_class(self.action.feedback_message)
+        self._status_class = registry.message_class(self.action.status)
+        self._goal_status_class = registry.message_class("action_msgs/msg/GoalStatus")
         self._goals: dict[bytes, ServerGoalHandle] = {}
         self._lock = threading.RLock()
         self._closed = False
@@ -372,7 +381,7 @@ class ActionServer:
         code = CANCEL_ERROR_NONE if canceling or not active else CANCEL_ERROR_REJECTED
         return {
             "return_code": code,
-            "goals_canceling": [{"goal_id": _uuid_dict(g.goal_id), "stamp": g.stamp} for g in canceling],
+            "goals_canceling": [g.goal_info for g in canceling],
         }
 
     def _publish_status(self) -> None:
@@ -380,15 +389,24 @@ class ActionServer:
             return
         now = time.monotonic()
         with self._lock:
-            for goal_id, handle in list(self._goals.items()):
-                if handle.terminated_at is not None and now - handle.terminated_at > self._result_timeout:
-                    del self._goals[goal_id]
-            statuses = [
-                {"goal_info": {"goal_id": _uuid_dict(h.goal_id), "stamp": h.stamp}, "status": h.status}
-                for h in self._goals.values()
+            finished = sorted(
+                ((h.terminated_at, h) for h in self._goals.values() if h.terminated_at is not None),
+                key=lambda pair: pair[0],
+            )
+            # Results stay available for result_timeout, but at most max_finished_goals of them, so a
+            # burst of goals does not make every status message (and get_result lookup) grow forever.
+            surplus = max(0, len(finished) - self._max_finished)
+            expired = [
+                h
+                for index, (ended, h) in enumerate(finished)
+                if index < surplus or now - ended > self._result_timeout
             ]
+            for handle in expired:
+                del self._goals[handle.goal_id]
+            make = self._goal_status_class
+            statuses = [make(goal_info=h.goal_info, status=h.status) for h in self._goals.values()]
             try:
-                self._status.publish(from_dict(self.action.status, {"status_list": statuses}))
+                self._status.publish(self._status_class(status_list=statuses))
             except TransportError:
                 log.debug("status publisher of %s closed", self.name)
 

@@ -154,10 +154,12 @@ class Node:
         goal_callback: GoalCallback | None = None,
         cancel_callback: CancelCallback | None = None,
         result_timeout: float = 900.0,
+        max_finished_goals: int = 100,
     ) -> ActionServer:
         """Serve the action ``name`` of ``action_type`` (``pkg/action/Name``).
 
-        ``execute_callback(goal_handle)`` runs on a thread of its own for each accepted goal.
+        ``execute_callback(goal_handle)`` runs on a thread of its own for each accepted goal. Results of
+        finished goals stay available for ``result_timeout`` seconds (at most ``max_finished_goals``).
         """
         self._check_open()
         return ActionServer(
@@ -168,6 +170,7 @@ class Node:
             goal_callback=goal_callback,
             cancel_callback=cancel_callback,
             result_timeout=result_timeout,
+            max_finished_goals=max_finished_goals,
         )
 
     def create_action_client(self, action_type: str, name: str) -> ActionClient:

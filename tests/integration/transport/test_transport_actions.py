@@ -204,3 +204,15 @@ def test_missing_action_server_is_named(connect: Callable[[], Session]) -> None:
     client = Node(connect(), "client").create_action_client(FIB, "/nobody")
     with pytest.raises(TransportError, match="no action server /nobody"):
         client.send_goal({"order": 1}, timeout=0.3)
+
+
+def test_finished_goals_are_kept_up_to_the_limit(connect: Callable[[], Session]) -> None:
+    server = Node(connect(), "server").create_action_server(FIB, "/many", _fibonacci, max_finished_goals=3)
+    client = _client(connect, "/many")
+    handles = []
+    for _ in range(6):
+        handles.append(client.send_goal({"order": 2}))
+        assert handles[-1].result(timeout=5).succeeded
+    server._publish_status()  # pruning happens on each status change
+    kept = {goal.goal_id for goal in server.goals()}
+    assert kept == {handle.goal_id for handle in handles[-3:]}
