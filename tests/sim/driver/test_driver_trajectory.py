@@ -124,12 +124,13 @@ def test_cancel_stops_the_arm_within_50_ms_of_sim_time(start_sim: Callable[..., 
     sim.joint_states.wait_until(canceled_at + 0.6)
     stamps, positions = sim.joint_states.history()
     with sim.joint_states.lock:
-        speeds = np.abs(np.array(sim.joint_states.velocities)[:, : len(ARM)])
+        speeds = np.abs(np.array(sim.joint_states.velocities))  # every joint, the gripper's too
     at_cancel = int(np.searchsorted(stamps, canceled_at))
     assert speeds[at_cancel].max() > 0.5, "the arm was not moving fast when cancelled"
     after_50ms = int(np.searchsorted(stamps, canceled_at + 0.05))
-    # From 50 ms after the cancel on, no joint moves more than 5 mm / 5 mrad ...
-    assert np.abs(positions[after_50ms:] - positions[after_50ms]).max() < 0.005
+    # From 50 ms after the cancel on, the robot is still: no joint faster than 0.01 rad/s (m/s) ...
+    assert speeds[after_50ms:].max() < 0.01
+    assert np.abs(positions[after_50ms:] - positions[after_50ms]).max() < 1e-3
     # ... and the arm stopped close to where it was, far from where it was heading.
     assert np.abs(positions[after_50ms] - positions[at_cancel]).max() < 0.1
     assert np.abs(positions[after_50ms] - goal).max() > 0.5

@@ -274,7 +274,12 @@ class MujocoDriver:
             damping = np.array([-self.model.actuator_biasprm[j.actuator, 2] for j in arm])
             feedforward = np.divide(damping, gains, out=np.zeros_like(gains), where=gains > 0)
             available[names.JOINT_TRAJECTORY_CONTROLLER] = lambda: JointTrajectoryController(
-                names.JOINT_TRAJECTORY_CONTROLLER, arm, feedforward, self.index.timestep
+                names.JOINT_TRAJECTORY_CONTROLLER,
+                arm,
+                feedforward,
+                self.index.timestep,
+                gains=gains if np.all(gains > 0) else None,
+                inertia=self._effective_inertia([j.dof_address for j in arm]),
             )
         if gripper_joint is not None:
             available[names.GRIPPER_CONTROLLER] = lambda: GripperController(
@@ -296,6 +301,19 @@ class MujocoDriver:
                 continue
             controllers[name.lstrip("/")] = factory()
         return controllers
+
+    def _effective_inertia(self, dofs: list[int]) -> Callable[[Any], np.ndarray]:
+        """Each dof's effective inertia in the current state: the diagonal of MuJoCo's mass matrix."""
+        import mujoco
+
+        full = np.zeros((self.model.nv, self.model.nv))
+        columns = np.asarray(dofs, dtype=int)
+
+        def inertia(data: Any) -> np.ndarray:
+            mujoco.mj_fullM(self.model, data, full)
+            return np.diag(full)[columns].copy()
+
+        return inertia
 
     def _serve(self) -> None:
         mujoco_node = self._node("mujoco")

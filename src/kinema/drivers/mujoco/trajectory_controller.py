@@ -4,7 +4,13 @@ It commands position actuators: every control period (one physics step) it looks
 position and velocity of the running trajectory and sets ``ctrl = q_des + (kv/kp)·qd_des`` — the
 velocity feed-forward that keeps a position servo from lagging by ``kv·v/kp``. While the trajectory
 runs it checks the path tolerances; after its last point it waits up to the goal time tolerance for the
-goal tolerances to hold. A failed check, a cancel or a deactivation holds the joints where they are.
+goal tolerances to hold.
+
+Stopping (a cancel, a failed check): holding the position the joints had when the stop came would let
+them overshoot and ring at the servo's own bandwidth for a few hundred milliseconds. Instead the
+controller brakes: each step it commands a pure velocity feedback ``F = -K·qd`` with ``K`` sized from
+each joint's effective inertia so the speed roughly halves every step, and once the joints are still it
+holds them where they stopped. A deactivation or a state reset holds at once.
 
 All methods run on the physics thread.
 """
@@ -13,6 +19,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -58,6 +65,20 @@ class _Running:
     row: int = 0
 
 
+# Braking: the fraction of a joint's speed removed per step (stable below 2 for a decoupled joint; the
+# margin covers the coupling between joints), when the joints count as still, and the longest brake.
+BRAKE_GAIN = 0.5
+BRAKE_DONE_SPEED = 0.002
+BRAKE_TIMEOUT = 0.1
+
+
+@dataclass
+class _Brake:
+    started: float
+    # ctrl = q + slope * qd gives the force -K·qd through the position servo.
+    slope: np.ndarray
+
+
 def _result(code: int, message: str) -> dict[str, Any]:
     return {"error_code": code, "error_string": message}
 
@@ -81,11 +102,22 @@ class JointTrajectoryController:
         joints: the joints it commands (each with an actuator).
         feedforward: ``kv/kp`` of each joint's position actuator, s.
         dt: the control period (the physics step), s.
+        gains: ``kp`` of each joint's position actuator (N/m or N·m/rad); with ``inertia``, stops brake.
+        inertia: returns each joint's effective inertia (kg or kg·m², the mass matrix diagonal) in the
+            current state; without it a stop holds the position the joints had.
     """
 
     type_name = "joint_trajectory_controller/JointTrajectoryController"
 
-    def __init__(self, name: str, joints: list[JointInfo], feedforward: np.ndarray, dt: float) -> None:
+    def __init__(
+        self,
+        name: str,
+        joints: list[JointInfo],
+        feedforward: np.ndarray,
+        dt: float,
+        gains: np.ndarray | None = None,
+        inertia: Callable[[Any], np.ndarray] | None = None,
+    ) -> None:
         self.name = name
         self.dt = dt
         self.joints = joints
@@ -99,6 +131,9 @@ class JointTrajectoryController:
         self._command = np.zeros(len(joints))
         self._command_velocity = np.zeros(len(joints))
         self._running: _Running | None = None
+        self._gains = None if gains is None else np.asarray(gains, dtype=float)
+        self._inertia = inertia
+        self._brake: _Brake | None = None
 
     @property
     def command_interfaces(self) -> list[str]:
@@ -115,6 +150,11 @@ class JointTrajectoryController:
         """True while a goal runs."""
         return self._running is not None
 
+    @property
+    def braking(self) -> bool:
+        """True while the joints are being brought to a stop."""
+        return self._brake is not None
+
     # -- lifecycle -------------------------------------------------------------------------------
 
     def activate(self, data: Any) -> None:
@@ -125,11 +165,14 @@ class JointTrajectoryController:
     def deactivate(self, data: Any) -> None:
         """Stop commanding (actuators keep their last set point); a running goal is aborted."""
         self._end(data, "aborted", _result(INVALID_GOAL, f"{self.name} was deactivated"), hold=False)
+        if self._brake is not None:
+            self._hold(data)
         self.active = False
 
     def on_state_reset(self, data: Any) -> None:
         """The simulation state was set from outside: abort a running goal and hold the new positions."""
         self._end(data, "aborted", _result(INVALID_GOAL, "the simulation state was reset"), hold=False)
+        self._brake = None
         if self.active:
             self._hold(data)
         else:
@@ -171,6 +214,11 @@ class JointTrajectoryController:
                 "aborted", _result(INVALID_GOAL, f"preempted by a newer goal at sim time {now:.3f} s")
             )
         self._settle_command()
+        if self._brake is not None:
+            # Interrupting a stop: start from where the joints are, at the speed they still have.
+            self._brake = None
+            self._command[:] = data.qpos[self._qpos]
+            self._command_velocity[:] = data.qvel[self._qvel]
         columns = goal.joint_indices
         table = sample_trajectory(
             goal.times,
@@ -215,7 +263,10 @@ class JointTrajectoryController:
         )
 
     def update(self, data: Any) -> None:
-        """One control period: command the desired state and check the tolerances."""
+        """One control period: command the desired state and check the tolerances (or brake)."""
+        if self._brake is not None:
+            self._brake_step(data)
+            return
         running = self._running
         if running is None:
             return
@@ -302,7 +353,7 @@ class JointTrajectoryController:
         self._settle_command()
         self._running = None
         if hold:
-            self._hold(data)
+            self._stop(data)
         else:
             self._command_velocity[:] = 0.0
         running.execution.finish(status, result)
@@ -314,6 +365,25 @@ class JointTrajectoryController:
             columns = running.goal.joint_indices
             self._command[columns] = running.table.positions[running.row]
             self._command_velocity[columns] = running.table.velocities[running.row]
+
+    def _stop(self, data: Any) -> None:
+        """Brake the joints to a stop (then hold), or hold at once when braking is not configured."""
+        if self._gains is None or self._inertia is None:
+            self._hold(data)
+            return
+        stiffness = BRAKE_GAIN * self._inertia(data) / self.dt
+        self._brake = _Brake(float(data.time), self._feedforward - stiffness / self._gains)
+        self._brake_step(data)
+
+    def _brake_step(self, data: Any) -> None:
+        brake = self._brake
+        assert brake is not None
+        speed = data.qvel[self._qvel]
+        if np.abs(speed).max() < BRAKE_DONE_SPEED or float(data.time) - brake.started > BRAKE_TIMEOUT:
+            self._brake = None
+            self._hold(data)
+            return
+        data.ctrl[self._ctrl] = data.qpos[self._qpos] + brake.slope * speed
 
     def _hold(self, data: Any) -> None:
         self._command[:] = data.qpos[self._qpos]
