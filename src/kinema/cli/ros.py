@@ -230,7 +230,7 @@ def topic_pub(
     connect: str | None,
     timeout: float,
 ) -> None:
-    """Publish VALUES (YAML flow, e.g. "{data: hello}") as MSG_TYPE on TOPIC_NAME."""
+    """Publish MSG_TYPE messages on TOPIC_NAME, with VALUES in YAML flow syntax like "{data: hello}"."""
     from kinema.transport import parse_yaml_flow, to_yaml
 
     count = 1 if once else times
@@ -344,7 +344,7 @@ def service_list(
 def service_call(
     service_name: str, srv_type: str | None, values: str, flow: bool, connect: str | None, timeout: float
 ) -> None:
-    """Call SERVICE_NAME with VALUES (YAML flow, e.g. "{a: 1, b: 2}") and print the response.
+    """Call SERVICE_NAME with VALUES in YAML flow syntax like "{a: 1, b: 2}"; print the response.
 
     SRV_TYPE (pkg/srv/Name) may be omitted when a server is on the graph.
     """
