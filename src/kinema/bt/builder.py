@@ -180,7 +180,7 @@ class TreeBuilder:
     ) -> TreeNode:
         tag = str(element.tag)
         line = line_of(element)
-        location = SourceLocation(filename, line)
+        location = _LazyLocation(filename, line)
         element_id = element.get("ID")
         if tag in EXPLICIT_TAGS:
             if element_id is None:
@@ -241,15 +241,18 @@ class TreeBuilder:
         config.other_attributes = other
         config.wake_up = self.tree.wake_up
         config.clock = self.factory.clock
-        config.location = location
-        for key in PRE_CONDITIONS:
-            code = element.get(key)
-            if code is not None:
-                config.pre_conditions[key] = _parse_condition(code, key, config.path, location)
-        for key in POST_CONDITIONS:
-            code = element.get(key)
-            if code is not None:
-                config.post_conditions[key] = _parse_condition(code, key, config.path, location)
+        config.source_file = filename
+        config.source_line = line
+        if other or len(element.attrib) > len(port_remap):
+            # Only elements with reserved attributes can carry pre/post-conditions.
+            for key in PRE_CONDITIONS:
+                code = element.get(key)
+                if code is not None:
+                    config.pre_conditions[key] = _parse_condition(code, key, config.path, location)
+            for key in POST_CONDITIONS:
+                code = element.get(key)
+                if code is not None:
+                    config.post_conditions[key] = _parse_condition(code, key, config.path, location)
         if is_subtree:
             config.input_ports = dict(port_remap)
             config.manifest = self.manifests.get("SubTree")
@@ -313,6 +316,14 @@ class TreeBuilder:
                     blackboard.create_entry(key, port_info.type)
                 except BTError as error:
                     raise BTRuntimeError(error.message, location=location) from None
+
+
+class _LazyLocation(SourceLocation):
+    """A SourceLocation for error paths; built per node, so it skips the frozen-dataclass init."""
+
+    def __init__(self, file: str, line: int) -> None:
+        object.__setattr__(self, "file", file)
+        object.__setattr__(self, "line", line)
 
 
 def _apply_defaults(manifest: Any, config: NodeConfig) -> None:

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import functools
+
 from kinema.bt.ports import RESERVED_PORT_NAMES
 
 _FORBIDDEN = frozenset(" \t\n\r<>&\"'/\\:*?|.")
@@ -44,6 +46,7 @@ def describe_char(c: str) -> str:
     return f"'{c}'"
 
 
+@functools.lru_cache(maxsize=4096)
 def model_name_problem(name: str, *, tree_id: bool = False) -> str | None:
     """Why ``name`` is not a valid node type / tree ID, or None.
 
@@ -74,6 +77,7 @@ def port_name_problem(name: str) -> str | None:
     return None
 
 
+@functools.lru_cache(maxsize=4096)
 def is_allowed_port_name(name: str) -> bool:
     """``IsAllowedPortName``: an attribute that is treated as a port."""
     if not name or not (name[0].isalpha() and ord(name[0]) < 0x80):

@@ -52,13 +52,14 @@ class NodeConfig:
         "clock",
         "enums",
         "input_ports",
-        "location",
         "manifest",
         "other_attributes",
         "output_ports",
         "path",
         "post_conditions",
         "pre_conditions",
+        "source_file",
+        "source_line",
         "uid",
         "wake_up",
     )
@@ -80,7 +81,22 @@ class NodeConfig:
         self.other_attributes: dict[str, str] = {}
         self.wake_up: Any = None
         self.clock: Clock | None = None
-        self.location: SourceLocation | None = None
+        self.source_file: str | None = None
+        self.source_line = 0
+
+    @property
+    def location(self) -> SourceLocation | None:
+        """``file:line`` of the node's XML element, if it came from XML."""
+        if self.source_file is None:
+            return None
+        from kinema.errors import SourceLocation
+
+        return SourceLocation(self.source_file, self.source_line)
+
+    @location.setter
+    def location(self, value: SourceLocation | None) -> None:
+        self.source_file = value.file if value is not None else None
+        self.source_line = value.line if value is not None else 0
 
 
 class PortError(BTRuntimeError):

@@ -35,7 +35,7 @@ _PORT_TAGS = {
 
 def element_children(element: etree._Element) -> list[etree._Element]:
     """Child elements only (comments and processing instructions skipped)."""
-    return [child for child in element if isinstance(child.tag, str)]
+    return list(element.iterchildren(etree.Element))
 
 
 def line_of(element: etree._Element) -> int:
