@@ -1,18 +1,34 @@
 """The Python SDK: start, cancel and watch objectives of a running Kinema from any process.
 
-``ObjectiveClient`` is what ``kinema objective ...`` and ``kinema shell`` use; results are typed
+``ObjectiveClient`` (the ROS interfaces: ``/execute_objective``, ``/do_objective``, the heartbeat and
+streams) is what programs and ``kinema shell`` use; ``QuickClient`` (the agent's JSON endpoints, no ROS
+type system to load) is what one-shot commands such as ``kinema objective run`` use. Results are typed
 (:class:`ObjectiveResult`: ``succeeded`` / ``cancelled`` / ``failed``, the MoveIt error code and message).
+
+Names are imported on first use, so ``import kinema.sdk.quick`` stays cheap.
 """
 
 from __future__ import annotations
 
-from kinema.runtime.error_codes import MoveItErrorCode
-from kinema.runtime.objective_status import ObjectiveStatus
-from kinema.runtime.overrides import ParameterOverride
-from kinema.runtime.result import ObjectiveResult
-from kinema.sdk.client import ObjectiveClient, ObjectiveHandle, parameter_messages
-from kinema.sdk.quick import QuickClient, QuickRun
-from kinema.sdk.streams import BlackboardSnapshot, BlackboardValue, LogEntry, MessageStream, ServerStatus
+import importlib
+from typing import TYPE_CHECKING, Any
+
+_EXPORTS = {
+    "BlackboardSnapshot": "kinema.sdk.streams",
+    "BlackboardValue": "kinema.sdk.streams",
+    "LogEntry": "kinema.sdk.streams",
+    "MessageStream": "kinema.sdk.streams",
+    "ServerStatus": "kinema.sdk.streams",
+    "MoveItErrorCode": "kinema.runtime.error_codes",
+    "ObjectiveStatus": "kinema.runtime.objective_status",
+    "ParameterOverride": "kinema.runtime.overrides",
+    "ObjectiveResult": "kinema.runtime.result",
+    "ObjectiveClient": "kinema.sdk.client",
+    "ObjectiveHandle": "kinema.sdk.client",
+    "parameter_messages": "kinema.sdk.client",
+    "QuickClient": "kinema.sdk.quick",
+    "QuickRun": "kinema.sdk.quick",
+}
 
 __all__ = [
     "BlackboardSnapshot",
@@ -30,3 +46,25 @@ __all__ = [
     "ServerStatus",
     "parameter_messages",
 ]
+
+if TYPE_CHECKING:
+    from kinema.runtime.error_codes import MoveItErrorCode
+    from kinema.runtime.objective_status import ObjectiveStatus
+    from kinema.runtime.overrides import ParameterOverride
+    from kinema.runtime.result import ObjectiveResult
+    from kinema.sdk.client import ObjectiveClient, ObjectiveHandle, parameter_messages
+    from kinema.sdk.quick import QuickClient, QuickRun
+    from kinema.sdk.streams import BlackboardSnapshot, BlackboardValue, LogEntry, MessageStream, ServerStatus
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'kinema.sdk' has no attribute {name!r}")
+    value = getattr(importlib.import_module(module), name)
+    globals()[name] = value
+    return value
+
+
+def __dir__() -> list[str]:
+    return __all__

@@ -19,7 +19,6 @@ no runtime answers within the client's ``timeout``.
 
 from __future__ import annotations
 
-import re
 import threading
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any
@@ -314,15 +313,7 @@ class ObjectiveClient:
         return f"<ObjectiveClient {self.session!r}>"
 
 
-_MAIN_TREE = re.compile(r"""main_tree_to_execute\s*=\s*["']([^"']+)["']""")
-_TREE_IDS = re.compile(r"""<BehaviorTree\b[^>]*?\bID\s*=\s*["']([^"']+)["']""")
-
-
 def _xml_name(xml: str) -> str:
-    """The name the agent will report for an XML objective (without loading the BT engine here)."""
-    head = xml[:65536]
-    found = _MAIN_TREE.search(head)
-    if found:
-        return found.group(1)
-    ids = _TREE_IDS.findall(head)
-    return ids[0] if len(ids) == 1 else "<objective XML>"
+    from kinema.sdk.quick import xml_objective_name
+
+    return xml_objective_name(xml)

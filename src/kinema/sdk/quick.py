@@ -9,6 +9,7 @@ interoperability with ROS tools use :class:`~kinema.sdk.ObjectiveClient`.
 from __future__ import annotations
 
 import os
+import re
 import time
 from collections.abc import Iterable, Mapping
 from typing import Any
@@ -37,6 +38,20 @@ def _domain(domain_id: int | None) -> int:
         return int(value)
     except ValueError:
         raise TransportError(f"ROS_DOMAIN_ID={value!r} is not an integer (valid: 0-232)") from None
+
+
+_MAIN_TREE = re.compile(r"""main_tree_to_execute\s*=\s*["']([^"']+)["']""")
+_TREE_IDS = re.compile(r"""<BehaviorTree\b[^>]*?\bID\s*=\s*["']([^"']+)["']""")
+
+
+def xml_objective_name(xml: str) -> str:
+    """The name the agent will report for an XML objective (found without loading the BT engine)."""
+    head = xml[:65536]
+    found = _MAIN_TREE.search(head)
+    if found:
+        return found.group(1)
+    ids = _TREE_IDS.findall(head)
+    return ids[0] if len(ids) == 1 else "<objective XML>"
 
 
 class QuickRun:
@@ -162,9 +177,7 @@ class QuickClient:
         if first.ok is None:
             raise TransportError(f"the agent refused the request: {first.err.payload.to_string()}")
         body = quick.decode(first.ok.payload.to_bytes())
-        from kinema.sdk.client import _xml_name
-
-        return QuickRun(self, replies, int(body["run_id"]), name or _xml_name(xml))
+        return QuickRun(self, replies, int(body["run_id"]), name or xml_objective_name(xml))
 
     def cancel(self) -> tuple[bool, str]:
         """Cancel whatever runs; ``(cancelled, objective name)``."""
