@@ -214,7 +214,11 @@ class TreeBuilder:
                             f"a port with name [{attr_name}] is found in the XML (<{tag}>, line {line}) "
                             "but not "
                             f"in the providedPorts() of its registered node type. "
-                            f"{did_you_mean(attr_name, manifest.ports).capitalize()}",
+                            + (
+                                f"{did_you_mean(attr_name, manifest.ports).capitalize()}."
+                                if manifest.ports
+                                else f"{type_id} has no ports."
+                            ),
                             location=location,
                         )
                     if (
