@@ -94,7 +94,10 @@ def parse_double_full(text: str) -> float | None:
     match = _FLOAT_PREFIX.fullmatch(text)
     if match is None:
         return None
-    return parse_double_prefix(text)
+    try:
+        return parse_double_prefix(text)
+    except ConversionError:  # out of range
+        return None
 
 
 def parse_bool(text: str) -> bool:

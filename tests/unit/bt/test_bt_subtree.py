@@ -47,13 +47,25 @@ def test_remapping_forms(bench, call: str) -> None:
 def test_literal_attributes_keep_numeric_types(bench) -> None:
     tree = bench.xml(
         doc(
-            tree_def("Main", '<SubTree ID="Sub" i="42" d="2.5" s="two words" v="1;2;3" big="9999999999"/>'),
+            tree_def(
+                "Main",
+                '<SubTree ID="Sub" i="42" d="2.5" s="two words" v="1;2;3" big="9999999999" huge="'
+                + "9" * 400
+                + '"/>',
+            ),
             tree_def("Sub", '<ScriptCondition code="i + 1 == 43 &amp;&amp; d * 2 == 5"/>'),
         )
     )
     assert tree.tick_once() is S
     scope = tree.subtrees[1].blackboard
-    assert [type(scope.get(k)) for k in ("i", "d", "s", "v", "big")] == [int, float, str, str, int]
+    assert [type(scope.get(k)) for k in ("i", "d", "s", "v", "big", "huge")] == [
+        int,
+        float,
+        str,
+        str,
+        int,
+        str,
+    ]
 
 
 def test_private_keys_are_never_auto_remapped(bench) -> None:
