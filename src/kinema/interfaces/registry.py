@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
@@ -115,6 +115,7 @@ class _Parsed:
     pending: dict[str, tuple[list[Any], list[Any]]]
     services: list[tuple[str, str]]
     actions: list[tuple[str, str]]
+    origins: dict[str, str] = field(default_factory=dict)
 
     def packages_used(self) -> set[str]:
         """Packages the parsed definitions refer to (actions also need action_msgs' CancelGoal)."""
@@ -139,9 +140,11 @@ def _parse_files(files: Iterable[Path]) -> _Parsed:
     pending: dict[str, tuple[list[Any], list[Any]]] = {}
     services: list[tuple[str, str]] = []
     actions: list[tuple[str, str]] = []
+    origins: dict[str, str] = {}
     for path in files:
         package, kind, name = path.parent.parent.name, path.parent.name, path.stem
         text = path.read_text(encoding="utf-8")
+        before = set(pending)
         if kind == "msg":
             pending[f"{package}/msg/{name}"] = _parse_struct(text, package, name, str(path))
         elif kind == "srv":
@@ -177,6 +180,7 @@ def _parse_files(files: Iterable[Path]) -> _Parsed:
                 [("goal_id", (Nodetype.NAME, _UUID)), ("feedback", (Nodetype.NAME, f"{base}_Feedback"))],
             )
             actions.append((package, name))
+        origins.update(dict.fromkeys(set(pending) - before, str(path)))
     # A bare reference inside a .srv/.action (``GripperCommand command``) was resolved to pkg/msg/*;
     # the parts of the service or action itself live under pkg/srv/* and pkg/action/*.
     renames = {
@@ -195,7 +199,7 @@ def _parse_files(files: Iterable[Path]) -> _Parsed:
         name: (constants, [(field, _rename(desc, renames)) for field, desc in fields])
         for name, (constants, fields) in pending.items()
     }
-    return _Parsed(renamed, services, actions)
+    return _Parsed(renamed, services, actions, origins)
 
 
 class TypeRegistry:
@@ -270,6 +274,7 @@ class TypeRegistry:
                 merged.pending.update(parsed.pending)
                 merged.services.extend(parsed.services)
                 merged.actions.extend(parsed.actions)
+                merged.origins.update(parsed.origins)
             self._register(merged)
 
     def _ensure_for(self, type_name: str) -> None:
@@ -278,19 +283,35 @@ class TypeRegistry:
 
     def _register(self, parsed: _Parsed) -> None:
         with self._lock:
+            for name, (_, fields) in parsed.pending.items():
+                known = self.typestore.fielddefs.get(name)
+                if known is not None and [(f.lower(), d) for f, d in known[1]] != [
+                    (f.lower(), d) for f, d in fields
+                ]:
+                    raise TransportError(
+                        f"{parsed.origins.get(name, name)}: {name} is already defined with other fields "
+                        f"({', '.join(f for f, _ in known[1])}); a type name can have only one definition"
+                    )
             fresh = {
                 name: defs for name, defs in parsed.pending.items() if name not in self.typestore.fielddefs
             }
-            self._check_references(fresh)
+            self._check_references(fresh, parsed.origins)
             if fresh:
-                self.typestore.register(fresh)  # type: ignore[arg-type]
+                try:
+                    self.typestore.register(fresh)  # type: ignore[arg-type]
+                except Exception as error:  # rosbags raises TypesysError for a conflicting redefinition
+                    raise TransportError(
+                        f"cannot register interfaces {', '.join(sorted(fresh))}: {error}"
+                    ) from error
             # CancelGoal (in action_msgs) must be known before any action refers to it.
             for package, name in sorted(parsed.services, key=lambda item: item[0] != "action_msgs"):
                 self._add_service(f"{package}/srv/{name}")
             for package, name in parsed.actions:
                 self._add_action(f"{package}/action/{name}")
 
-    def _check_references(self, typesdict: dict[str, tuple[list[Any], list[Any]]]) -> None:
+    def _check_references(
+        self, typesdict: dict[str, tuple[list[Any], list[Any]]], origins: dict[str, str]
+    ) -> None:
         known = set(self.typestore.fielddefs) | set(typesdict)
 
         def refs(desc: Any) -> Iterable[str]:
@@ -301,12 +322,12 @@ class TypeRegistry:
                 yield from refs(rest[0])
 
         for owner, (_, fields) in typesdict.items():
-            for field, desc in fields:
+            for field_name, desc in fields:
                 for ref in refs(desc):
                     if ref not in known:
                         raise TransportError(
-                            f"interface {owner}: field {field!r} uses unknown type {ref!r} "
-                            f"({did_you_mean(ref, known)})"
+                            f"{origins.get(owner, owner)}: field {field_name!r} of {owner} uses unknown type "
+                            f"{ref!r} ({did_you_mean(ref, known)})"
                         )
 
     def _service_wrapper(self, base: str) -> str:

@@ -70,7 +70,7 @@ class Graph:
         return [entity for entity in self.of_kind(EntityKind.SUBSCRIPTION) if entity.name == name]
 
     def actions(self) -> dict[str, list[str]]:
-        """Action name → action type names, for actions with a server (found by their send_goal service)."""
+        """Action name → action type names (from the send_goal service of their servers and clients)."""
         found: dict[str, set[str]] = {}
         for entity in self.of_kind(EntityKind.SERVICE_SERVER, EntityKind.SERVICE_CLIENT):
             base, sep, part = entity.name.rpartition(ACTION_INFIX)

@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
+import pytest
+
+from kinema.errors import TransportError
 from kinema.interfaces import TypeRegistry, interfaces_dir, load_interfaces
 
 
@@ -90,3 +95,16 @@ def test_packages_load_on_first_use() -> None:
     assert "moveit_msgs/msg/MoveItErrorCodes" in registry.typestore.fielddefs  # a dependency
     assert "kinema_msgs/msg/ObjectiveInfo" not in registry.typestore.fielddefs
     assert "kinema_msgs/srv/ListObjectives" in registry.names("srv")  # listing loads everything
+
+
+def test_bad_interface_files_are_reported_with_their_path(tmp_path: Path) -> None:
+    (tmp_path / "std_msgs" / "msg").mkdir(parents=True)
+    (tmp_path / "std_msgs" / "msg" / "String.msg").write_text("int32 data\n")
+    (tmp_path / "mine" / "msg").mkdir(parents=True)
+    (tmp_path / "mine" / "msg" / "Thing.msg").write_text("Missing part\n")
+    registry = TypeRegistry()
+    registry.add_directory(tmp_path)
+    with pytest.raises(TransportError, match=r"String\.msg: std_msgs/msg/String is already defined"):
+        registry.message_type("std_msgs/msg/String")
+    with pytest.raises(TransportError, match=r"Thing\.msg: field 'part' of mine/msg/Thing uses unknown type"):
+        registry.message_type("mine/msg/Thing")
