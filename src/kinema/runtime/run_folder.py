@@ -1,7 +1,7 @@
 """Per-run log folders under the user's state directory.
 
 Every ``kinema run`` writes its logs (the agent's, each driver's, the supervisor's) into a fresh folder
-``<state>/kinema/runs/<YYYYmmdd-HHMMSS>-<config>/``; ``<state>`` is ``$XDG_STATE_HOME`` (or
+``<state>/kinema/runs/<YYYYmmdd-HHMMSS-micro>-<config>/``; ``<state>`` is ``$XDG_STATE_HOME`` (or
 ``~/.local/state``) on Linux and the platform's equivalent elsewhere. ``kinema logs`` reads the newest
 folder and ``kinema export-logs`` zips it.
 """
@@ -58,7 +58,9 @@ class RunFolder:
     def create(cls, config_name: str, *, keep: int = KEEP_RUNS) -> RunFolder:
         """Create a fresh folder for a run of ``config_name`` and prune the oldest beyond ``keep``."""
         safe = re.sub(r"[^A-Za-z0-9_.-]+", "_", config_name) or "run"
-        stamp = time.strftime("%Y%m%d-%H%M%S")
+        now = time.time()
+        # The stamp leads the name, so names sort in creation order (mtimes can tie).
+        stamp = time.strftime("%Y%m%d-%H%M%S", time.localtime(now)) + f"-{int(now * 1e6) % 1_000_000:06d}"
         base = runs_dir()
         path = base / f"{stamp}-{safe}"
         suffix = 1
@@ -81,14 +83,12 @@ class RunFolder:
 def list_runs() -> list[RunFolder]:
     """Every run folder, oldest first."""
     base = runs_dir()
-    folders = [p for p in base.iterdir() if p.is_dir()]
-    folders.sort(key=lambda p: (p.stat().st_mtime, p.name))
-    return [RunFolder(p) for p in folders]
+    return [RunFolder(p) for p in sorted(p for p in base.iterdir() if p.is_dir())]
 
 
 def _prune(base: Path, keep: int) -> None:
     import shutil
 
-    folders = sorted((p for p in base.iterdir() if p.is_dir()), key=lambda p: (p.stat().st_mtime, p.name))
+    folders = sorted(p for p in base.iterdir() if p.is_dir())
     for old in folders[: max(0, len(folders) - keep)]:
         shutil.rmtree(old, ignore_errors=True)
