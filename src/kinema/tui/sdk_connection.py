@@ -195,6 +195,11 @@ class SdkConnection:
         from kinema.sdk import ObjectiveClient
 
         client = ObjectiveClient(self._endpoint, timeout=2.0)
+        # Published before subscribing: the latched heartbeat can arrive while subscribing, and a
+        # screen that sees "connected" must find a client to call.
+        with self._lock:
+            self._client = client
+            self._service_clients = {}
         node = client.node
         try:
             node.create_subscription(names.HEARTBEAT_TYPE, names.HEARTBEAT, self._on_heartbeat, latched=True)
@@ -205,11 +210,8 @@ class SdkConnection:
             node.create_subscription(names.LOG_TYPE, names.LOG, self._on_log)
             node.create_subscription(names.CLOCK_TYPE, names.CLOCK, self._on_clock)
         except Exception:
-            client.close()
+            self._drop_client()
             raise
-        with self._lock:
-            self._client = client
-            self._service_clients = {}
         self._last_heartbeat = time.monotonic()  # give the latched heartbeat a moment to arrive
         if self._state is ConnectionState.DISCONNECTED:
             self._set_state(ConnectionState.CONNECTING, "joined the router, waiting for a heartbeat")
