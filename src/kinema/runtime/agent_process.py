@@ -42,6 +42,7 @@ class AgentOptions:
         clock: ``sim`` follows ``/clock``; ``wall`` is wall time; ``auto`` picks sim when the config has
             a simulator.
         hot_reload: watch behavior packages and objective folders.
+        waypoints_file: the waypoints file to serve instead of the config's.
     """
 
     config: str | None = None
@@ -50,6 +51,7 @@ class AgentOptions:
     tick_rate_hz: float = 100.0
     clock: ClockChoice = "auto"
     hot_reload: bool = True
+    waypoints_file: Path | None = None
 
 
 def build_agent(options: AgentOptions, session: Session) -> Agent:
@@ -101,10 +103,11 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
     source = LibraryTreeSource(load_library, host=host, context=context, clock=clock)
     source.factory()  # load now: errors show at start, and the first objective starts fast
     waypoints = None
-    if resolved is not None and resolved.waypoints_path is not None:
+    waypoints_path = options.waypoints_file or (resolved.waypoints_path if resolved is not None else None)
+    if waypoints_path is not None:
         from kinema.config import WaypointStore
 
-        waypoints = WaypointStore(resolved.waypoints_path)
+        waypoints = WaypointStore(waypoints_path)
     server = ObjectiveServer(source, tick_rate_hz=options.tick_rate_hz)
     agent = Agent(session, server, source=source, waypoints=waypoints, log_sink=sink, clock=clock, node=node)
     if host is not None:
@@ -145,6 +148,7 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--tick-rate", type=float, default=100.0, help="ticks per second (default 100)")
     parser.add_argument("--clock", choices=("auto", "wall", "sim"), default="auto", help="time source")
     parser.add_argument("--no-hot-reload", action="store_true", help="do not watch files")
+    parser.add_argument("--waypoints", type=Path, help="waypoints file to serve (default: the config's)")
     parser.add_argument("--log-file", type=Path, help="write the log there (run format)")
     parser.add_argument("--ready-fd", type=int, help="write 'ready' to this file descriptor when serving")
     parser.add_argument("--verbose", "-v", action="store_true", help="log at DEBUG level")
@@ -167,6 +171,7 @@ def main(argv: list[str] | None = None) -> int:
         tick_rate_hz=args.tick_rate,
         clock=args.clock,
         hot_reload=not args.no_hot_reload,
+        waypoints_file=args.waypoints,
     )
     try:
         from kinema.transport import host_router, open_session

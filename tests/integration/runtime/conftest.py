@@ -51,7 +51,7 @@ class AgentProcess:
     log_file: Path
 
 
-def start_agent(tmp_path: Path, *extra: str) -> AgentProcess:
+def start_agent(tmp_path: Path, *extra: str, hot_reload: bool = False) -> AgentProcess:
     """Start ``python -m kinema.runtime.agent_process`` hosting a router on a free port; wait until ready."""
     folder = tmp_path / "objectives"
     folder.mkdir(exist_ok=True)
@@ -67,7 +67,7 @@ def start_agent(tmp_path: Path, *extra: str) -> AgentProcess:
         endpoint,
         "--objectives",
         str(folder),
-        "--no-hot-reload",
+        *([] if hot_reload else ["--no-hot-reload"]),
         "--log-file",
         str(log_file),
         "--ready-fd",
@@ -125,6 +125,16 @@ def free_endpoint() -> str:
 def sim_agent(tmp_path: Path) -> Iterator[AgentProcess]:
     """An agent whose clock follows /clock (as with a simulator), with nothing publishing it yet."""
     running = start_agent(tmp_path, "--clock", "sim")
+    try:
+        yield running
+    finally:
+        stop_agent(running)
+
+
+@pytest.fixture
+def lively_agent(tmp_path: Path) -> Iterator[AgentProcess]:
+    """An agent with hot reload on and a waypoints file of its own (``tmp_path/waypoints.yaml``)."""
+    running = start_agent(tmp_path, "--waypoints", str(tmp_path / "waypoints.yaml"), hot_reload=True)
     try:
         yield running
     finally:
