@@ -372,8 +372,8 @@ class Agent:
         try:
             overrides = overrides_from_messages(goal.parameter_overrides)
         except ObjectiveError as error:
-            result = ObjectiveResult.failure(str(error), goal.objective_name)
-            handle.abort({"error_code": result_message(result), "error_message": result.error_message})
+            refused = ObjectiveResult.failure(str(error), goal.objective_name)
+            handle.abort({"error_code": result_message(refused), "error_message": refused.error_message})
             return None
         request = ObjectiveRequest(goal.objective_name, goal.objective_xml_string, overrides, "do_objective")
         run = self.server.submit(request)
@@ -382,11 +382,12 @@ class Agent:
         try:
             if handle.is_cancel_requested:
                 self.server.cancel(run, reason="goal cancelled", timeout=0)
-            result = run.wait()
+            outcome = run.wait()
         finally:
             with self._goal_lock:
                 self._goal_runs.pop(handle.goal_id, None)
-        assert result is not None
+        assert outcome is not None
+        result = outcome
         payload = {"error_code": result_message(result), "error_message": result.error_message}
         if result.succeeded:
             handle.succeed(payload)
