@@ -80,6 +80,7 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
     if use_sim:
         node.create_subscription(names.CLOCK_TYPE, names.CLOCK, clock.on_clock_message)
         log.info("time follows %s (simulation time)", names.CLOCK)
+        _warn_without_clock(clock)
     sink = LogSink()
     context = BehaviorContext(
         node, clock=clock, log_sink=sink, robot_model=_robot_model_provider(resolved), config=resolved
@@ -122,6 +123,21 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
         watcher_host.subscribe(agent.on_reload_event)
         watcher_host.watch(extra)
     return agent
+
+
+def _warn_without_clock(clock: Any, after_s: float = 10.0) -> None:
+    """Say so in the log when no simulator publishes time: Sleep and Timeout would wait forever."""
+
+    def check() -> None:
+        if not clock.wait_until_running(after_s):
+            log.warning(
+                "no %s message after %.0f s: simulation time stands still, so Sleep/Timeout nodes wait "
+                "until a simulator runs (start its driver, or run the agent with --clock wall)",
+                "/clock",
+                after_s,
+            )
+
+    threading.Thread(target=check, name="kinema-clock-watch", daemon=True).start()
 
 
 def _robot_model_provider(resolved: Any) -> Any:
