@@ -163,11 +163,12 @@ class MujocoDriver:
                 controller = self._controllers.get(name)
                 if controller is not None:
                     controller.activate(self.data)
+            # Before the physics thread owns the data: from then on only it may read it.
+            self._publish_scene_state()
             self.simulation.start()
         except BaseException:
             self.stop()
             raise
-        self._publish_scene_state()
         active = [c.name for c in self._controllers.values() if c.active]
         log.info(
             "MuJoCo driver ready: %s%s, keyframe %s, sim speed %s, %d joints, controllers active: %s",
