@@ -50,7 +50,12 @@ if TYPE_CHECKING:
     from kinema.runtime.agent_process import AgentOptions, build_agent
     from kinema.runtime.error_codes import MoveItErrorCode
     from kinema.runtime.launcher import Launcher, LaunchOptions
-    from kinema.runtime.objective_server import FactoryTreeSource, ObjectiveRequest, ObjectiveRun, ObjectiveServer
+    from kinema.runtime.objective_server import (
+        FactoryTreeSource,
+        ObjectiveRequest,
+        ObjectiveRun,
+        ObjectiveServer,
+    )
     from kinema.runtime.objective_source import LibraryTreeSource
     from kinema.runtime.objective_status import ObjectiveStatus
     from kinema.runtime.overrides import ParameterOverride
