@@ -275,7 +275,9 @@ class BehaviorHost:
                 module: object = cached
             else:
                 try:
-                    module = import_fresh(spec.root, spec.module, spec.package)
+                    module = import_fresh(
+                        spec.root, spec.module, spec.package, cache_bytecode=not spec.hot_reloadable
+                    )
                 except PluginError as error:
                     raise PluginError(
                         f"plugin '{spec.name}': {error.message}", location=error.location

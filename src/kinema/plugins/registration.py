@@ -9,6 +9,7 @@ that uses it runs.
 from __future__ import annotations
 
 import inspect
+import linecache
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
@@ -51,11 +52,13 @@ def class_location(cls: type) -> SourceLocation:
         file = inspect.getsourcefile(cls) or "<unknown>"
     except TypeError:
         return SourceLocation("<built-in>")
-    try:
-        line = inspect.getsourcelines(cls)[1]
-    except (OSError, TypeError):
-        line = 0
-    return SourceLocation(file, line)
+    # Scanning for the class statement is much cheaper than inspect.getsourcelines (which tokenizes the
+    # whole class), and loading plugins registers many classes.
+    pattern = re.compile(rf"\s*class\s+{re.escape(cls.__name__)}\b")
+    for number, text in enumerate(linecache.getlines(file), start=1):
+        if pattern.match(text):
+            return SourceLocation(file, number)
+    return SourceLocation(file, 0)
 
 
 def validate_registration(cls: object, behavior_id: str | None, plugin: str) -> BehaviorRegistration:
