@@ -9,6 +9,7 @@ message instead of a decoder traceback.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -68,21 +69,24 @@ class YamlDocument:
 
 def read_text_file(path: Path, *, max_bytes: int, error: type[KinemaError] = ConfigError) -> str:
     """Read a UTF-8 text file, refusing unreadable, too large and non-UTF-8 files with a clear error."""
+    where = SourceLocation(str(path))
     try:
-        size = path.stat().st_size
+        with open(path, "rb") as handle:
+            size = os.fstat(handle.fileno()).st_size
+            # read one byte more than allowed: files whose size stat does not tell (pipes) are caught too
+            data = b"" if size > max_bytes else handle.read(max_bytes + 1)
     except FileNotFoundError:
-        raise error("the file does not exist", location=SourceLocation(str(path))) from None
+        raise error("the file does not exist", location=where) from None
+    except IsADirectoryError:
+        raise error("this is a folder, a file is expected", location=where) from None
     except OSError as exc:
-        raise error(f"cannot read the file: {exc.strerror}", location=SourceLocation(str(path))) from None
-    if size > max_bytes:
+        raise error(f"cannot read the file: {exc.strerror}", location=where) from None
+    if size > max_bytes or len(data) > max_bytes:
         raise error(
-            f"the file is {_megabytes(size)}, larger than the limit of {_megabytes(max_bytes)}",
-            location=SourceLocation(str(path)),
+            f"the file is {_megabytes(max(size, len(data)))}, "
+            f"larger than the limit of {_megabytes(max_bytes)}",
+            location=where,
         )
-    try:
-        data = path.read_bytes()
-    except OSError as exc:
-        raise error(f"cannot read the file: {exc.strerror}", location=SourceLocation(str(path))) from None
     return decode_utf8(data, str(path), error=error)
 
 
