@@ -3,7 +3,8 @@
 Precedence, highest first: the command's own ``-w``/``-c`` flags, the environment variables
 ``KINEMA_WORKSPACE`` / ``KINEMA_CONFIG``, and the selection stored by ``kinema configure`` in
 ``<user config dir>/kinema/selection.yaml`` (``platformdirs``; on Linux ``$XDG_CONFIG_HOME/kinema``,
-default ``~/.config/kinema``).
+default ``~/.config/kinema``). With none of these, the config is the bundled ``lab_sim``, so a fresh
+install runs the simulated robot cell with no set-up step.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ from kinema.errors import ConfigError, SourceLocation
 
 WORKSPACE_ENV = "KINEMA_WORKSPACE"
 CONFIG_ENV = "KINEMA_CONFIG"
+DEFAULT_CONFIG = "lab_sim"
 _SELECTION_FILE = "selection.yaml"
 
 
@@ -31,7 +33,8 @@ class Selection:
     Attributes:
         workspace: the workspace folder, or None (only bundled packages are visible).
         config: the config package name, or None when none is selected.
-        workspace_source / config_source: ``"flag"``, ``"environment"``, ``"stored"`` or ``"unset"``.
+        workspace_source / config_source: ``"flag"``, ``"environment"``, ``"stored"``, ``"default"``
+            (config only: the bundled lab_sim) or ``"unset"``.
     """
 
     workspace: Path | None
@@ -111,6 +114,8 @@ def active_selection(workspace: str | Path | None = None, config: str | None = N
         workspace, os.environ.get(WORKSPACE_ENV), str(stored_workspace) if stored_workspace else None
     )
     cfg_value, cfg_source = _pick(config, os.environ.get(CONFIG_ENV), stored_config)
+    if cfg_value is None:
+        cfg_value, cfg_source = DEFAULT_CONFIG, "default"
     return Selection(
         workspace=Path(ws_value).expanduser() if ws_value else None,
         config=cfg_value or None,

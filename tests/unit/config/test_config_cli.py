@@ -81,10 +81,14 @@ def test_verbose_prints_notices(capsys, tmp_path: Path):
     assert code == 0 and "note:" in err and "not used by Kinema" in err
 
 
+def test_with_nothing_selected_the_bundled_lab_sim_is_the_config(capsys):
+    code, out, _ = run(capsys, "config", "chain")
+    assert code == 0 and out.split()[0] == "lab_sim" and len(out.splitlines()) == 1
+
+
 @pytest.mark.parametrize(
     ("args", "words"),
     [
-        (("config", "show"), "no config package is selected"),
         (("config", "show", "-c", "lab_sm"), "did you mean 'lab_sim'"),
         (("config", "chain", "-c", "nope"), "no config package named 'nope'"),
         (("objective", "show", "Nope", "-c", "lab_sim"), "no objective named 'Nope'"),

@@ -9,12 +9,11 @@ from kinema.config.selection import selection_file
 from kinema.errors import ConfigError
 
 
-def test_nothing_selected_by_default(isolated_selection: Path):
+def test_with_nothing_selected_the_config_is_the_bundled_lab_sim(isolated_selection: Path):
     selection = active_selection()
-    assert selection.workspace is None and selection.config is None
-    assert selection.workspace_source == selection.config_source == "unset"
-    with pytest.raises(ConfigError, match="no config package is selected; pass -c NAME"):
-        selection.require_config()
+    assert selection.workspace is None and selection.workspace_source == "unset"
+    assert (selection.config, selection.config_source) == ("lab_sim", "default")
+    assert selection.require_config() == "lab_sim"
 
 
 def test_stored_selection_lives_in_the_xdg_config_dir(isolated_selection: Path, tmp_path: Path):
