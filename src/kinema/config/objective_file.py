@@ -13,6 +13,8 @@ MoveIt Pro's conventions (one ``<BehaviorTree>`` per file, named by ``main_tree_
 
 from __future__ import annotations
 
+import bisect
+import re
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -131,7 +133,7 @@ def objectives_of(root: etree._Element, path: Path, text: str | None = None) -> 
     ``text`` (the document's source) lets each objective's line be the line its ``<BehaviorTree`` tag
     starts on; libxml2 reports the line where a multi-line start tag ends.
     """
-    source_lines = text.replace("\r\n", "\n").replace("\r", "\n").split("\n") if text is not None else None
+    opener_lines = _lines_of("<BehaviorTree", text) if text is not None else None
     filename = str(path)
     if root.tag != "root":
         raise ObjectiveError(
@@ -148,7 +150,7 @@ def objectives_of(root: etree._Element, path: Path, text: str | None = None) -> 
     warnings: list[str] = []
     seen: dict[str, int] = {}
     for tree in trees:
-        line = _tag_start_line(source_lines, "<BehaviorTree", tree.sourceline or 0)
+        line = _tag_start_line(opener_lines, tree.sourceline or 0)
         tree_id = tree.get("ID")
         if not tree_id:
             raise ObjectiveError(
@@ -171,14 +173,25 @@ def objectives_of(root: etree._Element, path: Path, text: str | None = None) -> 
     return ParsedObjectiveFile(objectives, warnings)
 
 
-def _tag_start_line(source_lines: list[str] | None, opener: str, reported: int) -> int:
-    """Walk back from the line libxml2 reported to the line where ``opener`` appears."""
-    if source_lines is None or reported <= 0:
+def _lines_of(opener: str, text: str) -> list[int]:
+    """The lines (1-based, ascending) on which ``opener`` occurs in ``text``."""
+    if "\r" in text:
+        text = text.replace("\r\n", "\n").replace("\r", "\n")
+    lines: list[int] = []
+    line, previous = 1, 0
+    for match in re.finditer(re.escape(opener), text):
+        line += text.count("\n", previous, match.start())
+        previous = match.start()
+        lines.append(line)
+    return lines
+
+
+def _tag_start_line(opener_lines: list[int] | None, reported: int) -> int:
+    """The line of the nearest tag opener at or before the line libxml2 reported (the end of the tag)."""
+    if not opener_lines or reported <= 0:
         return reported
-    for line in range(min(reported, len(source_lines)), max(reported - 200, 0), -1):
-        if opener in source_lines[line - 1]:
-            return line
-    return reported
+    index = bisect.bisect_right(opener_lines, reported) - 1
+    return opener_lines[index] if index >= 0 else reported
 
 
 def _subtree_models(root: etree._Element) -> dict[str, etree._Element]:
