@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Callable
+from dataclasses import replace
 
 import numpy as np
 import pytest
@@ -195,3 +196,31 @@ def test_deactivation_and_state_resets_abort_the_goal(
     getattr(controller, event)(plant)
     assert execution.outcome is not None and execution.outcome.status == "aborted"
     assert not controller.busy
+
+
+def test_joints_a_preempting_goal_leaves_out_hold_their_last_desired_position() -> None:
+    joints = [JointInfo(name, i, i, None, i) for i, name in enumerate(NAMES)]
+    controller = JointTrajectoryController("arm", joints, np.full(2, 0.1), DT)  # with velocity feed-forward
+    plant = Plant()
+    controller.activate(plant)
+    # The fake plant goes where ctrl says, feed-forward included: allow for that offset on the path.
+    first = start(controller, plant, make_goal([1.0, 1.0], path_position_tolerance=np.full(2, 1.0)))
+    while plant.time < 0.5:
+        plant.step(controller)
+    moving_b = plant.ctrl[1]
+    partial = make_goal([0.0], joint_names=("a",), joint_indices=np.array([0]), velocities=None)
+    partial = replace(
+        partial,
+        path_position_tolerance=np.full(1, 1.0),
+        path_velocity_tolerance=np.full(1, math.inf),
+        goal_position_tolerance=np.full(1, 0.01),
+        goal_velocity_tolerance=np.full(1, 0.05),
+    )
+    execution = start(controller, plant, partial)
+    assert first.outcome is not None and "preempted" in first.outcome.result["error_string"]
+    plant.run(controller, execution)
+    assert execution.outcome is not None and execution.outcome.status == "succeeded"
+    # b holds where the first goal wanted it when preempted: its ctrl lost the feed-forward term.
+    assert plant.ctrl[1] < moving_b
+    assert plant.qpos[1] == pytest.approx(plant.ctrl[1])
+    assert 0.3 < plant.ctrl[1] < 0.7

@@ -220,6 +220,12 @@ class JointTrajectoryController:
             self._command[:] = data.qpos[self._qpos]
             self._command_velocity[:] = data.qvel[self._qvel]
         columns = goal.joint_indices
+        # Joints this goal leaves out hold the last desired position (without a preempted goal's
+        # velocity feed-forward, which would offset them).
+        others = np.setdiff1d(np.arange(len(self.joints)), columns)
+        if others.size:
+            self._command_velocity[others] = 0.0
+            data.ctrl[self._ctrl[others]] = self._command[others]
         table = sample_trajectory(
             goal.times,
             goal.positions,
@@ -249,7 +255,7 @@ class JointTrajectoryController:
         )
 
     def cancel(self, execution: Execution, data: Any) -> None:
-        """Stop the goal of ``execution`` now and hold the joints where they are."""
+        """Stop the goal of ``execution`` now: brake the joints to a stop and hold them there."""
         running = self._running
         if running is None or running.execution is not execution:
             execution.finish("canceled", _result(SUCCESSFUL, "canceled before it started"))
