@@ -1,0 +1,142 @@
+"""Core and MuJoCo behaviors against lab_sim's running driver: plan, execute, grip, switch, reset, wait."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+import pytest
+
+from kinema.behaviors import BehaviorContext
+from kinema.bt import NodeStatus
+from kinema.testing import tick_behavior
+
+pytestmark = pytest.mark.slow
+
+ARM = [
+    "linear_rail_joint",
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "elbow_joint",
+    "wrist_1_joint",
+    "wrist_2_joint",
+    "wrist_3_joint",
+]
+LOOK_AT_TABLE = [-0.1333, 0.0, -2.08806, 1.90997, -2.0927, -1.57079, 0.0]
+
+
+def _arm(behavior: Any, context: BehaviorContext) -> np.ndarray:
+    run = tick_behavior(behavior("GetJointState"), {"planning_group_name": "manipulator"}, context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    state = run.outputs["joint_state"]
+    assert list(state.name) == ARM
+    return np.array(state.position)
+
+
+def _goal(positions: list[float]) -> Any:
+    from kinema.transport import from_dict
+
+    return from_dict("sensor_msgs/msg/JointState", {"name": ARM, "position": positions})
+
+
+def _plan_and_execute(behavior: Any, context: BehaviorContext, positions: list[float]) -> Any:
+    plan = tick_behavior(
+        behavior("PlanToJointGoal"), {"joint_goal": _goal(positions)}, context=context, timeout=30
+    )
+    assert plan.status == NodeStatus.SUCCESS, plan.toasts
+    return tick_behavior(
+        behavior("ExecuteTrajectory"),
+        {"joint_trajectory_msg": plan.outputs["joint_trajectory_msg"]},
+        context=context,
+    )
+
+
+def test_planned_trajectories_bring_the_arm_to_the_goal(behavior: Any, context: BehaviorContext) -> None:
+    run = _plan_and_execute(behavior, context, LOOK_AT_TABLE)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    np.testing.assert_allclose(_arm(behavior, context), LOOK_AT_TABLE, atol=0.01)
+
+
+def test_a_trajectory_with_unknown_joint_names_is_rejected(behavior: Any, context: BehaviorContext) -> None:
+    from kinema.transport import from_dict
+
+    before = _arm(behavior, context)
+    names = ["linear_rail_joint", "elbow_jiont"]
+    trajectory = from_dict(
+        "trajectory_msgs/msg/JointTrajectory",
+        {
+            "joint_names": names,
+            "points": [
+                {"positions": [0.0, 1.0], "time_from_start": {"sec": 0}},
+                {"positions": [0.1, 1.2], "time_from_start": {"sec": 1}},
+            ],
+        },
+    )
+    run = tick_behavior(behavior("ExecuteTrajectory"), {"joint_trajectory_msg": trajectory}, context=context)
+    assert run.status == NodeStatus.FAILURE
+    assert "elbow_jiont" in run.toasts[-1] and "elbow_joint" in run.toasts[-1], run.toasts
+    np.testing.assert_allclose(_arm(behavior, context), before, atol=1e-3)
+
+
+def test_the_gripper_closes_and_opens(behavior: Any, context: BehaviorContext) -> None:
+    closed = tick_behavior(behavior("MoveGripperAction"), {"position": 0.7929}, context=context)
+    assert closed.status == NodeStatus.SUCCESS, closed.toasts
+    state = tick_behavior(behavior("GetJointState"), {"planning_group_name": "gripper"}, context=context)
+    assert state.outputs["joint_state"].position[0] > 0.7
+    opened = tick_behavior(behavior("MoveGripperAction"), {"position": 0.0}, context=context)
+    assert opened.status == NodeStatus.SUCCESS, opened.toasts
+
+
+def test_without_the_trajectory_controller_execution_fails_until_it_is_back(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    listing = tick_behavior(
+        behavior("ListControllers"), {"type": "command", "state": "active"}, context=context
+    )
+    assert set(listing.outputs["controller_list"]) == {
+        "joint_trajectory_controller",
+        "robotiq_gripper_controller",
+    }
+    off = tick_behavior(
+        behavior("SwitchController"),
+        {"deactivate_controllers": "joint_trajectory_controller"},
+        context=context,
+    )
+    assert off.status == NodeStatus.SUCCESS, off.toasts
+    start = _arm(behavior, context).tolist()
+    target = list(start)
+    target[1] += 0.3
+    refused = _plan_and_execute(behavior, context, target)
+    assert refused.status == NodeStatus.FAILURE
+    assert "joint_trajectory_controller is inactive" in refused.toasts[-1]
+    on = tick_behavior(
+        behavior("SwitchController"),
+        {"activate_controllers": "/joint_trajectory_controller"},
+        context=context,
+    )
+    assert on.status == NodeStatus.SUCCESS, on.toasts
+    assert _plan_and_execute(behavior, context, target).status == NodeStatus.SUCCESS
+
+
+def test_set_mujoco_state_jumps_the_arm(behavior: Any, context: BehaviorContext) -> None:
+    upright = [0.0, 0.0, -1.57, 0.0, 0.0, 0.0, 0.0]
+    state = tick_behavior(
+        behavior("CreateRobotState"), {"joint_names": ARM, "positions": upright}, context=context
+    ).outputs["robot_state"]
+    run = tick_behavior(behavior("SetMujocoState"), {"robot_state": state}, context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    np.testing.assert_allclose(_arm(behavior, context), upright, atol=0.02)
+    home = tick_behavior(
+        behavior("SetMujocoState"), {"keyframe": "home", "robot_state": None}, context=context
+    )
+    assert home.status == NodeStatus.SUCCESS, home.toasts
+    np.testing.assert_allclose(
+        _arm(behavior, context), [0.0, 0.0, -2.0, 2.0, -1.5708, -1.5708, 0.0], atol=0.02
+    )
+
+
+def test_wait_for_duration_counts_sim_time(behavior: Any, context: BehaviorContext) -> None:
+    before = context.clock.now()
+    run = tick_behavior(behavior("WaitForDuration"), {"delay_duration": 3.0}, context=context)
+    assert run.status == NodeStatus.SUCCESS
+    assert context.clock.now() - before >= 3.0
