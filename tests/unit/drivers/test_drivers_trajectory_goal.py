@@ -142,6 +142,7 @@ def test_tolerances_zero_means_default_negative_means_unchecked() -> None:
     assert parsed.goal_velocity_tolerance.tolist() == [math.inf, 0.05, 0.05]
     assert parsed.goal_time_tolerance == 0.5
     assert parse(goal()).goal_time_tolerance == 1.0
+    assert parse(goal(goal_time_tolerance={"sec": -1})).goal_time_tolerance == 1.0
 
 
 def test_a_stamped_trajectory_keeps_its_start_time() -> None:

@@ -3,7 +3,8 @@
 Rules follow ros2_control's joint trajectory controller: joint names must be joints of the controller
 (a goal may move a subset; the others hold), every point gives a position per joint and, if any point
 gives velocities or accelerations, all do; times from start increase strictly. A tolerance of 0 means
-"use the controller's default", a negative one "do not check". Unlike ros2_control, a rejected goal is
+"use the controller's default", a negative one "do not check" — except ``goal_time_tolerance``, where
+0 or negative means the default, so a goal always ends. Unlike ros2_control, a rejected goal is
 accepted and at once aborted with ``error_code``/``error_string``, so the client learns why (for
 example the list of valid joint names).
 """
@@ -242,5 +243,7 @@ def parse_trajectory_goal(
         path_velocity_tolerance=path_velocity,
         goal_position_tolerance=goal_position,
         goal_velocity_tolerance=goal_velocity,
-        goal_time_tolerance=_resolve(_duration(goal.goal_time_tolerance), defaults.goal_time),
+        # Unlike the joint tolerances a negative time does not switch the check off: a goal that never
+        # meets its tolerances must end some time, so anything but a positive time means the default.
+        goal_time_tolerance=max(_duration(goal.goal_time_tolerance), 0.0) or defaults.goal_time,
     )
