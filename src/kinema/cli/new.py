@@ -66,8 +66,13 @@ def new_config(
             "Based on", default=active if active in choices else (choices[0] if choices else None)
         )
     assert name is not None and based_on is not None
+    # Without a terminal there is nobody to answer the template's questions: use their defaults.
+    no_input = no_input or not click.get_text_stream("stdin").isatty()
+    overlaid = found.package(name) if found.has_package(name) else None
     path = new_config_package(name, based_on, output_dir, workspace=found, no_input=no_input)
     click.echo(f"created config package {name} in {path}")
+    if overlaid is not None and overlaid.origin == "bundled":
+        click.echo(f"note: it overlays Kinema's bundled {name} ({overlaid.path}) in this workspace")
     click.echo(f"try: kinema config show -c {name} --provenance")
 
 

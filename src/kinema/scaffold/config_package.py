@@ -39,7 +39,10 @@ def config_package_validator(workspace: Workspace) -> Validator:
     def validate(values: dict[str, str]) -> None:
         name, parent = values["package_name"], values["based_on_package"]
         check_package_name(name)
-        if workspace.has_package(name):
+        if name == parent:
+            raise ScaffoldError(f"{name!r} cannot be based on itself; choose another name or parent")
+        # A bundled package of the same name is fine: the new workspace package overlays it.
+        if workspace.has_package(name) and workspace.package(name).origin != "bundled":
             existing = workspace.package(name)
             raise ScaffoldError(
                 f"a package named {name!r} already exists ({existing.path}); choose another name"
@@ -68,7 +71,8 @@ def new_config_package(
     """Generate config package ``name`` based on ``based_on``.
 
     Args:
-        name: the new package's name (a valid ROS package name not used by any visible package).
+        name: the new package's name (a valid ROS package name not used by another workspace package;
+            a bundled package of that name is overlaid by the new one).
         based_on: the parent config package (must be visible from ``workspace``).
         output_dir: where to create it; default: the workspace's ``src/``.
         workspace: where names are checked; default: the active workspace.

@@ -76,7 +76,7 @@ def test_template_variables_can_be_given_and_prompted(workspace_root: Path):
         ("trailing_", "lab_sim", "not a valid package name"),
         ("9lives", "lab_sim", "not a valid package name"),
         ("class", "lab_sim", "Python keyword"),
-        ("lab_sim", "lab_sim", "already exists"),
+        ("lab_sim", "lab_sim", "based on itself"),
         ("fine_name", "lab_sm", "did you mean 'lab_sim'"),
         ("fine_name", "kinema_objectives", "no config package of that name"),
     ],
@@ -88,6 +88,18 @@ def test_bad_names_are_refused_before_anything_is_written(
     with pytest.raises(ScaffoldError, match=words):
         new_config_package(name, parent, workspace=Workspace.discover(workspace_root))
     assert _tree(workspace_root) == before
+
+
+def test_a_bundled_name_is_overlaid_by_the_new_workspace_package(workspace_root: Path):
+    """The tutorial's `kinema new config example_config --based-on lab_sim` in a fresh workspace."""
+    package = new_config_package("example_config", "lab_sim", workspace=Workspace.discover(workspace_root))
+    assert package == workspace_root.resolve() / "src" / "example_config"
+    found = Workspace.discover(workspace_root)
+    assert found.package("example_config").path == package
+    assert any("overlays the bundled one" in notice for notice in found.notices)
+    assert resolve_config("example_config", found).chain == ["lab_sim", "example_config"]
+    with pytest.raises(ScaffoldError, match="already exists"):
+        new_config_package("example_config", "lab_sim", workspace=found)
 
 
 def test_existing_folder_is_refused(workspace_root: Path, tmp_path: Path):
