@@ -1,0 +1,208 @@
+"""``kinema view`` as a library: attach to a runtime, serve its scene with meshcat, open the browser.
+
+::
+
+    viewer = start_viewer(ViewerOptions(endpoint="tcp/127.0.0.1:7447", open_browser=False))
+    print(viewer.url)          # http://127.0.0.1:7000/static/
+    ...
+    viewer.close()
+
+:func:`run_viewer` does the same and blocks until Ctrl-C or SIGTERM (what the CLI and ``kinema run`` use).
+"""
+
+from __future__ import annotations
+
+import logging
+import os
+import signal
+import sys
+import threading
+import webbrowser
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from kinema.errors import ConfigError
+
+log = logging.getLogger("kinema.viz")
+
+
+@dataclass
+class ViewerOptions:
+    """What ``kinema view`` attaches to and how it serves.
+
+    Attributes:
+        endpoint: the runtime's router (None: ``KINEMA_ZENOH_CONNECT`` or tcp/127.0.0.1:7447).
+        config: the config package whose MuJoCo scene is drawn (None: the running instance's, else the
+            active one).
+        workspace: the workspace to resolve it in (None: the active one).
+        port: the HTTP port (None: the first free one from 7000 up).
+        open_browser: open the page in the default browser.
+        frame_rate: most scene updates per second sent to the page.
+        echo: prints the URL and notices.
+    """
+
+    endpoint: str | None = None
+    config: str | None = None
+    workspace: Path | None = None
+    port: int | None = None
+    open_browser: bool = True
+    frame_rate: float = 60.0
+    echo: Callable[[str], None] = field(default=print)
+
+
+@dataclass
+class SceneSource:
+    """The config drawn, its MuJoCo scene, start keyframe and end effector (for planned paths)."""
+
+    config: str
+    model_path: Path
+    keyframe: str | None
+    end_effector: str | None
+
+
+def resolve_scene(config: str | None, workspace: Path | None, endpoint: str) -> SceneSource:
+    """Find the MuJoCo scene to draw (see :attr:`ViewerOptions.config` for which config).
+
+    Raises:
+        ConfigError: the config cannot be resolved or has no MuJoCo scene.
+    """
+    from kinema.config import Workspace, active_selection, resolve_config
+
+    selection = active_selection(workspace, config)
+    name = config
+    if name is None:
+        from kinema.runtime.instance import running_instances
+
+        matching = [r for r in running_instances() if r.router == endpoint and r.config]
+        name = matching[-1].config if matching else selection.config
+    if not name:
+        raise ConfigError("no config selected: pass -c NAME (or select one with `kinema configure`)")
+    found = Workspace.discover(selection.workspace) if selection.workspace else Workspace.bundled_only()
+    resolved = resolve_config(name, found, check_files=False)
+    model_path = resolved.mujoco_model_path
+    if model_path is None:
+        raise ConfigError(
+            f"config {name!r} has no MuJoCo scene to draw: set hardware.simulation.mujoco_model "
+            "({package, path})",
+            location=resolved.location_of("hardware"),
+        )
+    keyframe = resolved.get("hardware.simulation.mujoco_keyframe")
+    return SceneSource(name, model_path, str(keyframe) if keyframe else None, _end_effector(resolved))
+
+
+def _end_effector(resolved: Any) -> str | None:
+    """The SRDF's first end effector's parent link, else the first chain group's tip (None: neither)."""
+    from kinema.motion.srdf import parse_srdf
+
+    try:
+        semantic = parse_srdf(resolved.srdf_path)
+    except Exception as error:  # no or broken SRDF: the path is drawn for a guessed tool instead
+        log.info("no end effector from the SRDF (%s); guessing the tool per trajectory", error)
+        return None
+    if semantic.end_effectors:
+        return semantic.end_effectors[0].parent_link
+    for group in semantic.groups.values():
+        if group.chains:
+            return group.chains[-1][1]
+    return None
+
+
+class Viewer:
+    """A running ``kinema view``: the session, the meshcat server and the bridge between them."""
+
+    def __init__(self, options: ViewerOptions) -> None:
+        from kinema.transport import open_session, resolve_endpoints
+        from kinema.viz.meshcat_server import MeshcatServer
+        from kinema.viz.scene_model import SceneModel
+        from kinema.viz.scene_viewer import SceneViewer
+
+        self.endpoint = options.endpoint or resolve_endpoints(None)[0]
+        self.source = resolve_scene(options.config, options.workspace, self.endpoint)
+        scene = SceneModel.from_file(self.source.model_path, self.source.end_effector, self.source.keyframe)
+        self.session = open_session(self.endpoint)
+        self.bridge: SceneViewer | None = None
+        try:
+            self.server = MeshcatServer(options.port, status=lambda: self._status(), view=scene.camera_view)
+            self.bridge = SceneViewer(
+                self.session,
+                scene,
+                self.server,
+                endpoint=self.endpoint,
+                config=self.source.config,
+                frame_rate=options.frame_rate,
+            )
+            self.bridge.start()
+        except BaseException:
+            self.close()
+            raise
+
+    @property
+    def url(self) -> str:
+        """The page to open."""
+        return self.server.url
+
+    def _status(self) -> dict[str, Any]:
+        return self.bridge.status() if self.bridge is not None else {}
+
+    def close(self) -> None:
+        """Stop following the runtime and stop serving."""
+        if self.bridge is not None:
+            self.bridge.stop()
+            self.bridge = None
+        server = getattr(self, "server", None)
+        if server is not None:
+            server.stop()
+        self.session.close()
+
+
+def start_viewer(options: ViewerOptions) -> Viewer:
+    """Attach to the runtime and serve its scene; returns once the page can be opened.
+
+    Raises:
+        ConfigError: no MuJoCo scene to draw.
+        TransportError: no runtime answers at the endpoint.
+        KinemaError: the HTTP port is taken.
+    """
+    return Viewer(options)
+
+
+def open_browser(url: str) -> bool:
+    """Open ``url`` in a graphical browser; False when there is none (no display on Linux).
+
+    Without a display Python's ``webbrowser`` falls back to text browsers (lynx, w3m) that would take
+    over the terminal, which the TUI of ``kinema run`` needs.
+    """
+    if sys.platform.startswith("linux") and not (
+        os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    ):
+        return False
+    try:
+        return webbrowser.open(url, new=2)
+    except webbrowser.Error:
+        return False
+
+
+def run_viewer(options: ViewerOptions, ready: Callable[[str], None] | None = None) -> int:
+    """Start the viewer, print the URL, open the browser, block until Ctrl-C or SIGTERM; returns 0."""
+    viewer = start_viewer(options)
+    stop = threading.Event()
+    previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
+    for sig in previous:
+        signal.signal(sig, lambda *_: stop.set())
+    try:
+        options.echo(
+            f"3D view of {viewer.source.config}: {viewer.url} (runtime at {viewer.endpoint}; Ctrl-C to stop)"
+        )
+        if ready is not None:
+            ready(viewer.url)
+        if options.open_browser and not open_browser(viewer.url):
+            options.echo("no graphical browser here: open the URL above in one")
+        while not stop.wait(0.5):
+            pass
+        return 0
+    finally:
+        viewer.close()
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
