@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from pilot_harness import drive, settle
+from rich.text import Text
 from textual.widgets import DataTable, Input, OptionList, RichLog, Select, Tree
 
 from kinema.errors import TransportError
@@ -24,7 +25,11 @@ from kinema.tui.widgets.status_bar import StatusBar
 
 
 def table_rows(table: DataTable) -> list[list[str]]:  # type: ignore[type-arg]
-    return [[str(cell) for cell in table.get_row_at(i)] for i in range(table.row_count)]
+    """The table's cells as the user reads them (text cells are markup: render them)."""
+    return [
+        [Text.from_markup(cell).plain if isinstance(cell, str) else str(cell) for cell in table.get_row_at(i)]
+        for i in range(table.row_count)
+    ]
 
 
 def tree_labels(tree: Tree) -> list[str]:  # type: ignore[type-arg]

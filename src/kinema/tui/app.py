@@ -7,6 +7,7 @@ heartbeat, clock sample and blackboard snapshot, so a fast stream can never queu
 
 from __future__ import annotations
 
+import gc
 import logging
 import threading
 import time
@@ -168,6 +169,10 @@ class KinemaApp(App[None]):
     def on_mount(self) -> None:
         self.switch_mode(self.initial_mode)
         self.connection.open(self._receive)
+        # Textual, the stylesheets and the screens make ~10^5 long-lived objects; every full garbage
+        # collection walks them all (hundreds of ms while the blackboard streams). Freezing them after
+        # the first frame keeps those collections to what was allocated since.
+        self.call_after_refresh(gc.freeze)
 
     def on_unmount(self) -> None:
         try:

@@ -194,7 +194,7 @@ class SdkConnection:
         from kinema.runtime import names
         from kinema.sdk import ObjectiveClient
 
-        client = ObjectiveClient(self._endpoint, timeout=2.0)
+        client = ObjectiveClient(self._endpoint, timeout=CALL_TIMEOUT_S)
         # Published before subscribing: the latched heartbeat can arrive while subscribing, and a
         # screen that sees "connected" must find a client to call.
         with self._lock:

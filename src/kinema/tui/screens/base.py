@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import logging
+import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -23,6 +24,10 @@ if TYPE_CHECKING:
     from kinema.tui.runtime_status import RuntimeStatus
 
 log = logging.getLogger("kinema.tui")
+
+RETRY_PAUSE_S = 1.0
+#: How often the screens try to list what they show before saying it failed.
+LOAD_ATTEMPTS = 3
 
 
 class KinemaScreen(Screen[None]):
@@ -72,6 +77,7 @@ class KinemaScreen(Screen[None]):
         done: Callable[[Any], Message | None] | None = None,
         *,
         announce: bool = False,
+        attempts: int = 1,
     ) -> None:
         """Run ``call`` on a worker thread; post ``done(result)`` back to this screen.
 
@@ -83,18 +89,25 @@ class KinemaScreen(Screen[None]):
             call: the blocking call.
             done: builds the message to post with the result, or None.
             announce: notify the user on success.
+            attempts: how often to try a read-only call before reporting its failure (never retry a call
+                that changes something).
         """
 
         def work() -> None:
-            try:
-                result = call()
-            except KinemaError as error:
-                self.app.post_message(RuntimeCallFailed(what, str(error)))
-                return
-            except Exception as error:
-                log.exception("%s failed", what)
-                self.app.post_message(RuntimeCallFailed(what, f"{type(error).__name__}: {error}"))
-                return
+            for attempt in range(1, attempts + 1):
+                try:
+                    result = call()
+                    break
+                except KinemaError as error:
+                    if attempt < attempts:
+                        time.sleep(RETRY_PAUSE_S)  # a runtime that just appeared may not serve yet
+                        continue
+                    self.app.post_message(RuntimeCallFailed(what, str(error)))
+                    return
+                except Exception as error:  # shown to the user; the app must survive
+                    log.exception("%s failed", what)
+                    self.app.post_message(RuntimeCallFailed(what, f"{type(error).__name__}: {error}"))
+                    return
             if done is not None:
                 message = done(result)
                 if message is not None:

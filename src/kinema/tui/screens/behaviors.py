@@ -12,7 +12,7 @@ from textual.widgets import DataTable, Input, Label, Static
 
 from kinema.tui.connection import BehaviorSummary, ConnectionState, ReloadNotice
 from kinema.tui.messages import BehaviorsLoaded
-from kinema.tui.screens.base import KinemaScreen
+from kinema.tui.screens.base import LOAD_ATTEMPTS, KinemaScreen
 
 
 class BehaviorsScreen(KinemaScreen):
@@ -64,7 +64,9 @@ class BehaviorsScreen(KinemaScreen):
             self.action_reload()
 
     def action_reload(self) -> None:
-        self.call_runtime("List behaviors", self.kinema.connection.list_behaviors, BehaviorsLoaded)
+        self.call_runtime(
+            "List behaviors", self.kinema.connection.list_behaviors, BehaviorsLoaded, attempts=LOAD_ATTEMPTS
+        )
 
     def runtime_connected(self) -> None:
         self.action_reload()

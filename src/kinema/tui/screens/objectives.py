@@ -22,7 +22,7 @@ from textual.widgets.option_list import Option
 from kinema.errors import KinemaError
 from kinema.tui.connection import ConnectionState, NodeStatusBatch, ObjectiveSummary, RuntimeConnection
 from kinema.tui.messages import ObjectiveOutlineLoaded, ObjectiveRunRequested, ObjectivesLoaded
-from kinema.tui.screens.base import KinemaScreen
+from kinema.tui.screens.base import LOAD_ATTEMPTS, KinemaScreen
 from kinema.tui.tree_outline import build_outline
 from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
 from kinema.tui.widgets.override_form import OverrideForm
@@ -114,7 +114,12 @@ class ObjectivesScreen(KinemaScreen):
     # -- loading -----------------------------------------------------------------------------------
 
     def action_reload(self) -> None:
-        self.call_runtime("List objectives", self.kinema.connection.list_objectives, ObjectivesLoaded)
+        self.call_runtime(
+            "List objectives",
+            self.kinema.connection.list_objectives,
+            ObjectivesLoaded,
+            attempts=LOAD_ATTEMPTS,
+        )
 
     def runtime_connected(self) -> None:
         self.action_reload()

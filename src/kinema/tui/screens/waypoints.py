@@ -12,7 +12,7 @@ from kinema.tui.connection import ConnectionState, WaypointSummary
 from kinema.tui.dialogs.confirm import ConfirmDialog
 from kinema.tui.dialogs.text_prompt import TextPromptDialog
 from kinema.tui.messages import WaypointsLoaded
-from kinema.tui.screens.base import KinemaScreen
+from kinema.tui.screens.base import LOAD_ATTEMPTS, KinemaScreen
 
 
 class WaypointsScreen(KinemaScreen):
@@ -57,7 +57,9 @@ class WaypointsScreen(KinemaScreen):
             self.action_reload()
 
     def action_reload(self) -> None:
-        self.call_runtime("List waypoints", self.kinema.connection.list_waypoints, WaypointsLoaded)
+        self.call_runtime(
+            "List waypoints", self.kinema.connection.list_waypoints, WaypointsLoaded, attempts=LOAD_ATTEMPTS
+        )
 
     def runtime_connected(self) -> None:
         self.action_reload()
