@@ -30,6 +30,13 @@ from kinema.cli.options import selection_options
     help="Router endpoint to host or join (default: $KINEMA_ZENOH_CONNECT, else tcp/127.0.0.1:7447).",
 )
 @click.option("--tick-rate", type=float, default=100.0, show_default=True, help="Objective ticks per second.")
+@click.option(
+    "--sim-speed",
+    default=None,
+    metavar="FACTOR|max",
+    help="Simulated seconds per wall second: 1 (real time, the default), a factor such as 4, or max "
+    "(as fast as the CPU allows; for tests and CI).",
+)
 def run(
     workspace: Path | None,
     config: str | None,
@@ -41,6 +48,7 @@ def run(
     list_configs: bool,
     connect: str | None,
     tick_rate: float,
+    sim_speed: str | None,
 ) -> None:
     """Start Kinema: host the zenoh router (or join one), the agent and the config's drivers.
 
@@ -54,6 +62,10 @@ def run(
         return
     if no_drivers and only_drivers:
         raise click.UsageError("-n/--no-drivers and -o/--only-drivers exclude each other")
+    if sim_speed is not None:
+        from kinema.drivers.mujoco.sim_speed import parse_sim_speed
+
+        parse_sim_speed(sim_speed)  # refuse a bad value here rather than in the driver's log
     found, name = resolve_selection(workspace, config)
     from kinema.runtime.launcher import Launcher, LaunchOptions
 
@@ -76,6 +88,7 @@ def run(
         endpoint=connect,
         verbose=verbose,
         tick_rate_hz=tick_rate,
+        sim_speed=sim_speed,
         echo=click.echo,
         ui=ui,
     )

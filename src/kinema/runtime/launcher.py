@@ -52,6 +52,8 @@ class LaunchOptions:
         endpoint: the router endpoint to host or join (None: ``KINEMA_ZENOH_CONNECT`` or 7447).
         verbose: DEBUG logs, echoed to the terminal.
         tick_rate_hz: the agent's tick rate.
+        sim_speed: for simulated drivers, ``"1"`` (real time), a factor such as ``"4"``, or ``"max"``
+            (None: the driver's default, real time).
         ui: runs in the main thread once everything started (the TUI); returns an exit code.
         echo: print progress lines (the CLI); tests turn it off.
     """
@@ -63,6 +65,7 @@ class LaunchOptions:
     endpoint: str | None = None
     verbose: bool = False
     tick_rate_hz: float = 100.0
+    sim_speed: str | None = None
     ui: Callable[[Launcher], int] | None = None
     echo: Callable[[str], None] = field(default=print)
 
@@ -165,6 +168,7 @@ class Launcher:
                 config=self.options.config,
                 connect=self.endpoint,
                 workspace=self.options.workspace,
+                sim_speed=self.options.sim_speed,
                 log_file=log_file,
                 verbose=self.options.verbose,
             )
