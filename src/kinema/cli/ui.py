@@ -41,13 +41,16 @@ def ui(endpoint: str | None, screen: str, demo: bool, workspace: Path | None, co
     -w/-c (or `kinema configure`). Keys: 1-6 switch screens, ctrl+p opens the command palette, q quits.
     """
     from kinema.tui.app import run_app
+    from kinema.tui.connection import RuntimeConnection
 
+    connection: RuntimeConnection
     if demo:
         from kinema.tui.fake_connection import FakeConnection
 
-        connection = FakeConnection.demo()
+        fake = FakeConnection.demo()
         if workspace is not None:
-            connection.workspace_root = str(workspace)
+            fake.workspace_root = str(workspace)
+        connection = fake
     else:
         from kinema.tui.sdk_connection import SdkConnection
 

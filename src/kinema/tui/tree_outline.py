@@ -90,9 +90,9 @@ class TreeOutline:
             self._index = (by_uid, by_path)
         by_uid, by_path = self._index
         if self.exact_uids:
-            node = by_uid.get(uid)
-            if node is not None and (not path or node.path == path):
-                return node
+            numbered = by_uid.get(uid)
+            if numbered is not None and (not path or numbered.path == path):
+                return numbered
         return by_path.get(path) if path else None
 
 

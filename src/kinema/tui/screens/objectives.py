@@ -61,8 +61,16 @@ class ObjectivesScreen(KinemaScreen):
         ),
         Binding("x", "cancel", "Cancel", id="objectives.cancel", tooltip="Cancel the running objective"),
         Binding("slash", "search", "Search", id="objectives.search", tooltip="Search objectives by name"),
-        Binding("f", "toggle('favorites')", "Favorites", id="objectives.favorites", tooltip="Only favorites"),
-        Binding("u", "toggle('runnable')", "Runnable", id="objectives.runnable", tooltip="Only runnable"),
+        Binding(
+            "f",
+            "toggle_filter('favorites')",
+            "Favorites",
+            id="objectives.favorites",
+            tooltip="Only favorites",
+        ),
+        Binding(
+            "u", "toggle_filter('runnable')", "Runnable", id="objectives.runnable", tooltip="Only runnable"
+        ),
         Binding("t", "tab('tree')", "Tree", id="objectives.tree", tooltip="The behavior tree"),
         Binding("m", "tab('xml')", "XML", id="objectives.xml", tooltip="The objective's XML"),
         Binding("p", "tab('parameters')", "Parameters", id="objectives.parameters", tooltip="Overrides"),
@@ -254,7 +262,7 @@ class ObjectivesScreen(KinemaScreen):
     def action_search(self) -> None:
         self.query_one("#objective-search", Input).focus()
 
-    def action_toggle(self, which: str) -> None:
+    def action_toggle_filter(self, which: str) -> None:
         self.query_one(f"#{which}", Checkbox).toggle()
 
     def action_tab(self, tab: str) -> None:

@@ -2,13 +2,15 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
+
 from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.widgets import DataTable, Static
 
-from kinema.tui.connection import ConnectionState, WaypointSummary
+from kinema.tui.connection import ConnectionState, RuntimeConnection, WaypointSummary
 from kinema.tui.dialogs.confirm import ConfirmDialog
 from kinema.tui.dialogs.text_prompt import TextPromptDialog
 from kinema.tui.messages import WaypointsLoaded
@@ -128,7 +130,7 @@ class WaypointsScreen(KinemaScreen):
             if name:
                 self.call_runtime(
                     f"Save waypoint {name!r}",
-                    lambda: (connection.save_waypoint(name), connection.list_waypoints())[1],
+                    lambda: _then_list(connection, lambda: connection.save_waypoint(name)),
                     WaypointsLoaded,
                     announce=True,
                 )
@@ -148,10 +150,9 @@ class WaypointsScreen(KinemaScreen):
             if new_name and new_name != waypoint.name:
                 self.call_runtime(
                     f"Rename waypoint {waypoint.name!r} to {new_name!r}",
-                    lambda: (
-                        connection.rename_waypoint(waypoint.name, new_name),
-                        connection.list_waypoints(),
-                    )[1],
+                    lambda: _then_list(
+                        connection, lambda: connection.rename_waypoint(waypoint.name, new_name)
+                    ),
                     WaypointsLoaded,
                     announce=True,
                 )
@@ -171,9 +172,15 @@ class WaypointsScreen(KinemaScreen):
             if confirmed:
                 self.call_runtime(
                     f"Delete waypoint {waypoint.name!r}",
-                    lambda: (connection.erase_waypoint(waypoint.name), connection.list_waypoints())[1],
+                    lambda: _then_list(connection, lambda: connection.erase_waypoint(waypoint.name)),
                     WaypointsLoaded,
                     announce=True,
                 )
 
         self.app.push_screen(ConfirmDialog(f"Delete waypoint {waypoint.name!r}?", "Delete"), delete)
+
+
+def _then_list(connection: RuntimeConnection, change: Callable[[], object]) -> list[WaypointSummary]:
+    """Make a change, then read the list back (what the table shows is what the runtime has)."""
+    change()
+    return connection.list_waypoints()

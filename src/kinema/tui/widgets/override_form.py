@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from textual.app import ComposeResult
 from textual.containers import VerticalScroll
+from textual.widget import Widget
 from textual.widgets import Input, Label, Static
 
 from kinema.tui.connection import ObjectiveSummary
@@ -36,7 +37,7 @@ class OverrideForm(VerticalScroll):
         if not ports:
             await self.mount(Static(f"{objective.name} has no input ports to override.", classes="port-help"))
             return
-        widgets = [
+        widgets: list[Widget] = [
             Static(
                 "Values are YAML, parsed into each port's type. Empty keeps the default.", classes="port-help"
             )
