@@ -8,6 +8,7 @@ attributes (``MoveItErrorCodes.SUCCESS``). Numeric arrays are numpy arrays, as r
 
 from __future__ import annotations
 
+import dataclasses
 from collections.abc import Mapping
 from typing import Any
 
@@ -186,14 +187,30 @@ def parse_yaml_flow(type_name: str, text: str | None, *, registry: TypeRegistry 
     return from_dict(type_name, data, registry=registry)
 
 
+_DATA_FIELDS: dict[type, tuple[str, ...]] = {}
+
+
+def _data_fields(cls: type) -> tuple[str, ...]:
+    """The fields of a message class that carry data, in order.
+
+    The generated classes hold the type's constants (and ``__msgtype__``) as fields with a default
+    value; data fields have none. ``ros2 topic echo`` leaves constants out, and so do we.
+    """
+    names = _DATA_FIELDS.get(cls)
+    if names is None:
+        names = _DATA_FIELDS[cls] = tuple(
+            name for name, spec in cls.__dataclass_fields__.items() if spec.default is dataclasses.MISSING
+        )
+    return names
+
+
 def to_dict(message: Any) -> Any:
-    """Turn a message (or a list/array of them) into plain dicts, lists, numbers and strings."""
+    """Turn a message (or a list/array of them) into plain dicts, lists, numbers and strings.
+
+    Constants of the message type are left out (they are the same in every message).
+    """
     if hasattr(message, "__msgtype__") and hasattr(message, "__dataclass_fields__"):
-        return {
-            name: to_dict(getattr(message, name))
-            for name in message.__dataclass_fields__
-            if name != "__msgtype__"
-        }
+        return {name: to_dict(getattr(message, name)) for name in _data_fields(type(message))}
     if isinstance(message, np.ndarray):
         return message.tolist()
     if isinstance(message, list | tuple):

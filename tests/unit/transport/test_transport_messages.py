@@ -51,6 +51,18 @@ def test_constants_are_class_attributes() -> None:
     assert (codes.SUCCESS, codes.FAILURE, codes.PREEMPTED) == (1, 99999, -7)
 
 
+def test_echoed_messages_show_their_fields_not_their_constants() -> None:
+    status = msg("moveit_studio_agent_msgs/msg/ObjectiveServerStatus", objective_status="Idle")
+    assert list(to_dict(status)) == [
+        "process_timestamp",
+        "ros_timestamp",
+        "objective_name",
+        "objective_status",
+    ]
+    assert "OBJECTIVE_STATUS_IDLE" not in to_yaml(status)
+    assert to_dict(msg("moveit_msgs/msg/MoveItErrorCodes", val=1)) == {"val": 1, "message": "", "source": ""}
+
+
 @pytest.mark.parametrize(
     ("type_name", "text", "message"),
     [
