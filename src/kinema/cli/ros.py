@@ -12,6 +12,7 @@ import json
 import math
 import os
 import statistics
+import sys
 import threading
 import time
 from collections import deque
@@ -183,11 +184,17 @@ def topic_echo(
                 if done.is_set():
                     return
                 text = to_yaml(message, flow=flow)
-                click.echo(text if flow else f"{text}---")
+                try:
+                    click.echo(text if flow else f"{text}---")
+                except BrokenPipeError:  # the reader went away (`| head`): stop like ros2 does
+                    closed.set()
+                    done.set()
+                    return
                 received += 1
                 if wanted and received >= wanted:
                     done.set()
 
+        closed = threading.Event()
         node.create_subscription(type_name, name, show, latched=latched)
         if wanted:
             if not done.wait(timeout):
@@ -195,7 +202,11 @@ def topic_echo(
                     f"received {received} of {wanted} messages on {name} within {timeout:g} s"
                 )
         else:
-            _wait_forever()
+            while not done.wait(0.2):  # short waits so Ctrl-C is handled promptly
+                pass
+    if closed.is_set():
+        # Python would report the closed stdout again when it flushes at exit.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
 
 
 @topic.command("pub")
