@@ -161,3 +161,28 @@ def test_status_measures_elapsed_on_the_runtime_clock_and_forgets_a_lost_runtime
     status.apply_clock(ClockSample(4.0, 0.98))
     status.apply_connection(ConnectionChanged(ConnectionState.DISCONNECTED, "tcp/127.0.0.1:7447", "gone"))
     assert status.status == "Unknown" and status.sim_time is None
+
+
+def test_reload_outcomes_are_recognised_in_the_runtime_log() -> None:
+    from kinema.errors import SourceLocation
+    from kinema.plugins.events import ReloadEvent, ReloadKind
+    from kinema.tui.sdk_connection import reload_notice_from_log
+
+    failed = ReloadEvent(
+        ReloadKind.RELOAD_FAILED,
+        "my_behaviors",
+        "my_behaviors not reloaded, keeping the last good version: invalid syntax",
+        SourceLocation("/ws/src/my_behaviors/my_behaviors/b.py", 7),
+    )
+    notice = reload_notice_from_log(str(failed), 1)
+    assert notice is not None and not notice.ok
+    assert notice.location == "/ws/src/my_behaviors/my_behaviors/b.py:7"
+    assert notice.message.startswith("my_behaviors not reloaded")
+
+    good = ReloadEvent(ReloadKind.BEHAVIORS_RELOADED, "x", "Reloaded my_behaviors: MyBehavior, Other")
+    notice = reload_notice_from_log(str(good), 3)
+    assert notice is not None and notice.ok and notice.behaviors == ("MyBehavior", "Other")
+
+    changed = reload_notice_from_log("Objectives changed: pick.xml", 3)
+    assert changed is not None and changed.kind == "objectives_changed"
+    assert reload_notice_from_log("[MoveToWaypoint] planning took 2 s", 3) is None

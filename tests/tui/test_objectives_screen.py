@@ -139,3 +139,17 @@ def test_a_failing_runtime_call_is_shown_and_the_app_keeps_running(fake: FakeCon
         assert app.screen.selected.name == "Open Gripper"  # still responsive
 
     drive(fake, scenario)
+
+
+def test_the_command_palette_runs_an_objective(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        await pilot.press("ctrl+p")
+        await settle(pilot)
+        await pilot.press(*"run open gr")
+        await pilot.pause(0.5)
+        await settle(pilot)
+        await pilot.press("enter")
+        await settle(pilot)
+        assert fake.called("start_objective") == [("Open Gripper", {})]
+
+    drive(fake, scenario)

@@ -14,6 +14,7 @@ import time
 from collections import deque
 from collections.abc import Iterable
 from dataclasses import dataclass, field
+from functools import partial
 from pathlib import Path
 
 from textual.app import App, SystemCommand
@@ -328,6 +329,22 @@ class KinemaApp(App[None]):
         yield SystemCommand(
             "Cancel objective", "Cancel the running objective (ctrl+x)", self.action_cancel_objective
         )
+        for view in self.views:
+            if isinstance(view, ObjectivesScreen):
+                for objective in view.objectives:
+                    if objective.runnable:
+                        yield SystemCommand(
+                            f"Run {objective.name}",
+                            objective.description or "Run this objective with its default parameters",
+                            partial(view.run_by_name, objective.name),
+                        )
+            elif isinstance(view, WaypointsScreen):
+                for waypoint in view.waypoints:
+                    yield SystemCommand(
+                        f"Move to waypoint {waypoint.name}",
+                        waypoint.description or "Move the robot to this saved waypoint",
+                        partial(view.move_to, waypoint.name),
+                    )
 
 
 def run_app(

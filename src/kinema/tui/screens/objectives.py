@@ -245,6 +245,10 @@ class ObjectivesScreen(KinemaScreen):
             return
         self.post_message(ObjectiveRunRequested(self.selected.name, self.query_one(OverrideForm).overrides()))
 
+    def run_by_name(self, name: str) -> None:
+        """Run objective ``name`` with its defaults (the command palette's "Run ..." commands)."""
+        self.post_message(ObjectiveRunRequested(name, {}))
+
     def on_objective_run_requested(self, message: ObjectiveRunRequested) -> None:
         connection = self.kinema.connection
         self.query_one(TabbedContent).active = "tree"

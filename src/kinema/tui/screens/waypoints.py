@@ -116,10 +116,14 @@ class WaypointsScreen(KinemaScreen):
         if waypoint is None:
             self.notify("No waypoint selected.", severity="warning")
             return
+        self.move_to(waypoint.name)
+
+    def move_to(self, name: str) -> None:
+        """Move the robot to waypoint ``name``."""
         connection = self.kinema.connection
         self.call_runtime(
-            f"Move to waypoint {waypoint.name!r}",
-            lambda: connection.move_to_waypoint(waypoint.name),
+            f"Move to waypoint {name!r}",
+            lambda: connection.move_to_waypoint(name),
             announce=True,
         )
 

@@ -31,9 +31,23 @@ class StatusBar(Static):
     StatusBar { height: 1; background: $panel; color: $text; padding: 0 1; }
     """
 
+    _shown: tuple[object, ...] = ()
+
     def show(self, status: RuntimeStatus) -> None:
-        """Render ``status``."""
-        self.update(render_status(status))
+        """Render ``status`` (heartbeats come 10 times a second; only a visible change repaints)."""
+        key = (
+            status.state,
+            status.endpoint,
+            status.detail,
+            status.objective,
+            status.status,
+            None if status.elapsed is None else round(status.elapsed, 1),
+            None if status.sim_time is None else round(status.sim_time, 2),
+            None if status.real_time_factor is None else round(status.real_time_factor, 2),
+        )
+        if key != self._shown:
+            self._shown = key
+            self.update(render_status(status))
 
 
 def render_status(status: RuntimeStatus) -> Text:
