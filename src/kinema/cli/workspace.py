@@ -16,7 +16,8 @@ from kinema.errors import ConfigError
     "--workspace",
     default=None,
     metavar="PATH",
-    help="Workspace folder (one with src/). Asked for when missing; empty means none (bundled configs only).",
+    help="Workspace folder (one with src/); empty means none (bundled configs only). Asked for when "
+    "missing, unless -c is given (then the current workspace is kept).",
 )
 @click.option(
     "-c", "--config", default=None, metavar="NAME", help="Config package to use. Asked for when missing."
@@ -33,7 +34,10 @@ def configure(workspace: str | None, config: str | None) -> None:
     from kinema.errors import did_you_mean
 
     current = active_selection()
-    if workspace is None:
+    if workspace is None and config is not None:
+        # `kinema configure -c NAME` switches the config package and keeps the workspace.
+        workspace = str(current.workspace) if current.workspace else ""
+    elif workspace is None:
         workspace = click.prompt(
             "Workspace folder (empty: none, bundled configs only)",
             default=str(current.workspace) if current.workspace else "",

@@ -162,6 +162,16 @@ def test_configure_prompts_for_missing_values(capsys, monkeypatch: pytest.Monkey
     assert active_selection().workspace == (tmp_path / "w").resolve()
 
 
+def test_configure_with_only_a_config_keeps_the_workspace(capsys, tmp_path: Path):
+    from kinema.config import active_selection
+
+    run(capsys, "init", str(tmp_path / "w"))
+    assert run(capsys, "configure", "-w", str(tmp_path / "w"), "-c", "lab_sim")[0] == 0
+    code, out, _ = run(capsys, "configure", "-c", "example_config")
+    assert code == 0 and "config:    example_config" in out
+    assert active_selection().workspace == (tmp_path / "w").resolve()
+
+
 def test_configure_with_an_empty_workspace_selects_bundled_configs_only(capsys):
     from kinema.config import active_selection
 
