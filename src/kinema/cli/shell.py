@@ -7,10 +7,11 @@ import click
 from kinema.cli.objective import connect_option, timeout_option
 
 BANNER = """Kinema shell: `client` is a connected kinema.sdk.ObjectiveClient.
-  client.execute("Close Gripper")          run an objective and wait for its result
-  h = client.start("Forever"); h.cancel()  start one, then cancel it
-  client.status(), client.objectives()     what the runtime is doing, what it can run
-  for s in client.statuses(timeout=2): ... the heartbeat (also client.blackboard(), client.logs())
+  client.execute("Close Gripper")               run an objective and wait for its result
+  h = client.start("3 Waypoints Pick and Place") start one (it loops until cancelled) ...
+  h.cancel(); h.result()                        ... then cancel it
+  client.status(), client.objectives()          what the runtime is doing, what it can run
+  for s in client.statuses(timeout=2): ...      the heartbeat (also client.blackboard(), client.logs())
 Ctrl-D leaves."""
 
 
