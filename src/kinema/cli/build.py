@@ -141,7 +141,8 @@ def test(packages_select: tuple[str, ...], workspace: Path | None, pytest_args: 
     if failed:
         click.secho(f"tests failed in: {', '.join(failed)}", err=True, fg="red")
         raise click.exceptions.Exit(1)
-    click.secho(f"all tests passed ({len(packages)} packages)", fg="green")
+    count = len(packages)
+    click.secho(f"all tests passed ({count} package{'' if count == 1 else 's'})", fg="green")
 
 
 def _plugin_installed() -> bool:
