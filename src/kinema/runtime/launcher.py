@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("kinema.supervisor")
 
-AGENT_READY_TIMEOUT_S = 120.0
+READY_TIMEOUT_S = 120.0
 STOP_GRACE_S = 5.0
 
 
@@ -131,12 +131,15 @@ class Launcher:
             )
             self.record.save()
             clock = "auto"
-            if options.drivers:
-                started = self._start_drivers()
-                if not started and options.agent:
-                    clock = "wall"  # no simulator will publish /clock: time must not freeze
+            starting = self._start_drivers() if options.drivers else []
+            if options.drivers and not starting:
+                clock = "wall"  # no simulator will publish /clock: time must not freeze
             if options.agent:
-                self._start_agent(clock)
+                starting.append(self._start_agent(clock))
+            for child, stream in starting:
+                self._await_ready(child, stream)
+                if child.name != "agent":
+                    self.options.echo(f"driver {child.name!r} is running")
         except BaseException:
             self.stop()
             raise
@@ -147,14 +150,15 @@ class Launcher:
         workspace = Workspace.discover(self.options.workspace) if self.options.workspace else None
         return resolve_config(self.options.config, workspace)
 
-    def _start_drivers(self) -> bool:
+    def _start_drivers(self) -> list[tuple[Child, Any]]:
+        """Spawn the drivers the config wants; returns each with the read end of its ready pipe."""
         from kinema.drivers.registry import drivers_for_config
 
         specs = drivers_for_config(self._resolved())
         if not specs:
             self.options.echo(f"config {self.options.config!r} needs no driver")
-            return False
-        started = False
+            return []
+        started = []
         for spec in specs:
             if not _runnable_module(spec.module):
                 self.options.echo(
@@ -172,15 +176,12 @@ class Launcher:
                 log_file=log_file,
                 verbose=self.options.verbose,
             )
-            self._spawn(spec.name, argv, log_file)
-            self.options.echo(f"driver {spec.name!r} started ({spec.description})")
-            started = True
+            started.append(self._spawn_with_ready(spec.name, argv, log_file))
         return started
 
-    def _start_agent(self, clock: str) -> None:
+    def _start_agent(self, clock: str) -> tuple[Child, Any]:
         assert self.run_folder is not None
         log_file = self.run_folder.log_file("agent")
-        read_fd, write_fd = os.pipe()
         argv = [
             sys.executable,
             "-m",
@@ -191,8 +192,6 @@ class Launcher:
             self.endpoint,
             "--log-file",
             str(log_file),
-            "--ready-fd",
-            str(write_fd),
             "--tick-rate",
             str(self.options.tick_rate_hz),
             "--clock",
@@ -202,18 +201,32 @@ class Launcher:
             argv += ["--workspace", str(self.options.workspace)]
         if self.options.verbose:
             argv.append("--verbose")
+        return self._spawn_with_ready("agent", argv, log_file)
+
+    def _spawn_with_ready(self, name: str, argv: list[str], log_file: Path) -> tuple[Child, Any]:
+        """Spawn a child that writes ``ready`` to ``--ready-fd`` once it serves."""
+        read_fd, write_fd = os.pipe()
         try:
-            child = self._spawn("agent", argv, log_file, pass_fds=(write_fd,))
+            child = self._spawn(name, [*argv, "--ready-fd", str(write_fd)], log_file, pass_fds=(write_fd,))
+        except BaseException:
+            os.close(read_fd)
+            raise
         finally:
             os.close(write_fd)
-        with os.fdopen(read_fd, "r") as ready:
-            if not _wait_ready(ready, child.process, AGENT_READY_TIMEOUT_S, self._stop):
-                if self._stop.is_set():
-                    raise KinemaError(f"interrupted ({self._stop_reason}) while the agent was starting")
-                tail = _tail(log_file, 8)
-                raise KinemaError(
-                    f"the agent did not start (exit code {child.process.poll()}); end of {log_file}:\n{tail}"
-                )
+        return child, os.fdopen(read_fd, "r")
+
+    def _await_ready(self, child: Child, stream: Any) -> None:
+        """Wait for a child's ``ready`` line (the agent and the drivers start in parallel)."""
+        with stream:
+            if _wait_ready(stream, child.process, READY_TIMEOUT_S, self._stop):
+                log.info("%s is ready", child.name)
+                return
+        if self._stop.is_set():
+            raise KinemaError(f"interrupted ({self._stop_reason}) while {child.name} was starting")
+        tail = _tail(child.log_file, 8)
+        raise KinemaError(
+            f"{child.name} did not start (exit code {child.process.poll()}); end of {child.log_file}:\n{tail}"
+        )
 
     def _spawn(self, name: str, argv: list[str], log_file: Path, pass_fds: tuple[int, ...] = ()) -> Child:
         log.info("starting %s: %s", name, " ".join(argv))
