@@ -1,0 +1,68 @@
+"""What the agent turns into and out of messages: overrides, blackboard values, result codes."""
+
+from __future__ import annotations
+
+from types import SimpleNamespace
+from typing import Any
+
+import pytest
+
+from kinema.errors import ObjectiveError
+from kinema.runtime.agent import overrides_from_messages, render_value, result_message
+from kinema.runtime.overrides import ParameterOverride
+from kinema.runtime.result import ObjectiveResult
+
+
+def _parameter(name: str, kind: int, **values: Any) -> SimpleNamespace:
+    fields = {
+        "string_value": "",
+        "pose_value": None,
+        "double_value": 0.0,
+        "int_value": 0,
+        "bool_value": False,
+        "joint_state_value": None,
+        "behavior_namespaces": [],
+    }
+    fields.update(values)
+    return SimpleNamespace(description=SimpleNamespace(name=name, type=kind), **fields)
+
+
+def test_behavior_parameters_become_overrides() -> None:
+    parameters = [
+        _parameter("a", 0, string_value="[1, 2]", behavior_namespaces=["sub"]),
+        _parameter("b", 2, double_value=0.5),
+        _parameter("c", 3, int_value=7),
+        _parameter("d", 4, bool_value=True),
+    ]
+    assert overrides_from_messages(parameters) == (
+        ParameterOverride("a", "[1, 2]", ("sub",)),
+        ParameterOverride("b", 0.5, (), from_yaml=False),
+        ParameterOverride("c", 7, (), from_yaml=False),
+        ParameterOverride("d", True, (), from_yaml=False),
+    )
+
+
+@pytest.mark.parametrize(
+    ("parameter", "reason"), [(_parameter("", 0), "empty name"), (_parameter("x", 9), "has type 9")]
+)
+def test_malformed_parameters_are_refused(parameter: SimpleNamespace, reason: str) -> None:
+    with pytest.raises(ObjectiveError, match=reason):
+        overrides_from_messages([parameter])
+
+
+@pytest.mark.parametrize(
+    ("value", "text"),
+    [(42, "42"), (1.5, "1.5"), ("Look at Table", "Look at Table"), ([1, 2], "[1, 2]"), ({"a": 1}, "{a: 1}")],
+)
+def test_blackboard_values_render_as_yaml_flow(value: Any, text: str) -> None:
+    assert render_value(value) == text
+
+
+def test_long_values_are_cut() -> None:
+    rendered = render_value(list(range(5000)))
+    assert len(rendered) <= 2000 and "more" in rendered
+
+
+def test_results_become_moveit_error_codes() -> None:
+    message = result_message(ObjectiveResult.failure("node 'x' returned FAILURE", "Pick"))
+    assert message == {"val": 99999, "message": "node 'x' returned FAILURE", "source": "objective_server"}

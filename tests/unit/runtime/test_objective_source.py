@@ -1,0 +1,42 @@
+"""The agent's tree source: objective folders, files that do not load, and rebuilding after changes."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from kinema.bt import WallClock
+from kinema.runtime.objective_server import ObjectiveRequest, ObjectiveServer
+from kinema.runtime.objective_source import LibraryTreeSource, library_from_folders
+
+GOOD = '<root BTCPP_format="4"><BehaviorTree ID="Good"><AlwaysSuccess/></BehaviorTree></root>'
+BROKEN = '<root BTCPP_format="4"><BehaviorTree ID="Broken"><NoSuchBehavior/></BehaviorTree></root>'
+
+
+def _source(folder: Path) -> LibraryTreeSource:
+    load = lambda: library_from_folders([folder])  # noqa: E731 - the source calls it again after changes
+    return LibraryTreeSource(load, host=None, context=None, clock=WallClock())
+
+
+def test_only_objectives_whose_file_loads_are_runnable_and_the_others_say_why(tmp_path: Path) -> None:
+    (tmp_path / "good.xml").write_text(GOOD)
+    (tmp_path / "broken.xml").write_text(BROKEN)
+    source = _source(tmp_path)
+    assert source.objective_names() == ["Good"]
+    assert [info.id for info in source.objectives()] == ["Broken", "Good"]
+    with ObjectiveServer(source) as server:
+        assert server.submit(ObjectiveRequest("Good")).wait(5).succeeded  # type: ignore[union-attr]
+        result = server.submit(ObjectiveRequest("Broken")).wait(5)
+    assert result is not None and result.failed
+    assert "objective 'Broken' cannot run" in result.error_message
+    assert "broken.xml" in result.error_message and "NoSuchBehavior" in result.error_message
+
+
+def test_changed_objective_files_are_picked_up_after_invalidation(tmp_path: Path) -> None:
+    (tmp_path / "good.xml").write_text(GOOD)
+    source = _source(tmp_path)
+    first = source.factory()
+    assert source.factory() is first  # nothing changed: the factory is kept
+    (tmp_path / "later.xml").write_text(GOOD.replace("Good", "Later"))
+    source.invalidate_objectives()
+    assert source.factory() is not first
+    assert source.objective_names() == ["Good", "Later"]
