@@ -302,3 +302,36 @@ def test_the_json_endpoints_start_cancel_and_refuse_garbage(agent: Any) -> None:
         )
         assert len(replies) == 1 and "bad request" in replies[0].err.payload.to_string()
         assert quick.start("Quick").result().succeeded
+
+
+def test_a_router_without_an_agent_is_reported_after_the_timeout(free_endpoint: str) -> None:
+    from kinema.transport import host_router
+
+    with host_router(free_endpoint):
+        started = time.monotonic()
+        done = subprocess.run(
+            [
+                sys.executable,
+                "-m",
+                "kinema",
+                "objective",
+                "run",
+                "Quick",
+                "--connect",
+                free_endpoint,
+                "--timeout",
+                "1",
+            ],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+        assert done.returncode == 1
+        assert (
+            done.stderr.startswith("error: no Kinema runtime answered within 1 s")
+            and done.stderr.count("\n") == 1
+        )
+        assert time.monotonic() - started < 30
+        with pytest.raises(TransportError, match="no Kinema runtime answers"):
+            with ObjectiveClient(free_endpoint, timeout=0.5) as client:
+                client.execute("Quick")
