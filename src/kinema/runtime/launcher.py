@@ -297,8 +297,13 @@ class Launcher:
             self.start()
             assert self.run_folder is not None
             role = "hosting the router" if self.hosting else "joined the router"
+            what = (
+                "objectives can be started"
+                if self.options.agent
+                else "drivers only; objectives run by an agent elsewhere"
+            )
             self.options.echo(
-                f"Kinema is running: objectives can be started (config {self.options.config}, {role} at "
+                f"Kinema is running: {what} (config {self.options.config}, {role} at "
                 f"{self.endpoint}, logs in {self.run_folder.path}). Stop with Ctrl-C or `kinema down`."
             )
             if self.options.ui is not None:
