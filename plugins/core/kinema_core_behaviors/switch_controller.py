@@ -60,7 +60,7 @@ class SwitchController(AsyncBehavior):
             ),
             input_port("activate_asap", bool, True, "Start the activated controllers at once."),
             input_port("strictness", int, STRICT, "1: best effort, 2: strict (fail on any problem)."),
-            input_port("timeout", float, 3.0, "Seconds to wait for the controller manager."),
+            input_port("timeout", float, 10.0, "Seconds to wait for the controller manager."),
         ]
 
     async def do_work(self) -> bool:
