@@ -115,6 +115,11 @@ class SwitchController(AsyncBehavior):
                         and freed.intersection(controller.required_command_interfaces)
                     ):
                         activate.append(name)
+            states = {name: str(c.state) for name, c in controllers.items()}
+            if all(states.get(n) == "active" for n in activate) and all(
+                n in states and states[n] != "active" for n in deactivate
+            ):
+                return True  # already as asked: skip the switch (a round trip per motion)
         switch_name = str(self.get_input("controller_switch_action_name"))
         client = self.context.service_client(node, _SWITCH_TYPE, switch_name)
         request = {

@@ -208,3 +208,14 @@ def test_set_mujoco_state_reports_a_refusal(behavior: Any, context: BehaviorCont
     run = tick_behavior(behavior("SetMujocoState"), {"keyframe": "hom", "robot_state": None}, context=context)
     assert run.status == NodeStatus.FAILURE
     assert "unknown keyframe 'hom'" in run.toasts[-1]
+
+
+def test_activating_an_active_controller_needs_no_switch(behavior: Any, context: BehaviorContext) -> None:
+    manager = ControllerManager(context.node)
+    run = tick_behavior(
+        behavior("SwitchController"),
+        {"activate_controllers": "/joint_trajectory_controller"},
+        context=context,
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    assert manager.requests == []
