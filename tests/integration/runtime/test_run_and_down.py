@@ -112,3 +112,13 @@ def test_killing_the_supervisor_leaves_no_orphans(
     assert not any(pid_alive(pid) for pid in children)
     stale = _kinema(env, "down")
     assert stale.returncode == 1  # the record of a dead supervisor is stale, not a running instance
+
+
+def test_ctrl_c_stops_everything_and_removes_the_record(
+    kinema_run: subprocess.Popen[str], env: dict[str, str]
+) -> None:
+    children = [int(pid) for pid in _instance(env)["children"]]  # type: ignore[union-attr]
+    kinema_run.send_signal(signal.SIGINT)
+    assert kinema_run.wait(20) == 0
+    assert not any(pid_alive(pid) for pid in children)
+    assert not list((Path(env["XDG_STATE_HOME"]) / "kinema" / "instances").glob("*.json"))
