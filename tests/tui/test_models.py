@@ -186,3 +186,15 @@ def test_reload_outcomes_are_recognised_in_the_runtime_log() -> None:
     changed = reload_notice_from_log("Objectives changed: pick.xml", 3)
     assert changed is not None and changed.kind == "objectives_changed"
     assert reload_notice_from_log("[MoveToWaypoint] planning took 2 s", 3) is None
+
+
+def test_a_run_that_resumes_after_late_heartbeats_keeps_its_start() -> None:
+    status = RuntimeStatus()
+    endpoint = "tcp/127.0.0.1:7447"
+    status.apply_connection(ConnectionChanged(ConnectionState.CONNECTED, endpoint))
+    assert status.apply_heartbeat(Heartbeat(100.0, "Pick", "Running"))
+    status.apply_connection(ConnectionChanged(ConnectionState.DISCONNECTED, endpoint, "late"))
+    status.apply_connection(ConnectionChanged(ConnectionState.CONNECTED, endpoint))
+    assert not status.apply_heartbeat(Heartbeat(105.0, "Pick", "Running"))  # not a new run
+    assert status.elapsed == pytest.approx(5.0)
+    assert status.apply_heartbeat(Heartbeat(106.0, "Place", "Running"))  # this one is

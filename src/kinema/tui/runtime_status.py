@@ -26,6 +26,7 @@ class RuntimeStatus:
     sim_time: float | None = None
     real_time_factor: float | None = None
     _started_at: float | None = None
+    _interrupted: tuple[str, float] | None = None
 
     @property
     def running(self) -> bool:
@@ -38,6 +39,9 @@ class RuntimeStatus:
         self.endpoint = event.endpoint
         self.detail = event.detail
         if event.state is not ConnectionState.CONNECTED:
+            if self.running and self._started_at is not None:
+                # Heartbeats may only have been late: the same run resuming keeps its start time.
+                self._interrupted = (self.objective, self._started_at)
             self.status = "Unknown"
             self.sim_time = None
             self.real_time_factor = None
@@ -48,8 +52,12 @@ class RuntimeStatus:
         started = beat.status in ACTIVE_STATUSES and (
             self.status not in ACTIVE_STATUSES or beat.objective_name != self.objective
         )
-        if started:
+        if started and self._interrupted is not None and self._interrupted[0] == beat.objective_name:
+            started = False
+            self._started_at = self._interrupted[1]
+        elif started:
             self._started_at = beat.process_time
+        self._interrupted = None
         if self._started_at is not None and (
             beat.status in ACTIVE_STATUSES or self.status in ACTIVE_STATUSES
         ):

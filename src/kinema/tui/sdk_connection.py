@@ -47,10 +47,11 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("kinema.tui")
 
-#: The runtime counts as gone when no heartbeat (10 Hz) arrived for this long.
-HEARTBEAT_TIMEOUT_S = 1.5
+#: The runtime counts as gone when no heartbeat (10 Hz) arrived for this long. Generous: a runtime busy
+#: planning on a loaded machine delays heartbeats by a second or more without being gone.
+HEARTBEAT_TIMEOUT_S = 3.0
 #: After this long without heartbeats the session is dropped and a new one is opened.
-RECONNECT_AFTER_S = 4.0
+RECONNECT_AFTER_S = 6.0
 RETRY_PERIOD_S = 1.0
 CALL_TIMEOUT_S = 5.0
 #: The objective MoveIt Pro (and Kinema's core library) moves to a waypoint with.

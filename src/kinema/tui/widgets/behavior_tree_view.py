@@ -107,9 +107,9 @@ class BehaviorTreeView(Tree[OutlineNode]):
         text.append(node.type_id, style="bold" if node.is_subtree else "")
         if node.name and node.name != node.type_id:
             text.append(f" “{node.name}”", style="italic")
+        if status is not NodeStatus.IDLE:
+            text.append(f"  {status.name}", style=style)  # before the ports, which may run off the edge
         ports = " ".join(f"{k}={v}" for k, v in node.attributes.items() if not k.startswith("_"))
         if ports:
             text.append(f"  {ports}", style="dim")
-        if status is not NodeStatus.IDLE:
-            text.append(f"  {status.name}", style=style)
         return text

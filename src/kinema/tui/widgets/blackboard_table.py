@@ -29,8 +29,8 @@ class BlackboardTable(DataTable[str]):
         self._types: dict[RowKey, str] = {}
 
     def on_mount(self) -> None:
-        self.add_column("Scope", key="scope", width=18)
-        self.add_column("Key", key="key", width=24)
+        self.add_column("Scope", key="scope", width=22)
+        self.add_column("Key", key="key", width=28)
         self.add_column("Type", key="type", width=14)
         self.add_column("Value", key="value")
 
