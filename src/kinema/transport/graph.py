@@ -15,6 +15,7 @@ from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from kinema.transport.dispatch import channel, dispatch
 from kinema.transport.keys import LIVELINESS_PREFIX, EntityKind, GraphEntity, parse_token
 
 if TYPE_CHECKING:
@@ -106,8 +107,9 @@ class GraphCache:
         self._tokens: dict[str, GraphEntity] = {}
         self._changed = threading.Condition()
         self._subscriber = session.zenoh.liveliness().declare_subscriber(
-            f"{LIVELINESS_PREFIX}/{session.domain_id}/**", self._on_sample, history=True
+            f"{LIVELINESS_PREFIX}/{session.domain_id}/**", channel(), history=True
         )
+        session._track_dispatcher(dispatch(self._subscriber, self._on_sample, "-graph"))
 
     def _on_sample(self, sample: object) -> None:
         import zenoh

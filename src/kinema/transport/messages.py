@@ -199,7 +199,9 @@ def _data_fields(cls: type) -> tuple[str, ...]:
     names = _DATA_FIELDS.get(cls)
     if names is None:
         names = _DATA_FIELDS[cls] = tuple(
-            name for name, spec in cls.__dataclass_fields__.items() if spec.default is dataclasses.MISSING
+            name
+            for name, spec in getattr(cls, "__dataclass_fields__", {}).items()
+            if spec.default is dataclasses.MISSING
         )
     return names
 

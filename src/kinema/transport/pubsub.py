@@ -21,6 +21,7 @@ from zenoh import ext
 from kinema.errors import TransportError
 from kinema.interfaces import dds_type_name
 from kinema.transport.attachment import Attachment, new_gid
+from kinema.transport.dispatch import channel, dispatch
 from kinema.transport.keys import EntityKind, QoS, data_key, entity_token
 from kinema.transport.messages import from_dict, type_of
 
@@ -190,11 +191,12 @@ class Subscription(Entity):
             self._subscriber = ext.declare_advanced_subscriber(
                 session,
                 self.key,
-                self._on_sample,
+                channel(),
                 history=ext.HistoryConfig(detect_late_publishers=True, max_samples=max(qos.depth, 1)),
             )
         else:
-            self._subscriber = session.declare_subscriber(self.key, self._on_sample)
+            self._subscriber = session.declare_subscriber(self.key, channel())
+        node.session._track_dispatcher(dispatch(self._subscriber, self._on_sample, f"-sub{topic}"))
         self._announce()
 
     def _on_sample(self, sample: Any) -> None:

@@ -22,6 +22,7 @@ import zenoh
 from kinema.errors import TransportError
 from kinema.interfaces import ServiceType
 from kinema.transport.attachment import Attachment
+from kinema.transport.dispatch import channel, dispatch
 from kinema.transport.keys import SERVICE_QOS, EntityKind
 from kinema.transport.messages import from_dict, type_of
 from kinema.transport.pubsub import Entity
@@ -41,6 +42,10 @@ def _as_message(value: Any, type_name: str, what: str) -> Any:
     if type_of(value) != type_name:
         raise TransportError(f"{what} must be {type_name}, got {type_of(value)}")
     return value
+
+
+class _QueryTimedOut(TransportError):
+    """zenoh ended a query with its "Timeout" error (no reply within the query's own timeout)."""
 
 
 class _HandlerPool:
@@ -170,7 +175,8 @@ class ServiceServer(Entity):
         self._deferred = deferred
         self._after_reply = after_reply
         self._pool = _HandlerPool(max_concurrent, f"kinema-srv{name}") if max_concurrent > 1 else None
-        self._queryable = node.session.zenoh.declare_queryable(self.key, self._on_query, complete=True)
+        self._queryable = node.session.zenoh.declare_queryable(self.key, channel(), complete=True)
+        node.session._track_dispatcher(dispatch(self._queryable, self._on_query, f"-srv{name}"))
         self._announce()
 
     def _on_query(self, query: Any) -> None:
@@ -264,7 +270,14 @@ class ServiceClient(Entity):
         deadline = time.monotonic() + timeout
         while True:
             remaining = deadline - time.monotonic()
-            outcome = self._call_once(payload, max(remaining, 0.001))
+            try:
+                outcome = self._call_once(payload, max(remaining, 0.001))
+            except _QueryTimedOut:
+                # A server took the request but did not reply in time (or the last slice was too short
+                # for a reply to come back): say which.
+                if self.service_is_ready():
+                    raise TransportError(f"service {self.name} did not answer within {timeout:g} s") from None
+                outcome = None
             if outcome is not None:
                 return outcome
             if time.monotonic() + _RETRY_PAUSE >= deadline:
@@ -327,7 +340,7 @@ class ServiceClient(Entity):
         if errors:
             message = errors[0]
             if message == "Timeout":
-                raise TransportError(f"service {self.name} did not answer within {timeout:g} s")
+                raise _QueryTimedOut(message)
             raise TransportError(message)
         return response if answered else None
 

@@ -179,9 +179,11 @@ class Session:
         self.listen = list(listen)
         self.zid = str(raw.info.zid())
         self._ids = itertools.count()
-        self._lock = threading.Lock()
+        # Re-entrant: creating the graph cache (under the lock) registers its dispatch thread.
+        self._lock = threading.RLock()
         self._closers: list[Any] = []
         self._graph: GraphCache | None = None
+        self._dispatchers: list[threading.Thread] = []
         self._closed = False
         _open_sessions.add(self)
         _install_exit_hook()
@@ -216,6 +218,11 @@ class Session:
 
                 self._graph = GraphCache(self)
             return self._graph
+
+    def _track_dispatcher(self, thread: threading.Thread) -> None:
+        with self._lock:
+            self._dispatchers = [t for t in self._dispatchers if t.is_alive()]
+            self._dispatchers.append(thread)
 
     def _register_closer(self, closer: Any) -> None:
         with self._lock:
@@ -262,6 +269,16 @@ class Session:
         except Exception:
             log.exception("error while closing the zenoh session")
         _open_sessions.discard(self)
+        # The dispatch threads wake up with their channels closed and leave zenoh's code; wait for that,
+        # because a thread still inside it when the interpreter finalises aborts the process. A thread
+        # busy in a user callback is left alone (it is a daemon).
+        with self._lock:
+            dispatchers, self._dispatchers = self._dispatchers, []
+        deadline = time.monotonic() + 2.0
+        current = threading.current_thread()
+        for thread in dispatchers:
+            if thread is not current:
+                thread.join(max(0.0, deadline - time.monotonic()))
 
     def __enter__(self) -> Session:
         return self

@@ -22,10 +22,13 @@ def demo(connect: Callable[[], Session]) -> Iterator[Node]:
     publisher = node.create_publisher("std_msgs/msg/String", "/chatter")
 
     def fibonacci(handle: ServerGoalHandle) -> dict[str, list[int]]:
+        # Paced like a real server: feedback and result travel on different channels, so feedback sent
+        # in the same instant as the result may reach the client after it (as with ROS 2).
         sequence = [0, 1][: handle.goal.order]
         while len(sequence) < handle.goal.order:
             sequence.append(sequence[-1] + sequence[-2])
             handle.publish_feedback({"sequence": sequence})
+            time.sleep(0.05)
         return {"sequence": sequence}
 
     node.create_action_server("example_interfaces/action/Fibonacci", "/fibonacci", fibonacci)

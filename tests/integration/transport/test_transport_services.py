@@ -124,3 +124,20 @@ def test_a_server_with_another_definition_is_pointed_out(connect: Callable[[], S
     client = Node(connect(), "caller").create_client(ADD, "/mismatched")
     with pytest.raises(TransportError, match="a server with another type or interface definition is there"):
         client.call({}, timeout=0.5)
+
+
+def test_a_slow_server_is_reported_as_slow(connect: Callable[[], Session]) -> None:
+    release = threading.Event()
+
+    def slow(request: object) -> dict[str, int]:
+        release.wait(5)
+        return {"sum": 0}
+
+    Node(connect(), "server").create_service(ADD, "/slow", slow)
+    client = Node(connect(), "caller").create_client(ADD, "/slow")
+    assert client.wait_for_service(5)
+    try:
+        with pytest.raises(TransportError, match=r"service /slow did not answer within 0\.3 s"):
+            client.call({}, timeout=0.3)
+    finally:
+        release.set()
