@@ -47,7 +47,7 @@ def free_port() -> int:
         return int(sock.getsockname()[1])
 
 
-def start_agent(endpoint: str, objectives: Path) -> subprocess.Popen[bytes]:
+def start_agent(endpoint: str, objectives: Path, hot_reload: bool = False) -> subprocess.Popen[bytes]:
     env = {**os.environ, "KINEMA_CONFIG": "", "KINEMA_WORKSPACE": ""}
     return subprocess.Popen(
         [
@@ -60,7 +60,7 @@ def start_agent(endpoint: str, objectives: Path) -> subprocess.Popen[bytes]:
             str(objectives),
             "--clock",
             "wall",
-            "--no-hot-reload",
+            *([] if hot_reload else ["--no-hot-reload"]),
         ],
         env=env,
         stdout=subprocess.DEVNULL,
@@ -81,13 +81,14 @@ def stop(process: subprocess.Popen[bytes]) -> None:
 class Agent:
     """An agent process on a fixed endpoint that can be stopped and started again."""
 
-    def __init__(self, endpoint: str, objectives: Path) -> None:
+    def __init__(self, endpoint: str, objectives: Path, hot_reload: bool = False) -> None:
         self.endpoint = endpoint
         self.objectives = objectives
+        self.hot_reload = hot_reload
         self.process: subprocess.Popen[bytes] | None = None
 
     def start(self) -> None:
-        self.process = start_agent(self.endpoint, self.objectives)
+        self.process = start_agent(self.endpoint, self.objectives, self.hot_reload)
 
     def stop(self) -> None:
         if self.process is not None:
@@ -160,3 +161,38 @@ def test_the_app_runs_an_objective_on_a_real_runtime_and_follows_a_restart(agent
     assert agent.process is not None and agent.process.poll() is None, (
         "closing an attached app stopped the runtime"
     )
+
+
+def test_saved_objective_files_show_up_and_a_broken_one_is_reported_with_its_line(tmp_path: Path) -> None:
+    (tmp_path / "count_up.xml").write_text(COUNT_UP)
+    agent = Agent(f"tcp/127.0.0.1:{free_port()}", tmp_path, hot_reload=True)
+    agent.start()
+    app = KinemaApp(SdkConnection(agent.endpoint))
+
+    async def main() -> None:
+        async with app.run_test(size=(140, 40)) as pilot:
+            await wait_for(
+                pilot, lambda: app.status.state is ConnectionState.CONNECTED, "the first heartbeat"
+            )
+            screen = app.screen
+            assert isinstance(screen, ObjectivesScreen)
+            await wait_for(pilot, lambda: len(screen.objectives) == 1, "the objective list")
+            await asyncio.sleep(0.5)  # let the watcher settle before the first save
+
+            new = COUNT_UP.replace("Count Up", "Count Again")
+            (tmp_path / "count_again.xml").write_text(new)
+            await wait_for(pilot, lambda: len(screen.objectives) == 2, "the saved objective in the list")
+            assert any(notice.ok and "count_again.xml" in notice.message for notice in app.reloads)
+
+            (tmp_path / "broken.xml").write_text(
+                '<root BTCPP_format="4">\n  <BehaviorTree ID="B">\n    <Sequence>\n'
+            )
+            await wait_for(pilot, lambda: any(not n.ok for n in app.reloads), "the failed reload")
+            failure = next(n for n in app.reloads if not n.ok)
+            path, line = failure.location.rsplit(":", 1)
+            assert path.endswith("broken.xml") and line.isdigit()
+
+    try:
+        asyncio.run(main())
+    finally:
+        agent.stop()
