@@ -293,3 +293,29 @@ def test_every_binding_has_an_id_and_a_tooltip() -> None:
     for screen in KinemaApp.MODES.values():
         for binding in [*KinemaApp.BINDINGS, *screen.BINDINGS]:  # type: ignore[union-attr]
             assert binding.id and binding.tooltip, binding
+
+
+def test_a_broken_config_is_shown_with_its_error_and_files(fake: FakeConnection, tmp_path) -> None:  # type: ignore[no-untyped-def]
+    package = tmp_path / "src" / "my_config"
+    (package / "config").mkdir(parents=True)
+    (package / "config" / "config.yaml").write_text("# mine\nbased_on_package: lab_simm\n")
+    fake.workspace_root = str(tmp_path)
+    fake.fake_config = "my_config"
+
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        details = app.screen.details
+        assert details.name == "my_config"
+        assert "lab_simm" in details.error and "lab_sim" in details.error.replace("lab_simm", "")
+        assert "config.yaml:2" in details.error  # where the bad value is
+        title = str(app.screen.query_one("#config-title").render())
+        assert "lab_simm" in title
+        assert details.files == ["config/config.yaml"]
+        labels = {option.id: str(option.prompt) for option in _options(app)}
+        assert "bundled" in labels["lab_sim"] and "bundled" not in labels["my_config"]
+
+    drive(fake, scenario, mode="configs")
+
+
+def _options(app):  # type: ignore[no-untyped-def]
+    options = app.screen.query_one("#config-list", OptionList)
+    return [options.get_option_at_index(i) for i in range(options.option_count)]
