@@ -319,3 +319,19 @@ def test_a_broken_config_is_shown_with_its_error_and_files(fake: FakeConnection,
 def _options(app):  # type: ignore[no-untyped-def]
     options = app.screen.query_one("#config-list", OptionList)
     return [options.get_option_at_index(i) for i in range(options.option_count)]
+
+
+def test_the_mouse_switches_screens_and_picks_rows(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        await pilot.click("#nav-waypoints")
+        await settle(pilot)
+        assert app.current_mode == "waypoints"
+        table = app.screen.query_one("#waypoint-table", DataTable)
+        await pilot.click("#waypoint-table", offset=(10, 2))  # the second row (below the header)
+        await settle(pilot)
+        assert app.screen.selected().name == "Look at Table"
+        await pilot.click("#nav-objectives")
+        await settle(pilot)
+        assert app.current_mode == "objectives" and table.cursor_row == 1
+
+    drive(fake, scenario, mode="configs")
