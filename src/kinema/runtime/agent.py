@@ -92,10 +92,8 @@ def render_value(value: Any) -> str:
     """A blackboard value as one line of YAML flow text (messages as their fields), cut when long."""
     import yaml
 
-    from kinema.transport.messages import to_dict
-
     try:
-        data = _clip_lists(to_dict(value))
+        data = _preview(value)
         if isinstance(data, str | int | float | bool | list | dict | type(None)):
             text = yaml.safe_dump(data, default_flow_style=True, width=1 << 30).strip()
             if text.endswith("\n..."):
@@ -108,17 +106,33 @@ def render_value(value: Any) -> str:
     return text if len(text) <= MAX_VALUE_CHARS else text[: MAX_VALUE_CHARS - 1] + "…"
 
 
-def _clip_lists(data: Any) -> Any:
-    """Shorten long lists before rendering: the text is cut at MAX_VALUE_CHARS anyway, and YAML-dumping a
-    whole trajectory (hundreds of points) takes a second on the tick thread."""
-    if isinstance(data, dict):
-        return {key: _clip_lists(item) for key, item in data.items()}
-    if isinstance(data, list):
-        head = [_clip_lists(item) for item in data[:MAX_LIST_ITEMS]]
-        if len(data) > MAX_LIST_ITEMS:
-            return [*head, f"... {len(data) - MAX_LIST_ITEMS} more"]
+def _preview(value: Any) -> Any:
+    """``to_dict(value)`` with every list cut to MAX_LIST_ITEMS items (plus a "... N more" marker).
+
+    Lists are cut before their items are converted: the text is cut at MAX_VALUE_CHARS anyway, and
+    converting and YAML-dumping a whole trajectory (hundreds of points) on the tick thread at every
+    blackboard snapshot stalled the tree (and the simulation sharing the process) for most of each second.
+    """
+    import dataclasses
+
+    import numpy as np
+
+    from kinema.transport.messages import to_dict
+
+    if hasattr(value, "__msgtype__") and dataclasses.is_dataclass(value):
+        return {
+            field.name: _preview(getattr(value, field.name))
+            for field in dataclasses.fields(value)
+            if field.default is dataclasses.MISSING and field.name != "__msgtype__"
+        }
+    if isinstance(value, dict):
+        return {key: _preview(item) for key, item in value.items()}
+    if isinstance(value, list | tuple | np.ndarray):
+        head = [_preview(item) for item in value[:MAX_LIST_ITEMS]]
+        if len(value) > MAX_LIST_ITEMS:
+            return [*head, f"... {len(value) - MAX_LIST_ITEMS} more"]
         return head
-    return data
+    return to_dict(value)
 
 
 class _Streams:
@@ -133,6 +147,7 @@ class _Streams:
         self._log = node.create_publisher(names.LOG_TYPE, names.LOG)
         self._status: tuple[ObjectiveStatus, str] = (ObjectiveStatus.IDLE, "")
         self._last_blackboard: list[tuple[str, str, str, str]] | None = None
+        self._render_cache: dict[int, tuple[Any, str]] = {}
         self._lock = threading.Lock()
 
     def publish_heartbeat(self) -> None:
@@ -186,7 +201,19 @@ class _Streams:
     def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
         from kinema.transport.messages import msg
 
-        rendered = [(scope, key, type_name, render_value(value)) for scope, key, type_name, value in entries]
+        # Messages (trajectories, joint states) are rendered once per object: every subtree scope keeps
+        # its own, and re-rendering them all at each snapshot starves the tick thread.
+        cache, self._render_cache = self._render_cache, {}
+        rendered = []
+        for scope, key, type_name, value in entries:
+            cached = cache.get(id(value))
+            if cached is not None and cached[0] is value:
+                text = cached[1]
+            else:
+                text = render_value(value)
+            if hasattr(value, "__msgtype__"):
+                self._render_cache[id(value)] = (value, text)
+            rendered.append((scope, key, type_name, text))
         if rendered == self._last_blackboard:
             return
         self._last_blackboard = rendered
