@@ -6,6 +6,7 @@ the addresses replaced; certificates are generated as the page shows (X.509 v3, 
 
 from __future__ import annotations
 
+import queue
 import re
 import shutil
 import subprocess
@@ -131,9 +132,21 @@ def test_mutual_tls_and_access_rules(tmp_path: Path, endpoints: Callable[[], str
                 "/controller_manager/switch_controller",
                 lambda r: {"ok": True},
             )
+            snapshot = agent.create_publisher(
+                "std_msgs/msg/String", "/objective_server/blackboard", latched=True
+            )
+            snapshot.publish({"data": "latest snapshot"})
             with open_session(domain_id=0, mode="client", config_file=str(client_file)) as laptop:
                 assert laptop.endpoints == [lan]
                 operator = Node(laptop, "operator")
+                latched: queue.Queue[str] = queue.Queue()
+                operator.create_subscription(
+                    "std_msgs/msg/String",
+                    "/objective_server/blackboard",
+                    lambda m: latched.put(m.data),
+                    latched=True,
+                )
+                assert latched.get(timeout=5) == "latest snapshot"  # the cached sample passes the rules
                 execute = operator.create_client(
                     "moveit_studio_sdk_msgs/srv/ExecuteObjective", "/execute_objective"
                 )
