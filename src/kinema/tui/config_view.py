@@ -9,9 +9,10 @@ from __future__ import annotations
 import os
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from kinema.config import ResolvedConfig
+if TYPE_CHECKING:
+    from kinema.config import ResolvedConfig
 
 #: A config package with more files than this is listed up to here (a workspace is not a file browser).
 MAX_LISTED_FILES = 400

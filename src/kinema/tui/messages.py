@@ -8,6 +8,7 @@ what the user asked for with the ``...Requested`` messages.
 from __future__ import annotations
 
 from collections.abc import Mapping
+from typing import TYPE_CHECKING
 
 from textual.message import Message
 
@@ -16,7 +17,9 @@ from kinema.tui.connection import (
     ObjectiveSummary,
     WaypointSummary,
 )
-from kinema.tui.tree_outline import TreeOutline
+
+if TYPE_CHECKING:  # the outline module imports the BT engine; the first frame does not need it
+    from kinema.tui.tree_outline import TreeOutline
 
 
 class RuntimeEventsArrived(Message):

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 from rich.text import Text
 from textual.app import ComposeResult
@@ -12,10 +13,12 @@ from textual.message import Message
 from textual.widgets import DataTable, Label, OptionList, Static, TabbedContent, TabPane, Tree
 from textual.widgets.option_list import Option
 
-from kinema.config import Package, ResolvedConfig, Workspace, resolve_config
 from kinema.errors import KinemaError
 from kinema.tui.config_view import ConfigRow, config_rows, package_files
 from kinema.tui.screens.base import KinemaScreen
+
+if TYPE_CHECKING:
+    from kinema.config import Package, ResolvedConfig, Workspace
 
 
 @dataclass
@@ -196,6 +199,8 @@ def _package_label(package: Package) -> Text:
 
 
 def _details(name: str, workspace: Workspace) -> ConfigDetails:
+    from kinema.config import resolve_config  # after the first frame: it is not needed to draw it
+
     package = workspace.package(name)
     files, cut = package_files(package.path)
     try:

@@ -23,7 +23,6 @@ from kinema.errors import KinemaError
 from kinema.tui.connection import ConnectionState, NodeStatusBatch, ObjectiveSummary, RuntimeConnection
 from kinema.tui.messages import ObjectiveOutlineLoaded, ObjectiveRunRequested, ObjectivesLoaded
 from kinema.tui.screens.base import LOAD_ATTEMPTS, KinemaScreen
-from kinema.tui.tree_outline import build_outline
 from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
 from kinema.tui.widgets.override_form import OverrideForm
 
@@ -284,6 +283,8 @@ class ObjectivesScreen(KinemaScreen):
 
 
 def _load_outline(connection: RuntimeConnection, name: str) -> ObjectiveOutlineLoaded:
+    from kinema.tui.tree_outline import build_outline  # imports the BT engine: after the first frame
+
     xml = connection.objective_xml(name)
 
     def load_subtree(subtree_id: str) -> str | None:

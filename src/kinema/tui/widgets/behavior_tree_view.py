@@ -3,13 +3,16 @@
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import TYPE_CHECKING
 
 from rich.text import Text
 from textual.widgets import Tree
 from textual.widgets.tree import TreeNode
 
 from kinema.tui.connection import NodeStatus, NodeStatusUpdate
-from kinema.tui.tree_outline import OutlineNode, TreeOutline
+
+if TYPE_CHECKING:
+    from kinema.tui.tree_outline import OutlineNode, TreeOutline
 
 STATUS_MARK: dict[NodeStatus, tuple[str, str]] = {
     NodeStatus.IDLE: ("○", "dim"),
@@ -21,7 +24,7 @@ STATUS_MARK: dict[NodeStatus, tuple[str, str]] = {
 _RESULTS = frozenset({NodeStatus.SUCCESS, NodeStatus.FAILURE, NodeStatus.SKIPPED})
 
 
-class BehaviorTreeView(Tree[OutlineNode]):
+class BehaviorTreeView(Tree["OutlineNode"]):
     """Shows a :class:`TreeOutline`; :meth:`apply_statuses` marks nodes as the runtime reports them.
 
     A node keeps showing its last result (SUCCESS, FAILURE, SKIPPED) when its parent resets it to IDLE,
