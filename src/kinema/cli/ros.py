@@ -56,13 +56,21 @@ def _node(connect: str | None, timeout: float) -> Iterator[Node]:
 
 
 def _graph(node: Node, timeout: float) -> Graph:
-    """The network's graph; asks again while only this process shows up (links may still be forming)."""
+    """The network's graph, once two answers in a row agree.
+
+    Right after this process joins, its routes to the other processes are still forming: the first
+    answers can leave out whole processes (an agent, a driver) while the next ones have them all.
+    """
     deadline = time.monotonic() + timeout
     own = node.session.zid
+    previous: frozenset[Any] | None = None
     while True:
         graph = node.graph(timeout=max(0.05, min(deadline - time.monotonic(), 2.0)))
-        if any(entity.zid != own for entity in graph.entities) or time.monotonic() >= deadline:
+        seen = frozenset(graph.entities)
+        foreign = any(entity.zid != own for entity in graph.entities)
+        if (foreign and seen == previous) or time.monotonic() >= deadline:
             return graph
+        previous = seen if foreign else None
         time.sleep(0.05)
 
 
