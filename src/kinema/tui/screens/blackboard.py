@@ -54,7 +54,7 @@ class BlackboardScreen(KinemaScreen):
                 yield Input(placeholder="/ filter by key, scope, type or value", id="blackboard-filter")
                 yield Static("", id="blackboard-summary", classes="muted")
             with Horizontal(classes="split"):
-                yield BlackboardTable(id="blackboard-table")
+                yield BlackboardTable(self.kinema.blackboard, id="blackboard-table")
                 with Vertical(classes="side-panel"):
                     yield Label("History", classes="pane-title")
                     yield Static("", id="history-title")
@@ -93,17 +93,17 @@ class BlackboardScreen(KinemaScreen):
         if self.needs_rebuild:
             self.needs_rebuild = False
             self.pending = BlackboardDiff()
-            table.rebuild(model, self.query_one("#blackboard-filter", Input).value)
+            table.rebuild(self.query_one("#blackboard-filter", Input).value)
         elif self.pending:
             diff, self.pending = self.pending, BlackboardDiff()
             table.apply(diff)
         else:
             return
-        summary = Text(f"{len(table.shown)} of {len(model.entries)} entries")
+        summary = Text(f"{len(table.keys)} of {len(model.entries)} entries")
         if model.objective_name:
             summary.append(f"  ·  {model.objective_name}", style="bold")
         self.query_one("#blackboard-summary", Static).update(summary)
-        self._show_history(table.selected_key() if self.history_key is None else self.history_key)
+        self._show_history(table.selected_key())
 
     def on_input_changed(self, event: Input.Changed) -> None:
         if event.input.id == "blackboard-filter":
@@ -113,11 +113,9 @@ class BlackboardScreen(KinemaScreen):
     def on_input_submitted(self, event: Input.Submitted) -> None:
         self.query_one(BlackboardTable).focus()
 
-    def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
-        if event.data_table.id != "blackboard-table":
-            return
-        self.history_key = self.query_one(BlackboardTable).selected_key()
-        self._show_history(self.history_key)
+    def on_blackboard_table_key_highlighted(self, event: BlackboardTable.KeyHighlighted) -> None:
+        self.history_key = event.key
+        self._show_history(event.key)
 
     def _show_history(self, key: RowKey | None) -> None:
         table = self.query_one("#history-table", DataTable)
