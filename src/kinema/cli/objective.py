@@ -129,17 +129,25 @@ def _client(connect: str | None, timeout: float):  # type: ignore[no-untyped-def
     return QuickClient(connect, timeout=timeout)
 
 
+def _show_toast(level: str, text: str) -> None:
+    """Print a behavior's message to the UI; failures are left to the result line, which carries them."""
+    if level == "warn":
+        click.secho(f"warning: {text}", err=True, fg="yellow")
+    elif level != "failure":
+        click.echo(text)
+
+
 def _finish(run, wait: bool) -> None:  # type: ignore[no-untyped-def]
     """Wait for a started objective (Ctrl-C cancels it) and exit 0 only when it succeeded."""
     if not wait:
         click.echo(f"started {run.objective_name!r}")
         return
     try:
-        result = run.result()
+        result = run.result(on_toast=_show_toast)
     except KeyboardInterrupt:
         click.echo(f"cancelling {run.objective_name!r} ...", err=True)
         run.cancel()
-        result = run.result()
+        result = run.result(on_toast=_show_toast)
     if result.succeeded:
         click.echo(str(result))
         return
@@ -163,7 +171,8 @@ def _finish(run, wait: bool) -> None:  # type: ignore[no-untyped-def]
 def run_(name: str, params: tuple[str, ...], no_wait: bool, connect: str | None, timeout: float) -> None:
     """Run objective NAME on the running Kinema (a running objective is preempted).
 
-    Exits 0 when the objective succeeds, 1 when it fails or is cancelled; Ctrl-C cancels it.
+    Prints the messages its behaviors publish for the UI (toasts) while it runs. Exits 0 when the
+    objective succeeds, 1 when it fails or is cancelled; Ctrl-C cancels it.
     """
     from kinema.sdk import ParameterOverride
 

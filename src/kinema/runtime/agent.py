@@ -285,6 +285,8 @@ class Agent:
         self._goal_runs: dict[bytes, ObjectiveRun] = {}
         self._quick_runs: weakref.WeakValueDictionary[int, ObjectiveRun] = weakref.WeakValueDictionary()
         self._quick: list[Any] = []
+        # The JSON start queries of runs not yet ended: their clients also get the behaviors' toasts.
+        self._quick_listeners: dict[int, Any] = {}
         self._goal_lock = threading.Lock()
         self._stop = threading.Event()
         self._joint_state: Any = None
@@ -457,8 +459,12 @@ class Agent:
             return
         run = self.server.submit(request)
         query.reply(query.key_expr, quick.encode({"event": "accepted", "run_id": run.id}))
+        with self._goal_lock:
+            self._quick_listeners[run.id] = query
 
         def finish(result: ObjectiveResult) -> None:
+            with self._goal_lock:
+                self._quick_listeners.pop(run.id, None)
             payload = {
                 "event": "result",
                 "run_id": run.id,
@@ -598,7 +604,21 @@ class Agent:
         where = message.node_path or message.node_name or message.behavior_id
         if str(message.level) == "failure" and message.node_path:
             self.server.note_failure(message.node_path, message.text)
-        self._streams.publish_log(level, f"[{where}] {message.text}" if where else message.text)
+        text = f"[{where}] {message.text}" if where else message.text
+        self._streams.publish_log(level, text)
+        self._tell_quick_clients(str(message.level), text)
+
+    def _tell_quick_clients(self, level: str, text: str) -> None:
+        """Send a toast to the JSON clients waiting for a run (``kinema objective run`` prints it)."""
+        from kinema.runtime import quick_protocol as quick
+
+        with self._goal_lock:
+            listeners = list(self._quick_listeners.items())
+        for run_id, query in listeners:
+            try:
+                query.reply(query.key_expr, quick.encode({"event": "log", "level": level, "text": text}))
+            except Exception:
+                log.debug("could not send a toast to the JSON client of run %d", run_id, exc_info=True)
 
     def on_reload_event(self, event: ReloadEvent) -> None:
         """Publish a hot-reload outcome as a toast (subscribe it to the behavior host)."""

@@ -7,9 +7,10 @@ transport reference recommends for Kinema-internal traffic. These keys are not p
 ROS programs use ``/do_objective`` and ``/execute_objective``.
 
 * ``kinema/<domain>/objective_server/start`` — payload ``{"objective_name", "objective_xml",
-  "overrides": [{"name", "value", "behavior_namespaces"}]}``; the agent replies twice: ``{"event":
-  "accepted", "run_id"}`` at once, then ``{"event": "result", "error_code", "error_message",
-  "objective_name"}`` when the run ends.
+  "overrides": [{"name", "value", "behavior_namespaces"}]}``; the agent replies ``{"event":
+  "accepted", "run_id"}`` at once, ``{"event": "log", "level": "info|warn|failure", "text"}`` for each
+  toast a behavior publishes while the run lasts, then ``{"event": "result", "error_code",
+  "error_message", "objective_name"}`` when the run ends.
 * ``kinema/<domain>/objective_server/cancel`` — payload ``{"run_id"}`` (or ``{}`` for whatever runs);
   reply ``{"cancelled": bool, "objective_name"}``.
 * ``kinema/<domain>/objective_server/status`` — reply ``{"status", "objective_name"}``.

@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 import re
 import time
-from collections.abc import Iterable, Mapping
+from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
 from kinema.errors import TransportError
@@ -63,8 +63,12 @@ class QuickRun:
         self.run_id = run_id
         self.objective_name = objective_name
 
-    def result(self) -> ObjectiveResult:
+    def result(self, on_toast: Callable[[str, str], None] | None = None) -> ObjectiveResult:
         """Wait until the run ends and return its result.
+
+        Args:
+            on_toast: called with ``(level, text)`` for each toast a behavior publishes meanwhile
+                (level ``info``, ``warn`` or ``failure``).
 
         Raises:
             TransportError: the agent went away before answering.
@@ -73,6 +77,8 @@ class QuickRun:
             if reply.ok is None:
                 raise TransportError(f"the agent failed: {reply.err.payload.to_string()}")
             body = quick.decode(reply.ok.payload.to_bytes())
+            if body.get("event") == "log" and on_toast is not None:
+                on_toast(str(body.get("level", "info")), str(body.get("text", "")))
             if body.get("event") == "result":
                 return ObjectiveResult(
                     int(body["error_code"]), str(body["error_message"]), str(body["objective_name"])

@@ -139,3 +139,13 @@ def lively_agent(tmp_path: Path) -> Iterator[AgentProcess]:
         yield running
     finally:
         stop_agent(running)
+
+
+@pytest.fixture
+def lab_sim_agent(tmp_path: Path) -> Iterator[AgentProcess]:
+    """An agent for the bundled lab_sim config (its behaviors, wall time, no driver)."""
+    running = start_agent(tmp_path, "--config", "lab_sim", "--clock", "wall")
+    try:
+        yield running
+    finally:
+        stop_agent(running)

@@ -280,6 +280,29 @@ def test_the_cli_runs_and_reports_objectives(agent: Any, tmp_path: object) -> No
     assert cancelled.returncode == 0 and "cancelled 'Forever'" in cancelled.stdout
 
 
+def test_objective_run_prints_the_toasts_of_its_behaviors(lab_sim_agent: Any) -> None:
+    tree = """<root BTCPP_format="4" main_tree_to_execute="Toasts">
+      <BehaviorTree ID="Toasts">
+        <Sequence>
+          <Action ID="LogMessage" name="hello" message="Sum: 5"/>
+          <Action ID="LogMessage" name="careful" message="mind the gap" log_level="warn"/>
+        </Sequence>
+      </BehaviorTree>
+    </root>"""
+    done = subprocess.run(
+        [sys.executable, "-m", "kinema", "objective", "do", "-", "--connect", lab_sim_agent.endpoint],
+        capture_output=True,
+        text=True,
+        input=tree,
+        timeout=60,
+    )
+    assert done.returncode == 0, done.stderr
+    lines = done.stdout.splitlines()
+    assert lines[-1] == "objective 'Toasts' succeeded"
+    assert any(line.endswith("Sum: 5") and "hello" in line for line in lines[:-1]), done.stdout
+    assert "warning: " in done.stderr and "mind the gap" in done.stderr
+
+
 def test_the_json_endpoints_start_cancel_and_refuse_garbage(agent: Any) -> None:
     from kinema.runtime import quick_protocol
     from kinema.sdk import QuickClient
