@@ -196,7 +196,7 @@ RESETTING_CONTROLS = [c for c in CONTROLS if c not in ("SequenceWithMemory", "If
 
 
 def _work_factory() -> BehaviorTreeFactory:
-    from kinema.bt import StatefulActionNode, input_port
+    from kinema.bt import ManualClock, StatefulActionNode, input_port
 
     class Work(StatefulActionNode):
         @classmethod
@@ -211,7 +211,8 @@ def _work_factory() -> BehaviorTreeFactory:
             self.left -= 1
             return NodeStatus.SUCCESS if self.left <= 0 else NodeStatus.RUNNING
 
-    factory = BehaviorTreeFactory()
+    # A manual clock that never advances: a loaded machine must not make Timeout fire mid-example.
+    factory = BehaviorTreeFactory(clock=ManualClock())
     factory.register_node_type(Work, "Work")
     return factory
 
