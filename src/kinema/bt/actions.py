@@ -62,20 +62,33 @@ def _literal_code(config: NodeConfig) -> str | None:
     return None
 
 
-class ScriptNode(SyncActionNode):
-    """Runs the ``code`` script and returns SUCCESS (an empty script does nothing)."""
+class _ScriptCode:
+    """The parsed ``code`` port shared by Script and ScriptCondition.
 
-    @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return [input_port("code", str, description="Piece of code that can be parsed")]
+    A literal script is parsed once at construction; a ``{pointer}`` is re-parsed only when the
+    text it points to changes. The tick stays in each node (it compares ``_code`` inline, so an
+    unchanged script costs no extra call).
+    """
 
-    def __init__(self, name: str, config: NodeConfig | None = None) -> None:
-        super().__init__(name, config)
+    config: NodeConfig
+    full_path: str
+    _code: str
+    _script: Script | None
+    _literal: bool
+
+    def _init_script(self) -> None:
         self._code = ""
-        self._script: Script | None = None
+        self._script = None
         code = _literal_code(self.config)
         self._literal = code is not None
         if code:
+            self._load(code)
+
+    def _set_code(self, code: str) -> None:
+        if code == "":
+            self._script = None
+            self._code = ""
+        else:
             self._load(code)
 
     def _load(self, code: str) -> None:
@@ -87,21 +100,29 @@ class ScriptNode(SyncActionNode):
             ) from None
         self._code = code
 
+
+class ScriptNode(_ScriptCode, SyncActionNode):
+    """Runs the ``code`` script and returns SUCCESS (an empty script does nothing)."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [input_port("code", str, description="Piece of code that can be parsed")]
+
+    def __init__(self, name: str, config: NodeConfig | None = None) -> None:
+        super().__init__(name, config)
+        self._init_script()
+
     def tick(self) -> NodeStatus:
         # A literal code was parsed at construction; only a {pointer} is re-read every tick.
         code = self._code if self._literal else self.get_input("code", str)
         if code != self._code:
-            if code == "":
-                self._script = None
-                self._code = ""
-            else:
-                self._load(code)
+            self._set_code(code)
         if self._script is not None:
             self._script.run(self.config.blackboard, self.config.enums)
         return SUCCESS
 
 
-class ScriptConditionNode(ConditionNode):
+class ScriptConditionNode(_ScriptCode, ConditionNode):
     """SUCCESS if the ``code`` script evaluates to true, else FAILURE."""
 
     @classmethod
@@ -114,31 +135,13 @@ class ScriptConditionNode(ConditionNode):
 
     def __init__(self, name: str, config: NodeConfig | None = None) -> None:
         super().__init__(name, config)
-        self._code = ""
-        self._script: Script | None = None
-        code = _literal_code(self.config)
-        self._literal = code is not None
-        if code:
-            self._load(code)
-
-    def _load(self, code: str) -> None:
-        try:
-            self._script = parse_script(code)
-        except ScriptParseError as error:
-            raise BTRuntimeError(
-                f"Error in the script \"{code}\" of node '{self.full_path}': {error.message}"
-            ) from None
-        self._code = code
+        self._init_script()
 
     def tick(self) -> NodeStatus:
         # A literal code was parsed at construction; only a {pointer} is re-read every tick.
         code = self._code if self._literal else self.get_input("code", str)
         if code != self._code:
-            if code == "":
-                self._script = None
-                self._code = ""
-            else:
-                self._load(code)
+            self._set_code(code)
         if self._script is None:
             raise BTRuntimeError(
                 f"ScriptCondition '{self.full_path}' has an empty script (bad_function_call)"
