@@ -18,14 +18,14 @@ from __future__ import annotations
 
 import argparse
 import os
-import socket
 import statistics
 import subprocess
 import sys
 import tempfile
 import time
-from collections.abc import Callable
 from pathlib import Path
+
+from latency import MILLISECOND_NS, percentiles, time_calls
 
 TRIVIAL = """<root BTCPP_format="4" main_tree_to_execute="Trivial">
   <BehaviorTree ID="Trivial"><AlwaysSuccess/></BehaviorTree>
@@ -41,29 +41,6 @@ with open_session(sys.argv[1]) as session:
     print("ready", flush=True)
     sys.stdin.read()
 """
-
-
-def free_port() -> int:
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
-def percentiles(samples_ns: list[int]) -> tuple[float, float]:
-    """(p50, p99) in milliseconds."""
-    ordered = sorted(samples_ns)
-    return statistics.median(ordered) / 1e6, ordered[min(len(ordered) - 1, int(len(ordered) * 0.99))] / 1e6
-
-
-def time_calls(call: Callable[[], object], calls: int, warmup: int) -> list[int]:
-    for _ in range(warmup):
-        call()
-    samples = []
-    for _ in range(calls):
-        start = time.perf_counter_ns()
-        call()
-        samples.append(time.perf_counter_ns() - start)
-    return samples
 
 
 def start_agent(folder: Path, endpoint: str) -> subprocess.Popen[bytes]:
@@ -112,8 +89,9 @@ def main() -> None:
     args = parser.parse_args()
 
     from kinema.sdk import ObjectiveClient
+    from kinema.transport import free_endpoint
 
-    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    endpoint = free_endpoint()
     with tempfile.TemporaryDirectory() as tmp:
         folder = Path(tmp)
         (folder / "trivial.xml").write_text(TRIVIAL)
@@ -156,12 +134,12 @@ def main() -> None:
                         time_calls(do_xml, args.calls // 4, args.warmup // 4),
                     ),
                 ]
-            floor = percentiles(rows[0][1])[0]
+            floor = percentiles(rows[0][1], MILLISECOND_NS)[0]
             print(f"{'case':<36} {'p50 ms':>8} {'p99 ms':>8} {'p50 / floor':>12}")
             for name, samples in rows:
-                p50, p99 = percentiles(samples)
+                p50, p99 = percentiles(samples, MILLISECOND_NS)
                 print(f"{name:<36} {p50:8.3f} {p99:8.3f} {p50 / floor:11.1f}x")
-            target = percentiles(rows[1][1])[0]
+            target = percentiles(rows[1][1], MILLISECOND_NS)[0]
             print(f"execute p50 target < 5 ms: {'met' if target < 5 else 'NOT met'} ({target:.2f} ms)")
 
             env = {**os.environ, "KINEMA_ZENOH_CONNECT": endpoint}

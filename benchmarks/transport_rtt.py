@@ -9,40 +9,17 @@ process joins it as a peer and times, one after the other:
 
 It prints p50/p99 per case and the ratio of the Kinema call to the raw query measured in the same run.
 Run: ``python benchmarks/transport_rtt.py [--calls N] [--warmup N]``.
-
-The helpers (``time_calls``, ``percentiles``, ``serve``) are meant for reuse by other benchmarks.
 """
 
 from __future__ import annotations
 
 import argparse
-import statistics
 import subprocess
 import sys
-import time
-from collections.abc import Callable
+
+from latency import MICROSECOND_NS, percentiles, time_calls
 
 RAW_KEY = "kinema_bench/raw_echo"
-
-
-def percentiles(samples_ns: list[int]) -> tuple[float, float]:
-    """(p50, p99) in microseconds."""
-    ordered = sorted(samples_ns)
-    p50 = statistics.median(ordered) / 1000
-    p99 = ordered[min(len(ordered) - 1, int(len(ordered) * 0.99))] / 1000
-    return p50, p99
-
-
-def time_calls(call: Callable[[], object], calls: int, warmup: int) -> list[int]:
-    """Run ``call`` ``warmup`` times untimed, then ``calls`` times; return each duration in ns."""
-    for _ in range(warmup):
-        call()
-    samples = []
-    for _ in range(calls):
-        start = time.perf_counter_ns()
-        call()
-        samples.append(time.perf_counter_ns() - start)
-    return samples
 
 
 def serve(endpoint: str) -> None:
@@ -128,7 +105,7 @@ def main() -> None:
                 ("Kinema AddTwoInts call (2 processes)", kinema_call),
                 ("Kinema AddTwoInts call (same session)", local_call),
             ):
-                results[name] = percentiles(time_calls(call, args.calls, args.warmup))
+                results[name] = percentiles(time_calls(call, args.calls, args.warmup), MICROSECOND_NS)
         server.stdin.write("\n")
         server.stdin.flush()
         server.wait(10)
