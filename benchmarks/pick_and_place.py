@@ -23,7 +23,6 @@ from __future__ import annotations
 import argparse
 import math
 import shutil
-import socket
 import statistics
 import tempfile
 import threading
@@ -57,12 +56,6 @@ class Cycle:
     cube_error: float
 
 
-def _free_endpoint() -> str:
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return f"tcp/127.0.0.1:{probe.getsockname()[1]}"
-
-
 def _workspace(root: Path, library: str) -> tuple[str, Path | None]:
     """The config to run: lab_sim itself, or a temporary child of it running MoveIt Pro's files."""
     if library == "kinema":
@@ -94,9 +87,9 @@ class Cell:
         from kinema.drivers.mujoco import MujocoDriver, MujocoDriverSettings
         from kinema.runtime.agent_process import AgentOptions, build_agent
         from kinema.sdk import ObjectiveClient
-        from kinema.transport import Node, host_router, open_session
+        from kinema.transport import Node, free_endpoint, host_router, open_session
 
-        endpoint = _free_endpoint()
+        endpoint = free_endpoint()
         self._closers: list[Any] = []
         router = host_router(endpoint)
         self._closers.append(router.close)

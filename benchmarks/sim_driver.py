@@ -20,7 +20,6 @@ from __future__ import annotations
 import argparse
 import os
 import select
-import socket
 import statistics
 import subprocess
 import threading
@@ -33,7 +32,7 @@ import numpy as np
 from kinema.config import resolve_config
 from kinema.drivers import driver_spec
 from kinema.drivers.mujoco import names
-from kinema.transport import Node, host_router, open_session
+from kinema.transport import Node, free_endpoint, host_router, open_session
 
 ARM = (
     "linear_rail_joint",
@@ -46,13 +45,6 @@ ARM = (
 )
 DEFAULT = np.array([0.0, 0.0, -2.0, 2.0, -1.5708, -1.5708, 0.0])
 AWAY = DEFAULT + np.array([0.3, 0.8, 0.3, -0.3, 0.6, 0.6, 1.0])
-
-
-def free_endpoint() -> str:
-    """A loopback endpoint on a port the OS reports free."""
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return f"tcp/127.0.0.1:{probe.getsockname()[1]}"
 
 
 class Floor:
