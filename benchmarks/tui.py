@@ -206,7 +206,8 @@ def input_latency(seconds: float, stock_table: bool) -> list[float]:
             await asyncio.sleep(seconds)
             stop.set()
             for thread in threads:
-                thread.join()
+                # Joined off the event loop: the peer's stream thread waits on the loop (call_from_thread).
+                await asyncio.to_thread(thread.join)
             await pilot.pause(0.3)
             if not stock_table:
                 shown = app.screen.query_one(BlackboardTable).keys
