@@ -8,23 +8,9 @@ from kinema.bt.ports import RESERVED_PORT_NAMES
 
 _FORBIDDEN = frozenset(" \t\n\r<>&\"'/\\:*?|.")
 
-RESERVED_ATTRIBUTES = frozenset(
-    {
-        "name",
-        "ID",
-        "_autoremap",
-        "_failureIf",
-        "_successIf",
-        "_skipIf",
-        "_while",
-        "_onSuccess",
-        "_onFailure",
-        "_onHalted",
-        "_post",
-    }
-)
 PRE_CONDITIONS = ("_failureIf", "_successIf", "_skipIf", "_while")
 POST_CONDITIONS = ("_onSuccess", "_onFailure", "_onHalted", "_post")
+RESERVED_ATTRIBUTES = frozenset(("name", "ID", "_autoremap", *PRE_CONDITIONS, *POST_CONDITIONS))
 
 
 def forbidden_char(name: str, *, allow_space: bool = False) -> str | None:
