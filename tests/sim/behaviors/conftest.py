@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import math
-import socket
 from collections.abc import Iterator
 from typing import Any
 
@@ -13,18 +12,12 @@ from kinema.behaviors import BehaviorContext
 from kinema.plugins import BehaviorHost, BehaviorRegistry
 
 
-def _free_endpoint() -> str:
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return f"tcp/127.0.0.1:{probe.getsockname()[1]}"
-
-
 @pytest.fixture(scope="module")
 def endpoint() -> Iterator[str]:
     """A router on a free loopback port."""
-    from kinema.transport import host_router
+    from kinema.transport import free_endpoint, host_router
 
-    address = _free_endpoint()
+    address = free_endpoint()
     router = host_router(address)
     yield address
     router.close()

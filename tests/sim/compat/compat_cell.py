@@ -11,7 +11,6 @@ at max sim speed unless a test asks otherwise; positions come from the simulator
 from __future__ import annotations
 
 import shutil
-import socket
 import threading
 import time
 from collections.abc import Callable
@@ -52,13 +51,6 @@ UNREACHABLE_WAYPOINT = {
         "effort": [],
     },
 }
-
-
-def free_endpoint() -> str:
-    """``tcp/127.0.0.1:<port>`` on a port the OS just reported free."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return f"tcp/127.0.0.1:{probe.getsockname()[1]}"
 
 
 def wait_for(predicate: Callable[[], Any], timeout: float, what: str) -> Any:

@@ -9,7 +9,9 @@ from pathlib import Path
 from typing import Any
 
 import pytest
-from compat_cell import CONFIG, Cell, free_endpoint, make_workspace
+from compat_cell import CONFIG, Cell, make_workspace
+
+from kinema.transport import free_endpoint
 
 
 @pytest.fixture(scope="module")

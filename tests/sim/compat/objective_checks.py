@@ -10,6 +10,17 @@ from compat_cell import PICK_POSITION, PLACE_POSITION, TOLERANCE, Cell, wait_for
 # Sim seconds a full pick-and-place cycle may take at most, with margin (it takes about 30 s).
 CYCLE_TIMEOUT_WALL = 90.0
 
+# The lab_sim objectives of MoveIt Pro that both libraries (MoveIt Pro's copy and Kinema's) provide.
+MOVEIT_PRO_OBJECTIVES = (
+    "3 Waypoints Pick and Place",
+    "Close Gripper",
+    "Open Gripper",
+    "Look at Table",
+    "Reset MuJoCo Robot",
+    "Move to Waypoint",
+    "Move to Joint State",
+)
+
 
 def near(position: np.ndarray, target: np.ndarray) -> bool:
     """Within TOLERANCE (2 cm) of ``target``."""
@@ -72,12 +83,17 @@ def arm_at_waypoint(cell: Cell, waypoint: str, atol: float = 0.02) -> None:
 
     saved = WaypointStore(store_path).get(waypoint)
     expected = dict(zip(saved.joint_names, saved.positions, strict=True))
-    message = wait_for(lambda: _joint_state(cell), 10.0, "a joint state")
-    actual = dict(zip(message.name, message.position, strict=True))
+    actual = joint_positions(cell)
     for joint in ARM:
         assert abs(actual[joint] - expected[joint]) < atol, (
             f"{joint}: {actual[joint]:.4f} != {expected[joint]:.4f}"
         )
+
+
+def joint_positions(cell: Cell) -> dict[str, float]:
+    """The latest ``/joint_states`` as joint name -> position."""
+    message = wait_for(lambda: _joint_state(cell), 10.0, "a joint state")
+    return dict(zip(message.name, message.position, strict=True))
 
 
 def _joint_state(cell: Cell):

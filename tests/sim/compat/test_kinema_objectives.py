@@ -3,10 +3,11 @@
 from __future__ import annotations
 
 import pytest
-from compat_cell import Cell, wait_for
+from compat_cell import Cell
 from objective_checks import (
-    _joint_state,
+    MOVEIT_PRO_OBJECTIVES,
     arm_at_waypoint,
+    joint_positions,
     run_and_expect_success,
     run_pick_and_place_two_placements,
 )
@@ -21,15 +22,7 @@ def cell(start_cell) -> Cell:
 
 def test_kinemas_libraries_provide_the_moveit_pro_names(cell: Cell) -> None:
     infos = {info.name: info for info in cell.client.objectives()}
-    for expected in (
-        "3 Waypoints Pick and Place",
-        "Close Gripper",
-        "Open Gripper",
-        "Look at Table",
-        "Reset MuJoCo Robot",
-        "Move to Waypoint",
-        "Move to Joint State",
-    ):
+    for expected in MOVEIT_PRO_OBJECTIVES:
         assert expected in infos
     # The subtrees MoveIt Pro objectives call have MoveIt Pro's ports.
     ports = {port.name for port in infos["Move to Waypoint"].ports}
@@ -69,8 +62,7 @@ def test_look_at_table_moves_the_arm_to_its_waypoint(cell: Cell) -> None:
 
 def test_reset_mujoco_robot_puts_the_arm_upright(cell: Cell) -> None:
     run_and_expect_success(cell, "Reset MuJoCo Robot")
-    message = wait_for(lambda: _joint_state(cell), 10.0, "the arm state")
-    state = dict(zip(message.name, message.position, strict=True))
+    state = joint_positions(cell)
     assert abs(state["shoulder_lift_joint"] + 1.57) < 0.02
     run_and_expect_success(cell, "Look at Table")
 

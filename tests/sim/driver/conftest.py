@@ -10,12 +10,12 @@ from collections.abc import Callable, Iterator
 from typing import Any
 
 import pytest
-from driver_harness import GRIPPER, JointStates, Sim, free_endpoint
+from driver_harness import GRIPPER, JointStates, Sim
 
 from kinema.config import WaypointStore, resolve_config
 from kinema.drivers.mujoco import MujocoDriver, MujocoDriverSettings
 from kinema.drivers.mujoco import names as n
-from kinema.transport import Node, Session, host_router, open_session
+from kinema.transport import Node, Session, free_endpoint, host_router, open_session
 
 
 @pytest.fixture

@@ -7,7 +7,6 @@ Times in assertions are sim times read from ``/joint_states`` stamps, never wall
 
 from __future__ import annotations
 
-import socket
 import threading
 import time
 from collections.abc import Callable, Sequence
@@ -30,13 +29,6 @@ ARM = (
     "wrist_3_joint",
 )
 GRIPPER = "robotiq_85_left_knuckle_joint"
-
-
-def free_endpoint() -> str:
-    """``tcp/127.0.0.1:<port>`` on a port the OS just reported free."""
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind(("127.0.0.1", 0))
-        return f"tcp/127.0.0.1:{probe.getsockname()[1]}"
 
 
 def wait_for(predicate: Callable[[], Any], timeout: float = 10.0, what: str = "condition") -> Any:
