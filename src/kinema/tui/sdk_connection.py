@@ -17,6 +17,7 @@ from collections import deque
 from collections.abc import Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
+from xml.sax.saxutils import quoteattr
 
 from kinema.errors import KinemaError, ObjectiveError, TransportError
 from kinema.tui.connection import (
@@ -56,6 +57,7 @@ RETRY_PERIOD_S = 1.0
 CALL_TIMEOUT_S = 5.0
 #: The objective MoveIt Pro (and Kinema's core library) moves to a waypoint with.
 MOVE_TO_WAYPOINT_OBJECTIVE = "Move to Waypoint"
+MOVE_TO_WAYPOINT_TREE = "Move to Waypoint (from the UI)"
 _DIRECTIONS = {0: "input", 1: "output", 2: "inout"}
 # The runtime publishes hot-reload outcomes on its log stream (kinema.plugins.host wording).
 _RELOADED = re.compile(r"^Reloaded (?P<subject>\S+): (?P<ids>.*)$")
@@ -352,7 +354,15 @@ class SdkConnection:
                 f"the runtime has no {MOVE_TO_WAYPOINT_OBJECTIVE!r} objective to move with; "
                 "run a config whose objective library includes Kinema's core objectives"
             )
-        client.start(MOVE_TO_WAYPOINT_OBJECTIVE, {"waypoint_name": name})
+        # Wrapped as a SubTree, as MoveIt Pro's UI does: the subtree's other ports then take the defaults
+        # its TreeNodesModel declares (planning group, controller, ...), which a direct run would not.
+        xml = (
+            f'<root BTCPP_format="4" main_tree_to_execute="{MOVE_TO_WAYPOINT_TREE}">'
+            f'<BehaviorTree ID="{MOVE_TO_WAYPOINT_TREE}">'
+            f'<SubTree ID="{MOVE_TO_WAYPOINT_OBJECTIVE}" waypoint_name={quoteattr(name)}/>'
+            "</BehaviorTree></root>"
+        )
+        client.start(xml=xml)
 
     def save_waypoint(self, name: str, joint_group_names: tuple[str, ...] = ()) -> WaypointSummary:
         from kinema.runtime import names
