@@ -13,18 +13,30 @@ def _idle_child(node: ControlNode) -> BTLogicError:
     return BTLogicError(f"[{node.name}]: A children should not return IDLE")
 
 
-class SequenceNode(ControlNode):
+class _ResumingControl(ControlNode):
+    """State of Sequence and Fallback: the child to resume at and how many children were skipped.
+
+    Halting starts over from the first child (SequenceWithMemory keeps its index and is not one).
+    """
+
+    def __init__(self, name: str, config: NodeConfig | None = None) -> None:
+        super().__init__(name, config)
+        self._idx = 0
+        self._skipped = 0
+
+    def halt(self) -> None:
+        self._idx = 0
+        self._skipped = 0
+        ControlNode.halt(self)
+
+
+class SequenceNode(_ResumingControl):
     """Ticks children in order; remembers the running child; FAILURE restarts from the first.
 
     The async variant yields (wake-up + RUNNING) after each child that succeeds from IDLE.
     """
 
     _asynch = False
-
-    def __init__(self, name: str, config: NodeConfig | None = None) -> None:
-        super().__init__(name, config)
-        self._idx = 0
-        self._skipped = 0
 
     def tick(self) -> NodeStatus:
         children = self.children
@@ -64,11 +76,6 @@ class SequenceNode(ControlNode):
         self._idx = 0
         self._skipped = 0
         return SKIPPED if all_skipped else SUCCESS
-
-    def halt(self) -> None:
-        self._idx = 0
-        self._skipped = 0
-        ControlNode.halt(self)
 
 
 class AsyncSequenceNode(SequenceNode):
@@ -119,15 +126,10 @@ class SequenceWithMemoryNode(ControlNode):
         return SKIPPED if all_skipped else SUCCESS
 
 
-class FallbackNode(ControlNode):
+class FallbackNode(_ResumingControl):
     """Ticks children in order until one succeeds (the mirror of Sequence)."""
 
     _asynch = False
-
-    def __init__(self, name: str, config: NodeConfig | None = None) -> None:
-        super().__init__(name, config)
-        self._idx = 0
-        self._skipped = 0
 
     def tick(self) -> NodeStatus:
         children = self.children
@@ -166,11 +168,6 @@ class FallbackNode(ControlNode):
         self._skipped = 0
         return SKIPPED if all_skipped else FAILURE
 
-    def halt(self) -> None:
-        self._idx = 0
-        self._skipped = 0
-        ControlNode.halt(self)
-
 
 class AsyncFallbackNode(FallbackNode):
     """Fallback that yields to the tree after every child that fails from IDLE."""
@@ -178,12 +175,21 @@ class AsyncFallbackNode(FallbackNode):
     _asynch = True
 
 
-class ReactiveSequenceNode(ControlNode):
-    """Re-ticks every child from the first on every tick; a RUNNING child halts all the others."""
+class _RunningChildControl(ControlNode):
+    """State of ReactiveSequence, ReactiveFallback and Switch: the index of a child that went
+    RUNNING (-1: none); halting forgets it."""
 
     def __init__(self, name: str, config: NodeConfig | None = None) -> None:
         super().__init__(name, config)
         self._running_child = -1
+
+    def halt(self) -> None:
+        self._running_child = -1
+        ControlNode.halt(self)
+
+
+class ReactiveSequenceNode(_RunningChildControl):
+    """Re-ticks every child from the first on every tick; a RUNNING child halts all the others."""
 
     def tick(self) -> NodeStatus:
         all_skipped = True
@@ -215,17 +221,9 @@ class ReactiveSequenceNode(ControlNode):
         self.reset_children()
         return SKIPPED if all_skipped else SUCCESS
 
-    def halt(self) -> None:
-        self._running_child = -1
-        ControlNode.halt(self)
 
-
-class ReactiveFallbackNode(ControlNode):
+class ReactiveFallbackNode(_RunningChildControl):
     """Re-ticks every child from the first on every tick until one succeeds."""
-
-    def __init__(self, name: str, config: NodeConfig | None = None) -> None:
-        super().__init__(name, config)
-        self._running_child = -1
 
     def tick(self) -> NodeStatus:
         all_skipped = True
@@ -254,10 +252,6 @@ class ReactiveFallbackNode(ControlNode):
                 raise _idle_child(self)
         self.reset_children()
         return SKIPPED if all_skipped else FAILURE
-
-    def halt(self) -> None:
-        self._running_child = -1
-        ControlNode.halt(self)
 
 
 def _threshold(value: int, n: int) -> int:
@@ -485,7 +479,7 @@ def check_string_equality(a: str, b: str, enums: dict[str, int] | None) -> bool:
     return da is not None and db is not None and abs(da - db) <= FLT_EPSILON
 
 
-class SwitchNode(ControlNode):
+class SwitchNode(_RunningChildControl):
     """``SwitchN``: ticks the child whose ``case_i`` equals ``variable``, else the last (default) child."""
 
     cases = 2
@@ -495,10 +489,6 @@ class SwitchNode(ControlNode):
         ports = [input_port("variable", str)]
         ports += [input_port(f"case_{i}", str) for i in range(1, cls.cases + 1)]
         return ports
-
-    def __init__(self, name: str, config: NodeConfig | None = None) -> None:
-        super().__init__(name, config)
-        self._running_child = -1
 
     def tick(self) -> NodeStatus:
         n_cases = self.cases
@@ -524,10 +514,6 @@ class SwitchNode(ControlNode):
             self.reset_children()
             self._running_child = -1
         return status
-
-    def halt(self) -> None:
-        self._running_child = -1
-        ControlNode.halt(self)
 
 
 def make_switch(n: int) -> type[SwitchNode]:
