@@ -198,3 +198,21 @@ def test_a_run_that_resumes_after_late_heartbeats_keeps_its_start() -> None:
     assert not status.apply_heartbeat(Heartbeat(105.0, "Pick", "Running"))  # not a new run
     assert status.elapsed == pytest.approx(5.0)
     assert status.apply_heartbeat(Heartbeat(106.0, "Place", "Running"))  # this one is
+
+
+def test_the_behavior_catalog_lists_plugins_and_survives_a_config_that_is_not_here() -> None:
+    from kinema.tui.connection import LogEntry
+    from kinema.tui.sdk_connection import SdkConnection
+
+    here = SdkConnection("tcp/127.0.0.1:9", config="lab_sim")
+    catalog = {b.id: b for b in here.list_behaviors()}
+    assert catalog["Sequence"].source == "built-in node"
+    plugin_rows = [b for b in catalog.values() if b.plugin != "kinema.bt"]
+    assert plugin_rows and all(b.location and b.source for b in plugin_rows)
+
+    events: list[object] = []
+    elsewhere = SdkConnection("tcp/127.0.0.1:9", config="config_of_another_machine")
+    elsewhere.open = None  # type: ignore[assignment,method-assign]  # never connects in this test
+    elsewhere._listener = events.append
+    assert "Sequence" in {b.id for b in elsewhere.list_behaviors()}
+    assert any(isinstance(e, LogEntry) and "config_of_another_machine" in e.message for e in events)

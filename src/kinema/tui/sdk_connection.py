@@ -399,7 +399,19 @@ class SdkConnection:
         workspace, config = self._selection()
         catalog = builtin_behaviors()
         if config:
-            catalog += plugin_behaviors(resolve_config(config, workspace, check_files=False))
+            try:
+                catalog += plugin_behaviors(resolve_config(config, workspace, check_files=False))
+            except KinemaError as error:
+                # E.g. attached to a runtime on another machine whose config is not here: the built-in
+                # nodes are still worth listing; say why the rest is missing.
+                self._emit(
+                    LogEntry(
+                        f"behaviors: the plugins of config {config!r} could not be loaded here: {error}",
+                        LogLevel.WARN,
+                        time.time(),
+                        "ui",
+                    )
+                )
         return catalog
 
     def _selection(self) -> tuple[Workspace, str | None]:
