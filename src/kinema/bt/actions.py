@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-import threading
 from typing import Any
 
+from kinema.bt.clock import WakeUpTimer
 from kinema.bt.conversions import ConversionError, convert_from_string, has_converter, type_name
 from kinema.bt.decorators import entry_key_of
 from kinema.bt.errors import BTLogicError, BTRuntimeError, ScriptParseError
@@ -234,12 +234,7 @@ class SleepNode(StatefulActionNode):
 
     def __init__(self, name: str, config: NodeConfig | None = None) -> None:
         super().__init__(name, config)
-        self._fired = threading.Event()
-        self._timer: Any = None
-
-    def _on_timer(self) -> None:
-        self._fired.set()
-        self.emit_wake_up_signal()
+        self._timer = WakeUpTimer(self, "SleepNode")
 
     def on_start(self) -> NodeStatus:
         try:
@@ -248,25 +243,17 @@ class SleepNode(StatefulActionNode):
             raise BTRuntimeError("Missing parameter [msec] in SleepNode") from None
         if msec <= 0:
             return SUCCESS
-        clock = self.config.clock
-        if clock is None:
-            raise BTRuntimeError(f"SleepNode '{self.full_path}' is not part of a tree with a clock")
-        self._fired.clear()
-        self._timer = clock.call_later(msec / 1000.0, self._on_timer)
+        self._timer.start(msec / 1000.0)
         return RUNNING
 
     def on_running(self) -> NodeStatus:
-        if self._fired.is_set():
-            self._fired.clear()
-            self._timer = None
+        if self._timer.fired.is_set():
+            self._timer.cancel()
             return SUCCESS
         return RUNNING
 
     def on_halted(self) -> None:
-        if self._timer is not None:
-            self._timer.cancel()
-            self._timer = None
-        self._fired.clear()
+        self._timer.cancel()
 
 
 class WasEntryUpdatedNode(SyncActionNode):

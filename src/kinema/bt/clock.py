@@ -13,7 +13,12 @@ import itertools
 import threading
 import time
 from collections.abc import Callable
-from typing import Protocol, runtime_checkable
+from typing import TYPE_CHECKING, Protocol, runtime_checkable
+
+from kinema.bt.errors import BTRuntimeError
+
+if TYPE_CHECKING:
+    from kinema.bt.node import TreeNode
 
 
 @runtime_checkable
@@ -45,6 +50,42 @@ class _Timer:
 
     def cancel(self) -> None:
         self.cancelled = True
+
+
+class WakeUpTimer:
+    """A one-shot timer on a node's tree clock (Sleep, Delay, Timeout): when due it sets ``fired`` and
+    wakes the tree.
+
+    The callback runs on the clock's thread, so it only flags and wakes; the node acts on ``fired``
+    in its next tick (the tree is mutated by its tick thread only).
+    """
+
+    __slots__ = ("_handle", "_kind", "_node", "fired")
+
+    def __init__(self, node: TreeNode, kind: str) -> None:
+        self._node = node
+        self._kind = kind
+        self.fired = threading.Event()
+        self._handle: TimerHandle | None = None
+
+    def start(self, seconds: float) -> None:
+        """Clear ``fired`` and schedule it ``seconds`` from now on the node's tree clock."""
+        clock = self._node.config.clock
+        if clock is None:
+            raise BTRuntimeError(f"{self._kind} '{self._node.full_path}' is not part of a tree with a clock")
+        self.fired.clear()
+        self._handle = clock.call_later(seconds, self._fire)
+
+    def _fire(self) -> None:
+        self.fired.set()
+        self._node.emit_wake_up_signal()
+
+    def cancel(self) -> None:
+        """Drop the pending timer (harmless if it already fired) and clear ``fired``."""
+        if self._handle is not None:
+            self._handle.cancel()
+            self._handle = None
+        self.fired.clear()
 
 
 class WallClock:

@@ -2,10 +2,10 @@
 
 from __future__ import annotations
 
-import threading
 from collections import deque
 from typing import Any
 
+from kinema.bt.clock import WakeUpTimer
 from kinema.bt.conversions import convert_from_string, list_item_type
 from kinema.bt.errors import BTLogicError, BTRuntimeError
 from kinema.bt.node import DecoratorNode, NodeConfig, PortError, _set_status_unchecked, script_bool
@@ -203,14 +203,8 @@ class TimeoutNode(DecoratorNode):
     def __init__(self, name: str, config: NodeConfig | None = None) -> None:
         super().__init__(name, config)
         self._started = False
-        self._expired = threading.Event()
-        self._timer: Any = None
-
-    def _on_timer(self) -> None:
-        # Runs on the clock's thread: only flag and wake the tree; the tick thread halts the child
-        # (the tree is mutated by its tick thread only).
-        self._expired.set()
-        self.emit_wake_up_signal()
+        # Fires on the clock's thread; the tick thread halts the child when it sees the flag.
+        self._timer = WakeUpTimer(self, "TimeoutNode")
 
     def tick(self) -> NodeStatus:
         msec = _required(self, "msec", "TimeoutNode")
@@ -221,33 +215,24 @@ class TimeoutNode(DecoratorNode):
         if not self._started:
             self._started = True
             _set_status_unchecked(self, RUNNING)
-            self._expired.clear()
+            self._timer.fired.clear()
             if msec > 0:
-                clock = self.config.clock
-                if clock is None:
-                    raise BTRuntimeError(f"TimeoutNode '{self.full_path}' is not part of a tree with a clock")
-                self._timer = clock.call_later(msec / 1000.0, self._on_timer)
-        if self._expired.is_set() and child._status is RUNNING:
+                self._timer.start(msec / 1000.0)
+        if self._timer.fired.is_set() and child._status is RUNNING:
             self.reset_child()
             self._started = False
-            self._expired.clear()
+            self._timer.fired.clear()
             return FAILURE
         status = child.execute_tick()
         if status is SUCCESS or status is FAILURE:
             self._started = False
-            self._cancel()
+            self._timer.cancel()
             self.reset_child()
         return status
 
-    def _cancel(self) -> None:
-        if self._timer is not None:
-            self._timer.cancel()
-            self._timer = None
-        self._expired.clear()
-
     def halt(self) -> None:
         self._started = False
-        self._cancel()
+        self._timer.cancel()
         DecoratorNode.halt(self)
 
 
@@ -261,26 +246,18 @@ class DelayNode(DecoratorNode):
     def __init__(self, name: str, config: NodeConfig | None = None) -> None:
         super().__init__(name, config)
         self._started = False
-        self._complete = threading.Event()
-        self._timer: Any = None
-
-    def _on_timer(self) -> None:
-        self._complete.set()
-        self.emit_wake_up_signal()
+        self._timer = WakeUpTimer(self, "DelayNode")
 
     def tick(self) -> NodeStatus:
         msec = _required(self, "delay_msec", "DelayNode")
         if msec < 0:
             raise BTRuntimeError(f"DelayNode '{self.full_path}': delay_msec must not be negative ({msec})")
         if not self._started:
-            self._complete.clear()
+            self._timer.fired.clear()
             self._started = True
             _set_status_unchecked(self, RUNNING)
-            clock = self.config.clock
-            if clock is None:
-                raise BTRuntimeError(f"DelayNode '{self.full_path}' is not part of a tree with a clock")
-            self._timer = clock.call_later(msec / 1000.0, self._on_timer)
-        if self._complete.is_set():
+            self._timer.start(msec / 1000.0)
+        if self._timer.fired.is_set():
             assert self.child is not None
             status = self.child.execute_tick()
             if status is SUCCESS or status is FAILURE:
@@ -291,10 +268,7 @@ class DelayNode(DecoratorNode):
 
     def halt(self) -> None:
         self._started = False
-        if self._timer is not None:
-            self._timer.cancel()
-            self._timer = None
-        self._complete.clear()
+        self._timer.cancel()
         DecoratorNode.halt(self)
 
 
