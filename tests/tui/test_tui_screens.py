@@ -2,9 +2,9 @@
 
 from __future__ import annotations
 
-from pilot_harness import drive, settle
 from rich.text import Text
 from textual.widgets import DataTable, Input, OptionList, RichLog, Select, Tree
+from tui_pilot_harness import drive, settle
 
 from kinema.errors import TransportError
 from kinema.tui.connection import (

@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-from pilot_harness import drive, settle
 from textual.widgets import Checkbox, Input, OptionList, Select, TabbedContent, TextArea
+from tui_pilot_harness import drive, settle
 
 from kinema.errors import TransportError
 from kinema.tui.connection import Heartbeat, NodeStatus, NodeStatusBatch, NodeStatusUpdate

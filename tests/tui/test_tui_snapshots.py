@@ -1,13 +1,13 @@
 """Snapshot tests: each screen on the demo runtime at a fixed size, with no clocks and no toasts.
 
-Update after an intended change with ``pytest tests/tui/test_snapshots.py --snapshot-update`` and look at
+Update after an intended change with ``pytest tests/tui/test_tui_snapshots.py --snapshot-update`` and look at
 the SVGs (``__snapshots__/``) before committing them.
 """
 
 from __future__ import annotations
 
-from pilot_harness import settle
 from textual.pilot import Pilot
+from tui_pilot_harness import settle
 
 from kinema.tui.app import KinemaApp
 from kinema.tui.connection import (
