@@ -14,7 +14,6 @@ import os
 import re
 import shlex
 import signal
-import socket
 import subprocess
 import sys
 import time
@@ -23,14 +22,10 @@ from pathlib import Path
 import pytest
 from console_blocks import Step, missing_lines, parse_steps, tutorial_path
 
+from kinema.transport import free_endpoint
+
 COMMAND_TIMEOUT_S = 180.0
 BACKGROUND_READY_S = 120.0
-
-
-def _free_port() -> int:
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
 
 
 def _faster(command: str) -> str:
@@ -53,7 +48,7 @@ class Reader:
             "HOME": str(home),
             "XDG_CONFIG_HOME": str(home / ".config"),
             "XDG_STATE_HOME": str(home / ".state"),
-            "KINEMA_ZENOH_CONNECT": f"tcp/127.0.0.1:{_free_port()}",
+            "KINEMA_ZENOH_CONNECT": free_endpoint(),
             "PYTHONUNBUFFERED": "1",
             "NO_COLOR": "1",
         }

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import socket
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -11,6 +10,8 @@ from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
+
+from kinema.transport import free_endpoint
 
 OBJECTIVES = """<root BTCPP_format="4">
   <BehaviorTree ID="Quick">
@@ -35,13 +36,6 @@ OBJECTIVES = """<root BTCPP_format="4">
 """
 
 
-def free_port() -> int:
-    """A TCP port on 127.0.0.1 nobody listens on right now."""
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        return int(sock.getsockname()[1])
-
-
 @dataclass
 class AgentProcess:
     """A running agent: its router endpoint and process."""
@@ -56,7 +50,7 @@ def start_agent(tmp_path: Path, *extra: str, hot_reload: bool = False) -> AgentP
     folder = tmp_path / "objectives"
     folder.mkdir(exist_ok=True)
     (folder / "builtins.xml").write_text(OBJECTIVES)
-    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    endpoint = free_endpoint()
     log_file = tmp_path / "agent.log"
     read_fd, write_fd = os.pipe()
     argv = [
@@ -115,10 +109,10 @@ def client(agent: AgentProcess) -> Iterator[object]:
         yield connected
 
 
-@pytest.fixture
-def free_endpoint() -> str:
+@pytest.fixture(name="free_endpoint")
+def free_endpoint_fixture() -> str:
     """A loopback endpoint nothing listens on."""
-    return f"tcp/127.0.0.1:{free_port()}"
+    return free_endpoint()
 
 
 @pytest.fixture

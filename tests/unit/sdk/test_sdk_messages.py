@@ -117,10 +117,7 @@ def test_a_slow_consumer_drops_the_oldest_messages() -> None:
 
 
 def test_the_quick_client_says_when_no_router_answers() -> None:
-    import socket
+    from kinema.transport import free_endpoint
 
-    with socket.socket() as sock:
-        sock.bind(("127.0.0.1", 0))
-        port = sock.getsockname()[1]
     with pytest.raises(TransportError, match="no Kinema router answers at tcp/"):
-        QuickClient(f"tcp/127.0.0.1:{port}", timeout=0.3)
+        QuickClient(free_endpoint(), timeout=0.3)
