@@ -11,6 +11,7 @@ from kinema.behaviors.work_runner import RUNNER
 from kinema.errors import KinemaError, TransportError
 
 from .message_conversions import duration, trajectory_from_message
+from .planned_trajectory import publish_planned_trajectory
 
 FOLLOW_JOINT_TRAJECTORY = "control_msgs/action/FollowJointTrajectory"
 # How long the controller's action server may be missing from the graph before the run fails: long
@@ -100,6 +101,7 @@ class ExecuteTrajectory(AsyncBehavior):
             goal = self.create_goal()
         except KinemaError as error:
             return self._fail(str(error))
+        publish_planned_trajectory(self, goal["trajectory"])
         client = self.context.action_client(node, FOLLOW_JOINT_TRAJECTORY, name)
         sending = RUNNER.run_function(lambda: client.send_goal(goal, timeout=5.0))
         try:

@@ -9,6 +9,7 @@ from kinema.errors import KinemaError, did_you_mean
 
 from .joint_states import joint_state_monitor
 from .message_conversions import joint_positions, trajectory_message
+from .planned_trajectory import publish_planned_trajectory
 from .planning_resources import collision_checker, robot_model
 
 
@@ -99,7 +100,9 @@ class PlanToJointGoal(AsyncBehavior):
             trajectory = time_parameterize(path, model, velocity_scale, acceleration_scale)
         except KinemaError as error:
             return self._fail(str(error))
-        self.set_output("joint_trajectory_msg", trajectory_message(trajectory))
+        message = trajectory_message(trajectory)
+        self.set_output("joint_trajectory_msg", message)
+        publish_planned_trajectory(self, message)
         return True
 
     def _fail(self, reason: str) -> bool:
