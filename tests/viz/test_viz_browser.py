@@ -1,0 +1,236 @@
+"""The 3D view in a real (headless) Chromium: the robot is drawn, moves while a trajectory runs, the planned
+path shows, and the page says so when the runtime goes away and recovers when it returns.
+
+Needs Debian's ``chromium`` (``apt-get install -y chromium``); skipped with that hint when it is missing.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+import socket
+import time
+from collections.abc import Iterator
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+from headless_chromium import HeadlessChromium, find_chromium
+
+pytestmark = pytest.mark.slow
+
+CHROMIUM = find_chromium()
+if CHROMIUM is None:
+    pytest.skip(
+        "chromium is not installed (apt-get install -y chromium): kinema view's browser tests are skipped",
+        allow_module_level=True,
+    )
+
+ARM = (
+    "linear_rail_joint",
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "elbow_joint",
+    "wrist_1_joint",
+    "wrist_2_joint",
+    "wrist_3_joint",
+)
+HOME = np.array([0.0, 0.0, -2.0, 2.0, -1.5708, -1.5708, 0.0])
+# Pixels whose color changes by more than this (0-255, any channel) count as changed.
+PIXEL_DELTA = 30
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def _pixels(png: bytes) -> np.ndarray:
+    from PIL import Image
+
+    return np.asarray(Image.open(io.BytesIO(png)).convert("RGB"), dtype=np.int16)
+
+
+def _keep(name: str, png: bytes) -> None:
+    """Save a screenshot under $KINEMA_VIZ_SHOTS (to look at what the test saw)."""
+    folder = os.environ.get("KINEMA_VIZ_SHOTS")
+    if folder:
+        Path(folder).mkdir(parents=True, exist_ok=True)
+        (Path(folder) / f"{name}.png").write_bytes(png)
+
+
+def _changed(a: bytes, b: bytes) -> np.ndarray:
+    return np.abs(_pixels(a) - _pixels(b)).max(axis=2) > PIXEL_DELTA
+
+
+def _trajectory(goal: np.ndarray, duration: float, points: int = 31) -> dict[str, Any]:
+    rows = []
+    for t in np.linspace(0.0, duration, points):
+        s = t / duration
+        shape = 10 * s**3 - 15 * s**4 + 6 * s**5
+        nanoseconds = round(t * 1e9)
+        rows.append(
+            {
+                "positions": (HOME + (goal - HOME) * shape).tolist(),
+                "time_from_start": {"sec": nanoseconds // 10**9, "nanosec": nanoseconds % 10**9},
+            }
+        )
+    return {"trajectory": {"joint_names": list(ARM), "points": rows}}
+
+
+class Runtime:
+    """A router and the lab_sim driver in this process (real time), restartable."""
+
+    def __init__(self) -> None:
+        from kinema.transport import free_endpoint, host_router
+
+        self.endpoint = free_endpoint()
+        self.router = host_router(self.endpoint)
+        self.driver: Any = None
+        self.start_driver()
+
+    def start_driver(self) -> None:
+        from kinema.drivers.mujoco import MujocoDriver, MujocoDriverSettings
+
+        self.driver = MujocoDriver(self.router, MujocoDriverSettings.from_config("lab_sim"))
+        self.driver.start()
+
+    def stop_driver(self) -> None:
+        if self.driver is not None:
+            self.driver.stop()
+            self.driver = None
+
+    def close(self) -> None:
+        self.stop_driver()
+        self.router.close()
+
+
+@pytest.fixture(scope="module")
+def runtime() -> Iterator[Runtime]:
+    started = Runtime()
+    yield started
+    started.close()
+
+
+@pytest.fixture(scope="module")
+def viewer(runtime: Runtime) -> Iterator[Any]:
+    from kinema.viz.view import ViewerOptions, start_viewer
+
+    started = start_viewer(
+        ViewerOptions(endpoint=runtime.endpoint, config="lab_sim", port=_free_port(), open_browser=False)
+    )
+    yield started
+    started.close()
+
+
+@pytest.fixture(scope="module")
+def page(viewer: Any) -> Iterator[HeadlessChromium]:
+    assert CHROMIUM is not None
+    with HeadlessChromium(CHROMIUM, width=900, height=700) as browser:
+        browser.navigate(viewer.url)
+        browser.wait_for(
+            "typeof viewer !== 'undefined' && kinema.framed && viewer.num_messages_received > 30", timeout=60
+        )
+        # The info line shows the sim time, which changes every frame: keep it out of the pixels compared.
+        browser.evaluate("document.getElementById('kinema-info').style.visibility = 'hidden'")
+        yield browser
+
+
+def _settled_screenshot(page: HeadlessChromium) -> bytes:
+    page.evaluate("viewer.set_dirty()")
+    time.sleep(0.4)
+    return page.screenshot()
+
+
+def test_the_page_is_served_from_loopback_without_network_resources(viewer: Any) -> None:
+    import urllib.request
+
+    assert viewer.url.startswith("http://127.0.0.1:")
+    with urllib.request.urlopen(viewer.url, timeout=10) as answer:
+        html = answer.read().decode()
+    assert 'src="main.min.js"' in html and "http" not in html.split("<script", 1)[1].split(">", 1)[0]
+
+
+def test_the_robot_is_drawn(viewer: Any, page: HeadlessChromium) -> None:
+    from kinema.viz import scene_commands as sc
+
+    robot = [
+        node for node in viewer.bridge.scene.bodies if not node.static and node.name not in ("cube", "tray")
+    ]
+    assert len(robot) >= 8
+    with_robot = _settled_screenshot(page)
+    viewer.server.send([sc.set_property(node.path, "visible", False) for node in robot])
+    try:
+        without_robot = _settled_screenshot(page)
+    finally:
+        viewer.server.send([sc.set_property(node.path, "visible", True) for node in robot])
+    _keep("with_robot", with_robot)
+    _keep("without_robot", without_robot)
+    changed = _changed(with_robot, without_robot)
+    assert changed.sum() > 2000, "hiding the robot changed too few pixels: the robot is not drawn"
+
+
+def test_the_arm_moves_while_a_trajectory_executes(
+    runtime: Runtime, viewer: Any, page: HeadlessChromium
+) -> None:
+    from kinema.drivers.mujoco import names
+    from kinema.transport import Node
+
+    node = Node(runtime.router, "viz_test_client")
+    try:
+        client = node.create_action_client(
+            names.FOLLOW_JOINT_TRAJECTORY_TYPE, names.FOLLOW_JOINT_TRAJECTORY_ACTION
+        )
+        goal = HOME + np.array([0.0, 1.4, 0.5, -0.6, 0.0, 0.0, 0.0])
+        handle = client.send_goal(_trajectory(goal, 4.0), timeout=10.0)
+        assert handle.accepted
+        time.sleep(0.8)
+        first = page.screenshot()
+        time.sleep(1.5)
+        second = page.screenshot()
+        assert not handle.done(), "the trajectory ended before both screenshots were taken"
+        _keep("moving_1", first)
+        _keep("moving_2", second)
+        changed = _changed(first, second)
+        assert changed.sum() > 1000, "the arm's pixels did not move between two screenshots"
+        handle.result(15.0)
+    finally:
+        node.close()
+
+
+def test_a_planned_trajectory_is_drawn_as_the_tool_path(runtime: Runtime, page: HeadlessChromium) -> None:
+    from kinema.transport import Node, from_dict
+    from kinema.viz.topics import PLANNED_TRAJECTORY_TOPIC, PLANNED_TRAJECTORY_TYPE
+
+    node = Node(runtime.router, "viz_test_planner")
+    try:
+        publisher = node.create_publisher(PLANNED_TRAJECTORY_TYPE, PLANNED_TRAJECTORY_TOPIC)
+        message = from_dict(PLANNED_TRAJECTORY_TYPE, _trajectory(HOME + 0.3, 2.0)["trajectory"])
+        deadline = time.monotonic() + 20
+        drawn = None
+        while time.monotonic() < deadline and not drawn:
+            publisher.publish(message)  # until the viewer's subscription has matched
+            time.sleep(0.3)
+            drawn = page.evaluate(
+                "(function(){try{return viewer.scene_tree.find(['kinema','planned_path','line'])"
+                ".object !== null;}catch(e){return false;}})()"
+            )
+        assert drawn, "the planned tool path did not appear in the page"
+        _keep("planned_path", _settled_screenshot(page))
+    finally:
+        node.close()
+
+
+def test_the_page_says_when_the_runtime_goes_away_and_recovers(
+    runtime: Runtime, page: HeadlessChromium
+) -> None:
+    banner = "document.getElementById('kinema-banner')"
+    assert page.evaluate(f"{banner}.textContent") == ""
+    runtime.stop_driver()
+    text = page.wait_for(f"{banner}.className === 'error' && {banner}.textContent", timeout=15)
+    assert "not reachable" in text
+    _keep("runtime_lost", page.screenshot())
+    runtime.start_driver()
+    page.wait_for(f"{banner}.textContent === ''", timeout=20)
