@@ -91,6 +91,8 @@ def run(
         sim_speed=sim_speed,
         echo=click.echo,
         ui=ui,
+        # The 3D view comes with the interactive runtime (the TUI); headless runs skip it.
+        viewer=ui is not None and not no_browser and not only_drivers,
     )
     code = Launcher(options).run()
     if code:

@@ -38,6 +38,7 @@ log = logging.getLogger("kinema.supervisor")
 
 READY_TIMEOUT_S = 120.0
 STOP_GRACE_S = 5.0
+VIEWER_READY_TIMEOUT_S = 30.0
 
 
 @dataclass
@@ -55,6 +56,7 @@ class LaunchOptions:
         sim_speed: for simulated drivers, ``"1"`` (real time), a factor such as ``"4"``, or ``"max"``
             (None: the driver's default, real time).
         ui: runs in the main thread once everything started (the TUI); returns an exit code.
+        viewer: also start the 3D view (``python -m kinema.viz``, the process behind ``kinema view``).
         echo: print progress lines (the CLI); tests turn it off.
     """
 
@@ -67,6 +69,7 @@ class LaunchOptions:
     tick_rate_hz: float = 100.0
     sim_speed: str | None = None
     ui: Callable[[Launcher], int] | None = None
+    viewer: bool = False
     echo: Callable[[str], None] = field(default=print)
 
 
@@ -77,6 +80,8 @@ class Child:
     name: str
     process: subprocess.Popen[bytes]
     log_file: Path
+    # A child whose exit stops the instance (the 3D view is not: closing it leaves the runtime running).
+    essential: bool = True
 
 
 def _die_with_parent() -> None:
@@ -140,6 +145,8 @@ class Launcher:
                 self._await_ready(child, stream)
                 if child.name != "agent":
                     self.options.echo(f"driver {child.name!r} is running")
+            if options.viewer:
+                self._start_viewer()
         except BaseException:
             self.stop()
             raise
@@ -228,7 +235,35 @@ class Launcher:
             f"{child.name} did not start (exit code {child.process.poll()}); end of {child.log_file}:\n{tail}"
         )
 
-    def _spawn(self, name: str, argv: list[str], log_file: Path, pass_fds: tuple[int, ...] = ()) -> Child:
+    def _start_viewer(self) -> None:
+        """Start the 3D view and echo its URL; a view that cannot start is reported, not fatal."""
+        assert self.run_folder is not None
+        log_file = self.run_folder.log_file("viewer")
+        read_fd, write_fd = os.pipe()
+        argv = [sys.executable, "-m", "kinema.viz", "--connect", self.endpoint]
+        argv += ["--config", self.options.config, "--log-file", str(log_file), "--ready-fd", str(write_fd)]
+        if self.options.workspace is not None:
+            argv += ["--workspace", str(self.options.workspace)]
+        try:
+            child = self._spawn("viewer", argv, log_file, pass_fds=(write_fd,), essential=False)
+        finally:
+            os.close(write_fd)
+        with os.fdopen(read_fd, "r") as ready:
+            line = _read_line(ready, child.process, VIEWER_READY_TIMEOUT_S, self._stop)
+        if line and not line.startswith("error:"):
+            self.options.echo(f"3D view: {line} (`kinema view` opens another)")
+        else:
+            self.options.echo(f"the 3D view did not start ({line or 'no answer'}); see {log_file}")
+
+    def _spawn(
+        self,
+        name: str,
+        argv: list[str],
+        log_file: Path,
+        pass_fds: tuple[int, ...] = (),
+        *,
+        essential: bool = True,
+    ) -> Child:
         log.info("starting %s: %s", name, " ".join(argv))
         with open(log_file, "ab") as output:
             process = subprocess.Popen(
@@ -239,7 +274,7 @@ class Launcher:
                 pass_fds=pass_fds,
                 preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
             )
-        child = Child(name, process, log_file)
+        child = Child(name, process, log_file, essential)
         self.children.append(child)
         if self.record is not None:
             self.record.children.append(process.pid)
@@ -256,8 +291,12 @@ class Launcher:
     def wait(self) -> int:
         """Block until a stop is requested or a child exits; return the exit code for the CLI."""
         while not self._stop.wait(0.2):
-            for child in self.children:
+            for child in list(self.children):
                 code = child.process.poll()
+                if code is not None and not child.essential:
+                    log.warning("%s exited (code %s); the runtime keeps running", child.name, code)
+                    self.children.remove(child)
+                    continue
                 if code is not None:
                     log.error("%s exited with code %s", child.name, code)
                     self.options.echo(
@@ -335,6 +374,20 @@ def _wait_ready(stream: Any, process: subprocess.Popen[bytes], timeout: float, s
         if process.poll() is not None:
             return False
     return False
+
+
+def _read_line(stream: Any, process: subprocess.Popen[bytes], timeout: float, stop: threading.Event) -> str:
+    """The child's first line on ``stream`` ("" when it exits, times out or a stop is requested)."""
+    import select
+
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and not stop.is_set():
+        readable, _, _ = select.select([stream], [], [], 0.1)
+        if readable:
+            return str(stream.readline()).strip()
+        if process.poll() is not None:
+            return ""
+    return ""
 
 
 def _tail(path: Path, lines: int) -> str:
