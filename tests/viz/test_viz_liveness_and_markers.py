@@ -22,24 +22,24 @@ def test_banner_when_runtime_goes_away_and_clears_when_it_returns() -> None:
     clock = FakeClock()
     live = RuntimeLiveness("tcp/127.0.0.1:1", clock=clock)
     live.heard_heartbeat()
-    live.heard_clock()
+    live.heard_driver()
     assert live.verdict().level == "ok"
     clock.now += 2.5
     verdict = live.verdict()
     assert verdict.level == "error" and "not reachable" in verdict.banner
     live.heard_heartbeat()
-    live.heard_clock()
+    live.heard_driver()
     assert live.verdict().banner == ""
 
 
-def test_sim_stopping_alone_is_a_warning() -> None:
+def test_driver_stopping_alone_is_a_warning() -> None:
     clock = FakeClock()
     live = RuntimeLiveness("e", clock=clock)
-    live.heard_clock()
+    live.heard_driver()
     clock.now += 3
     live.heard_heartbeat()
     verdict = live.verdict()
-    assert verdict.level == "warning" and "/clock" in verdict.banner
+    assert verdict.level == "warning" and "driver stopped" in verdict.banner
 
 
 def _marker(ns: str, marker_id: int, lifetime: float, action: int = 0) -> NS:

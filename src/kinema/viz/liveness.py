@@ -1,7 +1,8 @@
-"""Is the runtime there? The viewer's verdict from the agent's heartbeat and the simulator's ``/clock``.
+"""Is the runtime there? The viewer's verdict from the agent's heartbeat and the driver's robot state.
 
-Both arrive many times a second (heartbeat 10 Hz, ``/clock`` 100 Hz of sim time), so silence for longer
-than :data:`SILENCE_S` means the process is gone (or stuck). The verdict is a :class:`Verdict` the page
+Both arrive many times a second (heartbeat 10 Hz; the driver's scene state 30 Hz, or ``/joint_states``
+from a driver without one), so silence for longer than :data:`SILENCE_S` means the process is gone (or
+stuck). The verdict is a :class:`Verdict` the page
 shows as a banner: red when nothing is heard, orange when one of the two stopped, none when all is well.
 """
 
@@ -24,7 +25,7 @@ class Verdict:
 
 
 class RuntimeLiveness:
-    """Tracks when the heartbeat and ``/clock`` were last heard (thread-safe).
+    """Tracks when the heartbeat and the driver's state were last heard (thread-safe).
 
     Args:
         endpoint: the router the viewer is connected to (named in the messages).
@@ -40,7 +41,7 @@ class RuntimeLiveness:
         self._now = clock
         self._started = clock()
         self._heartbeat: float | None = None
-        self._clock: float | None = None
+        self._driver: float | None = None
         self._lock = threading.Lock()
 
     def heard_heartbeat(self) -> None:
@@ -48,28 +49,28 @@ class RuntimeLiveness:
         with self._lock:
             self._heartbeat = self._now()
 
-    def heard_clock(self) -> None:
-        """A ``/clock`` message arrived."""
+    def heard_driver(self) -> None:
+        """The driver's scene state or joint states arrived."""
         with self._lock:
-            self._clock = self._now()
+            self._driver = self._now()
 
     def verdict(self) -> Verdict:
         """What to show now."""
         with self._lock:
             now = self._now()
-            heartbeat, clock = self._heartbeat, self._clock
+            heartbeat, driver = self._heartbeat, self._driver
         agent_alive = heartbeat is not None and now - heartbeat <= self.silence
-        sim_alive = clock is not None and now - clock <= self.silence
-        if heartbeat is None and clock is None:
+        driver_alive = driver is not None and now - driver <= self.silence
+        if heartbeat is None and driver is None:
             if now - self._started <= self.silence:
                 return Verdict("ok", "")
             return Verdict(
                 "error",
-                f"Waiting for the Kinema runtime at {self.endpoint}: no heartbeat or /clock yet "
+                f"Waiting for the Kinema runtime at {self.endpoint}: no heartbeat or robot state yet "
                 "(start it with `kinema run`).",
             )
-        if not agent_alive and not sim_alive:
-            last = max(t for t in (heartbeat, clock) if t is not None)
+        if not agent_alive and not driver_alive:
+            last = max(t for t in (heartbeat, driver) if t is not None)
             return Verdict(
                 "error",
                 f"Runtime not reachable: nothing heard from {self.endpoint} for {now - last:.0f} s. "
@@ -80,9 +81,9 @@ class RuntimeLiveness:
                 "warning",
                 f"The objective server stopped answering ({now - heartbeat:.0f} s without a heartbeat).",
             )
-        if clock is not None and not sim_alive:
+        if driver is not None and not driver_alive:
             return Verdict(
                 "warning",
-                f"The simulation stopped: no /clock for {now - clock:.0f} s; the robot shown may be stale.",
+                f"The driver stopped: no robot state for {now - driver:.0f} s; the robot shown may be stale.",
             )
         return Verdict("ok", "")

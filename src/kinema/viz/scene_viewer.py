@@ -2,9 +2,13 @@
 
 Inputs (all read-only subscriptions; the viewer never calls the runtime):
 
-- ``/mujoco/scene_state`` (whole qpos, free objects included) and ``/joint_states`` (100 Hz): the robot
-  and the objects, drawn at up to ``frame_rate`` Hz. Callbacks only keep the newest raw message; the frame
-  thread decodes the newest one per frame, so a fast publisher costs one decode per frame, not per message.
+- ``/mujoco/scene_state`` (whole qpos, free objects included, 30 Hz of wall time) and ``/joint_states``
+  (100 Hz of sim time): the robot and the objects, drawn at up to ``frame_rate`` Hz. Callbacks only keep
+  the newest raw message; the frame thread decodes the newest one per frame. ``/joint_states`` is
+  subscribed only while it is cheap and useful: when the driver has no scene state (a real robot), or when
+  the simulation runs at about real time (it then adds updates between scene states). A simulation running
+  many times faster than real time publishes thousands of joint states per second, and merely receiving
+  them would slow it down, so the view then draws the 30 Hz scene state alone.
 - ``/kinema/planned_trajectory``: the end effector's path along the planned trajectory (a line).
 - ``/visualization_marker_array`` and ``/visualization_marker``: markers (VisualizePose's triads).
 - the agent's heartbeat and ``/clock``: whether the runtime is there (a banner on the page when not).
@@ -36,6 +40,10 @@ log = logging.getLogger("kinema.viz")
 PLANNED_PATH = f"{ROOT}/planned_path"
 PLANNED_PATH_COLOR = 0xFF7F00
 DEFAULT_FRAME_RATE = 60.0
+# /joint_states is dropped while the sim runs faster than this many times real time (see the docstring).
+JOINT_STATES_MAX_SIM_SPEED = 2.0
+# Without a scene state for this long, the driver has none (a real robot): draw from /joint_states.
+SCENE_STATE_ABSENT_S = 1.0
 
 
 class SceneViewer:
@@ -70,7 +78,7 @@ class SceneViewer:
         self.server_id = uuid.uuid4().hex
         self.frames = 0
         self.state_updates = 0
-        self._latest: dict[str, bytes | None] = {"scene": None, "joints": None, "clock": None}
+        self._latest: dict[str, bytes | None] = {"scene": None, "joints": None}
         self._lock = threading.Lock()
         self._objective = ("", "")
         self._sim_time: float | None = None
@@ -78,6 +86,12 @@ class SceneViewer:
         self._was_lost = False
         self._rate_window: list[float] = []
         self._node: Node | None = None
+        self._joint_states: Any = None
+        self._started_at = time.monotonic()
+        self._last_scene: float | None = None
+        # (wall, sim) of the first scene state of the current speed window, and the speed measured.
+        self._speed_window: tuple[float, float] | None = None
+        self._sim_speed: float | None = None
         self._stop = threading.Event()
         self._thread = threading.Thread(target=self._frames, name="kinema-viz-frames", daemon=True)
 
@@ -94,10 +108,6 @@ class SceneViewer:
             latched=True,
             raw=True,
         )
-        node.create_subscription(
-            driver_names.JOINT_STATES_TYPE, driver_names.JOINT_STATES_TOPIC, self._keep("joints"), raw=True
-        )
-        node.create_subscription(driver_names.CLOCK_TYPE, driver_names.CLOCK_TOPIC, self._on_clock, raw=True)
         node.create_subscription(agent_names.HEARTBEAT_TYPE, agent_names.HEARTBEAT, self._on_heartbeat)
         node.create_subscription(topics.MARKER_ARRAY_TYPE, topics.MARKER_ARRAY_TOPIC, self._on_marker_array)
         node.create_subscription(topics.MARKER_TYPE, topics.MARKER_TOPIC, self._on_marker)
@@ -158,12 +168,43 @@ class SceneViewer:
     def _keep(self, slot: str) -> Any:
         def keep(payload: bytes) -> None:
             self._latest[slot] = payload  # one reference swap: the frame thread decodes the newest only
+            self.liveness.heard_driver()
 
         return keep
 
-    def _on_clock(self, payload: bytes) -> None:
-        self._latest["clock"] = payload
-        self.liveness.heard_clock()
+    def _follow_joint_states(self) -> None:
+        """Subscribe to ``/joint_states`` or drop it, as the module docstring says."""
+        now = time.monotonic()
+        last_scene = self._last_scene
+        no_scene = (last_scene is None and now - self._started_at > SCENE_STATE_ABSENT_S) or (
+            last_scene is not None and now - last_scene > SCENE_STATE_ABSENT_S
+        )
+        slow_sim = self._sim_speed is not None and self._sim_speed <= JOINT_STATES_MAX_SIM_SPEED
+        want = no_scene or slow_sim
+        node = self._node
+        if node is None:
+            return
+        if want and self._joint_states is None:
+            self._joint_states = node.create_subscription(
+                driver_names.JOINT_STATES_TYPE,
+                driver_names.JOINT_STATES_TOPIC,
+                self._keep("joints"),
+                raw=True,
+            )
+        elif not want and self._joint_states is not None:
+            self._joint_states.close()
+            self._joint_states = None
+            self._latest["joints"] = None
+
+    def _measure_sim_speed(self, sim_time: float) -> None:
+        wall = time.monotonic()
+        self._last_scene = wall
+        window = self._speed_window
+        if window is None or sim_time < window[1]:
+            self._speed_window = (wall, sim_time)  # first one, or the sim time went back (a new driver)
+        elif wall - window[0] >= 1.0:
+            self._sim_speed = (sim_time - window[1]) / (wall - window[0])
+            self._speed_window = (wall, sim_time)
 
     def _on_heartbeat(self, message: Any) -> None:
         self.liveness.heard_heartbeat()
@@ -214,10 +255,11 @@ class SceneViewer:
         commands: list[Command] = []
         scene_payload, self._latest["scene"] = self._latest["scene"], None
         joints_payload, self._latest["joints"] = self._latest["joints"], None
-        clock_payload, self._latest["clock"] = self._latest["clock"], None
         changed = False
         if scene_payload is not None:
             state = registry.deserialize(scene_payload, driver_names.SCENE_STATE_TYPE)
+            self._sim_time = state.stamp.sec + state.stamp.nanosec * 1e-9
+            self._measure_sim_speed(self._sim_time)
             qpos = list(state.qpos)
             if self.scene.set_qpos(qpos):
                 self._qpos_mismatch = None
@@ -227,9 +269,10 @@ class SceneViewer:
         if joints_payload is not None:
             joints = registry.deserialize(joints_payload, driver_names.JOINT_STATES_TYPE)
             changed = self.scene.set_joint_positions(list(joints.name), list(joints.position)) > 0 or changed
-        if clock_payload is not None:
-            clock = registry.deserialize(clock_payload, driver_names.CLOCK_TYPE)
-            self._sim_time = clock.clock.sec + clock.clock.nanosec * 1e-9
+            if scene_payload is None and self._last_scene is None:
+                self._sim_time = joints.header.stamp.sec + joints.header.stamp.nanosec * 1e-9
+        if self.frames % 10 == 0:
+            self._follow_joint_states()
         if changed:
             commands += self.scene.body_commands()
             now = time.monotonic()
