@@ -7,6 +7,7 @@ Needs Debian's ``chromium`` (``apt-get install -y chromium``); skipped with that
 from __future__ import annotations
 
 import io
+import json
 import os
 import socket
 import time
@@ -138,6 +139,14 @@ def page(viewer: Any) -> Iterator[HeadlessChromium]:
         yield browser
 
 
+def _drawn(path: list[str]) -> str:
+    """JavaScript: is there a meshcat object at ``path``? (Walks the tree; ``find`` would create nodes.)"""
+    return (
+        "(function(p){let n=viewer.scene_tree;for(const k of p){n=n.children[k];if(!n)return false;}"
+        f"return '<object>' in n.children;}})({json.dumps(path)})"
+    )
+
+
 def _settled_screenshot(page: HeadlessChromium) -> bytes:
     page.evaluate("viewer.set_dirty()")
     time.sleep(0.4)
@@ -184,18 +193,18 @@ def test_the_arm_moves_while_a_trajectory_executes(
             names.FOLLOW_JOINT_TRAJECTORY_TYPE, names.FOLLOW_JOINT_TRAJECTORY_ACTION
         )
         goal = HOME + np.array([0.0, 1.4, 0.5, -0.6, 0.0, 0.0, 0.0])
-        handle = client.send_goal(_trajectory(goal, 4.0), timeout=10.0)
+        handle = client.send_goal(_trajectory(goal, 8.0), timeout=10.0)
         assert handle.accepted
-        time.sleep(0.8)
-        first = page.screenshot()
         time.sleep(1.5)
+        first = page.screenshot()
+        time.sleep(2.0)
         second = page.screenshot()
         assert not handle.done(), "the trajectory ended before both screenshots were taken"
         _keep("moving_1", first)
         _keep("moving_2", second)
         changed = _changed(first, second)
         assert changed.sum() > 1000, "the arm's pixels did not move between two screenshots"
-        handle.result(15.0)
+        handle.cancel()
     finally:
         node.close()
 
@@ -213,12 +222,51 @@ def test_a_planned_trajectory_is_drawn_as_the_tool_path(runtime: Runtime, page: 
         while time.monotonic() < deadline and not drawn:
             publisher.publish(message)  # until the viewer's subscription has matched
             time.sleep(0.3)
-            drawn = page.evaluate(
-                "(function(){try{return viewer.scene_tree.find(['kinema','planned_path','line'])"
-                ".object !== null;}catch(e){return false;}})()"
-            )
+            drawn = page.evaluate(_drawn(["kinema", "planned_path", "line"]))
         assert drawn, "the planned tool path did not appear in the page"
         _keep("planned_path", _settled_screenshot(page))
+    finally:
+        node.close()
+
+
+def test_a_visualize_pose_triad_appears_and_expires_after_its_lifetime(
+    runtime: Runtime, page: HeadlessChromium
+) -> None:
+    from kinema.transport import Node, from_dict
+    from kinema.viz.topics import MARKER_ARRAY_TOPIC, MARKER_ARRAY_TYPE
+
+    triad = []
+    for axis in range(3):
+        tip = {"x": 0.6, "y": 0.0, "z": 1.0}
+        tip["xyz"[axis]] += 0.1
+        triad.append(
+            {
+                "header": {"frame_id": "world"},
+                "ns": "goal_pose",
+                "id": axis,
+                "type": 0,
+                "pose": {"orientation": {"w": 1.0}},
+                "scale": {"x": 0.008, "y": 0.015, "z": 0.02},
+                "color": {"r": float(axis == 0), "g": float(axis == 1), "b": float(axis == 2), "a": 1.0},
+                "lifetime": {"sec": 3, "nanosec": 0},
+                "points": [{"x": 0.6, "y": 0.0, "z": 1.0}, tip],
+            }
+        )
+    shown = _drawn(["kinema", "markers", "goal_pose", "2", "head"])
+    gone = f"!{shown}"
+    node = Node(runtime.router, "viz_test_markers")
+    try:
+        publisher = node.create_publisher(MARKER_ARRAY_TYPE, MARKER_ARRAY_TOPIC)
+        message = from_dict(MARKER_ARRAY_TYPE, {"markers": triad})
+        deadline = time.monotonic() + 20
+        while time.monotonic() < deadline and not page.evaluate(shown):
+            publisher.publish(message)
+            time.sleep(0.3)
+        assert page.evaluate(shown), "the triad did not appear in the page"
+        _keep("marker", _settled_screenshot(page))
+        appeared = time.monotonic()
+        page.wait_for(gone, timeout=10)
+        assert time.monotonic() - appeared > 1.5, "the triad went away long before its 3 s lifetime"
     finally:
         node.close()
 

@@ -15,6 +15,8 @@ loopback, and adds:
 from __future__ import annotations
 
 import asyncio
+import contextlib
+import io
 import json
 import logging
 import threading
@@ -113,7 +115,9 @@ class MeshcatServer:
     def _run(self, port: int | None) -> None:
         asyncio.set_event_loop(asyncio.new_event_loop())
         try:
-            bridge = _make_bridge(port, self)
+            # meshcat prints "Port: N in use, trying another..." for every taken port it skips.
+            with contextlib.redirect_stderr(io.StringIO()):
+                bridge = _make_bridge(port, self)
         except BaseException as error:
             self._error = error
             self._ready.set()
