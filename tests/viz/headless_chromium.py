@@ -148,7 +148,12 @@ class HeadlessChromium:
         """Stop chromium and delete its profile."""
         socket = getattr(self, "_socket", None)
         if socket is not None:
-            socket.close()
+            # Closing writes a close frame through tornado's stream, which needs this page's loop to be
+            # the running one (the main thread has no current loop of its own).
+            async def close_socket() -> None:
+                socket.close()
+
+            self._loop.run_until_complete(close_socket())
         if self.process.poll() is None:
             self.process.terminate()
             try:
