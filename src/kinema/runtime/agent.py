@@ -457,10 +457,14 @@ class Agent:
             with query:
                 query.reply_err(f"bad request: {error}".encode())
             return
-        run = self.server.submit(request)
-        query.reply(query.key_expr, quick.encode({"event": "accepted", "run_id": run.id}))
-        with self._goal_lock:
-            self._quick_listeners[run.id] = query
+
+        def listen(run: ObjectiveRun) -> None:
+            # Before the run is queued: a behavior that logs on the first tick must find its listener.
+            query.reply(query.key_expr, quick.encode({"event": "accepted", "run_id": run.id}))
+            with self._goal_lock:
+                self._quick_listeners[run.id] = query
+
+        run = self.server.submit(request, before_start=listen)
 
         def finish(result: ObjectiveResult) -> None:
             with self._goal_lock:

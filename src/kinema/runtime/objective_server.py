@@ -291,9 +291,19 @@ class ObjectiveServer:
         """``(status, objective_name)`` right now."""
         return self._status
 
-    def submit(self, request: ObjectiveRequest) -> ObjectiveRun:
-        """Queue ``request``; the running objective (if any) is preempted when the tick thread takes it."""
+    def submit(
+        self, request: ObjectiveRequest, before_start: Callable[[ObjectiveRun], None] | None = None
+    ) -> ObjectiveRun:
+        """Queue ``request``; the running objective (if any) is preempted when the tick thread takes it.
+
+        Args:
+            request: what to run.
+            before_start: called with the new run before the tick thread can see it, so whatever it
+                registers (a listener for the run's toasts, say) is in place before the first tick.
+        """
         run = ObjectiveRun(next(self._ids), request, self)
+        if before_start is not None:
+            before_start(run)
         self._post(run)
         return run
 
