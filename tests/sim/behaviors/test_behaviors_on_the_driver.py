@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import time
 from typing import Any
 
 import numpy as np
@@ -33,6 +34,23 @@ def _arm(behavior: Any, context: BehaviorContext) -> np.ndarray:
     return np.array(state.position)
 
 
+def _settled_arm(behavior: Any, context: BehaviorContext, timeout: float = 60.0) -> np.ndarray:
+    """The arm's positions once it has stopped moving (an earlier test's motion may still be settling).
+
+    Settled: two readings 0.25 s of simulated time apart agree within 0.2 mrad.
+    """
+    deadline = time.monotonic() + timeout
+    seen = [_arm(behavior, context)]
+    while time.monotonic() < deadline:
+        until = context.clock.now() + 0.25
+        while context.clock.now() < until and time.monotonic() < deadline:
+            time.sleep(0.005)
+        seen.append(_arm(behavior, context))
+        if np.max(np.abs(seen[-1] - seen[-2])) < 2e-4:
+            return seen[-1]
+    pytest.fail(f"the arm did not settle within {timeout} s; last readings: {seen[-5:]}")
+
+
 def _goal(positions: list[float]) -> Any:
     from kinema.transport import from_dict
 
@@ -60,7 +78,7 @@ def test_planned_trajectories_bring_the_arm_to_the_goal(behavior: Any, context: 
 def test_a_trajectory_with_unknown_joint_names_is_rejected(behavior: Any, context: BehaviorContext) -> None:
     from kinema.transport import from_dict
 
-    before = _arm(behavior, context)
+    before = _settled_arm(behavior, context)
     names = ["linear_rail_joint", "elbow_jiont"]
     trajectory = from_dict(
         "trajectory_msgs/msg/JointTrajectory",
@@ -75,7 +93,8 @@ def test_a_trajectory_with_unknown_joint_names_is_rejected(behavior: Any, contex
     run = tick_behavior(behavior("ExecuteTrajectory"), {"joint_trajectory_msg": trajectory}, context=context)
     assert run.status == NodeStatus.FAILURE
     assert "elbow_jiont" in run.toasts[-1] and "elbow_joint" in run.toasts[-1], run.toasts
-    np.testing.assert_allclose(_arm(behavior, context), before, atol=1e-3)
+    after = _settled_arm(behavior, context)
+    np.testing.assert_allclose(after, before, atol=1e-3, err_msg="the rejected trajectory moved the arm")
 
 
 def test_the_gripper_closes_and_opens(behavior: Any, context: BehaviorContext) -> None:
