@@ -173,6 +173,7 @@ def _parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the agent until SIGTERM/SIGINT; exit 1 with one line on stderr when it cannot start."""
+    from kinema.runtime import lifeline
     from kinema.runtime.log_files import configure_process_logging
 
     args = _parser().parse_args(argv)
@@ -180,6 +181,7 @@ def main(argv: list[str] | None = None) -> int:
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     signal.signal(signal.SIGINT, lambda *_: stop.set())
+    lifeline.hold()
     options = AgentOptions(
         config=args.config,
         workspace=args.workspace,

@@ -5,7 +5,8 @@ children; the agent and each driver run in processes of their own. The agent is 
 thread of the supervisor so that its 100 Hz tick thread never competes for the GIL with a UI running in
 the supervisor (the TUI), so a crashing behavior cannot take the router (and every client's connection)
 down with it, and so ``kinema down`` can stop it like any other process. Children get a parent-death
-signal, so even a supervisor killed with SIGKILL leaves no orphans behind.
+signal and a lifeline (:mod:`kinema.runtime.lifeline`), so even a supervisor killed with SIGKILL leaves
+no orphans behind: they end within about a second.
 
 A UI plugs in through :attr:`LaunchOptions.ui`: a callable that receives the started :class:`Launcher`
 (its ``session``, ``endpoint``, ``run_folder``) and runs in the main thread until the user quits; without
@@ -29,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 
 from kinema.errors import KinemaError
 from kinema.runtime.instance import InstanceRecord
+from kinema.runtime.lifeline import Lifeline
 from kinema.runtime.run_folder import RunFolder
 
 if TYPE_CHECKING:
@@ -107,6 +109,7 @@ class Launcher:
         self.run_folder: RunFolder | None = None
         self.children: list[Child] = []
         self.record: InstanceRecord | None = None
+        self.lifeline: Lifeline | None = None
         self._stop = threading.Event()
         self._stop_reason = ""
 
@@ -127,6 +130,7 @@ class Launcher:
         supervisor_log = self.run_folder.log_file("supervisor")
         configure_process_logging(supervisor_log, verbose=options.verbose, echo=options.verbose)
         self.endpoint = options.endpoint or resolve_endpoints(None)[0]
+        self.lifeline = Lifeline()
         try:
             self.session = host_or_join(self.endpoint)
             self.hosting = self.session.is_router
@@ -265,12 +269,17 @@ class Launcher:
         essential: bool = True,
     ) -> Child:
         log.info("starting %s: %s", name, " ".join(argv))
+        env = os.environ.copy()
+        if self.lifeline is not None:
+            env.update(self.lifeline.child_env())
+            pass_fds = (*pass_fds, self.lifeline.read_fd)
         with open(log_file, "ab") as output:
             process = subprocess.Popen(
                 argv,
                 stdin=subprocess.DEVNULL,
                 stdout=output,
                 stderr=subprocess.STDOUT,
+                env=env,
                 pass_fds=pass_fds,
                 preexec_fn=_die_with_parent if sys.platform.startswith("linux") else None,
             )
@@ -320,6 +329,9 @@ class Launcher:
                 child.process.kill()
                 child.process.wait(2.0)
         self.children.clear()
+        if self.lifeline is not None:
+            self.lifeline.close()
+            self.lifeline = None
         if self.session is not None:
             self.session.close()
             self.session = None

@@ -26,10 +26,12 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--ready-fd", type=int, help="write the URL to this file descriptor when serving")
     args = parser.parse_args(argv)
 
+    from kinema.runtime import lifeline
     from kinema.runtime.log_files import configure_process_logging
-    from kinema.viz.view import ViewerOptions, run_viewer
 
     configure_process_logging(args.log_file)
+    lifeline.hold()  # before the slow imports: a view whose supervisor died while it started ends too
+    from kinema.viz.view import ViewerOptions, run_viewer
 
     def report(line: str) -> None:
         if args.ready_fd is not None:

@@ -73,6 +73,7 @@ def _parser() -> argparse.ArgumentParser:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the driver until SIGINT/SIGTERM; return the exit code."""
     args = _parser().parse_args(argv)
+    from kinema.runtime import lifeline
     from kinema.runtime.log_files import configure_process_logging
 
     configure_process_logging(args.log_file, verbose=args.verbose)
@@ -84,6 +85,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     signal.signal(signal.SIGTERM, request_stop)
     signal.signal(signal.SIGINT, request_stop)
+    lifeline.hold()
     try:
         return _run(args, stop)
     except KinemaError as error:
