@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import pytest
+
+from failure_report import kinema_processes
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 SHARED_DIR = REPO_ROOT.parent / "shared"
@@ -16,3 +20,44 @@ def shared_dir() -> Path:
     if not SHARED_DIR.is_dir():
         pytest.skip(f"{SHARED_DIR} is not beside this checkout")
     return SHARED_DIR
+
+
+# -- what a failing test saw ---------------------------------------------------------------------------
+# A flaky failure in CI must be diagnosable from CI's output alone. Fixtures register what is worth
+# showing (a log tail, positions) with ``show_on_failure(request.node, title, describe)``; a failing test
+# gets those as report sections, plus the Kinema processes still running for the process-level suites.
+
+_SHOW_ON_FAILURE = pytest.StashKey[list[tuple[str, Callable[[], str]]]]()
+_PROCESS_SUITES = ("integration", "sim", "tui", "viz", "docs")
+
+
+@pytest.fixture(scope="session")
+def show_on_failure() -> Callable[[pytest.Item | pytest.Collector, str, Callable[[], str]], None]:
+    """``show_on_failure(request.node, title, describe)``: print ``describe()`` when a test under that
+    node fails (a module-scoped fixture passes its module, so every test in it shows it)."""
+
+    def register(node: pytest.Item | pytest.Collector, title: str, describe: Callable[[], str]) -> None:
+        node.stash.setdefault(_SHOW_ON_FAILURE, []).append((title, describe))
+
+    return register
+
+
+@pytest.hookimpl(wrapper=True)
+def pytest_runtest_makereport(item: pytest.Item, call: pytest.CallInfo[None]) -> Any:
+    report = yield
+    if report.failed and report.when in ("setup", "call"):
+        for node in item.listchain():
+            for title, describe in node.stash.get(_SHOW_ON_FAILURE, []):
+                try:
+                    text = describe()
+                except Exception as error:  # a broken description must not hide the failure itself
+                    text = f"(could not describe: {error!r})"
+                report.sections.append((f"what the test saw: {title}", text))
+        suite = (
+            Path(item.path).relative_to(REPO_ROOT / "tests").parts[0]
+            if item.path.is_relative_to(REPO_ROOT / "tests")
+            else ""
+        )
+        if suite in _PROCESS_SUITES:
+            report.sections.append(("what the test saw: Kinema processes", kinema_processes()))
+    return report

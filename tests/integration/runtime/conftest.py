@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 import subprocess
 import sys
@@ -11,6 +12,7 @@ from pathlib import Path
 
 import pytest
 
+from failure_report import log_tail
 from kinema.transport import free_endpoint
 
 OBJECTIVES = """<root BTCPP_format="4">
@@ -90,15 +92,27 @@ def stop_agent(agent: AgentProcess) -> None:
         agent.process.wait(5)
 
 
-@pytest.fixture(scope="module")
-def agent(tmp_path_factory: pytest.TempPathFactory) -> Iterator[AgentProcess]:
-    """One agent per test module: every test starts from whatever the previous one left running, which
-    is itself part of what is tested (the server keeps serving)."""
-    running = start_agent(tmp_path_factory.mktemp("agent"))
+@contextlib.contextmanager
+def running_agent(
+    request: pytest.FixtureRequest, tmp_path: Path, *extra: str, hot_reload: bool = False
+) -> Iterator[AgentProcess]:
+    """An agent for the life of a fixture; a failing test under it shows the end of the agent's log."""
+    running = start_agent(tmp_path, *extra, hot_reload=hot_reload)
+    request.getfixturevalue("show_on_failure")(
+        request.node, "the agent's log", lambda: log_tail(running.log_file)
+    )
     try:
         yield running
     finally:
         stop_agent(running)
+
+
+@pytest.fixture(scope="module")
+def agent(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory) -> Iterator[AgentProcess]:
+    """One agent per test module: every test starts from whatever the previous one left running, which
+    is itself part of what is tested (the server keeps serving)."""
+    with running_agent(request, tmp_path_factory.mktemp("agent")) as running:
+        yield running
 
 
 @pytest.fixture
@@ -116,30 +130,22 @@ def free_endpoint_fixture() -> str:
 
 
 @pytest.fixture
-def sim_agent(tmp_path: Path) -> Iterator[AgentProcess]:
+def sim_agent(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[AgentProcess]:
     """An agent whose clock follows /clock (as with a simulator), with nothing publishing it yet."""
-    running = start_agent(tmp_path, "--clock", "sim")
-    try:
+    with running_agent(request, tmp_path, "--clock", "sim") as running:
         yield running
-    finally:
-        stop_agent(running)
 
 
 @pytest.fixture
-def lively_agent(tmp_path: Path) -> Iterator[AgentProcess]:
+def lively_agent(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[AgentProcess]:
     """An agent with hot reload on and a waypoints file of its own (``tmp_path/waypoints.yaml``)."""
-    running = start_agent(tmp_path, "--waypoints", str(tmp_path / "waypoints.yaml"), hot_reload=True)
-    try:
+    waypoints = str(tmp_path / "waypoints.yaml")
+    with running_agent(request, tmp_path, "--waypoints", waypoints, hot_reload=True) as running:
         yield running
-    finally:
-        stop_agent(running)
 
 
 @pytest.fixture
-def lab_sim_agent(tmp_path: Path) -> Iterator[AgentProcess]:
+def lab_sim_agent(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[AgentProcess]:
     """An agent for the bundled lab_sim config (its behaviors, wall time, no driver)."""
-    running = start_agent(tmp_path, "--config", "lab_sim", "--clock", "wall")
-    try:
+    with running_agent(request, tmp_path, "--config", "lab_sim", "--clock", "wall") as running:
         yield running
-    finally:
-        stop_agent(running)

@@ -140,6 +140,19 @@ class Cell:
         with self._lock:
             self._joint_states.append((stamp, positions, velocities))
 
+    def describe(self) -> str:
+        """For a failing test: the cell's endpoint, sim time and the arm's last recorded state."""
+        sim_time = f"{self.driver.sim_time:.3f} s" if self.driver is not None else "(no driver here)"
+        with self._lock:
+            last = self._joint_states[-1] if self._joint_states else None
+        arm = (
+            f"arm at {np.round(last[1], 4).tolist()} rad, velocities {np.round(last[2], 3).tolist()} "
+            f"(stamp {last[0]:.3f} s)"
+            if last is not None
+            else "arm not recorded"
+        )
+        return f"cell at {self.endpoint}: sim time {sim_time}; {arm}"
+
     def joint_history(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """``(stamps, positions, velocities)`` of the arm joints received so far."""
         with self._lock:

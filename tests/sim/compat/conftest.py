@@ -15,7 +15,9 @@ from kinema.transport import free_endpoint
 
 
 @pytest.fixture(scope="module")
-def start_cell(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Callable[..., Cell]]:
+def start_cell(
+    request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFactory
+) -> Iterator[Callable[..., Cell]]:
     """Factory: ``start_cell(objectives=None, sim_speed=math.inf, driver=True)`` starts a cell.
 
     ``driver=False`` leaves the driver out (a test starts it, e.g. as a process it can kill).
@@ -27,6 +29,10 @@ def start_cell(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Callable[..
     from kinema.transport import Node, host_router, open_session
 
     cleanup: list[Callable[[], Any]] = []
+    cells: list[Cell] = []
+    request.getfixturevalue("show_on_failure")(
+        request.node, "the cells' arms", lambda: "\n".join(cell.describe() for cell in cells) or "(no cell)"
+    )
 
     def start(
         objectives: Path | None = None,
@@ -64,7 +70,8 @@ def start_cell(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Callable[..
         cleanup.append(client.close)
         client.wait_for_runtime()
         node = Node(client_session, "compat_probe")
-        return Cell(sim, agent, client, node, root, endpoint)
+        cells.append(Cell(sim, agent, client, node, root, endpoint))
+        return cells[-1]
 
     yield start
     for step in reversed(cleanup):
