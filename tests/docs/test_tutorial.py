@@ -18,10 +18,12 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+from typing import Any
 
 import pytest
 from console_blocks import Step, missing_lines, parse_steps, tutorial_path
 
+from failure_report import log_tail
 from kinema.transport import free_endpoint
 
 COMMAND_TIMEOUT_S = 180.0
@@ -133,6 +135,12 @@ class Reader:
                 process.wait(5)
 
 
+def _run_logs(home: Path) -> str:
+    """The end of every log the tutorial's runtimes wrote (``kinema run`` keeps them per run)."""
+    logs = sorted((home / ".state" / "kinema" / "runs").glob("*/*.log"), key=lambda p: p.stat().st_mtime)
+    return "\n".join(f"--- {log.parent.name}/{log.name}\n{log_tail(log, 25)}" for log in logs) or "(none)"
+
+
 def test_the_tutorial_parses_into_commands_and_files() -> None:
     steps = parse_steps(tutorial_path().read_text(encoding="utf-8"))
     commands = [shlex.split(c.text.split("\n")[0])[:2] for s in steps for c in s.commands]
@@ -152,9 +160,12 @@ def test_every_verb_of_the_command_line_appears_in_the_tutorial() -> None:
 
 @pytest.mark.slow
 @pytest.mark.timeout(900)
-def test_every_command_of_the_tutorial_prints_what_the_tutorial_says(tmp_path: Path) -> None:
+def test_every_command_of_the_tutorial_prints_what_the_tutorial_says(
+    tmp_path: Path, request: pytest.FixtureRequest, show_on_failure: Any
+) -> None:
     steps = parse_steps(tutorial_path().read_text(encoding="utf-8"))
     reader = Reader(tmp_path)
+    show_on_failure(request.node, "the runtimes' logs", lambda: _run_logs(tmp_path))
     try:
         for step in steps:
             if step.kind == "file":

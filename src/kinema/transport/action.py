@@ -60,6 +60,12 @@ CANCEL_ERROR_GOAL_TERMINATED = 3
 
 # A get_result request is held open until the goal ends; this only bounds a lost request.
 _RESULT_QUERY_TIMEOUT = 7 * 24 * 3600.0
+# Closing a server waits this long for its running goals to end as cancelled, so that clients get that
+# result rather than "the server went away".
+CLOSE_GRACE_S = 1.0
+# Feedback travels on a topic, the result on a service: feedback sent before the result may be
+# dispatched after it. A finished goal's feedback callback still gets such feedback for this long.
+LATE_FEEDBACK_S = 5.0
 _ZERO_ID = bytes(16)
 
 
@@ -416,9 +422,12 @@ class ActionServer:
             return
         self._closed = True
         with self._lock:
-            for handle in self._goals.values():
-                if handle.is_active:
-                    handle.cancel_requested_event.set()
+            active = [handle for handle in self._goals.values() if handle.is_active]
+        for handle in active:
+            handle.cancel_requested_event.set()
+        deadline = time.monotonic() + CLOSE_GRACE_S
+        while any(handle.is_active for handle in active) and time.monotonic() < deadline:
+            time.sleep(0.005)
         for entity in (self._send_goal, self._cancel, self._get_result, self._feedback, self._status):
             entity.close()
         self.node._forget(self)
@@ -448,6 +457,7 @@ class ClientGoalHandle:
         self._done = threading.Event()
         self._outcome: GoalResult | None = None
         self._error: TransportError | None = None
+        self.finished_at: float | None = None
         self._callbacks: list[Callable[[ClientGoalHandle], Any]] = []
         self._lock = threading.Lock()
 
@@ -508,6 +518,7 @@ class ClientGoalHandle:
             if self._done.is_set():
                 return
             self._outcome, self._error = outcome, error
+            self.finished_at = time.monotonic()
             if outcome is not None:
                 self.status = outcome.status
             self._done.set()
@@ -567,6 +578,7 @@ class ActionClient:
         goal_id = uuid.uuid4().bytes
         handle = ClientGoalHandle(self, goal_id, feedback_callback)
         with self._lock:
+            self._forget_finished()
             self._handles[goal_id] = handle
         request = from_dict(action.send_goal.request, {"goal_id": _uuid_dict(goal_id), "goal": goal_msg})
         try:
@@ -614,6 +626,11 @@ class ActionClient:
                     missing_since = None
                 else:
                     missing_since = missing_since or time.monotonic()
+                    if handle.status == STATUS_CANCELED:
+                        # The server's last status said so before it closed; a cancelled goal's result
+                        # is its empty default.
+                        handle._finish(GoalResult(STATUS_CANCELED, from_dict(self.action.result, None)), None)
+                        return
                     if time.monotonic() - missing_since > 2.0:
                         handle._finish(
                             None,
@@ -626,7 +643,14 @@ class ActionClient:
             handle._finish(None, TransportError(f"action client {self.name} was closed"))
         finally:
             with self._lock:
-                self._handles.pop(handle.goal_id, None)
+                self._forget_finished()
+
+    def _forget_finished(self) -> None:
+        """Drop the goals that finished more than LATE_FEEDBACK_S ago (call with the lock held)."""
+        now = time.monotonic()
+        for goal_id, handle in list(self._handles.items()):
+            if handle.finished_at is not None and now - handle.finished_at > LATE_FEEDBACK_S:
+                del self._handles[goal_id]
 
     def _on_feedback(self, message: Any) -> None:
         with self._lock:
