@@ -16,7 +16,7 @@ import logging
 import threading
 import time
 import weakref
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -291,6 +291,8 @@ class Agent:
         self._stop = threading.Event()
         self._joint_state: Any = None
         self._unsubscribe: list[Any] = []
+        # Called once the server stopped (tree listeners that hold files or sockets: Groot2, recordings).
+        self.on_close: list[Callable[[], None]] = []
         if log_sink is not None:
             self._unsubscribe.append(log_sink.subscribe(self._on_behavior_log))
         self._heartbeat_thread = threading.Thread(
@@ -345,6 +347,11 @@ class Agent:
         for unsubscribe in self._unsubscribe:
             unsubscribe()
         self.server.stop()
+        for close in self.on_close:
+            try:
+                close()
+            except Exception:
+                log.exception("closing %r raised", close)
         for queryable in self._quick:
             queryable.undeclare()
         if self._heartbeat_thread.is_alive():
