@@ -9,6 +9,7 @@ from __future__ import annotations
 import struct
 import threading
 import time
+from pathlib import Path
 
 import msgpack
 import pytest
@@ -213,3 +214,42 @@ def test_requests_from_another_thread_while_the_tree_ticks() -> None:
             stop.set()
             ticker.join()
             client.close()
+
+
+def _this_folders_conftest(request: pytest.FixtureRequest):
+    # Every test folder has a module called conftest: ask pytest for the one beside this file.
+    wanted = Path(__file__).with_name("conftest.py")
+    for plugin in request.config.pluginmanager.get_plugins():
+        if Path(getattr(plugin, "__file__", "") or "/").resolve() == wanted.resolve():
+            return plugin
+    raise LookupError(f"{wanted} is not loaded")
+
+
+def test_the_agent_process_serves_groot2_and_records_runs(tmp_path: Path, request) -> None:
+    fixtures = _this_folders_conftest(request)
+    start_agent, stop_agent = fixtures.start_agent, fixtures.stop_agent
+    from kinema.bt.btlog import read_btlog
+    from kinema.runtime.recordings import list_recordings
+    from kinema.sdk import ObjectiveClient
+
+    port = free_port_pair()
+    recordings = tmp_path / "recordings"
+    agent = start_agent(tmp_path, "--groot2-port", str(port), "--recordings", str(recordings))
+    client = Groot2Client(port)
+    try:
+        with ObjectiveClient(agent.endpoint, timeout=10) as sdk:
+            result = sdk.execute("Fails", wait=True)
+        assert result.failed, result
+        tree = client.request("T")[1].decode()
+        assert 'BehaviorTree ID="Fails"' in tree and 'name="broken"' in tree
+        status = client.request("S")[1]
+        broken_uid = int(tree.split('name="broken" _uid="')[1].split('"')[0])
+        assert struct.pack("<HB", broken_uid, 13) in status, "the failed node reads IDLE-after-FAILURE"
+        files = list_recordings(recordings)
+        assert [f.objective_name for f in files] == ["Fails"], files
+        recording = read_btlog(files[0].path)
+        assert (broken_uid, 3) in [(t.uid, int(t.status)) for t in recording.transitions]
+    finally:
+        client.close()
+        stop_agent(agent)
+    assert "Groot2 can attach at 127.0.0.1" in agent.log_file.read_text()
