@@ -530,8 +530,18 @@ class Agent:
             infos = [info for info in infos if info.subcategory == request.subcategory]
         return {
             "status": {"success": True, "error_message": ""},
-            "objectives": [_info_dict(i) for i in infos],
+            "objectives": [_info_dict(i, self._parameters(i)) for i in infos],
         }
+
+    def _parameters(self, info: ObjectiveInfo) -> list[Any]:
+        from kinema.config.objective_parameters import objective_interface
+
+        assert self.source is not None
+        try:
+            factory = self.source.factory()
+        except KinemaError:
+            factory = None
+        return objective_interface(info, factory)
 
     def _on_get_objective_xml(self, request: Any) -> dict[str, Any]:
         if self.source is None:
@@ -634,10 +644,11 @@ class Agent:
             self.source.invalidate_objectives()
 
 
-def _info_dict(info: ObjectiveInfo) -> dict[str, Any]:
+def _info_dict(info: ObjectiveInfo, parameters: Sequence[Any] | None = None) -> dict[str, Any]:
+    """The ObjectiveInfo message of ``info``; its ports are ``parameters`` (the overridable ones) if given."""
     directions = {"input": 0, "output": 1, "inout": 2}
     ports = []
-    for port in info.ports:
+    for port in info.ports if parameters is None else parameters:
         direction = getattr(port.direction, "value", port.direction)
         ports.append(
             {
@@ -647,6 +658,7 @@ def _info_dict(info: ObjectiveInfo) -> dict[str, Any]:
                 else direction,
                 "default_value": port.default or "",
                 "description": port.description or "",
+                "type_name": getattr(port, "type_name", "") or "",
             }
         )
     return {

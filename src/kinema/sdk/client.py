@@ -30,6 +30,7 @@ from kinema.runtime.result import ObjectiveResult
 from kinema.sdk.streams import BlackboardSnapshot, LogEntry, MessageStream, ServerStatus
 
 if TYPE_CHECKING:
+    from kinema.config.objective_file import ObjectivePort
     from kinema.transport import ActionClient, ClientGoalHandle, Node, ServiceClient, Session
 
 Overrides = Mapping[str, Any] | Iterable[ParameterOverride] | None
@@ -245,6 +246,35 @@ class ObjectiveClient:
         if not response.status.success:
             raise TransportError(response.status.error_message)
         return list(response.objectives)
+
+    def parameters(self, name: str) -> list[ObjectivePort]:
+        """What ``overrides`` can set when running ``name``: its input ports, types and defaults.
+
+        The same list as ``kinema objective show NAME`` and the terminal UI's override form (see
+        :mod:`kinema.config.objective_parameters` for the rule).
+
+        Raises:
+            TransportError: no objective has that name (the message suggests the closest ones).
+        """
+        from kinema.config.objective_file import ObjectivePort
+        from kinema.errors import did_you_mean
+
+        infos = {str(info.name): info for info in self.objectives()}
+        info = infos.get(name)
+        if info is None:
+            raise TransportError(f"no objective named {name!r}; {did_you_mean(name, infos)}")
+        directions = {0: "input", 1: "output", 2: "inout"}
+        ports = [
+            ObjectivePort(
+                str(port.name),
+                directions.get(int(port.direction), "input"),
+                str(port.default_value) if port.default_value else None,
+                str(port.description),
+                str(port.type_name),
+            )
+            for port in info.ports
+        ]
+        return [port for port in ports if port.direction != "output"]
 
     # -- streams -------------------------------------------------------------------------------------
 
