@@ -81,6 +81,7 @@ class ObjectivesScreen(KinemaScreen):
             "Dismiss",
             id="objectives.dismiss",
             tooltip="Hide the failure explanation of the last run",
+            show=False,  # the failure panel says so; the footer has no room to spare
         ),
     ]
 
@@ -301,13 +302,10 @@ class ObjectivesScreen(KinemaScreen):
         panel = self.query_one("#failure-panel", Static)
         failed = outcome.outcome == "Failure"
         text = Text()
-        text.append(
-            "✘ failed  " if failed else "◼ cancelled  ", style="bold red" if failed else "bold yellow"
-        )
+        text.append("✘ failed" if failed else "◼ cancelled", style="bold red" if failed else "bold yellow")
+        hint = "  (d dismisses; the tree below shows the failed path)" if failed else "  (d dismisses)"
+        text.append(hint + "\n", style="dim")
         text.append(outcome.message)
-        text.append(
-            "\n(d dismisses; the tree shows the failed path)" if failed else "\n(d dismisses)", style="dim"
-        )
         panel.update(text)
         panel.set_class(True, "shown")
         panel.set_class(not failed, "cancelled")
