@@ -327,6 +327,17 @@ class KinemaApp(App[None]):
         if isinstance(screen, KinemaScreen):
             screen.call_runtime("Cancel the objective", self.connection.cancel_objective, announce=True)
 
+    def action_replay_latest(self) -> None:
+        """Open the newest recording (of a runtime on this machine) in the replay screen."""
+        from kinema.errors import KinemaError
+        from kinema.runtime.recordings import latest_recording
+        from kinema.tui.screens.replay import ReplayScreen
+
+        try:
+            self.push_screen(ReplayScreen(latest_recording()))
+        except KinemaError as error:
+            self.notify(str(error), title="Nothing to replay", severity="warning", timeout=8)
+
     def get_system_commands(self, screen: Screen[object]) -> Iterable[SystemCommand]:
         yield from super().get_system_commands(screen)
         for mode, label, key in SCREENS:
@@ -337,6 +348,11 @@ class KinemaApp(App[None]):
             )  # type: ignore[misc]
         yield SystemCommand(
             "Cancel objective", "Cancel the running objective (ctrl+x)", self.action_cancel_objective
+        )
+        yield SystemCommand(
+            "Replay the latest recording",
+            "Step through the newest recorded run of this machine (`kinema ui --replay FILE` for another)",
+            self.action_replay_latest,
         )
         for view in self.views:
             if isinstance(view, ObjectivesScreen):
