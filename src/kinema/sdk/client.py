@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Iterable, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal, overload
 
 from kinema.errors import TransportError
 from kinema.runtime import names
@@ -184,6 +184,26 @@ class ObjectiveClient:
 
     # -- objectives ----------------------------------------------------------------------------------
 
+    @overload
+    def execute(
+        self,
+        name: str,
+        overrides: Overrides = None,
+        *,
+        wait: Literal[True] = True,
+        timeout: float | None = None,
+    ) -> ObjectiveResult: ...
+
+    @overload
+    def execute(
+        self, name: str, overrides: Overrides = None, *, wait: Literal[False], timeout: float | None = None
+    ) -> ObjectiveHandle: ...
+
+    @overload
+    def execute(
+        self, name: str, overrides: Overrides = None, *, wait: bool, timeout: float | None = None
+    ) -> ObjectiveResult | ObjectiveHandle: ...
+
     def execute(
         self, name: str, overrides: Overrides = None, *, wait: bool = True, timeout: float | None = None
     ) -> ObjectiveResult | ObjectiveHandle:
@@ -223,6 +243,26 @@ class ObjectiveClient:
         if not handle.accepted:
             raise TransportError(f"the agent rejected objective {name or '<XML>'!r}")
         return ObjectiveHandle(handle, name or _xml_name(xml))
+
+    @overload
+    def do_xml(
+        self,
+        xml: str,
+        overrides: Overrides = None,
+        *,
+        wait: Literal[True] = True,
+        timeout: float | None = None,
+    ) -> ObjectiveResult: ...
+
+    @overload
+    def do_xml(
+        self, xml: str, overrides: Overrides = None, *, wait: Literal[False], timeout: float | None = None
+    ) -> ObjectiveHandle: ...
+
+    @overload
+    def do_xml(
+        self, xml: str, overrides: Overrides = None, *, wait: bool, timeout: float | None = None
+    ) -> ObjectiveResult | ObjectiveHandle: ...
 
     def do_xml(
         self, xml: str, overrides: Overrides = None, *, wait: bool = True, timeout: float | None = None
@@ -308,6 +348,26 @@ class ObjectiveClient:
             BlackboardSnapshot.from_message,
             timeout=timeout,
         )
+
+    def blackboard_snapshot(
+        self, objective: str | None = None, *, timeout: float | None = None
+    ) -> BlackboardSnapshot:
+        """The blackboard of the running or last objective, now (``snapshot["sum"]`` reads a value).
+
+        Args:
+            objective: wait for a snapshot of this objective (the latched one may be of an earlier run).
+            timeout: how long to wait (default: the client's timeout).
+
+        Raises:
+            TransportError: no snapshot (of ``objective``) arrived within ``timeout``.
+        """
+        limit = self.timeout if timeout is None else timeout
+        with self.blackboard(timeout=limit) as snapshots:
+            for snapshot in snapshots:
+                if objective is None or snapshot.objective_name == objective:
+                    return snapshot
+        which = f" of objective {objective!r}" if objective else ""
+        raise TransportError(f"no blackboard snapshot{which} within {limit:g} s")
 
     def logs(self, *, timeout: float | None = None) -> MessageStream[LogEntry]:
         """Iterate over the agent's log messages (behavior toasts, reload events, failures)."""
