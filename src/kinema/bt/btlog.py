@@ -184,6 +184,18 @@ class Recording:
     # Bytes at the end that do not make a whole transition (a recording cut short).
     trailing_bytes: int = 0
 
+    @property
+    def tree_id(self) -> str:
+        """The ID of the recorded main tree (its first ``<BehaviorTree>``), "" when unreadable."""
+        from lxml import etree
+
+        try:
+            root = etree.fromstring(self.tree_xml.encode("utf-8"))
+        except etree.XMLSyntaxError:
+            return ""
+        first = next(root.iter("BehaviorTree"), None)
+        return (first.get("ID") or "") if first is not None else ""
+
     def statuses_at(self, index: int) -> dict[int, NodeStatus]:
         """``uid -> status`` after the first ``index`` transitions (0: every node IDLE)."""
         statuses: dict[int, NodeStatus] = {}

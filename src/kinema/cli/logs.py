@@ -74,13 +74,19 @@ def _print_recordings(folder: RunFolder) -> None:
             f"no recordings in {folder.path / FOLDER_NAME} (runs started with --no-record are not recorded)"
         )
         return
-    width = max(len(f.objective_name) for f in files)
+    rows = []
     for file in files:
+        name = file.objective_name
         try:
-            count = f"{len(read_btlog(file.path).transitions)} transitions"
+            recording = read_btlog(file.path)
+            count = f"{len(recording.transitions)} transitions"
+            name = recording.tree_id or name
         except BtlogError as error:
             count = f"unreadable: {error}"
-        click.echo(f"{file.objective_name:<{width}}  {count:>17}  {file.size / 1024:8.1f} kB  {file.path}")
+        rows.append((name, count, file))
+    width = max(len(name) for name, _, _ in rows)
+    for name, count, file in rows:
+        click.echo(f"{name:<{width}}  {count:>17}  {file.size / 1024:8.1f} kB  {file.path}")
 
 
 @click.command("export-logs")

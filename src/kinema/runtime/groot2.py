@@ -184,7 +184,22 @@ class Groot2Server:
         pass
 
     def on_run_finished(self, run: ObjectiveRun, result: ObjectiveResult) -> None:
-        pass
+        # A run that ends on an exception may end without its halt having been reported: show what
+        # the tree shows now, as Groot2 would see it from BT.CPP (IDLE after the status it had).
+        with self._lock:
+            state = self._state
+        if state is None:
+            return
+        now = state.tree.clock.now()
+        for node in state.tree.nodes():
+            index = state.status_index.get(node.uid)
+            if index is None:
+                continue
+            shown = state.status[index]
+            active = shown - 10 if shown >= 10 else shown
+            status = int(node.status)
+            if status != active:
+                self.transition(now, node.uid, active, status)
 
     # -- requests (server thread) --------------------------------------------------------------------
 

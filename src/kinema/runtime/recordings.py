@@ -94,6 +94,8 @@ class RunRecorder:
         self._blackboard_size = 0
         self._last_entries: list[list[str]] | None = None
         self._clock: Any = None
+        self._tree: Tree | None = None
+        self._recorded: dict[int, int] = {}
         self._t0 = 0.0
         self._objective = ""
 
@@ -116,6 +118,8 @@ class RunRecorder:
             self._writer = None
             return
         self._clock = tree.clock
+        self._tree = tree
+        self._recorded = {}
         self._t0 = tree.clock.now()
         self._objective = objective_name
         self._last_entries = None
@@ -132,6 +136,8 @@ class RunRecorder:
             return
         t0 = self._t0
         was_truncated = writer.truncated
+        for change in changes:
+            self._recorded[change.uid] = change.status
         try:
             writer.write((round((c.timestamp - t0) * 1e6), c.uid, c.status) for c in changes)
         except OSError as error:
@@ -147,6 +153,21 @@ class RunRecorder:
             )
 
     def on_run_finished(self, run: ObjectiveRun, result: ObjectiveResult) -> None:
+        # A run that ends on an exception (or a stop) may end without its last transitions (the halt)
+        # having been reported: record what the tree shows now, so a replay does not end RUNNING.
+        writer, tree = self._writer, self._tree
+        if writer is not None and tree is not None and self._clock is not None:
+            offset = round((self._clock.now() - self._t0) * 1e6)
+            missing = [
+                (offset, node.uid, int(node.status))
+                for node in tree.nodes()
+                if int(node.status) != self._recorded.get(node.uid, 0)
+            ]
+            try:
+                writer.write(missing)
+            except OSError as error:
+                log.warning("recording %s: the end of the run was not written: %s", writer.path, error)
+        self._tree = None
         self._close_writer()
 
     def on_status(self, status: ObjectiveStatus, objective_name: str) -> None:

@@ -205,3 +205,51 @@ def test_kinema_logs_lists_recordings_and_export_logs_zips_them(tmp_path: Path, 
     names = zipfile.ZipFile(target).namelist()
     assert f"{folder.name}/{FOLDER_NAME}/20261124-050000-000001-Fails.btlog" in names
     assert f"{folder.name}/agent.log" in names
+
+
+def test_a_run_ended_by_an_exception_is_recorded_and_served_as_halted(tmp_path: Path) -> None:
+    """The server halts the tree when a behavior raises; the halt must reach the recording and Groot2."""
+    from groot2_oracle import Groot2Client, free_port_pair
+
+    from kinema.bt import BehaviorTreeFactory, NodeStatus, SyncActionNode
+    from kinema.runtime.groot2 import Groot2Server
+    from kinema.runtime.objective_server import FactoryTreeSource, ObjectiveRequest, ObjectiveServer
+    from kinema.runtime.recordings import RunRecorder, list_recordings
+
+    class RaiseOnSecondTick(SyncActionNode):
+        ticks = 0
+
+        def tick(self) -> NodeStatus:
+            type(self).ticks += 1
+            if type(self).ticks >= 2:
+                raise RuntimeError("the gripper driver went away")
+            return NodeStatus.SUCCESS
+
+    factory = BehaviorTreeFactory()
+    factory.register_node_type(RaiseOnSecondTick)
+    factory.register_behavior_tree_from_text(
+        """<root BTCPP_format="4"><BehaviorTree ID="Breaks">
+             <ReactiveSequence>
+               <RaiseOnSecondTick name="boom"/>
+               <Sleep name="wait" msec="100000"/>
+             </ReactiveSequence>
+           </BehaviorTree></root>"""
+    )
+    port = free_port_pair()
+    recorder = RunRecorder(tmp_path / "recordings")
+    with Groot2Server(port) as groot2:
+        client = Groot2Client(port)
+        try:
+            listeners = [recorder, groot2]
+            with ObjectiveServer(FactoryTreeSource(factory), listeners=listeners, tick_rate_hz=200) as server:
+                result = server.submit(ObjectiveRequest(objective_name="Breaks")).wait(30)
+            assert result is not None and result.failed and "the gripper driver went away" in str(result)
+            status = client.request("S")[1]
+        finally:
+            client.close()
+    (file,) = list_recordings(tmp_path / "recordings")
+    recording = read_btlog(file.path)
+    final = recording.statuses_at(len(recording.transitions))
+    assert final[3] is NodeStatus.IDLE, "the Sleep that was RUNNING ends halted (IDLE), not RUNNING"
+    assert (3, NodeStatus.RUNNING) in [(t.uid, t.status) for t in recording.transitions]
+    assert struct.pack("<HB", 3, 11) in status, f"Groot2 sees the Sleep IDLE after RUNNING: {status.hex()}"
