@@ -133,11 +133,11 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         deepest node reported FAILURE) is marked failed, the path to it highlighted and expanded, and it
         opens onto its ports and ``message``. Returns the failed node, if one was found.
         """
-        for uid, status in list(self.statuses.items()):
+        for running, status in list(self.statuses.items()):
             if status is NodeStatus.RUNNING:
-                self.statuses[uid] = NodeStatus.IDLE
-                self.halted.add(uid)
-                self._relabel(uid)
+                self.statuses[running] = NodeStatus.IDLE
+                self.halted.add(running)
+                self._relabel(running)
         if outcome != "Failure" or self.outline is None:
             return None
         failed = self._failed_node(message)
@@ -148,10 +148,10 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         self.statuses[failed.uid] = NodeStatus.FAILURE
         self.halted.discard(failed.uid)
         path: list[int] = []
-        uid: int | None = failed.uid
-        while uid is not None:
-            path.append(uid)
-            uid = self._parents.get(uid)
+        step: int | None = failed.uid
+        while step is not None:
+            path.append(step)
+            step = self._parents.get(step)
         self.failed_path = list(reversed(path))
         for uid in self.failed_path:
             self._relabel(uid)
