@@ -123,6 +123,7 @@ class ObjectivesScreen(KinemaScreen):
         ports = self.query_one("#port-table", DataTable)
         ports.add_column("Port", key="name")
         ports.add_column("Direction", key="direction")
+        ports.add_column("Type", key="type")
         ports.add_column("Default", key="default")
         ports.add_column("Description", key="description")
         self.query_one("#objective-list", OptionList).focus()
@@ -223,7 +224,8 @@ class ObjectivesScreen(KinemaScreen):
         ports = self.query_one("#port-table", DataTable)
         ports.clear()
         for port in objective.ports:
-            ports.add_row(*(Text(v) for v in (port.name, port.direction, port.default, port.description)))
+            cells = (port.name, port.direction, port.type_name, port.default, port.description)
+            ports.add_row(*(Text(v) for v in cells))
         self.run_worker(self.query_one(OverrideForm).show_objective(objective), group="override-form")
         self.query_one(BehaviorTreeView).show_outline(None, "loading …")
         connection = self.kinema.connection
