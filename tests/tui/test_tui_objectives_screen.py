@@ -153,3 +153,17 @@ def test_the_command_palette_runs_an_objective(fake: FakeConnection) -> None:
         assert fake.called("start_objective") == [("Open Gripper", {})]
 
     drive(fake, scenario)
+
+
+def test_the_ports_tab_shows_each_parameters_type(fake: FakeConnection) -> None:
+    from textual.widgets import DataTable
+
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        table = app.screen.query_one("#port-table", DataTable)
+        rows = [[str(cell) for cell in table.get_row_at(i)] for i in range(table.row_count)]
+        assert rows[:2] == [
+            ["waypoint_name", "input", "std::string", "Look at Table", "Where to look before picking"],
+            ["speed", "input", "double", "0.5", "Velocity scale factor"],
+        ]
+
+    drive(fake, scenario)

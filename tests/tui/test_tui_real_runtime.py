@@ -196,3 +196,66 @@ def test_saved_objective_files_show_up_and_a_broken_one_is_reported_with_its_lin
         asyncio.run(main())
     finally:
         agent.stop()
+
+
+def test_the_tutorial_objective_runs_with_values_from_the_form_and_a_failure_stays_explained(
+    tmp_path: Path,
+) -> None:
+    """example_config's "Add Numbers" (the tutorial's objective): the form lists a and b (int); with
+    values it adds them; without, MyBehavior fails and the screen keeps saying why."""
+    from textual.widgets import Input, OptionList, Static
+
+    from kinema.tui.widgets.override_form import OverrideForm
+
+    endpoint = f"tcp/127.0.0.1:{free_port()}"
+    env = {**os.environ, "KINEMA_CONFIG": "", "KINEMA_WORKSPACE": ""}
+    argv = [sys.executable, "-m", "kinema.runtime.agent_process", "--host-router", endpoint]
+    process = subprocess.Popen(
+        [*argv, "--config", "example_config", "--clock", "wall", "--no-hot-reload"],
+        env=env,
+        stdout=subprocess.DEVNULL,
+        stderr=subprocess.PIPE,
+    )
+    app = KinemaApp(SdkConnection(endpoint))
+
+    async def main() -> None:
+        async with app.run_test(size=(140, 40)) as pilot:
+            await wait_for(pilot, lambda: app.status.state is ConnectionState.CONNECTED, "the heartbeat", 60)
+            screen = app.screen
+            assert isinstance(screen, ObjectivesScreen)
+            await wait_for(pilot, lambda: any(o.name == "Add Numbers" for o in screen.objectives), "the list")
+            screen.query_one("#objective-search", Input).value = "Add Numbers"
+            screen.query_one("#objective-list", OptionList).focus()
+            await wait_for(
+                pilot,
+                lambda: screen.selected is not None and screen.selected.name == "Add Numbers",
+                "Add Numbers selected",
+            )
+            form = screen.query_one(OverrideForm)
+            await wait_for(pilot, lambda: len(form.query(Input)) == 2, "the parameter form")
+            assert [(p.name, p.type_name) for p in screen.selected.ports] == [("a", "int"), ("b", "int")]
+            inputs = {field.name: field for field in form.query(Input)}
+            inputs["a"].value, inputs["b"].value = "40", "2"
+            await pilot.press("r")
+            await wait_for(pilot, lambda: app.status.status == "Success", "Add Numbers to succeed")
+            await wait_for(
+                pilot,
+                lambda: any(e.key == "sum" and e.value == "42" for e in app.blackboard.entries.values()),
+                "sum = 42 on the blackboard",
+            )
+
+            inputs["a"].value, inputs["b"].value = "", ""
+            await pilot.press("r")
+            panel = screen.query_one("#failure-panel", Static)
+            await wait_for(pilot, lambda: panel.has_class("shown"), "the failure panel")
+            assert "MyBehavior::2" in str(panel.render()) and "int_1" in str(panel.render())
+            view = screen.query_one(BehaviorTreeView)
+            await wait_for(pilot, lambda: view.shown_as("MyBehavior::2") == "FAILURE", "the failed node")
+            assert view.failed_path[-1] == 2
+            await pilot.pause(2.5)  # past the heartbeat's 2 s result hold: the explanation stays
+            assert panel.has_class("shown") and view.shown_as("MyBehavior::2") == "FAILURE"
+
+    try:
+        asyncio.run(main())
+    finally:
+        stop(process)

@@ -158,3 +158,16 @@ def test_waypoints_screen(snap_compare) -> None:  # type: ignore[no-untyped-def]
         await settle(pilot)
 
     assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+
+
+def test_objectives_screen_after_a_failed_run(snap_compare) -> None:  # type: ignore[no-untyped-def]
+    from test_tui_failures import failed_run
+
+    app, fake = app_on("objectives")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        failed_run(fake)
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)

@@ -121,6 +121,7 @@ def test(packages_select: tuple[str, ...], workspace: Path | None, pytest_args: 
     from kinema.errors import KinemaError
     from kinema.plugins.dependencies import workspace_behavior_packages
 
+    _require_pytest()
     found, _ = resolve_selection(workspace, None, need_config=False)
     if found.root is None:
         raise KinemaError("no workspace is selected: pass -w PATH or run `kinema configure -w PATH`")
@@ -143,6 +144,21 @@ def test(packages_select: tuple[str, ...], workspace: Path | None, pytest_args: 
         raise click.exceptions.Exit(1)
     count = len(packages)
     click.secho(f"all tests passed ({count} package{'' if count == 1 else 's'})", fg="green")
+
+
+def _require_pytest() -> None:
+    """Say which command installs pytest when this Python has none (an install with --no-deps skips it)."""
+    import importlib.util
+    import shlex
+
+    from kinema.errors import KinemaError
+
+    if importlib.util.find_spec("pytest") is None:
+        python = shlex.quote(sys.executable)
+        raise KinemaError(
+            f"`kinema test` runs pytest, which is not installed for {sys.executable}; install it with: "
+            f"{python} -m pip install 'pytest>=8'"
+        )
 
 
 def _plugin_installed() -> bool:

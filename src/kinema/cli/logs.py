@@ -35,10 +35,20 @@ def _run_folder(run_name: str | None) -> RunFolder:
     help="Only entries at or above this level: debug, info, warning, error, critical.",
 )
 @click.option("--run", "run_name", default=None, metavar="NAME", help=_RUN_HELP)
-def logs(follow: bool, level: str, run_name: str | None) -> None:
+@click.option(
+    "--recordings",
+    "list_recordings",
+    is_flag=True,
+    help="List the run's objective recordings (.btlog files: open them in Groot2 or `kinema ui`) "
+    "instead of its logs.",
+)
+def logs(follow: bool, level: str, run_name: str | None, list_recordings: bool) -> None:
     """Print the logs of the latest `kinema run` (agent, drivers, supervisor), merged in time order."""
     from kinema.runtime.log_files import follow_entries, level_number, merged_entries
 
+    if list_recordings:
+        _print_recordings(_run_folder(run_name))
+        return
     try:
         min_level = level_number(level)
     except ValueError as error:
@@ -54,6 +64,31 @@ def logs(follow: bool, level: str, run_name: str | None) -> None:
             return
 
 
+def _print_recordings(folder: RunFolder) -> None:
+    from kinema.bt.btlog import BtlogError, read_btlog
+    from kinema.runtime.recordings import FOLDER_NAME, list_recordings
+
+    files = list_recordings(folder.path / FOLDER_NAME)
+    if not files:
+        click.echo(
+            f"no recordings in {folder.path / FOLDER_NAME} (runs started with --no-record are not recorded)"
+        )
+        return
+    rows = []
+    for file in files:
+        name = file.objective_name
+        try:
+            recording = read_btlog(file.path)
+            count = f"{len(recording.transitions)} transitions"
+            name = recording.tree_id or name
+        except BtlogError as error:
+            count = f"unreadable: {error}"
+        rows.append((name, count, file))
+    width = max(len(name) for name, _, _ in rows)
+    for name, count, file in rows:
+        click.echo(f"{name:<{width}}  {count:>17}  {file.size / 1024:8.1f} kB  {file.path}")
+
+
 @click.command("export-logs")
 @click.option(
     "-o",
@@ -64,7 +99,7 @@ def logs(follow: bool, level: str, run_name: str | None) -> None:
 )
 @click.option("--run", "run_name", default=None, metavar="NAME", help=_RUN_HELP)
 def export_logs(output: Path | None, run_name: str | None) -> None:
-    """Zip the log folder of the latest run (to attach to a bug report)."""
+    """Zip the log folder of the latest run, objective recordings included (to attach to a bug report)."""
     import zipfile
 
     folder = _run_folder(run_name)

@@ -73,12 +73,22 @@ def list_(workspace: Path | None, config: str | None, as_json: bool, verbose: bo
 def show(
     name: str, workspace: Path | None, config: str | None, as_xml: bool, as_json: bool, verbose: bool
 ) -> None:
-    """Show one objective: source file, metadata, ports and XML."""
+    """Show one objective: source file, metadata, parameters (ports) and XML.
+
+    The ports listed are what `-p NAME=VALUE` can set (the subtree ports the objective declares, then
+    the blackboard keys its behaviors read), with their types, followed by its declared outputs: the
+    same list the SDK's `objectives()` and the terminal UI's override form give.
+    """
+    from dataclasses import replace
+
+    from kinema.config.objective_parameters import objective_interface
+
     library = _load_library(workspace, config, verbose)
     info = library.get(name)
     if as_xml:
         click.echo(info.read_xml(), nl=False)
         return
+    info = replace(info, ports=objective_interface(info, _behavior_factory(library, verbose)))
     if as_json:
         click.echo(json.dumps({**info.to_json(), "xml": info.read_xml()}, indent=2))
         return
@@ -94,14 +104,41 @@ def show(
     if info.ports:
         click.echo("  ports:")
         width = max(len(port.name) for port in info.ports)
+        type_width = max(len(port.type_name or "-") for port in info.ports)
         for port in info.ports:
             default = f" = {port.default}" if port.default is not None else ""
             description = f"  ({port.description})" if port.description else ""
-            click.echo(f"    {port.direction:<6} {port.name:<{width}}{default}{description}")
+            type_name = f"{port.type_name or '-':<{type_width}}"
+            click.echo(f"    {port.direction:<6} {port.name:<{width}}  {type_name}{default}{description}")
     else:
         click.echo("  ports:       none")
     click.echo("")
     click.echo(info.read_xml(), nl=False)
+
+
+def _behavior_factory(library: ObjectiveLibrary, verbose: bool) -> object:
+    """The config's behaviors and the library's subtrees in one factory, as the agent builds it.
+
+    Only read for the ports' directions and types; behaviors that fail to load are reported, not fatal.
+    """
+    from kinema.errors import KinemaError
+    from kinema.plugins import BehaviorHost
+
+    resolved = library.resolved
+    if resolved is None:
+        return None
+    host = BehaviorHost.for_config(resolved)
+    report = host.load()
+    if verbose:
+        for error in report.errors:
+            click.secho(f"warning: {error}", err=True, fg="yellow")
+    factory = host.registry.create_factory()
+    for path in library.files():
+        try:
+            factory.register_behavior_tree_from_file(path)
+        except KinemaError:
+            pass  # reported by `kinema objective list`; this objective's own file is what matters
+    return factory
 
 
 # -- running objectives on a live runtime (run, cancel, do, status) ------------------------------------

@@ -37,6 +37,20 @@ from kinema.cli.options import selection_options
     help="Simulated seconds per wall second: 1 (real time, the default), a factor such as 4, or max "
     "(as fast as the CPU allows; for tests and CI).",
 )
+@click.option(
+    "--groot2-port",
+    type=click.IntRange(1, 65534),
+    default=None,
+    metavar="PORT",
+    help="Let Groot2 attach to the running objective: serve its protocol on 127.0.0.1 at PORT and PORT+1 "
+    "(Groot2's default is 1667). Off unless given.",
+)
+@click.option(
+    "--no-record",
+    is_flag=True,
+    help="Do not record objective runs (by default each run is saved as a .btlog file Groot2 replays; "
+    "see `kinema logs --recordings`).",
+)
 def run(
     workspace: Path | None,
     config: str | None,
@@ -49,6 +63,8 @@ def run(
     connect: str | None,
     tick_rate: float,
     sim_speed: str | None,
+    groot2_port: int | None,
+    no_record: bool,
 ) -> None:
     """Start Kinema: host the zenoh router (or join one), the agent and the config's drivers.
 
@@ -93,6 +109,8 @@ def run(
         ui=ui,
         # The 3D view comes with the interactive runtime (the TUI); headless runs skip it.
         viewer=ui is not None and not no_browser and not only_drivers,
+        groot2_port=groot2_port,
+        record=not no_record,
     )
     code = Launcher(options).run()
     if code:

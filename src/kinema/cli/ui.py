@@ -33,13 +33,33 @@ SCREEN_CHOICES = ("configs", "objectives", "blackboard", "behaviors", "logs", "w
     is_flag=True,
     help="Show the app on a built-in demo runtime (no runtime needed; for a first look).",
 )
+@click.option(
+    "--replay",
+    "replay",
+    is_flag=False,
+    flag_value="latest",
+    default=None,
+    metavar="[FILE.btlog]",
+    help="Replay a recorded run instead (no runtime needed): step through its transitions and see the "
+    "blackboard at each. Without FILE, the newest recording (see `kinema logs --recordings`).",
+)
 @selection_options
-def ui(endpoint: str | None, screen: str, demo: bool, workspace: Path | None, config: str | None) -> None:
+def ui(
+    endpoint: str | None,
+    screen: str,
+    demo: bool,
+    replay: str | None,
+    workspace: Path | None,
+    config: str | None,
+) -> None:
     """Open the terminal UI attached to a running runtime (`kinema run` in another terminal or machine).
 
     Closing the UI leaves the runtime running. The Configs screen browses the workspace selected with
     -w/-c (or `kinema configure`). Keys: 1-6 switch screens, ctrl+p opens the command palette, q quits.
     """
+    if replay is not None:
+        _replay(replay)
+        return
     from kinema.tui.app import run_app
     from kinema.tui.connection import RuntimeConnection
 
@@ -56,3 +76,13 @@ def ui(endpoint: str | None, screen: str, demo: bool, workspace: Path | None, co
 
         connection = SdkConnection(endpoint=endpoint, workspace=workspace, config=config)
     run_app(connection, owns_runtime=False, initial_mode=screen)
+
+
+def _replay(which: str) -> None:
+    from kinema.bt.btlog import read_btlog
+    from kinema.runtime.recordings import latest_recording
+    from kinema.tui.screens.replay import ReplayApp
+
+    path = latest_recording() if which == "latest" else Path(which)
+    read_btlog(path)  # a missing or foreign file is a one-line error here, not inside the app
+    ReplayApp(path).run()

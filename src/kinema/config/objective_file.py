@@ -40,12 +40,14 @@ class ObjectivePort:
         direction: ``"input"``, ``"output"`` or ``"inout"``.
         default: the default value as written (``{key}`` for a blackboard default), or None.
         description: the port's description, "" when none.
+        type_name: the value type when known (from the behavior port that reads it), "" otherwise.
     """
 
     name: str
     direction: str
     default: str | None = None
     description: str = ""
+    type_name: str = ""
 
 
 @dataclass
@@ -99,7 +101,13 @@ class ObjectiveInfo:
             "runnable": self.runnable,
             "subcategory": self.subcategory,
             "ports": [
-                {"name": p.name, "direction": p.direction, "default": p.default, "description": p.description}
+                {
+                    "name": p.name,
+                    "direction": p.direction,
+                    "type": p.type_name,
+                    "default": p.default,
+                    "description": p.description,
+                }
                 for p in self.ports
             ],
             "metadata": self.metadata,

@@ -16,7 +16,7 @@ import logging
 import threading
 import time
 import weakref
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -291,6 +291,8 @@ class Agent:
         self._stop = threading.Event()
         self._joint_state: Any = None
         self._unsubscribe: list[Any] = []
+        # Called once the server stopped (tree listeners that hold files or sockets: Groot2, recordings).
+        self.on_close: list[Callable[[], None]] = []
         if log_sink is not None:
             self._unsubscribe.append(log_sink.subscribe(self._on_behavior_log))
         self._heartbeat_thread = threading.Thread(
@@ -345,6 +347,11 @@ class Agent:
         for unsubscribe in self._unsubscribe:
             unsubscribe()
         self.server.stop()
+        for close in self.on_close:
+            try:
+                close()
+            except Exception:
+                log.exception("closing %r raised", close)
         for queryable in self._quick:
             queryable.undeclare()
         if self._heartbeat_thread.is_alive():
@@ -527,8 +534,18 @@ class Agent:
             infos = [info for info in infos if info.subcategory == request.subcategory]
         return {
             "status": {"success": True, "error_message": ""},
-            "objectives": [_info_dict(i) for i in infos],
+            "objectives": [_info_dict(i, self._parameters(i)) for i in infos],
         }
+
+    def _parameters(self, info: ObjectiveInfo) -> list[Any]:
+        from kinema.config.objective_parameters import objective_interface
+
+        assert self.source is not None
+        try:
+            factory = self.source.factory()
+        except KinemaError:
+            factory = None
+        return objective_interface(info, factory)
 
     def _on_get_objective_xml(self, request: Any) -> dict[str, Any]:
         if self.source is None:
@@ -631,10 +648,11 @@ class Agent:
             self.source.invalidate_objectives()
 
 
-def _info_dict(info: ObjectiveInfo) -> dict[str, Any]:
+def _info_dict(info: ObjectiveInfo, parameters: Sequence[Any] | None = None) -> dict[str, Any]:
+    """The ObjectiveInfo message of ``info``; its ports are ``parameters`` (the overridable ones) if given."""
     directions = {"input": 0, "output": 1, "inout": 2}
     ports = []
-    for port in info.ports:
+    for port in info.ports if parameters is None else parameters:
         direction = getattr(port.direction, "value", port.direction)
         ports.append(
             {
@@ -644,6 +662,7 @@ def _info_dict(info: ObjectiveInfo) -> dict[str, Any]:
                 else direction,
                 "default_value": port.default or "",
                 "description": port.description or "",
+                "type_name": getattr(port, "type_name", "") or "",
             }
         )
     return {

@@ -43,6 +43,8 @@ class AgentOptions:
             a simulator.
         hot_reload: watch behavior packages and objective folders.
         waypoints_file: the waypoints file to serve instead of the config's.
+        groot2_port: serve the Groot2 protocol on 127.0.0.1 at this port and the next (None: off).
+        recordings_dir: write a ``.btlog`` recording of every run there (None: no recordings).
     """
 
     config: str | None = None
@@ -52,6 +54,8 @@ class AgentOptions:
     clock: ClockChoice = "auto"
     hot_reload: bool = True
     waypoints_file: Path | None = None
+    groot2_port: int | None = None
+    recordings_dir: Path | None = None
 
 
 def build_agent(options: AgentOptions, session: Session) -> Agent:
@@ -111,6 +115,7 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
         waypoints = WaypointStore(waypoints_path)
     server = ObjectiveServer(source, tick_rate_hz=options.tick_rate_hz)
     agent = Agent(session, server, source=source, waypoints=waypoints, log_sink=sink, clock=clock, node=node)
+    _add_debugging_doors(agent, options)
     if host is not None:
         host.subscribe(agent.on_reload_event)
         if options.hot_reload:
@@ -152,6 +157,24 @@ def _robot_model_provider(resolved: Any) -> Any:
     return load
 
 
+def _add_debugging_doors(agent: Agent, options: AgentOptions) -> None:
+    """Recordings and Groot2: tree listeners of the objective server, closed with the agent."""
+    if options.recordings_dir is not None:
+        from kinema.runtime.recordings import RunRecorder
+
+        recorder = RunRecorder(options.recordings_dir)
+        agent.server.add_listener(recorder)
+        agent.on_close.append(recorder.close)
+        log.info("recording every objective run into %s", options.recordings_dir)
+    if options.groot2_port is not None:
+        from kinema.runtime.groot2 import Groot2Server
+
+        groot2 = Groot2Server(options.groot2_port)
+        agent.server.add_listener(groot2)
+        agent.on_close.append(groot2.close)
+        log.info("Groot2 can attach at 127.0.0.1:%d", options.groot2_port)
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="python -m kinema.runtime.agent_process", description=__doc__)
     parser.add_argument("--config", "-c", help="config package to run")
@@ -166,6 +189,8 @@ def _parser() -> argparse.ArgumentParser:
     parser.add_argument("--no-hot-reload", action="store_true", help="do not watch files")
     parser.add_argument("--waypoints", type=Path, help="waypoints file to serve (default: the config's)")
     parser.add_argument("--log-file", type=Path, help="write the log there (run format)")
+    parser.add_argument("--groot2-port", type=int, help="serve Groot2 on 127.0.0.1 at this port and the next")
+    parser.add_argument("--recordings", type=Path, help="record every run (.btlog) in this folder")
     parser.add_argument("--ready-fd", type=int, help="write 'ready' to this file descriptor when serving")
     parser.add_argument("--verbose", "-v", action="store_true", help="log at DEBUG level")
     return parser
@@ -190,6 +215,8 @@ def main(argv: list[str] | None = None) -> int:
         clock=args.clock,
         hot_reload=not args.no_hot_reload,
         waypoints_file=args.waypoints,
+        groot2_port=args.groot2_port,
+        recordings_dir=args.recordings,
     )
     try:
         from kinema.transport import host_router, open_session

@@ -59,6 +59,10 @@ class LaunchOptions:
             (None: the driver's default, real time).
         ui: runs in the main thread once everything started (the TUI); returns an exit code.
         viewer: also start the 3D view (``python -m kinema.viz``, the process behind ``kinema view``).
+        groot2_port: the agent serves the Groot2 protocol on 127.0.0.1 at this port and the next
+            (None: off).
+        record: the agent records every objective run as a ``.btlog`` file in the run folder's
+            ``recordings/``.
         echo: print progress lines (the CLI); tests turn it off.
     """
 
@@ -72,6 +76,8 @@ class LaunchOptions:
     sim_speed: str | None = None
     ui: Callable[[Launcher], int] | None = None
     viewer: bool = False
+    groot2_port: int | None = None
+    record: bool = True
     echo: Callable[[str], None] = field(default=print)
 
 
@@ -149,6 +155,8 @@ class Launcher:
                 self._await_ready(child, stream)
                 if child.name != "agent":
                     self.options.echo(f"driver {child.name!r} is running")
+                elif options.groot2_port is not None:
+                    self.options.echo(f"Groot2: connect to 127.0.0.1 port {options.groot2_port}")
             if options.viewer:
                 self._start_viewer()
         except BaseException:
@@ -212,6 +220,12 @@ class Launcher:
             argv += ["--workspace", str(self.options.workspace)]
         if self.options.verbose:
             argv.append("--verbose")
+        if self.options.record:
+            from kinema.runtime.recordings import FOLDER_NAME
+
+            argv += ["--recordings", str(self.run_folder.path / FOLDER_NAME)]
+        if self.options.groot2_port is not None:
+            argv += ["--groot2-port", str(self.options.groot2_port)]
         return self._spawn_with_ready("agent", argv, log_file)
 
     def _spawn_with_ready(self, name: str, argv: list[str], log_file: Path) -> tuple[Child, Any]:

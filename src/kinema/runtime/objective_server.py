@@ -98,6 +98,17 @@ class ServerListener(Protocol):
         """A run ended (succeeded, failed, was cancelled or preempted)."""
 
 
+class TreeListener(ServerListener, Protocol):
+    """A listener that also sees each run's Tree (Groot2, recordings): it reads, never ticks or halts it.
+
+    The node transitions it gets are the ``on_node_status`` batches every listener gets: one status
+    observer on the tree feeds them all.
+    """
+
+    def on_tree_loaded(self, objective_name: str, tree: Tree) -> None:
+        """A new run's tree was built and its overrides applied; it has not been ticked yet."""
+
+
 class ObjectiveRun:
     """A submitted request and, once it ends, its result. Thread-safe; returned by ``submit``."""
 
@@ -482,6 +493,13 @@ class ObjectiveServer:
         self._last_snapshot = 0.0
         tree.add_status_observer(self._on_node_status)
         tree.wake_up.listener = self._wake_up
+        for listener in self._listeners:
+            loaded = getattr(listener, "on_tree_loaded", None)
+            if loaded is not None:
+                try:
+                    loaded(name, tree)
+                except Exception:
+                    log.exception("a tree listener raised")
         self._set_status(ObjectiveStatus.RUNNING, name)
 
     def _build(self, request: ObjectiveRequest) -> tuple[Tree, str]:

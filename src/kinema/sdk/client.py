@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Iterable, Mapping
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Literal, overload
 
 from kinema.errors import TransportError
 from kinema.runtime import names
@@ -30,6 +30,7 @@ from kinema.runtime.result import ObjectiveResult
 from kinema.sdk.streams import BlackboardSnapshot, LogEntry, MessageStream, ServerStatus
 
 if TYPE_CHECKING:
+    from kinema.config.objective_file import ObjectivePort
     from kinema.transport import ActionClient, ClientGoalHandle, Node, ServiceClient, Session
 
 Overrides = Mapping[str, Any] | Iterable[ParameterOverride] | None
@@ -183,6 +184,26 @@ class ObjectiveClient:
 
     # -- objectives ----------------------------------------------------------------------------------
 
+    @overload
+    def execute(
+        self,
+        name: str,
+        overrides: Overrides = None,
+        *,
+        wait: Literal[True] = True,
+        timeout: float | None = None,
+    ) -> ObjectiveResult: ...
+
+    @overload
+    def execute(
+        self, name: str, overrides: Overrides = None, *, wait: Literal[False], timeout: float | None = None
+    ) -> ObjectiveHandle: ...
+
+    @overload
+    def execute(
+        self, name: str, overrides: Overrides = None, *, wait: bool, timeout: float | None = None
+    ) -> ObjectiveResult | ObjectiveHandle: ...
+
     def execute(
         self, name: str, overrides: Overrides = None, *, wait: bool = True, timeout: float | None = None
     ) -> ObjectiveResult | ObjectiveHandle:
@@ -223,6 +244,26 @@ class ObjectiveClient:
             raise TransportError(f"the agent rejected objective {name or '<XML>'!r}")
         return ObjectiveHandle(handle, name or _xml_name(xml))
 
+    @overload
+    def do_xml(
+        self,
+        xml: str,
+        overrides: Overrides = None,
+        *,
+        wait: Literal[True] = True,
+        timeout: float | None = None,
+    ) -> ObjectiveResult: ...
+
+    @overload
+    def do_xml(
+        self, xml: str, overrides: Overrides = None, *, wait: Literal[False], timeout: float | None = None
+    ) -> ObjectiveHandle: ...
+
+    @overload
+    def do_xml(
+        self, xml: str, overrides: Overrides = None, *, wait: bool, timeout: float | None = None
+    ) -> ObjectiveResult | ObjectiveHandle: ...
+
     def do_xml(
         self, xml: str, overrides: Overrides = None, *, wait: bool = True, timeout: float | None = None
     ) -> ObjectiveResult | ObjectiveHandle:
@@ -245,6 +286,35 @@ class ObjectiveClient:
         if not response.status.success:
             raise TransportError(response.status.error_message)
         return list(response.objectives)
+
+    def parameters(self, name: str) -> list[ObjectivePort]:
+        """What ``overrides`` can set when running ``name``: its input ports, types and defaults.
+
+        The same list as ``kinema objective show NAME`` and the terminal UI's override form (see
+        :mod:`kinema.config.objective_parameters` for the rule).
+
+        Raises:
+            TransportError: no objective has that name (the message suggests the closest ones).
+        """
+        from kinema.config.objective_file import ObjectivePort
+        from kinema.errors import did_you_mean
+
+        infos = {str(info.name): info for info in self.objectives()}
+        info = infos.get(name)
+        if info is None:
+            raise TransportError(f"no objective named {name!r}; {did_you_mean(name, infos)}")
+        directions = {0: "input", 1: "output", 2: "inout"}
+        ports = [
+            ObjectivePort(
+                str(port.name),
+                directions.get(int(port.direction), "input"),
+                str(port.default_value) if port.default_value else None,
+                str(port.description),
+                str(port.type_name),
+            )
+            for port in info.ports
+        ]
+        return [port for port in ports if port.direction != "output"]
 
     # -- streams -------------------------------------------------------------------------------------
 
@@ -278,6 +348,26 @@ class ObjectiveClient:
             BlackboardSnapshot.from_message,
             timeout=timeout,
         )
+
+    def blackboard_snapshot(
+        self, objective: str | None = None, *, timeout: float | None = None
+    ) -> BlackboardSnapshot:
+        """The blackboard of the running or last objective, now (``snapshot["sum"]`` reads a value).
+
+        Args:
+            objective: wait for a snapshot of this objective (the latched one may be of an earlier run).
+            timeout: how long to wait (default: the client's timeout).
+
+        Raises:
+            TransportError: no snapshot (of ``objective``) arrived within ``timeout``.
+        """
+        limit = self.timeout if timeout is None else timeout
+        with self.blackboard(timeout=limit) as snapshots:
+            for snapshot in snapshots:
+                if objective is None or snapshot.objective_name == objective:
+                    return snapshot
+        which = f" of objective {objective!r}" if objective else ""
+        raise TransportError(f"no blackboard snapshot{which} within {limit:g} s")
 
     def logs(self, *, timeout: float | None = None) -> MessageStream[LogEntry]:
         """Iterate over the agent's log messages (behavior toasts, reload events, failures)."""

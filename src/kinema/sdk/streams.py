@@ -60,14 +60,111 @@ class BlackboardValue:
     type_name: str
     value: str
 
+    @property
+    def parsed(self) -> Any:
+        """The value as Python data: ``42`` → 42, ``[1, 2]`` → [1, 2], a message → a dict.
+
+        A ``std::string`` entry stays the string it holds; text that is not YAML stays text.
+        """
+        import yaml
+
+        try:
+            data = yaml.safe_load(self.value)
+        except yaml.YAMLError:
+            return self.value
+        if self.type_name in _STRING_TYPES and not isinstance(data, str):
+            return self.value if data is None else str(data)
+        return data
+
 
 @dataclass(frozen=True)
 class BlackboardSnapshot:
-    """Every blackboard entry of the running (or last) objective."""
+    """Every blackboard entry of the running (or last) objective.
+
+    Read it like a mapping of the objective's own keys, values parsed into Python data::
+
+        snapshot["sum"]                  # 42 (an int)
+        snapshot.value("sum", int)       # 42, typed for mypy (TypeError if it is not an int)
+        snapshot.get("missing", 0)       # 0
+        snapshot.scope("Add::3")["x"]    # a key of a subtree's own blackboard
+
+    A key is looked up in the objective's root blackboard first, then in the only subtree scope that
+    has it; ``scopes`` names every scope.
+    """
 
     objective_name: str
     stamp: float
     entries: tuple[BlackboardValue, ...]
+
+    @property
+    def scopes(self) -> list[str]:
+        """The scopes (the root's is the objective's name, subtrees are their instance paths)."""
+        return list(dict.fromkeys(entry.scope for entry in self.entries))
+
+    def scope(self, name: str) -> dict[str, Any]:
+        """``{key: parsed value}`` of one scope.
+
+        Raises:
+            KeyError: no such scope (the message lists them).
+        """
+        if name not in self.scopes:
+            raise KeyError(f"no blackboard scope {name!r}; scopes: {', '.join(self.scopes) or 'none'}")
+        return {entry.key: entry.parsed for entry in self.entries if entry.scope == name}
+
+    def entry(self, key: str) -> BlackboardValue:
+        """The entry ``key`` resolves to (see the class docstring).
+
+        Raises:
+            KeyError: no scope has ``key``, or several subtree scopes do and the root does not.
+        """
+        found = [entry for entry in self.entries if entry.key == key]
+        root = [entry for entry in found if entry.scope in (self.objective_name, "")]
+        if root:
+            return root[0]
+        if len(found) == 1:
+            return found[0]
+        if found:
+            scopes = ", ".join(entry.scope for entry in found)
+            raise KeyError(f"blackboard key {key!r} is in several scopes ({scopes}); use scope(name)[key]")
+        from kinema.errors import did_you_mean
+
+        raise KeyError(f"no blackboard key {key!r}; {did_you_mean(key, self.keys())}")
+
+    def keys(self) -> list[str]:
+        """Every key, root scope first."""
+        return list(dict.fromkeys(entry.key for entry in sorted(self.entries, key=self._root_first)))
+
+    def _root_first(self, entry: BlackboardValue) -> bool:
+        return entry.scope not in (self.objective_name, "")
+
+    def __getitem__(self, key: str) -> Any:
+        return self.entry(key).parsed
+
+    def __contains__(self, key: object) -> bool:
+        return isinstance(key, str) and any(entry.key == key for entry in self.entries)
+
+    def get(self, key: str, default: Any = None) -> Any:
+        """``snapshot[key]``, or ``default`` when no scope has it."""
+        try:
+            return self[key]
+        except KeyError:
+            return default
+
+    def value(self, key: str, kind: type[T]) -> T:
+        """``snapshot[key]`` checked to be a ``kind`` (an int is accepted where a float is asked).
+
+        Raises:
+            KeyError: see :meth:`entry`.
+            TypeError: the value is of another type (the message says which).
+        """
+        data = self[key]
+        if kind is float and isinstance(data, int) and not isinstance(data, bool):
+            return float(data)  # type: ignore[return-value]
+        if not isinstance(data, kind) or (kind is int and isinstance(data, bool)):
+            raise TypeError(
+                f"blackboard key {key!r} holds {data!r} ({self.entry(key).type_name}), not a {kind.__name__}"
+            )
+        return data
 
     @classmethod
     def from_message(cls, message: Any) -> BlackboardSnapshot:
@@ -83,6 +180,7 @@ class BlackboardSnapshot:
         return out
 
 
+_STRING_TYPES = frozenset({"std::string", "string", "str"})
 _LEVELS = {1: "error", 2: "warn", 3: "info"}
 
 

@@ -40,6 +40,7 @@ from kinema.tui.connection import (
 )
 from kinema.tui.dialogs.confirm import ConfirmDialog
 from kinema.tui.messages import ModeSelected, RuntimeCallFailed, RuntimeCallSucceeded, RuntimeEventsArrived
+from kinema.tui.run_outcome import RunOutcome, parse_outcome
 from kinema.tui.runtime_status import RuntimeStatus
 from kinema.tui.screens.base import KinemaScreen
 from kinema.tui.screens.behaviors import BehaviorsScreen
@@ -161,6 +162,8 @@ class KinemaApp(App[None]):
         self.logs: deque[LogEntry] = deque(maxlen=MAX_LOGS)
         self.reloads: deque[ReloadNotice] = deque(maxlen=MAX_RELOADS)
         self.node_statuses: dict[str, dict[tuple[int, str], NodeStatusUpdate]] = {}
+        # The last run of each objective that failed or was cancelled, until it runs again.
+        self.outcomes: dict[str, RunOutcome] = {}
         self.inbox = EventInbox()
         self.views: list[KinemaScreen] = []
         self.sub_title = connection.endpoint + ("  (closing stops the runtime)" if owns_runtime else "")
@@ -223,6 +226,7 @@ class KinemaApp(App[None]):
                 was_connected = self.status.state is ConnectionState.CONNECTED
                 if self.status.apply_heartbeat(event):
                     self.node_statuses.pop(event.objective_name, None)
+                    self.outcomes.pop(event.objective_name, None)
                     name = event.objective_name
                     self._views_call(lambda view: view.runtime_run_started(name))  # noqa: B023 - called now
                 if not was_connected:
@@ -257,7 +261,12 @@ class KinemaApp(App[None]):
     def add_log(self, entry: LogEntry, *, toast: bool = False) -> None:
         """Keep ``entry`` for the Logs screen and, for runtime toasts, show it as a notification."""
         self.logs.append(entry)
+        outcome = parse_outcome(entry.message) if entry.level <= LogLevel.WARN else None
+        if outcome is not None:
+            self.outcomes[outcome.objective_name] = outcome
         self._views_call(lambda view: view.runtime_log(entry))
+        if outcome is not None:
+            self._views_call(lambda view: view.runtime_run_ended(outcome))
         if toast and entry.level <= LogLevel.INFO:
             self.notify(entry.message, severity=TOAST_SEVERITY.get(entry.level, "information"))  # type: ignore[arg-type]
 
@@ -318,6 +327,17 @@ class KinemaApp(App[None]):
         if isinstance(screen, KinemaScreen):
             screen.call_runtime("Cancel the objective", self.connection.cancel_objective, announce=True)
 
+    def action_replay_latest(self) -> None:
+        """Open the newest recording (of a runtime on this machine) in the replay screen."""
+        from kinema.errors import KinemaError
+        from kinema.runtime.recordings import latest_recording
+        from kinema.tui.screens.replay import ReplayScreen
+
+        try:
+            self.push_screen(ReplayScreen(latest_recording()))
+        except KinemaError as error:
+            self.notify(str(error), title="Nothing to replay", severity="warning", timeout=8)
+
     def get_system_commands(self, screen: Screen[object]) -> Iterable[SystemCommand]:
         yield from super().get_system_commands(screen)
         for mode, label, key in SCREENS:
@@ -328,6 +348,11 @@ class KinemaApp(App[None]):
             )  # type: ignore[misc]
         yield SystemCommand(
             "Cancel objective", "Cancel the running objective (ctrl+x)", self.action_cancel_objective
+        )
+        yield SystemCommand(
+            "Replay the latest recording",
+            "Step through the newest recorded run of this machine (`kinema ui --replay FILE` for another)",
+            self.action_replay_latest,
         )
         for view in self.views:
             if isinstance(view, ObjectivesScreen):

@@ -156,8 +156,10 @@ class FakeConnection:
     def demo(cls) -> FakeConnection:
         """A small, fixed library: two objectives (one with a subtree and ports), waypoints, behaviors."""
         pick_ports = (
-            PortSummary("waypoint_name", "input", "Look at Table", "Where to look before picking"),
-            PortSummary("speed", "input", "0.5", "Velocity scale factor"),
+            PortSummary(
+                "waypoint_name", "input", "Look at Table", "Where to look before picking", "std::string"
+            ),
+            PortSummary("speed", "input", "0.5", "Velocity scale factor", "double"),
             PortSummary("grasp_pose", "output", "{grasp_pose}", "The pose that was picked"),
         )
         objectives = [

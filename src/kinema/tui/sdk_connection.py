@@ -509,6 +509,7 @@ def _objective_summary(info: Any) -> ObjectiveSummary:
                 _DIRECTIONS.get(int(port.direction), "input"),
                 str(port.default_value),
                 str(port.description),
+                str(getattr(port, "type_name", "")),
             )
             for port in info.ports
         ),

@@ -126,3 +126,26 @@ def test_test_runs_the_packages_tests(ws: Path, capsys) -> None:
     module.write_text(module.read_text().replace("int_1 + int_2", "int_1 - int_2"))
     assert main(["test", "--", "-q", *LEAN_PYTEST]) == 1
     assert "tests failed in: my_adder" in capsys.readouterr().err
+
+
+def test_test_without_pytest_says_which_command_installs_it(ws: Path, capsys, monkeypatch) -> None:
+    import importlib.util
+    import sys
+
+    real_find_spec = importlib.util.find_spec
+
+    def no_pytest(name: str, *args: object):  # type: ignore[no-untyped-def]
+        return None if name == "pytest" else real_find_spec(name, *args)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(importlib.util, "find_spec", no_pytest)
+    assert main(["test"]) == 1
+    err = capsys.readouterr().err
+    assert err.count("\n") == 1 and "Traceback" not in err
+    assert f"install it with: {sys.executable} -m pip install 'pytest>=8'" in err, err
+
+
+def test_pytest_comes_with_kinema() -> None:
+    from importlib import metadata
+
+    requirements = metadata.requires("kinema") or []
+    assert any(r.split(";")[0].strip().startswith("pytest>=") and "extra" not in r for r in requirements)

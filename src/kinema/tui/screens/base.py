@@ -21,6 +21,7 @@ if TYPE_CHECKING:
     from kinema.tui.app import KinemaApp
     from kinema.tui.blackboard_model import BlackboardDiff
     from kinema.tui.connection import LogEntry, NodeStatusBatch, ReloadNotice
+    from kinema.tui.run_outcome import RunOutcome
     from kinema.tui.runtime_status import RuntimeStatus
 
 log = logging.getLogger("kinema.tui")
@@ -133,6 +134,9 @@ class KinemaScreen(Screen[None]):
 
     def runtime_log(self, entry: LogEntry) -> None:
         """A log message or toast arrived."""
+
+    def runtime_run_ended(self, outcome: RunOutcome) -> None:
+        """An objective run failed or was cancelled (its message stays shown until dismissed)."""
 
     def runtime_reload(self, notice: ReloadNotice) -> None:
         """A hot reload happened."""

@@ -22,6 +22,7 @@ from textual.widgets.option_list import Option
 from kinema.errors import KinemaError
 from kinema.tui.connection import ConnectionState, NodeStatusBatch, ObjectiveSummary, RuntimeConnection
 from kinema.tui.messages import ObjectiveOutlineLoaded, ObjectiveRunRequested, ObjectivesLoaded
+from kinema.tui.run_outcome import RunOutcome
 from kinema.tui.screens.base import LOAD_ATTEMPTS, KinemaScreen
 from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
 from kinema.tui.widgets.override_form import OverrideForm
@@ -74,6 +75,14 @@ class ObjectivesScreen(KinemaScreen):
         Binding("m", "tab('xml')", "XML", id="objectives.xml", tooltip="The objective's XML"),
         Binding("p", "tab('parameters')", "Parameters", id="objectives.parameters", tooltip="Overrides"),
         Binding("f5", "reload", "Reload", id="objectives.reload", tooltip="List the objectives again"),
+        Binding(
+            "d",
+            "dismiss_failure",
+            "Dismiss",
+            id="objectives.dismiss",
+            tooltip="Hide the failure explanation of the last run",
+            show=False,  # the failure panel says so; the footer has no room to spare
+        ),
     ]
 
     def __init__(self) -> None:
@@ -81,6 +90,7 @@ class ObjectivesScreen(KinemaScreen):
         self.objectives: list[ObjectiveSummary] = []
         self.shown_objectives: list[ObjectiveSummary] = []
         self.selected: ObjectiveSummary | None = None
+        self.failure_shown: RunOutcome | None = None
 
     def compose_body(self) -> ComposeResult:
         with Horizontal(classes="split"):
@@ -97,6 +107,7 @@ class ObjectivesScreen(KinemaScreen):
             with Vertical(classes="main"):
                 yield Static("", id="objective-title", classes="pane-title")
                 yield Static("", id="objective-description")
+                yield Static("", id="failure-panel")
                 with TabbedContent(initial="tree", id="objective-tabs"):
                     with TabPane("Tree", id="tree"):
                         yield BehaviorTreeView(id="behavior-tree")
@@ -112,9 +123,12 @@ class ObjectivesScreen(KinemaScreen):
         ports = self.query_one("#port-table", DataTable)
         ports.add_column("Port", key="name")
         ports.add_column("Direction", key="direction")
+        ports.add_column("Type", key="type")
         ports.add_column("Default", key="default")
         ports.add_column("Description", key="description")
         self.query_one("#objective-list", OptionList).focus()
+        if self.kinema.outcomes:
+            self._show_outcome(list(self.kinema.outcomes.values())[-1])
         if self.kinema.status.state is ConnectionState.CONNECTED:
             self.action_reload()
 
@@ -210,7 +224,8 @@ class ObjectivesScreen(KinemaScreen):
         ports = self.query_one("#port-table", DataTable)
         ports.clear()
         for port in objective.ports:
-            ports.add_row(*(Text(v) for v in (port.name, port.direction, port.default, port.description)))
+            cells = (port.name, port.direction, port.type_name, port.default, port.description)
+            ports.add_row(*(Text(v) for v in cells))
         self.run_worker(self.query_one(OverrideForm).show_objective(objective), group="override-form")
         self.query_one(BehaviorTreeView).show_outline(None, "loading …")
         connection = self.kinema.connection
@@ -229,6 +244,9 @@ class ObjectivesScreen(KinemaScreen):
         latest = self.kinema.node_statuses.get(message.name)
         if latest:
             view.apply_statuses(latest.values())
+        outcome = self.kinema.outcomes.get(message.name)
+        if outcome is not None:
+            view.finish_run(outcome.outcome, outcome.message)
 
     # -- running -----------------------------------------------------------------------------------
 
@@ -276,6 +294,28 @@ class ObjectivesScreen(KinemaScreen):
     def runtime_run_started(self, objective_name: str) -> None:
         if self.selected is not None and self.selected.name == objective_name:
             self.query_one(BehaviorTreeView).reset_statuses()
+
+    def runtime_run_ended(self, outcome: RunOutcome) -> None:
+        self._show_outcome(outcome)
+        if self.selected is not None and self.selected.name == outcome.objective_name:
+            self.query_one(BehaviorTreeView).finish_run(outcome.outcome, outcome.message)
+
+    def _show_outcome(self, outcome: RunOutcome) -> None:
+        panel = self.query_one("#failure-panel", Static)
+        failed = outcome.outcome == "Failure"
+        text = Text()
+        text.append("✘ failed" if failed else "◼ cancelled", style="bold red" if failed else "bold yellow")
+        hint = "  (d dismisses; the tree below shows the failed path)" if failed else "  (d dismisses)"
+        text.append(hint + "\n", style="dim")
+        text.append(outcome.message)
+        panel.update(text)
+        panel.set_class(True, "shown")
+        panel.set_class(not failed, "cancelled")
+        self.failure_shown = outcome
+
+    def action_dismiss_failure(self) -> None:
+        self.query_one("#failure-panel", Static).set_class(False, "shown")
+        self.failure_shown = None
 
     def runtime_node_statuses(self, batch: NodeStatusBatch) -> None:
         if self.selected is not None and self.selected.name == batch.objective_name:

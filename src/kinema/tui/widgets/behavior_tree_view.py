@@ -1,7 +1,14 @@
-"""An objective's behavior tree as a tree view whose nodes show their live status."""
+"""An objective's behavior tree as a tree view whose nodes show their live status.
+
+After a run that failed or was cancelled the view explains it: nodes keep how they ended (a node that
+was RUNNING when the run stopped shows HALTED), the path from the root to the failed node is
+highlighted and expanded, the cursor is put on the failed node, and that node opens onto its ports and
+the failure message. Everything stays until the next run starts.
+"""
 
 from __future__ import annotations
 
+import re
 from collections.abc import Iterable
 from typing import TYPE_CHECKING
 
@@ -22,6 +29,16 @@ STATUS_MARK: dict[NodeStatus, tuple[str, str]] = {
     NodeStatus.SKIPPED: ("⊘", "dim cyan"),
 }
 _RESULTS = frozenset({NodeStatus.SUCCESS, NodeStatus.FAILURE, NodeStatus.SKIPPED})
+HALTED_MARK = ("◼", "bold dark_orange")
+FAILED_PATH_STYLE = "on #5f0000"
+# "objective 'X' failed: node 'Sub::3/Fail' [AlwaysFailure]: message" (the objective server's wording).
+_FAILED_NODE = re.compile(r"node '([^']+)' \[")
+
+
+def failed_node_path(message: str) -> str | None:
+    """The node path a failure message names, or None."""
+    found = _FAILED_NODE.search(message)
+    return found.group(1) if found else None
 
 
 class BehaviorTreeView(Tree["OutlineNode"]):
@@ -35,13 +52,23 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         super().__init__("(no objective selected)", id=id)
         self.outline: TreeOutline | None = None
         self.statuses: dict[int, NodeStatus] = {}
+        self.halted: set[int] = set()
+        self.failed_path: list[int] = []
+        self.failure_message = ""
         self._by_uid: dict[int, TreeNode[OutlineNode]] = {}
+        self._parents: dict[int, int | None] = {}
+        self._details: list[TreeNode[OutlineNode]] = []
 
     def show_outline(self, outline: TreeOutline | None, message: str = "") -> None:
         """Replace the tree with ``outline`` (or an empty tree labelled ``message``)."""
         self.outline = outline
         self.statuses = {}
+        self.halted = set()
+        self.failed_path = []
+        self.failure_message = ""
         self._by_uid = {}
+        self._parents = {}
+        self._details = []
         self.clear()
         if outline is None or outline.root is None:
             self.root.set_label(Text(message or "(empty tree)"))
@@ -57,6 +84,8 @@ class BehaviorTreeView(Tree["OutlineNode"]):
             else:
                 item = parent.add_leaf(label, data=node)
             self._by_uid[node.uid] = item
+            parent_node = parent.data
+            self._parents[node.uid] = parent_node.uid if parent_node is not None else None
             stack.extend((child, item) for child in reversed(node.children))
         if outline.missing_subtrees:
             self.root.set_label(
@@ -80,19 +109,116 @@ class BehaviorTreeView(Tree["OutlineNode"]):
             previous = self.statuses.get(node.uid, NodeStatus.IDLE)
             if update.status is NodeStatus.IDLE and previous in _RESULTS:
                 continue  # parents reset finished children to IDLE; keep showing how they ended
+            if update.status is NodeStatus.IDLE and previous is NodeStatus.RUNNING:
+                self.halted.add(node.uid)  # a running node reset to IDLE was halted
+            else:
+                self.halted.discard(node.uid)
             self.statuses[node.uid] = update.status
-            item = self._by_uid.get(node.uid)
-            if item is not None:
-                item.set_label(self._label(node, update.status))
+            self._relabel(node.uid)
         return found
 
     def reset_statuses(self) -> None:
         """Show every node as idle (a new run started)."""
-        for uid in list(self.statuses):
-            item = self._by_uid.get(uid)
-            if item is not None and item.data is not None:
-                item.set_label(self._label(item.data, NodeStatus.IDLE))
+        self._clear_failure()
+        uids = set(self.statuses) | self.halted
         self.statuses = {}
+        self.halted = set()
+        for uid in uids:
+            self._relabel(uid)
+
+    def finish_run(self, outcome: str, message: str = "") -> OutlineNode | None:
+        """The run ended with ``outcome`` (``Failure`` or ``Cancelled``): explain it on the tree.
+
+        Nodes still shown RUNNING were halted. For a failure, the node named by ``message`` (else the
+        deepest node reported FAILURE) is marked failed, the path to it highlighted and expanded, and it
+        opens onto its ports and ``message``. Returns the failed node, if one was found.
+        """
+        for running, status in list(self.statuses.items()):
+            if status is NodeStatus.RUNNING:
+                self.statuses[running] = NodeStatus.IDLE
+                self.halted.add(running)
+                self._relabel(running)
+        if outcome != "Failure" or self.outline is None:
+            return None
+        failed = self._failed_node(message)
+        if failed is None:
+            return None
+        self._clear_failure()
+        self.failure_message = message
+        self.statuses[failed.uid] = NodeStatus.FAILURE
+        self.halted.discard(failed.uid)
+        path: list[int] = []
+        step: int | None = failed.uid
+        while step is not None:
+            path.append(step)
+            step = self._parents.get(step)
+        self.failed_path = list(reversed(path))
+        for uid in self.failed_path:
+            self._relabel(uid)
+            item = self._by_uid.get(uid)
+            if item is not None and uid != failed.uid:
+                item.expand()
+        item = self._by_uid.get(failed.uid)
+        if item is not None:
+            self._add_details(item, failed, message)
+            self.move_cursor(item)
+        return failed
+
+    def _failed_node(self, message: str) -> OutlineNode | None:
+        assert self.outline is not None
+        path = failed_node_path(message)
+        if path:
+            for node in self.outline.nodes():
+                if node.path == path:
+                    return node
+        failed = [n for n in self.outline.nodes() if self.statuses.get(n.uid) is NodeStatus.FAILURE]
+        deepest = [
+            n for n in failed if not any(self.statuses.get(c.uid) is NodeStatus.FAILURE for c in n.children)
+        ]
+        return deepest[-1] if deepest else None
+
+    def _add_details(self, item: TreeNode[OutlineNode], node: OutlineNode, message: str) -> None:
+        item.allow_expand = True
+        lines: list[Text] = []
+        for key, value in node.attributes.items():
+            if not key.startswith("_"):
+                lines.append(Text.assemble((f"{key}", "bold"), (" = ", "dim"), value))
+        if message:
+            lines.append(Text.assemble(("why: ", "bold red"), message))
+        lines.append(Text(f"path: {node.path}" + (f"  (line {node.line})" if node.line else ""), style="dim"))
+        for line in lines:
+            self._details.append(item.add_leaf(line))
+        item.expand()
+
+    def _clear_failure(self) -> None:
+        for detail in self._details:
+            detail.remove()
+        self._details = []
+        path, self.failed_path = self.failed_path, []
+        self.failure_message = ""
+        for uid in path:
+            self._relabel(uid)
+
+    def _relabel(self, uid: int) -> None:
+        item = self._by_uid.get(uid)
+        if item is None or item.data is None:
+            return
+        label = self._label(item.data, self.statuses.get(uid, NodeStatus.IDLE), halted=uid in self.halted)
+        if uid in self.failed_path:
+            label.stylize(FAILED_PATH_STYLE)
+        item.set_label(label)
+
+    def shown_as(self, path: str) -> str:
+        """What the view shows for node ``path``: a status name, or ``HALTED``."""
+        if self.outline is not None:
+            for node in self.outline.nodes():
+                if node.path == path:
+                    return (
+                        "HALTED"
+                        if node.uid in self.halted
+                        else self.statuses.get(node.uid, NodeStatus.IDLE).name
+                    )
+        return NodeStatus.IDLE.name
 
     def status_of(self, path: str) -> NodeStatus:
         """The status shown for the node with full path ``path`` (IDLE when not reported)."""
@@ -103,14 +229,16 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         return NodeStatus.IDLE
 
     @staticmethod
-    def _label(node: OutlineNode, status: NodeStatus) -> Text:
-        mark, style = STATUS_MARK[status]
+    def _label(node: OutlineNode, status: NodeStatus, *, halted: bool = False) -> Text:
+        mark, style = HALTED_MARK if halted else STATUS_MARK[status]
         text = Text()
         text.append(f"{mark} ", style=style)
         text.append(node.type_id, style="bold" if node.is_subtree else "")
         if node.name and node.name != node.type_id:
             text.append(f" “{node.name}”", style="italic")
-        if status is not NodeStatus.IDLE:
+        if halted:
+            text.append("  HALTED", style=style)
+        elif status is not NodeStatus.IDLE:
             text.append(f"  {status.name}", style=style)  # before the ports, which may run off the edge
         ports = " ".join(f"{k}={v}" for k, v in node.attributes.items() if not k.startswith("_"))
         if ports:

@@ -1,4 +1,8 @@
-"""A form of parameter overrides built from an objective's ports: one input per input/inout port."""
+"""A form of parameter overrides built from an objective's ports: one input per input/inout port.
+
+The ports are the runtime's list of the objective's parameters (:mod:`kinema.config.objective_parameters`),
+the same as ``kinema objective show`` and the SDK's ``parameters()`` give.
+"""
 
 from __future__ import annotations
 
@@ -35,7 +39,7 @@ class OverrideForm(VerticalScroll):
             return
         ports = [p for p in objective.ports if p.direction in ("input", "inout")]
         if not ports:
-            await self.mount(Static(f"{objective.name} has no input ports to override.", classes="port-help"))
+            await self.mount(Static(f"{objective.name} takes no parameters.", classes="port-help"))
             return
         widgets: list[Widget] = [
             Static(
@@ -43,7 +47,8 @@ class OverrideForm(VerticalScroll):
             )
         ]
         for port in ports:
-            widgets.append(Label(f"{port.name} ({port.direction})", classes="port-label"))
+            kind = f"{port.type_name}, {port.direction}" if port.type_name else port.direction
+            widgets.append(Label(f"{port.name} ({kind})", classes="port-label"))
             if port.description:
                 widgets.append(Static(port.description, classes="port-help"))
             widgets.append(

@@ -1,0 +1,162 @@
+"""The TUI explains a failed or cancelled run: statuses stay, the failed path is shown, the message stays."""
+
+from __future__ import annotations
+
+from textual.pilot import Pilot
+from textual.widgets import RichLog, Static
+from tui_pilot_harness import drive, settle
+
+from kinema.tui.connection import Heartbeat, LogEntry, LogLevel, NodeStatus, NodeStatusBatch, NodeStatusUpdate
+from kinema.tui.fake_connection import FakeConnection
+from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
+
+# Pick Object's nodes as the engine numbers them (see fake_connection._PICK_XML).
+SEQUENCE = (1, "TopLevelSequence", "Sequence", "TopLevelSequence")
+MOVE = (2, "MoveToWaypoint::2", "MoveToWaypoint", "")
+WAIT = (3, "Wait and Log::3", "SubTree", "")
+SLEEP = (5, "Wait and Log::3/Sleep::5", "Sleep", "")
+FALLBACK = (7, "Fallback::7", "Fallback", "")
+FAILING = (8, "AlwaysFailure::8", "AlwaysFailure", "")
+SCRIPT = (9, "Script::9", "Script", "")
+FAILED = (
+    "objective 'Pick Object' failed (FAILURE): objective 'Pick Object' failed: node 'Script::9' [Script]: "
+    "the script could not assign grasp_pose: the blackboard entry has type Pose, not std::string " * 2
+).strip()
+
+
+def update(node: tuple[int, str, str, str], status: NodeStatus, previous: NodeStatus = NodeStatus.IDLE):
+    return NodeStatusUpdate(*node, status, previous)
+
+
+def failed_run(fake: FakeConnection) -> None:
+    """A run of Pick Object whose Script fails; parents reset their children to IDLE as the run ends."""
+    fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
+    fake.emit(
+        NodeStatusBatch(
+            "Pick Object",
+            (
+                update(SEQUENCE, NodeStatus.RUNNING),
+                update(MOVE, NodeStatus.SUCCESS),
+                update(WAIT, NodeStatus.SUCCESS),
+                update(FAILING, NodeStatus.FAILURE),
+                update(SCRIPT, NodeStatus.FAILURE),
+                update(FALLBACK, NodeStatus.FAILURE),
+                update(SEQUENCE, NodeStatus.FAILURE, NodeStatus.RUNNING),
+                update(MOVE, NodeStatus.IDLE, NodeStatus.SUCCESS),
+                update(SCRIPT, NodeStatus.IDLE, NodeStatus.FAILURE),
+                update(FALLBACK, NodeStatus.IDLE, NodeStatus.FAILURE),
+                update(SEQUENCE, NodeStatus.IDLE, NodeStatus.FAILURE),
+            ),
+        )
+    )
+    fake.emit(Heartbeat(11.0, "Pick Object", "Failure"))
+    fake.emit(LogEntry(FAILED, LogLevel.ERROR, 1.0, "objective_server"))
+
+
+def detail_lines(view: BehaviorTreeView) -> list[str]:
+    return [str(item.label) for item in view._details]
+
+
+def test_a_failed_run_keeps_statuses_highlights_the_path_and_explains_the_node(fake: FakeConnection) -> None:
+    async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
+        failed_run(fake)
+        await settle(pilot)
+        view = app.screen.query_one(BehaviorTreeView)
+        assert view.shown_as("Script::9") == "FAILURE"
+        assert view.shown_as("Fallback::7") == "FAILURE"
+        assert view.shown_as("MoveToWaypoint::2") == "SUCCESS"
+        assert view.failed_path == [1, 7, 9]
+        assert view.cursor_node is not None and view.cursor_node.data.path == "Script::9"
+        lines = detail_lines(view)
+        assert "code = grasp_pose := 'on the table'" in lines
+        assert any(line.startswith("why: objective 'Pick Object' failed") for line in lines)
+        panel = app.screen.query_one("#failure-panel", Static)
+        assert panel.has_class("shown") and "node 'Script::9'" in str(panel.render())
+        # The failure stays: a later heartbeat (Idle) changes nothing; d dismisses the panel only.
+        fake.emit(Heartbeat(13.0, "Pick Object", "Idle"))
+        await settle(pilot)
+        assert panel.has_class("shown") and view.shown_as("Script::9") == "FAILURE"
+        await pilot.press("d")
+        await settle(pilot)
+        assert not panel.has_class("shown")
+        assert view.shown_as("Script::9") == "FAILURE", "the tree keeps explaining until the next run"
+        # A new run starts clean.
+        fake.emit(Heartbeat(20.0, "Pick Object", "Running"))
+        await settle(pilot)
+        assert view.failed_path == [] and detail_lines(view) == []
+        assert view.shown_as("Script::9") == "IDLE"
+
+    drive(fake, scenario)
+
+
+def test_a_cancelled_run_shows_halted_nodes(fake: FakeConnection) -> None:
+    async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
+        fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
+        fake.emit(
+            NodeStatusBatch(
+                "Pick Object",
+                (
+                    update(SEQUENCE, NodeStatus.RUNNING),
+                    update(MOVE, NodeStatus.SUCCESS),
+                    update(WAIT, NodeStatus.RUNNING),
+                    update(SLEEP, NodeStatus.RUNNING),
+                ),
+            )
+        )
+        fake.emit(NodeStatusBatch("Pick Object", (update(SLEEP, NodeStatus.IDLE, NodeStatus.RUNNING),)))
+        fake.emit(Heartbeat(11.0, "Pick Object", "Cancelled"))
+        fake.emit(LogEntry("objective 'Pick Object' was cancelled: cancelled", LogLevel.WARN, 1.0))
+        await settle(pilot)
+        view = app.screen.query_one(BehaviorTreeView)
+        assert view.shown_as("Wait and Log::3/Sleep::5") == "HALTED"
+        # Nodes whose halt was never reported (the run ended) show HALTED too, not RUNNING.
+        assert view.shown_as("TopLevelSequence") == "HALTED"
+        assert view.shown_as("MoveToWaypoint::2") == "SUCCESS"
+        assert view.failed_path == []
+        panel = app.screen.query_one("#failure-panel", Static)
+        assert panel.has_class("shown") and panel.has_class("cancelled")
+
+    drive(fake, scenario)
+
+
+def test_a_failure_whose_node_never_reported_it_is_still_shown(fake: FakeConnection) -> None:
+    """An exception in a behavior ends the run before the node's FAILURE reaches the UI."""
+
+    async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
+        fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
+        fake.emit(
+            NodeStatusBatch(
+                "Pick Object",
+                (
+                    update(SEQUENCE, NodeStatus.RUNNING),
+                    update(WAIT, NodeStatus.RUNNING),
+                    update(SLEEP, NodeStatus.RUNNING),
+                ),
+            )
+        )
+        message = (
+            "objective 'Pick Object' failed (FAILURE): "
+            "Exception in node 'Wait and Log::3/Sleep::5' [Sleep]: ValueError: no clock"
+        )
+        fake.emit(LogEntry(message, LogLevel.ERROR, 1.0))
+        await settle(pilot)
+        view = app.screen.query_one(BehaviorTreeView)
+        assert view.shown_as("Wait and Log::3/Sleep::5") == "FAILURE"
+        assert view.shown_as("TopLevelSequence") == "HALTED"
+        assert view.failed_path == [1, 3, 4, 5]
+
+    drive(fake, scenario)
+
+
+def test_long_log_lines_wrap(fake: FakeConnection) -> None:
+    async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
+        fake.emit(LogEntry(FAILED, LogLevel.ERROR, 1.0, "objective_server"))
+        await pilot.press("5")
+        await settle(pilot)
+        panel = app.screen.query_one(RichLog)
+        assert len(FAILED) > 2 * panel.size.width
+        assert len(panel.lines) >= 2, "the message is wrapped onto several lines, not cut at the edge"
+        shown = "".join(line.text for line in panel.lines)
+        assert "not std::string" in shown.split("std::string", 1)[1], "the end of the message is shown"
+
+    drive(fake, scenario)
