@@ -9,6 +9,7 @@ from __future__ import annotations
 import asyncio
 import concurrent.futures
 import threading
+import time
 from collections.abc import Callable, Coroutine
 from typing import Any
 
@@ -22,6 +23,7 @@ class WorkRunner:
         self._lock = threading.Lock()
         self._loop: asyncio.AbstractEventLoop | None = None
         self._pool: concurrent.futures.ThreadPoolExecutor | None = None
+        self._halted: list[tuple[concurrent.futures.Future[Any], str, str, float]] = []
 
     def run_coroutine(self, coroutine: Coroutine[Any, Any, Any]) -> concurrent.futures.Future[Any]:
         """Schedule ``coroutine`` on the shared event loop."""
@@ -36,6 +38,18 @@ class WorkRunner:
                 )
             pool = self._pool
         return pool.submit(function)
+
+    def note_halted(self, future: concurrent.futures.Future[Any], behavior: str, node_path: str) -> None:
+        """Remember work whose behavior was halted while it still ran (reported until it returns)."""
+        with self._lock:
+            self._halted.append((future, behavior, node_path, time.monotonic()))
+
+    def halted_still_running(self) -> list[tuple[str, str, float]]:
+        """``(behavior, node path, seconds since the halt)`` of halted work that has not returned yet."""
+        now = time.monotonic()
+        with self._lock:
+            self._halted = [item for item in self._halted if not item[0].done()]
+            return [(behavior, path, now - since) for _future, behavior, path, since in self._halted]
 
     def _event_loop(self) -> asyncio.AbstractEventLoop:
         with self._lock:
