@@ -69,6 +69,8 @@ WATCHDOG_REPORT_S = 1.0
 # server abandon that thread. With the watchdog's period, cancel wins within a tick period plus 100 ms.
 ABANDON_AFTER_S = 0.07
 WATCHDOG_PERIOD_S = 0.02
+# The halt of an abandoned tree waits this long for its thread to come back from behavior code first.
+HALT_WAITS_FOR_ABANDONED_S = 0.5
 # A stuck behavior is logged again this often while it stays stuck.
 WATCHDOG_LOG_EVERY_S = 10.0
 
@@ -265,7 +267,10 @@ class _Worker:
         self.busy_since: float | None = None
         self.busy_stage = ""
         self.stuck: StuckCode | None = None
+        self.stuck_since = 0.0
         self.logged_at = 0.0
+        # Set whenever the thread comes back from behavior code (before it waits for the state lock).
+        self.returned = threading.Event()
 
     @property
     def name(self) -> str:
@@ -332,7 +337,7 @@ class ObjectiveServer:
         self._tree: Tree | None = None
         self._run: ObjectiveRun | None = None
         # Set when the current run's tick thread was abandoned in its behavior code.
-        self._run_stuck: StuckCode | None = None
+        self._run_stuck: _Worker | None = None
         # Requests taken from the inbox and not yet done; the watchdog queues them again for the thread
         # that replaces an abandoned one.
         self._in_hand: list[ObjectiveRun | _Cancel | _Call] = []
@@ -412,7 +417,7 @@ class ObjectiveServer:
             warnings.append(worker.stuck.describe(now - worker.busy_since))
         for old in list(self._abandoned):
             stuck = old.stuck or StuckCode("", "", old.busy_stage)
-            since = old.busy_since if old.busy_since is not None else old.abandoned_at
+            since = old.stuck_since
             warnings.append(
                 f"abandoned tick thread {old.name}: {stuck.describe(now - since)} "
                 f"(abandoned {now - old.abandoned_at:.1f} s ago)"
@@ -501,10 +506,12 @@ class ObjectiveServer:
         """Run behavior code with the state lock released, so that the watchdog can take over."""
         worker.busy_stage = stage
         worker.busy_since = time.monotonic()
+        worker.returned.clear()
         self._state_lock.release()
         try:
             yield
         finally:
+            worker.returned.set()
             self._state_lock.acquire()
             worker.busy_since = None
             worker.stuck = None
@@ -596,6 +603,7 @@ class ObjectiveServer:
             assert worker.thread is not None
             stuck = stuck_code(worker.thread.ident, worker.busy_stage)
             worker.stuck = stuck
+            worker.stuck_since = busy_since
             worker.abandoned = True
             worker.abandoned_at = time.monotonic()
             self._abandoned.append(worker)
@@ -606,13 +614,13 @@ class ObjectiveServer:
                 worker.name,
             )
             if self._run is not None:
-                self._run_stuck = stuck
+                self._run_stuck = worker
             pending: list[ObjectiveRun | _Cancel | _Call] = []
             if self._in_hand_start is not None:
                 pending.append(self._in_hand_start)
             for item in self._in_hand:
                 if isinstance(item, _Call) and item is self._in_hand[0] and worker.busy_stage == _CALL_STAGE:
-                    item.error = KinemaError(f"the tick thread was abandoned in this request: {stuck}")
+                    item.error = KinemaError(f"the tick thread was abandoned in it: {stuck.describe(0.0)}")
                     item.done.set()
                 else:
                     pending.append(item)
@@ -625,11 +633,13 @@ class ObjectiveServer:
         finally:
             self._state_lock.release()
 
-    def _release_stuck_tree(self, tree: Tree) -> None:
+    def _release_stuck_tree(self, tree: Tree, worker: _Worker) -> None:
         """Disarm a tree whose thread was abandoned and halt it on a thread of its own.
 
         Every node of it fails at once from now on, so the stuck call, if it returns, cannot start
-        anything new (a motion, a goal) after the cancel; the halt stops what its other nodes run.
+        anything new (a motion, a goal) after the cancel; the halt stops what its other nodes run. It
+        waits a moment for the abandoned thread to come back, so that a tick that was only slow (a
+        loaded machine) is never halted while it still runs.
         """
 
         def refuse(_node: Any) -> NodeStatus:
@@ -639,6 +649,7 @@ class ObjectiveServer:
             node.set_pre_tick_callback(refuse)
 
         def halt() -> None:
+            worker.returned.wait(HALT_WAITS_FOR_ABANDONED_S)
             try:
                 tree.halt_tree()
             except BaseException:
@@ -879,19 +890,14 @@ class ObjectiveServer:
         if stuck is not None:
             # Its tick thread was abandoned in behavior code: never wait for that tree again.
             if tree is not None:
-                self._release_stuck_tree(tree)
-            seconds = time.monotonic() - self._abandoned_since(stuck)
-            reason = f"{reason} ({stuck.describe(seconds)}; its tick thread was abandoned)"
+                self._release_stuck_tree(tree, stuck)
+            code = stuck.stuck or StuckCode("", "", stuck.busy_stage)
+            seconds = time.monotonic() - stuck.stuck_since
+            reason = f"{reason} ({code.describe(seconds)}; its tick thread was abandoned)"
         elif tree is not None:
             self._halt_quietly(worker, tree)
             self._flush_node_changes(run)
         self._end(run, make(reason, run.objective_name), ObjectiveStatus.CANCELLED)
-
-    def _abandoned_since(self, stuck: StuckCode) -> float:
-        for old in self._abandoned:
-            if old.stuck is stuck and old.busy_since is not None:
-                return old.busy_since
-        return time.monotonic()
 
     def _end(self, run: ObjectiveRun, result: ObjectiveResult, status: ObjectiveStatus) -> None:
         self._tree = None

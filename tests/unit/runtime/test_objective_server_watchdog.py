@@ -59,6 +59,27 @@ class IgnoresHalt(AsyncBehavior):
         return True
 
 
+EVENTS: list[str] = []
+
+
+class Moves(AsyncBehavior):
+    """Stands for a motion: runs until halted, and records the halt."""
+
+    def do_work(self) -> bool:
+        while not self.stop_requested():
+            time.sleep(0.005)
+        return True
+
+    def do_halt(self) -> None:
+        EVENTS.append("motion halted")
+
+
+class Records(SyncBehavior):
+    def tick(self) -> NodeStatus:
+        EVENTS.append("ticked after the stuck node")
+        return NodeStatus.SUCCESS
+
+
 class Exits(SyncBehavior):
     def tick(self) -> NodeStatus:
         raise SystemExit(3)
@@ -84,7 +105,18 @@ class AsyncOk(AsyncBehavior):
         return True
 
 
-BEHAVIORS = [BlockingTick, BlockingHalt, IgnoresHalt, Exits, Interrupted, GeneratorExits, AsyncExits, AsyncOk]
+BEHAVIORS = [
+    BlockingTick,
+    BlockingHalt,
+    IgnoresHalt,
+    Moves,
+    Records,
+    Exits,
+    Interrupted,
+    GeneratorExits,
+    AsyncExits,
+    AsyncOk,
+]
 
 
 def _tree(node: str, tree_id: str = "T") -> str:
@@ -212,6 +244,36 @@ def test_a_blocking_halt_does_not_block_the_cancel(server: ObjectiveServer) -> N
     assert result is not None and result.cancelled, result
     assert "behavior 'BlockingHalt' (halts slowly) has been in" in result.error_message, result
     assert _xml(server, QUICK).wait(5) == ObjectiveResult.success("Quick")
+
+
+def test_the_abandoned_tree_stops_its_motion_and_starts_nothing_new(server: ObjectiveServer) -> None:
+    EVENTS.clear()
+    xml = _tree(
+        '<Parallel success_count="2" failure_count="1"><Moves/>'
+        '<Sequence><BlockingTick name="stuck"/><Records/></Sequence></Parallel>'
+    )
+    run = _xml(server, xml)
+    _wait(lambda: _running(server), "the objective to run")
+    time.sleep(0.05)
+    assert server.cancel(timeout=5)
+    result = run.wait(5)
+    assert result is not None and result.cancelled, result
+    # The motion beside the stuck node is halted (after a moment's grace for the stuck thread).
+    _wait(lambda: "motion halted" in EVENTS, "the motion of the abandoned tree to be halted")
+    # When the stuck tick returns, the rest of that tree no longer runs.
+    RELEASE.set()
+    _wait(lambda: not any("abandoned" in w for w in server.health().warnings), "the abandoned thread to end")
+    assert "ticked after the stuck node" not in EVENTS, EVENTS
+
+
+def test_a_new_objective_preempts_a_tree_whose_halt_blocks(server: ObjectiveServer) -> None:
+    run = _xml(server, _tree('<BlockingHalt name="halts slowly"/>'))
+    _wait(lambda: _running(server), "the objective to run")
+    time.sleep(0.05)
+    assert _xml(server, QUICK).wait(5) == ObjectiveResult.success("Quick")
+    result = run.result
+    assert result is not None and result.cancelled and "newer objective" in result.error_message, result
+    assert "behavior 'BlockingHalt' (halts slowly)" in result.error_message, result.error_message
 
 
 def test_do_work_that_ignores_halt_is_reported(server: ObjectiveServer) -> None:
