@@ -110,8 +110,12 @@ def _violations(
 def _lead_in(goal: TrajectoryGoal, actual: np.ndarray, actual_velocity: np.ndarray) -> float:
     """Seconds to add before ``goal``'s first point so that the arm can get there from its actual state.
 
-    0 when the arm is at the first point and moves as it says (within the goal's goal tolerances).
+    0 when the arm is at the first point and moves as it says (within the goal's goal tolerances), and
+    when the first point is given a time of its own to be reached (ros2_control then interpolates from
+    the commanded state over that time, and so does this controller).
     """
+    if float(goal.times[0]) >= LEAD_IN_MIN:
+        return 0.0
     first = goal.positions[0]
     first_velocity = goal.velocities[0] if goal.velocities is not None else np.zeros_like(first)
     gap = np.abs(actual - first)
@@ -122,8 +126,7 @@ def _lead_in(goal: TrajectoryGoal, actual: np.ndarray, actual_velocity: np.ndarr
         LEAD_IN_MIN,
         1.5 * float(gap.max()) / LEAD_IN_SPEED + float(speed_gap.max()) / LEAD_IN_ACCELERATION,
     )
-    # A first point later than 0 already leads in over its own time.
-    return max(0.0, needed - float(goal.times[0]))
+    return needed - float(goal.times[0])
 
 
 class JointTrajectoryController:
