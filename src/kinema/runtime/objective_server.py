@@ -686,6 +686,9 @@ class ObjectiveServer:
                 stopping = self._stopping
                 inbox = list(self._inbox)
                 self._inbox.clear()
+                # Taken: the requests are being served now (a halt they need counts again as waiting).
+                if not stopping:
+                    self._waiting_since = None
             if stopping:
                 self._finish_current(worker, ObjectiveResult.preempted, "the objective server stopped")
                 for item in inbox:
@@ -696,10 +699,6 @@ class ObjectiveServer:
             if start is not None:
                 self._load(worker, start)
                 next_tick = time.monotonic()
-            with self._wake:
-                # What was waiting is served; what arrived meanwhile waits from now on.
-                waiting = any(not isinstance(item, _Call) for item in self._inbox) or self._stopping
-                self._waiting_since = time.monotonic() if waiting else None
             if self._run_stuck is not None and self._run is not None:
                 # A stuck run that no request ended (a cancel of another run): it can never tick again.
                 self._finish_current(worker, ObjectiveResult.preempted, "its tick thread was abandoned")
@@ -895,7 +894,15 @@ class ObjectiveServer:
             seconds = time.monotonic() - stuck.stuck_since
             reason = f"{reason} ({code.describe(seconds)}; its tick thread was abandoned)"
         elif tree is not None:
+            # A cancel, a newer request or a stop waits for this halt: the watchdog gives it as long
+            # as it gives a pending request.
+            with self._wake:
+                if self._waiting_since is None:
+                    self._waiting_since = time.monotonic()
             self._halt_quietly(worker, tree)
+            with self._wake:
+                waiting = any(not isinstance(item, _Call) for item in self._inbox) or self._stopping
+                self._waiting_since = time.monotonic() if waiting else None
             self._flush_node_changes(run)
         self._end(run, make(reason, run.objective_name), ObjectiveStatus.CANCELLED)
 
