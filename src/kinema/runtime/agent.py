@@ -529,8 +529,12 @@ class Agent:
         from kinema.runtime import quick_protocol as quick
 
         status, name = self.server.status
+        warnings = list(self.server.health().warnings)
         with query:
-            query.reply(query.key_expr, quick.encode({"status": str(status), "objective_name": name}))
+            query.reply(
+                query.key_expr,
+                quick.encode({"status": str(status), "objective_name": name, "warnings": warnings}),
+            )
 
     # -- library -----------------------------------------------------------------------------------
 

@@ -3,6 +3,8 @@ code that never returns; the watchdog's report reaches the health topic beside t
 
 from __future__ import annotations
 
+import subprocess
+import sys
 import threading
 import time
 from collections.abc import Callable, Iterator
@@ -77,12 +79,14 @@ def test_an_endless_repeat_sent_to_do_objective_is_cancelled(client: ObjectiveCl
 
 
 @pytest.fixture
-def stuck_runtime() -> Iterator[tuple[ObjectiveClient, ObjectiveServer, list[str], list[str]]]:
+def stuck_runtime() -> Iterator[tuple[ObjectiveClient, ObjectiveServer, list[str], list[str], str]]:
     """An agent in this process whose library knows BlockingTick, on a private network."""
-    from kinema.transport import Node, open_session
+    from kinema.transport import Node, free_endpoint, host_router, open_session
 
     RELEASE.clear()
-    session = open_session([])
+    endpoint = free_endpoint()
+    router = host_router(endpoint)
+    session = open_session(endpoint)
     factory = registry_of([BlockingTick]).create_factory(BehaviorContext.offline())
     server = ObjectiveServer(FactoryTreeSource(factory), watchdog_report_s=0.3)
     agent = Agent(session, server)
@@ -99,21 +103,32 @@ def stuck_runtime() -> Iterator[tuple[ObjectiveClient, ObjectiveServer, list[str
     listener.create_subscription(names.LOG_TYPE, names.LOG, lambda m: logs.append(str(m.message)))
     try:
         client.wait_for_runtime()
-        yield client, server, warnings, logs
+        yield client, server, warnings, logs, endpoint
     finally:
         RELEASE.set()
         client.close()
         listener.close()
         agent.close()
         session.close()
+        router.close()
 
 
 def test_a_stuck_behavior_is_reported_and_cancel_still_ends_the_objective(stuck_runtime: Any) -> None:
-    client, server, warnings, logs = stuck_runtime
+    client, server, warnings, logs, endpoint = stuck_runtime
     handle = client.start(xml=STUCK)
     expected = "behavior 'BlockingTick' (reads a socket) has been in tick for"
     _wait(lambda: any(expected in w for w in warnings), f"the watchdog's report on {names.HEALTH}")
     _wait(lambda: any("watchdog: behavior 'BlockingTick'" in line for line in logs), "the report in the log")
+    # `kinema objective status` says so too.
+    shown = subprocess.run(
+        [sys.executable, "-m", "kinema", "objective", "status", "--connect", endpoint],
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert shown.returncode == 0, shown.stderr
+    assert "Running: Stuck" in shown.stdout, shown.stdout
+    assert f"warning: {expected}" in shown.stdout, shown.stdout
     started = time.monotonic()
     assert handle.cancel(), "the agent refused the cancel"
     result = handle.result(10)
@@ -127,7 +142,7 @@ def test_a_stuck_behavior_is_reported_and_cancel_still_ends_the_objective(stuck_
 
 
 def test_a_new_objective_preempts_a_stuck_behavior(stuck_runtime: Any) -> None:
-    client, _server, _warnings, _logs = stuck_runtime
+    client, _server, _warnings, _logs, _endpoint = stuck_runtime
     handle = client.start(xml=STUCK)
     _wait(_running(client, "Stuck"), "the stuck objective to run")
     assert client.do_xml(QUICK, timeout=10).succeeded
