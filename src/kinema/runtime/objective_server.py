@@ -269,8 +269,9 @@ class _Worker:
         self.stuck: StuckCode | None = None
         self.stuck_since = 0.0
         self.logged_at = 0.0
-        # Set whenever the thread comes back from behavior code (before it waits for the state lock).
+        # Set while the thread is outside behavior code (set again before it waits for the state lock).
         self.returned = threading.Event()
+        self.returned.set()
 
     @property
     def name(self) -> str:
@@ -543,10 +544,12 @@ class ObjectiveServer:
         log.critical("%s", self._last_death, exc_info=error)
         if self._worker is worker:
             self._replacements += 1
-            run = self._run
+            run, tree = self._run, self._tree
+            if tree is not None:
+                # Whatever its nodes run (a motion) must still stop.
+                self._release_stuck_tree(tree, worker)
             if run is not None:
                 message = f"objective {run.objective_name!r} stopped: {self._last_death}"
-                self._tree = None
                 self._end(run, ObjectiveResult.failure(message, run.objective_name), ObjectiveStatus.FAILURE)
             # A new thread takes over the requests at once (the watchdog would, a moment later).
             if not self._stopping:

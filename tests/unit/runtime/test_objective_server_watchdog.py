@@ -342,3 +342,25 @@ def test_a_dead_tick_thread_is_reported_and_replaced() -> None:
         assert any("died: SystemExit: listener bug" in w for w in health.warnings), health
         _wait(lambda: server.health().tick_thread_alive, "a new tick thread")
         assert _xml(server, QUICK).wait(5) == ObjectiveResult.success("Quick")
+
+
+def test_a_tick_thread_dying_mid_motion_still_halts_the_motion() -> None:
+    EVENTS.clear()
+
+    class Killer:
+        fired = False
+
+        def on_status(self, *args: object) -> None: ...
+        def on_blackboard(self, *args: object) -> None: ...
+        def on_run_finished(self, *args: object) -> None: ...
+        def on_node_status(self, name: str, changes: list[object]) -> None:
+            if not Killer.fired:
+                Killer.fired = True
+                raise KeyboardInterrupt
+
+    factory = registry_of(BEHAVIORS).create_factory(BehaviorContext.offline())
+    with ObjectiveServer(FactoryTreeSource(factory), listeners=[Killer()]) as server:
+        result = _xml(server, _tree("<Moves/>")).wait(5)
+        assert result is not None and result.failed and "died: KeyboardInterrupt" in result.error_message
+        _wait(lambda: "motion halted" in EVENTS, "the motion of the dead thread's tree to be halted")
+        assert _xml(server, QUICK).wait(5) == ObjectiveResult.success("Quick")
