@@ -334,6 +334,8 @@ class ObjectiveServer:
         self._last_death = ""
         self._stopped = threading.Event()
         self._watchdog: threading.Thread | None = None
+        # What blocked each retired event loop of async behaviors (by thread id).
+        self._loop_codes: dict[int | None, StuckCode] = {}
         # Owned by the tick thread:
         self._tree: Tree | None = None
         self._run: ObjectiveRun | None = None
@@ -424,6 +426,11 @@ class ObjectiveServer:
                 f"(abandoned {now - old.abandoned_at:.1f} s ago)"
             )
         warnings.extend(_halted_work_warnings(self._watchdog_report))
+        runner = _work_runner()
+        if runner is not None:
+            for seconds, ident in runner.retired_loops():
+                code = self._loop_codes.get(ident) or StuckCode("", "", "a coroutine")
+                warnings.append(f"{code.describe(seconds)}, {_LOOP_BLOCKED}")
         if self._last_death:
             warnings.append(self._last_death)
         if not alive and self._watchdog is not None and not self._stopping:
@@ -565,7 +572,20 @@ class ObjectiveServer:
             except Exception:
                 log.exception("the tick watchdog raised")
 
+    def _watch_event_loop(self) -> None:
+        """A coroutine that blocks the async behaviors' event loop: report it, move on to a fresh loop."""
+        runner = _work_runner()
+        blocked = runner.blocked_loop() if runner is not None else None
+        if blocked is None or blocked[0] < self._watchdog_report:
+            return
+        seconds, ident = blocked
+        code = stuck_code(ident, "a coroutine")
+        self._loop_codes[ident] = code
+        runner.retire_blocked_loop()
+        log.error("watchdog: %s, %s", code.describe(seconds), _LOOP_BLOCKED)
+
     def _watch_once(self) -> None:
+        self._watch_event_loop()
         now = time.monotonic()
         worker = self._worker
         if worker is None:
@@ -1029,15 +1049,24 @@ def _location_of(error: BaseException) -> str:
     return f" at {location}" if location is not None else ""
 
 
-def _halted_work_warnings(after_s: float) -> list[str]:
-    """Behaviors whose ``do_work`` still runs ``after_s`` after they were halted."""
+_LOOP_BLOCKED = "blocking the event loop async behaviors share (new ones run on a fresh loop)"
+
+
+def _work_runner() -> Any:
+    """The runner of AsyncBehavior work, or None while no behavior ever ran work off the tick thread."""
     import sys
 
-    runner = sys.modules.get("kinema.behaviors.work_runner")
-    if runner is None:  # no behavior ever ran work off the tick thread
+    module = sys.modules.get("kinema.behaviors.work_runner")
+    return module.RUNNER if module is not None else None
+
+
+def _halted_work_warnings(after_s: float) -> list[str]:
+    """Behaviors whose ``do_work`` still runs ``after_s`` after they were halted."""
+    runner = _work_runner()
+    if runner is None:
         return []
     return [
         f"behavior '{behavior}' ({path}) has ignored a halt for {seconds:.1f} s: its do_work still runs"
-        for behavior, path, seconds in runner.RUNNER.halted_still_running()
+        for behavior, path, seconds in runner.halted_still_running()
         if seconds >= after_s
     ]

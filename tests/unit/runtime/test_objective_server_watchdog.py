@@ -80,6 +80,14 @@ class Records(SyncBehavior):
         return NodeStatus.SUCCESS
 
 
+class BlocksTheLoop(AsyncBehavior):
+    """An ``async def`` that blocks instead of awaiting: every async behavior of the process stalls."""
+
+    async def do_work(self) -> bool:
+        RELEASE.wait(30)
+        return True
+
+
 class Exits(SyncBehavior):
     def tick(self) -> NodeStatus:
         raise SystemExit(3)
@@ -116,6 +124,7 @@ BEHAVIORS = [
     GeneratorExits,
     AsyncExits,
     AsyncOk,
+    BlocksTheLoop,
 ]
 
 
@@ -288,6 +297,21 @@ def test_do_work_that_ignores_halt_is_reported(server: ObjectiveServer) -> None:
     assert _xml(server, QUICK).wait(5) == ObjectiveResult.success("Quick")
     RELEASE.set()
     _wait(lambda: not any("ignored a halt" in w for w in server.health().warnings), "the work to end")
+
+
+def test_a_coroutine_blocking_the_event_loop_is_reported_and_async_work_goes_on(
+    server: ObjectiveServer,
+) -> None:
+    run = _xml(server, _tree('<BlocksTheLoop name="sleeps in async"/>'))
+    expected = "behavior 'BlocksTheLoop' (sleeps in async) has been in do_work for"
+    _wait(lambda: any(expected in w for w in server.health().warnings), "the report of the blocked loop")
+    assert server.cancel(timeout=5)
+    result = run.wait(5)
+    assert result is not None and result.cancelled, result
+    # Other async behaviors run on a fresh loop meanwhile.
+    assert _xml(server, _tree("<AsyncOk/>")).wait(5) == ObjectiveResult.success("T")
+    RELEASE.set()
+    _wait(lambda: not any(expected in w for w in server.health().warnings), "the blocked loop to run again")
 
 
 # -- 3. BaseExceptions from behavior code -------------------------------------------------------------
