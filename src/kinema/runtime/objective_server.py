@@ -71,6 +71,9 @@ ABANDON_AFTER_S = 0.07
 WATCHDOG_PERIOD_S = 0.02
 # The halt of an abandoned tree waits this long for its thread to come back from behavior code first.
 HALT_WAITS_FOR_ABANDONED_S = 0.5
+# A tree that re-ticks itself for a whole tick period pauses this long before the tick it owes, so that
+# it cannot starve the transport and a simulator running in the same process.
+RETICK_PAUSE_S = 0.005
 # A stuck behavior is logged again this often while it stays stuck.
 WATCHDOG_LOG_EVERY_S = 10.0
 
@@ -687,7 +690,12 @@ class ObjectiveServer:
         while True:
             with self._wake:
                 if self._tree is not None and self._tree.retick_due:
+                    # A tree that re-ticks itself used up a whole tick: before the tick it owes, give
+                    # the process's other threads (the transport, a simulator) the interpreter for a
+                    # moment, unless a request already waits.
                     timeout: float | None = 0.0
+                    if not self._inbox and not self._stopping:
+                        self._pause(RETICK_PAUSE_S)
                 elif self._tree is not None:
                     timeout = max(0.0, next_tick - time.monotonic())
                 elif self._ended_at is not None:
@@ -695,14 +703,7 @@ class ObjectiveServer:
                 else:
                     timeout = None
                 if not self._woken and not self._stopping and (timeout is None or timeout > 0):
-                    self._state_lock.release()
-                    try:
-                        self._wake.wait(timeout)
-                    finally:
-                        # Never wait for the state lock while holding the condition's lock.
-                        self._wake.release()
-                        self._state_lock.acquire()
-                        self._wake.acquire()
+                    self._pause(timeout)
                 self._woken = False
                 self._interrupt = False
                 tick_now, self._tick_now = self._tick_now, False
@@ -740,6 +741,19 @@ class ObjectiveServer:
                     # Fell behind (a slow tick): do not try to catch up with a burst of ticks.
                     next_tick = now + self._period
                 self._tick(worker)
+
+    def _pause(self, seconds: float | None) -> None:
+        """Wait on the request condition (its lock held) without the state lock; a request ends it.
+
+        The state lock is taken back before the condition's (never wait for it holding the other).
+        """
+        self._state_lock.release()
+        try:
+            self._wake.wait(seconds)
+        finally:
+            self._wake.release()
+            self._state_lock.acquire()
+            self._wake.acquire()
 
     def _reject(self, item: ObjectiveRun | _Cancel | _Call, reason: str) -> None:
         if isinstance(item, ObjectiveRun):
