@@ -129,6 +129,17 @@ def test_a_stuck_behavior_is_reported_and_cancel_still_ends_the_objective(stuck_
     assert shown.returncode == 0, shown.stderr
     assert "Running: Stuck" in shown.stdout, shown.stdout
     assert f"warning: {expected}" in shown.stdout, shown.stdout
+    # And the TUI's connection hands the warning to the status bar with the heartbeats.
+    from kinema.tui.connection import Heartbeat
+    from kinema.tui.sdk_connection import SdkConnection
+
+    beats: list[Heartbeat] = []
+    connection = SdkConnection(endpoint)
+    connection.open(lambda event: beats.append(event) if isinstance(event, Heartbeat) else None)
+    try:
+        _wait(lambda: any(expected in w for b in beats for w in b.warnings), "a heartbeat with the warning")
+    finally:
+        connection.close()
     started = time.monotonic()
     assert handle.cancel(), "the agent refused the cancel"
     result = handle.result(10)
