@@ -215,3 +215,16 @@ def test_the_behavior_catalog_lists_plugins_and_survives_a_config_that_is_not_he
     elsewhere._listener = events.append
     assert "Sequence" in {b.id for b in elsewhere.list_behaviors()}
     assert any(isinstance(e, LogEntry) and "config_of_another_machine" in e.message for e in events)
+
+
+def test_the_status_line_shows_the_watchdog_warning_until_it_clears() -> None:
+    from kinema.tui.widgets.status_bar import render_status
+
+    status = RuntimeStatus()
+    status.apply_connection(ConnectionChanged(ConnectionState.CONNECTED, "tcp/127.0.0.1:7447"))
+    stuck = "behavior 'Block' (main/block) has been in tick for 3.4 s"
+    status.apply_heartbeat(Heartbeat(1.0, "Pick", "Running", (stuck, "another")))
+    line = render_status(status).plain
+    assert "⚠ behavior 'Block' (main/block) has been in tick for 3 s (+1 more)" in line, line
+    status.apply_heartbeat(Heartbeat(2.0, "Pick", "Cancelled"))
+    assert "⚠" not in render_status(status).plain

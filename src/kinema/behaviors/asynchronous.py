@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import asyncio
 import concurrent.futures
 import inspect
 import threading
@@ -70,12 +71,22 @@ class AsyncBehavior(Behavior, StatefulActionNode):
         self._tick_thread = threading.get_ident()
         self._pending_outputs = []
         if inspect.iscoroutinefunction(self.do_work):
-            future = RUNNER.run_coroutine(self.do_work())  # type: ignore[arg-type]
+            future = RUNNER.run_coroutine(self._guarded(self.do_work()))  # type: ignore[arg-type]
         else:
             future = RUNNER.run_function(self.do_work)
         self._future = future
         future.add_done_callback(lambda _done: self.emit_wake_up_signal())
         return NodeStatus.RUNNING
+
+    async def _guarded(self, work: Awaitable[bool]) -> bool:
+        # asyncio lets SystemExit and KeyboardInterrupt out of the event loop, which would end it for
+        # every async behavior of the process: they become this behavior's fault instead.
+        try:
+            return await work
+        except asyncio.CancelledError:
+            raise
+        except (KeyboardInterrupt, SystemExit) as error:
+            raise behavior_fault(self, error, "do_work") from error
 
     def on_running(self) -> NodeStatus:
         """Return RUNNING until the work is done, then its outcome (no need to override)."""
@@ -110,10 +121,12 @@ class AsyncBehavior(Behavior, StatefulActionNode):
         future, self._future = self._future, None
         try:
             self.do_halt()
-        except Exception as error:
+        except BaseException as error:
             # Halting must always complete (a cancel has to stop the tree), so a faulty do_halt is
             # reported as a failure toast naming the behavior, plugin and line, not raised.
             self.logger.publish_failure(str(behavior_fault(self, error, "do_halt")))
         finally:
-            if future is not None:
-                future.cancel()
+            if future is not None and not future.cancel() and not future.done():
+                # A plain function cannot be cancelled once it runs: the watchdog reports it while it
+                # keeps running (it ignores stop_requested()).
+                RUNNER.note_halted(future, str(self.registration_id), str(self.full_path))

@@ -3,8 +3,10 @@
 The engine constructs nodes as ``cls(name, config)`` and knows nothing about robots. When a registry
 populates a factory, each behavior class is wrapped in a thin subclass that carries the
 :class:`BehaviorContext` and the plugin name as class attributes, and that names the behavior and the
-plugin in any exception escaping ``tick`` or ``halt``. The author's class is never modified, so the
-same class can be bound to several contexts at once (a running objective and the next one).
+plugin in any exception escaping ``tick`` or ``halt`` (``BaseException`` included: a ``SystemExit`` in a
+behavior fails the objective, it does not end the runtime's tick thread). The author's class is never
+modified, so the same class can be bound to several contexts at once (a running objective and the next
+one).
 """
 
 from __future__ import annotations
@@ -33,7 +35,9 @@ def bind_behavior(registration: BehaviorRegistration, context: BehaviorContext) 
             return base_tick(self)
         except (NodeExecutionError, BehaviorExecutionError):
             raise
-        except Exception as error:
+        except BaseException as error:
+            # SystemExit, KeyboardInterrupt and GeneratorExit raised by behavior code are bugs like any
+            # other: they fail the objective with the line that raised, never end the tick thread.
             raise behavior_fault(self, error, "tick") from error
 
     @functools.wraps(base_halt)
@@ -42,7 +46,7 @@ def bind_behavior(registration: BehaviorRegistration, context: BehaviorContext) 
             base_halt(self)
         except (NodeExecutionError, BehaviorExecutionError):
             raise
-        except Exception as error:
+        except BaseException as error:
             raise behavior_fault(self, error, "halt") from error
 
     namespace = {

@@ -116,6 +116,8 @@ class Tree:
         self._uid = 0
         self._observer_handles: dict[int, list[Callable[[], None]]] = {}
         self._next_handle = 1
+        # True when the last tick_once stopped at its ``until`` with a re-tick still owed.
+        self.retick_due = False
 
     def next_uid(self) -> int:
         """Allocate the next node uid (1-based, used by the builder)."""
@@ -181,7 +183,7 @@ class Tree:
 
     # -- ticking ---------------------------------------------------------------------------------
 
-    def _tick_root(self, mode: int, sleep_time: float) -> NodeStatus:
+    def _tick_root(self, mode: int, sleep_time: float, until: Callable[[], bool] | None = None) -> NodeStatus:
         root = self.root_node
         if root is None:
             from kinema.bt.errors import BTRuntimeError
@@ -189,12 +191,20 @@ class Tree:
             raise BTRuntimeError("Empty Tree")
         wake_up = self.wake_up
         status = IDLE
+        self.retick_due = False
         while status is IDLE or (mode == 2 and status is RUNNING):
             status = root.execute_tick()
             while mode != 0 and status is RUNNING and wake_up.consume():
+                if until is not None and until():
+                    # The signal is consumed and the tick it asks for is owed: the caller's next
+                    # tick_once starts with it, so the sequence of root ticks is BT.CPP's.
+                    self.retick_due = True
+                    return status
                 status = root.execute_tick()
             if status is SUCCESS or status is FAILURE:
                 root.reset_status()
+            if status is RUNNING and until is not None and until():
+                return status
             if status is RUNNING and sleep_time > 0:
                 self.sleep(sleep_time)
             if status is SKIPPED:
@@ -205,16 +215,27 @@ class Tree:
         """Tick the root once, even if a node asked to be ticked again."""
         return self._tick_root(0, 0.0)
 
-    def tick_once(self) -> NodeStatus:
-        """Tick the root, again immediately while a node emitted a wake-up signal."""
-        return self._tick_root(1, 0.0)
+    def tick_once(self, until: Callable[[], bool] | None = None) -> NodeStatus:
+        """Tick the root, again immediately while a node emitted a wake-up signal.
 
-    def tick_while_running(self, sleep_time: float = 0.01) -> NodeStatus:
+        Args:
+            until: checked before each immediate re-tick; when it returns True the method returns
+                RUNNING at once and sets :attr:`retick_due` (the re-tick is owed: call ``tick_once``
+                again to continue). A ticker uses it to notice a halt request or a time budget between
+                the iterations of a tree that re-ticks itself forever, such as
+                ``<Repeat num_cycles="-1"><AlwaysSuccess/></Repeat>``.
+        """
+        return self._tick_root(1, 0.0, until)
+
+    def tick_while_running(
+        self, sleep_time: float = 0.01, until: Callable[[], bool] | None = None
+    ) -> NodeStatus:
         """Tick until the root is no longer RUNNING, sleeping ``sleep_time`` between ticks.
 
-        The sleep is interrupted by wake-up signals and measured on the tree's clock.
+        The sleep is interrupted by wake-up signals and measured on the tree's clock. ``until`` works
+        as in :meth:`tick_once`; it is also checked between ticks, and RUNNING is returned when it is true.
         """
-        return self._tick_root(2, sleep_time)
+        return self._tick_root(2, sleep_time, until)
 
     def sleep(self, seconds: float) -> bool:
         """Sleep ``seconds`` of the tree's clock; return True early if a wake-up signal arrives."""

@@ -259,11 +259,13 @@ def status_(follow: bool, as_json: bool, connect: str | None, timeout: float) ->
 
     if not follow:
         with _client(connect, timeout) as quick:
-            status, name = quick.status()
+            status, name, warnings = quick.status_report()
         if as_json:
-            click.echo(json.dumps({"status": str(status), "objective_name": name}))
+            click.echo(json.dumps({"status": str(status), "objective_name": name, "warnings": warnings}))
         else:
             click.echo(f"{status}: {name}" if name else str(status))
+            for warning in warnings:  # the watchdog: a behavior stuck in tick, an abandoned thread
+                click.secho(f"warning: {warning}", fg="red")
         return
     from kinema.sdk import ObjectiveClient
 

@@ -138,10 +138,13 @@ def _preview(value: Any) -> Any:
 class _Streams:
     """Publishes what the server reports (a :class:`ServerListener`, called on the tick thread)."""
 
-    def __init__(self, node: Node, clock: Clock | None) -> None:
+    def __init__(self, node: Node, clock: Clock | None, server: ObjectiveServer) -> None:
         self._node = node
         self._clock = clock
+        self._server = server
         self._heartbeat = node.create_publisher(names.HEARTBEAT_TYPE, names.HEARTBEAT, latched=True)
+        self._health = node.create_publisher(names.HEALTH_TYPE, names.HEALTH, latched=True)
+        self._last_warnings: tuple[str, ...] = ()
         self._node_status = node.create_publisher(names.NODE_STATUS_TYPE, names.NODE_STATUS)
         self._blackboard = node.create_publisher(names.BLACKBOARD_TYPE, names.BLACKBOARD, latched=True)
         self._log = node.create_publisher(names.LOG_TYPE, names.LOG)
@@ -163,8 +166,23 @@ class _Streams:
             objective_name=name,
             objective_status=str(status),
         )
+        health = self._server.health()
+        report = msg(
+            names.HEALTH_TYPE,
+            stamp=_stamp(now),
+            tick_thread_alive=health.tick_thread_alive,
+            tick_thread_replacements=health.replacements,
+            warnings=list(health.warnings),
+        )
         with self._lock:
             self._heartbeat.publish(message)
+            self._health.publish(report)
+            seen = {_topic(old) for old in self._last_warnings}
+            new = [warning for warning in health.warnings if _topic(warning) not in seen]
+            self._last_warnings = health.warnings
+        for warning in new:
+            # Once per problem on the log topic too, so `kinema run`'s terminal and the TUI's log show it.
+            self.publish_log(LOG_WARN, f"watchdog: {warning}")
 
     def publish_log(self, level: int, text: str) -> None:
         from kinema.transport.messages import msg
@@ -240,6 +258,11 @@ class _Streams:
             self.publish_log(LOG_ERROR, str(result))
 
 
+def _topic(warning: str) -> str:
+    """A watchdog warning without its growing number of seconds (the same problem, a later beat)."""
+    return warning.split(" for ", 1)[0]
+
+
 def _is_wall(clock: Clock) -> bool:
     return bool(getattr(clock, "realtime", False))
 
@@ -280,7 +303,7 @@ class Agent:
         self.waypoints = waypoints
         self.clock = clock
         self.node = node if node is not None else Node(session, names.NODE_NAME)
-        self._streams = _Streams(self.node, clock)
+        self._streams = _Streams(self.node, clock, server)
         server.add_listener(self._streams)
         self._goal_runs: dict[bytes, ObjectiveRun] = {}
         self._quick_runs: weakref.WeakValueDictionary[int, ObjectiveRun] = weakref.WeakValueDictionary()
@@ -517,8 +540,12 @@ class Agent:
         from kinema.runtime import quick_protocol as quick
 
         status, name = self.server.status
+        warnings = list(self.server.health().warnings)
         with query:
-            query.reply(query.key_expr, quick.encode({"status": str(status), "objective_name": name}))
+            query.reply(
+                query.key_expr,
+                quick.encode({"status": str(status), "objective_name": name, "warnings": warnings}),
+            )
 
     # -- library -----------------------------------------------------------------------------------
 

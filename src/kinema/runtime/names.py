@@ -17,6 +17,9 @@ DO_OBJECTIVE_TYPE = "moveit_studio_sdk_msgs/action/DoObjectiveSequence"
 HEARTBEAT = "/objective_server_heartbeat"
 HEARTBEAT_TYPE = "moveit_studio_agent_msgs/msg/ObjectiveServerStatus"
 HEARTBEAT_PERIOD_S = 0.1
+# Published with every heartbeat: the watchdog's view (stuck behaviors, replaced tick threads).
+HEALTH = "/objective_server/health"
+HEALTH_TYPE = "kinema_msgs/msg/ObjectiveServerHealth"
 
 NODE_STATUS = "/objective_server/node_status"
 NODE_STATUS_TYPE = "kinema_msgs/msg/NodeStatusChanges"

@@ -5,6 +5,24 @@ hot reload) sends the tick thread a request; only the tick thread builds, ticks 
 (DESIGN invariant 1). A cancel or a newer request wakes the tick thread at once, so running behaviors
 are halted well within one tick period (invariant 2).
 
+Cancel always wins, whatever the tree does:
+
+- a tree that re-ticks itself synchronously (``<Repeat num_cycles="-1"><AlwaysSuccess/></Repeat>``)
+  is interrupted between two iterations when a request arrives or a tick period is used up; the
+  iteration it owes runs at the next tick, so a tree nobody cancels ticks exactly as in BT.CPP;
+- behavior code that does not return (a blocking ``tick``, a ``halt`` that waits) is caught by the
+  watchdog: after :data:`WATCHDOG_REPORT_S` it reports "behavior X (node path) has been in tick for N s"
+  in the log and in :meth:`ObjectiveServer.health`; a cancel or a newer request pending for
+  :data:`ABANDON_AFTER_S` makes it abandon the stuck tick thread: the run ends cancelled, the stuck tree
+  is disarmed (its nodes fail at once if the stuck call returns into it) and halted on a thread of its
+  own, and a fresh tick thread serves the next request. The abandoned thread is reported until it
+  returns, then it exits;
+- any exception from behavior code, ``SystemExit`` and ``KeyboardInterrupt`` included, fails the run;
+  if the tick thread dies nonetheless, the health report says so and a fresh one serves the next request.
+
+The tick thread owns the server's state (the tree, the run) except while it is inside behavior code;
+the watchdog takes the state over only then, under the same lock.
+
 The server knows nothing about the transport: :mod:`kinema.runtime.agent` serves it over zenoh and a
 :class:`ServerListener` receives what the streams publish (status, node status changes, blackboard
 snapshots, finished runs), always on the tick thread.
@@ -18,7 +36,8 @@ import logging
 import threading
 import time
 from collections import deque
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Iterator, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any, Protocol
 
@@ -28,6 +47,7 @@ from kinema.errors import KinemaError, ObjectiveError, did_you_mean
 from kinema.runtime.objective_status import ObjectiveStatus
 from kinema.runtime.overrides import ParameterOverride, apply_overrides
 from kinema.runtime.result import ObjectiveResult
+from kinema.runtime.watchdog import StuckCode, stuck_code
 
 if TYPE_CHECKING:
     from kinema.bt import BehaviorTreeFactory, Tree
@@ -43,6 +63,19 @@ MAX_OBJECTIVE_XML_BYTES = 2 * 1024 * 1024
 RESULT_HOLD_S = 2.0
 # Blackboard snapshots are taken at most this often while a tree runs.
 BLACKBOARD_SNAPSHOT_PERIOD_S = 0.1
+# Behavior code (a tick, a halt, a tree's constructors) running longer than this is reported.
+WATCHDOG_REPORT_S = 1.0
+# A cancel, a newer request or a stop waiting this long for a tick thread stuck in behavior code makes the
+# server abandon that thread. With the watchdog's period, cancel wins within a tick period plus 100 ms.
+ABANDON_AFTER_S = 0.07
+WATCHDOG_PERIOD_S = 0.02
+# The halt of an abandoned tree waits this long for its thread to come back from behavior code first.
+HALT_WAITS_FOR_ABANDONED_S = 0.5
+# A tree that re-ticks itself for a whole tick period pauses this long before the tick it owes, so that
+# it cannot starve the transport and a simulator running in the same process.
+RETICK_PAUSE_S = 0.005
+# A stuck behavior is logged again this often while it stays stuck.
+WATCHDOG_LOG_EVERY_S = 10.0
 
 
 @dataclass(frozen=True)
@@ -214,6 +247,54 @@ class FactoryTreeSource:
         self._factory = factory
 
 
+@dataclass(frozen=True)
+class ServerHealth:
+    """What the watchdog sees, published beside the heartbeat.
+
+    Attributes:
+        tick_thread_alive: False while no tick thread serves requests (a dead one not yet replaced).
+        replacements: tick threads replaced since the start (abandoned while stuck, or died).
+        warnings: one sentence per problem seen now: behavior code stuck in a tick or halt, halted work
+            still running, abandoned threads still stuck, the last death of a tick thread.
+    """
+
+    tick_thread_alive: bool = True
+    replacements: int = 0
+    warnings: tuple[str, ...] = ()
+
+
+_CALL_STAGE = "a hot-reload request"
+
+
+class _Abandoned(BaseException):
+    """Raised in a tick thread returning from behavior code after the watchdog abandoned it."""
+
+
+class _Worker:
+    """One tick thread. ``busy_since`` is set while it runs behavior code (the server lock released)."""
+
+    def __init__(self, generation: int) -> None:
+        self.generation = generation
+        self.thread: threading.Thread | None = None
+        self.abandoned = False
+        self.abandoned_at = 0.0
+        self.busy_since: float | None = None
+        self.busy_stage = ""
+        self.stuck: StuckCode | None = None
+        self.stuck_since = 0.0
+        self.logged_at = 0.0
+        # Set while the thread is outside behavior code (set again before it waits for the state lock).
+        self.returned = threading.Event()
+        self.returned.set()
+
+    @property
+    def name(self) -> str:
+        return "kinema-tick" if self.generation == 1 else f"kinema-tick-{self.generation}"
+
+    def alive(self) -> bool:
+        return self.thread is not None and self.thread.is_alive()
+
+
 class ObjectiveServer:
     """Runs one objective at a time on its own tick thread.
 
@@ -223,6 +304,9 @@ class ObjectiveServer:
         listeners: receive status, node status changes, blackboard snapshots and results.
         blackboard_period_s: the minimum time between two blackboard snapshots (0 disables them).
         result_hold_s: how long a run's final status is shown before the server reports Idle again.
+        watchdog_report_s: behavior code running longer than this in one call is reported.
+        abandon_after_s: how long a cancel or newer request waits for a tick thread stuck in behavior
+            code before the thread is abandoned.
     """
 
     def __init__(
@@ -233,6 +317,8 @@ class ObjectiveServer:
         listeners: Sequence[ServerListener] = (),
         blackboard_period_s: float = BLACKBOARD_SNAPSHOT_PERIOD_S,
         result_hold_s: float = RESULT_HOLD_S,
+        watchdog_report_s: float = WATCHDOG_REPORT_S,
+        abandon_after_s: float = ABANDON_AFTER_S,
     ) -> None:
         if tick_rate_hz <= 0:
             raise KinemaError(f"the tick rate must be positive, got {tick_rate_hz} Hz")
@@ -240,16 +326,39 @@ class ObjectiveServer:
         self._period = 1.0 / tick_rate_hz
         self._listeners = list(listeners)
         self._blackboard_period = blackboard_period_s
+        self._watchdog_report = watchdog_report_s
+        self._abandon_after = abandon_after_s
         self._ids = itertools.count(1)
         self._inbox: deque[ObjectiveRun | _Cancel | _Call] = deque()
         self._wake = threading.Condition()
         self._woken = False
         self._tick_now = False
         self._stopping = False
-        self._thread: threading.Thread | None = None
+        # Set by every request: a tree re-ticking itself stops between two iterations to serve it.
+        self._interrupt = False
+        # When the oldest request that a stuck tick thread would have to serve was posted.
+        self._waiting_since: float | None = None
+        # The tick thread holds this lock while it touches the state below; it releases it only while it
+        # runs behavior code, which is when the watchdog may take the state over.
+        self._state_lock = threading.RLock()
+        self._worker: _Worker | None = None
+        self._generations = itertools.count(1)
+        self._abandoned: list[_Worker] = []
+        self._replacements = 0
+        self._last_death = ""
+        self._stopped = threading.Event()
+        self._watchdog: threading.Thread | None = None
+        # What blocked each retired event loop of async behaviors (by thread id).
+        self._loop_codes: dict[int | None, StuckCode] = {}
         # Owned by the tick thread:
         self._tree: Tree | None = None
         self._run: ObjectiveRun | None = None
+        # Set when the current run's tick thread was abandoned in its behavior code.
+        self._run_stuck: _Worker | None = None
+        # Requests taken from the inbox and not yet done; the watchdog queues them again for the thread
+        # that replaces an abandoned one.
+        self._in_hand: list[ObjectiveRun | _Cancel | _Call] = []
+        self._in_hand_start: ObjectiveRun | None = None
         self._pending_changes: list[NodeStatusChange] = []
         self._last_snapshot = 0.0
         self._failures: list[tuple[str, str]] = []
@@ -263,21 +372,29 @@ class ObjectiveServer:
     # -- lifecycle --------------------------------------------------------------------------------
 
     def start(self) -> None:
-        """Start the tick thread."""
-        if self._thread is not None:
+        """Start the tick thread and its watchdog."""
+        if self._watchdog is not None:
             return
-        self._thread = threading.Thread(target=self._loop, name="kinema-tick", daemon=True)
-        self._thread.start()
+        self._stopped.clear()
+        with self._state_lock:
+            self._start_worker()
+        self._watchdog = threading.Thread(target=self._watch, name="kinema-tick-watchdog", daemon=True)
+        self._watchdog.start()
 
     def stop(self, timeout: float = 5.0) -> None:
         """Halt the running objective (its result is PREEMPTED) and stop the tick thread."""
+        if self._watchdog is None:
+            return
         with self._wake:
             self._stopping = True
+            self._interrupt = True
             self._woken = True
-            self._wake.notify()
-        if self._thread is not None:
-            self._thread.join(timeout)
-            self._thread = None
+            if self._waiting_since is None:
+                self._waiting_since = time.monotonic()
+            self._wake.notify_all()
+        self._stopped.wait(timeout)
+        self._watchdog.join(timeout)
+        self._watchdog = None
 
     def __enter__(self) -> ObjectiveServer:
         self.start()
@@ -295,12 +412,44 @@ class ObjectiveServer:
         """Seconds between two ticks."""
         return self._period
 
+    @property
+    def _thread(self) -> threading.Thread | None:
+        worker = self._worker
+        return worker.thread if worker is not None else None
+
     # -- requests (any thread) ------------------------------------------------------------------
 
     @property
     def status(self) -> tuple[ObjectiveStatus, str]:
         """``(status, objective_name)`` right now."""
         return self._status
+
+    def health(self) -> ServerHealth:
+        """What the watchdog sees now (safe from any thread)."""
+        now = time.monotonic()
+        warnings: list[str] = []
+        worker = self._worker
+        alive = worker is not None and worker.alive()
+        if worker is not None and worker.stuck is not None and worker.busy_since is not None:
+            warnings.append(worker.stuck.describe(now - worker.busy_since))
+        for old in list(self._abandoned):
+            stuck = old.stuck or StuckCode("", "", old.busy_stage)
+            since = old.stuck_since
+            warnings.append(
+                f"abandoned tick thread {old.name}: {stuck.describe(now - since)} "
+                f"(abandoned {now - old.abandoned_at:.1f} s ago)"
+            )
+        warnings.extend(_halted_work_warnings(self._watchdog_report))
+        runner = _work_runner()
+        if runner is not None:
+            for seconds, ident in runner.retired_loops():
+                code = self._loop_codes.get(ident) or StuckCode("", "", "a coroutine")
+                warnings.append(f"{code.describe(seconds)}, {_LOOP_BLOCKED}")
+        if self._last_death:
+            warnings.append(self._last_death)
+        if not alive and self._watchdog is not None and not self._stopping:
+            warnings.append("no tick thread is running; a new one starts within a moment")
+        return ServerHealth(alive, self._replacements, tuple(warnings))
 
     def submit(
         self, request: ObjectiveRequest, before_start: Callable[[ObjectiveRun], None] | None = None
@@ -341,7 +490,7 @@ class ObjectiveServer:
         Raises:
             whatever ``fn`` raised; KinemaError when the tick thread did not get to it within ``timeout``.
         """
-        if threading.current_thread() is self._thread or self._thread is None:
+        if threading.current_thread() is self._thread or self._watchdog is None:
             return fn()
         call = _Call(fn)
         self._post(call)
@@ -355,14 +504,17 @@ class ObjectiveServer:
         with self._wake:
             self._inbox.append(item)
             self._woken = True
-            self._wake.notify()
+            self._interrupt = True
+            if self._waiting_since is None and not isinstance(item, _Call):
+                self._waiting_since = time.monotonic()
+            self._wake.notify_all()
 
     def _wake_up(self) -> None:
         # A tree's wake-up signal (a behavior finished its work off-thread): tick again at once.
         with self._wake:
             self._woken = True
             self._tick_now = True
-            self._wake.notify()
+            self._wake.notify_all()
 
     def note_failure(self, node_path: str, message: str) -> None:
         """Remember why a node is failing (a behavior's ``publish_failure``), for the run's error message.
@@ -372,48 +524,257 @@ class ObjectiveServer:
         with self._notes_lock:
             self._failure_notes[node_path] = message
 
+    # -- tick threads and the watchdog ------------------------------------------------------------
+
+    def _start_worker(self) -> None:
+        """Start a tick thread (the state lock held)."""
+        worker = _Worker(next(self._generations))
+        worker.thread = threading.Thread(target=self._serve, args=(worker,), name=worker.name, daemon=True)
+        self._worker = worker
+        worker.thread.start()
+
+    @contextmanager
+    def _behavior_code(self, worker: _Worker, stage: str) -> Iterator[None]:
+        """Run behavior code with the state lock released, so that the watchdog can take over."""
+        worker.busy_stage = stage
+        worker.busy_since = time.monotonic()
+        worker.returned.clear()
+        self._state_lock.release()
+        try:
+            yield
+        finally:
+            worker.returned.set()
+            self._state_lock.acquire()
+            worker.busy_since = None
+            worker.stuck = None
+            if worker.abandoned:
+                raise _Abandoned
+
+    def _serve(self, worker: _Worker) -> None:
+        self._state_lock.acquire()
+        try:
+            self._loop(worker)
+        except _Abandoned:
+            seconds = time.monotonic() - worker.abandoned_at
+            log.warning(
+                "abandoned tick thread %s returned %.1f s after it was abandoned", worker.name, seconds
+            )
+        except BaseException as error:  # the tick thread must never vanish silently
+            self._tick_thread_died(worker, error)
+        finally:
+            if worker in self._abandoned:
+                self._abandoned.remove(worker)
+            self._state_lock.release()
+
+    def _tick_thread_died(self, worker: _Worker, error: BaseException) -> None:
+        where = _location_of(error)
+        self._last_death = (
+            f"the tick thread {worker.name} died: {type(error).__name__}: {error}{where}; "
+            "a new one serves the next objective"
+        )
+        log.critical("%s", self._last_death, exc_info=error)
+        if self._worker is worker:
+            self._replacements += 1
+            run, tree = self._run, self._tree
+            if tree is not None:
+                # Whatever its nodes run (a motion) must still stop.
+                self._release_stuck_tree(tree, worker)
+            if run is not None:
+                message = f"objective {run.objective_name!r} stopped: {self._last_death}"
+                self._end(run, ObjectiveResult.failure(message, run.objective_name), ObjectiveStatus.FAILURE)
+            # A new thread takes over the requests at once (the watchdog would, a moment later).
+            if not self._stopping:
+                self._start_worker()
+            else:
+                self._stopped.set()
+
+    def _watch(self) -> None:
+        """The watchdog: reports stuck behavior code, abandons stuck tick threads, replaces dead ones."""
+        while not self._stopped.wait(WATCHDOG_PERIOD_S):
+            try:
+                self._watch_once()
+            except Exception:
+                log.exception("the tick watchdog raised")
+
+    def _watch_event_loop(self) -> None:
+        """A coroutine that blocks the async behaviors' event loop: report it, move on to a fresh loop."""
+        runner = _work_runner()
+        blocked = runner.blocked_loop() if runner is not None else None
+        if blocked is None or blocked[0] < self._watchdog_report:
+            return
+        seconds, ident = blocked
+        code = stuck_code(ident, "a coroutine")
+        self._loop_codes[ident] = code
+        runner.retire_blocked_loop()
+        log.error("watchdog: %s, %s", code.describe(seconds), _LOOP_BLOCKED)
+
+    def _watch_once(self) -> None:
+        self._watch_event_loop()
+        now = time.monotonic()
+        worker = self._worker
+        if worker is None:
+            return
+        busy_since = worker.busy_since
+        if busy_since is not None and worker.thread is not None:
+            if now - busy_since >= self._watchdog_report:
+                stuck = stuck_code(worker.thread.ident, worker.busy_stage)
+                if worker.busy_since == busy_since:
+                    worker.stuck = stuck
+                    if now - worker.logged_at >= WATCHDOG_LOG_EVERY_S:
+                        worker.logged_at = now
+                        log.warning("watchdog: %s", stuck.describe(now - busy_since))
+            waiting = self._waiting_since
+            if waiting is not None and now - max(waiting, busy_since) >= self._abandon_after:
+                self._abandon(worker, busy_since)
+            return
+        if not worker.alive() and not self._stopped.is_set():
+            # Died without reaching its own handler (or before it could start a successor).
+            with self._state_lock:
+                if self._worker is worker and not worker.alive():
+                    self._replacements += 1
+                    if not self._last_death:
+                        self._last_death = f"the tick thread {worker.name} died; a new one took over"
+                    log.critical("%s", self._last_death)
+                    if self._stopping:
+                        self._stopped.set()
+                    else:
+                        self._start_worker()
+
+    def _abandon(self, worker: _Worker, busy_since: float) -> None:
+        """Give up on a tick thread stuck in behavior code: a fresh one serves the pending requests."""
+        if not self._state_lock.acquire(timeout=WATCHDOG_PERIOD_S):
+            return
+        try:
+            if self._worker is not worker or worker.busy_since != busy_since:
+                return  # it came back meanwhile
+            assert worker.thread is not None
+            stuck = stuck_code(worker.thread.ident, worker.busy_stage)
+            worker.stuck = stuck
+            worker.stuck_since = busy_since
+            worker.abandoned = True
+            worker.abandoned_at = time.monotonic()
+            self._abandoned.append(worker)
+            self._replacements += 1
+            log.error(
+                "watchdog: %s; abandoning tick thread %s to serve a cancel or a newer request",
+                stuck.describe(worker.abandoned_at - busy_since),
+                worker.name,
+            )
+            if self._run is not None:
+                self._run_stuck = worker
+            pending: list[ObjectiveRun | _Cancel | _Call] = []
+            if self._in_hand_start is not None:
+                pending.append(self._in_hand_start)
+            for item in self._in_hand:
+                if isinstance(item, _Call) and item is self._in_hand[0] and worker.busy_stage == _CALL_STAGE:
+                    item.error = KinemaError(f"the tick thread was abandoned in it: {stuck.describe(0.0)}")
+                    item.done.set()
+                else:
+                    pending.append(item)
+            self._in_hand, self._in_hand_start = [], None
+            with self._wake:
+                self._inbox.extendleft(reversed(pending))
+                self._woken = True
+                self._wake.notify_all()
+            self._start_worker()
+        finally:
+            self._state_lock.release()
+
+    def _release_stuck_tree(self, tree: Tree, worker: _Worker) -> None:
+        """Disarm a tree whose thread was abandoned and halt it on a thread of its own.
+
+        Every node of it fails at once from now on, so the stuck call, if it returns, cannot start
+        anything new (a motion, a goal) after the cancel; the halt stops what its other nodes run. It
+        waits a moment for the abandoned thread to come back, so that a tick that was only slow (a
+        loaded machine) is never halted while it still runs.
+        """
+
+        def refuse(_node: Any) -> NodeStatus:
+            return NodeStatus.FAILURE
+
+        for node in tree.nodes():
+            node.set_pre_tick_callback(refuse)
+
+        def halt() -> None:
+            worker.returned.wait(HALT_WAITS_FOR_ABANDONED_S)
+            try:
+                tree.halt_tree()
+            except BaseException:
+                log.exception("halting the tree of an abandoned tick thread raised")
+
+        threading.Thread(target=halt, name="kinema-halt-abandoned", daemon=True).start()
+
     # -- tick thread ------------------------------------------------------------------------------
 
-    def _loop(self) -> None:
+    def _loop(self, worker: _Worker) -> None:
         next_tick = time.monotonic()
         while True:
             with self._wake:
-                if self._tree is not None:
-                    timeout: float | None = max(0.0, next_tick - time.monotonic())
+                if self._tree is not None and self._tree.retick_due:
+                    # A tree that re-ticks itself used up a whole tick: before the tick it owes, give
+                    # the process's other threads (the transport, a simulator) the interpreter for a
+                    # moment, unless a request already waits.
+                    timeout: float | None = 0.0
+                    if not self._inbox and not self._stopping:
+                        self._pause(RETICK_PAUSE_S)
+                elif self._tree is not None:
+                    timeout = max(0.0, next_tick - time.monotonic())
                 elif self._ended_at is not None:
                     timeout = max(0.0, self._ended_at + self._result_hold - time.monotonic())
                 else:
                     timeout = None
                 if not self._woken and not self._stopping and (timeout is None or timeout > 0):
-                    self._wake.wait(timeout)
+                    self._pause(timeout)
                 self._woken = False
+                self._interrupt = False
                 tick_now, self._tick_now = self._tick_now, False
                 stopping = self._stopping
                 inbox = list(self._inbox)
                 self._inbox.clear()
+                # Taken: the requests are being served now (a halt they need counts again as waiting).
+                if not stopping:
+                    self._waiting_since = None
             if stopping:
-                self._finish_current(ObjectiveResult.preempted, "the objective server stopped")
+                self._finish_current(worker, ObjectiveResult.preempted, "the objective server stopped")
                 for item in inbox:
                     self._reject(item, "the objective server stopped")
+                self._stopped.set()
                 return
-            start = self._take_requests(inbox)
+            start = self._take_requests(worker, inbox)
             if start is not None:
-                self._load(start)
+                self._load(worker, start)
                 next_tick = time.monotonic()
-            elif (
+            if self._run_stuck is not None and self._run is not None:
+                # A stuck run that no request ended (a cancel of another run): it can never tick again.
+                self._finish_current(worker, ObjectiveResult.preempted, "its tick thread was abandoned")
+            if (
                 self._tree is None
                 and self._ended_at is not None
                 and time.monotonic() >= self._ended_at + self._result_hold
             ):
                 self._ended_at = None
                 self._set_status(ObjectiveStatus.IDLE, self._status[1])
-            if self._tree is not None and (tick_now or time.monotonic() >= next_tick - 1e-4):
+            tree = self._tree
+            if tree is not None and (tick_now or tree.retick_due or time.monotonic() >= next_tick - 1e-4):
                 next_tick += self._period
                 now = time.monotonic()
                 if next_tick < now:
                     # Fell behind (a slow tick): do not try to catch up with a burst of ticks.
                     next_tick = now + self._period
-                self._tick()
+                self._tick(worker)
+
+    def _pause(self, seconds: float | None) -> None:
+        """Wait on the request condition (its lock held) without the state lock; a request ends it.
+
+        The state lock is taken back before the condition's (never wait for it holding the other).
+        """
+        self._state_lock.release()
+        try:
+            self._wake.wait(seconds)
+        finally:
+            self._wake.release()
+            self._state_lock.acquire()
+            self._wake.acquire()
 
     def _reject(self, item: ObjectiveRun | _Cancel | _Call, reason: str) -> None:
         if isinstance(item, ObjectiveRun):
@@ -424,14 +785,17 @@ class ObjectiveServer:
             item.error = KinemaError(reason)
             item.done.set()
 
-    def _take_requests(self, inbox: list[ObjectiveRun | _Cancel | _Call]) -> ObjectiveRun | None:
+    def _take_requests(
+        self, worker: _Worker, inbox: list[ObjectiveRun | _Cancel | _Call]
+    ) -> ObjectiveRun | None:
         """Apply queued requests in order; returns the newest start request still wanted.
 
         Of a burst of start requests only the last one is built: each earlier one is preempted by the
         next without ever being loaded, which keeps a flood of requests cheap.
         """
         start: ObjectiveRun | None = None
-        for item in inbox:
+        for index, item in enumerate(inbox):
+            self._in_hand, self._in_hand_start = inbox[index:], start
             if isinstance(item, ObjectiveRun):
                 if start is not None:
                     start._finish(
@@ -446,15 +810,19 @@ class ObjectiveServer:
                     start = None
                     item.cancelled = True
                 if self._run is not None and (item.run is None or item.run is self._run):
-                    self._finish_current(ObjectiveResult.preempted, item.reason)
+                    self._finish_current(worker, ObjectiveResult.preempted, item.reason)
                     item.cancelled = True
                 item.ack.set()
             else:
                 try:
-                    item.value = item.fn()
+                    with self._behavior_code(worker, _CALL_STAGE):
+                        item.value = item.fn()
+                except _Abandoned:
+                    raise
                 except BaseException as error:
                     item.error = error
                 item.done.set()
+        self._in_hand, self._in_hand_start = [], start
         return start
 
     def _set_status(self, status: ObjectiveStatus, name: str) -> None:
@@ -467,22 +835,29 @@ class ObjectiveServer:
             except Exception:
                 log.exception("a status listener raised")
 
-    def _load(self, run: ObjectiveRun) -> None:
+    def _load(self, worker: _Worker, run: ObjectiveRun) -> None:
         """Build the tree of ``run`` (preempting what runs now) and apply its overrides."""
         if self._run is not None:
-            self._finish_current(ObjectiveResult.preempted, "preempted by a newer objective request")
+            self._finish_current(worker, ObjectiveResult.preempted, "preempted by a newer objective request")
         self._run = run
+        self._in_hand_start = None
         self._set_status(ObjectiveStatus.LOADING, run.objective_name)
         try:
-            tree, name = self._build(run.request)
-            run.objective_name = name
-            apply_overrides(tree, run.request.overrides, objective_name=name)
+            with self._behavior_code(worker, "building the tree"):
+                tree, name = self._build(run.request)
+                run.objective_name = name
+                apply_overrides(tree, run.request.overrides, objective_name=name)
+        except _Abandoned:
+            raise
         except KinemaError as error:
             self._end(run, ObjectiveResult.failure(str(error), run.objective_name), ObjectiveStatus.FAILURE)
             return
-        except Exception as error:  # a behavior's constructor raised: report it, keep serving
+        except BaseException as error:  # a behavior's constructor raised: report it, keep serving
             log.exception("building objective %r failed", run.objective_name)
-            message = f"building objective {run.objective_name!r} failed: {type(error).__name__}: {error}"
+            message = (
+                f"building objective {run.objective_name!r} failed: {type(error).__name__}: {error}"
+                f"{_location_of(error)}"
+            )
             self._end(run, ObjectiveResult.failure(message, run.objective_name), ObjectiveStatus.FAILURE)
             return
         self._tree = tree
@@ -524,19 +899,30 @@ class ObjectiveServer:
         name = main_tree_id(xml)
         return _create_from_scratch_text(factory, xml), name
 
-    def _tick(self) -> None:
+    def _tick(self, worker: _Worker) -> None:
         tree, run = self._tree, self._run
         assert tree is not None and run is not None
+        deadline = time.monotonic() + self._period
+
+        def interrupted() -> bool:
+            # Checked between the iterations of a tree that re-ticks itself: serve a request, or let
+            # the server publish and breathe once a tick period is used up.
+            return self._interrupt or time.monotonic() >= deadline
+
         try:
-            status = tree.tick_once()
+            with self._behavior_code(worker, "tick"):
+                status = tree.tick_once(interrupted)
+        except _Abandoned:
+            raise
         except KinemaError as error:
-            self._halt_quietly(tree)
+            self._halt_quietly(worker, tree)
             self._end(run, ObjectiveResult.failure(str(error), run.objective_name), ObjectiveStatus.FAILURE)
             return
-        except Exception as error:
-            log.exception("ticking objective %r raised", run.objective_name)
-            self._halt_quietly(tree)
-            message = f"objective {run.objective_name!r} raised {type(error).__name__}: {error}"
+        except BaseException as error:  # SystemExit, KeyboardInterrupt...: fail the run, keep serving
+            log.error("ticking objective %r raised", run.objective_name, exc_info=error)
+            self._halt_quietly(worker, tree)
+            where = _location_of(error)
+            message = f"objective {run.objective_name!r} raised {type(error).__name__}: {error}{where}"
             self._end(run, ObjectiveResult.failure(message, run.objective_name), ObjectiveStatus.FAILURE)
             return
         self._flush_node_changes(run)
@@ -550,23 +936,44 @@ class ObjectiveServer:
                 ObjectiveStatus.FAILURE,
             )
 
-    def _halt_quietly(self, tree: Tree) -> None:
+    def _halt_quietly(self, worker: _Worker, tree: Tree) -> None:
         try:
-            tree.halt_tree()
-        except Exception:
+            with self._behavior_code(worker, "halt"):
+                tree.halt_tree()
+        except _Abandoned:
+            raise
+        except BaseException:
             log.exception("halting the tree raised")
 
-    def _finish_current(self, make: Callable[[str, str], ObjectiveResult], reason: str) -> None:
-        run, tree = self._run, self._tree
+    def _finish_current(
+        self, worker: _Worker, make: Callable[[str, str], ObjectiveResult], reason: str
+    ) -> None:
+        run, tree, stuck = self._run, self._tree, self._run_stuck
         if run is None:
             return
-        if tree is not None:
-            self._halt_quietly(tree)
+        if stuck is not None:
+            # Its tick thread was abandoned in behavior code: never wait for that tree again.
+            if tree is not None:
+                self._release_stuck_tree(tree, stuck)
+            code = stuck.stuck or StuckCode("", "", stuck.busy_stage)
+            seconds = time.monotonic() - stuck.stuck_since
+            reason = f"{reason} ({code.describe(seconds)}; its tick thread was abandoned)"
+        elif tree is not None:
+            # A cancel, a newer request or a stop waits for this halt: the watchdog gives it as long
+            # as it gives a pending request.
+            with self._wake:
+                if self._waiting_since is None:
+                    self._waiting_since = time.monotonic()
+            self._halt_quietly(worker, tree)
+            with self._wake:
+                waiting = any(not isinstance(item, _Call) for item in self._inbox) or self._stopping
+                self._waiting_since = time.monotonic() if waiting else None
             self._flush_node_changes(run)
         self._end(run, make(reason, run.objective_name), ObjectiveStatus.CANCELLED)
 
     def _end(self, run: ObjectiveRun, result: ObjectiveResult, status: ObjectiveStatus) -> None:
         self._tree = None
+        self._run_stuck = None
         self._run = None
         self._ended_at = time.monotonic()
         self._set_status(status, run.objective_name)
@@ -674,3 +1081,34 @@ def _create_from_scratch_text(factory: BehaviorTreeFactory, xml: str) -> Tree:
         return factory.create_tree_from_text(xml, filename="<objective XML>")
     finally:
         factory.library = saved
+
+
+def _location_of(error: BaseException) -> str:
+    """`` at file:line`` of the author's code that raised ``error`` ("" when none is outside Kinema)."""
+    from kinema.behaviors.faults import author_location
+
+    location = author_location(error)
+    return f" at {location}" if location is not None else ""
+
+
+_LOOP_BLOCKED = "blocking the event loop async behaviors share (new ones run on a fresh loop)"
+
+
+def _work_runner() -> Any:
+    """The runner of AsyncBehavior work, or None while no behavior ever ran work off the tick thread."""
+    import sys
+
+    module = sys.modules.get("kinema.behaviors.work_runner")
+    return module.RUNNER if module is not None else None
+
+
+def _halted_work_warnings(after_s: float) -> list[str]:
+    """Behaviors whose ``do_work`` still runs ``after_s`` after they were halted."""
+    runner = _work_runner()
+    if runner is None:
+        return []
+    return [
+        f"behavior '{behavior}' ({path}) has ignored a halt for {seconds:.1f} s: its do_work still runs"
+        for behavior, path, seconds in runner.halted_still_running()
+        if seconds >= after_s
+    ]

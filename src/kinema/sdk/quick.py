@@ -192,8 +192,14 @@ class QuickClient:
 
     def status(self) -> tuple[ObjectiveStatus, str]:
         """``(status, objective name)`` of the objective server right now."""
+        status, name, _warnings = self.status_report()
+        return status, name
+
+    def status_report(self) -> tuple[ObjectiveStatus, str, list[str]]:
+        """``(status, objective name, watchdog warnings)``: the warnings name stuck behaviors."""
         body = self._ask(quick.STATUS, {})
-        return ObjectiveStatus(body["status"]), str(body["objective_name"])
+        warnings = [str(warning) for warning in body.get("warnings", ())]
+        return ObjectiveStatus(body["status"]), str(body["objective_name"]), warnings
 
     def close(self) -> None:
         """Close the session."""

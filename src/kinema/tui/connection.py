@@ -125,11 +125,16 @@ class ConnectionChanged:
 
 @dataclass(frozen=True)
 class Heartbeat:
-    """One ``/objective_server_heartbeat``: the server's process time, objective and status."""
+    """One ``/objective_server_heartbeat``: the server's process time, objective and status.
+
+    ``warnings`` are the watchdog's (``/objective_server/health``, published with each heartbeat):
+    behavior code stuck in a tick, tick threads abandoned or dead; empty when all is well.
+    """
 
     process_time: float
     objective_name: str
     status: str
+    warnings: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True)

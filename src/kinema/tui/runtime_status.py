@@ -25,6 +25,7 @@ class RuntimeStatus:
     elapsed: float | None = None
     sim_time: float | None = None
     real_time_factor: float | None = None
+    warnings: tuple[str, ...] = ()
     _started_at: float | None = None
     _interrupted: tuple[str, float] | None = None
 
@@ -43,6 +44,7 @@ class RuntimeStatus:
                 # Heartbeats may only have been late: the same run resuming keeps its start time.
                 self._interrupted = (self.objective, self._started_at)
             self.status = "Unknown"
+            self.warnings = ()
             self.sim_time = None
             self.real_time_factor = None
             self._started_at = None
@@ -64,6 +66,7 @@ class RuntimeStatus:
             self.elapsed = max(0.0, beat.process_time - self._started_at)
         self.objective = beat.objective_name
         self.status = beat.status
+        self.warnings = beat.warnings
         if self.state is not ConnectionState.CONNECTED:
             self.state = ConnectionState.CONNECTED
         return started

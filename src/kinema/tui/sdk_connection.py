@@ -114,6 +114,8 @@ class SdkConnection:
         self._stop = threading.Event()
         self._thread: threading.Thread | None = None
         self._last_heartbeat = 0.0
+        # The watchdog warnings of the last /objective_server/health, shown with each heartbeat.
+        self._warnings: tuple[str, ...] = ()
         self._state = ConnectionState.CONNECTING
         self._clock_window: deque[tuple[float, float]] = deque(maxlen=50)
         self._last_clock_event = 0.0
@@ -206,6 +208,7 @@ class SdkConnection:
         node = client.node
         try:
             node.create_subscription(names.HEARTBEAT_TYPE, names.HEARTBEAT, self._on_heartbeat, latched=True)
+            node.create_subscription(names.HEALTH_TYPE, names.HEALTH, self._on_health, latched=True)
             node.create_subscription(names.NODE_STATUS_TYPE, names.NODE_STATUS, self._on_node_status)
             node.create_subscription(
                 names.BLACKBOARD_TYPE, names.BLACKBOARD, self._on_blackboard, latched=True
@@ -240,8 +243,12 @@ class SdkConnection:
                 float(stamp.sec) + float(stamp.nanosec) * 1e-9,
                 str(message.objective_name),
                 str(message.objective_status),
+                self._warnings,
             )
         )
+
+    def _on_health(self, message: Any) -> None:
+        self._warnings = tuple(str(warning) for warning in message.warnings)
 
     def _on_node_status(self, message: Any) -> None:
         by_objective: dict[str, list[NodeStatusUpdate]] = {}

@@ -274,3 +274,46 @@ def test_write_tree_to_xml_matches_btcpp_layout(bench) -> None:
     assert subtree_call.attrib == {"ID": "Sub", "_fullpath": "sub1", "_uid": "3", "v": "{x}"}
     assert main.find(".//Sleep").attrib == {"name": "Sleep", "_uid": "7", "msec": "20", "_skipIf": "x == 2"}
     assert [e.get("_uid") for e in sub.iter() if e is not sub] == ["4", "5", "6"]
+
+
+def _counting_tree(cycles: int):
+    factory = BehaviorTreeFactory()
+    ticks: list[int] = []
+
+    def count(node):
+        ticks.append(len(ticks))
+        return S
+
+    factory.register_simple_action("Count", count)
+    xml = (
+        '<root BTCPP_format="4"><BehaviorTree ID="T">'
+        f'<Repeat num_cycles="{cycles}"><Count/></Repeat></BehaviorTree></root>'
+    )
+    return factory.create_tree_from_text(xml), ticks
+
+
+def test_tick_once_until_stops_a_self_reticking_tree_and_owes_the_tick() -> None:
+    # An endless Repeat of a synchronous child re-ticks itself inside one tick_once forever (as in
+    # BT.CPP); ``until`` lets a ticker stop it between iterations.
+    tree, ticks = _counting_tree(-1)
+    checks = []
+    status = tree.tick_once(until=lambda: checks.append(1) or len(checks) >= 3)
+    assert status is R and tree.retick_due
+    assert len(ticks) == 3
+    tree.halt_tree()
+
+
+def test_tick_once_until_keeps_bt_cpp_results_for_trees_nobody_cancels() -> None:
+    # Stopping at every chance and calling tick_once again gives the same ticks and result as one
+    # uninterrupted tick_once.
+    plain, plain_ticks = _counting_tree(7)
+    assert plain.tick_once() is S
+    interrupted, interrupted_ticks = _counting_tree(7)
+    calls = 0
+    status = R
+    while status is R:
+        calls += 1
+        status = interrupted.tick_once(until=lambda: True)
+    assert status is S and not interrupted.retick_due
+    assert interrupted_ticks == plain_ticks and len(plain_ticks) == 7
+    assert calls == 7

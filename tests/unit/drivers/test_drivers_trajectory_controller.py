@@ -224,3 +224,35 @@ def test_joints_a_preempting_goal_leaves_out_hold_their_last_desired_position() 
     assert plant.ctrl[1] < moving_b
     assert plant.qpos[1] == pytest.approx(plant.ctrl[1])
     assert 0.3 < plant.ctrl[1] < 0.7
+
+
+def _from_now(points: list[list[float]], times: list[float]) -> TrajectoryGoal:
+    """A goal whose first point is at time 0 (a planner's start state), without velocities."""
+    return make_goal(points[-1], times=np.array(times), positions=np.array(points), velocities=None)
+
+
+def test_a_goal_starting_off_the_arm_is_led_in_from_where_the_arm_is(
+    controller: JointTrajectoryController,
+) -> None:
+    # Planned from [0, 0] while the arm went on to [0.3, -0.2]: starting at the first point would be
+    # 0.3 off at once, beyond the 0.1 path tolerance ("0.000 s into the trajectory").
+    plant = Plant()
+    plant.qpos[:] = plant.ctrl[:] = [0.3, -0.2]
+    controller.activate(plant)
+    execution = start(controller, plant, _from_now([[0.0, 0.0], [0.5, 0.5]], [0.0, 1.0]))
+    plant.step(controller)
+    desired_at_start = plant.ctrl.copy()
+    plant.run(controller, execution)
+    assert execution.outcome is not None and execution.outcome.status == "succeeded", execution.outcome
+    np.testing.assert_allclose(desired_at_start, [0.3, -0.2], atol=1e-6)
+    np.testing.assert_allclose(plant.qpos, [0.5, 0.5], atol=0.01)
+    assert plant.time > 1.0 + 0.1, "the lead-in adds time before the planned trajectory"
+
+
+def test_a_goal_starting_where_the_arm_rests_keeps_its_timing(controller: JointTrajectoryController) -> None:
+    plant = Plant()
+    controller.activate(plant)
+    execution = start(controller, plant, _from_now([[0.0, 0.0], [0.5, 0.5]], [0.0, 1.0]))
+    plant.run(controller, execution)
+    assert execution.outcome is not None and execution.outcome.status == "succeeded"
+    assert plant.time == pytest.approx(1.0, abs=0.01)

@@ -6,6 +6,14 @@ velocity feed-forward that keeps a position servo from lagging by ``kv·v/kp``. 
 runs it checks the path tolerances; after its last point it waits up to the goal time tolerance for the
 goal tolerances to hold.
 
+Starting where the arm is: a trajectory is planned from the joint state the planner read, and when it
+preempts a motion (the old goal's cancel still on its way, or the arm still braking) the arm is no longer
+there when the goal arrives. Starting the table at its first point would then abort it "0.000 s into
+the trajectory". Instead, when the arm is off the first point or moving differently (beyond the goal's
+own goal tolerances), the trajectory is shifted by a lead-in during which a smooth segment takes the arm
+from its actual position and speed to the first point; a goal started from rest where it was planned
+is tracked unchanged.
+
 Stopping (a cancel, a failed check): holding the position the joints had when the stop came would let
 them overshoot and ring at the servo's own bandwidth for a few hundred milliseconds. Instead the
 controller brakes: each step it commands a pure velocity feedback ``F = -K·qd`` with ``K`` sized from
@@ -70,6 +78,11 @@ class _Running:
 BRAKE_GAIN = 0.5
 BRAKE_DONE_SPEED = 0.002
 BRAKE_TIMEOUT = 0.1
+# Lead-in onto a trajectory that does not start where the arm is: long enough to cover the gap at
+# LEAD_IN_SPEED and to turn the arm's speed around at LEAD_IN_ACCELERATION (rad or m, per second).
+LEAD_IN_SPEED = 1.0
+LEAD_IN_ACCELERATION = 4.0
+LEAD_IN_MIN = 0.1
 
 
 @dataclass
@@ -92,6 +105,28 @@ def _violations(
         f"{names[i]} {what} {values[i]:+.4f} (tolerance {tolerance[i]:.4g})"
         for i in np.flatnonzero(np.abs(values) > tolerance)
     ]
+
+
+def _lead_in(goal: TrajectoryGoal, actual: np.ndarray, actual_velocity: np.ndarray) -> float:
+    """Seconds to add before ``goal``'s first point so that the arm can get there from its actual state.
+
+    0 when the arm is at the first point and moves as it says (within the goal's goal tolerances), and
+    when the first point is given a time of its own to be reached (ros2_control then interpolates from
+    the commanded state over that time, and so does this controller).
+    """
+    if float(goal.times[0]) >= LEAD_IN_MIN:
+        return 0.0
+    first = goal.positions[0]
+    first_velocity = goal.velocities[0] if goal.velocities is not None else np.zeros_like(first)
+    gap = np.abs(actual - first)
+    speed_gap = np.abs(actual_velocity - first_velocity)
+    if (gap <= goal.goal_position_tolerance).all() and (speed_gap <= goal.goal_velocity_tolerance).all():
+        return 0.0
+    needed = max(
+        LEAD_IN_MIN,
+        1.5 * float(gap.max()) / LEAD_IN_SPEED + float(speed_gap.max()) / LEAD_IN_ACCELERATION,
+    )
+    return needed - float(goal.times[0])
 
 
 class JointTrajectoryController:
@@ -226,13 +261,29 @@ class JointTrajectoryController:
         if others.size:
             self._command_velocity[others] = 0.0
             data.ctrl[self._ctrl[others]] = self._command[others]
+        times = goal.times
+        start_positions = self._command[columns]
+        start_velocities = self._command_velocity[columns]
+        if goal.start_stamp is None:
+            actual = data.qpos[self._qpos[columns]]
+            actual_velocity = data.qvel[self._qvel[columns]]
+            lead_in = _lead_in(goal, actual, actual_velocity)
+            if lead_in > 0.0:
+                log.info(
+                    "%s: the arm is off the trajectory's start (by up to %.3f); leading it in over %.3f s",
+                    self.name,
+                    float(np.abs(actual - goal.positions[0]).max()),
+                    lead_in,
+                )
+                times = goal.times + lead_in
+                start_positions, start_velocities = actual.copy(), actual_velocity.copy()
         table = sample_trajectory(
-            goal.times,
+            times,
             goal.positions,
             goal.velocities,
             goal.accelerations,
-            self._command[columns],
-            self._command_velocity[columns],
+            start_positions,
+            start_velocities,
             self.dt,
         )
         self._running = _Running(

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import re
+
 from rich.text import Text
 from textual.widgets import Static
 
@@ -44,6 +46,8 @@ class StatusBar(Static):
             None if status.elapsed is None else round(status.elapsed, 1),
             None if status.sim_time is None else round(status.sim_time, 2),
             None if status.real_time_factor is None else round(status.real_time_factor, 2),
+            # The watchdog's seconds grow every beat; whole seconds are enough on screen.
+            tuple(_whole_seconds(warning) for warning in status.warnings),
         )
         if key != self._shown:
             self._shown = key
@@ -73,4 +77,15 @@ def render_status(status: RuntimeStatus) -> Text:
         text.append(f"{status.sim_time:.2f} s")
         if status.real_time_factor is not None:
             text.append(f"  RTF {status.real_time_factor:.2f}x")
+    if status.warnings:
+        # The watchdog: a behavior stuck in tick is the first thing a user must see.
+        text.append("  │  ")
+        text.append(f"⚠ {_whole_seconds(status.warnings[0])}", style="bold red")
+        if len(status.warnings) > 1:
+            text.append(f" (+{len(status.warnings) - 1} more)", style="red")
     return text
+
+
+def _whole_seconds(warning: str) -> str:
+    """``... for 3.4 s`` as ``... for 3 s``."""
+    return re.sub(r"(\d+)\.\d s\b", r"\1 s", warning)
