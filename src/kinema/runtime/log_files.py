@@ -104,7 +104,7 @@ def follow_entries(
     The current end of every file is taken when this function is called, not at the first ``next()``.
     Files that appear later are read from their start. The iteration ends when ``stop`` is set.
     """
-    offsets = {path: path.stat().st_size for path in folder.glob("*.log")}
+    offsets = {path: path.stat().st_size for path in folder.glob("*.log") if not path.is_symlink()}
     return _follow(folder, offsets, min_level, poll_s, stop)
 
 
@@ -115,6 +115,8 @@ def _follow(
     while stop is None or not stop.is_set():
         produced = False
         for path in sorted(folder.glob("*.log")):
+            if path.is_symlink():
+                continue  # not a log of the run: it could point anywhere
             offset = offsets.get(path, 0)
             try:
                 size = path.stat().st_size
