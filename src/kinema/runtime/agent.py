@@ -561,6 +561,18 @@ class Agent:
         if self.waypoints is None:
             return {"status": {"success": False, "error_message": "the config has no waypoints file"}}
         operation = int(request.operation)
+        copy_existed = self.waypoints.path.exists()
+        try:
+            response = self._edit_waypoints(operation, request)
+        finally:
+            if self.waypoints.notice and not copy_existed and self.waypoints.path.exists():
+                # The first change of inherited waypoints: say once where they are kept from now on.
+                log.warning("waypoints: %s", self.waypoints.notice)
+                self._streams.publish_log(LOG_WARN, f"Waypoints: {self.waypoints.notice}")
+        return response
+
+    def _edit_waypoints(self, operation: int, request: Any) -> dict[str, Any]:
+        assert self.waypoints is not None
         try:
             if operation == 0:
                 waypoint = self._save_current(request.waypoint_name, list(request.joint_group_names))

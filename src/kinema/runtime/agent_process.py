@@ -103,12 +103,7 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
 
     source = LibraryTreeSource(load_library, host=host, context=context, clock=clock)
     source.factory()  # load now: errors show at start, and the first objective starts fast
-    waypoints = None
-    waypoints_path = options.waypoints_file or (resolved.waypoints_path if resolved is not None else None)
-    if waypoints_path is not None:
-        from kinema.config import WaypointStore
-
-        waypoints = WaypointStore(waypoints_path)
+    waypoints = _waypoint_store(options, resolved)
     server = ObjectiveServer(source, tick_rate_hz=options.tick_rate_hz)
     agent = Agent(session, server, source=source, waypoints=waypoints, log_sink=sink, clock=clock, node=node)
     if host is not None:
@@ -123,6 +118,26 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
         watcher_host.subscribe(agent.on_reload_event)
         watcher_host.watch(extra)
     return agent
+
+
+def _waypoint_store(options: AgentOptions, resolved: Any) -> Any:
+    """The waypoints the agent serves (see :mod:`kinema.config.waypoint_location`), tidied at start."""
+    from kinema.config import WaypointStore
+    from kinema.config.waypoint_location import waypoint_store_for
+
+    if options.waypoints_file is not None:
+        store = WaypointStore(options.waypoints_file)
+    elif resolved is not None:
+        store = waypoint_store_for(resolved)
+    else:
+        return None
+    if store is None:
+        return None
+    for stray in store.remove_stray_temporaries():
+        log.warning("removed %s, left by a save that was interrupted", stray)
+    if store.notice:
+        log.info("waypoints: %s", store.notice)
+    return store
 
 
 def _warn_without_clock(clock: Any, after_s: float = 10.0) -> None:

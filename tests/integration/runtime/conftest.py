@@ -143,3 +143,19 @@ def lab_sim_agent(tmp_path: Path) -> Iterator[AgentProcess]:
         yield running
     finally:
         stop_agent(running)
+
+
+@pytest.fixture
+def derived_config_agent(tmp_path: Path) -> Iterator[AgentProcess]:
+    """An agent for config ``my_cell`` (based on the bundled lab_sim) of a workspace at ``tmp_path/ws``."""
+    package = tmp_path / "ws" / "src" / "my_cell"
+    (package / "config").mkdir(parents=True)
+    (package / "config" / "config.yaml").write_text('based_on_package: "lab_sim"\n')
+    (package / "package.xml").write_text("<package><name>my_cell</name></package>\n")
+    running = start_agent(
+        tmp_path, "--config", "my_cell", "--workspace", str(tmp_path / "ws"), "--clock", "wall"
+    )
+    try:
+        yield running
+    finally:
+        stop_agent(running)
