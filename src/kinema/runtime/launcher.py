@@ -109,6 +109,7 @@ class Launcher:
         self.record: InstanceRecord | None = None
         self._stop = threading.Event()
         self._stop_reason = ""
+        self._echo_stop = threading.Event()
 
     # -- start --------------------------------------------------------------------------------------
 
@@ -308,6 +309,7 @@ class Launcher:
 
     def stop(self) -> None:
         """Stop the children (SIGTERM, SIGKILL after a grace period), close the router, drop the record."""
+        self._echo_stop.set()
         for child in reversed(self.children):
             if child.process.poll() is None:
                 child.process.terminate()
@@ -347,11 +349,31 @@ class Launcher:
             )
             if self.options.ui is not None:
                 return self.options.ui(self)
+            self._echo_plugin_reports()
             return self.wait()
         finally:
             self.stop()
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
+
+    def _echo_plugin_reports(self) -> None:
+        """Print the agent's plugin load errors and hot-reload outcomes here as they are logged.
+
+        Without a UI this terminal is where the user looks; the log file (``kinema logs``) has them too.
+        """
+        from kinema.runtime.log_files import PLUGIN_LOGGER, follow_entries
+
+        assert self.run_folder is not None
+        entries = follow_entries(self.run_folder.path, stop=self._echo_stop, from_start=True)
+        marker = f"[{PLUGIN_LOGGER}] "
+
+        def echo() -> None:
+            for entry in entries:
+                rest = entry.text.partition(marker)[2]
+                if rest:
+                    self.options.echo(f"{entry.process}: {entry.level.lower()}: {rest}")
+
+        threading.Thread(target=echo, name="kinema-plugin-echo", daemon=True).start()
 
 
 def _runnable_module(module: str) -> bool:
