@@ -53,7 +53,9 @@ def run(
     """Start Kinema: host the zenoh router (or join one), the agent and the config's drivers.
 
     Prints one line once objectives can be started, writes every process's log to a per-run folder
-    (see `kinema logs`), and blocks until Ctrl-C or `kinema down`.
+    (see `kinema logs`), and blocks until Ctrl-C or `kinema down`. One runtime per cell: when the router
+    already has an agent (or drivers) it refuses to start another, and says how to join or stop it;
+    -n and -o start the two halves of one cell.
     """
     from kinema.cli.options import resolve_selection
 

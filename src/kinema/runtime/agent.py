@@ -635,6 +635,11 @@ class Agent:
             except Exception:
                 log.debug("could not send a toast to the JSON client of run %d", run_id, exc_info=True)
 
+    def report_cell_conflict(self, message: str) -> None:
+        """Two agents or two drivers share this network (see :mod:`kinema.runtime.cell`): log and toast."""
+        log.error("%s", message)
+        self._streams.publish_log(LOG_ERROR, message)
+
     def on_reload_event(self, event: ReloadEvent) -> None:
         """Report a hot-reload outcome: a toast, and the agent's log (``kinema logs``, the run terminal).
 

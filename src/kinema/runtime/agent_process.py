@@ -212,6 +212,12 @@ def main(argv: list[str] | None = None) -> int:
         log.error("%s", error)
         print(f"error: {error}", file=sys.stderr)
         return 1
+    from kinema.runtime.cell import AGENT, CellWatch, declare_presence
+
+    # Announced before its nodes exist, so whoever sees them also knows whose they are.
+    declare_presence(
+        session, AGENT, config=options.config or "", endpoint=args.connect or args.host_router or ""
+    )
     try:
         agent = build_agent(options, session)
         agent.start()
@@ -220,6 +226,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {error}", file=sys.stderr)
         session.close()
         return 1
+    CellWatch(session, agent.report_cell_conflict)  # reports another agent; closed with the session
     log.info("agent serving (config %s, pid %d)", options.config or "-", os.getpid())
     if args.ready_fd is not None:
         with os.fdopen(args.ready_fd, "w") as ready:

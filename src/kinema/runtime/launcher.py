@@ -136,6 +136,7 @@ class Launcher:
                 os.getpid(), self.endpoint, str(self.run_folder.path), options.config
             )
             self.record.save()
+            self._check_cell_is_free()
             clock = "auto"
             starting = self._start_drivers() if options.drivers else []
             if options.drivers and not starting:
@@ -347,6 +348,7 @@ class Launcher:
                 f"Kinema is running: {what} (config {self.options.config}, {role} at "
                 f"{self.endpoint}, logs in {self.run_folder.path}). Stop with Ctrl-C or `kinema down`."
             )
+            self._watch_cell()
             if self.options.ui is not None:
                 return self.options.ui(self)
             self._echo_plugin_reports()
@@ -355,6 +357,29 @@ class Launcher:
             self.stop()
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
+
+    def _check_cell_is_free(self) -> None:
+        """Refuse to start a second agent or second drivers on a router that has them (one per cell)."""
+        if self.hosting or self.session is None:
+            return  # a router of our own: nobody else is there yet
+        from kinema.runtime.cell import check_cell_is_free
+
+        check_cell_is_free(
+            self.session, agent=self.options.agent, drivers=self.options.drivers, endpoint=self.endpoint
+        )
+
+    def _watch_cell(self) -> None:
+        """Report two agents or two drivers on the network, should they appear anyway."""
+        from kinema.runtime.cell import CellWatch
+
+        assert self.session is not None
+
+        def report(message: str) -> None:
+            log.error("%s", message)
+            if self.options.ui is None:
+                self.options.echo(f"warning: {message}")
+
+        CellWatch(self.session, report)  # closed with the session
 
     def _echo_plugin_reports(self) -> None:
         """Print the agent's plugin load errors and hot-reload outcomes here as they are logged.

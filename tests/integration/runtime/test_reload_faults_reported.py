@@ -3,18 +3,13 @@
 from __future__ import annotations
 
 import os
-import queue
-import signal
 import subprocess
 import sys
-import threading
-import time
 from collections.abc import Iterator
 from pathlib import Path
 
 import pytest
-
-READY = "objectives can be started"
+from kinema_run_terminal import READY, Terminal
 
 BEHAVIOR = '''
 from kinema.behaviors import NodeStatus, SyncBehavior
@@ -75,54 +70,14 @@ def env(tmp_path: Path, free_endpoint: str) -> dict[str, str]:
     return {**os.environ, "XDG_STATE_HOME": str(tmp_path / "state"), "KINEMA_ZENOH_CONNECT": free_endpoint}
 
 
-class Terminal:
-    """The output of a `kinema run`, line by line."""
-
-    def __init__(self, process: subprocess.Popen[str]) -> None:
-        self.process = process
-        self.lines: list[str] = []
-        self._queue: queue.Queue[str] = queue.Queue()
-        threading.Thread(target=self._read, daemon=True).start()
-
-    def _read(self) -> None:
-        assert self.process.stdout is not None
-        for line in self.process.stdout:
-            self._queue.put(line)
-
-    def wait_for(self, *needles: str, timeout: float = 60) -> str:
-        deadline = time.monotonic() + timeout
-        while time.monotonic() < deadline:
-            try:
-                line = self._queue.get(timeout=0.5)
-            except queue.Empty:
-                continue
-            self.lines.append(line)
-            if all(needle in line for needle in needles):
-                return line
-        raise AssertionError(f"no line with {needles} in:\n{''.join(self.lines)}")
-
-
 @pytest.fixture
 def terminal(workspace: Path, env: dict[str, str]) -> Iterator[Terminal]:
-    process = subprocess.Popen(
-        [sys.executable, "-m", "kinema", "run", "-n", "--headless", "-w", str(workspace), "-c", "my_cell"],
-        stdout=subprocess.PIPE,
-        stderr=subprocess.STDOUT,
-        text=True,
-        env=env,
-    )
+    output = Terminal(["-n", "--headless", "-w", str(workspace), "-c", "my_cell"], env)
     try:
-        output = Terminal(process)
         output.wait_for(READY, timeout=120)
         yield output
     finally:
-        if process.poll() is None:
-            process.send_signal(signal.SIGINT)
-            try:
-                process.wait(20)
-            except subprocess.TimeoutExpired:
-                process.kill()
-                process.wait(5)
+        output.stop()
 
 
 def test_reload_errors_appear_in_the_run_terminal_and_in_kinema_logs(
