@@ -209,9 +209,8 @@ class WaypointStore:
         for waypoint in waypoints:
             if waypoint.name == name:
                 return waypoint
-        raise ConfigError(
-            f"no waypoint named {name!r} in {self.path}; {did_you_mean(name, [w.name for w in waypoints])}"
-        )
+        names = [w.name for w in waypoints]
+        raise ConfigError(f"no waypoint named {name!r} in {self.read_path}; {did_you_mean(name, names)}")
 
     def save(self, waypoint: Waypoint) -> None:
         """Add ``waypoint``, or replace the one with the same name (keeping its place in the file)."""
@@ -244,7 +243,8 @@ class WaypointStore:
             waypoints = self._read()
             names = [waypoint.name for waypoint in waypoints]
             if old not in names:
-                raise ConfigError(f"no waypoint named {old!r} in {self.path}; {did_you_mean(old, names)}")
+                where = self.read_path
+                raise ConfigError(f"no waypoint named {old!r} in {where}; {did_you_mean(old, names)}")
             if new != old and new in names:
                 raise ConfigError(f"a waypoint named {new!r} already exists in {self.path}")
             waypoints[names.index(old)].name = new
@@ -260,7 +260,8 @@ class WaypointStore:
             waypoints = self._read()
             names = [waypoint.name for waypoint in waypoints]
             if name not in names:
-                raise ConfigError(f"no waypoint named {name!r} in {self.path}; {did_you_mean(name, names)}")
+                where = self.read_path
+                raise ConfigError(f"no waypoint named {name!r} in {where}; {did_you_mean(name, names)}")
             del waypoints[names.index(name)]
             self._write(waypoints)
 

@@ -58,6 +58,8 @@ class LaunchOptions:
         ui: runs in the main thread once everything started (the TUI); returns an exit code.
         viewer: also start the 3D view (``python -m kinema.viz``, the process behind ``kinema view``).
         echo: print progress lines (the CLI); tests turn it off.
+        insecure: allow a plain-text listener beyond loopback (with a warning).
+        security_dir: the folder of ``kinema security init`` for ``tls/`` endpoints (None: the default).
     """
 
     config: str
@@ -71,6 +73,8 @@ class LaunchOptions:
     ui: Callable[[Launcher], int] | None = None
     viewer: bool = False
     echo: Callable[[str], None] = field(default=print)
+    insecure: bool = False
+    security_dir: Path | None = None
 
 
 @dataclass
@@ -121,15 +125,13 @@ class Launcher:
                 carries the end of its log).
         """
         from kinema.runtime.log_files import configure_process_logging
-        from kinema.transport import host_or_join, resolve_endpoints
 
         options = self.options
         self.run_folder = RunFolder.create(options.config)
         supervisor_log = self.run_folder.log_file("supervisor")
         configure_process_logging(supervisor_log, verbose=options.verbose, echo=options.verbose)
-        self.endpoint = options.endpoint or resolve_endpoints(None)[0]
         try:
-            self.session = host_or_join(self.endpoint)
+            self.session = self._open_router()
             self.hosting = self.session.is_router
             log.info("%s the router at %s", "hosting" if self.hosting else "joined", self.endpoint)
             self.record = InstanceRecord(
@@ -357,6 +359,25 @@ class Launcher:
             self.stop()
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
+
+    def _open_router(self) -> Session:
+        """Host (or join) the router as planned from ``--connect``; say what listens beyond loopback."""
+        from kinema.runtime.router_plan import open_router, plan_router
+        from kinema.transport.exposure import insecure_warning
+
+        plan = plan_router(self.options.endpoint, self.options.security_dir)
+        session = open_router(plan, insecure=self.options.insecure)
+        self.endpoint = plan.local
+        if session.exposed:
+            log.warning("%s", insecure_warning(session.exposed))
+            self.options.echo(insecure_warning(session.exposed))
+        if plan.config_file is not None and session.is_router:
+            remote = [endpoint for endpoint in plan.listen if endpoint != plan.local]
+            self.options.echo(
+                f"other machines join at {', '.join(remote)} with a client certificate from "
+                f"{plan.config_file.parent} (mutual TLS, access rules of {plan.config_file})"
+            )
+        return session
 
     def _check_cell_is_free(self) -> None:
         """Refuse to start a second agent or second drivers on a router that has them (one per cell)."""
