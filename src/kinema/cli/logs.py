@@ -74,9 +74,14 @@ def export_logs(output: Path | None, run_name: str | None) -> None:
     folder = _run_folder(run_name)
     target = output if output is not None else Path.cwd() / f"kinema-logs-{folder.name}.zip"
     files = folder.files()
-    with zipfile.ZipFile(target, "w", compression=zipfile.ZIP_DEFLATED) as archive:
-        for path in files:
-            archive.write(path, Path(folder.name) / path.relative_to(folder.path))
+    try:
+        with zipfile.ZipFile(target, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+            for path in files:
+                archive.write(path, Path(folder.name) / path.relative_to(folder.path))
+    except OSError as error:
+        from kinema.errors import KinemaError
+
+        raise KinemaError(f"cannot write {target}: {error.strerror or error}") from None
     for link in folder.links():
         click.echo(
             f"skipped {link.relative_to(folder.path)}: a symbolic link, not a file of the run", err=True

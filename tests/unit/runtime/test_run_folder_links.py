@@ -63,3 +63,13 @@ def test_a_linked_run_folder_is_not_a_run(tmp_path: Path, run_with_links: RunFol
         elsewhere, target_is_directory=True
     )
     assert [run.path for run in list_runs()] == [run_with_links.path]
+
+
+def test_export_logs_into_a_missing_folder_is_one_line_not_a_traceback(
+    run_with_links: RunFolder, tmp_path: Path
+) -> None:
+    from kinema.cli.main import main
+
+    target = tmp_path / "no" / "such" / "folder" / "logs.zip"
+    code = main(["export-logs", "-o", str(target)])
+    assert code == 1 and not target.exists()
