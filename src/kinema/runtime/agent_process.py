@@ -125,6 +125,7 @@ def _waypoint_store(options: AgentOptions, resolved: Any) -> Any:
     from kinema.config import WaypointStore
     from kinema.config.waypoint_location import waypoint_store_for
 
+    store: WaypointStore | None
     if options.waypoints_file is not None:
         store = WaypointStore(options.waypoints_file)
     elif resolved is not None:
