@@ -3,8 +3,9 @@
 Unlike loading (which stops at the first error, as BT.CPP does), validation reports every problem
 it can find: unknown node IDs (with the closest registered names), structure (child counts, IDs),
 ports that the node type does not declare, literals that cannot be converted, scripts that do not
-parse, SubTree IDs that name no tree, mandatory SubTree model ports that are not given. Files whose
-structure is sound are then built, which also catches type conflicts and recursive subtrees.
+parse, SubTree IDs and a ``main_tree_to_execute`` that name no tree, mandatory SubTree model ports
+that are not given. Files whose structure is sound are then built, which also catches type conflicts
+and recursive subtrees.
 """
 
 from __future__ import annotations
@@ -66,6 +67,7 @@ def validate_files(paths: list[str | Path], factory: BehaviorTreeFactory | None 
     manifests = scratch.manifests()
     known_trees = set(scratch.library.trees)
     for filename, root in documents:
+        problems += _main_tree_problems(root, filename, known_trees)
         problems += [
             Problem(SourceLocation(filename, line), message)
             for line, message in find_structure_problems(root, filename, manifests, known_trees=known_trees)
@@ -77,6 +79,19 @@ def validate_files(paths: list[str | Path], factory: BehaviorTreeFactory | None 
         for filename, root in documents:
             problems += _build_problems(root, filename, scratch)
     return problems
+
+
+def _main_tree_problems(root: etree._Element, filename: str, known_trees: set[str]) -> list[Problem]:
+    """``main_tree_to_execute`` must name a tree of these files (BT.CPP's createTree fails otherwise)."""
+    main = root.get("main_tree_to_execute")
+    if main is None or main in known_trees:
+        return []
+    return [
+        Problem(
+            SourceLocation(filename, line_of(root)),
+            f"main_tree_to_execute={main!r} names no tree; {did_you_mean(main, sorted(known_trees))}",
+        )
+    ]
 
 
 def _scratch_factory(base: BehaviorTreeFactory) -> BehaviorTreeFactory:

@@ -99,13 +99,26 @@ def _print_recordings(folder: RunFolder) -> None:
 )
 @click.option("--run", "run_name", default=None, metavar="NAME", help=_RUN_HELP)
 def export_logs(output: Path | None, run_name: str | None) -> None:
-    """Zip the log folder of the latest run, objective recordings included (to attach to a bug report)."""
+    """Zip the log folder of the latest run, objective recordings included (to attach to a bug report).
+
+    Only the run folder's own files go in: symbolic links (which could point anywhere on the machine)
+    are skipped and listed.
+    """
     import zipfile
 
     folder = _run_folder(run_name)
     target = output if output is not None else Path.cwd() / f"kinema-logs-{folder.name}.zip"
-    files = sorted(p for p in folder.path.rglob("*") if p.is_file())
-    with zipfile.ZipFile(target, "w", compression=zipfile.ZIP_DEFLATED) as archive:
-        for path in files:
-            archive.write(path, Path(folder.name) / path.relative_to(folder.path))
+    files = folder.files()
+    try:
+        with zipfile.ZipFile(target, "w", compression=zipfile.ZIP_DEFLATED) as archive:
+            for path in files:
+                archive.write(path, Path(folder.name) / path.relative_to(folder.path))
+    except OSError as error:
+        from kinema.errors import KinemaError
+
+        raise KinemaError(f"cannot write {target}: {error.strerror or error}") from None
+    for link in folder.links():
+        click.echo(
+            f"skipped {link.relative_to(folder.path)}: a symbolic link, not a file of the run", err=True
+        )
     click.echo(f"wrote {target} ({len(files)} files from {folder.path})")

@@ -20,6 +20,7 @@ from kinema.errors import KinemaError
 VERBS: dict[str, str] = {
     "run": "kinema.cli.run:run",
     "down": "kinema.cli.run:down",
+    "security": "kinema.cli.security:security",
     "ui": "kinema.cli.ui:ui",
     "view": "kinema.cli.view:view",
     "configure": "kinema.cli.workspace:configure",

@@ -114,7 +114,8 @@ def new_behavior(
     point, the behavior module, the registration, an example objective and a passing test. The example
     works before any edit (e.g. async sums int_1 and int_2; service_client calls /add_two_ints). When the
     active config package is in the workspace, the loader and the example objectives are added to its
-    config.yaml. Nothing is written when a name is invalid or taken.
+    config.yaml. Nothing is written when a name is invalid or taken, or when it would shadow a Python
+    module (a standard-library or installed one, e.g. os or numpy).
     """
     from kinema.cli.options import resolve_selection
     from kinema.scaffold.behavior_package import new_behavior as create

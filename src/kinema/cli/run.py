@@ -27,7 +27,23 @@ from kinema.cli.options import selection_options
     "--connect",
     default=None,
     metavar="ENDPOINT",
-    help="Router endpoint to host or join (default: $KINEMA_ZENOH_CONNECT, else tcp/127.0.0.1:7447).",
+    help="Router endpoint(s) to host or join, comma-separated (default: $KINEMA_ZENOH_CONNECT, else "
+    "tcp/127.0.0.1:7447). Beyond loopback use tls/<address>:7448 after `kinema security init`.",
+)
+@click.option(
+    "--security",
+    "security_dir",
+    type=click.Path(file_okay=False, path_type=Path),
+    default=None,
+    metavar="DIR",
+    help="The folder of `kinema security init` for tls/ endpoints (default: $KINEMA_SECURITY_DIR, else "
+    "~/.config/kinema/security).",
+)
+@click.option(
+    "--insecure",
+    is_flag=True,
+    help="Allow a plain-text listener beyond loopback (e.g. --connect tcp/0.0.0.0:7447): anyone who reaches "
+    "it can run objectives and drive the robot. Prints a warning; for trusted networks only.",
 )
 @click.option("--tick-rate", type=float, default=100.0, show_default=True, help="Objective ticks per second.")
 @click.option(
@@ -61,6 +77,8 @@ def run(
     no_browser: bool,
     list_configs: bool,
     connect: str | None,
+    security_dir: Path | None,
+    insecure: bool,
     tick_rate: float,
     sim_speed: str | None,
     groot2_port: int | None,
@@ -69,7 +87,12 @@ def run(
     """Start Kinema: host the zenoh router (or join one), the agent and the config's drivers.
 
     Prints one line once objectives can be started, writes every process's log to a per-run folder
-    (see `kinema logs`), and blocks until Ctrl-C or `kinema down`.
+    (see `kinema logs`), and blocks until Ctrl-C or `kinema down`. One runtime per cell: when the router
+    already has an agent (or drivers) it refuses to start another, and says how to join or stop it;
+    -n and -o start the two halves of one cell.
+
+    The network is closed by default: the router listens beyond loopback only on tls/ endpoints, with
+    client certificates and access rules from `kinema security init`, or in plain text with --insecure.
     """
     from kinema.cli.options import resolve_selection
 
@@ -102,6 +125,8 @@ def run(
         agent=not only_drivers,
         drivers=not no_drivers,
         endpoint=connect,
+        insecure=insecure,
+        security_dir=security_dir,
         verbose=verbose,
         tick_rate_hz=tick_rate,
         sim_speed=sim_speed,

@@ -80,18 +80,21 @@ def init(path: Path) -> None:
     src = path / "src"
     if src.is_dir():
         raise ConfigError(f"{path} is already a workspace (it has src/)")
-    src.mkdir(parents=True)
     readme = path / "README.md"
-    if not readme.exists():
-        readme.write_text(
-            "# Kinema workspace\n\n"
-            "Packages live in `src/`: config packages (`config/config.yaml`) and behavior packages.\n\n"
-            "```bash\n"
-            f"kinema configure -w {path} -c lab_sim\n"
-            "kinema new config my_robot_config --based-on lab_sim\n"
-            "kinema config show -c my_robot_config --provenance\n"
-            "```\n",
-            encoding="utf-8",
-        )
+    try:
+        src.mkdir(parents=True)
+        if not readme.exists():
+            readme.write_text(
+                "# Kinema workspace\n\n"
+                "Packages live in `src/`: config packages (`config/config.yaml`) and behavior packages.\n\n"
+                "```bash\n"
+                f"kinema configure -w {path} -c lab_sim\n"
+                "kinema new config my_robot_config --based-on lab_sim\n"
+                "kinema config show -c my_robot_config --provenance\n"
+                "```\n",
+                encoding="utf-8",
+            )
+    except OSError as error:
+        raise ConfigError(f"cannot create the workspace {path}: {error.strerror or error}") from None
     click.echo(f"created workspace {path.resolve()}")
     click.echo(f"next: kinema configure -w {path} -c lab_sim")

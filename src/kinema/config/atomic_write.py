@@ -2,12 +2,15 @@
 
 The new content goes to a temporary file in the same folder (same file system, so ``os.replace`` is an
 atomic rename), is flushed to disk, and then takes the old file's name. An existing file's permission
-bits are kept.
+bits are kept. A writer killed between the two steps leaves its temporary file
+(``.<name>.<random>.tmp``) behind; :func:`remove_temporaries_of` deletes those, for callers that
+know no other writer is busy (they hold the file's lock).
 """
 
 from __future__ import annotations
 
 import contextlib
+import glob
 import os
 import tempfile
 from pathlib import Path
@@ -45,7 +48,7 @@ def _replace(path: Path, data: bytes) -> None:
         mode: int | None = path.stat().st_mode & 0o7777
     except FileNotFoundError:
         mode = None
-    descriptor, temporary = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
+    descriptor, temporary = tempfile.mkstemp(prefix=temporary_prefix(path), suffix=".tmp", dir=path.parent)
     try:
         with os.fdopen(descriptor, "wb") as handle:
             handle.write(data)
@@ -60,6 +63,29 @@ def _replace(path: Path, data: bytes) -> None:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(temporary)
         raise
+
+
+def temporary_prefix(path: Path) -> str:
+    """The name prefix of the temporary files written for ``path``."""
+    return f".{path.name}."
+
+
+def remove_temporaries_of(path: str | Path) -> list[Path]:
+    """Delete the temporary files a killed writer of ``path`` left behind; return what was deleted.
+
+    Only call it while no other writer of ``path`` can be busy (e.g. under the file's lock).
+    """
+    path = Path(path)
+    removed = []
+    try:
+        candidates = list(path.parent.glob(f"{glob.escape(temporary_prefix(path))}*.tmp"))
+    except OSError:
+        return []
+    for candidate in candidates:
+        with contextlib.suppress(OSError):
+            candidate.unlink()
+            removed.append(candidate)
+    return removed
 
 
 def atomic_write_text(path: str | Path, text: str, *, error: type[KinemaError] = ConfigError) -> None:

@@ -20,14 +20,15 @@ half-written file.
 from __future__ import annotations
 
 import copy
-from contextlib import AbstractContextManager
+from collections.abc import Iterator
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import yaml
 
-from kinema.config.atomic_write import atomic_write_text
+from kinema.config.atomic_write import atomic_write_text, remove_temporaries_of
 from kinema.config.file_lock import locked
 from kinema.config.yamlsource import YamlDocument, load_yaml_file
 from kinema.errors import ConfigError, SourceLocation, did_you_mean
@@ -155,10 +156,36 @@ def _list(
 
 
 class WaypointStore:
-    """The waypoints of one file, read fresh on every call and changed under the file's lock."""
+    """The waypoints of one file, read fresh on every call and changed under the file's lock.
 
-    def __init__(self, path: str | Path) -> None:
+    Args:
+        path: the file changes are written to.
+        seed_from: the file to read while ``path`` does not exist yet (an inherited waypoints file, see
+            :mod:`kinema.config.waypoint_location`); the first change copies its waypoints to ``path``.
+        notice: why ``path`` is not the file the config names (for logs and UIs); empty otherwise.
+    """
+
+    def __init__(self, path: str | Path, *, seed_from: str | Path | None = None, notice: str = "") -> None:
         self.path = Path(path)
+        self.seed_from = Path(seed_from) if seed_from is not None else None
+        self.notice = notice
+
+    @property
+    def read_path(self) -> Path:
+        """The file waypoints are read from now."""
+        if self.seed_from is not None and not self.path.exists():
+            return self.seed_from
+        return self.path
+
+    def remove_stray_temporaries(self) -> list[Path]:
+        """Delete temporary files a writer killed mid-save left beside the file; return them.
+
+        Safe at any time: every writer holds the file's lock while its temporary file exists.
+        """
+        if not self.path.parent.is_dir():
+            return []
+        with locked(self.path):
+            return remove_temporaries_of(self.path)
 
     def all(self) -> list[Waypoint]:
         """Every waypoint, in file order (an absent file has none).
@@ -182,9 +209,8 @@ class WaypointStore:
         for waypoint in waypoints:
             if waypoint.name == name:
                 return waypoint
-        raise ConfigError(
-            f"no waypoint named {name!r} in {self.path}; {did_you_mean(name, [w.name for w in waypoints])}"
-        )
+        names = [w.name for w in waypoints]
+        raise ConfigError(f"no waypoint named {name!r} in {self.read_path}; {did_you_mean(name, names)}")
 
     def save(self, waypoint: Waypoint) -> None:
         """Add ``waypoint``, or replace the one with the same name (keeping its place in the file)."""
@@ -217,7 +243,8 @@ class WaypointStore:
             waypoints = self._read()
             names = [waypoint.name for waypoint in waypoints]
             if old not in names:
-                raise ConfigError(f"no waypoint named {old!r} in {self.path}; {did_you_mean(old, names)}")
+                where = self.read_path
+                raise ConfigError(f"no waypoint named {old!r} in {where}; {did_you_mean(old, names)}")
             if new != old and new in names:
                 raise ConfigError(f"a waypoint named {new!r} already exists in {self.path}")
             waypoints[names.index(old)].name = new
@@ -233,11 +260,13 @@ class WaypointStore:
             waypoints = self._read()
             names = [waypoint.name for waypoint in waypoints]
             if name not in names:
-                raise ConfigError(f"no waypoint named {name!r} in {self.path}; {did_you_mean(name, names)}")
+                where = self.read_path
+                raise ConfigError(f"no waypoint named {name!r} in {where}; {did_you_mean(name, names)}")
             del waypoints[names.index(name)]
             self._write(waypoints)
 
-    def _locked(self) -> AbstractContextManager[None]:
+    @contextmanager
+    def _locked(self) -> Iterator[None]:
         try:
             self.path.parent.mkdir(parents=True, exist_ok=True)
         except OSError as error:
@@ -245,12 +274,15 @@ class WaypointStore:
                 f"cannot create the folder of the waypoints file: {error.strerror}",
                 location=SourceLocation(str(self.path.parent)),
             ) from None
-        return locked(self.path)
+        with locked(self.path):
+            remove_temporaries_of(self.path)  # what a writer killed mid-save left behind
+            yield
 
     def _read(self) -> list[Waypoint]:
-        if not self.path.exists():
+        path = self.read_path
+        if not path.exists():
             return []
-        document = load_yaml_file(self.path, max_bytes=MAX_WAYPOINTS_BYTES, track_lines=False)
+        document = load_yaml_file(path, max_bytes=MAX_WAYPOINTS_BYTES, track_lines=False)
         if document.data is None:
             return []
         if not isinstance(document.data, list):

@@ -20,6 +20,7 @@ from kinema.errors import KinemaError, PluginError
 from kinema.plugins.discovery import PluginSpec, available_plugins, select_loaders
 from kinema.plugins.events import ReloadEvent, ReloadKind
 from kinema.plugins.hot_reload import DirectoryWatcher
+from kinema.plugins.import_deadline import IMPORT_TIME_LIMIT_S, call_with_deadline
 from kinema.plugins.importer import describe_exception, import_fresh, purge_modules
 from kinema.plugins.manager import KinemaPluginManager
 from kinema.plugins.registration import BehaviorRegistration
@@ -59,11 +60,20 @@ class BehaviorHost:
     Args:
         loader_names: the config's merged ``objectives.behavior_loader_plugins`` names.
         workspace: the user workspace whose ``src/`` holds behavior packages (loaded by path).
+        import_time_limit: seconds a plugin's import may take before it is reported and abandoned
+            (see :mod:`kinema.plugins.import_deadline`).
     """
 
-    def __init__(self, loader_names: Iterable[str], workspace: Path | None = None) -> None:
+    def __init__(
+        self,
+        loader_names: Iterable[str],
+        workspace: Path | None = None,
+        *,
+        import_time_limit: float = IMPORT_TIME_LIMIT_S,
+    ) -> None:
         self.loader_names = list(loader_names)
         self.workspace = Path(workspace) if workspace is not None else None
+        self.import_time_limit = import_time_limit
         self._manager = KinemaPluginManager()
         self._registry = BehaviorRegistry()
         self._loaded_tops: dict[str, str] = {}
@@ -274,9 +284,16 @@ class BehaviorHost:
             if cached is not None:
                 module: object = cached
             else:
+                root = spec.root
                 try:
-                    module = import_fresh(
-                        spec.root, spec.module, spec.package, cache_bytecode=not spec.hot_reloadable
+                    module = call_with_deadline(
+                        lambda: import_fresh(
+                            root, spec.module, spec.package, cache_bytecode=not spec.hot_reloadable
+                        ),
+                        self.import_time_limit,
+                        what=f"behavior package '{spec.package}'",
+                        root=root,
+                        on_late_result=_discard_module,
                     )
                 except PluginError as error:
                     raise PluginError(
@@ -286,7 +303,15 @@ class BehaviorHost:
                     _STATIC_MODULES[key] = module
         else:
             try:
-                module = importlib.import_module(spec.module)
+                module = call_with_deadline(
+                    lambda: importlib.import_module(spec.module),
+                    self.import_time_limit,
+                    what=f"module {spec.module} (entry point of {spec.package})",
+                )
+            except PluginError as error:
+                raise PluginError(
+                    f"plugin '{spec.name}': {error.message}", location=error.location
+                ) from error
             except Exception as error:
                 raise PluginError(
                     f"plugin '{spec.name}' (entry point of {spec.package}) failed to import {spec.module}: "
@@ -300,6 +325,13 @@ class BehaviorHost:
                     f"plugin '{spec.name}': module {spec.module} has no attribute '{spec.attribute}'"
                 ) from error
         return module
+
+
+def _discard_module(module: object) -> None:
+    """Forget a fresh module whose import finished only after it was abandoned."""
+    top = getattr(module, "__name__", "").split(".")[0]
+    if top:
+        purge_modules(top)
 
 
 def _check_factory(registrations: list[BehaviorRegistration], spec: PluginSpec) -> None:

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 from kinema.errors import KinemaError, ObjectiveError
 from kinema.runtime import names
 from kinema.runtime.error_codes import MoveItErrorCode
+from kinema.runtime.log_files import PLUGIN_LOGGER
 from kinema.runtime.objective_server import (
     NodeStatusChange,
     ObjectiveRequest,
@@ -42,6 +43,8 @@ if TYPE_CHECKING:
     from kinema.transport import Node, Session
 
 log = logging.getLogger("kinema.agent")
+# Plugin load and hot-reload outcomes have a logger of their own: `kinema run` echoes it in its terminal.
+plugin_log = logging.getLogger(PLUGIN_LOGGER)
 
 # Blackboard values are rendered for display; longer renderings are cut.
 MAX_VALUE_CHARS = 2000
@@ -609,6 +612,18 @@ class Agent:
         if self.waypoints is None:
             return {"status": {"success": False, "error_message": "the config has no waypoints file"}}
         operation = int(request.operation)
+        copy_existed = self.waypoints.path.exists()
+        try:
+            response = self._edit_waypoints(operation, request)
+        finally:
+            if self.waypoints.notice and not copy_existed and self.waypoints.path.exists():
+                # The first change of inherited waypoints: say once where they are kept from now on.
+                log.warning("waypoints: %s", self.waypoints.notice)
+                self._streams.publish_log(LOG_WARN, f"Waypoints: {self.waypoints.notice}")
+        return response
+
+    def _edit_waypoints(self, operation: int, request: Any) -> dict[str, Any]:
+        assert self.waypoints is not None
         try:
             if operation == 0:
                 waypoint = self._save_current(request.waypoint_name, list(request.joint_group_names))
@@ -668,8 +683,17 @@ class Agent:
             except Exception:
                 log.debug("could not send a toast to the JSON client of run %d", run_id, exc_info=True)
 
+    def report_cell_conflict(self, message: str) -> None:
+        """Two agents or two drivers share this network (see :mod:`kinema.runtime.cell`): log and toast."""
+        log.error("%s", message)
+        self._streams.publish_log(LOG_ERROR, message)
+
     def on_reload_event(self, event: ReloadEvent) -> None:
-        """Publish a hot-reload outcome as a toast (subscribe it to the behavior host)."""
+        """Report a hot-reload outcome: a toast, and the agent's log (``kinema logs``, the run terminal).
+
+        Subscribe it to the behavior host.
+        """
+        plugin_log.log(logging.INFO if event.ok else logging.ERROR, "%s", event)
         self._streams.publish_log(LOG_INFO if event.ok else LOG_ERROR, str(event))
         if str(event.kind) == "objectives_changed" and self.source is not None:
             self.source.invalidate_objectives()
@@ -731,7 +755,7 @@ def build_host(resolved: Any) -> BehaviorHost:
     host = BehaviorHost.for_config(resolved)
     report = host.load()
     for warning in report.warnings:
-        log.warning("plugins: %s", warning)
+        plugin_log.warning("%s", warning)
     for error in report.errors:
-        log.error("plugins: %s", error)
+        plugin_log.error("%s", error)
     return host

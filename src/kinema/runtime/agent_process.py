@@ -107,12 +107,7 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
 
     source = LibraryTreeSource(load_library, host=host, context=context, clock=clock)
     source.factory()  # load now: errors show at start, and the first objective starts fast
-    waypoints = None
-    waypoints_path = options.waypoints_file or (resolved.waypoints_path if resolved is not None else None)
-    if waypoints_path is not None:
-        from kinema.config import WaypointStore
-
-        waypoints = WaypointStore(waypoints_path)
+    waypoints = _waypoint_store(options, resolved)
     server = ObjectiveServer(source, tick_rate_hz=options.tick_rate_hz)
     agent = Agent(session, server, source=source, waypoints=waypoints, log_sink=sink, clock=clock, node=node)
     _add_debugging_doors(agent, options)
@@ -128,6 +123,27 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
         watcher_host.subscribe(agent.on_reload_event)
         watcher_host.watch(extra)
     return agent
+
+
+def _waypoint_store(options: AgentOptions, resolved: Any) -> Any:
+    """The waypoints the agent serves (see :mod:`kinema.config.waypoint_location`), tidied at start."""
+    from kinema.config import WaypointStore
+    from kinema.config.waypoint_location import waypoint_store_for
+
+    store: WaypointStore | None
+    if options.waypoints_file is not None:
+        store = WaypointStore(options.waypoints_file)
+    elif resolved is not None:
+        store = waypoint_store_for(resolved)
+    else:
+        return None
+    if store is None:
+        return None
+    for stray in store.remove_stray_temporaries():
+        log.warning("removed %s, left by a save that was interrupted", stray)
+    if store.notice:
+        log.info("waypoints: %s", store.notice)
+    return store
 
 
 def _warn_without_clock(clock: Any, after_s: float = 10.0) -> None:
@@ -226,6 +242,12 @@ def main(argv: list[str] | None = None) -> int:
         log.error("%s", error)
         print(f"error: {error}", file=sys.stderr)
         return 1
+    from kinema.runtime.cell import AGENT, CellWatch, declare_presence
+
+    # Announced before its nodes exist, so whoever sees them also knows whose they are.
+    declare_presence(
+        session, AGENT, config=options.config or "", endpoint=args.connect or args.host_router or ""
+    )
     try:
         agent = build_agent(options, session)
         agent.start()
@@ -234,6 +256,7 @@ def main(argv: list[str] | None = None) -> int:
         print(f"error: {error}", file=sys.stderr)
         session.close()
         return 1
+    CellWatch(session, agent.report_cell_conflict)  # reports another agent; closed with the session
     log.info("agent serving (config %s, pid %d)", options.config or "-", os.getpid())
     if args.ready_fd is not None:
         with os.fdopen(args.ready_fd, "w") as ready:

@@ -64,6 +64,8 @@ class LaunchOptions:
         record: the agent records every objective run as a ``.btlog`` file in the run folder's
             ``recordings/``.
         echo: print progress lines (the CLI); tests turn it off.
+        insecure: allow a plain-text listener beyond loopback (with a warning).
+        security_dir: the folder of ``kinema security init`` for ``tls/`` endpoints (None: the default).
     """
 
     config: str
@@ -79,6 +81,8 @@ class LaunchOptions:
     groot2_port: int | None = None
     record: bool = True
     echo: Callable[[str], None] = field(default=print)
+    insecure: bool = False
+    security_dir: Path | None = None
 
 
 @dataclass
@@ -118,6 +122,7 @@ class Launcher:
         self.lifeline: Lifeline | None = None
         self._stop = threading.Event()
         self._stop_reason = ""
+        self._echo_stop = threading.Event()
 
     # -- start --------------------------------------------------------------------------------------
 
@@ -129,22 +134,21 @@ class Launcher:
                 carries the end of its log).
         """
         from kinema.runtime.log_files import configure_process_logging
-        from kinema.transport import host_or_join, resolve_endpoints
 
         options = self.options
         self.run_folder = RunFolder.create(options.config)
         supervisor_log = self.run_folder.log_file("supervisor")
         configure_process_logging(supervisor_log, verbose=options.verbose, echo=options.verbose)
-        self.endpoint = options.endpoint or resolve_endpoints(None)[0]
         self.lifeline = Lifeline()
         try:
-            self.session = host_or_join(self.endpoint)
+            self.session = self._open_router()
             self.hosting = self.session.is_router
             log.info("%s the router at %s", "hosting" if self.hosting else "joined", self.endpoint)
             self.record = InstanceRecord(
                 os.getpid(), self.endpoint, str(self.run_folder.path), options.config
             )
             self.record.save()
+            self._check_cell_is_free()
             clock = "auto"
             starting = self._start_drivers() if options.drivers else []
             if options.drivers and not starting:
@@ -331,6 +335,7 @@ class Launcher:
 
     def stop(self) -> None:
         """Stop the children (SIGTERM, SIGKILL after a grace period), close the router, drop the record."""
+        self._echo_stop.set()
         for child in reversed(self.children):
             if child.process.poll() is None:
                 child.process.terminate()
@@ -371,13 +376,76 @@ class Launcher:
                 f"Kinema is running: {what} (config {self.options.config}, {role} at "
                 f"{self.endpoint}, logs in {self.run_folder.path}). Stop with Ctrl-C or `kinema down`."
             )
+            self._watch_cell()
             if self.options.ui is not None:
                 return self.options.ui(self)
+            self._echo_plugin_reports()
             return self.wait()
         finally:
             self.stop()
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
+
+    def _open_router(self) -> Session:
+        """Host (or join) the router as planned from ``--connect``; say what listens beyond loopback."""
+        from kinema.runtime.router_plan import open_router, plan_router
+        from kinema.transport.exposure import insecure_warning
+
+        plan = plan_router(self.options.endpoint, self.options.security_dir)
+        session = open_router(plan, insecure=self.options.insecure)
+        self.endpoint = plan.local
+        if session.exposed:
+            log.warning("%s", insecure_warning(session.exposed))
+            self.options.echo(insecure_warning(session.exposed))
+        if plan.config_file is not None and session.is_router:
+            remote = [endpoint for endpoint in plan.listen if endpoint != plan.local]
+            self.options.echo(
+                f"other machines join at {', '.join(remote)} with a client certificate from "
+                f"{plan.config_file.parent} (mutual TLS, access rules of {plan.config_file})"
+            )
+        return session
+
+    def _check_cell_is_free(self) -> None:
+        """Refuse to start a second agent or second drivers on a router that has them (one per cell)."""
+        if self.hosting or self.session is None:
+            return  # a router of our own: nobody else is there yet
+        from kinema.runtime.cell import check_cell_is_free
+
+        check_cell_is_free(
+            self.session, agent=self.options.agent, drivers=self.options.drivers, endpoint=self.endpoint
+        )
+
+    def _watch_cell(self) -> None:
+        """Report two agents or two drivers on the network, should they appear anyway."""
+        from kinema.runtime.cell import CellWatch
+
+        assert self.session is not None
+
+        def report(message: str) -> None:
+            log.error("%s", message)
+            if self.options.ui is None:
+                self.options.echo(f"warning: {message}")
+
+        CellWatch(self.session, report)  # closed with the session
+
+    def _echo_plugin_reports(self) -> None:
+        """Print the agent's plugin load errors and hot-reload outcomes here as they are logged.
+
+        Without a UI this terminal is where the user looks; the log file (``kinema logs``) has them too.
+        """
+        from kinema.runtime.log_files import PLUGIN_LOGGER, follow_entries
+
+        assert self.run_folder is not None
+        entries = follow_entries(self.run_folder.path, stop=self._echo_stop, from_start=True)
+        marker = f"[{PLUGIN_LOGGER}] "
+
+        def echo() -> None:
+            for entry in entries:
+                rest = entry.text.partition(marker)[2]
+                if rest:
+                    self.options.echo(f"{entry.process}: {entry.level.lower()}: {rest}")
+
+        threading.Thread(target=echo, name="kinema-plugin-echo", daemon=True).start()
 
 
 def _runnable_module(module: str) -> bool:

@@ -19,6 +19,8 @@ from pathlib import Path
 LOG_FORMAT = "%(asctime)s.%(msecs)03d %(levelname)-7s [%(name)s] %(message)s"
 DATE_FORMAT = "%Y-%m-%d %H:%M:%S"
 LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
+#: The agent's logger for plugin load errors and hot-reload outcomes; `kinema run` echoes its entries.
+PLUGIN_LOGGER = "kinema.plugins"
 
 _ENTRY = re.compile(r"^(\d{4}-\d\d-\d\d \d\d:\d\d:\d\d\.\d{3}) (DEBUG|INFO|WARNING|ERROR|CRITICAL)\s")
 
@@ -97,14 +99,24 @@ def merged_entries(paths: list[Path], *, min_level: int = logging.DEBUG) -> list
 
 
 def follow_entries(
-    folder: Path, *, min_level: int = logging.DEBUG, poll_s: float = 0.2, stop: threading.Event | None = None
+    folder: Path,
+    *,
+    min_level: int = logging.DEBUG,
+    poll_s: float = 0.2,
+    stop: threading.Event | None = None,
+    from_start: bool = False,
 ) -> Iterator[LogEntry]:
     """Yield entries appended to any ``*.log`` file of ``folder`` after this call (like ``tail -f``).
 
-    The current end of every file is taken when this function is called, not at the first ``next()``.
-    Files that appear later are read from their start. The iteration ends when ``stop`` is set.
+    The current end of every file is taken when this function is called, not at the first ``next()``
+    (with ``from_start``, every file is read from its start). Files that appear later are read from
+    their start. The iteration ends when ``stop`` is set.
     """
-    offsets = {path: path.stat().st_size for path in folder.glob("*.log")}
+    offsets = {
+        path: 0 if from_start else path.stat().st_size
+        for path in folder.glob("*.log")
+        if not path.is_symlink()
+    }
     return _follow(folder, offsets, min_level, poll_s, stop)
 
 
@@ -115,6 +127,8 @@ def _follow(
     while stop is None or not stop.is_set():
         produced = False
         for path in sorted(folder.glob("*.log")):
+            if path.is_symlink():
+                continue  # not a log of the run: it could point anywhere
             offset = offsets.get(path, 0)
             try:
                 size = path.stat().st_size

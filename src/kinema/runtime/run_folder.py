@@ -8,7 +8,9 @@ folder and ``kinema export-logs`` zips it.
 
 from __future__ import annotations
 
+import os
 import re
+import stat
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -51,8 +53,29 @@ class RunFolder:
         return self.path / f"{process}.log"
 
     def log_files(self) -> list[Path]:
-        """Every log file in the folder, sorted by name."""
-        return sorted(self.path.glob("*.log"))
+        """Every log file in the folder, sorted by name (symbolic links are not log files of the run)."""
+        return [path for path in self.files() if path.parent == self.path and path.suffix == ".log"]
+
+    def files(self) -> list[Path]:
+        """Every regular file under the folder, sorted, never through a symbolic link.
+
+        A link (to a file or a folder) could point anywhere on the machine; what ``kinema logs`` prints
+        and ``kinema export-logs`` archives must come from the run folder itself.
+        """
+        found = []
+        for folder, subfolders, names in os.walk(self.path, followlinks=False):
+            base = Path(folder)
+            subfolders[:] = [name for name in subfolders if not (base / name).is_symlink()]
+            found += [base / name for name in names if _regular_file(base / name)]
+        return sorted(found)
+
+    def links(self) -> list[Path]:
+        """The symbolic links under the folder (skipped by :meth:`files`), sorted."""
+        found = []
+        for folder, subfolders, names in os.walk(self.path, followlinks=False):
+            base = Path(folder)
+            found += [base / name for name in (*subfolders, *names) if (base / name).is_symlink()]
+        return sorted(found)
 
     @classmethod
     def create(cls, config_name: str, *, keep: int = KEEP_RUNS) -> RunFolder:
@@ -81,9 +104,16 @@ class RunFolder:
 
 
 def list_runs() -> list[RunFolder]:
-    """Every run folder, oldest first."""
+    """Every run folder, oldest first (a symbolic link in the runs folder is not a run)."""
     base = runs_dir()
-    return [RunFolder(p) for p in sorted(p for p in base.iterdir() if p.is_dir())]
+    return [RunFolder(p) for p in sorted(p for p in base.iterdir() if p.is_dir() and not p.is_symlink())]
+
+
+def _regular_file(path: Path) -> bool:
+    try:
+        return stat.S_ISREG(path.lstat().st_mode)
+    except OSError:
+        return False
 
 
 def _prune(base: Path, keep: int) -> None:

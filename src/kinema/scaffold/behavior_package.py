@@ -23,7 +23,7 @@ from typing import Any
 from kinema.config.workspace import Package, Workspace
 from kinema.errors import ConfigError, ScaffoldError, did_you_mean
 from kinema.scaffold.generate import generate
-from kinema.scaffold.names import package_name_problem
+from kinema.scaffold.names import module_name_problem, package_name_problem
 
 TEMPLATE = "behavior_package"
 BEHAVIOR_TYPES = ("sync", "async", "service_client", "action_client", "topic_subscriber", "topic_publisher")
@@ -66,6 +66,9 @@ def check_behavior_name(name: str) -> None:
         raise ScaffoldError(
             f"{name!r} is not a valid behavior name: {problem.replace('my_robot_config', 'my_behavior')}"
         )
+    clash = module_name_problem(name)
+    if clash is not None:
+        raise ScaffoldError(f"{clash}; choose another behavior name, e.g. my_{name}")
 
 
 def check_behavior_type(behavior_type: str) -> None:

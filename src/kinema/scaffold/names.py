@@ -7,8 +7,10 @@ underscore: ``my_robot_config``, ``lab_sim2``. The same rule is repeated in each
 
 from __future__ import annotations
 
+import importlib.util
 import keyword
 import re
+import sys
 
 from kinema.errors import ScaffoldError
 
@@ -29,6 +31,25 @@ def package_name_problem(name: str) -> str | None:
         return _NAME_RULE
     if keyword.iskeyword(name):
         return "the name is a Python keyword"
+    return None
+
+
+def module_name_problem(name: str) -> str | None:
+    """Return why a Python package called ``name`` would clash with a module Python already has, or None.
+
+    A behavior package is a Python package of its own name: called ``os`` or ``numpy`` it would shadow
+    the standard-library or installed module in its own tests and in everything imported after it.
+    """
+    if name in sys.stdlib_module_names or name in sys.builtin_module_names:
+        return f"{name!r} is a module of Python's standard library; a package of that name would shadow it"
+    try:
+        spec = importlib.util.find_spec(name)
+    except (ImportError, ValueError):
+        spec = None
+    # A namespace spec is only a folder on sys.path (the current folder included), not a module.
+    if spec is not None and spec.origin is not None:
+        where = spec.origin
+        return f"{name!r} is an installed Python module ({where}); a package of that name would shadow it"
     return None
 
 

@@ -108,9 +108,18 @@ class QuickClient:
         import zenoh
 
         self.timeout = timeout
-        self.endpoints = _endpoints(connect)
         self.domain_id = _domain(domain_id)
-        config = zenoh.Config()
+        # KINEMA_ZENOH_CONFIG (e.g. a client config of `kinema security init`: TLS, certificates) is the
+        # base, as for every other Kinema session; its endpoints apply unless others are given.
+        config_file = os.environ.get("KINEMA_ZENOH_CONFIG")
+        try:
+            config = zenoh.Config.from_file(config_file) if config_file else zenoh.Config()
+        except zenoh.ZError as error:
+            raise TransportError(f"{config_file}: cannot load zenoh config: {error}") from None
+        if config_file and connect is None and not os.environ.get("KINEMA_ZENOH_CONNECT"):
+            self.endpoints = [str(e) for e in json.loads(config.get_json("connect/endpoints")) or []]
+        else:
+            self.endpoints = _endpoints(connect)
         settings = {
             "mode": "client",
             "connect/endpoints": self.endpoints,

@@ -26,6 +26,7 @@ from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, Literal
 
 from kinema.errors import TransportError
+from kinema.transport.exposure import ExposureError, check_listeners
 
 if TYPE_CHECKING:
     import zenoh
@@ -177,6 +178,8 @@ class Session:
         self.mode: Mode = mode
         self.endpoints = list(endpoints)
         self.listen = list(listen)
+        # Listeners beyond loopback opened without mutual TLS and access rules (only with ``insecure``).
+        self.exposed: list[str] = []
         self.zid = str(raw.info.zid())
         self._ids = itertools.count()
         # Re-entrant: creating the graph cache (under the lock) registers its dispatch thread.
@@ -308,11 +311,12 @@ def open_session(
     connect: str | Sequence[str] | None = None,
     domain_id: int | None = None,
     *,
-    mode: Literal["peer", "client"] = "peer",
+    mode: Literal["peer", "client"] | None = None,
     listen: Sequence[str] | None = None,
     config_file: str | None = None,
     config_overrides: Mapping[str, Any] | None = None,
     connect_timeout: float = 2.0,
+    insecure: bool = False,
 ) -> Session:
     """Join the Kinema zenoh network (the router at ``connect``) and return the session.
 
@@ -320,17 +324,25 @@ def open_session(
         connect: endpoint(s) of the router; default ``KINEMA_ZENOH_CONNECT`` or ``tcp/127.0.0.1:7447``.
             An empty list opens a standalone session (in-process use only).
         domain_id: ROS domain id; default ``ROS_DOMAIN_ID`` or 0.
-        mode: ``peer`` (default; direct links to other peers via gossip) or ``client`` (everything
-            through the router).
+        mode: ``peer`` (direct links to other peers via gossip) or ``client`` (everything through the
+            router). Default: ``client`` when the config file says so (a client config of ``kinema
+            security init``: its traffic must pass the router's access rules), else ``peer``.
         listen: peer listen endpoints; default one ephemeral loopback port.
         config_file: zenoh JSON5 config used as the base (default ``KINEMA_ZENOH_CONFIG``).
         config_overrides: zenoh config paths → values, applied last.
         connect_timeout: how long to wait for the link to a router or peer (seconds).
+        insecure: allow listening beyond loopback without mutual TLS and access rules (see
+            :mod:`kinema.transport.exposure`).
 
     Raises:
         TransportError: nothing answers at the endpoints within ``connect_timeout``.
+        ExposureError: a listener beyond loopback without mutual TLS and access rules.
     """
     from_file = bool(config_file or os.environ.get(ENV_CONFIG))
+    if mode is None:
+        mode = (
+            "client" if _file_mode(config_file or os.environ.get(ENV_CONFIG) or None) == "client" else "peer"
+        )
     if connect is None and from_file and not os.environ.get(ENV_CONNECT):
         endpoints: list[str] = []  # the config file says where to connect
     else:
@@ -343,8 +355,20 @@ def open_session(
     config = build_config(
         mode, listen=listen_endpoints, connect=endpoints, config_file=config_file, overrides=config_overrides
     )
+    file_mode = _file_mode(config_file or os.environ.get(ENV_CONFIG) or None)
+    if (
+        from_file
+        and listen is None
+        and mode == "peer"
+        and (file_mode == "router" or _listen_is_default(config))
+    ):
+        # zenoh's default peer listener is every interface, and a router's file (what `kinema run` hosts
+        # with) names the router's own endpoints: a peer keeps one ephemeral loopback port instead.
+        config.insert_json5("listen/endpoints", json.dumps([PEER_LISTEN]))
+        listen_endpoints = [PEER_LISTEN]
     if from_file and not endpoints:
         endpoints = _configured_endpoints(config, "connect/endpoints", mode)
+    check_listeners(config, _configured_endpoints(config, "listen/endpoints", mode), insecure=insecure)
     where = ", ".join(endpoints) or "no endpoint"
     raw = _open_raw(config, f"{mode} connecting to {where}")
     session = Session(raw, domain_id=domain, mode=mode, endpoints=endpoints, listen=listen_endpoints)
@@ -368,15 +392,20 @@ def host_router(
     connect: Sequence[str] = (),
     config_file: str | None = None,
     config_overrides: Mapping[str, Any] | None = None,
+    insecure: bool = False,
 ) -> Session:
     """Host the zenoh router in this process and return its session (usable like any other).
 
     Args:
         listen: endpoint(s) to listen on; default ``tcp/127.0.0.1:7447``, or the config file's.
         connect: other routers to link to (multi-machine, or two routers on one host).
+        insecure: allow listening beyond loopback without mutual TLS and access rules (the session's
+            ``exposed`` lists such listeners, for a warning).
 
     Raises:
         TransportError: the endpoint is taken (another router runs there) or invalid.
+        ExposureError: a listener beyond loopback without mutual TLS and access rules, and not
+            ``insecure`` (see :mod:`kinema.transport.exposure`).
     """
     from_file = bool(config_file or os.environ.get(ENV_CONFIG))
     # With a config file and no explicit endpoint, the file's own listen endpoints apply.
@@ -391,8 +420,30 @@ def host_router(
     )
     if not listen_endpoints:
         listen_endpoints = _configured_endpoints(config, "listen/endpoints", "router")
+    exposed = check_listeners(config, listen_endpoints, insecure=insecure)
     raw = _open_raw(config, f"router listening on {', '.join(listen_endpoints) or 'no endpoint'}")
-    return Session(raw, domain_id=domain, mode="router", endpoints=list(connect), listen=listen_endpoints)
+    session = Session(raw, domain_id=domain, mode="router", endpoints=list(connect), listen=listen_endpoints)
+    session.exposed = exposed
+    return session
+
+
+def _file_mode(config_file: str | None) -> str:
+    """The mode a zenoh config file sets (``peer``, zenoh's default, when none or unreadable)."""
+    if not config_file:
+        return "peer"
+    import zenoh
+
+    try:
+        return str(json.loads(zenoh.Config.from_file(config_file).get_json("mode")))
+    except Exception:
+        return "peer"  # build_config reports a bad file with its message
+
+
+def _listen_is_default(config: zenoh.Config) -> bool:
+    """True when ``config`` keeps zenoh's default listen endpoints (its file does not set any)."""
+    import zenoh
+
+    return bool(config.get_json("listen/endpoints") == zenoh.Config().get_json("listen/endpoints"))
 
 
 def _configured_endpoints(config: zenoh.Config, key: str, mode: str) -> list[str]:
@@ -409,14 +460,27 @@ def host_or_join(
     *,
     config_file: str | None = None,
     config_overrides: Mapping[str, Any] | None = None,
+    insecure: bool = False,
 ) -> Session:
     """Host the router at ``endpoint``, or join the one already listening there (what ``kinema run`` does).
 
-    ``endpoint`` defaults to the first of ``KINEMA_ZENOH_CONNECT`` or ``tcp/127.0.0.1:7447``.
+    ``endpoint`` defaults to the first of ``KINEMA_ZENOH_CONNECT`` or ``tcp/127.0.0.1:7447``; several
+    comma-separated endpoints are all listened on (and joined through). A router this process may not
+    host (a listener beyond loopback without mutual TLS, see :mod:`kinema.transport.exposure`) is still
+    joined when one runs there (that is connecting, not listening); when none does, the refusal is
+    raised.
     """
     target = endpoint or resolve_endpoints(None)[0]
     try:
-        return host_router(target, domain_id, config_file=config_file, config_overrides=config_overrides)
+        return host_router(
+            target, domain_id, config_file=config_file, config_overrides=config_overrides, insecure=insecure
+        )
+    except ExposureError as refusal:
+        log.info("not hosting a router at %s (%s); joining one there", target, refusal)
+        try:
+            return open_session(target, domain_id, config_file=config_file, config_overrides=config_overrides)
+        except TransportError:
+            raise refusal from None
     except TransportError as hosting_error:
         log.info("cannot host the router at %s (%s); joining it", target, hosting_error)
         try:

@@ -149,3 +149,17 @@ def lab_sim_agent(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[Ag
     """An agent for the bundled lab_sim config (its behaviors, wall time, no driver)."""
     with running_agent(request, tmp_path, "--config", "lab_sim", "--clock", "wall") as running:
         yield running
+
+
+@pytest.fixture
+def derived_config_agent(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[AgentProcess]:
+    """An agent for config ``my_cell`` (based on the bundled lab_sim) of a workspace at ``tmp_path/ws``."""
+    package = tmp_path / "ws" / "src" / "my_cell"
+    (package / "config").mkdir(parents=True)
+    (package / "config" / "config.yaml").write_text('based_on_package: "lab_sim"\n')
+    (package / "package.xml").write_text("<package><name>my_cell</name></package>\n")
+    workspace = str(tmp_path / "ws")
+    with running_agent(
+        request, tmp_path, "--config", "my_cell", "--workspace", workspace, "--clock", "wall"
+    ) as running:
+        yield running

@@ -209,3 +209,15 @@ def test_bad_configs_through_the_cli(capsys, ws, setup: str, words: str):
         assert code == 1, verb
         assert err.startswith("error: ") and words in err, err
         assert "Traceback" not in err
+
+
+def test_init_where_no_folder_can_be_made_is_one_line_not_a_traceback(
+    tmp_path: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    from kinema.cli.main import main
+
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    assert main(["init", str(blocker / "ws")]) == 1
+    err = capsys.readouterr().err
+    assert "cannot create the workspace" in err and "Traceback" not in err

@@ -111,6 +111,10 @@ def _run(args: argparse.Namespace, stop: threading.Event) -> int:
     settings = MujocoDriverSettings.from_config(args.config, workspace, **overrides)
     session = host_router(args.host_router) if args.host_router else open_session(args.connect)
     with session:
+        from kinema.runtime.cell import DRIVER, declare_presence
+
+        # Announced before its nodes exist, so whoever sees them also knows whose they are.
+        declare_presence(session, DRIVER, name="mujoco", config=args.config, endpoint=args.connect or "")
         driver = MujocoDriver(session, settings)
         driver.start()
         if args.ready_fd is not None:

@@ -1,0 +1,48 @@
+"""A waypoint saved in a config based on lab_sim lands in that config's package, never in lab_sim's."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import Any
+
+import yaml
+
+from kinema.resources import bundled_dir
+from kinema.runtime import names
+
+LAB_SIM_WAYPOINTS = bundled_dir("configs") / "lab_sim" / "waypoints" / "lab_sim_waypoints.yaml"
+
+
+def test_saving_a_waypoint_writes_the_derived_package_and_says_so(
+    derived_config_agent: Any, tmp_path: Path
+) -> None:
+    from kinema.transport import Node, open_session
+
+    shipped = LAB_SIM_WAYPOINTS.read_bytes()
+    copy = tmp_path / "ws" / "src" / "my_cell" / "waypoints" / "lab_sim_waypoints.yaml"
+    with open_session(derived_config_agent.endpoint) as session:
+        node = Node(session, "waypoint_user")
+        toasts: list[str] = []
+        node.create_subscription(names.LOG_TYPE, names.LOG, lambda message: toasts.append(message.message))
+        get = node.create_client(names.GET_WAYPOINTS_TYPE, names.GET_WAYPOINTS)
+        edit = node.create_client(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS)
+        inherited = [w.name for w in get.call({}, timeout=10).waypoints]
+        assert inherited and "Look at Table" in inherited, inherited
+        joints = node.create_publisher(names.JOINT_STATES_TYPE, names.JOINT_STATES)
+        deadline = time.monotonic() + 15
+        while True:
+            joints.publish({"name": ["linear_rail_joint"], "position": [0.3]})
+            saved = edit.call({"operation": 0, "waypoint_name": "My Spot"}, timeout=10)
+            if saved.status.success or time.monotonic() > deadline:
+                break
+            time.sleep(0.05)
+        assert saved.status.success, saved.status.error_message
+        assert [w.name for w in get.call({}, timeout=10).waypoints] == [*inherited, "My Spot"]
+        deadline = time.monotonic() + 10
+        while not any("saved waypoints go to" in toast for toast in toasts) and time.monotonic() < deadline:
+            time.sleep(0.05)
+    assert LAB_SIM_WAYPOINTS.read_bytes() == shipped
+    assert [item["name"] for item in yaml.safe_load(copy.read_text())] == [*inherited, "My Spot"]
+    assert any(str(copy) in toast for toast in toasts), toasts
+    assert "saved waypoints go to" in derived_config_agent.log_file.read_text()
