@@ -50,7 +50,13 @@ class SequenceNode(_ResumingControl):
         while idx < n:
             child = children[idx]
             prev = child._status
-            status = child.execute_tick()
+            try:
+                status = child.execute_tick()
+            except BaseException:
+                # BT.CPP advances its member index in place: an exception that escapes a child
+                # leaves it on that child, and the next tick resumes there.
+                self._idx = idx
+                raise
             if status is SUCCESS:
                 idx += 1
                 if asynch and prev is IDLE and idx < n:
@@ -142,7 +148,13 @@ class FallbackNode(_ResumingControl):
         while idx < n:
             child = children[idx]
             prev = child._status
-            status = child.execute_tick()
+            try:
+                status = child.execute_tick()
+            except BaseException:
+                # BT.CPP advances its member index in place: an exception that escapes a child
+                # leaves it on that child, and the next tick resumes there.
+                self._idx = idx
+                raise
             if status is FAILURE:
                 idx += 1
                 if self._asynch and prev is IDLE and idx < n:

@@ -599,11 +599,15 @@ class SimpleActionNode(SyncActionNode):
         self._fn = fn
 
     def tick(self) -> NodeStatus:
-        # BT.CPP sets RUNNING before calling the functor (observers see IDLE -> RUNNING -> result);
+        # BT.CPP sets RUNNING before calling the functor and the result right after it, inside
+        # tick() (observers see IDLE -> RUNNING -> result even when a post-condition then throws);
         # the sync-node rule only forbids *returning* RUNNING, so the status is set directly.
         if self._status is IDLE:
             _set_status_unchecked(self, RUNNING)
-        return self._fn(self)
+        status = self._fn(self)
+        if status is not self._status and status is not IDLE:
+            _set_status_unchecked(self, status)
+        return status
 
 
 class SimpleConditionNode(ConditionNode):
