@@ -50,6 +50,22 @@ def to_bool(v: Any) -> bool:
     raise EvalError(f"[Any::convert]: no known safe conversion between [{value_type_name(v)}] and [bool]")
 
 
+_MAX_EXACT_INT = 2**53 - 1  # the largest integer a double holds exactly (and everything below it)
+
+
+def to_double(v: Any) -> float:
+    """``Any::cast<double>`` of a number: an integer a double cannot hold exactly raises.
+
+    Raises:
+        EvalError: ``|v| > 2**53 - 1`` (so ``9223372036854775807 + 1`` fails instead of rounding).
+    """
+    if v.__class__ is float:
+        return v
+    if -_MAX_EXACT_INT <= v <= _MAX_EXACT_INT:
+        return float(v)
+    raise EvalError(f"Loss of precision when converting a large integer number to floating point:{v}")
+
+
 def to_int64(v: Any) -> int:
     """``Any::cast<int64_t>`` of a number: floats must be integral."""
     if isinstance(v, float):
@@ -150,7 +166,7 @@ class Unary(Expr):
     def evaluate(self, bb: Blackboard, enums: dict[str, int] | None) -> Any:
         v = self.operand.evaluate(bb, enums)
         if is_num(v):
-            rv = float(v)
+            rv = to_double(v)
             op = self.op
             if op == "-":
                 return -rv
@@ -192,14 +208,17 @@ class Binary(Expr):
         lnum = isinstance(lv, _NUMBER)
         rnum = isinstance(rv, _NUMBER)
         if lnum and rnum:
+            # BT.CPP casts both to double first, whatever the operator
+            lf = lv if lv.__class__ is float else to_double(lv)
+            rf = rv if rv.__class__ is float else to_double(rv)
             if op == "+":
-                return float(lv) + float(rv)
+                return lf + rf
             if op == "-":
-                return float(lv) - float(rv)
+                return lf - rf
             if op == "*":
-                return float(lv) * float(rv)
+                return lf * rf
             if op == "/":
-                return _divide(float(lv), float(rv))
+                return _divide(lf, rf)
             if op in ("&", "|", "^"):
                 try:
                     li, ri = to_int64(lv), to_int64(rv)
@@ -270,13 +289,13 @@ class Comparison(Expr):
             lnum = isinstance(lhs, _NUMBER)
             rnum = isinstance(rhs, _NUMBER)
             if lnum and rnum:
-                ok = _compare(op, float(lhs), float(rhs))
+                ok = _compare(op, to_double(lhs), to_double(rhs))
             elif isinstance(lhs, str) and isinstance(rhs, str):
                 ok = _compare(op, lhs, rhs)
             elif isinstance(lhs, str) and rnum:
-                ok = _compare(op, string_to_double(lhs, enums), float(rhs))
+                ok = _compare(op, string_to_double(lhs, enums), to_double(rhs))
             elif lnum and isinstance(rhs, str):
-                ok = _compare(op, float(lhs), string_to_double(rhs, enums))
+                ok = _compare(op, to_double(lhs), string_to_double(rhs, enums))
             else:
                 raise EvalError(
                     f"Can't mix different types in Comparison. Left operand [{value_type_name(lhs)}] "
@@ -305,7 +324,7 @@ class Ternary(Expr):
                 "Any failed string to number conversion: the ternary condition is an empty string"
             )
         elif is_num(c):
-            valid = float(c) != 0.0
+            valid = to_double(c) != 0.0
         elif c is None:
             raise EvalError("The condition of the ternary operator is not initialized")
         else:
@@ -372,7 +391,7 @@ class Assignment(Expr):
             if isinstance(value, _NUMBER):
                 if not isinstance(dst, _NUMBER):
                     raise EvalError("This Assignment operator can't be used with a non-numeric type")
-                lv, rv = float(dst), float(value)
+                lv, rv = to_double(dst), to_double(value)
                 if op == "+=":
                     temp: Any = lv + rv
                 elif op == "-=":
