@@ -72,6 +72,7 @@ class _ScriptCode:
 
     config: NodeConfig
     full_path: str
+    registration_id: str
     _code: str
     _script: Script | None
     _literal: bool
@@ -79,6 +80,9 @@ class _ScriptCode:
     def _init_script(self) -> None:
         self._code = ""
         self._script = None
+        if self.config.input_ports.get("code") is None:
+            # BT.CPP reads the port in the constructor: a Script without code fails createTree
+            raise BTRuntimeError(f"Missing port [code] in {self.registration_id} '{self.full_path}'")
         code = _literal_code(self.config)
         self._literal = code is not None
         if code:
