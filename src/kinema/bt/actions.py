@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from kinema.bt.clock import WakeUpTimer
-from kinema.bt.conversions import ConversionError, convert_from_string, has_converter, type_name
+from kinema.bt.conversions import ConversionError, Unsigned, convert_from_string, has_converter, type_name
 from kinema.bt.decorators import entry_key_of
 from kinema.bt.errors import BTLogicError, BTRuntimeError, ScriptParseError
 from kinema.bt.node import (
@@ -234,7 +234,7 @@ class SleepNode(StatefulActionNode):
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
-        return [input_port("msec", int)]
+        return [input_port("msec", Unsigned)]
 
     def __init__(self, name: str, config: NodeConfig | None = None) -> None:
         super().__init__(name, config)

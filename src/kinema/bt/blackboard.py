@@ -17,6 +17,7 @@ from typing import Any
 from kinema.bt.conversions import (
     AnyValue,
     ConversionError,
+    Unsigned,
     cast_value,
     convert_from_string,
     has_converter,
@@ -190,7 +191,13 @@ class Blackboard:
     def _create_entry_impl(self, key: str, port_type: Any) -> Entry:
         entry = self._storage.get(key)
         if entry is not None:
-            if entry.type != port_type and is_strongly_typed(entry.type) and is_strongly_typed(port_type):
+            if (
+                entry.type != port_type
+                and is_strongly_typed(entry.type)
+                and is_strongly_typed(port_type)
+                # a Python int is how an unsigned value is written (Python has no unsigned type)
+                and not (entry.type is Unsigned and port_type is int)
+            ):
                 raise BTLogicError(
                     f"Blackboard entry [{key}]: once declared, the type of a port shall not change. "
                     f"Previously declared type [{type_name(entry.type)}], "
@@ -294,7 +301,7 @@ def coerce_into_entry(key: str, entry: Entry, value: Any) -> Any:
             return convert_from_string(target, value)
         except ConversionError:
             pass
-    elif target in (int, float, bool) and isinstance(value, int | float):
+    elif target in (int, Unsigned, float, bool) and isinstance(value, int | float):
         try:
             converted = cast_value(value, target)
         except ConversionError:

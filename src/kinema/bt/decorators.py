@@ -6,7 +6,7 @@ from collections import deque
 from typing import Any
 
 from kinema.bt.clock import WakeUpTimer
-from kinema.bt.conversions import convert_from_string, list_item_type
+from kinema.bt.conversions import Unsigned, convert_from_string, list_item_type
 from kinema.bt.errors import BTLogicError, BTRuntimeError, ScriptParseError
 from kinema.bt.node import DecoratorNode, NodeConfig, PortError, _set_status_unchecked, script_bool
 from kinema.bt.ports import PortInfo, bidirectional_port, blackboard_pointer, input_port, output_port
@@ -195,7 +195,7 @@ class TimeoutNode(DecoratorNode):
         return [
             input_port(
                 "msec",
-                int,
+                Unsigned,
                 description="After a certain amount of time, halt() the child if it is still running.",
             )
         ]
@@ -241,7 +241,7 @@ class DelayNode(DecoratorNode):
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
-        return [input_port("delay_msec", int, description="Tick the child after a few milliseconds")]
+        return [input_port("delay_msec", Unsigned, description="Tick the child after a few milliseconds")]
 
     def __init__(self, name: str, config: NodeConfig | None = None) -> None:
         super().__init__(name, config)

@@ -122,9 +122,23 @@ def test_precondition_with_an_unknown_else_status_fails_when_ticked() -> None:
     assert compare(kinema, btcpp) is None, compare(kinema, btcpp)
 
 
-@pytest.mark.xfail(reason="Delay/Timeout ports are int in Kinema, unsigned int in BT.CPP (not fixed yet)")
-def test_delay_msec_pointing_at_an_int_entry_is_refused() -> None:
-    body = '<Delay name="n1" delay_msec="{a}"><AlwaysSuccess name="n2"/></Delay>'
-    kinema, btcpp = both(doc(body), ticks=1)
+@pytest.mark.parametrize(
+    "body",
+    [
+        '<Delay name="n1" delay_msec="{a}"><AlwaysSuccess name="n2"/></Delay>',
+        '<Timeout name="n1" msec="{a}"><AlwaysSuccess name="n2"/></Timeout>',
+        '<Sleep name="n1" msec="{a}"/>',
+        '<Sleep name="n1" msec="-5"/>',
+    ],
+)
+def test_unsigned_milliseconds_refuse_int_entries_and_negative_literals(body: str) -> None:
+    kinema, btcpp = both(doc(body), ticks=1)  # a is an int entry
     assert btcpp.build_error is not None
-    assert kinema.build_error is not None
+    assert kinema.build_error is not None, f"Kinema accepted it and ticked: {kinema.ticks}"
+    assert ("unsigned int" in kinema.build_error) == ("unsigned int" in btcpp.build_error), kinema.build_error
+
+
+def test_unsigned_milliseconds_from_a_string_entry_work() -> None:
+    body = '<Delay name="n1" delay_msec="{s}"><AlwaysSuccess name="n2"/></Delay>'
+    kinema, btcpp = both(doc(body), ticks=1, seed_bb={"s": "0"})
+    assert compare(kinema, btcpp) is None, compare(kinema, btcpp)
