@@ -6,28 +6,38 @@ ScriptCondition, SetBlackboard, pre/post-condition attributes and the scripted l
 so transitions printed by BT.CPP's StdCoutLogger can be matched to nodes; each SubTree ID is used
 by one SubTree node only, for the same reason.
 
-Kinema follows BT.CPP 4.10; the oracle is 4.8.2. The generator stays out of what changed between
-the two (shared/reference/btcpp-v4-semantics.md section 0, BT.CPP's CHANGELOG 4.8.3 -> 4.10.0), so
-the trees it makes behave the same in both versions:
+Kinema follows BT.CPP 4.10; the oracle is 4.8.2. These are the 4.8 -> 4.10 changes where Kinema
+follows 4.10 (shared/reference/btcpp-v4-semantics.md section 0 and BT.CPP's CHANGELOG for 4.8.3 to
+4.10.0), and how the generator keeps the trees it makes out of them, so both versions agree:
 
-* scripts: ``A - B + C`` chains were right-associative in 4.8 (#1029)    -> binary operators
-  appear only with parenthesised operands, one operator per level;
-* ``&&`` binds tighter than ``||`` since 4.9 (Pratt parser, #1099)      -> never mixed unparenthesised;
-* ``true``/``false`` are doubles since 4.9 (int64 before)               -> never stored, only tested;
-* double-quoted script strings rejected since 4.9                      -> single quotes only;
-* math, bitwise and ``..`` mixed without parentheses (4.9+)            -> not generated;
-* prefix operators on non-atoms (4.9+)                                 -> not generated;
-* ``TryCatch`` (4.9+)                                                   -> not generated;
-* exceptions wrapped in NodeExecutionError (4.9+)                       -> only "an exception
-  escaped the tick" is compared, not its type or message;
-* literal SubTree attributes keep numeric types (4.9.1)                -> SubTrees remap only
-  ``{key}`` pointers or use ``_autoremap``;
-* SubTree recursion detection, duplicate SubTree paths (4.8.4/4.9)     -> SubTree IDs are unique
-  and never recursive;
-* ``LoopX`` queue port typing (4.9), ``EntryUpdated`` halting its child (4.9),
-  Switch rejecting trailing characters in numeric cases (4.10)         -> not generated
-  (Switch cases are plain integers or strings without digits);
-* time-based nodes (Delay, Timeout, Sleep) are left out: the comparison is tick by tick.
+* 4.9.0 #1029 ``A - B + C`` chains are left-associative (right-associative in 4.8)
+  -> binary operators only take atoms or parenthesised operands, one operator per level;
+* 4.9.0 #1099 hand-written Pratt parser replaces lexy: ``&&`` binds tighter than ``||``; math,
+  bitwise and ``..`` mix without parentheses; prefix operators apply to any operand
+  -> ``&&``/``||`` never mixed unparenthesised, no such mixes, prefix only on parenthesised operands;
+* 4.9.0 #1099 ``true``/``false`` are doubles 1.0/0.0 (int64 1/0 in 4.8)
+  -> used only in conditions, never stored;
+* 4.9.0 #1099 double-quoted script strings are rejected -> single quotes only;
+* 4.9.0 #1099 an integer literal beyond int64 reads as 0 (a parse error at createTree in 4.8)
+  -> no such literal (test_bt_script covers 4.10's rule);
+* 4.9.0 TryCatch control node -> not generated;
+* 4.9.0 #1106 exceptions from tick() wrapped in NodeExecutionError (the original in 4.8)
+  -> only "an exception escaped this tick" is compared, not its type or text;
+* 4.9.1 #1121 literal SubTree attributes keep numeric types (always strings in 4.8)
+  -> SubTrees remap only ``{key}`` pointers or use ``_autoremap``;
+* 4.9.0 #1085 recursive SubTree cycles detected, 4.8.4 duplicate SubTree paths rejected,
+  4.8.4 new name validation rules -> SubTree IDs unique and never recursive, names ``n<k>``;
+* 4.9.0 #969 LoopX queue port untyped, #1112 EntryUpdated halts its child -> not generated;
+* 4.9.0 #1097/#1103 Delay created from XML honours delay_msec -> time-based nodes (Delay,
+  Timeout, Sleep) are left out anyway: the comparison is tick by tick;
+* 4.10.0 #1178 Switch numeric cases reject trailing characters
+  -> Switch variables and cases are strings without a numeric prefix, or plain integers;
+* 4.10.0 #1162 float-to-int cast at the int64 limit -> no such values.
+
+Two more things the generator avoids, where 4.8.2 misbehaves: SetBlackboard on an entry
+seeded from C++ as ``std::string`` throws "convertFromString ... BT::Any" in 4.8.2, so
+SetBlackboard writes only a key of its own (``f``); BT.CPP's Tree destructor halts the tree and an
+``_onHalted`` script that throws there terminates the process, so those scripts cannot fail.
 
 Loops are bounded (Repeat/Retry counts 1-3, never -1) so a tick always ends.
 """
