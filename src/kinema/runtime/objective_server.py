@@ -19,7 +19,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any, Protocol
 
 from kinema.bt.node import node_children
@@ -142,7 +142,15 @@ class ObjectiveRun:
             result = self._result
         callback(result)
 
+    def release_xml(self) -> None:
+        """Let go of the request's objective XML (up to MAX_OBJECTIVE_XML_BYTES, or a larger refused
+        one): it is not needed once the tree is built or the run ended, and the tick thread may keep
+        the run referenced while it waits for the next request."""
+        if self.request.objective_xml:
+            self.request = replace(self.request, objective_xml="")
+
     def _finish(self, result: ObjectiveResult) -> bool:
+        self.release_xml()
         with self._lock:
             if self._result is not None:
                 return False
@@ -464,6 +472,7 @@ class ObjectiveServer:
             message = f"building objective {run.objective_name!r} failed: {type(error).__name__}: {error}"
             self._end(run, ObjectiveResult.failure(message, run.objective_name), ObjectiveStatus.FAILURE)
             return
+        run.release_xml()
         self._tree = tree
         self._failures = []
         with self._notes_lock:

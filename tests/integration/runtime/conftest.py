@@ -143,3 +143,13 @@ def lab_sim_agent(tmp_path: Path) -> Iterator[AgentProcess]:
         yield running
     finally:
         stop_agent(running)
+
+
+@pytest.fixture
+def own_agent(tmp_path: Path) -> Iterator[AgentProcess]:
+    """An agent no other test has used (for measuring the process itself)."""
+    running = start_agent(tmp_path)
+    try:
+        yield running
+    finally:
+        stop_agent(running)
