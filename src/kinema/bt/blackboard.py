@@ -28,6 +28,7 @@ from kinema.bt.conversions import (
     value_type_name,
 )
 from kinema.bt.errors import BTLogicError, BTRuntimeError
+from kinema.bt.limits import SIZED_TYPES, check_entry_value
 
 BlackboardObserver = Callable[[str, "Entry"], None]
 
@@ -254,10 +255,13 @@ class Blackboard:
         A new key gets the type of the value, except a string, which makes a generic entry. An
         existing entry without a type takes the value's type. A typed entry accepts the same type,
         a string it can parse, or a number that converts without loss; otherwise BTLogicError.
+        A string, bytes or container past :mod:`kinema.bt.limits` raises BTRuntimeError.
         """
         if key[:1] == "@":
             self.root().set(key[1:], value)
             return
+        if value.__class__ in SIZED_TYPES:
+            check_entry_value(key, value)
         entry = self._storage.get(key)
         if entry is None:
             new_type = None if isinstance(value, str) else python_type_of(value)

@@ -51,3 +51,40 @@ def test_memory_returns_to_baseline_after_refused_10_to_50_mb_requests(own_agent
             f"agent RSS {current:.1f} MB after the requests, baseline {baseline:.1f} MB "
             f"(margin {MARGIN_MB} MB); RSS after each request (MB sent, RSS): {seen}"
         )
+
+
+def test_a_script_growing_a_string_fails_the_objective_at_the_documented_limit(
+    client: ObjectiveClient,
+) -> None:
+    xml = (
+        '<root BTCPP_format="4"><BehaviorTree ID="Grow"><Sequence><Script code="s := \'x\'"/>'
+        '<KeepRunningUntilFailure><Script name="double" code="s := s .. s"/></KeepRunningUntilFailure>'
+        "</Sequence></BehaviorTree></root>"
+    )
+    result = client.do_xml(xml, timeout=30)
+    assert result.failed, result
+    assert "MAX_SCRIPT_STRING_CHARS" in result.error_message and "double" in result.error_message, result
+    assert client.execute("Quick").succeeded
+
+
+def test_trees_past_65535_nodes_are_refused_at_load_and_trees_at_the_limit_run(
+    client: ObjectiveClient,
+) -> None:
+    def sequence(children: int) -> str:
+        leaves = "<AlwaysSuccess/>" * children
+        return f'<root BTCPP_format="4"><BehaviorTree ID="Big"><Sequence>{leaves}</Sequence>' + (
+            "</BehaviorTree></root>"
+        )
+
+    refused = client.do_xml(sequence(65_535), timeout=60)
+    assert refused.failed and "more than 65,535 nodes" in refused.error_message, refused
+    stream = client.node_statuses(timeout=5)
+    time.sleep(0.5)  # let the subscription reach the agent
+    assert client.do_xml(sequence(65_534), timeout=60).succeeded
+    uids = set()
+    for message in stream:
+        uids.update(change.uid for change in message.changes)
+        if 65_535 in uids:
+            break
+    stream.close()
+    assert 65_535 in uids, f"the status stream never showed the last node (max uid {max(uids, default=0)})"

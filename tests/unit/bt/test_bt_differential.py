@@ -140,5 +140,7 @@ def test_unsigned_milliseconds_refuse_int_entries_and_negative_literals(body: st
 
 def test_unsigned_milliseconds_from_a_string_entry_work() -> None:
     body = '<Delay name="n1" delay_msec="{s}"><AlwaysSuccess name="n2"/></Delay>'
-    kinema, btcpp = both(doc(body), ticks=1, seed_bb={"s": "0"})
+    # a string entry is a universal donor: both accept it at creation and start waiting
+    kinema, btcpp = both(doc(body), ticks=1, seed_bb={"s": "60000"})
+    assert kinema.ticks[0].result == "RUNNING"
     assert compare(kinema, btcpp) is None, compare(kinema, btcpp)

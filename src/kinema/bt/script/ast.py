@@ -22,6 +22,7 @@ from kinema.bt.conversions import (
     value_type_name,
 )
 from kinema.bt.errors import BTLogicError, BTRuntimeError
+from kinema.bt.limits import MAX_SCRIPT_STRING_CHARS, script_string_too_long
 
 if TYPE_CHECKING:
     from kinema.bt.blackboard import Blackboard
@@ -180,6 +181,13 @@ class Unary(Expr):
         raise EvalError("ExprUnaryArithmetic: undefined")
 
 
+def _bounded(text: str) -> str:
+    """``text`` if it is within the script string limit (kinema.bt.limits), else EvalError."""
+    if len(text) > MAX_SCRIPT_STRING_CHARS:
+        raise EvalError(script_string_too_long(len(text)))
+    return text
+
+
 def _divide(a: float, b: float) -> float:
     try:
         return a / b
@@ -243,11 +251,11 @@ class Binary(Expr):
         lstr = isinstance(lv, str)
         rstr = isinstance(rv, str)
         if lstr and rstr and op == "+":
-            return lv + rv
+            return _bounded(lv + rv)
         if op == ".." and ((lstr and rstr) or (lstr and rnum) or (lnum and rstr)):
             left = lv if lstr else number_to_string(lv)
             right = rv if rstr else number_to_string(rv)
-            return left + right
+            return _bounded(left + right)
         raise EvalError("Operation not permitted")
 
 
@@ -405,7 +413,7 @@ class Assignment(Expr):
                     raise EvalError("Operator not supported for strings")
                 if not isinstance(dst, str):
                     raise EvalError("Operation not permitted: the left operand is not a string")
-                temp = dst + value
+                temp = _bounded(dst + value)
             else:
                 raise EvalError("Operation not permitted")
             dst_type = type(dst)
