@@ -20,7 +20,7 @@ import time
 from collections import deque
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any, Protocol
+from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
 
 from kinema.bt.node import node_children
 from kinema.bt.status import NodeStatus
@@ -69,9 +69,12 @@ class ObjectiveRequest:
         return "<objective XML>" if self.objective_xml else "<empty request>"
 
 
-@dataclass(frozen=True)
-class NodeStatusChange:
-    """One node of the running tree changed status (published as kinema_msgs/NodeStatusChange)."""
+class NodeStatusChange(NamedTuple):
+    """One node of the running tree changed status (published as kinema_msgs/NodeStatusChange).
+
+    A named tuple: one is made per status transition on the tick thread (thousands per tick in a
+    large tree), and a tuple is built several times faster than a frozen dataclass.
+    """
 
     timestamp: float
     uid: int

@@ -8,6 +8,7 @@ Binding powers (higher binds tighter): assignments 2 (right side is a full expre
 
 from __future__ import annotations
 
+import functools
 from typing import TYPE_CHECKING, Any
 
 from kinema.bt.conversions import int64_from_digits, parse_double_prefix
@@ -208,12 +209,28 @@ class Script:
         return f"Script({self.code!r})"
 
 
+#: Scripts up to this length are parsed once and shared (trees repeat the same conditions and
+#: counters many times; a parsed Script holds no state of its own).
+_CACHED_CODE_CHARS = 4096
+
+
 def parse_script(code: str) -> Script:
-    """Parse ``code``.
+    """Parse ``code`` (a short one at most once: the same Script object is returned again).
 
     Raises:
         ScriptParseError: a syntax error, or an empty script ("Empty Script").
     """
+    if len(code) <= _CACHED_CODE_CHARS:
+        return _parse_cached(code)
+    return _parse(code)
+
+
+@functools.lru_cache(maxsize=2048)
+def _parse_cached(code: str) -> Script:
+    return _parse(code)  # an error is raised each time, never cached
+
+
+def _parse(code: str) -> Script:
     try:
         statements = _Parser(tokenize(code)).parse_all()
     except ScriptParseError:
