@@ -206,57 +206,59 @@ class Binary(Expr):
         self.rhs = rhs
 
     def evaluate(self, bb: Blackboard, enums: dict[str, int] | None) -> Any:
-        lv = self.lhs.evaluate(bb, enums)
-        rv = self.rhs.evaluate(bb, enums)
-        op = self.op
-        if lv is None:
-            raise _not_init("left", op)
-        if rv is None:
-            raise _not_init("right", op)
-        lnum = isinstance(lv, _NUMBER)
-        rnum = isinstance(rv, _NUMBER)
-        if lnum and rnum:
-            # BT.CPP casts both to double first, whatever the operator
-            lf = lv if lv.__class__ is float else to_double(lv)
-            rf = rv if rv.__class__ is float else to_double(rv)
-            if op == "+":
-                return lf + rf
-            if op == "-":
-                return lf - rf
-            if op == "*":
-                return lf * rf
-            if op == "/":
-                return _divide(lf, rf)
-            if op in ("&", "|", "^"):
-                try:
-                    li, ri = to_int64(lv), to_int64(rv)
-                except EvalError:
-                    raise EvalError(
-                        "Binary operators are not allowed if one of the operands is not an integer"
-                    ) from None
-                if op == "&":
-                    return float(li & ri)
-                if op == "|":
-                    return float(li | ri)
-                return float(li ^ ri)
-            if op in ("&&", "||"):
-                try:
-                    lb, rb = to_bool(lv), to_bool(rv)
-                except EvalError:
-                    raise EvalError(
-                        "Logic operators are not allowed if one of the operands is not castable to bool"
-                    ) from None
-                return float(lb and rb) if op == "&&" else float(lb or rb)
-            return None  # number .. number: BT.CPP silently yields an empty value
-        lstr = isinstance(lv, str)
-        rstr = isinstance(rv, str)
-        if lstr and rstr and op == "+":
-            return _bounded(lv + rv)
-        if op == ".." and ((lstr and rstr) or (lstr and rnum) or (lnum and rstr)):
-            left = lv if lstr else number_to_string(lv)
-            right = rv if rstr else number_to_string(rv)
-            return _bounded(left + right)
-        raise EvalError("Operation not permitted")
+        return binary_values(self.op, self.lhs.evaluate(bb, enums), self.rhs.evaluate(bb, enums))
+
+
+def binary_values(op: str, lv: Any, rv: Any) -> Any:
+    """The value of ``lv op rv`` for an infix operator other than comparisons and assignments."""
+    if lv is None:
+        raise _not_init("left", op)
+    if rv is None:
+        raise _not_init("right", op)
+    lnum = isinstance(lv, _NUMBER)
+    rnum = isinstance(rv, _NUMBER)
+    if lnum and rnum:
+        # BT.CPP casts both to double first, whatever the operator
+        lf = lv if lv.__class__ is float else to_double(lv)
+        rf = rv if rv.__class__ is float else to_double(rv)
+        if op == "+":
+            return lf + rf
+        if op == "-":
+            return lf - rf
+        if op == "*":
+            return lf * rf
+        if op == "/":
+            return _divide(lf, rf)
+        if op in ("&", "|", "^"):
+            try:
+                li, ri = to_int64(lv), to_int64(rv)
+            except EvalError:
+                raise EvalError(
+                    "Binary operators are not allowed if one of the operands is not an integer"
+                ) from None
+            if op == "&":
+                return float(li & ri)
+            if op == "|":
+                return float(li | ri)
+            return float(li ^ ri)
+        if op in ("&&", "||"):
+            try:
+                lb, rb = to_bool(lv), to_bool(rv)
+            except EvalError:
+                raise EvalError(
+                    "Logic operators are not allowed if one of the operands is not castable to bool"
+                ) from None
+            return float(lb and rb) if op == "&&" else float(lb or rb)
+        return None  # number .. number: BT.CPP silently yields an empty value
+    lstr = isinstance(lv, str)
+    rstr = isinstance(rv, str)
+    if lstr and rstr and op == "+":
+        return _bounded(lv + rv)
+    if op == ".." and ((lstr and rstr) or (lstr and rnum) or (lnum and rstr)):
+        left = lv if lstr else number_to_string(lv)
+        right = rv if rstr else number_to_string(rv)
+        return _bounded(left + right)
+    raise EvalError("Operation not permitted")
 
 
 def _compare(op: str, lv: Any, rv: Any) -> bool:
@@ -290,29 +292,33 @@ class Comparison(Expr):
         lhs = operands[0].evaluate(bb, enums)
         for i, op in enumerate(self.ops):
             rhs = operands[i + 1].evaluate(bb, enums)
-            if lhs is None:
-                raise _not_init("left", op)
-            if rhs is None:
-                raise _not_init("right", op)
-            lnum = isinstance(lhs, _NUMBER)
-            rnum = isinstance(rhs, _NUMBER)
-            if lnum and rnum:
-                ok = _compare(op, to_double(lhs), to_double(rhs))
-            elif isinstance(lhs, str) and isinstance(rhs, str):
-                ok = _compare(op, lhs, rhs)
-            elif isinstance(lhs, str) and rnum:
-                ok = _compare(op, string_to_double(lhs, enums), to_double(rhs))
-            elif lnum and isinstance(rhs, str):
-                ok = _compare(op, to_double(lhs), string_to_double(rhs, enums))
-            else:
-                raise EvalError(
-                    f"Can't mix different types in Comparison. Left operand [{value_type_name(lhs)}] "
-                    f"right operand [{value_type_name(rhs)}]"
-                )
-            if not ok:
+            if not compare_operands(op, lhs, rhs, enums):
                 return 0.0
             lhs = rhs
         return 1.0
+
+
+def compare_operands(op: str, lhs: Any, rhs: Any, enums: dict[str, int] | None) -> bool:
+    """One link of a comparison chain: numbers as doubles, strings as text, a string against a
+    number through ``StringToDouble``; anything else raises."""
+    if lhs is None:
+        raise _not_init("left", op)
+    if rhs is None:
+        raise _not_init("right", op)
+    lnum = isinstance(lhs, _NUMBER)
+    rnum = isinstance(rhs, _NUMBER)
+    if lnum and rnum:
+        return _compare(op, to_double(lhs), to_double(rhs))
+    if isinstance(lhs, str) and isinstance(rhs, str):
+        return _compare(op, lhs, rhs)
+    if isinstance(lhs, str) and rnum:
+        return _compare(op, string_to_double(lhs, enums), to_double(rhs))
+    if lnum and isinstance(rhs, str):
+        return _compare(op, to_double(lhs), string_to_double(rhs, enums))
+    raise EvalError(
+        f"Can't mix different types in Comparison. Left operand [{value_type_name(lhs)}] "
+        f"right operand [{value_type_name(rhs)}]"
+    )
 
 
 class Ternary(Expr):

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING, Any
 from kinema.bt.conversions import int64_from_digits, parse_double_prefix
 from kinema.bt.errors import BTError, ScriptError, ScriptParseError
 from kinema.bt.script.ast import Assignment, Binary, Comparison, Expr, Literal, Name, Ternary, Unary
+from kinema.bt.script.compiled import compile_expr
 from kinema.bt.script.tokenizer import Tok, Token, tokenize
 
 if TYPE_CHECKING:
@@ -179,11 +180,12 @@ class Script:
         statements: the parsed statements; the value of the script is that of the last one.
     """
 
-    __slots__ = ("code", "statements")
+    __slots__ = ("_fns", "code", "statements")
 
     def __init__(self, code: str, statements: list[Expr]) -> None:
         self.code = code
         self.statements = statements
+        self._fns = [compile_expr(statement) for statement in statements]
 
     def run(self, blackboard: Blackboard, enums: dict[str, int] | None = None) -> Any:
         """Execute every statement and return the value of the last one.
@@ -192,12 +194,12 @@ class Script:
             ScriptError: "Error in script [<code>]" followed by what went wrong.
         """
         try:
-            statements = self.statements
-            if len(statements) == 1:
-                return statements[0].evaluate(blackboard, enums)
+            fns = self._fns
+            if len(fns) == 1:
+                return fns[0](blackboard, enums)
             value = None
-            for statement in statements:
-                value = statement.evaluate(blackboard, enums)
+            for fn in fns:
+                value = fn(blackboard, enums)
             return value
         except ScriptError:
             raise
