@@ -46,10 +46,10 @@ class SequenceNode(_ResumingControl):
                 self._skipped = 0
             _set_status_unchecked(self, RUNNING)
         idx = self._idx
-        asynch = self._asynch
-        while idx < n:
-            child = children[idx]
-            prev = child._status
+        if self._asynch:
+            return self._tick_async(children, n, idx)
+        # The plain Sequence's hot loop (the async one is the same plus a yield after each success).
+        for child in children if idx == 0 else children[idx:]:
             try:
                 status = child.execute_tick()
             except BaseException:
@@ -59,7 +59,33 @@ class SequenceNode(_ResumingControl):
                 raise
             if status is SUCCESS:
                 idx += 1
-                if asynch and prev is IDLE and idx < n:
+            elif status is RUNNING:
+                self._idx = idx
+                return RUNNING
+            elif status is FAILURE:
+                self.reset_children()
+                self._idx = 0
+                return FAILURE
+            elif status is SKIPPED:
+                idx += 1
+                self._skipped += 1
+            else:
+                self._idx = idx
+                raise _idle_child(self)
+        return self._finish(n)
+
+    def _tick_async(self, children: list, n: int, idx: int) -> NodeStatus:
+        while idx < n:
+            child = children[idx]
+            prev = child._status
+            try:
+                status = child.execute_tick()
+            except BaseException:
+                self._idx = idx  # as in the plain loop
+                raise
+            if status is SUCCESS:
+                idx += 1
+                if prev is IDLE and idx < n:
                     self._idx = idx
                     self.emit_wake_up_signal()
                     return RUNNING
@@ -77,6 +103,9 @@ class SequenceNode(_ResumingControl):
             else:
                 self._idx = idx
                 raise _idle_child(self)
+        return self._finish(n)
+
+    def _finish(self, n: int) -> NodeStatus:
         all_skipped = self._skipped == n
         self.reset_children()
         self._idx = 0
