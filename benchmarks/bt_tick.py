@@ -1,29 +1,37 @@
-"""Tick speed of kinema.bt against py_trees on the same tree structures, measured in one run.
+"""Tick and build speed of kinema.bt against the real BehaviorTree.CPP and py_trees, in one run.
 
-Two structures, built for both engines:
+BT.CPP is the ``behaviortreepy`` bindings (BT.CPP 4.8.2 in C++; one Python call ticks the whole
+tree). The same XML runs in Kinema and BT.CPP; py_trees gets hand-built equivalents where it has
+them. Structures:
 
-* a Sequence of 1000 ``AlwaysSuccess`` leaves;
-* a mixed tree of about 1000 nodes: groups under a Sequence, each a reactive sequence holding a
-  script condition, an inverted failure, a fallback, a script that increments a blackboard counter
-  and a subtree (py_trees has no subtrees or scripts: the equivalents are a nested composite and
-  behaviours reading/writing its blackboard).
+* ``sequence`` - a Sequence of 1000 ``AlwaysSuccess`` leaves;
+* ``mixed`` - about 1000 nodes: groups under a Sequence, each a ReactiveSequence holding a
+  ScriptCondition, an inverted failure, a Fallback, a Script incrementing a blackboard counter
+  and a SubTree;
+* ``pick_place`` - shaped like lab_sim's "3 Waypoints Pick and Place": nested SubTrees with
+  remapped ports (``Move to Waypoint`` -> ``Move to Joint State``, grippers) under
+  KeepRunningUntilFailure; the robot behaviors are a registered action ``Work`` that succeeds
+  (a Python callback in both engines), with Scripts passing values as the real ones pass poses;
+* building the sequence and the mixed tree from XML.
 
-It prints ticks per second for each engine, the ratio, and the time Kinema needs to build the
-1000-node Sequence from XML. Targets (issue 2): ratio >= 20x, >= 2,500 ticks/s on the Sequence,
-build < 50 ms. Run: ``python benchmarks/bt_tick.py [--seconds S]``.
+Kinema is also measured "as objectives run": with the objective server's status observer (one
+NodeStatusChange per transition, like ``ObjectiveServer._on_node_status``) and a blackboard
+snapshot at 10 Hz attached. Rates are ticks per CPU second (``time.process_time``), median of
+``--rounds`` rounds; ratios are Kinema's time over BT.CPP's (lower is better; 1.0 = parity).
+Targets (issue 17): sequence <= 1.0x, mixed <= 1.5x, XML build <= 2x, observers <= +20 %.
+Run: ``python benchmarks/bt_tick.py [--seconds S] [--rounds N] [--profile STRUCTURE]``.
 """
 
 from __future__ import annotations
 
 import argparse
+import cProfile
 import operator
+import pstats
 import statistics
 import time
 from collections.abc import Callable
-
-import py_trees
-
-from kinema.bt import BehaviorTreeFactory, Blackboard
+from typing import Any
 
 N_LEAVES = 1000
 GROUP_SIZE = 11
@@ -34,7 +42,8 @@ def sequence_xml(n: int = N_LEAVES) -> str:
     """A Sequence with ``n`` AlwaysSuccess children."""
     leaves = "".join("<AlwaysSuccess/>" for _ in range(n))
     return (
-        f'<root BTCPP_format="4"><BehaviorTree ID="Main"><Sequence>{leaves}</Sequence></BehaviorTree></root>'
+        '<root BTCPP_format="4" main_tree_to_execute="Main">'
+        f'<BehaviorTree ID="Main"><Sequence>{leaves}</Sequence></BehaviorTree></root>'
     )
 
 
@@ -57,32 +66,156 @@ def mixed_xml(groups: int = N_GROUPS) -> str:
     )
 
 
-class _Increment(py_trees.behaviour.Behaviour):
-    """py_trees equivalent of ``<Script code="counter += 1"/>``."""
+def pick_place_xml() -> str:
+    """A tree shaped like lab_sim's pick and place: SubTrees three deep, remapped ports, a loop."""
+    move_to_joint_state = (
+        '<BehaviorTree ID="Move to Joint State"><Sequence name="plan and execute">'
+        '<Work name="activate controllers"/>'
+        '<Script name="plan" code="trajectory := target .. \'/planned\'"/>'
+        '<Work name="validate trajectory"/>'
+        '<Fallback name="execute"><Work name="execute trajectory"/><AlwaysFailure name="stop"/></Fallback>'
+        "</Sequence></BehaviorTree>"
+    )
+    move_to_waypoint = (
+        '<BehaviorTree ID="Move to Waypoint"><Sequence name="move to waypoint">'
+        '<Script name="look up the waypoint" code="target_joint_state := waypoint_name"/>'
+        '<SubTree ID="Move to Joint State" name="plan and execute" target="{target_joint_state}"'
+        ' joint_group_name="{joint_group_name}"/>'
+        "</Sequence></BehaviorTree>"
+    )
+    gripper = (
+        '<BehaviorTree ID="Open Gripper"><Work name="open gripper"/></BehaviorTree>'
+        '<BehaviorTree ID="Close Gripper"><Work name="close gripper"/></BehaviorTree>'
+    )
+    carry = (
+        '<BehaviorTree ID="Pick and Place Between Waypoints"><Sequence name="carry">'
+        '<SubTree ID="Move to Waypoint" name="down to the object" waypoint_name="{from}"'
+        ' joint_group_name="{group}"/>'
+        '<SubTree ID="Close Gripper" name="grasp"/>'
+        '<SubTree ID="Move to Waypoint" name="lift" waypoint_name="{mid}" joint_group_name="{group}"/>'
+        '<SubTree ID="Move to Waypoint" name="down to the target" waypoint_name="{to}"'
+        ' joint_group_name="{group}"/>'
+        '<SubTree ID="Open Gripper" name="release"/>'
+        '<SubTree ID="Move to Waypoint" name="back up" waypoint_name="{mid}" joint_group_name="{group}"/>'
+        '<Script name="count" code="cycles += 1"/>'
+        "</Sequence></BehaviorTree>"
+    )
+    main = (
+        '<BehaviorTree ID="Main"><Sequence name="pick and place">'
+        "<Script name=\"setup\" code=\"mid := 'mid'; pick := 'pick'; place := 'place'; group := 'arm'\"/>"
+        '<SubTree ID="Move to Waypoint" name="start above the table" waypoint_name="{mid}"'
+        ' joint_group_name="{group}"/>'
+        '<SubTree ID="Open Gripper" name="open"/>'
+        '<KeepRunningUntilFailure name="until cancelled"><Sequence name="one cycle">'
+        '<SubTree ID="Pick and Place Between Waypoints" name="table to tray" from="{pick}" to="{place}"'
+        ' mid="{mid}" group="{group}" cycles="{cycles}"/>'
+        '<SubTree ID="Pick and Place Between Waypoints" name="tray to table" from="{place}" to="{pick}"'
+        ' mid="{mid}" group="{group}" cycles="{cycles}"/>'
+        "</Sequence></KeepRunningUntilFailure></Sequence></BehaviorTree>"
+    )
+    return (
+        '<root BTCPP_format="4" main_tree_to_execute="Main">'
+        f"{main}{carry}{move_to_waypoint}{move_to_joint_state}{gripper}</root>"
+    )
 
-    def __init__(self, name: str) -> None:
-        super().__init__(name)
-        self.bb = self.attach_blackboard_client()
-        self.bb.register_key("counter", access=py_trees.common.Access.WRITE)
 
-    def update(self) -> py_trees.common.Status:
-        self.bb.counter += 1
-        return py_trees.common.Status.SUCCESS
+STRUCTURES = {"sequence": sequence_xml, "mixed": mixed_xml, "pick_place": pick_place_xml}
 
 
-def py_trees_sequence(n: int = N_LEAVES) -> py_trees.behaviour.Behaviour:
-    """py_trees Sequence of ``n`` Success behaviours."""
+# -- engines ----------------------------------------------------------------------------------------
+
+
+def kinema_tree(xml: str) -> Any:
+    from kinema.bt import BehaviorTreeFactory, Blackboard, NodeStatus
+
+    factory = BehaviorTreeFactory()
+    factory.register_simple_action("Work", lambda node: NodeStatus.SUCCESS)
+    bb = Blackboard.create()
+    bb.set("counter", 0)
+    bb.set("cycles", 0)
+    return factory.create_tree_from_text(xml, bb)
+
+
+_KEEP_ALIVE: list[Any] = []
+
+
+def btcpp_tree(xml: str) -> Any:
+    import behaviortreepy as bt
+
+    factory = bt.BehaviorTreeFactory()
+    success = bt.NodeStatus.SUCCESS
+    factory.register_simple_action("Work", lambda node: success)
+    bb = bt.Blackboard.create()
+    bb.set_int("counter", 0)
+    bb.set_int("cycles", 0)
+    tree = factory.create_tree_from_text(xml, bb)
+    _KEEP_ALIVE.append((factory, bb))  # BT.CPP 4.8 trees must not outlive their factory (#1046)
+    return tree
+
+
+class ObjectiveObservers:
+    """What the objective server attaches to a running tree: a NodeStatusChange per transition
+    (flushed after every tick) and a blackboard snapshot at 10 Hz."""
+
+    def __init__(self, tree: Any) -> None:
+        from kinema.runtime.objective_server import NodeStatusChange, blackboard_entries
+
+        self.tree = tree
+        self.pending: list[Any] = []
+        self.published = 0
+        self.snapshots = 0
+        self._last = 0.0
+        self._entries = blackboard_entries
+        change = NodeStatusChange
+
+        def on_status(timestamp: float, node: Any, previous: Any, status: Any) -> None:
+            self.pending.append(
+                change(timestamp, int(node.uid), node.full_path, node.registration_id, node.name,
+                       int(previous), int(status))
+            )  # fmt: skip
+
+        self._handle = tree.add_status_observer(on_status)
+
+    def tick(self) -> None:
+        self.tree.tick_once()
+        changes, self.pending = self.pending, []
+        self.published += len(changes)
+        now = time.monotonic()
+        if now - self._last >= 0.1:
+            self._last = now
+            self._entries(self.tree)
+            self.snapshots += 1
+
+
+# -- py_trees equivalents ---------------------------------------------------------------------------
+
+
+def py_trees_sequence(n: int = N_LEAVES) -> Any:
+    import py_trees
+
     children = [py_trees.behaviours.Success(name=f"s{i}") for i in range(n)]
     return py_trees.composites.Sequence(name="root", memory=True, children=children)
 
 
-def py_trees_mixed(groups: int = N_GROUPS) -> py_trees.behaviour.Behaviour:
+def py_trees_mixed(groups: int = N_GROUPS) -> Any:
     """py_trees version of :func:`mixed_xml` (same node count and control flow)."""
+    import py_trees
+
+    class Increment(py_trees.behaviour.Behaviour):
+        def __init__(self, name: str) -> None:
+            super().__init__(name)
+            self.bb = self.attach_blackboard_client()
+            self.bb.register_key("counter", access=py_trees.common.Access.WRITE)
+
+        def update(self) -> Any:
+            self.bb.counter += 1
+            return py_trees.common.Status.SUCCESS
+
     py_trees.blackboard.Blackboard.clear()
     writer = py_trees.blackboard.Client(name="setup")
     writer.register_key("counter", access=py_trees.common.Access.WRITE)
     writer.counter = 0
-    group_nodes = []
+    groups_nodes = []
     for g in range(groups):
         check = py_trees.behaviours.CheckBlackboardVariableValue(
             name=f"check{g}",
@@ -105,84 +238,102 @@ def py_trees_mixed(groups: int = N_GROUPS) -> py_trees.behaviour.Behaviour:
                 )
             ],
         )
-        group_nodes.append(
+        groups_nodes.append(
             py_trees.composites.Sequence(
                 name=f"g{g}",
                 memory=False,
-                children=[check, inverted, fallback, _Increment(f"inc{g}"), subtree],
+                children=[check, inverted, fallback, Increment(f"inc{g}"), subtree],
             )
         )
-    return py_trees.composites.Sequence(name="root", memory=True, children=group_nodes)
+    return py_trees.composites.Sequence(name="root", memory=True, children=groups_nodes)
 
 
-def ticks_per_second(tick: Callable[[], object], seconds: float) -> float:
-    """Best of three runs of ``seconds / 3`` each (the least disturbed by other processes)."""
+# -- measuring --------------------------------------------------------------------------------------
+
+
+def rate(tick: Callable[[], object], seconds: float, rounds: int) -> float:
+    """Median ticks per CPU second over ``rounds`` rounds of ``seconds / rounds`` each."""
     rates = []
-    for _ in range(3):
+    for _ in range(rounds):
         count = 0
-        start = time.perf_counter()
-        deadline = start + seconds / 3
+        start = time.process_time()
+        deadline = start + seconds / rounds
         while True:
-            for _ in range(10):
+            for _ in range(5):
                 tick()
-            count += 10
-            now = time.perf_counter()
+            count += 5
+            now = time.process_time()
             if now >= deadline:
                 break
         rates.append(count / (now - start))
-    return max(rates)
+    return statistics.median(rates)
 
 
-def build_ms(xml: str, repeats: int = 10) -> float:
-    """Median time to load ``xml`` and build its tree with a fresh factory, in ms."""
+def build_ms(build: Callable[[], object], rounds: int) -> float:
+    """Median CPU milliseconds of ``build()`` over ``max(rounds, 5) * 2`` runs."""
     times = []
-    for _ in range(repeats):
-        factory = BehaviorTreeFactory()
-        start = time.perf_counter()
-        factory.create_tree_from_text(xml)
-        times.append((time.perf_counter() - start) * 1000.0)
+    for _ in range(max(rounds, 5) * 2):
+        start = time.process_time()
+        build()
+        times.append((time.process_time() - start) * 1000.0)
     return statistics.median(times)
+
+
+def _btcpp_available() -> bool:
+    try:
+        import behaviortreepy  # noqa: F401
+    except ImportError:
+        print("behaviortreepy is not installed (pip install -e '.[test]'): BT.CPP columns are empty")
+        return False
+    return True
 
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--seconds", type=float, default=3.0, help="time spent per engine and structure")
+    parser.add_argument("--seconds", type=float, default=3.0, help="CPU seconds per engine and structure")
+    parser.add_argument("--rounds", type=int, default=5, help="rounds per measurement (median)")
+    parser.add_argument("--profile", choices=sorted(STRUCTURES), help="profile Kinema ticking STRUCTURE")
     args = parser.parse_args()
 
-    factory = BehaviorTreeFactory()
-    seq_tree = factory.create_tree_from_text(sequence_xml())
-    bb = Blackboard.create()
-    bb.set("counter", 0)
-    mixed_tree = BehaviorTreeFactory().create_tree_from_text(mixed_xml(), bb)
-    pt_seq = py_trees_sequence()
-    pt_mixed = py_trees_mixed()
+    if args.profile:
+        tree = kinema_tree(STRUCTURES[args.profile]())
+        profiler = cProfile.Profile()
+        profiler.enable()
+        for _ in range(300):
+            tree.tick_once()
+        profiler.disable()
+        pstats.Stats(profiler).sort_stats("tottime").print_stats(25)
+        return
 
-    rows = []
-    for label, kinema_tree, pt_root in (
-        (f"Sequence of {N_LEAVES} AlwaysSuccess", seq_tree, pt_seq),
-        ("mixed tree", mixed_tree, pt_mixed),
-    ):
-        n_kinema = len(kinema_tree)
-        n_pt = sum(1 for _ in pt_root.iterate())
-        kinema_rate = ticks_per_second(kinema_tree.tick_once, args.seconds)
-        pt_rate = ticks_per_second(pt_root.tick_once, args.seconds)
-        rows.append((label, n_kinema, n_pt, kinema_rate, pt_rate))
-
-    print(f"{'structure':<34} {'nodes':>11} {'kinema t/s':>11} {'py_trees t/s':>13} {'ratio':>7}")
-    for label, n_kinema, n_pt, kinema_rate, pt_rate in rows:
-        nodes = f"{n_kinema}/{n_pt}"
-        print(f"{label:<34} {nodes:>11} {kinema_rate:>11.0f} {pt_rate:>13.0f} {kinema_rate / pt_rate:>6.1f}x")
-    build = build_ms(sequence_xml())
-    print(f"build {N_LEAVES}-node Sequence from XML: {build:.1f} ms (median of 10)")
-    seq_rate, seq_ratio = rows[0][3], rows[0][3] / rows[0][4]
-    print(
-        "targets: ratio >= 20x: {}, >= 2500 ticks/s: {}, build < 50 ms: {}".format(
-            "met" if seq_ratio >= 20 else "MISSED",
-            "met" if seq_rate >= 2500 else "MISSED",
-            "met" if build < 50 else "MISSED",
+    have_btcpp = _btcpp_available()
+    py_trees_builders = {"sequence": py_trees_sequence, "mixed": py_trees_mixed}
+    print(f"ticks per CPU second, median of {args.rounds} rounds; ratio = BT.CPP rate / Kinema rate")
+    header = f"{'structure':<12} {'nodes':>6} {'BT.CPP':>9} {'Kinema':>9} {'ratio':>6} "
+    print(header + f"{'+observers':>11} {'cost':>6} {'py_trees':>9}")
+    observed_cost = {}
+    for name, make_xml in STRUCTURES.items():
+        xml = make_xml()
+        tree = kinema_tree(xml)
+        kinema = rate(tree.tick_once, args.seconds, args.rounds)
+        observed_tree = kinema_tree(xml)
+        observers = ObjectiveObservers(observed_tree)
+        observed = rate(observers.tick, args.seconds, args.rounds)
+        observed_cost[name] = kinema / observed - 1.0
+        btcpp = rate(btcpp_tree(xml).tick_once, args.seconds, args.rounds) if have_btcpp else float("nan")
+        pt = float("nan")
+        if name in py_trees_builders:
+            pt = rate(py_trees_builders[name]().tick_once, args.seconds, args.rounds)
+        print(
+            f"{name:<12} {len(tree):>6} {btcpp:>9.0f} {kinema:>9.0f} {btcpp / kinema:>5.2f}x "
+            f"{observed:>11.0f} {observed_cost[name]:>+5.0%} {pt:>9.0f}"
         )
-    )
-    print(f"counter after the mixed runs: {bb.get('counter')} (the scripts really ran)")
+    print("\nbuild from XML, CPU ms (median); ratio = Kinema / BT.CPP")
+    for name in ("sequence", "mixed", "pick_place"):
+        xml = STRUCTURES[name]()
+        kinema_ms = build_ms(lambda xml=xml: kinema_tree(xml), args.rounds)
+        btcpp_ms = build_ms(lambda xml=xml: btcpp_tree(xml), args.rounds) if have_btcpp else float("nan")
+        ratio = kinema_ms / btcpp_ms
+        print(f"{name:<12} BT.CPP {btcpp_ms:7.2f} ms   Kinema {kinema_ms:7.2f} ms   {ratio:5.2f}x")
 
 
 if __name__ == "__main__":

@@ -5,7 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from kinema.bt.clock import WakeUpTimer
-from kinema.bt.conversions import ConversionError, convert_from_string, has_converter, type_name
+from kinema.bt.conversions import ConversionError, Unsigned, convert_from_string, has_converter, type_name
 from kinema.bt.decorators import entry_key_of
 from kinema.bt.errors import BTLogicError, BTRuntimeError, ScriptParseError
 from kinema.bt.node import (
@@ -72,6 +72,7 @@ class _ScriptCode:
 
     config: NodeConfig
     full_path: str
+    registration_id: str
     _code: str
     _script: Script | None
     _literal: bool
@@ -79,6 +80,9 @@ class _ScriptCode:
     def _init_script(self) -> None:
         self._code = ""
         self._script = None
+        if self.config.input_ports.get("code") is None:
+            # BT.CPP reads the port in the constructor: a Script without code fails createTree
+            raise BTRuntimeError(f"Missing port [code] in {self.registration_id} '{self.full_path}'")
         code = _literal_code(self.config)
         self._literal = code is not None
         if code:
@@ -230,7 +234,7 @@ class SleepNode(StatefulActionNode):
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
-        return [input_port("msec", int)]
+        return [input_port("msec", Unsigned)]
 
     def __init__(self, name: str, config: NodeConfig | None = None) -> None:
         super().__init__(name, config)

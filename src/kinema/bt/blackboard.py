@@ -17,6 +17,7 @@ from typing import Any
 from kinema.bt.conversions import (
     AnyValue,
     ConversionError,
+    Unsigned,
     cast_value,
     convert_from_string,
     has_converter,
@@ -27,6 +28,7 @@ from kinema.bt.conversions import (
     value_type_name,
 )
 from kinema.bt.errors import BTLogicError, BTRuntimeError
+from kinema.bt.limits import SIZED_TYPES, check_entry_value
 
 BlackboardObserver = Callable[[str, "Entry"], None]
 
@@ -190,7 +192,13 @@ class Blackboard:
     def _create_entry_impl(self, key: str, port_type: Any) -> Entry:
         entry = self._storage.get(key)
         if entry is not None:
-            if entry.type != port_type and is_strongly_typed(entry.type) and is_strongly_typed(port_type):
+            if (
+                entry.type != port_type
+                and is_strongly_typed(entry.type)
+                and is_strongly_typed(port_type)
+                # a Python int is how an unsigned value is written (Python has no unsigned type)
+                and not (entry.type is Unsigned and port_type is int)
+            ):
                 raise BTLogicError(
                     f"Blackboard entry [{key}]: once declared, the type of a port shall not change. "
                     f"Previously declared type [{type_name(entry.type)}], "
@@ -247,10 +255,13 @@ class Blackboard:
         A new key gets the type of the value, except a string, which makes a generic entry. An
         existing entry without a type takes the value's type. A typed entry accepts the same type,
         a string it can parse, or a number that converts without loss; otherwise BTLogicError.
+        A string, bytes or container past :mod:`kinema.bt.limits` raises BTRuntimeError.
         """
         if key[:1] == "@":
             self.root().set(key[1:], value)
             return
+        if value.__class__ in SIZED_TYPES:
+            check_entry_value(key, value)
         entry = self._storage.get(key)
         if entry is None:
             new_type = None if isinstance(value, str) else python_type_of(value)
@@ -294,7 +305,7 @@ def coerce_into_entry(key: str, entry: Entry, value: Any) -> Any:
             return convert_from_string(target, value)
         except ConversionError:
             pass
-    elif target in (int, float, bool) and isinstance(value, int | float):
+    elif target in (int, Unsigned, float, bool) and isinstance(value, int | float):
         try:
             converted = cast_value(value, target)
         except ConversionError:

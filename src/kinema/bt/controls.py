@@ -46,14 +46,46 @@ class SequenceNode(_ResumingControl):
                 self._skipped = 0
             _set_status_unchecked(self, RUNNING)
         idx = self._idx
-        asynch = self._asynch
+        if self._asynch:
+            return self._tick_async(children, n, idx)
+        # The plain Sequence's hot loop (the async one is the same plus a yield after each success).
+        for child in children if idx == 0 else children[idx:]:
+            try:
+                status = child.execute_tick()
+            except BaseException:
+                # BT.CPP advances its member index in place: an exception that escapes a child
+                # leaves it on that child, and the next tick resumes there.
+                self._idx = idx
+                raise
+            if status is SUCCESS:
+                idx += 1
+            elif status is RUNNING:
+                self._idx = idx
+                return RUNNING
+            elif status is FAILURE:
+                self.reset_children()
+                self._idx = 0
+                return FAILURE
+            elif status is SKIPPED:
+                idx += 1
+                self._skipped += 1
+            else:
+                self._idx = idx
+                raise _idle_child(self)
+        return self._finish(n)
+
+    def _tick_async(self, children: list, n: int, idx: int) -> NodeStatus:
         while idx < n:
             child = children[idx]
             prev = child._status
-            status = child.execute_tick()
+            try:
+                status = child.execute_tick()
+            except BaseException:
+                self._idx = idx  # as in the plain loop
+                raise
             if status is SUCCESS:
                 idx += 1
-                if asynch and prev is IDLE and idx < n:
+                if prev is IDLE and idx < n:
                     self._idx = idx
                     self.emit_wake_up_signal()
                     return RUNNING
@@ -71,6 +103,9 @@ class SequenceNode(_ResumingControl):
             else:
                 self._idx = idx
                 raise _idle_child(self)
+        return self._finish(n)
+
+    def _finish(self, n: int) -> NodeStatus:
         all_skipped = self._skipped == n
         self.reset_children()
         self._idx = 0
@@ -142,7 +177,13 @@ class FallbackNode(_ResumingControl):
         while idx < n:
             child = children[idx]
             prev = child._status
-            status = child.execute_tick()
+            try:
+                status = child.execute_tick()
+            except BaseException:
+                # BT.CPP advances its member index in place: an exception that escapes a child
+                # leaves it on that child, and the next tick resumes there.
+                self._idx = idx
+                raise
             if status is FAILURE:
                 idx += 1
                 if self._asynch and prev is IDLE and idx < n:

@@ -100,6 +100,24 @@ def parse_double_full(text: str) -> float | None:
         return None
 
 
+class Unsigned(int):
+    """Port type of BT.CPP's ``unsigned`` ports (the milliseconds of Sleep, Delay and Timeout).
+
+    A marker for typing rules only: ``unsigned int`` entries and ports differ from ``int`` ones (a
+    ``{key}`` shared with an ``int`` port is refused when the tree is built), literals must lie in
+    0 .. 2**32-1, and what a node reads from such a port is a plain ``int``.
+    """
+
+
+_UINT32_MAX = 2**32 - 1
+
+
+def _check_unsigned(value: int, text: Any) -> int:
+    if value < 0 or value > _UINT32_MAX:
+        raise ConversionError(f"Value out of bound when converting [{text}] to integer")
+    return value
+
+
 def parse_bool(text: str) -> bool:
     """Exactly ``0 1 true TRUE True false FALSE False``."""
     try:
@@ -145,6 +163,7 @@ def type_name(port_type: Any) -> str:
 
 _SIMPLE_NAMES: dict[Any, str] = {
     int: "int",
+    Unsigned: "unsigned int",
     float: "double",
     str: "std::string",
     bool: "bool",
@@ -214,6 +233,8 @@ def convert_from_string(port_type: Any, text: str, enums: dict[str, int] | None 
         return text
     if port_type is int:
         return parse_int_prefix(text)
+    if port_type is Unsigned:
+        return _check_unsigned(parse_int_prefix(text), text[:80])
     if port_type is float:
         return parse_double_prefix(text)
     if port_type is bool:
@@ -265,7 +286,7 @@ def has_converter(port_type: Any) -> bool:
         return False
     if isinstance(port_type, type) and issubclass(port_type, enum.Enum) and port_type is not NodeStatus:
         return False
-    if port_type in (int, float, str, bool, NodeStatus, list):
+    if port_type in (int, Unsigned, float, str, bool, NodeStatus, list):
         return True
     if list_item_type(port_type) is not None:
         return True
@@ -308,6 +329,8 @@ def cast_value(value: Any, target: Any) -> Any:
         if isinstance(value, int):
             return int(value)
         raise _no_conversion(value, target)
+    if target is Unsigned:
+        return _check_unsigned(cast_value(value, int), value)
     if target is float:
         if isinstance(value, int):
             return float(value)

@@ -6,8 +6,8 @@ from collections import deque
 from typing import Any
 
 from kinema.bt.clock import WakeUpTimer
-from kinema.bt.conversions import convert_from_string, list_item_type
-from kinema.bt.errors import BTLogicError, BTRuntimeError
+from kinema.bt.conversions import Unsigned, convert_from_string, list_item_type
+from kinema.bt.errors import BTLogicError, BTRuntimeError, ScriptParseError
 from kinema.bt.node import DecoratorNode, NodeConfig, PortError, _set_status_unchecked, script_bool
 from kinema.bt.ports import PortInfo, bidirectional_port, blackboard_pointer, input_port, output_port
 from kinema.bt.script import Script, parse_script
@@ -195,7 +195,7 @@ class TimeoutNode(DecoratorNode):
         return [
             input_port(
                 "msec",
-                int,
+                Unsigned,
                 description="After a certain amount of time, halt() the child if it is still running.",
             )
         ]
@@ -241,7 +241,7 @@ class DelayNode(DecoratorNode):
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
-        return [input_port("delay_msec", int, description="Tick the child after a few milliseconds")]
+        return [input_port("delay_msec", Unsigned, description="Tick the child after a few milliseconds")]
 
     def __init__(self, name: str, config: NodeConfig | None = None) -> None:
         super().__init__(name, config)
@@ -321,6 +321,19 @@ class PreconditionNode(DecoratorNode):
         self._children_running = False
         self._script: Script | None = None
         self._script_code: str | None = None
+        # BT.CPP parses the condition in the constructor: a missing or malformed literal `if`
+        # fails createTree (a {pointer} is read and parsed when ticked).
+        code = self.config.input_ports.get("if")
+        if code is None:
+            raise BTRuntimeError(f"Missing parameter [if] in Precondition '{self.full_path}'")
+        if code and blackboard_pointer(code, "if") is None:
+            try:
+                self._script = parse_script(code)
+            except ScriptParseError as error:
+                raise BTRuntimeError(
+                    f"Error in the script \"{code}\" of node '{self.full_path}': {error.message}"
+                ) from None
+            self._script_code = code
 
     def _executor(self) -> Script:
         code = self.get_input("if", str)

@@ -154,7 +154,8 @@ class TreeNode:
         self.name = name
         self.config = config if config is not None else NodeConfig()
         self._status = IDLE
-        self._observers: list[StatusObserver] = []
+        # A tuple, replaced on (un)subscribe: notifying iterates it without copying it.
+        self._observers: tuple[StatusObserver, ...] = ()
         self._bindings: dict[str, tuple[str | None, Any, Any]] = {}
         self._literal_cache: dict[tuple[str, Any], Any] = {}
         manifest = self.config.manifest
@@ -245,7 +246,7 @@ class TreeNode:
     def _notify(self, prev: NodeStatus, new: NodeStatus) -> None:
         clock = self.config.clock
         now = clock.now() if clock is not None else 0.0
-        for callback in tuple(self._observers):
+        for callback in self._observers:
             callback(now, self, prev, new)
 
     def _wrap_exception(self, error: Exception) -> NodeExecutionError:
@@ -328,7 +329,7 @@ class TreeNode:
         if self._observers:
             clock = self.config.clock
             now = clock.now() if clock is not None else 0.0
-            for callback in tuple(self._observers):
+            for callback in self._observers:
                 callback(now, self, prev, new)
 
     def set_status(self, new: NodeStatus) -> None:
@@ -344,7 +345,7 @@ class TreeNode:
         if self._observers:
             clock = self.config.clock
             now = clock.now() if clock is not None else 0.0
-            for callback in tuple(self._observers):
+            for callback in self._observers:
                 callback(now, self, prev, IDLE)
 
     def halt_node(self) -> None:
@@ -365,11 +366,13 @@ class TreeNode:
 
     def subscribe_to_status_change(self, callback: StatusObserver) -> Callable[[], None]:
         """Call ``callback(timestamp, node, prev, new)`` on every status change; returns an unsubscriber."""
-        self._observers.append(callback)
+        self._observers = (*self._observers, callback)
 
         def unsubscribe() -> None:
             if callback in self._observers:
-                self._observers.remove(callback)
+                observers = list(self._observers)
+                observers.remove(callback)
+                self._observers = tuple(observers)
 
         return unsubscribe
 
@@ -599,11 +602,15 @@ class SimpleActionNode(SyncActionNode):
         self._fn = fn
 
     def tick(self) -> NodeStatus:
-        # BT.CPP sets RUNNING before calling the functor (observers see IDLE -> RUNNING -> result);
+        # BT.CPP sets RUNNING before calling the functor and the result right after it, inside
+        # tick() (observers see IDLE -> RUNNING -> result even when a post-condition then throws);
         # the sync-node rule only forbids *returning* RUNNING, so the status is set directly.
         if self._status is IDLE:
             _set_status_unchecked(self, RUNNING)
-        return self._fn(self)
+        status = self._fn(self)
+        if status is not self._status and status is not IDLE:
+            _set_status_unchecked(self, status)
+        return status
 
 
 class SimpleConditionNode(ConditionNode):
@@ -627,7 +634,7 @@ def _set_status_unchecked(node: TreeNode, new: NodeStatus) -> None:
     if node._observers:
         clock = node.config.clock
         now = clock.now() if clock is not None else 0.0
-        for callback in tuple(node._observers):
+        for callback in node._observers:
             callback(now, node, prev, new)
 
 

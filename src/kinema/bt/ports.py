@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from enum import IntEnum
+from enum import EnumMeta, IntEnum
 from typing import Any
 
 from kinema.bt.conversions import has_converter, is_strongly_typed, to_str, type_name
@@ -88,7 +88,9 @@ class PortInfo:
         self.default_str: str | None = None if default is NO_DEFAULT else to_str(default)
         self.description = description
         self.strongly_typed = is_strongly_typed(type)
-        self.has_converter = has_converter(type)
+        # BT.CPP gives enum-typed ports (NodeStatus included) no string converter, so their
+        # literals are not checked when the tree is built, only when the port is read.
+        self.has_converter = has_converter(type) and not (isinstance(type, EnumMeta))
 
     @property
     def has_default(self) -> bool:

@@ -8,6 +8,8 @@ from collections.abc import Callable, Iterator
 from typing import TYPE_CHECKING, Any
 
 from kinema.bt.clock import Clock
+from kinema.bt.errors import BTRuntimeError
+from kinema.bt.limits import MAX_TREE_NODES
 from kinema.bt.node import StatusObserver, TreeNode, node_children
 from kinema.bt.status import FAILURE, IDLE, RUNNING, SKIPPED, SUCCESS, NodeStatus
 
@@ -120,8 +122,18 @@ class Tree:
         self.retick_due = False
 
     def next_uid(self) -> int:
-        """Allocate the next node uid (1-based, used by the builder)."""
+        """Allocate the next node uid (1-based, used by the builder).
+
+        Raises:
+            BTRuntimeError: the tree would pass :data:`~kinema.bt.limits.MAX_TREE_NODES` nodes.
+        """
         self._uid += 1
+        if self._uid > MAX_TREE_NODES:
+            raise BTRuntimeError(
+                f"the tree has more than {MAX_TREE_NODES:,} nodes (the nodes of every SubTree instance "
+                "included): node uids are 16-bit in BT.CPP's and Groot2's formats and in Kinema's status "
+                "stream (kinema.bt.limits.MAX_TREE_NODES); split it into objectives or reuse fewer SubTrees"
+            )
         return self._uid
 
     # -- structure -------------------------------------------------------------------------------

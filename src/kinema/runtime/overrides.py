@@ -162,9 +162,11 @@ def parse_yaml_value(text: str, port_type: Any) -> Any:
 
 
 def _is_class_type(port_type: Any) -> bool:
+    from kinema.bt.conversions import Unsigned
+
     return (
         isinstance(port_type, type)
-        and port_type not in (int, float, str, bool, list)
+        and port_type not in (int, Unsigned, float, str, bool, list)
         and not issubclass(port_type, enum.Enum)
     )
 
@@ -175,7 +177,7 @@ def coerce_value(value: Any, port_type: Any, *, text: str | None = None) -> Any:
     Raises:
         ValueError: the value does not fit the type (a float for an int port, a word for a bool, ...).
     """
-    from kinema.bt.conversions import AnyValue, list_item_type
+    from kinema.bt.conversions import AnyValue, Unsigned, list_item_type
 
     shown = text if text is not None else repr(value)
     label = _type_label(port_type)
@@ -185,12 +187,17 @@ def coerce_value(value: Any, port_type: Any, *, text: str | None = None) -> Any:
         if isinstance(value, bool):
             return value
         raise ValueError(f"{shown} is not a bool (port type {label}; use true or false)")
-    if port_type is int:
+    if port_type is int or port_type is Unsigned:
+        number = None
         if isinstance(value, int) and not isinstance(value, bool):
-            return value
-        if isinstance(value, float) and value.is_integer():
-            return int(value)
-        raise ValueError(f"{shown} is not an int (port type {label})")
+            number = value
+        elif isinstance(value, float) and value.is_integer():
+            number = int(value)
+        if number is None:
+            raise ValueError(f"{shown} is not an int (port type {label})")
+        if port_type is Unsigned and not 0 <= number <= 2**32 - 1:
+            raise ValueError(f"{shown} is not in 0 .. 4294967295 (port type {label})")
+        return number
     if port_type is float:
         if isinstance(value, int | float) and not isinstance(value, bool):
             return float(value)

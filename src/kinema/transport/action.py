@@ -206,6 +206,9 @@ class ServerGoalHandle:
             self.result = result
             self.error = error
             self.terminated_at = time.monotonic()
+            # An ended goal is kept until it expires only to answer get_result: its request (up
+            # to a whole objective's XML) is let go now, so rejected large goals do not pile up.
+            self.goal = None
             waiters, self._waiters = self._waiters, []
         self.server._publish_status()
         for responder in waiters:

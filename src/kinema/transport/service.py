@@ -23,6 +23,7 @@ from kinema.errors import TransportError
 from kinema.interfaces import ServiceType
 from kinema.transport.attachment import Attachment
 from kinema.transport.dispatch import channel, dispatch
+from kinema.transport.heap import note_message_size
 from kinema.transport.keys import SERVICE_QOS, EntityKind
 from kinema.transport.messages import from_dict, type_of
 from kinema.transport.pubsub import Entity
@@ -198,6 +199,7 @@ class ServiceServer(Entity):
     def _serve(self, query: Any, responder: Responder) -> None:
         try:
             payload = query.payload.to_bytes() if query.payload is not None else b""
+            note_message_size(len(payload))
             request = self.registry.deserialize(payload, self.service.request)
         except TransportError as error:
             responder.error(f"service {self.name}: bad request: {error}")

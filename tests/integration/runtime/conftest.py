@@ -163,3 +163,10 @@ def derived_config_agent(request: pytest.FixtureRequest, tmp_path: Path) -> Iter
         request, tmp_path, "--config", "my_cell", "--workspace", workspace, "--clock", "wall"
     ) as running:
         yield running
+
+
+@pytest.fixture
+def own_agent(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[AgentProcess]:
+    """An agent no other test has used (for measuring the process itself)."""
+    with running_agent(request, tmp_path) as running:
+        yield running

@@ -80,7 +80,7 @@ def test_valid_overrides_apply(client: ObjectiveClient) -> None:
 @pytest.mark.parametrize(
     ("overrides", "reason"),
     [
-        ({"delay": "soon", "greeting": "x"}, "'soon' is not a valid int"),
+        ({"delay": "soon", "greeting": "x"}, "'soon' is not a valid unsigned int"),
         ({"delay": 1.5, "greeting": "x"}, "1.5 is not an int"),
         ({"dealy": "5"}, "did you mean 'delay'"),
         ([ParameterOverride("delay", "5", ("nowhere",))], "no subtree is named 'nowhere'"),

@@ -22,6 +22,7 @@ from kinema.bt.conversions import (
     value_type_name,
 )
 from kinema.bt.errors import BTLogicError, BTRuntimeError
+from kinema.bt.limits import MAX_SCRIPT_STRING_CHARS, script_string_too_long
 
 if TYPE_CHECKING:
     from kinema.bt.blackboard import Blackboard
@@ -48,6 +49,22 @@ def to_bool(v: Any) -> bool:
             return bool(v)
         raise EvalError(f"Implicit casting to bool is not allowed (value {v})")
     raise EvalError(f"[Any::convert]: no known safe conversion between [{value_type_name(v)}] and [bool]")
+
+
+_MAX_EXACT_INT = 2**53 - 1  # the largest integer a double holds exactly (and everything below it)
+
+
+def to_double(v: Any) -> float:
+    """``Any::cast<double>`` of a number: an integer a double cannot hold exactly raises.
+
+    Raises:
+        EvalError: ``|v| > 2**53 - 1`` (so ``9223372036854775807 + 1`` fails instead of rounding).
+    """
+    if v.__class__ is float:
+        return v
+    if -_MAX_EXACT_INT <= v <= _MAX_EXACT_INT:
+        return float(v)
+    raise EvalError(f"Loss of precision when converting a large integer number to floating point:{v}")
 
 
 def to_int64(v: Any) -> int:
@@ -150,7 +167,7 @@ class Unary(Expr):
     def evaluate(self, bb: Blackboard, enums: dict[str, int] | None) -> Any:
         v = self.operand.evaluate(bb, enums)
         if is_num(v):
-            rv = float(v)
+            rv = to_double(v)
             op = self.op
             if op == "-":
                 return -rv
@@ -162,6 +179,13 @@ class Unary(Expr):
         if isinstance(v, str):
             raise EvalError("Invalid operator for std::string")
         raise EvalError("ExprUnaryArithmetic: undefined")
+
+
+def _bounded(text: str) -> str:
+    """``text`` if it is within the script string limit (kinema.bt.limits), else EvalError."""
+    if len(text) > MAX_SCRIPT_STRING_CHARS:
+        raise EvalError(script_string_too_long(len(text)))
+    return text
 
 
 def _divide(a: float, b: float) -> float:
@@ -182,54 +206,59 @@ class Binary(Expr):
         self.rhs = rhs
 
     def evaluate(self, bb: Blackboard, enums: dict[str, int] | None) -> Any:
-        lv = self.lhs.evaluate(bb, enums)
-        rv = self.rhs.evaluate(bb, enums)
-        op = self.op
-        if lv is None:
-            raise _not_init("left", op)
-        if rv is None:
-            raise _not_init("right", op)
-        lnum = isinstance(lv, _NUMBER)
-        rnum = isinstance(rv, _NUMBER)
-        if lnum and rnum:
-            if op == "+":
-                return float(lv) + float(rv)
-            if op == "-":
-                return float(lv) - float(rv)
-            if op == "*":
-                return float(lv) * float(rv)
-            if op == "/":
-                return _divide(float(lv), float(rv))
-            if op in ("&", "|", "^"):
-                try:
-                    li, ri = to_int64(lv), to_int64(rv)
-                except EvalError:
-                    raise EvalError(
-                        "Binary operators are not allowed if one of the operands is not an integer"
-                    ) from None
-                if op == "&":
-                    return float(li & ri)
-                if op == "|":
-                    return float(li | ri)
-                return float(li ^ ri)
-            if op in ("&&", "||"):
-                try:
-                    lb, rb = to_bool(lv), to_bool(rv)
-                except EvalError:
-                    raise EvalError(
-                        "Logic operators are not allowed if one of the operands is not castable to bool"
-                    ) from None
-                return float(lb and rb) if op == "&&" else float(lb or rb)
-            return None  # number .. number: BT.CPP silently yields an empty value
-        lstr = isinstance(lv, str)
-        rstr = isinstance(rv, str)
-        if lstr and rstr and op == "+":
-            return lv + rv
-        if op == ".." and ((lstr and rstr) or (lstr and rnum) or (lnum and rstr)):
-            left = lv if lstr else number_to_string(lv)
-            right = rv if rstr else number_to_string(rv)
-            return left + right
-        raise EvalError("Operation not permitted")
+        return binary_values(self.op, self.lhs.evaluate(bb, enums), self.rhs.evaluate(bb, enums))
+
+
+def binary_values(op: str, lv: Any, rv: Any) -> Any:
+    """The value of ``lv op rv`` for an infix operator other than comparisons and assignments."""
+    if lv is None:
+        raise _not_init("left", op)
+    if rv is None:
+        raise _not_init("right", op)
+    lnum = isinstance(lv, _NUMBER)
+    rnum = isinstance(rv, _NUMBER)
+    if lnum and rnum:
+        # BT.CPP casts both to double first, whatever the operator
+        lf = lv if lv.__class__ is float else to_double(lv)
+        rf = rv if rv.__class__ is float else to_double(rv)
+        if op == "+":
+            return lf + rf
+        if op == "-":
+            return lf - rf
+        if op == "*":
+            return lf * rf
+        if op == "/":
+            return _divide(lf, rf)
+        if op in ("&", "|", "^"):
+            try:
+                li, ri = to_int64(lv), to_int64(rv)
+            except EvalError:
+                raise EvalError(
+                    "Binary operators are not allowed if one of the operands is not an integer"
+                ) from None
+            if op == "&":
+                return float(li & ri)
+            if op == "|":
+                return float(li | ri)
+            return float(li ^ ri)
+        if op in ("&&", "||"):
+            try:
+                lb, rb = to_bool(lv), to_bool(rv)
+            except EvalError:
+                raise EvalError(
+                    "Logic operators are not allowed if one of the operands is not castable to bool"
+                ) from None
+            return float(lb and rb) if op == "&&" else float(lb or rb)
+        return None  # number .. number: BT.CPP silently yields an empty value
+    lstr = isinstance(lv, str)
+    rstr = isinstance(rv, str)
+    if lstr and rstr and op == "+":
+        return _bounded(lv + rv)
+    if op == ".." and ((lstr and rstr) or (lstr and rnum) or (lnum and rstr)):
+        left = lv if lstr else number_to_string(lv)
+        right = rv if rstr else number_to_string(rv)
+        return _bounded(left + right)
+    raise EvalError("Operation not permitted")
 
 
 def _compare(op: str, lv: Any, rv: Any) -> bool:
@@ -263,29 +292,33 @@ class Comparison(Expr):
         lhs = operands[0].evaluate(bb, enums)
         for i, op in enumerate(self.ops):
             rhs = operands[i + 1].evaluate(bb, enums)
-            if lhs is None:
-                raise _not_init("left", op)
-            if rhs is None:
-                raise _not_init("right", op)
-            lnum = isinstance(lhs, _NUMBER)
-            rnum = isinstance(rhs, _NUMBER)
-            if lnum and rnum:
-                ok = _compare(op, float(lhs), float(rhs))
-            elif isinstance(lhs, str) and isinstance(rhs, str):
-                ok = _compare(op, lhs, rhs)
-            elif isinstance(lhs, str) and rnum:
-                ok = _compare(op, string_to_double(lhs, enums), float(rhs))
-            elif lnum and isinstance(rhs, str):
-                ok = _compare(op, float(lhs), string_to_double(rhs, enums))
-            else:
-                raise EvalError(
-                    f"Can't mix different types in Comparison. Left operand [{value_type_name(lhs)}] "
-                    f"right operand [{value_type_name(rhs)}]"
-                )
-            if not ok:
+            if not compare_operands(op, lhs, rhs, enums):
                 return 0.0
             lhs = rhs
         return 1.0
+
+
+def compare_operands(op: str, lhs: Any, rhs: Any, enums: dict[str, int] | None) -> bool:
+    """One link of a comparison chain: numbers as doubles, strings as text, a string against a
+    number through ``StringToDouble``; anything else raises."""
+    if lhs is None:
+        raise _not_init("left", op)
+    if rhs is None:
+        raise _not_init("right", op)
+    lnum = isinstance(lhs, _NUMBER)
+    rnum = isinstance(rhs, _NUMBER)
+    if lnum and rnum:
+        return _compare(op, to_double(lhs), to_double(rhs))
+    if isinstance(lhs, str) and isinstance(rhs, str):
+        return _compare(op, lhs, rhs)
+    if isinstance(lhs, str) and rnum:
+        return _compare(op, string_to_double(lhs, enums), to_double(rhs))
+    if lnum and isinstance(rhs, str):
+        return _compare(op, to_double(lhs), string_to_double(rhs, enums))
+    raise EvalError(
+        f"Can't mix different types in Comparison. Left operand [{value_type_name(lhs)}] "
+        f"right operand [{value_type_name(rhs)}]"
+    )
 
 
 class Ternary(Expr):
@@ -305,7 +338,7 @@ class Ternary(Expr):
                 "Any failed string to number conversion: the ternary condition is an empty string"
             )
         elif is_num(c):
-            valid = float(c) != 0.0
+            valid = to_double(c) != 0.0
         elif c is None:
             raise EvalError("The condition of the ternary operator is not initialized")
         else:
@@ -372,7 +405,7 @@ class Assignment(Expr):
             if isinstance(value, _NUMBER):
                 if not isinstance(dst, _NUMBER):
                     raise EvalError("This Assignment operator can't be used with a non-numeric type")
-                lv, rv = float(dst), float(value)
+                lv, rv = to_double(dst), to_double(value)
                 if op == "+=":
                     temp: Any = lv + rv
                 elif op == "-=":
@@ -386,7 +419,7 @@ class Assignment(Expr):
                     raise EvalError("Operator not supported for strings")
                 if not isinstance(dst, str):
                     raise EvalError("Operation not permitted: the left operand is not a string")
-                temp = dst + value
+                temp = _bounded(dst + value)
             else:
                 raise EvalError("Operation not permitted")
             dst_type = type(dst)

@@ -8,11 +8,13 @@ Binding powers (higher binds tighter): assignments 2 (right side is a full expre
 
 from __future__ import annotations
 
+import functools
 from typing import TYPE_CHECKING, Any
 
 from kinema.bt.conversions import int64_from_digits, parse_double_prefix
 from kinema.bt.errors import BTError, ScriptError, ScriptParseError
 from kinema.bt.script.ast import Assignment, Binary, Comparison, Expr, Literal, Name, Ternary, Unary
+from kinema.bt.script.compiled import compile_expr
 from kinema.bt.script.tokenizer import Tok, Token, tokenize
 
 if TYPE_CHECKING:
@@ -178,11 +180,12 @@ class Script:
         statements: the parsed statements; the value of the script is that of the last one.
     """
 
-    __slots__ = ("code", "statements")
+    __slots__ = ("_fns", "code", "statements")
 
     def __init__(self, code: str, statements: list[Expr]) -> None:
         self.code = code
         self.statements = statements
+        self._fns = [compile_expr(statement) for statement in statements]
 
     def run(self, blackboard: Blackboard, enums: dict[str, int] | None = None) -> Any:
         """Execute every statement and return the value of the last one.
@@ -191,12 +194,12 @@ class Script:
             ScriptError: "Error in script [<code>]" followed by what went wrong.
         """
         try:
-            statements = self.statements
-            if len(statements) == 1:
-                return statements[0].evaluate(blackboard, enums)
+            fns = self._fns
+            if len(fns) == 1:
+                return fns[0](blackboard, enums)
             value = None
-            for statement in statements:
-                value = statement.evaluate(blackboard, enums)
+            for fn in fns:
+                value = fn(blackboard, enums)
             return value
         except ScriptError:
             raise
@@ -208,12 +211,28 @@ class Script:
         return f"Script({self.code!r})"
 
 
+#: Scripts up to this length are parsed once and shared (trees repeat the same conditions and
+#: counters many times; a parsed Script holds no state of its own).
+_CACHED_CODE_CHARS = 4096
+
+
 def parse_script(code: str) -> Script:
-    """Parse ``code``.
+    """Parse ``code`` (a short one at most once: the same Script object is returned again).
 
     Raises:
         ScriptParseError: a syntax error, or an empty script ("Empty Script").
     """
+    if len(code) <= _CACHED_CODE_CHARS:
+        return _parse_cached(code)
+    return _parse(code)
+
+
+@functools.lru_cache(maxsize=2048)
+def _parse_cached(code: str) -> Script:
+    return _parse(code)  # an error is raised each time, never cached
+
+
+def _parse(code: str) -> Script:
     try:
         statements = _Parser(tokenize(code)).parse_all()
     except ScriptParseError:

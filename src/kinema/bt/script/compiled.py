@@ -1,0 +1,148 @@
+"""Script expressions compiled once into Python closures (never ``eval``/``exec`` of text).
+
+:func:`compile_expr` turns a parsed expression into ``fn(bb, enums) -> value`` with the same
+semantics as ``expr.evaluate``. The shapes that dominate real trees get specialised closures:
+literals, blackboard names, infix operators, a single comparison of two operands (``counter >= 0``)
+and a compound assignment of a literal or a name (``counter += 1``). Numbers take a short path; anything else
+goes through the same helpers :mod:`.ast` uses, so errors and conversions stay BT.CPP's. Every
+other expression is its own ``evaluate``.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Any
+
+from kinema.bt.conversions import FLT_EPSILON
+from kinema.bt.script.ast import (
+    Assignment,
+    Binary,
+    Comparison,
+    EvalError,
+    Expr,
+    Literal,
+    Name,
+    binary_values,
+    compare_operands,
+    to_double,
+)
+
+if TYPE_CHECKING:
+    from kinema.bt.blackboard import Blackboard
+
+Evaluator = Callable[["Blackboard", "dict[str, int] | None"], Any]
+
+_NUMBERS = (int, float)  # exact classes: bools and enums take the general path
+
+_FLOAT_COMPARE: dict[str, Callable[[float, float], bool]] = {
+    "==": lambda a, b: abs(a - b) <= FLT_EPSILON,
+    "!=": lambda a, b: not abs(a - b) <= FLT_EPSILON,
+    "<": lambda a, b: a < b,
+    ">": lambda a, b: a > b,
+    "<=": lambda a, b: a <= b,
+    ">=": lambda a, b: a >= b,
+}
+
+
+def compile_expr(expr: Expr) -> Evaluator:
+    """A closure evaluating ``expr`` exactly as ``expr.evaluate`` does."""
+    kind = type(expr)
+    if kind is Literal:
+        return _literal(expr)  # type: ignore[arg-type]
+    if kind is Name:
+        return _name(expr)  # type: ignore[arg-type]
+    if kind is Comparison and len(expr.ops) == 1:  # type: ignore[attr-defined]
+        return _comparison(expr)  # type: ignore[arg-type]
+    if kind is Binary:
+        return _binary(expr)  # type: ignore[arg-type]
+    if kind is Assignment:
+        fast = _compound_assignment(expr)  # type: ignore[arg-type]
+        if fast is not None:
+            return fast
+    return expr.evaluate
+
+
+def _literal(expr: Literal) -> Evaluator:
+    value = expr.value
+
+    def literal(bb: Blackboard, enums: dict[str, int] | None) -> Any:
+        return value
+
+    return literal
+
+
+def _name(expr: Name) -> Evaluator:
+    name = expr.name
+
+    def lookup(bb: Blackboard, enums: dict[str, int] | None) -> Any:
+        if enums and name in enums:
+            return float(enums[name])
+        entry = bb.get_entry(name)
+        if entry is None:
+            raise EvalError(f"Variable not found: {name}")
+        return entry.value
+
+    return lookup
+
+
+def _binary(expr: Binary) -> Evaluator:
+    left = compile_expr(expr.lhs)
+    right = compile_expr(expr.rhs)
+    op = expr.op
+
+    def binary(bb: Blackboard, enums: dict[str, int] | None) -> Any:
+        return binary_values(op, left(bb, enums), right(bb, enums))
+
+    return binary
+
+
+def _comparison(expr: Comparison) -> Evaluator:
+    left = compile_expr(expr.operands[0])
+    right = compile_expr(expr.operands[1])
+    op = expr.ops[0]
+    floats = _FLOAT_COMPARE[op]
+
+    def comparison(bb: Blackboard, enums: dict[str, int] | None) -> Any:
+        lhs = left(bb, enums)
+        rhs = right(bb, enums)
+        if lhs.__class__ in _NUMBERS and rhs.__class__ in _NUMBERS:
+            ok = floats(to_double(lhs), to_double(rhs))
+        else:
+            ok = compare_operands(op, lhs, rhs, enums)
+        return 1.0 if ok else 0.0
+
+    return comparison
+
+
+def _compound_assignment(expr: Assignment) -> Evaluator | None:
+    """``name op= literal-or-name`` on numbers; None for every other assignment."""
+    if expr.op not in ("+=", "-=", "*=") or type(expr.lhs) is not Name:
+        return None
+    if type(expr.rhs) is not Literal and type(expr.rhs) is not Name:
+        return None  # only pure right operands: the general path may evaluate it again
+    key = expr.lhs.name  # type: ignore[attr-defined]
+    rhs = compile_expr(expr.rhs)
+    op = expr.op
+    general = expr.evaluate
+
+    def compound(bb: Blackboard, enums: dict[str, int] | None) -> Any:
+        entry = bb.get_entry(key)
+        if entry is not None:
+            dst = entry.value
+            value = rhs(bb, enums)
+            if dst.__class__ in _NUMBERS and value.__class__ in _NUMBERS:
+                lv = to_double(dst)
+                rv = to_double(value)
+                temp = lv + rv if op == "+=" else lv - rv if op == "-=" else lv * rv
+                if dst.__class__ is float:
+                    new: Any = temp
+                elif temp.is_integer():
+                    new = int(temp)  # the common `counter += 1` on an int entry
+                else:
+                    return general(bb, enums)  # raises BT.CPP's conversion error
+                entry.value = new
+                bb.notify_written(key, entry)
+                return new
+        return general(bb, enums)
+
+    return compound

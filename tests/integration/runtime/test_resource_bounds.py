@@ -1,0 +1,90 @@
+"""Resource bounds of a running agent: refused large requests leave no memory behind."""
+
+from __future__ import annotations
+
+import time
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import pytest
+
+from kinema.sdk import ObjectiveClient
+
+if TYPE_CHECKING:
+    from conftest import AgentProcess
+
+MB = 1024 * 1024
+#: How far above its baseline the agent may stay once the large requests are gone. Each request
+#: alone is 10-50 MB on the wire, 2-3 times that while decoded; kept, they add up to hundreds of MB.
+MARGIN_MB = 40.0
+
+
+def rss_mb(pid: int) -> float:
+    """Resident set size of process ``pid`` in MB (Linux /proc)."""
+    with open(f"/proc/{pid}/status") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+    raise AssertionError(f"no VmRSS for pid {pid}")
+
+
+@pytest.mark.slow
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="needs Linux /proc to read the RSS")
+def test_memory_returns_to_baseline_after_refused_10_to_50_mb_requests(own_agent: AgentProcess) -> None:
+    pid = own_agent.process.pid
+    with ObjectiveClient(own_agent.endpoint, timeout=10) as client:
+        assert client.execute("Quick").succeeded
+        time.sleep(1.0)
+        baseline = rss_mb(pid)
+        seen = []
+        for size in (10, 20, 30, 40, 50, 50, 50):
+            result = client.do_xml("x" * (size * MB), timeout=60)
+            assert result.failed and "limit is" in result.error_message, result
+            seen.append((size, round(rss_mb(pid), 1)))
+        assert client.execute("Quick").succeeded
+        deadline = time.monotonic() + 20
+        current = rss_mb(pid)
+        while current > baseline + MARGIN_MB and time.monotonic() < deadline:
+            time.sleep(0.5)
+            current = rss_mb(pid)
+        assert current <= baseline + MARGIN_MB, (
+            f"agent RSS {current:.1f} MB after the requests, baseline {baseline:.1f} MB "
+            f"(margin {MARGIN_MB} MB); RSS after each request (MB sent, RSS): {seen}"
+        )
+
+
+def test_a_script_growing_a_string_fails_the_objective_at_the_documented_limit(
+    client: ObjectiveClient,
+) -> None:
+    xml = (
+        '<root BTCPP_format="4"><BehaviorTree ID="Grow"><Sequence><Script code="s := \'x\'"/>'
+        '<KeepRunningUntilFailure><Script name="double" code="s := s .. s"/></KeepRunningUntilFailure>'
+        "</Sequence></BehaviorTree></root>"
+    )
+    result = client.do_xml(xml, timeout=30)
+    assert result.failed, result
+    assert "MAX_SCRIPT_STRING_CHARS" in result.error_message and "double" in result.error_message, result
+    assert client.execute("Quick").succeeded
+
+
+def test_trees_past_65535_nodes_are_refused_at_load_and_trees_at_the_limit_run(
+    client: ObjectiveClient,
+) -> None:
+    def sequence(children: int) -> str:
+        leaves = "<AlwaysSuccess/>" * children
+        return f'<root BTCPP_format="4"><BehaviorTree ID="Big"><Sequence>{leaves}</Sequence>' + (
+            "</BehaviorTree></root>"
+        )
+
+    refused = client.do_xml(sequence(65_535), timeout=60)
+    assert refused.failed and "more than 65,535 nodes" in refused.error_message, refused
+    stream = client.node_statuses(timeout=5)
+    time.sleep(0.5)  # let the subscription reach the agent
+    assert client.do_xml(sequence(65_534), timeout=60).succeeded
+    uids = set()
+    for message in stream:
+        uids.update(change.uid for change in message.changes)
+        if 65_535 in uids:
+            break
+    stream.close()
+    assert 65_535 in uids, f"the status stream never showed the last node (max uid {max(uids, default=0)})"
