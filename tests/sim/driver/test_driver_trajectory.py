@@ -107,9 +107,10 @@ def test_an_unreachable_goal_tolerance_aborts_after_the_goal_time_tolerance(sim:
 
 
 def test_cancel_stops_the_arm_within_50_ms_of_sim_time(start_sim: Callable[..., Sim]) -> None:
-    # At 2x the wall-time latency of watching and cancelling maps to little sim time, so the cancel
-    # reliably lands while the arm moves fast; the 50 ms are measured from the driver's cancel time.
-    sim = start_sim(sim_speed=2.0)
+    # At real time the wall-time latency of watching and cancelling (up to a second on a loaded machine)
+    # is the same sim time, well inside the 2 s the arm moves fast; the 50 ms are measured from the
+    # driver's cancel time.
+    sim = start_sim(sim_speed=1.0)
     start = sim.joint_states.latest()
     goal = start + np.array([0.5, 2.5, 0.3, -0.3, 1.0, 1.0, 2.5])
     handle = sim.follow(trajectory(start, goal, 4.0))
