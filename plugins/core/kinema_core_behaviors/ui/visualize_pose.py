@@ -9,7 +9,7 @@ import numpy as np
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import ObjectiveError
 
-from .message_conversions import duration, pose_matrix
+from ..messages.conversions import duration, pose_matrix
 
 MARKER_TOPIC = "/visualization_marker_array"
 MARKER_ARRAY_TYPE = "visualization_msgs/msg/MarkerArray"

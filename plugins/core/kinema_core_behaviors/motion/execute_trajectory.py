@@ -10,7 +10,7 @@ from kinema.behaviors import AsyncBehavior, PortInfo, input_port
 from kinema.behaviors.work_runner import RUNNER
 from kinema.errors import KinemaError, TransportError
 
-from .message_conversions import duration, trajectory_from_message
+from ..messages.conversions import duration, trajectory_from_message
 from .planned_trajectory import publish_planned_trajectory
 
 FOLLOW_JOINT_TRAJECTORY = "control_msgs/action/FollowJointTrajectory"

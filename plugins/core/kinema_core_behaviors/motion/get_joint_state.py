@@ -5,8 +5,8 @@ from __future__ import annotations
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
 from kinema.errors import KinemaError, did_you_mean
 
+from ..messages.conversions import joint_state_message
 from .joint_states import joint_state_monitor
-from .message_conversions import joint_state_message
 
 
 class GetJointState(AsyncBehavior):

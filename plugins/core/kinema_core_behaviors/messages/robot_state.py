@@ -5,7 +5,7 @@ from __future__ import annotations
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
 from kinema.errors import did_you_mean
 
-from .message_conversions import robot_state_message
+from .conversions import robot_state_message
 
 
 class CreateRobotState(SyncBehavior):

@@ -6,7 +6,7 @@ import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
 
-from .message_conversions import pose_stamped_message
+from .conversions import pose_stamped_message
 
 
 def pose_from_ports(position: list[float], orientation: list[float], what: str) -> np.ndarray | str:

@@ -7,7 +7,7 @@ from typing import Any
 from kinema.behaviors import PortInfo, ServiceClientBehavior, input_port, output_port
 from kinema.errors import did_you_mean
 
-from .message_conversions import joint_state_message
+from ..messages.conversions import joint_state_message
 
 GET_WAYPOINTS = "/get_saved_waypoints"
 

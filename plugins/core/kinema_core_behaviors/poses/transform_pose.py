@@ -5,9 +5,9 @@ from __future__ import annotations
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
 from kinema.errors import ObjectiveError
 
-from .create_pose_stamped import pose_from_ports
-from .message_conversions import pose_matrix, pose_stamped_message
-from .visualize_pose import publish_pose_marker
+from ..messages.conversions import pose_matrix, pose_stamped_message
+from ..messages.pose_stamped import pose_from_ports
+from ..ui.visualize_pose import publish_pose_marker
 
 
 class TransformPose(SyncBehavior):

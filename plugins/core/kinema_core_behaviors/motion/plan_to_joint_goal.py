@@ -7,8 +7,8 @@ from typing import Any
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
 from kinema.errors import KinemaError, did_you_mean
 
+from ..messages.conversions import joint_positions, trajectory_message
 from .joint_states import joint_state_monitor
-from .message_conversions import joint_positions, trajectory_message
 from .planned_trajectory import publish_planned_trajectory
 from .planning_resources import collision_checker, robot_model
 
