@@ -44,7 +44,11 @@ def set_planning_scene(context: Any, scene: PlanningScene) -> None:
 
 
 def planning_scene(context: Any, model: RobotModel) -> PlanningScene:
-    """The planning scene of ``context``: the static geometry of its config's MuJoCo scene by default."""
+    """The planning scene of ``context``: the static geometry of its config's MuJoCo scene by default.
+
+    With a transport node, every change of the scene is published (latched) on
+    ``/monitored_planning_scene`` for ``kinema view`` and other subscribers.
+    """
     from kinema.motion import PlanningScene
 
     with _SCENES_LOCK:
@@ -54,7 +58,26 @@ def planning_scene(context: Any, model: RobotModel) -> PlanningScene:
             path = getattr(config, "mujoco_model_path", None) if config is not None else None
             scene = PlanningScene.from_mjcf(path, model.link_names) if path is not None else PlanningScene()
             _SCENES[context] = scene
+            if getattr(context, "node", None) is not None:
+                _publish_changes(context, scene, model)
         return scene
+
+
+def _publish_changes(context: Any, scene: PlanningScene, model: RobotModel) -> None:
+    from ..planning_scene.scene_messages import (
+        PLANNING_SCENE_TOPIC,
+        PLANNING_SCENE_TYPE,
+        planning_scene_message,
+    )
+
+    publisher = context.publisher(context.node, PLANNING_SCENE_TYPE, PLANNING_SCENE_TOPIC, latched=True)
+    name = model.name if hasattr(model, "name") else ""
+
+    def publish(changed: PlanningScene) -> None:
+        publisher.publish(planning_scene_message(changed, str(name)))
+
+    scene.subscribe(publish)
+    publish(scene)
 
 
 def collision_checker(context: Any, behavior: str, padding: float) -> CollisionChecker:
