@@ -1,4 +1,4 @@
-"""Core behaviors, by family: messages, poses, motion, controllers, waypoints, UI, waiting, ...
+"""Core behaviors, by family: vectors, messages, poses, motion, controllers, waypoints, UI, waiting, ...
 
 Loaded by ``kinema::CoreBehaviorsLoader`` (alias ``moveit_pro::behaviors::CoreBehaviorsLoader``). IDs and
 ports are MoveIt Pro's, so its objectives run unchanged. Each family is a package whose ``BEHAVIORS``
@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from kinema.plugins import RegisterBehavior, hookimpl
 
-from . import controllers, messages, motion, poses, ui, waiting, waypoints
+from . import controllers, messages, motion, planning_scene, poses, ui, vectors, waiting, waypoints
 
-FAMILIES = (controllers, messages, motion, poses, ui, waiting, waypoints)
+FAMILIES = (controllers, messages, motion, planning_scene, poses, ui, vectors, waiting, waypoints)
 
 BEHAVIORS = tuple(behavior for family in FAMILIES for behavior in family.BEHAVIORS)
 

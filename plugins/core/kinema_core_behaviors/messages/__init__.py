@@ -6,7 +6,38 @@ the conversions between messages and numpy (:mod:`.conversions`), which every fa
 
 from __future__ import annotations
 
-from .pose_stamped import CreatePoseStamped
-from .robot_state import CreateRobotState
+from .collision_object import (
+    CreateGraspableObjectMessage,
+    UnpackCollisionObjectMessage,
+    UnpackGraspableObjectMessage,
+)
+from .pose import CreatePointMessage, CreatePoseMessage, UnpackPointMessage, UnpackPoseMessage
+from .pose_stamped import CreatePoseStamped, UnpackPoseStampedMessage
+from .robot_state import CreateRobotState, UnpackRobotStateMessage
+from .string_message import CreateStringMessage, UnpackStringMessage
+from .twist_wrench import (
+    CreateTwistStamped,
+    CreateWrenchStamped,
+    UnpackTwistStampedMessage,
+    UnpackWrenchStampedMessage,
+)
 
-BEHAVIORS = (CreatePoseStamped, CreateRobotState)
+BEHAVIORS = (
+    CreatePoseStamped,
+    UnpackPoseStampedMessage,
+    CreatePoseMessage,
+    UnpackPoseMessage,
+    CreatePointMessage,
+    UnpackPointMessage,
+    CreateTwistStamped,
+    UnpackTwistStampedMessage,
+    CreateWrenchStamped,
+    UnpackWrenchStampedMessage,
+    CreateStringMessage,
+    UnpackStringMessage,
+    CreateRobotState,
+    UnpackRobotStateMessage,
+    UnpackCollisionObjectMessage,
+    CreateGraspableObjectMessage,
+    UnpackGraspableObjectMessage,
+)

@@ -81,7 +81,10 @@ def message_vector_inout(
 ) -> PortInfo:
     """An input/output port holding a vector of messages of ``ros_type``."""
     return bidirectional_port(
-        name, list[message_type(ros_type)], default, _describe(description, ros_type, True)  # type: ignore[misc]
+        name,
+        list[message_type(ros_type)],
+        default,
+        _describe(description, ros_type, True),  # type: ignore[misc]
     )
 
 
@@ -178,10 +181,10 @@ def read_floats(node: Any, port: str, count: int, meaning: str) -> list[float]:
     try:
         numbers = [float(v) for v in (values if isinstance(values, list | tuple) else [values])]
     except (TypeError, ValueError):
-        raise port_error(node, port, f"got {shown(values)}", f"expected {count} numbers {meaning}") from None
+        raise port_error(node, port, f"got {shown(values)}", f"expected {count} values {meaning}") from None
     if len(numbers) != count:
         raise port_error(
-            node, port, f"has {len(numbers)} values {numbers}", f"expected {count} numbers {meaning}"
+            node, port, f"has {len(numbers)} values {numbers}", f"expected {count} values {meaning}"
         )
     return numbers
 

@@ -1,12 +1,15 @@
-"""CreatePoseStamped: a stamped pose from a frame, a position and a quaternion."""
+"""PoseStamped messages: CreatePoseStamped builds one, UnpackPoseStampedMessage splits it."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
+from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
 from .conversions import pose_stamped_message
+from .ports import fails_on_bad_input, message_input, message_output, port_error, read_floats, read_message
+
+POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 
 
 def pose_from_ports(position: list[float], orientation: list[float], what: str) -> np.ndarray | str:
@@ -38,17 +41,38 @@ class CreatePoseStamped(SyncBehavior):
             input_port("reference_frame", str, "world", "Frame the pose is expressed in."),
             input_port("position_xyz", list[float], "0.0;0.0;0.0", "Position x;y;z (m)."),
             input_port("orientation_xyzw", list[float], "0.0;0.0;0.0;1.0", "Orientation quaternion x;y;z;w."),
-            output_port("pose_stamped", None, "{pose_stamped}", "The pose (geometry_msgs/PoseStamped)."),
+            message_output("pose_stamped", POSE_STAMPED, "{pose_stamped}", "The pose."),
         ]
 
+    @fails_on_bad_input
     def tick(self) -> NodeStatus:
-        matrix = pose_from_ports(
-            list(self.get_input("position_xyz")),
-            list(self.get_input("orientation_xyzw")),
-            "CreatePoseStamped:",
-        )
+        position = read_floats(self, "position_xyz", 3, "x;y;z")
+        orientation = read_floats(self, "orientation_xyzw", 4, "x;y;z;w")
+        matrix = pose_from_ports(position, orientation, "")
         if isinstance(matrix, str):
-            self.logger.publish_failure(matrix)
-            return NodeStatus.FAILURE
+            raise port_error(
+                self, "orientation_xyzw", f"= {orientation} is a zero quaternion", "e.g. 0;0;0;1"
+            )
         self.set_output("pose_stamped", pose_stamped_message(str(self.get_input("reference_frame")), matrix))
+        return NodeStatus.SUCCESS
+
+
+class UnpackPoseStampedMessage(SyncBehavior):
+    """Splits a ``geometry_msgs/PoseStamped`` into its ``header`` and ``pose``."""
+
+    subcategory = "Messages"
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            message_input("pose_stamped", POSE_STAMPED, "{pose_stamped}", "The pose to unpack."),
+            message_output("header", "std_msgs/msg/Header", "{header}", "Its header (frame and stamp)."),
+            message_output("pose", "geometry_msgs/msg/Pose", "{pose}", "Its pose."),
+        ]
+
+    @fails_on_bad_input
+    def tick(self) -> NodeStatus:
+        message = read_message(self, "pose_stamped")
+        self.set_output("header", message.header)
+        self.set_output("pose", message.pose)
         return NodeStatus.SUCCESS
