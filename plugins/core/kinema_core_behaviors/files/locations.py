@@ -1,0 +1,121 @@
+"""Where the files behaviors read and write live, resolved as MoveIt Pro resolves them.
+
+- A relative path names a file in the config package's objectives folder: reads look in every
+  objective library of the config (most-derived package first), writes go to the most-derived package's
+  own library. A relative path may not climb out of that folder (``../``): a save never lands outside
+  the folder it was meant for.
+- ``~/user_ws/src/<package>/<rest>`` (MoveIt Pro's workspace path, common in its objectives) names
+  ``<rest>`` inside that package's folder when the workspace knows the package.
+- With a ``package_name``, a relative path is inside that package's folder.
+- Any other absolute path (``/tmp/image.png``, ``~/file``) is used as written.
+Without a config (offline runs, ``kinema tree run``) relative paths resolve against the working directory.
+"""
+
+from __future__ import annotations
+
+import re
+from pathlib import Path
+from typing import Any
+
+from ..messages.ports import PortValueError, port_error
+
+_USER_WS = re.compile(r"^~/user_ws/src/([^/]+)/(.*)$")
+
+
+def objective_folders(node: Any) -> list[Path]:
+    """The config's objective library folders, the one saves go to first (cwd without a config)."""
+    resolved = node.context.config
+    if resolved is None:
+        return [Path.cwd()]
+    chain = list(resolved.chain)
+    libraries = list(resolved.objective_library_paths)
+    ranked = sorted(
+        libraries,
+        key=lambda lib: chain.index(lib.package) if lib.package in chain else -1,
+        reverse=True,
+    )
+    own = [lib.path for lib in ranked if lib.package == resolved.name]
+    rest = [lib.path for lib in ranked if lib.path not in own]
+    return list(dict.fromkeys([*own, *rest])) or [Path.cwd()]
+
+
+def _package_dir(node: Any, package: str, port: str) -> Path:
+    resolved = node.context.config
+    if resolved is None:
+        raise port_error(node, port, f"names package {package!r}, but no config is loaded", "")
+    try:
+        return Path(resolved.package_dir(package))
+    except Exception as error:  # the workspace's own lookup error names the known packages
+        raise port_error(node, port, f"names unknown package {package!r}", str(error)) from None
+
+
+def _explicit(node: Any, port: str, text: str, package: str = "") -> Path | None:
+    """The path for forms that name their folder themselves; None for a plain relative path."""
+    match = _USER_WS.match(text)
+    if match is not None:
+        try:
+            return _package_dir(node, match.group(1), port) / match.group(2)
+        except PortValueError:
+            return Path(text).expanduser()
+    if text.startswith("~") or Path(text).is_absolute():
+        return Path(text).expanduser()
+    if package:
+        return _package_dir(node, package, port) / text
+    return None
+
+
+def _inside(folder: Path, relative: str, node: Any, port: str) -> Path:
+    path = (folder / relative).resolve()
+    if not path.is_relative_to(folder.resolve()):
+        raise port_error(
+            node,
+            port,
+            f"= {relative!r} leaves the folder {folder}",
+            "give a path inside the objectives folder",
+        )
+    return path
+
+
+def with_suffix(text: str, suffix: str) -> str:
+    """``text`` with ``suffix`` appended unless it already ends with it (``.yaml``/``.yml`` both count)."""
+    lowered = text.lower()
+    if suffix == ".yaml" and lowered.endswith((".yaml", ".yml")):
+        return text
+    return text if lowered.endswith(suffix) else text + suffix
+
+
+def file_to_read(node: Any, port: str, text: str, package: str = "") -> Path:
+    """The existing file ``text`` names.
+
+    Raises:
+        PortValueError: empty, or no such file (naming every folder looked in).
+    """
+    if not text.strip():
+        raise port_error(node, port, "is empty", "give a file name, e.g. my_poses.yaml")
+    explicit = _explicit(node, port, text, package)
+    candidates = (
+        [explicit]
+        if explicit is not None
+        else [_inside(folder, text, node, port) for folder in objective_folders(node)]
+    )
+    for candidate in candidates:
+        if candidate.is_file():
+            return candidate
+    looked = ", ".join(str(c.parent) for c in candidates)
+    raise port_error(node, port, f"= {text!r}: no such file", f"looked in {looked}")
+
+
+def file_to_write(node: Any, port: str, text: str, suffix: str = "") -> Path:
+    """Where a save of ``text`` goes (with ``suffix`` added when missing); its folder must exist.
+
+    Raises:
+        PortValueError: empty, climbing out of the objectives folder, or the folder does not exist.
+    """
+    if not text.strip():
+        raise port_error(node, port, "is empty", "give a file name, e.g. my_trajectory")
+    text = with_suffix(text, suffix) if suffix else text
+    explicit = _explicit(node, port, text)
+    path = explicit if explicit is not None else _inside(objective_folders(node)[0], text, node, port)
+    if not path.parent.is_dir():
+        raise port_error(node, port, f"= {text!r}: the folder {path.parent} does not exist", "")
+    return path
