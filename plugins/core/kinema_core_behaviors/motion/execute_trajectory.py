@@ -8,7 +8,7 @@ from typing import Any
 
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port
 from kinema.behaviors.work_runner import RUNNER
-from kinema.errors import KinemaError, TransportError
+from kinema.errors import KinemaError, ObjectiveError, TransportError
 
 from ..messages.conversions import duration, trajectory_from_message
 from .planned_trajectory import publish_planned_trajectory
@@ -53,21 +53,38 @@ class ExecuteTrajectory(AsyncBehavior):
             ),
             input_port(
                 "goal_position_tolerance",
-                float,
-                0.0,
-                "Accepted final position error per joint (0: the controller's default).",
+                list[float],
+                "0.0",
+                "Accepted final position error per joint: one value for all joints or one per joint "
+                "(0: the controller's default).",
             ),
             input_port(
                 "path_position_tolerance",
-                float,
-                0.0,
-                "Accepted tracking error per joint along the way (0: the controller's default).",
+                list[float],
+                "0.0",
+                "Accepted tracking error along the way: one value for all joints or one per joint "
+                "(0: the controller's default).",
             ),
             input_port(
                 "execution_pipeline",
                 str,
                 "",
                 "MoveIt Pro's execution pipeline; Kinema sends trajectories to the controller directly.",
+            ),
+            input_port(
+                "absolute_force_torque_threshold",
+                list[float],
+                "",
+                "Stop when the wrist force/torque exceeds fx;fy;fz;tx;ty;tz (N, Nm). Needs a force-torque "
+                "sensor and the admittance controller, which Kinema's drivers do not have yet: a non-empty "
+                "value fails the behavior when it runs.",
+            ),
+            input_port(
+                "admittance_parameters_msg",
+                None,
+                "",
+                "Admittance parameters (from SetAdmittanceParameters) for the admittance controller, which "
+                "Kinema's drivers do not have yet: a value fails the behavior when it runs.",
             ),
         ]
 
@@ -82,13 +99,19 @@ class ExecuteTrajectory(AsyncBehavior):
             message, "joint_trajectory_msg"
         )  # reject malformed input here, not in the driver
         names = [str(n) for n in message.joint_names]
+        unsupported = self._unsupported_port()
+        if unsupported:
+            raise ObjectiveError(unsupported)
         goal: dict[str, Any] = {"trajectory": message}
-        path_tolerance = float(self.get_input("path_position_tolerance"))
-        goal_tolerance = float(self.get_input("goal_position_tolerance"))
-        if path_tolerance > 0:
-            goal["path_tolerance"] = [{"name": n, "position": path_tolerance} for n in names]
-        if goal_tolerance > 0:
-            goal["goal_tolerance"] = [{"name": n, "position": goal_tolerance} for n in names]
+        for port, key in (
+            ("path_position_tolerance", "path_tolerance"),
+            ("goal_position_tolerance", "goal_tolerance"),
+        ):
+            tolerances = _per_joint(list(self.get_input(port)), names, port)
+            if any(t > 0 for t in tolerances):
+                goal[key] = [
+                    {"name": n, "position": t} for n, t in zip(names, tolerances, strict=True) if t > 0
+                ]
         time_tolerance = float(self.get_input("goal_duration_tolerance"))
         if time_tolerance >= 0:
             goal["goal_time_tolerance"] = duration(time_tolerance)
@@ -151,6 +174,39 @@ class ExecuteTrajectory(AsyncBehavior):
     def _fail(self, reason: str) -> bool:
         self.logger.publish_failure(f"ExecuteTrajectory: {reason}")
         return False
+
+    def _unsupported_port(self) -> str:
+        """Why a set admittance port cannot be honoured ('' when none is set)."""
+        threshold = self.get_input_or("absolute_force_torque_threshold", [])
+        if isinstance(threshold, list) and threshold:
+            return (
+                f"port [absolute_force_torque_threshold] = {threshold}: force-torque limits need a "
+                "force-torque sensor and the admittance controller, which Kinema's drivers do not provide "
+                "yet; leave it empty"
+            )
+        parameters = self.get_input_or("admittance_parameters_msg", "")
+        if parameters not in ("", None):
+            return (
+                "port [admittance_parameters_msg] is set: admittance control is not supported by Kinema's "
+                "drivers yet; remove the port to run the trajectory without it"
+            )
+        return ""
+
+
+def _per_joint(values: list[float], names: list[str], port: str) -> list[float]:
+    """One tolerance per joint from one value for all, or one per joint.
+
+    Raises:
+        ObjectiveError: another count of values, naming the port and the joints.
+    """
+    if len(values) == 1:
+        return [float(values[0])] * len(names)
+    if len(values) == len(names):
+        return [float(v) for v in values]
+    raise ObjectiveError(
+        f"port [{port}] has {len(values)} values but the trajectory moves {len(names)} joints "
+        f"({', '.join(names)}); give one value or one per joint"
+    )
 
 
 def _cancel_when_accepted(sending: Any) -> None:

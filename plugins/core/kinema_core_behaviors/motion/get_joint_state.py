@@ -22,7 +22,21 @@ class GetJointState(AsyncBehavior):
         return [
             input_port("planning_group_name", str, "", "Keep only this group's joints ('' keeps all)."),
             input_port("timeout", float, 2.0, "Seconds to wait for a joint state."),
-            output_port("joint_state", None, "{joint_state}", "The joint state (sensor_msgs/JointState)."),
+            input_port(
+                "planning_scene",
+                None,
+                "",
+                "MoveIt Pro's planning scene input (moveit_msgs/PlanningScene); the state comes from "
+                "/joint_states, so it is accepted and not needed.",
+            ),
+            output_port(
+                "joint_state",
+                None,
+                "{robot_joint_state}",
+                "The joint state (sensor_msgs/JointState). Default from the corpus: "
+                "save_robot_joint_state.xml saves {robot_joint_state} right after a GetJointState with "
+                "default ports.",
+            ),
         ]
 
     def do_work(self) -> bool:

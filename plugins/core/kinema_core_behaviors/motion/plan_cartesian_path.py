@@ -4,6 +4,8 @@ from __future__ import annotations
 
 from typing import Any
 
+import numpy as np
+
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
 from kinema.errors import KinemaError, ObjectiveError, did_you_mean
 
@@ -50,11 +52,52 @@ class PlanCartesianPath(AsyncBehavior):
                 1.0,
                 "Fraction of the joints' acceleration limits, (0, 1].",
             ),
+            input_port(
+                "ik_joint_space_density",
+                float,
+                0.1,
+                "Largest joint change (rad or m) allowed between consecutive IK solutions; a larger jump "
+                "stops the path (the arm would flip).",
+            ),
+            input_port(
+                "tip_offset",
+                list[float],
+                "0;0;0;0;0;0",
+                "Offset x;y;z;roll;pitch;yaw (m, rad) of the point that follows the path, in the tip "
+                "link's frame.",
+            ),
+            input_port(
+                "trajectory_timing",
+                str,
+                "[{mode: time_optimal}]",
+                "How the path is timed: [{mode: time_optimal}] (the only mode; time-optimal under the "
+                "scaled joint limits).",
+            ),
+            input_port(
+                "blending_radius",
+                float,
+                0.02,
+                "MoveIt Pro's corner blending (m); Kinema passes through every pose exactly, so it is "
+                "accepted and has no effect.",
+            ),
+            input_port(
+                "max_optimizer_iterations",
+                int,
+                1,
+                "MoveIt Pro's path optimizer iterations; Kinema does not optimise the IK path, so it is "
+                "accepted and has no effect (default from the corpus).",
+            ),
             output_port(
                 "joint_trajectory_msg",
                 None,
                 "{joint_trajectory_msg}",
                 "The timed trajectory (trajectory_msgs/JointTrajectory).",
+            ),
+            output_port(
+                "debug_solution",
+                None,
+                "{debug_solution}",
+                "The solution to show for approval (WaitForMTCSolutionApproval): the same trajectory.",
             ),
         ]
 
@@ -72,11 +115,21 @@ class PlanCartesianPath(AsyncBehavior):
             if len(tips) > 1:
                 return self._fail(f"one tip link at a time is supported, got {', '.join(tips)}")
             tip = tips[0] if tips else model.group(group).tip_link
+            timing = self._timing()
+            if timing is not None:
+                return self._fail(timing)
+            tip_from_offset = self._tip_offset()
+            if isinstance(tip_from_offset, str):
+                return self._fail(tip_from_offset)
+            jump = float(self.get_input("ik_joint_space_density"))
+            if not jump > 0:
+                return self._fail(f"ik_joint_space_density must be > 0, got {jump}")
             poses = self._poses()
             start = joint_state_monitor(self.context, "PlanCartesianPath").positions(model.joint_names)
             targets = []
             for frame, matrix in poses:
-                targets.append(matrix if frame in WORLD_FRAMES else fk(model, start, frame) @ matrix)
+                world_T_point = matrix if frame in WORLD_FRAMES else fk(model, start, frame) @ matrix
+                targets.append(world_T_point @ tip_from_offset)
             checker = collision_checker(
                 self.context, "PlanCartesianPath", float(self.get_input("link_padding"))
             )
@@ -87,6 +140,7 @@ class PlanCartesianPath(AsyncBehavior):
                 group,
                 tip,
                 max_step=float(self.get_input("ik_cartesian_space_density")),
+                jump_threshold=jump,
                 position_only=bool(self.get_input("position_only")),
             )
             if result.fraction < 1.0 - 1e-6:
@@ -105,8 +159,38 @@ class PlanCartesianPath(AsyncBehavior):
             return self._fail(str(error))
         message = trajectory_message(trajectory)
         self.set_output("joint_trajectory_msg", message)
+        self.set_output("debug_solution", message)
         publish_planned_trajectory(self, message)
         return True
+
+    def _timing(self) -> str | None:
+        """None when ``trajectory_timing`` asks for what Kinema does, else the reason it cannot."""
+        import yaml
+
+        text = str(self.get_input("trajectory_timing")).strip()
+        try:
+            value = yaml.safe_load(text) if text else []
+        except yaml.YAMLError as error:
+            return f"trajectory_timing {text!r} is not YAML: {error.problem}"
+        entries = value if isinstance(value, list) else [value]
+        for entry in entries:
+            mode = entry.get("mode") if isinstance(entry, dict) else entry
+            if mode not in (None, "time_optimal"):
+                return f"trajectory_timing mode {mode!r} is not supported; valid: time_optimal"
+        return None
+
+    def _tip_offset(self) -> Any:
+        """``tip_T_point`` inverted (what the tip must do so the offset point follows the path)."""
+        from scipy.spatial.transform import Rotation
+
+        values = [float(v) for v in self.get_input("tip_offset")]
+        if len(values) not in (3, 6):
+            return f"tip_offset needs 6 values x;y;z;roll;pitch;yaw (or 3, x;y;z), got {len(values)}"
+        tip_T_point = np.eye(4)
+        tip_T_point[:3, 3] = values[:3]
+        if len(values) == 6:
+            tip_T_point[:3, :3] = Rotation.from_euler("xyz", values[3:]).as_matrix()
+        return np.linalg.inv(tip_T_point)
 
     def _poses(self) -> list[tuple[str, Any]]:
         value = self.get_input("path")
