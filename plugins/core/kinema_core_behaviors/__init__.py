@@ -10,9 +10,9 @@ from __future__ import annotations
 
 from kinema.plugins import RegisterBehavior, hookimpl
 
-from . import controllers, files, messages, motion, planning_scene, poses, ui, vectors, waiting, waypoints
+from . import controllers, files, io, messages, motion, planning_scene, poses, ui, vectors, waiting, waypoints
 
-FAMILIES = (controllers, files, messages, motion, planning_scene, poses, ui, vectors, waiting, waypoints)
+FAMILIES = (controllers, files, io, messages, motion, planning_scene, poses, ui, vectors, waiting, waypoints)
 
 BEHAVIORS = tuple(behavior for family in FAMILIES for behavior in family.BEHAVIORS)
 
