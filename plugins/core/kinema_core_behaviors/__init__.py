@@ -10,7 +10,19 @@ from __future__ import annotations
 
 from kinema.plugins import RegisterBehavior, hookimpl
 
-from . import controllers, files, io, messages, motion, planning_scene, poses, ui, vectors, waiting, waypoints
+from . import (
+    controllers,
+    files,
+    io,
+    messages,
+    motion,
+    planning_scene,
+    poses,
+    ui,
+    vectors,
+    waiting,
+    waypoints,
+)
 
 FAMILIES = (controllers, files, io, messages, motion, planning_scene, poses, ui, vectors, waiting, waypoints)
 

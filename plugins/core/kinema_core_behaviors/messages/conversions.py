@@ -171,3 +171,55 @@ def pose_matrix(pose_stamped: Any, what: str) -> tuple[str, np.ndarray]:
     matrix[:3, :3] = Rotation.from_quat(quaternion / np.linalg.norm(quaternion)).as_matrix()
     matrix[:3, 3] = [pose.position.x, pose.position.y, pose.position.z]
     return str(header.frame_id), matrix
+
+
+_POINT_FIELD_DTYPES = {1: "i1", 2: "u1", 3: "i2", 4: "u2", 5: "i4", 6: "u4", 7: "f4", 8: "f8"}
+
+
+def point_cloud_xyz(cloud: Any) -> np.ndarray:
+    """The finite ``x, y, z`` of a ``sensor_msgs/PointCloud2`` as an ``(N, 3)`` float array (m).
+
+    Raises:
+        ObjectiveError: not a point cloud, or without x, y and z fields.
+    """
+    fields = {str(f.name): f for f in getattr(cloud, "fields", [])}
+    if not all(axis in fields for axis in "xyz"):
+        raise ObjectiveError(
+            f"the point cloud has fields {sorted(fields)}; x, y and z are needed (a sensor_msgs/PointCloud2)"
+        )
+    order = ">" if cloud.is_bigendian else "<"
+    dtype = np.dtype(
+        {
+            "names": list("xyz"),
+            "formats": [order + _POINT_FIELD_DTYPES[int(fields[a].datatype)] for a in "xyz"],
+            "offsets": [int(fields[a].offset) for a in "xyz"],
+            "itemsize": int(cloud.point_step),
+        }
+    )
+    count = int(cloud.width) * int(cloud.height)
+    data = np.asarray(cloud.data, dtype=np.uint8)[: count * int(cloud.point_step)]
+    records = np.frombuffer(data.tobytes(), dtype=dtype, count=count)
+    xyz = np.stack([records[a].astype(float) for a in "xyz"], axis=1)
+    return xyz[np.isfinite(xyz).all(axis=1)]
+
+
+def point_cloud_message(xyz: np.ndarray, frame_id: str) -> Any:
+    """A dense ``sensor_msgs/PointCloud2`` of ``(N, 3)`` points (float32 x, y, z)."""
+    from kinema.transport import from_dict
+
+    points = np.ascontiguousarray(xyz, dtype="<f4")
+    fields = [{"name": a, "offset": 4 * i, "datatype": 7, "count": 1} for i, a in enumerate("xyz")]
+    return from_dict(
+        "sensor_msgs/msg/PointCloud2",
+        {
+            "header": {"frame_id": frame_id},
+            "height": 1,
+            "width": len(points),
+            "fields": fields,
+            "is_bigendian": False,
+            "point_step": 12,
+            "row_step": 12 * len(points),
+            "data": np.frombuffer(points.tobytes(), dtype=np.uint8),
+            "is_dense": True,
+        },
+    )
