@@ -15,15 +15,16 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from kinema.errors import ObjectiveError
+from kinema.viz.topics import PLANNING_SCENE_TOPIC, PLANNING_SCENE_TYPE
 
 from ..poses.frame_tree import pose_of
 
 if TYPE_CHECKING:
     from kinema.motion import CollisionObject, FrameTree, PlanningScene
 
+__all__ = ["PLANNING_SCENE_TOPIC", "PLANNING_SCENE_TYPE", "planning_scene_message", "primitives_of"]
+
 COLLISION_OBJECT_TYPE = "moveit_msgs/msg/CollisionObject"
-PLANNING_SCENE_TYPE = "moveit_msgs/msg/PlanningScene"
-PLANNING_SCENE_TOPIC = "/monitored_planning_scene"
 BOX, SPHERE, CYLINDER, CONE = 1, 2, 3, 4
 ADD, REMOVE, APPEND, MOVE = 0, 1, 2, 3
 _SUPPORTED = "BOX (1), SPHERE (2), CYLINDER (3) primitives and meshes"
