@@ -18,6 +18,7 @@ from ..messages.ports import (
     port_error,
     read_input,
     read_message,
+    read_text,
 )
 from .locations import file_to_read, file_to_write
 
@@ -91,7 +92,7 @@ class LoadImageFromFile(SyncBehavior):
     def tick(self) -> NodeStatus:
         from PIL import Image, UnidentifiedImageError
 
-        package = str(read_input(self, "package_name"))
+        package = read_text(self, "package_name")
         path = file_to_read(self, "file_path", str(read_input(self, "file_path")), package)
         try:
             with Image.open(path) as opened:

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
-from ..messages.ports import fails_on_bad_input, port_error, read_input
+from ..messages.ports import fails_on_bad_input, port_error, read_input, read_text
 
 
 class PublishString(SyncBehavior):
@@ -36,5 +36,5 @@ class PublishString(SyncBehavior):
             raise port_error(self, "topic", "is empty", "give a topic name such as /status")
         node = self.context.require_node(self.registration_id)
         publisher = self.context.publisher(node, "std_msgs/msg/String", topic)
-        publisher.publish(from_dict("std_msgs/msg/String", {"data": str(read_input(self, "message"))}))
+        publisher.publish(from_dict("std_msgs/msg/String", {"data": read_text(self, "message")}))
         return NodeStatus.SUCCESS

@@ -9,8 +9,8 @@ from .ports import (
     message_input,
     message_output,
     message_vector_output,
-    read_input,
     read_message,
+    read_text,
 )
 
 COLLISION_OBJECT = "moveit_msgs/msg/CollisionObject"
@@ -101,7 +101,7 @@ class CreateGraspableObjectMessage(SyncBehavior):
             {
                 "object": to_dict(read_message(self, "object")),
                 "object_color": {"r": r, "g": g, "b": b, "a": a},
-                "grasp_info": str(read_input(self, "grasp_info")),
+                "grasp_info": read_text(self, "grasp_info"),
             },
         )
         self.set_output("graspable_object", message)

@@ -139,6 +139,17 @@ def read_input(node: Any, port: str, type: Any = None) -> Any:
         raise port_error(node, port, f"{problem}: {detail}", _expected(node, port)) from None
 
 
+def read_text(node: Any, port: str) -> str:
+    """An optional text port: its value, or "" when it is not set.
+
+    BT.CPP does not apply an empty default (``InputPort<std::string>(name, "", ...)``), so a port whose
+    default is "" has no value unless the XML sets it; for optional text that means "".
+    """
+    if port not in node.config.input_ports:
+        return ""
+    return str(read_input(node, port))
+
+
 def read_message(node: Any, port: str, ros_type: str | None = None) -> Any:
     """The message on input port ``port``, checked to be of ``ros_type`` (default: the port's type).
 

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
 
-from .ports import fails_on_bad_input, message_input, message_output, read_input, read_message
+from .ports import fails_on_bad_input, message_input, message_output, read_message, read_text
 
 
 class CreateStringMessage(SyncBehavior):
@@ -23,7 +23,7 @@ class CreateStringMessage(SyncBehavior):
     def tick(self) -> NodeStatus:
         from kinema.transport import from_dict
 
-        self.set_output("string", from_dict("std_msgs/msg/String", {"data": str(read_input(self, "data"))}))
+        self.set_output("string", from_dict("std_msgs/msg/String", {"data": read_text(self, "data")}))
         return NodeStatus.SUCCESS
 
 
