@@ -142,3 +142,58 @@ def test_text_and_image_files(behavior: Any, offline: BehaviorContext, folder: P
     back = loaded.outputs["image"]
     assert (back.width, back.height, back.encoding) == (6, 4, "rgb8")
     assert np.array_equal(np.asarray(back.data).reshape(4, 6, 3), pixels)
+
+
+def test_paths_resolve_in_the_configs_objective_folders(behavior: Any, node: Any, tmp_path: Path) -> None:
+    """Saves go to the config's own objectives; reads also find inherited ones; MoveIt Pro's
+    ``~/user_ws/src/lab_sim/objectives/...`` names the config's own objectives, not the installed lab_sim."""
+    import yaml
+
+    from kinema.config import Workspace, resolve_config
+
+    package = tmp_path / "ws" / "src" / "my_cell"
+    (package / "config").mkdir(parents=True)
+    (package / "objectives").mkdir()
+    (package / "package.xml").write_text(
+        '<?xml version="1.0"?><package format="3"><name>my_cell</name><version>0.0.0</version>'
+        "<description>t</description><maintainer email='t@example.com'>t</maintainer>"
+        "<license>BSD-3-Clause</license></package>"
+    )
+    config = {
+        "based_on_package": "lab_sim",
+        "objectives": {
+            "objective_library_paths": {
+                "my_objectives": {"package_name": "my_cell", "relative_path": "objectives"}
+            }
+        },
+    }
+    (package / "config" / "config.yaml").write_text(yaml.safe_dump(config))
+    resolved = resolve_config("my_cell", Workspace.discover(tmp_path / "ws"))
+    context = BehaviorContext(node, config=resolved)
+    installed = {p.name for p in resolved.package_dir("lab_sim").joinpath("objectives").iterdir()}
+
+    from kinema.transport import from_dict
+
+    trajectory = from_dict(
+        "trajectory_msgs/msg/JointTrajectory",
+        {"joint_names": ["elbow_joint"], "points": [{"positions": [0.5], "time_from_start": {"sec": 1}}]},
+    )
+    saved = tick_behavior(
+        behavior("SaveJointTrajectoryToYaml"),
+        {"message": trajectory, "yaml_filename": "~/user_ws/src/lab_sim/objectives/joint_trajectory"},
+        context=context,
+    )
+    assert saved.status == NodeStatus.SUCCESS, saved.toasts
+    assert (package / "objectives" / "joint_trajectory.yaml").is_file()
+    assert {p.name for p in resolved.package_dir("lab_sim").joinpath("objectives").iterdir()} == installed
+    loaded = tick_behavior(
+        behavior("LoadJointTrajectoryFromYaml"), {"file_path": "joint_trajectory.yaml"}, context=context
+    )
+    assert loaded.outputs["output"].points[0].positions[0] == 0.5
+    inherited = tick_behavior(
+        behavior("ReadTextFileAsString"), {"text_filename": "close_gripper.xml"}, context=context
+    )
+    assert (
+        inherited.status == NodeStatus.SUCCESS
+        and "Close Gripper" in inherited.outputs["string_file_contents"]
+    )

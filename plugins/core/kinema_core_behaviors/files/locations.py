@@ -4,11 +4,14 @@
   objective library of the config (most-derived package first), writes go to the most-derived package's
   own library. A relative path may not climb out of that folder (``../``): a save never lands outside
   the folder it was meant for.
-- ``~/user_ws/src/<package>/<rest>`` (MoveIt Pro's workspace path, common in its objectives) names
-  ``<rest>`` inside that package's folder when the workspace knows the package.
+- ``~/user_ws/src/<package>/objectives/<rest>`` (MoveIt Pro's workspace path, common in its objectives)
+  is ``<rest>`` relative to the objectives folder as above, so a copy of the objective in another config
+  reads and writes its own config's files, never an installed package's. Other
+  ``~/user_ws/src/<package>/<rest>`` paths are ``<rest>`` inside that package's folder.
 - With a ``package_name``, a relative path is inside that package's folder.
 - Any other absolute path (``/tmp/image.png``, ``~/file``) is used as written.
-Without a config (offline runs, ``kinema tree run``) relative paths resolve against the working directory.
+Saves need a library folder of the config's own package; without a config (offline runs, ``kinema tree
+run``) relative paths resolve against the working directory.
 """
 
 from __future__ import annotations
@@ -23,20 +26,38 @@ _USER_WS = re.compile(r"^~/user_ws/src/([^/]+)/(.*)$")
 
 
 def objective_folders(node: Any) -> list[Path]:
-    """The config's objective library folders, the one saves go to first (cwd without a config)."""
+    """The config's objective library folders, its own package's first (the working directory offline)."""
     resolved = node.context.config
     if resolved is None:
         return [Path.cwd()]
     chain = list(resolved.chain)
-    libraries = list(resolved.objective_library_paths)
     ranked = sorted(
-        libraries,
+        resolved.objective_library_paths,
         key=lambda lib: chain.index(lib.package) if lib.package in chain else -1,
         reverse=True,
     )
-    own = [lib.path for lib in ranked if lib.package == resolved.name]
-    rest = [lib.path for lib in ranked if lib.path not in own]
-    return list(dict.fromkeys([*own, *rest])) or [Path.cwd()]
+    return list(dict.fromkeys(lib.path for lib in ranked)) or [Path.cwd()]
+
+
+def save_folder(node: Any, port: str) -> Path:
+    """Where relative saves go: the first objective library of the config's own package.
+
+    Raises:
+        PortValueError: the config has no library folder of its own (saving into an inherited or
+            installed package is refused).
+    """
+    resolved = node.context.config
+    if resolved is None:
+        return Path.cwd()
+    for lib in resolved.objective_library_paths:
+        if lib.package == resolved.name:
+            return Path(lib.path)
+    raise port_error(
+        node,
+        port,
+        f"names a file to save, but config {resolved.name!r} has no objective library of its own",
+        f"add an objective_library_paths entry with package_name: {resolved.name}",
+    )
 
 
 def _package_dir(node: Any, package: str, port: str) -> Path:
@@ -50,11 +71,14 @@ def _package_dir(node: Any, package: str, port: str) -> Path:
 
 
 def _explicit(node: Any, port: str, text: str, package: str = "") -> Path | None:
-    """The path for forms that name their folder themselves; None for a plain relative path."""
+    """The path for forms that name their folder themselves; None for a path relative to the objectives."""
     match = _USER_WS.match(text)
     if match is not None:
+        inside = match.group(2)
+        if inside.startswith("objectives/"):
+            return None
         try:
-            return _package_dir(node, match.group(1), port) / match.group(2)
+            return _package_dir(node, match.group(1), port) / inside
         except PortValueError:
             return Path(text).expanduser()
     if text.startswith("~") or Path(text).is_absolute():
@@ -62,6 +86,12 @@ def _explicit(node: Any, port: str, text: str, package: str = "") -> Path | None
     if package:
         return _package_dir(node, package, port) / text
     return None
+
+
+def _relative(text: str) -> str:
+    """The part of ``text`` relative to the objectives folder."""
+    match = _USER_WS.match(text)
+    return match.group(2)[len("objectives/") :] if match is not None else text
 
 
 def _inside(folder: Path, relative: str, node: Any, port: str) -> Path:
@@ -115,7 +145,7 @@ def file_to_write(node: Any, port: str, text: str, suffix: str = "") -> Path:
         raise port_error(node, port, "is empty", "give a file name, e.g. my_trajectory")
     text = with_suffix(text, suffix) if suffix else text
     explicit = _explicit(node, port, text)
-    path = explicit if explicit is not None else _inside(objective_folders(node)[0], text, node, port)
+    path = explicit if explicit is not None else _inside(save_folder(node, port), _relative(text), node, port)
     if not path.parent.is_dir():
         raise port_error(node, port, f"= {text!r}: the folder {path.parent} does not exist", "")
     return path
