@@ -37,6 +37,13 @@ from kinema.cli.options import selection_options
     help="Simulated seconds per wall second: 1 (real time, the default), a factor such as 4, or max "
     "(as fast as the CPU allows; for tests and CI).",
 )
+@click.option(
+    "--auto-approve",
+    is_flag=True,
+    help="Grant every approval and breakpoint without asking (WaitForMTCSolutionApproval, "
+    "BreakpointSubscriber; each is logged as a warning). Without it, a headless run has no user to ask "
+    "and approvals fail.",
+)
 def run(
     workspace: Path | None,
     config: str | None,
@@ -49,6 +56,7 @@ def run(
     connect: str | None,
     tick_rate: float,
     sim_speed: str | None,
+    auto_approve: bool,
 ) -> None:
     """Start Kinema: host the zenoh router (or join one), the agent and the config's drivers.
 
@@ -68,6 +76,13 @@ def run(
         parse_sim_speed(sim_speed)  # refuse a bad value here rather than in the driver's log
     found, name = resolve_selection(workspace, config)
     from kinema.runtime.launcher import Launcher, LaunchOptions
+
+    if auto_approve:
+        import os
+
+        # Read by the approval behaviors in the agent process, which inherits this environment.
+        os.environ["KINEMA_AUTO_APPROVE"] = "1"
+        click.echo("approvals and breakpoints are granted automatically (--auto-approve)")
 
     ui = None
     if not headless:
