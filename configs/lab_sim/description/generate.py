@@ -245,6 +245,8 @@ LINKS: tuple[Link, ...] = (
         ),
     ),
     Link("grasp_link", "robotiq_85_base_link", xyz=(0.0, 0.0, TCP_DEPTH)),
+    # MoveIt Pro's lab_sim calls the point between the fingertips "pinch" too.
+    Link("pinch", "grasp_link"),
 )
 
 MIMIC = {
