@@ -80,6 +80,8 @@ def _sim_bodies(behavior: Any) -> dict[str, np.ndarray]:
         return {}
     try:
         client = behavior.context.service_client(node, BODIES_TYPE, BODIES_SERVICE)
+        if not client.service_is_ready():
+            return {}  # no simulator on the graph (a real robot): objects come from perception instead
         response = client.call({}, timeout=BODIES_TIMEOUT)
     except KinemaError:
         return {}  # no simulator (a real robot): objects come from perception instead
