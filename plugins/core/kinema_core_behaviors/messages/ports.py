@@ -121,6 +121,8 @@ def _expected(node: Any, port: str) -> str:
     if ros_type is not None:
         producers = PRODUCERS.get(ros_type)
         return f"expected a {ros_type}" + (f" (from {producers})" if producers else "")
+    if not info.strongly_typed:
+        return ""
     return f"expected {info.type_name}"
 
 
@@ -134,9 +136,15 @@ def read_input(node: Any, port: str, type: Any = None) -> Any:
         return node.get_input(port, type)
     except BTError as error:
         raw = node.config.input_ports.get(port)
-        problem = f"= {raw!r} cannot be read" if raw is not None else "is not set"
-        detail = error.message.split(": ", 1)[-1] if "can not be" in error.message else error.message
-        raise port_error(node, port, f"{problem}: {detail}", _expected(node, port)) from None
+        key = node.port_blackboard_key(port)
+        if raw is None:
+            problem = "is not set"
+        elif key is not None and getattr(node.config.blackboard.get_entry(key), "value", None) is None:
+            problem = f"= {raw!r}, but nothing has written blackboard entry '{key}' yet"
+        else:
+            detail = error.message.split(": ", 1)[-1] if "can not be" in error.message else error.message
+            problem = f"= {raw!r} cannot be read: {detail}"
+        raise port_error(node, port, problem, _expected(node, port)) from None
 
 
 def read_text(node: Any, port: str) -> str:
