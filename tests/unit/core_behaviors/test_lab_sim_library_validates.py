@@ -10,6 +10,7 @@ from __future__ import annotations
 
 import shutil
 from pathlib import Path
+from typing import Any
 
 import pytest
 import yaml
@@ -120,3 +121,31 @@ def test_objective_list_says_why_each_objective_cannot_load(corpus_workspace: Pa
     table = {line[4:].split("  ")[0].strip(): line[:3] for line in lines[:header] if line[:1] in "R-"}
     assert table["Take Scene Camera Snapshot"].endswith("!")
     assert not table["Vector and String Example"].endswith("!")
+
+
+def test_every_port_the_corpus_sets_on_a_kinema_behavior_is_declared(registry: Any) -> None:
+    """Beyond the files that validate: wherever MoveIt Pro's files use a behavior Kinema has, the ports
+    they set exist (a file failing on another behavior first would hide a missing port)."""
+    from lxml import etree
+
+    from kinema.bt.names import RESERVED_ATTRIBUTES
+
+    corpus = SHARED_DIR / "compat" / "moveit_pro"
+    files = sorted(corpus.glob("**/*.xml"))
+    if not files:
+        pytest.skip(f"{corpus} is not beside this checkout")
+    undeclared: dict[str, set[str]] = {}
+    for path in files:
+        for element in etree.parse(str(path)).getroot().iter("Action", "Decorator", "Condition", "Control"):
+            behavior_id = element.get("ID")
+            if behavior_id not in registry:
+                continue
+            declared = {port.name for port in registry[behavior_id].ports}
+            extra = {
+                name
+                for name in element.attrib
+                if name not in declared and name not in RESERVED_ATTRIBUTES and not name.startswith("_")
+            } - {"ID", "name"}
+            if extra:
+                undeclared.setdefault(behavior_id, set()).update(extra)
+    assert not undeclared, f"ports MoveIt Pro's files set that Kinema's behaviors lack: {undeclared}"

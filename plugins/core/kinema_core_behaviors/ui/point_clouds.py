@@ -84,7 +84,7 @@ class SendPointCloudToUI(SyncBehavior):
 
 
 class PublishPointCloud(SyncBehavior):
-    """Publishes a point cloud on ``topic`` and draws it in ``kinema view`` (replacing the last one drawn)."""
+    """Publishes a point cloud on ``point_cloud_topic``; draws it in ``kinema view``, replacing the last."""
 
     subcategory = "User Interface"
 
@@ -92,14 +92,14 @@ class PublishPointCloud(SyncBehavior):
     def provided_ports(cls) -> list[PortInfo]:
         return [
             message_input("point_cloud", POINT_CLOUD, "{point_cloud}", "The cloud to publish."),
-            input_port("topic", str, "/point_cloud", "Topic to publish on."),
+            input_port("point_cloud_topic", str, "/point_cloud", "Topic to publish on."),
         ]
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
         cloud = read_message(self, "point_cloud")
         _draw(self, cloud, keep_previous=False)
-        _publish_cloud(self, cloud, str(read_input(self, "topic")))
+        _publish_cloud(self, cloud, str(read_input(self, "point_cloud_topic")))
         return NodeStatus.SUCCESS
 
 
