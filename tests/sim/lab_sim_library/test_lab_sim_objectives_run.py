@@ -183,3 +183,26 @@ def test_record_and_replay_scanning_motion_stops_where_plan_and_save_does(librar
     assert result.failed, result
     assert "PlanCartesianPath" in result.error_message and "table" in result.error_message, result
     assert saved.read_text() == before
+
+
+FRAME_OBJECTIVE = """<root BTCPP_format="4" main_tree_to_execute="Box On The Cube">
+  <BehaviorTree ID="Box On The Cube">
+    <Sequence>
+      <Action ID="CreatePoseStamped" reference_frame="cube" position_xyz="0; 0; 0.1"
+              pose_stamped="{on_cube}" />
+      <Action ID="AddCollisionBox" object_id="above_cube" dimensions="0.05;0.05;0.05" pose="{on_cube}" />
+    </Sequence>
+  </BehaviorTree>
+</root>"""
+
+
+def test_a_simulated_object_is_a_frame(library_cell: LibraryCell) -> None:
+    """A pose given in the cube's frame lands where the simulator has the cube."""
+    bodies = library_cell.node.create_client("kinema_msgs/srv/GetSimBodies", "/mujoco/bodies")
+    cube = next(b for b in bodies.call({}, timeout=10.0).bodies if b.name == "cube").pose.position
+    result = library_cell.client.start(xml=FRAME_OBJECTIVE).result(RUN_TIMEOUT)
+    assert result.succeeded, result
+    box = wait_for(lambda: scene_objects(library_cell).get("above_cube"), 10.0, "the box above the cube")
+    p = box.primitive_poses[0].position
+    assert [p.x, p.y, p.z] == pytest.approx([cube.x, cube.y, cube.z + 0.1], abs=1e-3)
+    assert run(library_cell, "Clear Previous Obstacles").succeeded
