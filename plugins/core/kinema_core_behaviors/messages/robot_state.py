@@ -49,7 +49,14 @@ class CreateRobotState(SyncBehavior):
         return [
             input_port("joint_names", list[str], "", "Joint names (';'-separated)."),
             input_port("positions", list[float], "", "One position per joint (';'-separated)."),
-            message_output("robot_state", ROBOT_STATE_TYPE, "{robot_state}", "The robot state."),
+            message_output(
+                "robot_state",
+                ROBOT_STATE_TYPE,
+                "{joint_state_msg}",
+                "The robot state. The default entry is the one SetMujocoState reads by default: MoveIt Pro's "
+                "'Reset MuJoCo Robot' wires CreateRobotState to SetMujocoState by defaults only, and 'Load "
+                "MuJoCo Robot State' writes {joint_state_msg} for the same SetMujocoState.",
+            ),
         ]
 
     @fails_on_bad_input
