@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import shutil
+import time
 from pathlib import Path
 from typing import Any
 
@@ -197,3 +198,55 @@ def test_paths_resolve_in_the_configs_objective_folders(behavior: Any, node: Any
         inherited.status == NodeStatus.SUCCESS
         and "Close Gripper" in inherited.outputs["string_file_contents"]
     )
+
+
+def test_package_paths_into_the_chains_objectives_find_the_configs_copy(
+    behavior: Any, node: Any, tmp_path: Path
+) -> None:
+    """``package://lab_sim/objectives/x`` and ``package_name=lab_sim, objectives/x`` in a config based on
+    lab_sim name the x beside the config's objectives (where a copy of MoveIt Pro's lab_sim files has it)."""
+    import yaml
+
+    from kinema.config import Workspace, resolve_config
+
+    package = tmp_path / "ws" / "src" / "my_cell"
+    (package / "config").mkdir(parents=True)
+    (package / "objectives").mkdir()
+    (package / "package.xml").write_text(
+        '<?xml version="1.0"?><package format="3"><name>my_cell</name><version>0.0.0</version>'
+        "<description>t</description><maintainer email='t@example.com'>t</maintainer>"
+        "<license>BSD-3-Clause</license></package>"
+    )
+    libraries = {"lab_sim_objectives": {"package_name": "my_cell", "relative_path": "objectives"}}
+    config = {"based_on_package": "lab_sim", "objectives": {"objective_library_paths": libraries}}
+    (package / "config" / "config.yaml").write_text(yaml.safe_dump(config))
+    (package / "objectives" / "token.stl").write_text("solid t\nendsolid t\n")
+    from PIL import Image
+
+    Image.new("RGB", (3, 2), (10, 20, 30)).save(package / "objectives" / "lab.png")
+    resolved = resolve_config("my_cell", Workspace.discover(tmp_path / "ws"))
+    context = BehaviorContext(node, config=resolved)
+    image = tick_behavior(
+        behavior("LoadImageFromFile"),
+        {"file_path": "objectives/lab.png", "package_name": "lab_sim"},
+        context=context,
+    )
+    assert image.status == NodeStatus.SUCCESS, image.toasts
+    assert (image.outputs["image"].width, image.outputs["image"].height) == (3, 2)
+    received: list[Any] = []
+    node.create_subscription(
+        "visualization_msgs/msg/MarkerArray",
+        "/visualization_marker_array",
+        lambda m: received.extend(m.markers),
+    )
+    pose = tick_behavior(behavior("CreatePoseStamped"), {}, context=context).outputs["pose_stamped"]
+    mesh = tick_behavior(
+        behavior("VisualizeMesh"),
+        {"mesh_path": "package://lab_sim/objectives/token.stl", "mesh_pose": pose},
+        context=context,
+    )
+    assert mesh.status == NodeStatus.SUCCESS, mesh.toasts
+    deadline = time.monotonic() + 10
+    while not received and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert received and received[0].mesh_resource == (package / "objectives" / "token.stl").resolve().as_uri()

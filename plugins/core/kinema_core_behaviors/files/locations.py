@@ -70,6 +70,15 @@ def _package_dir(node: Any, package: str, port: str) -> Path:
         raise port_error(node, port, f"names unknown package {package!r}", str(error)) from None
 
 
+def _in_chain_objectives(node: Any, package: str, rest: str) -> str | None:
+    """``rest`` relative to the objectives folder when it is ``objectives/...`` of a package of the config's
+    chain (``package://lab_sim/objectives/x`` in a copy of lab_sim's objectives means the copy's ``x``)."""
+    resolved = node.context.config
+    if resolved is not None and package in resolved.chain and rest.startswith("objectives/"):
+        return rest[len("objectives/") :]
+    return None
+
+
 def _explicit(node: Any, port: str, text: str, package: str = "") -> Path | None:
     """The path for forms that name their folder themselves; None for a path relative to the objectives."""
     match = _USER_WS.match(text)
@@ -84,6 +93,8 @@ def _explicit(node: Any, port: str, text: str, package: str = "") -> Path | None
     if text.startswith("~") or Path(text).is_absolute():
         return Path(text).expanduser()
     if package:
+        if _in_chain_objectives(node, package, text) is not None:
+            return None
         return _package_dir(node, package, port) / text
     return None
 
@@ -91,7 +102,17 @@ def _explicit(node: Any, port: str, text: str, package: str = "") -> Path | None
 def _relative(text: str) -> str:
     """The part of ``text`` relative to the objectives folder."""
     match = _USER_WS.match(text)
-    return match.group(2)[len("objectives/") :] if match is not None else text
+    if match is not None:
+        return match.group(2)[len("objectives/") :]
+    return text[len("objectives/") :] if text.startswith("objectives/") else text
+
+
+def split_package_uri(text: str) -> tuple[str, str]:
+    """``("pkg", "path")`` of ``package://pkg/path``; ``("", text)`` for anything else."""
+    if text.startswith("package://"):
+        package, _, rest = text[len("package://") :].partition("/")
+        return package, rest
+    return "", text
 
 
 def _inside(folder: Path, relative: str, node: Any, port: str) -> Path:
@@ -123,15 +144,19 @@ def file_to_read(node: Any, port: str, text: str, package: str = "") -> Path:
     if not text.strip():
         raise port_error(node, port, "is empty", "give a file name, e.g. my_poses.yaml")
     explicit = _explicit(node, port, text, package)
-    candidates = (
-        [explicit]
-        if explicit is not None
-        else [_inside(folder, text, node, port) for folder in objective_folders(node)]
-    )
+    if explicit is not None:
+        candidates = [explicit]
+    else:
+        names = list(
+            dict.fromkeys([_relative(text), text] if not _USER_WS.match(text) else [_relative(text)])
+        )
+        candidates = [
+            _inside(folder, name, node, port) for folder in objective_folders(node) for name in names
+        ]
     for candidate in candidates:
         if candidate.is_file():
             return candidate
-    looked = ", ".join(str(c.parent) for c in candidates)
+    looked = ", ".join(dict.fromkeys(str(c.parent) for c in candidates))
     raise port_error(node, port, f"= {text!r}: no such file", f"looked in {looked}")
 
 

@@ -7,7 +7,15 @@ import numpy as np
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
 from .conversions import pose_stamped_message
-from .ports import fails_on_bad_input, message_input, message_output, port_error, read_floats, read_message
+from .ports import (
+    fails_on_bad_input,
+    message_input,
+    message_output,
+    port_error,
+    read_floats,
+    read_input,
+    read_message,
+)
 
 POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 
@@ -53,7 +61,8 @@ class CreatePoseStamped(SyncBehavior):
             raise port_error(
                 self, "orientation_xyzw", f"= {orientation} is a zero quaternion", "e.g. 0;0;0;1"
             )
-        self.set_output("pose_stamped", pose_stamped_message(str(self.get_input("reference_frame")), matrix))
+        frame = str(read_input(self, "reference_frame"))
+        self.set_output("pose_stamped", pose_stamped_message(frame, matrix))
         return NodeStatus.SUCCESS
 
 

@@ -9,7 +9,7 @@ import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
-from ..files.locations import file_to_read
+from ..files.locations import file_to_read, split_package_uri
 from ..messages.conversions import duration, pose_matrix
 from ..messages.ports import (
     fails_on_bad_input,
@@ -143,10 +143,7 @@ class VisualizeMesh(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
-        text = str(read_input(self, "mesh_path"))
-        package = ""
-        if text.startswith("package://"):
-            package, _, text = text[len("package://") :].partition("/")
+        package, text = split_package_uri(str(read_input(self, "mesh_path")))
         path = file_to_read(self, "mesh_path", text, package)
         if path.suffix.lower() not in (".stl", ".obj", ".dae"):
             raise port_error(self, "mesh_path", f"= {str(path)!r}", "give an .stl, .obj or .dae file")

@@ -20,7 +20,7 @@ class SwitchUIPrimaryView(SyncBehavior):
         ]
 
     def tick(self) -> NodeStatus:
-        view = str(self.get_input("primary_view_name"))
+        view = str(self.get_input_or("primary_view_name", "Visualization"))
         where = "the 3D view (kinema view)" if view == "Visualization" else repr(view)
         self.logger.publish_info(f"Look at {where}")
         return NodeStatus.SUCCESS
