@@ -71,7 +71,8 @@ def list_(workspace: Path | None, config: str | None, as_json: bool, no_check: b
     category_width = max(len(info.subcategory or "-") for info in objectives)
     for info in objectives:
         flags = ("R" if info.runnable else "-") + ("*" if info.favorite else " ")
-        flags += "!" if info.id in problems else " "
+        if problems:  # the third column only when something cannot load, so the usual table keeps its shape
+            flags += "!" if info.id in problems else " "
         click.echo(f"{flags} {info.id:<{width}}  {info.subcategory or '-':<{category_width}}  {info.package}")
     if problems:
         click.echo(f"\n{len(problems)} of {len(objectives)} objectives cannot load:")
