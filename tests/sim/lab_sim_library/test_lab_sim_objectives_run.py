@@ -125,11 +125,6 @@ def test_save_robot_joint_state_writes_where_the_arm_is(library_cell: LibraryCel
     assert np.abs(np.array([state[j] for j in ARM]) - now).max() < 1e-3, data
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="the file is loaded into {joint_state_msg} but SetMujocoState reads {robot_state} (its default, "
-    "shared with CreateRobotState for 'Reset MuJoCo Robot'); which default MoveIt Pro uses is not public",
-)
 def test_load_mujoco_robot_state_puts_the_arm_in_the_saved_state(library_cell: LibraryCell) -> None:
     result = run(library_cell, "Load MuJoCo Robot State")
     assert result.succeeded, result
