@@ -103,17 +103,8 @@ def test_load_and_execute_joint_trajectory_ends_where_the_file_ends(library_cell
     )
 
 
-def test_playback_square_trajectory_ends_where_the_file_ends(library_cell: LibraryCell) -> None:
-    result = run(library_cell, "Playback Square Trajectory")
-    assert result.succeeded, result
-    end = settled_arm(library_cell)
-    expected = last_point(library_cell, "square_traj.yaml")
-    assert np.abs(end - expected).max() < 0.02, (
-        f"arm at {end.round(3)}, trajectory ends at {expected.round(3)}"
-    )
-
-
 def test_save_robot_joint_state_writes_where_the_arm_is(library_cell: LibraryCell) -> None:
+    """The arm is where joint_trajectory.yaml ends, not in the state the corpus file holds."""
     saved = library_cell.objectives / "robot_joint_state.yaml"
     before = saved.read_text()
     now = settled_arm(library_cell)
@@ -125,12 +116,25 @@ def test_save_robot_joint_state_writes_where_the_arm_is(library_cell: LibraryCel
     assert np.abs(np.array([state[j] for j in ARM]) - now).max() < 1e-3, data
 
 
-def test_load_mujoco_robot_state_puts_the_arm_in_the_saved_state(library_cell: LibraryCell) -> None:
-    result = run(library_cell, "Load MuJoCo Robot State")
+def test_playback_square_trajectory_ends_where_the_file_ends(library_cell: LibraryCell) -> None:
+    result = run(library_cell, "Playback Square Trajectory")
     assert result.succeeded, result
+    end = settled_arm(library_cell)
+    expected = last_point(library_cell, "square_traj.yaml")
+    assert np.abs(end - expected).max() < 0.02, (
+        f"arm at {end.round(3)}, trajectory ends at {expected.round(3)}"
+    )
+
+
+def test_load_mujoco_robot_state_puts_the_arm_in_the_saved_state(library_cell: LibraryCell) -> None:
+    """Loads the state saved above while the arm is where square_traj.yaml ends."""
     data = yaml.safe_load((library_cell.objectives / "robot_joint_state.yaml").read_text())
     state = dict(zip(data["joint_state"]["name"], data["joint_state"]["position"], strict=True))
-    assert np.abs(settled_arm(library_cell) - np.array([state[j] for j in ARM])).max() < 0.02
+    saved = np.array([state[j] for j in ARM])
+    assert np.abs(settled_arm(library_cell) - saved).max() > 0.1, "the arm is already in the saved state"
+    result = run(library_cell, "Load MuJoCo Robot State")
+    assert result.succeeded, result
+    assert np.abs(settled_arm(library_cell) - saved).max() < 0.02
 
 
 def test_vector_and_string_example_publishes_the_secret_message(library_cell: LibraryCell) -> None:
