@@ -403,3 +403,47 @@ def test_cartesian_path_honours_tip_offset_and_refuses_unknown_timing(
         timeout=30.0,
     )
     assert timing.status == NodeStatus.FAILURE and "valid: time_optimal" in timing.toasts[-1]
+
+
+def _empty_trajectory() -> Any:
+    return from_dict("trajectory_msgs/msg/JointTrajectory", {"joint_names": ARM, "points": []})
+
+
+def _unknown_joint_trajectory() -> Any:
+    points = [{"positions": [0.0], "time_from_start": {"sec": 0, "nanosec": 0}}]
+    return from_dict("trajectory_msgs/msg/JointTrajectory", {"joint_names": ["elbow"], "points": points})
+
+
+@pytest.mark.parametrize(
+    ("behavior_id", "inputs", "expected"),
+    [
+        (
+            "ValidateTrajectory",
+            {"joint_trajectory_msg": _unknown_joint_trajectory()},
+            "unknown joint(s) elbow",
+        ),
+        (
+            "ValidateTrajectory",
+            {"joint_trajectory_msg": _trajectory(), "joint_space_step": 0.0},
+            "[joint_space_step] = 0",
+        ),
+        (
+            "ValidateTrajectory",
+            {"joint_trajectory_msg": _trajectory(), "planning_group_name": "arm"},
+            "[planning_group_name] = 'arm'",
+        ),
+        ("GetRobotStateFromTrajectory", {"joint_trajectory_msg": _empty_trajectory()}, "has no points"),
+        (
+            "IsCollisionObjectInPlanningScene",
+            {"planning_scene": "nothing", "collision_object_name": "x"},
+            "[planning_scene]",
+        ),
+        ("ComputeLinkPoseForwardKinematics", {"joint_state": "1;2;3"}, "[joint_state]"),
+    ],
+)
+def test_bad_input_fails_the_behavior_naming_the_port(
+    behavior: Any, context: BehaviorContext, at_home: Any, behavior_id: str, inputs: dict, expected: str
+) -> None:
+    run = tick_behavior(behavior(behavior_id), inputs, context=context, timeout=30.0)
+    assert run.status == NodeStatus.FAILURE
+    assert expected in run.toasts[-1], run.toasts
