@@ -447,3 +447,27 @@ def test_bad_input_fails_the_behavior_naming_the_port(
     run = tick_behavior(behavior(behavior_id), inputs, context=context, timeout=30.0)
     assert run.status == NodeStatus.FAILURE
     assert expected in run.toasts[-1], run.toasts
+
+
+def test_cartesian_path_honours_ik_joint_space_density(
+    behavior: Any, context: BehaviorContext, at_home: Any, lab_sim_model: Any
+) -> None:
+    from scipy.spatial.transform import Rotation
+
+    from kinema.motion import fk
+
+    target = fk(lab_sim_model, _q(lab_sim_model, HOME), "grasp_link")
+    target[0, 3] += 0.05
+    x, y, z, w = Rotation.from_matrix(target[:3, :3]).as_quat()
+    goal = _pose("world", tuple(target[:3, 3]), (x, y, z, w))
+    inputs = {"path": [goal], "ik_cartesian_space_density": 0.01}
+    assert tick_behavior(behavior("PlanCartesianPath"), inputs, context=context, timeout=30.0).status == (
+        NodeStatus.SUCCESS
+    )
+    strict = tick_behavior(
+        behavior("PlanCartesianPath"),
+        {**inputs, "ik_joint_space_density": 1e-4},
+        context=context,
+        timeout=30.0,
+    )
+    assert strict.status == NodeStatus.FAILURE and "exceeds the threshold 0.0001" in strict.toasts[-1]
