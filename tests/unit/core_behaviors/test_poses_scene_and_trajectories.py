@@ -471,3 +471,13 @@ def test_cartesian_path_honours_ik_joint_space_density(
         timeout=30.0,
     )
     assert strict.status == NodeStatus.FAILURE and "exceeds the threshold 0.0001" in strict.toasts[-1]
+
+
+def test_a_camera_of_the_scene_is_a_frame(behavior: Any, context: BehaviorContext, at_home: Any) -> None:
+    run = tick_behavior(
+        behavior("TransformPoseFrame"),
+        {"input_pose": _pose("scene_camera", (0, 0, 0)), "target_frame_id": "world"},
+        context=context,
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    np.testing.assert_allclose(_xyz(run.outputs["output_pose"]), [2.1, 0.0, 1.9], atol=1e-6)
