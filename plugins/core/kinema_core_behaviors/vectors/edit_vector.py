@@ -14,7 +14,7 @@ from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, out
 from ..messages.ports import fails_on_bad_input, index_in, port_error, read_input, read_vector
 from .element_type import mismatch
 
-SUBCATEGORY = "Vectors"
+SUBCATEGORY = "Vector Handling"
 
 
 def _vector_ports(*extra: PortInfo) -> list[PortInfo]:

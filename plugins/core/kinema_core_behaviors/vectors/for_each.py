@@ -28,7 +28,7 @@ IDLE, RUNNING, SUCCESS, FAILURE, SKIPPED = (
 class _VectorLoop(Behavior, DecoratorNode):
     """Shared loop: subclasses say which child result ends the loop and what an empty vector gives."""
 
-    subcategory = "Vectors"
+    subcategory = "Vector Handling"
     stop_on: NodeStatus = FAILURE
     if_exhausted: NodeStatus = SUCCESS
 

@@ -10,7 +10,7 @@ from ..messages.ports import fails_on_bad_input, index_in, read_input, read_vect
 class GetElementOfVector(SyncBehavior):
     """Writes the element at ``index`` of ``vector_in`` to ``element``; fails if the index is outside it."""
 
-    subcategory = "Vectors"
+    subcategory = "Vector Handling"
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
@@ -30,7 +30,7 @@ class GetElementOfVector(SyncBehavior):
 class GetSizeOfVector(SyncBehavior):
     """Writes the number of elements of ``vector_in`` to ``vector_size``."""
 
-    subcategory = "Vectors"
+    subcategory = "Vector Handling"
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

@@ -13,7 +13,7 @@ class ResetVector(SyncBehavior):
     The vector may hold any type (messages, numbers, strings); an existing vector keeps its type.
     """
 
-    subcategory = "Vectors"
+    subcategory = "Vector Handling"
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
@@ -27,7 +27,7 @@ class ResetVector(SyncBehavior):
 class ResetPoseStampedVector(SyncBehavior):
     """Sets ``vector`` to an empty vector of ``geometry_msgs/PoseStamped``."""
 
-    subcategory = "Vectors"
+    subcategory = "Vector Handling"
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
