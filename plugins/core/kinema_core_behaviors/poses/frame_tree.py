@@ -61,7 +61,7 @@ def _camera_frames(context: Any) -> dict[str, np.ndarray]:
             model = None
         if model is not None:
             data = mujoco.MjData(model)
-            mujoco.mj_kinematics(model, data)
+            mujoco.mj_forward(model, data)  # camera poses come from mj_camlight, which this runs
             for index in range(model.ncam):
                 name = model.camera(index).name
                 if name and int(model.body_weldid[model.cam_bodyid[index]]) == 0:
