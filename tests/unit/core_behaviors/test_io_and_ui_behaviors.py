@@ -249,3 +249,68 @@ def test_switch_ui_primary_view_is_a_notice(behavior: Any, context: BehaviorCont
         behavior("SwitchUIPrimaryView"), {"primary_view_name": "Visualization"}, context=context
     )
     assert run.status == NodeStatus.SUCCESS and "kinema view" in run.toasts[-1]
+
+
+def _image(width: int, height: int) -> Any:
+    from kinema.transport import from_dict
+
+    return from_dict(
+        "sensor_msgs/msg/Image",
+        {
+            "header": {"frame_id": "camera"},
+            "height": height,
+            "width": width,
+            "encoding": "rgb8",
+            "step": width * 3,
+            "data": np.zeros(width * height * 3, dtype=np.uint8),
+        },
+    )
+
+
+def _images(context: BehaviorContext, topic: str) -> list[Any]:
+    received: list[Any] = []
+    context.node.create_subscription("sensor_msgs/msg/Image", topic, received.append)
+    return received
+
+
+def test_2d_detections_are_drawn_onto_the_image_and_published(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    from types import SimpleNamespace as NS
+
+    from kinema.transport import from_dict
+
+    boxes_seen = _images(context, "/boxes")
+    box = NS(x=1, y=1, width=3, height=2)
+    run = tick_behavior(
+        behavior("PublishBoundingBoxes2D"),
+        {"image": _image(8, 6), "bounding_boxes": [box], "visualization_topic": "/boxes"},
+        context=context,
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    drawn = wait_for(lambda: boxes_seen[-1] if boxes_seen else None, "the boxes image")
+    pixels = np.asarray(drawn.data).reshape(6, 8, 3)
+    assert pixels[1, 1].any() and pixels[3, 4].any() and not pixels[2, 2].any(), "outline only"
+    masks_seen = _images(context, "/masks")
+    mask_image = from_dict(
+        "sensor_msgs/msg/Image",
+        {"height": 2, "width": 2, "encoding": "mono8", "step": 2, "data": np.full(4, 255, dtype=np.uint8)},
+    )
+    run = tick_behavior(
+        behavior("PublishMask2D"),
+        {
+            "image": _image(8, 6),
+            "masks": [NS(x=5, y=3, mask=mask_image)],
+            "masks_visualization_topic": "/masks",
+            "opacity": 1.0,
+        },
+        context=context,
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    drawn = wait_for(lambda: masks_seen[-1] if masks_seen else None, "the masks image")
+    pixels = np.asarray(drawn.data).reshape(6, 8, 3)
+    assert pixels[3:5, 5:7].all(axis=2).any() and not pixels[0, 0].any()
+    bad = tick_behavior(
+        behavior("PublishMask2D"), {"image": _image(8, 6), "masks": [], "opacity": 2.0}, context=context
+    )
+    assert bad.status == NodeStatus.FAILURE and "port [opacity]" in bad.toasts[-1]
