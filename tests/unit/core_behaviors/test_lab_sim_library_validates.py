@@ -8,6 +8,7 @@ in one line why each of the others cannot load.
 
 from __future__ import annotations
 
+import json
 import shutil
 from pathlib import Path
 from typing import Any
@@ -121,6 +122,11 @@ def test_objective_list_says_why_each_objective_cannot_load(corpus_workspace: Pa
     table = {line[4:].split("  ")[0].strip(): line[:3] for line in lines[:header] if line[:1] in "R-"}
     assert table["Take Scene Camera Snapshot"].endswith("!")
     assert not table["Vector and String Example"].endswith("!")
+    as_json = CliRunner().invoke(
+        cli, ["objective", "list", "-w", str(corpus_workspace), "-c", CONFIG, "--json"]
+    )
+    cannot_load = json.loads(as_json.output)["cannot_load"]
+    assert len(cannot_load) == count and "GetPointCloud" in cannot_load["Take Scene Camera Snapshot"]
 
 
 def test_every_port_the_corpus_sets_on_a_kinema_behavior_is_declared(registry: Any) -> None:
