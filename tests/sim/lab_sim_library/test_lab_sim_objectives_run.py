@@ -205,3 +205,11 @@ def test_a_simulated_object_is_a_frame(library_cell: LibraryCell) -> None:
     p = box.primitive_poses[0].position
     assert [p.x, p.y, p.z] == pytest.approx([cube.x, cube.y, cube.z + 0.1], abs=1e-3)
     assert run(library_cell, "Clear Previous Obstacles").succeeded
+
+
+@pytest.mark.parametrize("name", ["GetPoseAtGripperandDisplay", "ComputeLinkPoseFromWaypoint"])
+def test_pose_subtrees_run_on_their_own(library_cell: LibraryCell, name: str) -> None:
+    """Not runnable in MoveIt Pro's UI (they are called as subtrees), but they run: the pinch frame, the
+    "MPC Pose Tracking" waypoint and forward kinematics are there."""
+    result = run(library_cell, name)
+    assert result.succeeded, result
