@@ -52,8 +52,8 @@ def check_shape(obj: CollisionObject) -> None:
         raise MotionError(
             f"a {obj.shape} needs {_SIZE_COUNTS[obj.shape]} size values, {obj.name!r} has {len(obj.size)}"
         )
-    if not all(np.isfinite(v) and v > 0 for v in obj.size):
-        raise MotionError(f"the sizes of {obj.name!r} must be finite and > 0 m, got {list(obj.size)}")
+    if not all(np.isfinite(v) and v >= 0 for v in obj.size):
+        raise MotionError(f"the sizes of {obj.name!r} must be finite and >= 0 m, got {list(obj.size)}")
     if np.shape(obj.world_T_object) != (4, 4) or not np.all(np.isfinite(obj.world_T_object)):
         raise MotionError(f"the pose of {obj.name!r} must be a finite 4x4 transform")
 

@@ -43,7 +43,7 @@ def test_world_objects_are_added_replaced_and_reset_leaving_the_environment(lab_
     [
         ("", [CollisionObject("", "box", (0.1, 0.1, 0.1), np.eye(4))], "non-empty id"),
         ("b", [], "no shape"),
-        ("b", [CollisionObject("", "box", (0.1, -0.1, 0.1), np.eye(4))], "must be finite and > 0"),
+        ("b", [CollisionObject("", "box", (0.1, -0.1, 0.1), np.eye(4))], "must be finite and >= 0"),
         ("b", [CollisionObject("", "cone", (0.1, 0.1), np.eye(4))], "unknown collision shape"),
     ],
 )
