@@ -137,7 +137,7 @@ def test_for_each_until_success_fails_when_nothing_succeeds_and_for_each_succeed
         ("CreatePoseStamped", {"position_xyz": [1.0, 2.0]}, "position_xyz", "expected 3 values x;y;z"),
         ("CreateTwistStamped", {"angular_velocity_xyz": [1.0]}, "angular_velocity_xyz", "expected 3 values"),
         ("UnpackPoseStampedMessage", {"pose_stamped": "not a pose"}, "pose_stamped", "geometry_msgs"),
-        ("UnpackRobotStateMessage", {"robot_state": 7}, "robot_state", "moveit_msgs/RobotState"),
+        ("UnpackRobotStateMessage", {"robot_state": 7}, "robot_state", "RobotJointState"),
     ],
 )
 def test_bad_input_fails_the_behavior_naming_port_value_and_alternatives(
@@ -204,7 +204,7 @@ def test_messages_are_created_and_unpacked(behavior: Any, context: BehaviorConte
     state = tick_behavior(
         behavior("CreateRobotState"), {"joint_names": ["elbow_joint"], "positions": [0.5]}, context=context
     ).outputs["robot_state"]
-    assert state.__msgtype__ == "moveit_msgs/msg/RobotState"
+    assert state.__msgtype__ == "moveit_studio_agent_msgs/msg/RobotJointState"
     joints = tick_behavior(behavior("UnpackRobotStateMessage"), {"robot_state": state}, context=context)
     assert list(joints.outputs["joint_state"].name) == ["elbow_joint"]
 

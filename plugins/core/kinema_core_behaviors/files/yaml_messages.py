@@ -31,7 +31,7 @@ from .locations import file_to_read, file_to_write
 
 POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
-ROBOT_STATE = "moveit_msgs/msg/RobotState"
+ROBOT_STATE = "moveit_studio_agent_msgs/msg/RobotJointState"
 SUBCATEGORY = "File Management"
 
 
@@ -236,7 +236,7 @@ class SaveJointTrajectoryToYaml(SyncBehavior):
 
 
 class LoadRobotJointStateFromYaml(SyncBehavior):
-    """Reads a robot state (``moveit_msgs/RobotState``: joint state and multi-DOF state) from a YAML file."""
+    """Reads a robot state (``RobotJointState``: joint state and multi-DOF state) from a YAML file."""
 
     subcategory = SUBCATEGORY
 
@@ -261,7 +261,7 @@ class LoadRobotJointStateFromYaml(SyncBehavior):
 
 
 class SaveRobotJointStateToYaml(SyncBehavior):
-    """Writes a robot state (or a joint state) to a YAML file as a ``moveit_msgs/RobotState``, atomically.
+    """Writes a robot state (or a joint state) to a YAML file as a ``RobotJointState``, atomically.
 
     An existing file is replaced (this behavior has no ``overwrite`` port in MoveIt Pro).
     """

@@ -18,7 +18,7 @@ if TYPE_CHECKING:
     from kinema.motion import JointTrajectory
 
 JOINT_STATE_TYPE = "sensor_msgs/msg/JointState"
-ROBOT_STATE_TYPE = "moveit_msgs/msg/RobotState"
+ROBOT_STATE_TYPE = "moveit_studio_agent_msgs/msg/RobotJointState"
 TRAJECTORY_TYPE = "trajectory_msgs/msg/JointTrajectory"
 POSE_STAMPED_TYPE = "geometry_msgs/msg/PoseStamped"
 
@@ -44,7 +44,11 @@ def joint_state_message(names: Sequence[str], positions: Sequence[float]) -> Any
 
 
 def robot_state_message(names: Sequence[str], positions: Sequence[float]) -> Any:
-    """A ``moveit_msgs/RobotState`` with positions only (what CreateRobotState and waypoints give)."""
+    """A ``RobotJointState`` (joint state plus empty multi-DOF state), MoveIt Pro's robot state shape.
+
+    MoveIt Pro's "Move to Joint State" takes this type, and its ``robot_joint_state.yaml`` holds exactly
+    these two parts.
+    """
     from kinema.transport import from_dict
 
     return from_dict(

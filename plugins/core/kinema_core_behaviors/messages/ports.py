@@ -37,7 +37,7 @@ PRODUCERS: dict[str, str] = {
     "geometry_msgs/msg/WrenchStamped": "CreateWrenchStamped",
     "std_msgs/msg/String": "CreateStringMessage",
     "sensor_msgs/msg/JointState": "GetJointState, RetrieveWaypoint, UnpackRobotStateMessage",
-    "moveit_msgs/msg/RobotState": "CreateRobotState, LoadRobotJointStateFromYaml",
+    "moveit_studio_agent_msgs/msg/RobotJointState": "CreateRobotState, LoadRobotJointStateFromYaml",
     "trajectory_msgs/msg/JointTrajectory": "PlanToJointGoal, PlanCartesianPath, LoadJointTrajectoryFromYaml",
     "moveit_msgs/msg/CollisionObject": "UnpackGraspableObjectMessage",
 }

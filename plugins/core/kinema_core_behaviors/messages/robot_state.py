@@ -1,4 +1,9 @@
-"""RobotState messages: CreateRobotState builds one, UnpackRobotStateMessage splits one."""
+"""Robot states: CreateRobotState builds one, UnpackRobotStateMessage splits one.
+
+MoveIt Pro's robot state on the blackboard is a ``moveit_studio_agent_msgs/RobotJointState`` (a joint
+state and a multi-DOF joint state); a ``moveit_msgs/RobotState`` or a bare ``sensor_msgs/JointState`` is
+accepted where one is read.
+"""
 
 from __future__ import annotations
 
@@ -12,7 +17,7 @@ from .ports import fails_on_bad_input, message_output, port_error, read_input
 
 
 def as_robot_state(node: Any, port: str, value: Any) -> Any:
-    """``value`` as a ``moveit_msgs/RobotState``: a RobotState, a RobotJointState or a bare JointState.
+    """``value`` as a ``RobotJointState`` (given one, a ``moveit_msgs/RobotState`` or a JointState).
 
     Raises:
         PortValueError: none of these.
@@ -23,21 +28,25 @@ def as_robot_state(node: Any, port: str, value: Any) -> Any:
     ros_type = getattr(value, "__msgtype__", None)
     if ros_type == ROBOT_STATE_TYPE:
         return value
-    if ros_type == "moveit_studio_agent_msgs/msg/RobotJointState":
-        return from_dict(ROBOT_STATE_TYPE, to_dict(value))
+    if ros_type == "moveit_msgs/msg/RobotState":
+        parts = to_dict(value)
+        return from_dict(
+            ROBOT_STATE_TYPE,
+            {"joint_state": parts["joint_state"], "multi_dof_joint_state": parts["multi_dof_joint_state"]},
+        )
     if ros_type == "sensor_msgs/msg/JointState":
         return from_dict(ROBOT_STATE_TYPE, {"joint_state": to_dict(value)})
     raise port_error(
         node,
         port,
         f"got {ros_type or type(value).__name__}",
-        "expected a moveit_msgs/RobotState or sensor_msgs/JointState (from CreateRobotState, "
-        "RetrieveWaypoint, GetJointState or LoadRobotJointStateFromYaml)",
+        "expected a RobotJointState, moveit_msgs/RobotState or sensor_msgs/JointState (from "
+        "CreateRobotState, RetrieveWaypoint, GetJointState or LoadRobotJointStateFromYaml)",
     )
 
 
 class CreateRobotState(SyncBehavior):
-    """Builds a ``moveit_msgs/RobotState`` setting ``joint_names`` to ``positions``.
+    """Builds a robot state (``RobotJointState``) setting ``joint_names`` to ``positions``.
 
     When the runtime has a robot model, every name must be one of its joints.
     """
@@ -86,7 +95,8 @@ class CreateRobotState(SyncBehavior):
 class UnpackRobotStateMessage(SyncBehavior):
     """Splits a robot state into its ``joint_state`` and ``multi_dof_joint_state``.
 
-    Accepts a ``moveit_msgs/RobotState`` or, as RetrieveWaypoint gives, a ``sensor_msgs/JointState``.
+    Accepts a ``RobotJointState``, a ``moveit_msgs/RobotState`` or, as RetrieveWaypoint gives, a
+    ``sensor_msgs/JointState``.
     """
 
     subcategory = "Messages"
@@ -94,7 +104,12 @@ class UnpackRobotStateMessage(SyncBehavior):
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
         return [
-            input_port("robot_state", None, "{robot_state}", "The robot state (moveit_msgs/RobotState)."),
+            input_port(
+                "robot_state",
+                None,
+                "{robot_state}",
+                "The robot state (RobotJointState or moveit_msgs/RobotState).",
+            ),
             message_output("joint_state", "sensor_msgs/msg/JointState", "{joint_state}", "Its joint state."),
             message_output(
                 "multi_dof_joint_state",
