@@ -20,9 +20,10 @@ from __future__ import annotations
 import asyncio
 import os
 import threading
+import time
 from typing import Any
 
-from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, SyncBehavior, input_port
+from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, StatefulBehavior, input_port
 from kinema.errors import TransportError
 
 APPROVAL_SERVICE = "/kinema/user_approval"
@@ -46,16 +47,12 @@ def approval_client(behavior: Any) -> Any | None:
     return behavior.context.service_client(node, APPROVAL_TYPE, APPROVAL_SERVICE)
 
 
-def user_available(behavior: Any, wait: float = DISCOVERY_SECONDS) -> bool:
-    """True when a UI that asks the user is attached (its approval service is on the graph)."""
-    client = approval_client(behavior)
-    return client is not None and bool(client.wait_for_service(wait))
-
-
-class IsUserAvailable(SyncBehavior):
+class IsUserAvailable(StatefulBehavior):
     """Succeeds when a user can answer (a TUI is attached), fails otherwise; see the headless rule.
 
-    With ``KINEMA_AUTO_APPROVE=1`` it succeeds (the automatic approver counts as the user).
+    With ``KINEMA_AUTO_APPROVE=1`` it succeeds (the automatic approver counts as the user). It looks for
+    the UI's service for up to half a second (discovery on a fresh connection takes a moment) without
+    holding the tick thread.
     """
 
     subcategory = "User Input"
@@ -64,10 +61,27 @@ class IsUserAvailable(SyncBehavior):
     def provided_ports(cls) -> list[PortInfo]:
         return []
 
-    def tick(self) -> NodeStatus:
-        if user_available(self) or auto_approve():
+    def __init__(self, name: str, config: Any = None) -> None:
+        super().__init__(name, config)
+        self._client: Any = None
+        self._deadline = 0.0
+
+    def on_start(self) -> NodeStatus:
+        if auto_approve():
             return NodeStatus.SUCCESS
-        return NodeStatus.FAILURE
+        self._client = approval_client(self)
+        if self._client is None:
+            return NodeStatus.FAILURE
+        self._deadline = time.monotonic() + DISCOVERY_SECONDS
+        return self.on_running()
+
+    def on_running(self) -> NodeStatus:
+        if self._client.service_is_ready():
+            return NodeStatus.SUCCESS
+        return NodeStatus.FAILURE if time.monotonic() >= self._deadline else NodeStatus.RUNNING
+
+    def on_halted(self) -> None:
+        self._client = None
 
 
 class _AskUser(AsyncBehavior):
