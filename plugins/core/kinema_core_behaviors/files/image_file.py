@@ -7,7 +7,7 @@ from typing import Any
 
 import numpy as np
 
-from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
+from kinema.behaviors import AsyncBehavior, PortInfo, input_port
 from kinema.config.atomic_write import atomic_write_bytes
 from kinema.errors import KinemaError
 
@@ -69,7 +69,7 @@ def image_pixels(node: Any, port: str, image: Any) -> tuple[np.ndarray, str]:
     return (pixels[:, :, 0] if channels == 1 else pixels), mode
 
 
-class LoadImageFromFile(SyncBehavior):
+class LoadImageFromFile(AsyncBehavior):
     """Reads a PNG or JPEG file into a ``sensor_msgs/Image`` (rgb8, rgba8 or mono8)."""
 
     subcategory = "File Management"
@@ -89,7 +89,7 @@ class LoadImageFromFile(SyncBehavior):
         ]
 
     @fails_on_bad_input
-    def tick(self) -> NodeStatus:
+    def do_work(self) -> bool:
         from PIL import Image, UnidentifiedImageError
 
         package = read_text(self, "package_name")
@@ -109,10 +109,10 @@ class LoadImageFromFile(SyncBehavior):
             ) from None
         encoding = {"RGB": "rgb8", "RGBA": "rgba8", "L": "mono8"}[picture.mode]
         self.set_output("image", image_message(np.asarray(picture), encoding))
-        return NodeStatus.SUCCESS
+        return True
 
 
-class SaveImageToFile(SyncBehavior):
+class SaveImageToFile(AsyncBehavior):
     """Writes a ``sensor_msgs/Image`` to a file, atomically; the extension picks the format (PNG default)."""
 
     subcategory = "File Management"
@@ -125,7 +125,7 @@ class SaveImageToFile(SyncBehavior):
         ]
 
     @fails_on_bad_input
-    def tick(self) -> NodeStatus:
+    def do_work(self) -> bool:
         from PIL import Image
 
         image = read_message(self, "image")
@@ -144,4 +144,4 @@ class SaveImageToFile(SyncBehavior):
             atomic_write_bytes(path, buffer.getvalue())
         except KinemaError as error:
             raise port_error(self, "file_path", f"= {text!r}: {error}", "") from None
-        return NodeStatus.SUCCESS
+        return True

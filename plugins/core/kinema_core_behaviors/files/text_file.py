@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
+from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
 
 from ..messages.ports import fails_on_bad_input, port_error, read_input
 from .locations import file_to_read
@@ -10,7 +10,7 @@ from .locations import file_to_read
 MAX_BYTES = 10 * 1024 * 1024
 
 
-class ReadTextFileAsString(SyncBehavior):
+class ReadTextFileAsString(AsyncBehavior):
     """Reads a UTF-8 text file (relative paths: the objectives folder) into ``string_file_contents``."""
 
     subcategory = "File Management"
@@ -23,7 +23,7 @@ class ReadTextFileAsString(SyncBehavior):
         ]
 
     @fails_on_bad_input
-    def tick(self) -> NodeStatus:
+    def do_work(self) -> bool:
         path = file_to_read(self, "text_filename", str(read_input(self, "text_filename")))
         if path.stat().st_size > MAX_BYTES:
             raise port_error(self, "text_filename", f"file {path} is larger than {MAX_BYTES} bytes", "")
@@ -34,4 +34,4 @@ class ReadTextFileAsString(SyncBehavior):
                 self, "text_filename", f"file {path} cannot be read as text: {error}", ""
             ) from None
         self.set_output("string_file_contents", text)
-        return NodeStatus.SUCCESS
+        return True

@@ -1,5 +1,8 @@
 """Messages as YAML files, in the layout MoveIt Pro writes them (``ros2 topic echo`` style).
 
+Reading and writing run off the tick thread (the behaviors are asynchronous), so a large file never
+holds the tree.
+
 One message is one YAML document; a vector of messages is a stream of documents separated by ``---``
 (as ``pill_bottle_place_poses.yaml``). Loading checks the fields against the message type, so a typo in
 a field name or a wrong value fails with the file and the field named.
@@ -13,7 +16,7 @@ from typing import Any
 
 import yaml
 
-from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
+from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
 from kinema.config.atomic_write import atomic_write_bytes
 from kinema.errors import KinemaError
 
@@ -33,13 +36,17 @@ POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
 ROBOT_STATE = "moveit_studio_agent_msgs/msg/RobotJointState"
 SUBCATEGORY = "File Management"
+# libyaml when PyYAML has it: a recorded trajectory is hundreds of kB, which the pure-Python parser takes
+# seconds to read.
+_LOADER: Any = getattr(yaml, "CSafeLoader", yaml.SafeLoader)
+_DUMPER: Any = getattr(yaml, "CSafeDumper", yaml.SafeDumper)
 
 
 def read_documents(node: Any, port: str, path: Path) -> list[Any]:
     """The YAML documents of ``path`` (empty documents dropped)."""
     try:
         text = path.read_text(encoding="utf-8")
-        return [doc for doc in yaml.safe_load_all(text) if doc is not None]
+        return [doc for doc in yaml.load_all(text, Loader=_LOADER) if doc is not None]
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         where = f"{path}:{mark.line + 1}" if mark is not None else str(path)
@@ -68,8 +75,8 @@ def dump(messages: list[Any]) -> bytes:
     """YAML text of one message or a document stream of several."""
     from kinema.transport.messages import to_dict
 
-    return yaml.safe_dump_all(
-        [to_dict(message) for message in messages], sort_keys=False, default_flow_style=False
+    return yaml.dump_all(
+        [to_dict(message) for message in messages], Dumper=_DUMPER, sort_keys=False, default_flow_style=False
     ).encode()
 
 
@@ -117,7 +124,7 @@ def _save_ports(ros_type: str, what: str, overwrite: bool = True) -> list[PortIn
     return ports
 
 
-class LoadPoseStampedFromYaml(SyncBehavior):
+class LoadPoseStampedFromYaml(AsyncBehavior):
     """Reads a ``geometry_msgs/PoseStamped`` from a YAML file into ``output``."""
 
     subcategory = SUBCATEGORY
@@ -127,7 +134,7 @@ class LoadPoseStampedFromYaml(SyncBehavior):
         return _load_ports(POSE_STAMPED, False, "The pose.")
 
     @fails_on_bad_input
-    def tick(self) -> NodeStatus:
+    def do_work(self) -> bool:
         path = file_to_read(self, "file_path", str(read_input(self, "file_path")))
         documents = read_documents(self, "file_path", path)
         if len(documents) != 1:
@@ -136,10 +143,10 @@ class LoadPoseStampedFromYaml(SyncBehavior):
                 self, "file_path", problem, "use LoadPoseStampedVectorFromYaml for several poses"
             )
         self.set_output("output", message_from(self, "file_path", path, POSE_STAMPED, documents[0], 0))
-        return NodeStatus.SUCCESS
+        return True
 
 
-class LoadPoseStampedVectorFromYaml(SyncBehavior):
+class LoadPoseStampedVectorFromYaml(AsyncBehavior):
     """Reads a vector of ``geometry_msgs/PoseStamped`` (YAML documents split by ``---``) into ``output``."""
 
     subcategory = SUBCATEGORY
@@ -149,17 +156,17 @@ class LoadPoseStampedVectorFromYaml(SyncBehavior):
         return _load_ports(POSE_STAMPED, True, "The poses, in file order.")
 
     @fails_on_bad_input
-    def tick(self) -> NodeStatus:
+    def do_work(self) -> bool:
         path = file_to_read(self, "file_path", str(read_input(self, "file_path")))
         documents = read_documents(self, "file_path", path)
         poses = [
             message_from(self, "file_path", path, POSE_STAMPED, doc, i + 1) for i, doc in enumerate(documents)
         ]
         self.set_output("output", poses)
-        return NodeStatus.SUCCESS
+        return True
 
 
-class SavePoseStampedToYaml(SyncBehavior):
+class SavePoseStampedToYaml(AsyncBehavior):
     """Writes a ``geometry_msgs/PoseStamped`` to a YAML file, atomically."""
 
     subcategory = SUBCATEGORY
@@ -169,14 +176,14 @@ class SavePoseStampedToYaml(SyncBehavior):
         return _save_ports(POSE_STAMPED, "The pose to save")
 
     @fails_on_bad_input
-    def tick(self) -> NodeStatus:
+    def do_work(self) -> bool:
         message = read_message(self, "message", POSE_STAMPED)
         name = str(read_input(self, "yaml_filename"))
         save(self, "yaml_filename", name, [message], bool(read_input(self, "overwrite")))
-        return NodeStatus.SUCCESS
+        return True
 
 
-class SavePoseStampedVectorToYaml(SyncBehavior):
+class SavePoseStampedVectorToYaml(AsyncBehavior):
     """Writes a vector of ``geometry_msgs/PoseStamped`` to a YAML file (one document each), atomically."""
 
     subcategory = SUBCATEGORY
@@ -186,17 +193,17 @@ class SavePoseStampedVectorToYaml(SyncBehavior):
         return _save_ports(POSE_STAMPED, "The poses to save")
 
     @fails_on_bad_input
-    def tick(self) -> NodeStatus:
+    def do_work(self) -> bool:
         poses = read_vector(self, "message")
         wrong = [i for i, pose in enumerate(poses) if getattr(pose, "__msgtype__", None) != POSE_STAMPED]
         if wrong:
             raise port_error(self, "message", f"element {wrong[0]} is not a {POSE_STAMPED}", "")
         name = str(read_input(self, "yaml_filename"))
         save(self, "yaml_filename", name, poses, bool(read_input(self, "overwrite")))
-        return NodeStatus.SUCCESS
+        return True
 
 
-class LoadJointTrajectoryFromYaml(SyncBehavior):
+class LoadJointTrajectoryFromYaml(AsyncBehavior):
     """Reads a ``trajectory_msgs/JointTrajectory`` from a YAML file into ``output``."""
 
     subcategory = SUBCATEGORY
@@ -206,7 +213,7 @@ class LoadJointTrajectoryFromYaml(SyncBehavior):
         return _load_ports(TRAJECTORY, False, "The trajectory.")
 
     @fails_on_bad_input
-    def tick(self) -> NodeStatus:
+    def do_work(self) -> bool:
         path = file_to_read(self, "file_path", str(read_input(self, "file_path")))
         documents = read_documents(self, "file_path", path)
         if len(documents) != 1:
@@ -215,10 +222,10 @@ class LoadJointTrajectoryFromYaml(SyncBehavior):
         if not len(trajectory.points):
             raise port_error(self, "file_path", f"file {path} has a trajectory without points", "")
         self.set_output("output", trajectory)
-        return NodeStatus.SUCCESS
+        return True
 
 
-class SaveJointTrajectoryToYaml(SyncBehavior):
+class SaveJointTrajectoryToYaml(AsyncBehavior):
     """Writes a ``trajectory_msgs/JointTrajectory`` to a YAML file, atomically."""
 
     subcategory = SUBCATEGORY
@@ -228,14 +235,14 @@ class SaveJointTrajectoryToYaml(SyncBehavior):
         return _save_ports(TRAJECTORY, "The trajectory to save")
 
     @fails_on_bad_input
-    def tick(self) -> NodeStatus:
+    def do_work(self) -> bool:
         message = read_message(self, "message", TRAJECTORY)
         name = str(read_input(self, "yaml_filename"))
         save(self, "yaml_filename", name, [message], bool(read_input(self, "overwrite")))
-        return NodeStatus.SUCCESS
+        return True
 
 
-class LoadRobotJointStateFromYaml(SyncBehavior):
+class LoadRobotJointStateFromYaml(AsyncBehavior):
     """Reads a robot state (``RobotJointState``: joint state and multi-DOF state) from a YAML file."""
 
     subcategory = SUBCATEGORY
@@ -248,7 +255,7 @@ class LoadRobotJointStateFromYaml(SyncBehavior):
         ]
 
     @fails_on_bad_input
-    def tick(self) -> NodeStatus:
+    def do_work(self) -> bool:
         path = file_to_read(self, "file_path", str(read_input(self, "file_path")))
         documents = read_documents(self, "file_path", path)
         if len(documents) != 1:
@@ -257,10 +264,10 @@ class LoadRobotJointStateFromYaml(SyncBehavior):
         if not len(state.joint_state.name):
             raise port_error(self, "file_path", f"file {path} names no joints", "expected joint_state.name")
         self.set_output("output", state)
-        return NodeStatus.SUCCESS
+        return True
 
 
-class SaveRobotJointStateToYaml(SyncBehavior):
+class SaveRobotJointStateToYaml(AsyncBehavior):
     """Writes a robot state (or a joint state) to a YAML file as a ``RobotJointState``, atomically.
 
     An existing file is replaced (this behavior has no ``overwrite`` port in MoveIt Pro).
@@ -273,7 +280,7 @@ class SaveRobotJointStateToYaml(SyncBehavior):
         return _save_ports(ROBOT_STATE, "The robot or joint state to save", overwrite=False)
 
     @fails_on_bad_input
-    def tick(self) -> NodeStatus:
+    def do_work(self) -> bool:
         state = as_robot_state(self, "message", read_input(self, "message"))
         save(self, "yaml_filename", str(read_input(self, "yaml_filename")), [state], True)
-        return NodeStatus.SUCCESS
+        return True
