@@ -48,3 +48,29 @@ def test_every_core_behavior_has_a_description_and_a_subcategory(registry: Any) 
         or record.metadata.get("subcategory", "User Created Behaviors") == "User Created Behaviors"
     ]
     assert not bare, f"behaviors without a description or subcategory: {bare}"
+
+
+def test_a_plugins_own_message_port_connects_to_the_core_behaviors(registry: Any) -> None:
+    """Message port types come from the SDK, so another plugin's PoseStamped port is the core's type."""
+    from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, message_type
+    from kinema.plugins import BehaviorRegistry
+    from kinema.testing import registry_of, run_objective
+
+    class NeedsPose(SyncBehavior):
+        """Succeeds on a pose above the table."""
+
+        subcategory = "Test"
+
+        @classmethod
+        def provided_ports(cls) -> list[PortInfo]:
+            return [input_port("pose", message_type("geometry_msgs/msg/PoseStamped"), "{pose}")]
+
+        def tick(self) -> NodeStatus:
+            return NodeStatus.SUCCESS if self.get_input("pose").pose.position.z > 0.5 else NodeStatus.FAILURE
+
+    combined = BehaviorRegistry({**registry, **registry_of([NeedsPose])})
+    xml = """<root BTCPP_format="4" main_tree_to_execute="M"><BehaviorTree ID="M"><Sequence>
+      <Action ID="CreatePoseStamped" position_xyz="0;0;1" pose_stamped="{pose}"/>
+      <Action ID="NeedsPose" pose="{pose}"/>
+    </Sequence></BehaviorTree></root>"""
+    assert run_objective(xml, registry=combined).status == NodeStatus.SUCCESS
