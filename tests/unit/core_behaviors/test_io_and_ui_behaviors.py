@@ -314,3 +314,22 @@ def test_2d_detections_are_drawn_onto_the_image_and_published(
         behavior("PublishMask2D"), {"image": _image(8, 6), "masks": [], "opacity": 2.0}, context=context
     )
     assert bad.status == NodeStatus.FAILURE and "port [opacity]" in bad.toasts[-1]
+
+
+def test_the_trajectory_to_approve_is_shown_in_the_view(
+    behavior: Any, context: BehaviorContext, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from kinema.transport import from_dict
+
+    monkeypatch.setenv("KINEMA_AUTO_APPROVE", "1")
+    shown: list[Any] = []
+    context.node.create_subscription(
+        "trajectory_msgs/msg/JointTrajectory", "/kinema/planned_trajectory", shown.append
+    )
+    trajectory = from_dict(
+        "trajectory_msgs/msg/JointTrajectory",
+        {"joint_names": ["elbow_joint"], "points": [{"positions": [0.3], "time_from_start": {"sec": 1}}]},
+    )
+    run = tick_behavior(behavior("WaitForMTCSolutionApproval"), {"solution": trajectory}, context=context)
+    assert run.status == NodeStatus.SUCCESS
+    assert wait_for(lambda: shown, "the trajectory on the view's topic")[0].points[0].positions[0] == 0.3

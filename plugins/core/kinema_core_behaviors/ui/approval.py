@@ -26,6 +26,8 @@ from typing import Any
 from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, StatefulBehavior, input_port
 from kinema.errors import TransportError
 
+from ..motion.planned_trajectory import publish_planned_trajectory
+
 APPROVAL_SERVICE = "/kinema/user_approval"
 APPROVAL_TYPE = "kinema_msgs/srv/RequestApproval"
 AUTO_APPROVE_ENV = "KINEMA_AUTO_APPROVE"
@@ -122,7 +124,8 @@ class _AskUser(AsyncBehavior):
 class WaitForMTCSolutionApproval(_AskUser):
     """Asks the user to approve the planned ``solution`` and succeeds only if they do.
 
-    Kinema's view draws the planned path while the question is open; see the headless rule above.
+    When the solution is a joint trajectory, it is published for ``kinema view``, which draws the tool's
+    path while the question is open; see the headless rule above.
     """
 
     subcategory = "User Input"
@@ -139,6 +142,10 @@ class WaitForMTCSolutionApproval(_AskUser):
         return "Approve the planned motion?"
 
     async def do_work(self) -> bool:
+        solution = self.get_input_or("solution", None)
+        if getattr(solution, "__msgtype__", None) == "trajectory_msgs/msg/JointTrajectory":
+            # Show what is being approved: kinema view draws the tool's path along it.
+            publish_planned_trajectory(self, solution)
         return await self.ask()
 
 
