@@ -19,14 +19,19 @@ SUBCATEGORY = "Vector Handling"
 
 def _vector_ports(*extra: PortInfo) -> list[PortInfo]:
     return [
-        input_port("input_vector", None, "{vector}", "The vector to edit (any element type)."),
+        input_port(
+            "input_vector",
+            None,
+            "{vector}",
+            "The vector to edit (any element kind). MoveIt Pro's default is not public; Kinema's: {vector}.",
+        ),
         *extra,
         output_port(
             "output_vector",
             None,
             "{vector}",
-            "The edited vector; the corpus points it at the same entry as input_vector, so that is the "
-            "default.",
+            "The edited vector. MoveIt Pro's objectives point it at the same entry as input_vector, so "
+            "that is Kinema's default.",
         ),
     ]
 
