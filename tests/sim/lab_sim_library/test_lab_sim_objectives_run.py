@@ -213,3 +213,52 @@ def test_pose_subtrees_run_on_their_own(library_cell: LibraryCell, name: str) ->
     "MPC Pose Tracking" waypoint and forward kinematics are there."""
     result = run(library_cell, name)
     assert result.succeeded, result
+
+
+RECORD_IN_KINEMAS_CELL = """<root BTCPP_format="4" main_tree_to_execute="Plan and Save Over the Table">
+  <BehaviorTree ID="Plan and Save Over the Table">
+    <Sequence>
+      <SubTree ID="Move to Waypoint" waypoint_name="Workspace Right" joint_group_name="manipulator" />
+      <Action ID="ResetPoseStampedVector" vector="{target_poses}" />
+      <Action ID="CreatePoseStamped" reference_frame="world" position_xyz="0.6; -0.3; 1.1"
+              orientation_xyzw="0;-1;0;0" pose_stamped="{pose}" />
+      <Action ID="PushBackVector" input_vector="{target_poses}" element="{pose}"
+              output_vector="{target_poses}" />
+      <Action ID="CreatePoseStamped" reference_frame="world" position_xyz="0.6; 0.3; 1.0"
+              orientation_xyzw="0;-1;0;0" pose_stamped="{pose}" />
+      <Action ID="PushBackVector" input_vector="{target_poses}" element="{pose}"
+              output_vector="{target_poses}" />
+      <Action ID="PlanCartesianPath" path="{target_poses}" planning_group_name="manipulator"
+              tip_links="grasp_link" ik_cartesian_space_density="0.01" ik_joint_space_density="0.1"
+              blending_radius="0.02" trajectory_timing="[{mode: time_optimal}]"
+              joint_trajectory_msg="{joint_trajectory_msg}" debug_solution="{debug_solution}" />
+      <Action ID="WaitForMTCSolutionApproval" solution="{debug_solution}" />
+      <Action ID="SaveJointTrajectoryToYaml" yaml_filename="~/user_ws/src/lab_sim/objectives/joint_trajectory"
+              message="{joint_trajectory_msg}" overwrite="true" />
+    </Sequence>
+  </BehaviorTree>
+</root>"""
+
+
+def test_a_trajectory_saved_the_way_plan_and_save_does_is_replayed_by_load_and_execute(
+    library_cell: LibraryCell, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A "Plan and Save Trajectory" with poses over Kinema's table (approved by the headless rule), then
+    MoveIt Pro's unchanged "Load and Execute Joint Trajectory": the arm ends where the new plan ends.
+    (overwrite is set here: Kinema's SaveJointTrajectoryToYaml keeps an existing file by default.)"""
+    from kinema.motion import RobotDescription, fk
+
+    monkeypatch.setenv("KINEMA_AUTO_APPROVE", "1")
+    saved = library_cell.objectives / "joint_trajectory.yaml"
+    before = saved.read_text()
+    result = library_cell.client.start(xml=RECORD_IN_KINEMAS_CELL).result(RUN_TIMEOUT)
+    assert result.succeeded, result
+    assert saved.read_text() != before
+    result = run(library_cell, "Load and Execute Joint Trajectory")
+    assert result.succeeded, result
+    end = settled_arm(library_cell)
+    assert np.abs(end - last_point(library_cell, "joint_trajectory.yaml")).max() < 0.02
+    model = RobotDescription.lab_sim().load_model()
+    q = np.zeros(len(model.joint_names))
+    q[[model.joint_names.index(j) for j in ARM]] = end
+    assert fk(model, q, "grasp_link")[:3, 3] == pytest.approx([0.6, 0.3, 1.0], abs=0.01)
