@@ -235,3 +235,20 @@ def test_collision_and_graspable_objects_unpack(behavior: Any, context: Behavior
     assert fields.outputs["id"] == "table" and fields.outputs["header"].frame_id == "world"
     assert list(fields.outputs["primitives"][0].dimensions) == [1.0, 2.0, 0.1]
     assert fields.outputs["primitive_poses"][0].position.z == 0.5 and fields.outputs["operation"] == 0
+
+
+def test_writing_an_element_into_an_entry_of_another_type_fails_the_behavior(
+    registry: Any, context: BehaviorContext
+) -> None:
+    body = (
+        POSES
+        + """
+        <Action ID="GetSizeOfVector" vector_in="{poses}" vector_size="{n}"/>
+        <Action ID="GetElementOfVector" vector_in="{poses}" index="0" element="{n}"/>
+        """
+    )
+    result = run_objective(_xml(body), registry=registry, context=context)
+    assert result.status == NodeStatus.FAILURE
+    message = result.toasts[-1]
+    assert "port [element] cannot take a geometry_msgs/msg/PoseStamped message" in message, message
+    assert "[int]" in message, message

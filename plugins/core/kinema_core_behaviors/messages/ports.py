@@ -147,6 +147,19 @@ def read_input(node: Any, port: str, type: Any = None) -> Any:
         raise port_error(node, port, problem, _expected(node, port)) from None
 
 
+def write_output(node: Any, port: str, value: Any) -> None:
+    """``set_output`` whose failure (the entry holds another type) is a :class:`PortValueError`.
+
+    Raises:
+        PortValueError: naming the port, the value and the type the blackboard entry already holds.
+    """
+    try:
+        node.set_output(port, value)
+    except BTError as error:
+        detail = error.message.split("once declared, the type of a port shall not change. ")[-1]
+        raise port_error(node, port, f"cannot take {shown(value)}: {detail}", "") from None
+
+
 def read_text(node: Any, port: str) -> str:
     """An optional text port: its value, or "" when it is not set.
 

@@ -11,7 +11,7 @@ from typing import Any
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
 
-from ..messages.ports import fails_on_bad_input, index_in, port_error, read_input, read_vector
+from ..messages.ports import fails_on_bad_input, index_in, port_error, read_input, read_vector, write_output
 from .element_type import mismatch
 
 SUBCATEGORY = "Vector Handling"
@@ -57,7 +57,7 @@ class PushBackVector(SyncBehavior):
     def tick(self) -> NodeStatus:
         vector = read_vector(self, "input_vector")
         vector.append(_element(self, vector))
-        self.set_output("output_vector", vector)
+        write_output(self, "output_vector", vector)
         return NodeStatus.SUCCESS
 
 
@@ -78,7 +78,7 @@ class InsertInVector(SyncBehavior):
         vector = read_vector(self, "input_vector")
         index = index_in(self, "index", read_input(self, "index"), vector, insert=True)
         vector.insert(index, _element(self, vector))
-        self.set_output("output_vector", vector)
+        write_output(self, "output_vector", vector)
         return NodeStatus.SUCCESS
 
 
@@ -95,7 +95,7 @@ class RemoveFromVector(SyncBehavior):
     def tick(self) -> NodeStatus:
         vector = read_vector(self, "input_vector")
         del vector[index_in(self, "index", read_input(self, "index"), vector)]
-        self.set_output("output_vector", vector)
+        write_output(self, "output_vector", vector)
         return NodeStatus.SUCCESS
 
 
@@ -116,5 +116,5 @@ class ReplaceInVector(SyncBehavior):
         vector = read_vector(self, "input_vector")
         index = index_in(self, "index", read_input(self, "index"), vector)
         vector[index] = _element(self, vector)
-        self.set_output("output_vector", vector)
+        write_output(self, "output_vector", vector)
         return NodeStatus.SUCCESS

@@ -14,7 +14,7 @@ from kinema.behaviors import NodeStatus, PortInfo, input_port, output_port
 from kinema.behaviors.base import Behavior
 from kinema.bt import DecoratorNode
 
-from ..messages.ports import PortValueError, read_vector
+from ..messages.ports import PortValueError, read_vector, write_output
 
 IDLE, RUNNING, SUCCESS, FAILURE, SKIPPED = (
     NodeStatus.IDLE,
@@ -58,8 +58,12 @@ class _VectorLoop(Behavior, DecoratorNode):
         while self._position < len(self._elements):
             prev = child.status
             if prev is IDLE:
-                self.set_output("out", self._elements[self._position])
-                self.set_output("index", self._position)
+                try:
+                    write_output(self, "out", self._elements[self._position])
+                    write_output(self, "index", self._position)
+                except PortValueError as error:
+                    self.logger.publish_failure(error.message)
+                    return self._finish(FAILURE)
             status = child.execute_tick()
             if status is RUNNING:
                 return RUNNING

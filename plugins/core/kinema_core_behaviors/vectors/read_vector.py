@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
 
-from ..messages.ports import fails_on_bad_input, index_in, read_input, read_vector
+from ..messages.ports import fails_on_bad_input, index_in, read_input, read_vector, write_output
 
 
 class GetElementOfVector(SyncBehavior):
@@ -23,7 +23,7 @@ class GetElementOfVector(SyncBehavior):
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
         vector = read_vector(self, "vector_in")
-        self.set_output("element", vector[index_in(self, "index", read_input(self, "index"), vector)])
+        write_output(self, "element", vector[index_in(self, "index", read_input(self, "index"), vector)])
         return NodeStatus.SUCCESS
 
 
