@@ -75,7 +75,12 @@ def primitives_of(message: Any, frames: FrameTree | None) -> list[CollisionObjec
         shapes.append(
             primitive(int(shape.type), [float(d) for d in shape.dimensions], placed, f"{name} primitive {k}")
         )
-    for k, (mesh, pose) in enumerate(zip(message.meshes, message.mesh_poses, strict=False)):
+    if len(message.mesh_poses) != len(message.meshes):
+        raise ObjectiveError(
+            f"collision object {name!r} has {len(message.meshes)} meshes but "
+            f"{len(message.mesh_poses)} mesh_poses"
+        )
+    for k, (mesh, pose) in enumerate(zip(message.meshes, message.mesh_poses, strict=True)):
         vertices = np.array([[v.x, v.y, v.z] for v in mesh.vertices], dtype=float)
         if len(vertices) == 0:
             raise ObjectiveError(f"collision object {name!r} mesh {k} has no vertices")

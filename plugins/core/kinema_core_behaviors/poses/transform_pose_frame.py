@@ -32,6 +32,9 @@ class TransformPoseFrame(SyncBehavior):
     def tick(self) -> NodeStatus:
         source, matrix = pose_matrix(read_message(self, "input_pose"), "input_pose")
         target = str(self.get_input("target_frame_id"))
+        if source == target or {source, target} <= {"", "world"}:
+            self.set_output("output_pose", pose_stamped_message(target, matrix))
+            return NodeStatus.SUCCESS
         try:
             result = current_frame_tree(self).transform(matrix, source, target)
         except KinemaError as error:
