@@ -9,39 +9,18 @@ Pro's core library does beside lab_sim. Files the objectives save land in that t
 from __future__ import annotations
 
 import shutil
-import threading
 from collections.abc import Callable, Iterator
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
 import pytest
+from lab_sim_library_cell import LibraryCell
 
 from kinema.resources import bundled_dir
 from kinema.transport import free_endpoint
 
 SHARED = Path(__file__).resolve().parents[3].parent / "shared"
 CORPUS = SHARED / "compat" / "moveit_pro" / "lab_sim" / "objectives"
-
-
-@dataclass
-class LibraryCell:
-    """A running lab_sim cell whose lab_sim objectives are MoveIt Pro's."""
-
-    client: Any
-    node: Any
-    objectives: Path
-    _topics: dict[str, list[Any]] = field(default_factory=dict)
-    _lock: threading.Lock = field(default_factory=threading.Lock)
-
-    def listen(self, msg_type: str, topic: str, *, latched: bool = False) -> list[Any]:
-        """Keep every message on ``topic`` from now on; the list fills as they arrive."""
-        with self._lock:
-            if topic not in self._topics:
-                box: list[Any] = []
-                self._topics[topic] = box
-                self.node.create_subscription(msg_type, topic, box.append, latched=latched)
-            return self._topics[topic]
 
 
 def _workspace(root: Path) -> Path:

@@ -14,8 +14,7 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-
-from conftest import LibraryCell
+from lab_sim_library_cell import LibraryCell
 
 pytestmark = pytest.mark.slow
 
