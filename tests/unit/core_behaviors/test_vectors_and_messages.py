@@ -252,3 +252,31 @@ def test_writing_an_element_into_an_entry_of_another_type_fails_the_behavior(
     message = result.toasts[-1]
     assert "port [element] cannot take a geometry_msgs/msg/PoseStamped message" in message, message
     assert "[int]" in message, message
+
+
+def test_a_collision_object_is_created_from_its_fields_and_unpacks_to_them(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    from kinema.transport import from_dict
+
+    box = from_dict("shape_msgs/msg/SolidPrimitive", {"type": 1, "dimensions": [0.1, 0.2, 0.3]})
+    where = from_dict("geometry_msgs/msg/Pose", {"position": {"z": 0.4}, "orientation": {"w": 1.0}})
+    header = from_dict("std_msgs/msg/Header", {"frame_id": "world"})
+    created = tick_behavior(
+        behavior("CreateCollisionObjectMessage"),
+        {"id": "crate", "header": header, "primitives": [box], "primitive_poses": [where]},
+        context=context,
+    )
+    assert created.status == NodeStatus.SUCCESS, created.toasts
+    crate = created.outputs["collision_object"]
+    fields = tick_behavior(
+        behavior("UnpackCollisionObjectMessage"), {"collision_object": crate}, context=context
+    )
+    assert fields.outputs["id"] == "crate" and fields.outputs["header"].frame_id == "world"
+    assert list(fields.outputs["primitives"][0].dimensions) == pytest.approx([0.1, 0.2, 0.3])
+    assert fields.outputs["primitive_poses"][0].position.z == 0.4
+    missing_pose = tick_behavior(
+        behavior("CreateCollisionObjectMessage"), {"id": "crate", "primitives": [box]}, context=context
+    )
+    assert missing_pose.status == NodeStatus.FAILURE
+    assert "port [primitive_poses] has 0 poses for 1 primitives" in missing_pose.toasts[-1]

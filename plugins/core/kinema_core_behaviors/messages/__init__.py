@@ -7,6 +7,7 @@ the conversions between messages and numpy (:mod:`.conversions`), which every fa
 from __future__ import annotations
 
 from .collision_object import (
+    CreateCollisionObjectMessage,
     CreateGraspableObjectMessage,
     UnpackCollisionObjectMessage,
     UnpackGraspableObjectMessage,
@@ -37,6 +38,7 @@ BEHAVIORS = (
     UnpackStringMessage,
     CreateRobotState,
     UnpackRobotStateMessage,
+    CreateCollisionObjectMessage,
     UnpackCollisionObjectMessage,
     CreateGraspableObjectMessage,
     UnpackGraspableObjectMessage,

@@ -2,15 +2,22 @@
 
 from __future__ import annotations
 
+from typing import Any
+
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
 
 from .ports import (
+    NO_DEFAULT,
     fails_on_bad_input,
     message_input,
     message_output,
     message_vector_output,
+    port_error,
+    read_input,
     read_message,
     read_text,
+    read_vector,
+    shown,
 )
 
 COLLISION_OBJECT = "moveit_msgs/msg/CollisionObject"
@@ -43,6 +50,84 @@ def _output(port: str, ros_type: str | None, vector: bool, description: str) -> 
     if vector:
         return message_vector_output(port, ros_type, default, description)
     return message_output(port, ros_type, default, description)
+
+
+def _input(port: str, ros_type: str | None, vector: bool, description: str) -> PortInfo:
+    if ros_type is None:
+        plain = list[str] if vector else (int if port == "operation" else str)
+        return input_port(port, plain, 0 if port == "operation" else NO_DEFAULT, description)
+    if vector:
+        # Untyped, so a vector built by PushBackVector (a vector of any) connects; elements are checked
+        # when read.
+        return input_port(port, None, NO_DEFAULT, f"{description} (std::vector<{ros_type}>)")
+    return message_input(port, ros_type, NO_DEFAULT, description)
+
+
+def _field_value(node: Any, port: str, ros_type: str | None, vector: bool) -> Any:
+    from kinema.transport.messages import to_dict
+
+    if ros_type is None:
+        value = read_input(node, port)
+        if port == "operation":
+            if int(value) not in (0, 1, 2, 3):
+                raise port_error(node, port, f"= {value}", "valid: 0 add, 1 remove, 2 append, 3 move")
+            return int(value)
+        return [str(v) for v in value] if vector else str(value)
+    if not vector:
+        return to_dict(read_message(node, port))
+    items = read_vector(node, port)
+    wrong = [i for i, item in enumerate(items) if getattr(item, "__msgtype__", None) != ros_type]
+    if wrong:
+        raise port_error(
+            node, port, f"element {wrong[0]} is {shown(items[wrong[0]])}", f"expected {ros_type}"
+        )
+    return [to_dict(item) for item in items]
+
+
+SHAPES_AND_POSES = (
+    ("primitives", "primitive_poses"),
+    ("meshes", "mesh_poses"),
+    ("planes", "plane_poses"),
+    ("subframe_names", "subframe_poses"),
+)
+
+
+class CreateCollisionObjectMessage(SyncBehavior):
+    """Builds a ``moveit_msgs/CollisionObject`` from the fields given (the others keep ROS defaults).
+
+    Each list of shapes needs one pose per shape (``primitives``/``primitive_poses`` and so on).
+    """
+
+    subcategory = "Messages"
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            *(_input(port, ros_type, vector, text) for port, _, ros_type, vector, text in _FIELDS),
+            message_output("collision_object", COLLISION_OBJECT, "{collision_object}", "The object."),
+        ]
+
+    @fails_on_bad_input
+    def tick(self) -> NodeStatus:
+        from kinema.transport import from_dict
+
+        given = self.config.input_ports
+        data = {
+            field: _field_value(self, port, ros_type, vector)
+            for port, field, ros_type, vector, _ in _FIELDS
+            if port in given
+        }
+        for shapes, poses in (
+            ("primitives", "primitive_poses"),
+            ("meshes", "mesh_poses"),
+            ("planes", "plane_poses"),
+            ("subframe_names", "subframe_poses"),
+        ):
+            if len(data.get(shapes, [])) != len(data.get(poses, [])):
+                problem = f"has {len(data.get(poses, []))} poses for {len(data.get(shapes, []))} {shapes}"
+                raise port_error(self, poses, problem, f"give one pose per element of {shapes}")
+        self.set_output("collision_object", from_dict(COLLISION_OBJECT, data))
+        return NodeStatus.SUCCESS
 
 
 class UnpackCollisionObjectMessage(SyncBehavior):
