@@ -82,7 +82,7 @@ LINKS: tuple[Link, ...] = (
     Link(
         "linear_rail_base_link",
         "world",
-        geoms=(Geom("rail_pedestal", "box", (0.12, 1.3, 0.36), pos=(0.0, 0.0, 0.36), rgba=DARK),),
+        geoms=(Geom("rail_pedestal", "box", (0.12, 1.4, 0.36), pos=(0.0, 0.0, 0.36), rgba=DARK),),
     ),
     Link(
         "linear_rail_carriage_link",
@@ -91,7 +91,8 @@ LINKS: tuple[Link, ...] = (
         "prismatic",
         axis=(0.0, 1.0, 0.0),
         xyz=(0.0, 0.0, 0.72),
-        limits=(-1.0, 1.0),
+        # +-1.2 m: MoveIt Pro's lab_sim trajectories (joint_trajectory.yaml) drive the rail to 1.175 m.
+        limits=(-1.2, 1.2),
         effort=2000.0,
         velocity=1.0,
         mass=8.0,
@@ -244,6 +245,8 @@ LINKS: tuple[Link, ...] = (
         ),
     ),
     Link("grasp_link", "robotiq_85_base_link", xyz=(0.0, 0.0, TCP_DEPTH)),
+    # MoveIt Pro's lab_sim calls the point between the fingertips "pinch" too.
+    Link("pinch", "grasp_link"),
 )
 
 MIMIC = {

@@ -24,8 +24,10 @@ class SetMujocoState(ServiceClientBehavior["kinema_msgs/srv/SetMujocoState"]):
             input_port(
                 "robot_state",
                 None,
-                "{robot_state}",
-                "Joint positions to set (a RobotJointState, e.g. from CreateRobotState, or a JointState).",
+                "{joint_state_msg}",
+                "Joint positions to set (a RobotState, e.g. from CreateRobotState or "
+                "LoadRobotJointStateFromYaml, or a JointState). The default entry is what MoveIt Pro's "
+                "lab_sim objectives imply ('Load MuJoCo Robot State' writes {joint_state_msg}).",
             ),
             input_port("keyframe", str, "", "MJCF keyframe to reset the whole scene to first ('' for none)."),
             input_port("service_name", str, SET_STATE_SERVICE, "The simulator's SetMujocoState service."),

@@ -39,6 +39,7 @@ from kinema.behaviors.base import Behavior
 from kinema.behaviors.context import BehaviorContext
 from kinema.behaviors.faults import BehaviorExecutionError
 from kinema.behaviors.logger import BehaviorLogger, LogLevel, LogMessage, LogSink
+from kinema.behaviors.message_type import message_type
 from kinema.behaviors.required_inputs import MissingInputsError, get_required_inputs
 from kinema.behaviors.service_client import ServiceClientBehavior
 from kinema.behaviors.sync import StatefulBehavior, SyncBehavior
@@ -66,5 +67,6 @@ __all__ = [
     "bidirectional_port",
     "get_required_inputs",
     "input_port",
+    "message_type",
     "output_port",
 ]

@@ -264,6 +264,13 @@ class Blackboard:
             check_entry_value(key, value)
         entry = self._storage.get(key)
         if entry is None:
+            # BT.CPP keeps a remapped entry in the subtree's own storage once a port has created it, so
+            # a later set finds it and takes the existing-entry path below; do the same here.
+            remapped = self.get_entry(key)
+            if remapped is not None and is_strongly_typed(remapped.type):
+                remapped.value = coerce_into_entry(key, remapped, value)
+                self._written(key, remapped)
+                return
             new_type = None if isinstance(value, str) else python_type_of(value)
             entry = self._create_entry_impl(key, new_type)
             entry.value = value

@@ -307,7 +307,14 @@ class TreeBuilder:
                 mismatch = (
                     existing.strongly_typed and port_info.strongly_typed and existing.type != port_info.type
                 )
-                if mismatch and existing.type is not str:
+                # A value set from outside the tree (Blackboard.set, a test) types its entry by its class;
+                # a port type that accepts that very value (a message type, say) is the same type to it.
+                accepts = (
+                    existing.value is not None
+                    and isinstance(port_info.type, type)
+                    and isinstance(existing.value, port_info.type)
+                )
+                if mismatch and existing.type is not str and not accepts:
                     raise BTRuntimeError(
                         f"The creation of the tree failed because the port [{key}] was initially "
                         f"created with type [{type_name(existing.type)}] and, later type "

@@ -6,6 +6,11 @@ typed by class, parsed from text through an optional ``from_string`` classmethod
 (``AnyTypeAllowed``: no type, no converter). :func:`convert_from_string` mirrors
 ``convertFromString<T>`` (a numeric prefix is enough, booleans are strict, ``a;b;c`` and ``json:[...]``
 vectors) and :func:`cast_value` mirrors ``BT::Any::tryCast`` between stored values.
+
+Doubles written in XML follow BT.CPP 4.8 (``std::stod``), the version MoveIt Pro's objectives are
+written against: leading whitespace and a ``+`` sign are accepted, so ``"0.0; 0.0; 1.0"`` is three
+numbers. BT.CPP 4.9 and later parse with ``std::from_chars`` and reject ``" 0.0"``; Kinema keeps 4.8's
+rule because it only accepts more files, never changes the value of one 4.10 accepts.
 """
 
 from __future__ import annotations
@@ -78,6 +83,49 @@ def parse_double_prefix(text: str) -> float:
     value = float(token)
     if math.isinf(value) and "inf" not in lowered:
         # from_chars reports result_out_of_range instead of rounding to infinity
+        raise ConversionError(f"Value out of bound when converting [{text[:80]}] to double")
+    return value
+
+
+_STOD_SPACE = " \t\n\v\f\r"
+_HEX_FLOAT = re.compile(r"[-+]?0[xX](?:[0-9a-fA-F]+\.?[0-9a-fA-F]*|\.[0-9a-fA-F]+)(?:[pP][-+]?[0-9]+)?")
+_SIGNED_FLOAT = re.compile(r"[-+]?(?:[0-9]+\.?[0-9]*|\.[0-9]+)(?:[eE][-+]?[0-9]+)?")
+_SIGNED_SPECIAL = re.compile(r"[-+]?(?:inf(?:inity)?|nan(?:\([0-9A-Za-z_]*\))?)", re.IGNORECASE)
+DBL_MIN = 2.2250738585072014e-308
+
+
+def parse_double_stod(text: str) -> float:
+    """``convertFromString<double>`` of BT.CPP 4.8 (``std::stod``): strtod's rules on a prefix.
+
+    Leading whitespace is skipped, ``+``/``-`` signs, hex floats (``0x1p3``), ``inf`` and ``nan``
+    are accepted, and parsing stops at the first character that does not continue the number. A
+    result out of double's normal range (overflow, or underflow to zero or a subnormal) raises, as
+    ``std::stod`` does.
+    """
+    body = text.lstrip(_STOD_SPACE)
+    match = _HEX_FLOAT.match(body)
+    if match is not None:
+        token = match.group()
+        mantissa = token.lower().split("p")[0][token.lower().index("x") + 1 :]
+        try:
+            value = float.fromhex(token)
+        except OverflowError:
+            raise ConversionError(f"Value out of bound when converting [{text[:80]}] to double") from None
+    else:
+        special = _SIGNED_SPECIAL.match(body)
+        if special is not None:
+            word = special.group().lower()
+            if "nan" in word:
+                return math.nan
+            return -math.inf if word.startswith("-") else math.inf
+        match = _SIGNED_FLOAT.match(body)
+        if match is None:
+            raise ConversionError(f"Can't convert string [{text}] to double")
+        token = match.group()
+        mantissa = token.lower().split("e")[0]
+        value = float(token)
+    nonzero = any(c not in "0.+-" for c in mantissa)
+    if math.isinf(value) or (nonzero and abs(value) < DBL_MIN):
         raise ConversionError(f"Value out of bound when converting [{text[:80]}] to double")
     return value
 
@@ -236,7 +284,7 @@ def convert_from_string(port_type: Any, text: str, enums: dict[str, int] | None 
     if port_type is Unsigned:
         return _check_unsigned(parse_int_prefix(text), text[:80])
     if port_type is float:
-        return parse_double_prefix(text)
+        return parse_double_stod(text)
     if port_type is bool:
         return parse_bool(text)
     if port_type is NodeStatus:

@@ -33,22 +33,32 @@ def _load_library(workspace: Path | None, config: str | None, verbose: bool) -> 
 @objective.command("list")
 @selection_options
 @click.option(
-    "--json", "as_json", is_flag=True, help='Print {"config", "objectives": [...], "errors": [...]}.'
+    "--json",
+    "as_json",
+    is_flag=True,
+    help='Print {"config", "objectives": [...], "errors": [...], "cannot_load": {id: reason}}.',
+)
+@click.option(
+    "--no-check", is_flag=True, help="Do not load the config's behaviors to check which objectives can load."
 )
 @verbose_option
-def list_(workspace: Path | None, config: str | None, as_json: bool, verbose: bool) -> None:
-    """List the objectives of the config's objective libraries.
+def list_(workspace: Path | None, config: str | None, as_json: bool, no_check: bool, verbose: bool) -> None:
+    """List the objectives of the config's objective libraries, and which of them cannot load and why.
 
-    Columns: R = runnable (subtree-only objectives are not), * = favorite. Files that cannot be read are
-    reported as file:line: message on stderr; the other objectives are still listed.
+    Columns: R = runnable (subtree-only objectives are not), * = favorite, ! = cannot load. Each objective
+    that cannot load (its file or a SubTree it reaches does not validate against the config's behaviors)
+    is listed after the table, one line each, with the first problem as file:line: message. Files that
+    cannot be read are reported as file:line: message on stderr; the other objectives are still listed.
     """
     library = _load_library(workspace, config, verbose)
     objectives = library.sorted()
+    problems = {} if no_check else _load_problems(library)
     if as_json:
         payload = {
             "config": library.resolved.name if library.resolved else None,
             "objectives": [info.to_json() for info in objectives],
             "errors": [str(error) for error in library.errors],
+            "cannot_load": problems,
         }
         click.echo(json.dumps(payload, indent=2))
         return
@@ -61,7 +71,27 @@ def list_(workspace: Path | None, config: str | None, as_json: bool, verbose: bo
     category_width = max(len(info.subcategory or "-") for info in objectives)
     for info in objectives:
         flags = ("R" if info.runnable else "-") + ("*" if info.favorite else " ")
+        if problems:  # the third column only when something cannot load, so the usual table keeps its shape
+            flags += "!" if info.id in problems else " "
         click.echo(f"{flags} {info.id:<{width}}  {info.subcategory or '-':<{category_width}}  {info.package}")
+    if problems:
+        click.echo(f"\n{len(problems)} of {len(objectives)} objectives cannot load:")
+        for objective_id, problem in problems.items():
+            click.echo(f"  {objective_id}: {problem}")
+
+
+def _load_problems(library: ObjectiveLibrary) -> dict[str, str]:
+    """Objective ID -> why it cannot load, against the behaviors the config loads."""
+    from kinema.plugins import BehaviorHost
+    from kinema.runtime.library_check import library_problems
+
+    if library.resolved is None:
+        return {}
+    host = BehaviorHost.for_config(library.resolved)
+    report = host.load()
+    for error in report.errors:
+        click.secho(f"warning: {error}", err=True, fg="yellow")
+    return library_problems(library, host.registry.create_factory())
 
 
 @objective.command()

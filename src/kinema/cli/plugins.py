@@ -83,11 +83,23 @@ def plugins(workspace: Path | None, config: str | None, as_json: bool) -> None:
 @click.option(
     "--json", "as_json", is_flag=True, help="Print JSON: each behavior with its ports and metadata."
 )
+@click.option(
+    "--markdown",
+    is_flag=True,
+    help="Print the behavior reference as Markdown (by subcategory; ports with direction, type, default).",
+)
 @click.argument("behavior_ids", nargs=-1, metavar="[ID]...")
 def behaviors(
-    workspace: Path | None, config: str | None, as_json: bool, behavior_ids: tuple[str, ...]
+    workspace: Path | None,
+    config: str | None,
+    as_json: bool,
+    markdown: bool,
+    behavior_ids: tuple[str, ...],
 ) -> None:
-    """List the behaviors the active config can use, with their ports and metadata (or only ID...)."""
+    """List the behaviors the active config can use, with their ports and metadata (or only ID...).
+
+    With --markdown, print them as a behavior reference (docs/behavior-reference.md is this for lab_sim).
+    """
     from kinema.errors import PluginError, did_you_mean
 
     host, report, _name = _load(workspace, config)
@@ -100,6 +112,10 @@ def behaviors(
     chosen = [registry[i] for i in (behavior_ids or sorted(registry))]
     if as_json:
         click.echo(json.dumps([_behavior_json(record) for record in chosen], indent=2))
+    elif markdown:
+        from kinema.plugins.reference import reference_markdown
+
+        click.echo(reference_markdown(chosen), nl=False)
     else:
         for record in chosen:
             _print_behavior(record)

@@ -67,6 +67,13 @@ from kinema.cli.options import selection_options
     help="Do not record objective runs (by default each run is saved as a .btlog file Groot2 replays; "
     "see `kinema logs --recordings`).",
 )
+@click.option(
+    "--auto-approve",
+    is_flag=True,
+    help="Grant every approval and breakpoint without asking (WaitForMTCSolutionApproval, "
+    "BreakpointSubscriber; each is logged as a warning). Without it, a headless run has no user to ask "
+    "and approvals fail.",
+)
 def run(
     workspace: Path | None,
     config: str | None,
@@ -83,6 +90,7 @@ def run(
     sim_speed: str | None,
     groot2_port: int | None,
     no_record: bool,
+    auto_approve: bool,
 ) -> None:
     """Start Kinema: host the zenoh router (or join one), the agent and the config's drivers.
 
@@ -107,6 +115,13 @@ def run(
         parse_sim_speed(sim_speed)  # refuse a bad value here rather than in the driver's log
     found, name = resolve_selection(workspace, config)
     from kinema.runtime.launcher import Launcher, LaunchOptions
+
+    if auto_approve:
+        import os
+
+        # Read by the approval behaviors in the agent process, which inherits this environment.
+        os.environ["KINEMA_AUTO_APPROVE"] = "1"
+        click.echo("approvals and breakpoints are granted automatically (--auto-approve)")
 
     ui = None
     if not headless:

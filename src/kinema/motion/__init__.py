@@ -25,6 +25,7 @@ _EXPORTS = {
     "RobotDescription": "description",
     "fk": "kinematics",
     "frame_poses": "kinematics",
+    "FrameTree": "frames",
     "ik": "inverse_kinematics",
     "IkOptions": "inverse_kinematics",
     "PlanningScene": "planning_scene",

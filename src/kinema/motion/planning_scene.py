@@ -1,8 +1,16 @@
-"""The planning scene: collision objects in the world the robot must not touch (table, tray, walls, ...)."""
+"""The planning scene: collision objects in the world the robot must not touch (table, tray, walls, ...).
+
+Two kinds of objects live in it. The *environment* is what the config's cell is made of (the static geoms
+of its MuJoCo scene); it is always there. *World objects* are what objectives add at run time
+(``AddCollisionBox``, ``AddCollisionObject``), each under an id as in MoveIt, made of one or more
+primitives; :meth:`PlanningScene.reset_world` removes them all and leaves the environment. Planning
+checks both; listeners (the runtime's publisher for ``kinema view``) hear of every change.
+"""
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+import threading
+from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -31,30 +39,154 @@ class CollisionObject:
     world_T_object: np.ndarray
 
 
+_SIZE_COUNTS = {"box": 3, "cylinder": 2, "capsule": 2, "sphere": 1}
+
+
+def check_shape(obj: CollisionObject) -> None:
+    """Raise :class:`MotionError` unless ``obj`` has a known shape, the right sizes and a finite pose."""
+    if obj.shape not in _SIZE_COUNTS:
+        raise MotionError(
+            f"unknown collision shape {obj.shape!r} for {obj.name!r}; {did_you_mean(obj.shape, SHAPES)}"
+        )
+    if len(obj.size) != _SIZE_COUNTS[obj.shape]:
+        raise MotionError(
+            f"a {obj.shape} needs {_SIZE_COUNTS[obj.shape]} size values, {obj.name!r} has {len(obj.size)}"
+        )
+    if not all(np.isfinite(v) and v >= 0 for v in obj.size):
+        raise MotionError(f"the sizes of {obj.name!r} must be finite and >= 0 m, got {list(obj.size)}")
+    if np.shape(obj.world_T_object) != (4, 4) or not np.all(np.isfinite(obj.world_T_object)):
+        raise MotionError(f"the pose of {obj.name!r} must be a finite 4x4 transform")
+
+
 @dataclass
 class PlanningScene:
-    """The obstacles planning checks against, by name. ``version`` changes whenever the scene does."""
+    """The obstacles planning checks against, by name. ``version`` changes whenever the scene does.
+
+    Attributes:
+        objects: every primitive the planner checks (environment and world objects), by unique name.
+        world: the world objects added at run time: id -> names of its primitives in :attr:`objects`.
+        version: incremented on every change.
+    """
 
     objects: dict[str, CollisionObject] = field(default_factory=dict)
     version: int = 0
+    world: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    _listeners: list[Callable[[PlanningScene], None]] = field(default_factory=list, repr=False)
+    _lock: threading.RLock = field(default_factory=threading.RLock, repr=False)
 
     def add(self, obj: CollisionObject) -> None:
-        """Add or replace an object.
+        """Add or replace an environment primitive.
 
         Raises:
             MotionError: unknown shape or wrong number of size values.
         """
-        expected = {"box": 3, "cylinder": 2, "capsule": 2, "sphere": 1}
-        if obj.shape not in expected:
-            raise MotionError(
-                f"unknown collision shape {obj.shape!r} for {obj.name!r}; {did_you_mean(obj.shape, SHAPES)}"
+        check_shape(obj)
+        with self._lock:
+            self.objects[obj.name] = obj
+            self.version += 1
+        self._changed()
+
+    # -- world objects -----------------------------------------------------------------------------
+
+    def add_world_object(
+        self, object_id: str, primitives: Sequence[CollisionObject], *, replace: bool = True
+    ) -> None:
+        """Add world object ``object_id`` made of ``primitives`` (their names are ignored).
+
+        Args:
+            object_id: the object's id (MoveIt's ``CollisionObject.id``).
+            primitives: its shapes, each placed in the world.
+            replace: replace an object of the same id; when False an existing id is an error.
+
+        Raises:
+            MotionError: empty id, no primitive, a bad shape, an id taken by the environment, or an
+                existing id without ``replace``.
+        """
+        if not object_id:
+            raise MotionError("a collision object needs a non-empty id")
+        if not primitives:
+            raise MotionError(f"collision object {object_id!r} has no shape")
+        names = [object_id] if len(primitives) == 1 else [f"{object_id}/{k}" for k in range(len(primitives))]
+        placed = [
+            CollisionObject(
+                name, p.shape, tuple(float(v) for v in p.size), np.asarray(p.world_T_object, float)
             )
-        if len(obj.size) != expected[obj.shape]:
-            raise MotionError(
-                f"a {obj.shape} needs {expected[obj.shape]} size values, {obj.name!r} has {len(obj.size)}"
-            )
-        self.objects[obj.name] = obj
-        self.version += 1
+            for name, p in zip(names, primitives, strict=True)
+        ]
+        for obj in placed:
+            check_shape(obj)
+        with self._lock:
+            if object_id in self.world:
+                if not replace:
+                    raise MotionError(
+                        f"collision object {object_id!r} is already in the planning scene "
+                        "(overwrite it to replace it)"
+                    )
+                for name in self.world[object_id]:
+                    self.objects.pop(name, None)
+            taken = [n for n in names if n in self.objects]
+            if taken:
+                raise MotionError(
+                    f"collision object id {object_id!r} is the name of part of the cell's environment; "
+                    "pick another id"
+                )
+            for obj in placed:
+                self.objects[obj.name] = obj
+            self.world[object_id] = tuple(names)
+            self.version += 1
+        self._changed()
+
+    def remove_world_object(self, object_id: str) -> None:
+        """Remove world object ``object_id``.
+
+        Raises:
+            MotionError: no such world object (the message lists those there are).
+        """
+        with self._lock:
+            if object_id not in self.world:
+                raise MotionError(
+                    f"no collision object {object_id!r} in the planning scene; "
+                    f"{did_you_mean(object_id, self.world)}"
+                )
+            for name in self.world.pop(object_id):
+                self.objects.pop(name, None)
+            self.version += 1
+        self._changed()
+
+    def world_object(self, object_id: str) -> list[CollisionObject]:
+        """The primitives of world object ``object_id`` (an empty list when there is none)."""
+        with self._lock:
+            return [self.objects[n] for n in self.world.get(object_id, ())]
+
+    def world_objects(self) -> dict[str, list[CollisionObject]]:
+        """Every world object: id -> its primitives (a snapshot)."""
+        with self._lock:
+            return {oid: [self.objects[n] for n in names] for oid, names in self.world.items()}
+
+    def reset_world(self) -> int:
+        """Remove every world object (the environment stays); returns how many were removed."""
+        with self._lock:
+            count = len(self.world)
+            if not count:
+                return 0
+            for names in self.world.values():
+                for name in names:
+                    self.objects.pop(name, None)
+            self.world.clear()
+            self.version += 1
+        self._changed()
+        return count
+
+    # -- listeners ---------------------------------------------------------------------------------
+
+    def subscribe(self, listener: Callable[[PlanningScene], None]) -> None:
+        """Call ``listener(scene)`` after every change (on the thread that made it; it must not block)."""
+        with self._lock:
+            self._listeners.append(listener)
+
+    def _changed(self) -> None:
+        for listener in list(self._listeners):
+            listener(self)
 
     def add_box(self, name: str, half_extents: Iterable[float], world_T_object: np.ndarray) -> None:
         """Add a box with half extents (x, y, z) in metres at ``world_T_object`` (shape ``(4, 4)``)."""
@@ -70,12 +202,21 @@ class PlanningScene:
         Raises:
             MotionError: no such object, with the names there are.
         """
-        if name not in self.objects:
-            raise MotionError(
-                f"no collision object {name!r} in the planning scene; {did_you_mean(name, self.objects)}"
-            )
-        del self.objects[name]
-        self.version += 1
+        with self._lock:
+            if name not in self.objects:
+                raise MotionError(
+                    f"no collision object {name!r} in the planning scene; {did_you_mean(name, self.objects)}"
+                )
+            del self.objects[name]
+            for object_id, names in list(self.world.items()):
+                if name in names:
+                    rest = tuple(n for n in names if n != name)
+                    if rest:
+                        self.world[object_id] = rest
+                    else:
+                        del self.world[object_id]
+            self.version += 1
+        self._changed()
 
     @classmethod
     def from_mjcf(

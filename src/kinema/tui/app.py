@@ -24,6 +24,7 @@ from textual.screen import Screen
 
 from kinema.tui.blackboard_model import BlackboardModel
 from kinema.tui.connection import (
+    ApprovalRequested,
     BlackboardSnapshot,
     ClockSample,
     ConnectionChanged,
@@ -254,9 +255,20 @@ class KinemaApp(App[None]):
                     self.notify(f"{where}{event.message}", title="Reload failed", severity="error", timeout=8)
             elif isinstance(event, ObjectivesChanged):
                 self._views_call(lambda view: view.runtime_objectives_changed())
+            elif isinstance(event, ApprovalRequested):
+                self.ask_approval(event)
         if status_changed:
             for view in self.views:
                 view.show_status(self.status)
+
+    def ask_approval(self, request: ApprovalRequested) -> None:
+        """Show a behavior's question (approve a motion, resume a breakpoint); the answer goes back to it."""
+
+        def answered(approved: bool | None) -> None:
+            request.answer(bool(approved), "" if approved else "declined in the TUI")
+
+        question = f"{request.prompt}\n({request.behavior} at {request.node_path})"
+        self.push_screen(ConfirmDialog(question, confirm_label="Approve"), answered)
 
     def add_log(self, entry: LogEntry, *, toast: bool = False) -> None:
         """Keep ``entry`` for the Logs screen and, for runtime toasts, show it as a notification."""

@@ -212,6 +212,23 @@ class ObjectivesChanged:
     """The runtime's objective library changed (an objective file was saved): list it again."""
 
 
+@dataclass(frozen=True)
+class ApprovalRequested:
+    """A behavior asks the user (WaitForMTCSolutionApproval, BreakpointSubscriber) and waits for the answer.
+
+    Attributes:
+        prompt: the question.
+        behavior: the behavior ID that asks.
+        node_path: its node in the running tree.
+        answer: call once with ``(approved, message)``; any thread.
+    """
+
+    prompt: str
+    behavior: str
+    node_path: str
+    answer: Callable[[bool, str], None] = field(compare=False, repr=False)
+
+
 RuntimeEvent = (
     ConnectionChanged
     | Heartbeat
@@ -221,6 +238,7 @@ RuntimeEvent = (
     | ClockSample
     | ReloadNotice
     | ObjectivesChanged
+    | ApprovalRequested
 )
 EventListener = Callable[[RuntimeEvent], None]
 

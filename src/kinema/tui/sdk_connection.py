@@ -21,6 +21,7 @@ from xml.sax.saxutils import quoteattr
 
 from kinema.errors import KinemaError, ObjectiveError, TransportError
 from kinema.tui.connection import (
+    ApprovalRequested,
     BehaviorSummary,
     BlackboardEntry,
     BlackboardSnapshot,
@@ -55,6 +56,9 @@ HEARTBEAT_TIMEOUT_S = 3.0
 RECONNECT_AFTER_S = 6.0
 RETRY_PERIOD_S = 1.0
 CALL_TIMEOUT_S = 5.0
+# The service the core approval behaviors call to ask the user (kinema_core_behaviors/ui/approval.py).
+APPROVAL_SERVICE = "/kinema/user_approval"
+APPROVAL_TYPE = "kinema_msgs/srv/RequestApproval"
 #: The objective MoveIt Pro (and Kinema's core library) moves to a waypoint with.
 MOVE_TO_WAYPOINT_OBJECTIVE = "Move to Waypoint"
 MOVE_TO_WAYPOINT_TREE = "Move to Waypoint (from the UI)"
@@ -215,6 +219,11 @@ class SdkConnection:
             )
             node.create_subscription(names.LOG_TYPE, names.LOG, self._on_log)
             node.create_subscription(names.CLOCK_TYPE, names.CLOCK, self._on_clock)
+            # While the TUI is attached it is the user the approval behaviors ask (see ui/approval.py
+            # of the core behaviors): each request waits for the dialog's answer.
+            node.create_service(
+                APPROVAL_TYPE, APPROVAL_SERVICE, self._on_approval, deferred=True, max_concurrent=4
+            )
         except Exception:
             self._drop_client()
             raise
@@ -233,6 +242,15 @@ class SdkConnection:
                 log.debug("closing the SDK client failed", exc_info=True)
 
     # -- stream callbacks (transport threads) --------------------------------------------------
+
+    def _on_approval(self, request: Any, responder: Any) -> None:
+        def answer(approved: bool, message: str) -> None:
+            if not responder.done:
+                responder.reply({"approved": approved, "message": message})
+
+        self._emit(
+            ApprovalRequested(str(request.prompt), str(request.behavior), str(request.node_path), answer)
+        )
 
     def _on_heartbeat(self, message: Any) -> None:
         self._last_heartbeat = time.monotonic()

@@ -5,8 +5,10 @@ A marker is keyed by ``(ns, id)`` as in RViz: a new one with the same key replac
 seconds after it arrived (wall time of the viewer); lifetime 0 keeps it until replaced or deleted.
 
 Shapes: ARROW (by two points, or by pose and scale), CUBE, SPHERE, CYLINDER, LINE_STRIP, LINE_LIST,
-CUBE_LIST / SPHERE_LIST / POINTS (as points), TRIANGLE_LIST. TEXT_VIEW_FACING and MESH_RESOURCE are not
-drawn (meshcat 0.3.2 has no text sprites; mesh resources are ``package://`` files).
+CUBE_LIST / SPHERE_LIST / POINTS (as points), TRIANGLE_LIST, and MESH_RESOURCE for ``file://`` URIs and
+absolute paths of STL, OBJ and DAE files (what VisualizeMesh sends; the file must be on the viewer's
+machine). TEXT_VIEW_FACING and ``package://`` mesh resources are not drawn (meshcat 0.3.2 has no text
+sprites; the viewer does not resolve packages).
 """
 
 from __future__ import annotations
@@ -148,6 +150,8 @@ def marker_shapes(marker: Any, frame: np.ndarray) -> list[MarkerShape]:
         stretch = np.diag([sx / sy if sy else 1.0, 1.0, 1.0, 1.0])
         cylinder = g.Mesh(g.Cylinder(sz, sy / 2), _material(color))
         return [MarkerShape("cylinder", cylinder, pose @ turn @ stretch)]
+    if kind == MESH_RESOURCE:
+        return _mesh_shapes(marker, pose, sx, sy, sz)
     if kind in (LINE_STRIP, LINE_LIST, CUBE_LIST, SPHERE_LIST, POINTS, TRIANGLE_LIST):
         if not points:
             return []
@@ -168,6 +172,36 @@ def marker_shapes(marker: Any, frame: np.ndarray) -> list[MarkerShape]:
         size = max(sx, 0.001)
         return [MarkerShape("points", g.Points(geometry, g.PointsMaterial(size=size)), pose)]
     return []
+
+
+_MESH_LOADERS = {".stl": "StlMeshGeometry", ".obj": "ObjMeshGeometry", ".dae": "DaeMeshGeometry"}
+
+
+def mesh_resource_geometry(uri: str) -> Any | None:
+    """The meshcat geometry of a ``file://`` (or absolute path) STL/OBJ/DAE mesh, or None."""
+    from pathlib import Path
+    from urllib.parse import unquote, urlparse
+
+    parsed = urlparse(uri)
+    if parsed.scheme not in ("", "file"):
+        return None
+    path = Path(unquote(parsed.path))
+    loader = _MESH_LOADERS.get(path.suffix.lower())
+    if loader is None or not path.is_file():
+        return None
+    try:
+        return getattr(g, loader).from_file(str(path))
+    except (OSError, ValueError) as error:
+        log.info("mesh %s cannot be drawn: %s", path, error)
+        return None
+
+
+def _mesh_shapes(marker: Any, pose: np.ndarray, sx: float, sy: float, sz: float) -> list[MarkerShape]:
+    geometry = mesh_resource_geometry(str(marker.mesh_resource))
+    if geometry is None:
+        return []
+    scale = np.diag([sx or 1.0, sy or 1.0, sz or 1.0, 1.0])
+    return [MarkerShape("mesh", g.Mesh(geometry, _material(marker.color)), pose @ scale)]
 
 
 def _point_colors(marker: Any, count: int) -> np.ndarray:

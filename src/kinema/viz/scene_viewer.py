@@ -33,6 +33,7 @@ from kinema.viz import topics
 from kinema.viz.liveness import RuntimeLiveness
 from kinema.viz.markers import MarkerBoard
 from kinema.viz.meshcat_server import Command, MeshcatServer
+from kinema.viz.planning_scene import PlanningSceneLayer
 from kinema.viz.scene_model import ROOT, SceneModel
 
 log = logging.getLogger("kinema.viz")
@@ -75,6 +76,7 @@ class SceneViewer:
         self.frame_rate = frame_rate
         self.liveness = RuntimeLiveness(endpoint or "the router")
         self.markers = MarkerBoard(f"{ROOT}/markers")
+        self.planning_scene = PlanningSceneLayer(f"{ROOT}/planning_scene")
         self.server_id = uuid.uuid4().hex
         self.frames = 0
         self.state_updates = 0
@@ -113,6 +115,9 @@ class SceneViewer:
         node.create_subscription(topics.MARKER_TYPE, topics.MARKER_TOPIC, self._on_marker)
         node.create_subscription(
             topics.PLANNED_TRAJECTORY_TYPE, topics.PLANNED_TRAJECTORY_TOPIC, self._on_planned_trajectory
+        )
+        node.create_subscription(
+            topics.PLANNING_SCENE_TYPE, topics.PLANNING_SCENE_TOPIC, self._on_planning_scene, latched=True
         )
         self._thread.start()
 
@@ -223,6 +228,9 @@ class SceneViewer:
             )
             frame = np.eye(4)
         self.server.send(self.markers.update(marker, frame))
+
+    def _on_planning_scene(self, message: Any) -> None:
+        self.server.send(self.planning_scene.update(message, self.scene.frame_pose))
 
     def _on_planned_trajectory(self, message: Any) -> None:
         positions = [list(point.positions) for point in message.points]

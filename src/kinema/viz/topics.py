@@ -15,3 +15,7 @@ MARKER_ARRAY_TOPIC = "/visualization_marker_array"
 MARKER_ARRAY_TYPE = "visualization_msgs/msg/MarkerArray"
 MARKER_TOPIC = "/visualization_marker"
 MARKER_TYPE = "visualization_msgs/msg/Marker"
+
+# The agent's planning scene (collision objects objectives added), latched; the view draws its objects.
+PLANNING_SCENE_TOPIC = "/monitored_planning_scene"
+PLANNING_SCENE_TYPE = "moveit_msgs/msg/PlanningScene"

@@ -111,7 +111,8 @@ def test_number_concatenation_yields_an_empty_value_that_cannot_be_stored() -> N
         "3foo",
         "0X100.",
         "'open",
-        '"double"',
+        '"open',  # double quotes are strings (BT.CPP 4.8, MoveIt Pro's objectives), but must close
+        "'mixed\"",
         "(1 + 2",
         "1 +",
         "a ? 1",

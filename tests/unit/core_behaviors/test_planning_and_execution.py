@@ -187,7 +187,7 @@ def test_execute_trajectory_sends_the_trajectory_and_tolerances(
         behavior("ExecuteTrajectory"),
         {
             "joint_trajectory_msg": _trajectory(),
-            "goal_position_tolerance": 0.01,
+            "goal_position_tolerance": [0.01],  # a vector, as in MoveIt Pro (one value: every joint)
             "goal_duration_tolerance": 0.5,
         },
         context=context,

@@ -119,7 +119,8 @@ def test_output_ports_default_to_moveit_pros_blackboard_keys(registry: BehaviorR
         for port in registry[behavior_id].ports
         if port.name == "robot_state"
     }
-    assert robot_state == {"{robot_state}"}
+    # 'Load MuJoCo Robot State' loads into {joint_state_msg} and runs SetMujocoState by default wiring.
+    assert robot_state == {"{joint_state_msg}"}
 
 
 def test_every_bundled_objective_builds_against_the_behaviors(registry: BehaviorRegistry) -> None:

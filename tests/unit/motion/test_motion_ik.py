@@ -49,7 +49,7 @@ def test_ik_honours_tight_limits(model, waypoint_q):
     seed = waypoint_q("3 Waypoint Mid Point")
     far = np.eye(4)
     far[:3, :3] = fk(model, seed, "grasp_link")[:3, :3]
-    far[:3, 3] = (0.5, 1.6, 0.95)  # 1.6 m along the rail: beyond the 1 m rail plus the arm's sideways reach
+    far[:3, 3] = (0.5, 2.4, 0.95)  # 2.4 m along the rail: beyond the 1.2 m rail plus the arm's sideways reach
     with pytest.raises(MotionError, match="no IK solution for 'grasp_link' in group 'manipulator'"):
         ik(model, far, seed, options=IkOptions(attempts=4))
 

@@ -41,7 +41,7 @@ def test_srdf_groups_resolve_to_joints(model, group, joints, tip):
 
 def test_limits_combine_urdf_positions_and_yaml_velocities(model):
     rail = model.limits["linear_rail_joint"]
-    assert (rail.lower, rail.upper) == (-1.0, 1.0)
+    assert (rail.lower, rail.upper) == (-1.2, 1.2)
     assert rail.max_velocity == 0.8 and rail.max_acceleration == 2.0
     assert model.limits["robotiq_85_left_knuckle_joint"].upper == pytest.approx(0.7929)
     assert np.all(np.isfinite(model.max_acceleration))

@@ -3,6 +3,10 @@
 Identifiers are ASCII (``[A-Za-z_@][A-Za-z0-9_]*``), strings use single quotes without escapes, and
 a number glued to letters, a dangling ``.`` or an empty exponent (``3foo``, ``65.``, ``0x``, ``3e``)
 is an error token, while ``65..66`` is ``65 .. 66``.
+
+Strings may also be double-quoted (``"place_pose_"``), as BT.CPP up to 4.8 accepts and MoveIt Pro's
+objectives use (written ``&quot;`` inside an XML attribute); 4.9 and later reject the ``"``. Either
+quote may appear inside a string delimited by the other (``"it's"``); there are no escapes.
 """
 
 from __future__ import annotations
@@ -129,8 +133,8 @@ def tokenize(src: str) -> list[Token]:
             i += 1
             continue
         start = i
-        if c == "'":
-            end = src.find("'", i + 1)
+        if c in "'\"":
+            end = src.find(c, i + 1)
             if end < 0:
                 tokens.append(Token(Tok.ERROR, src[start:], start))
                 i = n

@@ -1,0 +1,23 @@
+"""Motion: planning, execution, trajectories, the joint state and the gripper."""
+
+from __future__ import annotations
+
+from .create_stationary_trajectory import CreateStationaryTrajectory
+from .execute_trajectory import ExecuteTrajectory
+from .get_joint_state import GetJointState
+from .get_robot_state_from_trajectory import GetRobotStateFromTrajectory
+from .move_gripper_action import MoveGripperAction
+from .plan_cartesian_path import PlanCartesianPath
+from .plan_to_joint_goal import PlanToJointGoal
+from .validate_trajectory import ValidateTrajectory
+
+BEHAVIORS = (
+    CreateStationaryTrajectory,
+    ExecuteTrajectory,
+    GetJointState,
+    GetRobotStateFromTrajectory,
+    MoveGripperAction,
+    PlanCartesianPath,
+    PlanToJointGoal,
+    ValidateTrajectory,
+)

@@ -1,0 +1,217 @@
+"""ExecuteTrajectory: run a timed joint trajectory on the robot's trajectory controller."""
+
+from __future__ import annotations
+
+import asyncio
+import time
+from typing import Any
+
+from kinema.behaviors import AsyncBehavior, PortInfo, input_port
+from kinema.behaviors.work_runner import RUNNER
+from kinema.errors import KinemaError, ObjectiveError, TransportError
+
+from ..messages.conversions import duration, trajectory_from_message
+from .planned_trajectory import publish_planned_trajectory
+
+FOLLOW_JOINT_TRAJECTORY = "control_msgs/action/FollowJointTrajectory"
+# How long the controller's action server may be missing from the graph before the run fails: long
+# enough to ride out a liveliness hiccup, short enough that a crashed driver fails the run within 1 s.
+SERVER_LOST_AFTER = 0.3
+_POLL = 0.01
+
+
+class ExecuteTrajectory(AsyncBehavior):
+    """Sends ``joint_trajectory_msg`` to a FollowJointTrajectory controller and waits until it is done.
+
+    Halting the behavior (cancelling the objective) cancels the controller's goal, which stops the
+    arm where it is. Fails with the controller's error when it rejects the trajectory (unknown joints,
+    limits) or aborts it (tolerances), and fails within a second when the controller goes away.
+    """
+
+    subcategory = "Motion - Execute"
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            input_port(
+                "joint_trajectory_msg",
+                None,
+                "{joint_trajectory_msg}",
+                "The trajectory to run (trajectory_msgs/JointTrajectory).",
+            ),
+            input_port(
+                "controller_action_name",
+                str,
+                "/joint_trajectory_controller/follow_joint_trajectory",
+                "The FollowJointTrajectory action of the controller.",
+            ),
+            input_port(
+                "goal_duration_tolerance",
+                float,
+                -1.0,
+                "Seconds the motion may overrun its duration (negative: the controller's default).",
+            ),
+            input_port(
+                "goal_position_tolerance",
+                list[float],
+                "0.0",
+                "Accepted final position error per joint: one value for all joints or one per joint "
+                "(0: the controller's default).",
+            ),
+            input_port(
+                "path_position_tolerance",
+                list[float],
+                "0.0",
+                "Accepted tracking error along the way: one value for all joints or one per joint "
+                "(0: the controller's default).",
+            ),
+            input_port(
+                "execution_pipeline",
+                str,
+                "",
+                "MoveIt Pro's execution pipeline; Kinema sends trajectories to the controller directly.",
+            ),
+            input_port(
+                "absolute_force_torque_threshold",
+                list[float],
+                "",
+                "Stop when the wrist force/torque exceeds fx;fy;fz;tx;ty;tz (N, Nm). Needs a force-torque "
+                "sensor and the admittance controller, which Kinema's drivers do not have yet: a non-empty "
+                "value fails the behavior when it runs.",
+            ),
+            input_port(
+                "admittance_parameters_msg",
+                None,
+                "",
+                "Admittance parameters (from SetAdmittanceParameters) for the admittance controller, which "
+                "Kinema's drivers do not have yet: a value fails the behavior when it runs.",
+            ),
+        ]
+
+    def __init__(self, name: str, config: Any = None) -> None:
+        super().__init__(name, config)
+        self._handle: Any = None
+
+    def create_goal(self) -> dict[str, Any]:
+        """The FollowJointTrajectory goal: the trajectory and the tolerances given on the ports."""
+        message = self.get_input("joint_trajectory_msg")
+        trajectory_from_message(
+            message, "joint_trajectory_msg"
+        )  # reject malformed input here, not in the driver
+        names = [str(n) for n in message.joint_names]
+        unsupported = self._unsupported_port()
+        if unsupported:
+            raise ObjectiveError(unsupported)
+        goal: dict[str, Any] = {"trajectory": message}
+        for port, key in (
+            ("path_position_tolerance", "path_tolerance"),
+            ("goal_position_tolerance", "goal_tolerance"),
+        ):
+            tolerances = _per_joint(list(self.get_input(port)), names, port)
+            if any(t > 0 for t in tolerances):
+                goal[key] = [
+                    {"name": n, "position": t} for n, t in zip(names, tolerances, strict=True) if t > 0
+                ]
+        time_tolerance = float(self.get_input("goal_duration_tolerance"))
+        if time_tolerance >= 0:
+            goal["goal_time_tolerance"] = duration(time_tolerance)
+        return goal
+
+    async def do_work(self) -> bool:
+        node = self.context.require_node(self.registration_id)
+        name = str(self.get_input("controller_action_name"))
+        try:
+            goal = self.create_goal()
+        except KinemaError as error:
+            return self._fail(str(error))
+        publish_planned_trajectory(self, goal["trajectory"])
+        client = self.context.action_client(node, FOLLOW_JOINT_TRAJECTORY, name)
+        sending = RUNNER.run_function(lambda: client.send_goal(goal, timeout=5.0))
+        try:
+            handle = await asyncio.shield(asyncio.wrap_future(sending))
+        except asyncio.CancelledError:
+            sending.add_done_callback(_cancel_when_accepted)
+            raise
+        except TransportError as error:
+            return self._fail(f"cannot send the trajectory to {name}: {error}")
+        if not handle.accepted:
+            return self._fail(f"the controller {name} rejected the trajectory")
+        self._handle = handle
+        graph = node.session.graph_cache()
+        missing_since: float | None = None
+        try:
+            while not handle.done():
+                await asyncio.sleep(_POLL)
+                if graph.snapshot().action_server_ready(client.name):
+                    missing_since = None
+                    continue
+                missing_since = missing_since or time.monotonic()
+                if time.monotonic() - missing_since > SERVER_LOST_AFTER and not handle.done():
+                    return self._fail(
+                        f"lost the controller: {name} went away during execution (driver stopped or crashed)"
+                    )
+        except asyncio.CancelledError:
+            if not handle.done():
+                RUNNER.run_function(handle.cancel)
+            raise
+        finally:
+            self._handle = None
+        try:
+            outcome = handle.result(0)
+        except TransportError as error:
+            return self._fail(f"the controller {name} failed: {error}")
+        result = outcome.result
+        if outcome.succeeded and int(result.error_code) == 0:
+            return True
+        detail = str(result.error_string) or f"error code {int(result.error_code)}"
+        return self._fail(f"the controller {name} ended the trajectory {outcome.status_name}: {detail}")
+
+    def do_halt(self) -> None:
+        handle, self._handle = self._handle, None
+        if handle is not None and not handle.done():
+            RUNNER.run_function(handle.cancel)
+
+    def _fail(self, reason: str) -> bool:
+        self.logger.publish_failure(f"ExecuteTrajectory: {reason}")
+        return False
+
+    def _unsupported_port(self) -> str:
+        """Why a set admittance port cannot be honoured ('' when none is set)."""
+        threshold = self.get_input_or("absolute_force_torque_threshold", [])
+        if isinstance(threshold, list) and threshold:
+            return (
+                f"port [absolute_force_torque_threshold] = {threshold}: force-torque limits need a "
+                "force-torque sensor and the admittance controller, which Kinema's drivers do not provide "
+                "yet; leave it empty"
+            )
+        parameters = self.get_input_or("admittance_parameters_msg", "")
+        if parameters not in ("", None):
+            return (
+                "port [admittance_parameters_msg] is set: admittance control is not supported by Kinema's "
+                "drivers yet; remove the port to run the trajectory without it"
+            )
+        return ""
+
+
+def _per_joint(values: list[float], names: list[str], port: str) -> list[float]:
+    """One tolerance per joint from one value for all, or one per joint.
+
+    Raises:
+        ObjectiveError: another count of values, naming the port and the joints.
+    """
+    if len(values) == 1:
+        return [float(values[0])] * len(names)
+    if len(values) == len(names):
+        return [float(v) for v in values]
+    raise ObjectiveError(
+        f"port [{port}] has {len(values)} values but the trajectory moves {len(names)} joints "
+        f"({', '.join(names)}); give one value or one per joint"
+    )
+
+
+def _cancel_when_accepted(sending: Any) -> None:
+    if sending.cancelled() or sending.exception() is not None:
+        return
+    handle = sending.result()
+    if handle.accepted and not handle.done():
+        RUNNER.run_function(handle.cancel)

@@ -1,0 +1,204 @@
+"""PlanCartesianPath: a timed trajectory moving the tool in straight lines through poses."""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
+from kinema.errors import KinemaError, ObjectiveError, did_you_mean
+
+from ..messages.conversions import pose_matrix, trajectory_message
+from .joint_states import joint_state_monitor
+from .planned_trajectory import publish_planned_trajectory
+from .planning_resources import collision_checker, robot_model
+
+WORLD_FRAMES = ("", "world")
+
+
+class PlanCartesianPath(AsyncBehavior):
+    """Plans the tool link through ``path`` (PoseStamped waypoints) in straight lines from the current state.
+
+    Each pose is in ``world`` or in a robot link's frame (taken at the start state). IK is solved every
+    ``ik_cartesian_space_density`` metres along the lines, seeded by the previous solution. Fails naming
+    where and why the line could not be followed (no IK solution, a joint jump, a collision); the
+    result is timed under the scaled joint limits.
+    """
+
+    subcategory = "Motion - Planning"
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            input_port(
+                "path", None, "{path}", "Poses to pass through (a list of geometry_msgs/PoseStamped)."
+            ),
+            input_port("planning_group_name", str, "manipulator", "The planning group that moves."),
+            input_port(
+                "tip_links", list[str], "", "The tool frame that follows the path ('': the group's tip)."
+            ),
+            input_port(
+                "position_only", bool, False, "Follow the positions only, leave the orientation free."
+            ),
+            input_port("ik_cartesian_space_density", float, 0.005, "Distance (m) between IK solutions."),
+            input_port("link_padding", float, 0.0, "Clearance (m) kept between the robot and the scene."),
+            input_port(
+                "velocity_scale_factor", float, 1.0, "Fraction of the joints' velocity limits, (0, 1]."
+            ),
+            input_port(
+                "acceleration_scale_factor",
+                float,
+                1.0,
+                "Fraction of the joints' acceleration limits, (0, 1].",
+            ),
+            input_port(
+                "ik_joint_space_density",
+                float,
+                0.1,
+                "Largest joint change (rad or m) allowed between consecutive IK solutions; a larger jump "
+                "stops the path (the arm would flip).",
+            ),
+            input_port(
+                "tip_offset",
+                list[float],
+                "0;0;0;0;0;0",
+                "Offset x;y;z;roll;pitch;yaw (m, rad) of the point that follows the path, in the tip "
+                "link's frame.",
+            ),
+            input_port(
+                "trajectory_timing",
+                str,
+                "[{mode: time_optimal}]",
+                "How the path is timed: [{mode: time_optimal}] (the only mode; time-optimal under the "
+                "scaled joint limits).",
+            ),
+            input_port(
+                "blending_radius",
+                float,
+                0.02,
+                "MoveIt Pro's corner blending (m); Kinema passes through every pose exactly, so it is "
+                "accepted and has no effect.",
+            ),
+            input_port(
+                "max_optimizer_iterations",
+                int,
+                1,
+                "MoveIt Pro's path optimizer iterations; Kinema does not optimise the IK path, so it is "
+                "accepted and has no effect (default from the corpus).",
+            ),
+            output_port(
+                "joint_trajectory_msg",
+                None,
+                "{joint_trajectory_msg}",
+                "The timed trajectory (trajectory_msgs/JointTrajectory).",
+            ),
+            output_port(
+                "debug_solution",
+                None,
+                "{debug_solution}",
+                "The solution to show for approval (WaitForMTCSolutionApproval): the same trajectory.",
+            ),
+        ]
+
+    def do_work(self) -> bool:
+        from kinema.motion import fk, plan_cartesian_path, time_parameterize
+
+        try:
+            group = str(self.get_input("planning_group_name"))
+            model = robot_model(self.context, "PlanCartesianPath")
+            if group not in model.groups:
+                return self._fail(
+                    f"unknown planning group {group!r}; {did_you_mean(group, list(model.groups))}"
+                )
+            tips = [t.strip() for t in self.get_input_or("tip_links", []) if t.strip()]
+            if len(tips) > 1:
+                return self._fail(f"one tip link at a time is supported, got {', '.join(tips)}")
+            tip = tips[0] if tips else model.group(group).tip_link
+            timing = self._timing()
+            if timing is not None:
+                return self._fail(timing)
+            tip_from_offset = self._tip_offset()
+            if isinstance(tip_from_offset, str):
+                return self._fail(tip_from_offset)
+            jump = float(self.get_input("ik_joint_space_density"))
+            if not jump > 0:
+                return self._fail(f"ik_joint_space_density must be > 0, got {jump}")
+            poses = self._poses()
+            start = joint_state_monitor(self.context, "PlanCartesianPath").positions(model.joint_names)
+            targets = []
+            for frame, matrix in poses:
+                world_T_point = matrix if frame in WORLD_FRAMES else fk(model, start, frame) @ matrix
+                targets.append(world_T_point @ tip_from_offset)
+            checker = collision_checker(
+                self.context, "PlanCartesianPath", float(self.get_input("link_padding"))
+            )
+            result = plan_cartesian_path(
+                checker,
+                start,
+                targets,
+                group,
+                tip,
+                max_step=float(self.get_input("ik_cartesian_space_density")),
+                jump_threshold=jump,
+                position_only=bool(self.get_input("position_only")),
+            )
+            if result.fraction < 1.0 - 1e-6:
+                return self._fail(
+                    f"could follow only {100 * result.fraction:.0f} % of the path: {result.reason}"
+                )
+            if self.stop_requested():
+                return False
+            trajectory = time_parameterize(
+                result.path,
+                model,
+                float(self.get_input("velocity_scale_factor")),
+                float(self.get_input("acceleration_scale_factor")),
+            )
+        except KinemaError as error:
+            return self._fail(str(error))
+        message = trajectory_message(trajectory)
+        self.set_output("joint_trajectory_msg", message)
+        self.set_output("debug_solution", message)
+        publish_planned_trajectory(self, message)
+        return True
+
+    def _timing(self) -> str | None:
+        """None when ``trajectory_timing`` asks for what Kinema does, else the reason it cannot."""
+        import yaml
+
+        text = str(self.get_input("trajectory_timing")).strip()
+        try:
+            value = yaml.safe_load(text) if text else []
+        except yaml.YAMLError as error:
+            return f"trajectory_timing {text!r} is not YAML: {error.problem}"
+        entries = value if isinstance(value, list) else [value]
+        for entry in entries:
+            mode = entry.get("mode") if isinstance(entry, dict) else entry
+            if mode not in (None, "time_optimal"):
+                return f"trajectory_timing mode {mode!r} is not supported; valid: time_optimal"
+        return None
+
+    def _tip_offset(self) -> Any:
+        """``tip_T_point`` inverted (what the tip must do so the offset point follows the path)."""
+        from scipy.spatial.transform import Rotation
+
+        values = [float(v) for v in self.get_input("tip_offset")]
+        if len(values) not in (3, 6):
+            return f"tip_offset needs 6 values x;y;z;roll;pitch;yaw (or 3, x;y;z), got {len(values)}"
+        tip_T_point = np.eye(4)
+        tip_T_point[:3, 3] = values[:3]
+        if len(values) == 6:
+            tip_T_point[:3, :3] = Rotation.from_euler("xyz", values[3:]).as_matrix()
+        return np.linalg.inv(tip_T_point)
+
+    def _poses(self) -> list[tuple[str, Any]]:
+        value = self.get_input("path")
+        items = list(value) if isinstance(value, list | tuple) else [value]
+        if not items:
+            raise ObjectiveError("path is empty")
+        return [pose_matrix(item, f"path[{i}]") for i, item in enumerate(items)]
+
+    def _fail(self, reason: str) -> bool:
+        self.logger.publish_failure(f"PlanCartesianPath: planning failed: {reason}")
+        return False

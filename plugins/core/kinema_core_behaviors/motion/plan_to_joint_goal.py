@@ -1,0 +1,110 @@
+"""PlanToJointGoal: a collision-free, timed trajectory from the current state to a joint goal."""
+
+from __future__ import annotations
+
+from typing import Any
+
+from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
+from kinema.errors import KinemaError, did_you_mean
+
+from ..messages.conversions import joint_positions, trajectory_message
+from .joint_states import joint_state_monitor
+from .planned_trajectory import publish_planned_trajectory
+from .planning_resources import collision_checker, robot_model
+
+
+def no_orientation_constraint(value: Any) -> bool:
+    """True for the ways objectives say "no orientation constraint" (unset, '', '[]')."""
+    if value is None:
+        return True
+    if isinstance(value, str):
+        return value.strip() in ("", "[]")
+    if isinstance(value, list | tuple):
+        return len(value) == 0
+    return False
+
+
+class PlanToJointGoal(AsyncBehavior):
+    """Plans from the robot's current joint state to ``joint_goal`` for ``planning_group_name``.
+
+    The start is the latest ``/joint_states``; the path keeps ``link_padding`` metres between the
+    robot and the planning scene (a straight joint-space move when that is collision-free, OMPL
+    otherwise), and is timed with the joint limits scaled by the velocity and acceleration factors.
+    Fails with the planner's reason: unknown joints, a goal outside the limits or in collision, or no
+    path within ``planning_time``.
+    """
+
+    subcategory = "Motion - Planning"
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            input_port(
+                "joint_goal", None, "{target_joint_state}", "Goal joint state (sensor_msgs/JointState)."
+            ),
+            input_port("planning_group_name", str, "manipulator", "The planning group that moves."),
+            input_port("link_padding", float, 0.01, "Clearance (m) kept between the robot and the scene."),
+            input_port(
+                "velocity_scale_factor", float, 1.0, "Fraction of the joints' velocity limits, (0, 1]."
+            ),
+            input_port(
+                "acceleration_scale_factor",
+                float,
+                1.0,
+                "Fraction of the joints' acceleration limits, (0, 1].",
+            ),
+            input_port(
+                "orientation_constraint",
+                None,
+                "[]",
+                "Keep the tool's orientation (not supported yet: only '[]', no constraint, is accepted).",
+            ),
+            input_port("planner_id", str, "RRTConnect", "OMPL planner used when a straight move collides."),
+            input_port("planning_time", float, 1.0, "Seconds the planner may search."),
+            output_port(
+                "joint_trajectory_msg",
+                None,
+                "{joint_trajectory_msg}",
+                "The timed trajectory (trajectory_msgs/JointTrajectory).",
+            ),
+        ]
+
+    def do_work(self) -> bool:
+        from kinema.motion import PLANNERS, PlanningOptions, plan_joint_goal, time_parameterize
+
+        goal_value = self.get_input("joint_goal")
+        group = str(self.get_input("planning_group_name"))
+        padding = float(self.get_input("link_padding"))
+        velocity_scale = float(self.get_input("velocity_scale_factor"))
+        acceleration_scale = float(self.get_input("acceleration_scale_factor"))
+        planner = str(self.get_input("planner_id"))
+        if not no_orientation_constraint(self.get_input("orientation_constraint")):
+            return self._fail("orientation constraints are not supported yet; pass '[]'")
+        if planner not in PLANNERS:
+            return self._fail(f"unknown planner_id {planner!r}; {did_you_mean(planner, PLANNERS)}")
+        try:
+            goal = joint_positions(goal_value, "joint_goal")
+            model = robot_model(self.context, "PlanToJointGoal")
+            if group not in model.groups:
+                return self._fail(
+                    f"unknown planning group {group!r}; {did_you_mean(group, list(model.groups))}"
+                )
+            if not goal:
+                return self._fail("joint_goal names no joint")
+            start = joint_state_monitor(self.context, "PlanToJointGoal").positions(model.joint_names)
+            checker = collision_checker(self.context, "PlanToJointGoal", padding)
+            options = PlanningOptions(planner=planner, timeout=float(self.get_input("planning_time")))
+            path = plan_joint_goal(checker, start, goal, group, options)
+            if self.stop_requested():
+                return False
+            trajectory = time_parameterize(path, model, velocity_scale, acceleration_scale)
+        except KinemaError as error:
+            return self._fail(str(error))
+        message = trajectory_message(trajectory)
+        self.set_output("joint_trajectory_msg", message)
+        publish_planned_trajectory(self, message)
+        return True
+
+    def _fail(self, reason: str) -> bool:
+        self.logger.publish_failure(f"PlanToJointGoal: planning failed: {reason}")
+        return False

@@ -1,0 +1,17 @@
+"""Poses: pose maths and frames (transforms between poses and frames, forward kinematics)."""
+
+from __future__ import annotations
+
+from .calculate_pose_offset import CalculatePoseOffset
+from .compute_link_pose_forward_kinematics import ComputeLinkPoseForwardKinematics
+from .transform_pose import TransformPose
+from .transform_pose_frame import TransformPoseFrame
+from .transform_pose_with_pose import TransformPoseWithPose
+
+BEHAVIORS = (
+    CalculatePoseOffset,
+    ComputeLinkPoseForwardKinematics,
+    TransformPose,
+    TransformPoseFrame,
+    TransformPoseWithPose,
+)

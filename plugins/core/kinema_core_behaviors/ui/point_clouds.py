@@ -1,0 +1,119 @@
+"""Point clouds in ``kinema view``: SendPointCloudToUI, PublishPointCloud and ClearSnapshot.
+
+The view draws markers, so a cloud is drawn as a POINTS marker (at most ``MAX_DRAWN_POINTS``, evenly
+sub-sampled) in the ``snapshot`` namespace; the cloud itself is also published on its topic for other
+subscribers. ClearSnapshot deletes the drawn snapshots.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+import numpy as np
+
+from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
+
+from ..messages.conversions import point_cloud_xyz
+from ..messages.ports import fails_on_bad_input, message_input, port_error, read_input, read_message
+from .markers import publish_markers
+
+POINT_CLOUD = "sensor_msgs/msg/PointCloud2"
+SNAPSHOT_NAMESPACE = "snapshot"
+MAX_DRAWN_POINTS = 20000
+_SNAPSHOT_IDS: dict[int, int] = {}
+
+
+def cloud_marker(xyz: np.ndarray, frame_id: str, marker_id: int) -> dict[str, Any]:
+    """A POINTS marker of the cloud (sub-sampled to at most MAX_DRAWN_POINTS)."""
+    if len(xyz) > MAX_DRAWN_POINTS:
+        xyz = xyz[np.linspace(0, len(xyz) - 1, MAX_DRAWN_POINTS).astype(int)]
+    return {
+        "header": {"frame_id": frame_id},
+        "ns": SNAPSHOT_NAMESPACE,
+        "id": marker_id,
+        "type": 8,  # POINTS
+        "action": 0,
+        "pose": {"orientation": {"w": 1.0}},
+        "scale": {"x": 0.005, "y": 0.005},
+        "color": {"r": 0.9, "g": 0.9, "b": 0.9, "a": 1.0},
+        "points": [{"x": float(x), "y": float(y), "z": float(z)} for x, y, z in xyz],
+    }
+
+
+def _publish_cloud(behavior: Any, cloud: Any, topic: str) -> None:
+    node = behavior.context.require_node(behavior.registration_id)
+    behavior.context.publisher(node, POINT_CLOUD, topic).publish(cloud)
+
+
+def _draw(behavior: Any, cloud: Any, *, keep_previous: bool) -> None:
+    try:
+        xyz = point_cloud_xyz(cloud)
+    except Exception as error:
+        raise port_error(behavior, "point_cloud", str(error), "") from None
+    context_key = id(behavior.context)
+    marker_id = _SNAPSHOT_IDS.get(context_key, -1) + 1 if keep_previous else 0
+    _SNAPSHOT_IDS[context_key] = marker_id
+    publish_markers(behavior, [cloud_marker(xyz, str(cloud.header.frame_id) or "world", marker_id)])
+
+
+class SendPointCloudToUI(SyncBehavior):
+    """Shows a point cloud as a snapshot in ``kinema view`` (kept until ClearSnapshot) and publishes it."""
+
+    subcategory = "User Interface"
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            message_input("point_cloud", POINT_CLOUD, "{point_cloud}", "The cloud to show."),
+            input_port("pcd_topic", str, "/pcd_pointcloud_captures", "Topic the cloud is published on."),
+            input_port(
+                "use_latest_transform",
+                bool,
+                False,
+                "MoveIt Pro transforms with the latest TF instead of the cloud's stamp; Kinema's frames "
+                "are always current, so it changes nothing.",
+            ),
+        ]
+
+    @fails_on_bad_input
+    def tick(self) -> NodeStatus:
+        cloud = read_message(self, "point_cloud")
+        _draw(self, cloud, keep_previous=True)
+        _publish_cloud(self, cloud, str(read_input(self, "pcd_topic")))
+        return NodeStatus.SUCCESS
+
+
+class PublishPointCloud(SyncBehavior):
+    """Publishes a point cloud on ``point_cloud_topic``; draws it in ``kinema view``, replacing the last."""
+
+    subcategory = "User Interface"
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            message_input("point_cloud", POINT_CLOUD, "{point_cloud}", "The cloud to publish."),
+            input_port("point_cloud_topic", str, "/point_cloud", "Topic to publish on."),
+        ]
+
+    @fails_on_bad_input
+    def tick(self) -> NodeStatus:
+        cloud = read_message(self, "point_cloud")
+        _draw(self, cloud, keep_previous=False)
+        _publish_cloud(self, cloud, str(read_input(self, "point_cloud_topic")))
+        return NodeStatus.SUCCESS
+
+
+class ClearSnapshot(SyncBehavior):
+    """Removes the point cloud snapshots SendPointCloudToUI drew in ``kinema view``."""
+
+    subcategory = "User Interface"
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return []
+
+    def tick(self) -> NodeStatus:
+        count = _SNAPSHOT_IDS.pop(id(self.context), -1) + 1
+        markers = [{"ns": SNAPSHOT_NAMESPACE, "id": i, "action": 2} for i in range(max(count, 1))]
+        publish_markers(self, markers)
+        return NodeStatus.SUCCESS

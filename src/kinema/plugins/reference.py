@@ -1,0 +1,81 @@
+"""The behavior reference: every registered behavior as MoveIt Pro's behavior documentation shows it.
+
+Generated from the registry, so it cannot drift from the code: behaviors grouped by subcategory, each
+with its ID, description and a table of ports (direction, type, default, description). ``kinema
+behaviors --markdown`` prints it; ``docs/behavior-reference.md`` is this text for lab_sim's loaders and a
+test keeps it current.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from typing import Any
+
+HEADER = """# Behavior reference
+
+The behaviors of Kinema's bundled loaders (`kinema::CoreBehaviorsLoader`, `kinema::MujocoBehaviorsLoader`),
+grouped by subcategory. Generated from the registry: do not edit by hand; regenerate with
+
+```bash
+kinema behaviors --markdown -c lab_sim > docs/behavior-reference.md
+```
+
+Types are BehaviorTree.CPP's names (`std::string`, `double`, `std::vector<...>`, ROS messages as
+`pkg::msg::Name`); `BT::AnyTypeAllowed` ports take a value of any type. Outputs default to the
+blackboard entry named in braces.
+"""
+
+
+def _cell(text: str | None) -> str:
+    if text is None:
+        return ""
+    return str(text).replace("\\", "\\\\").replace("|", "\\|").replace("\n", " ").strip()
+
+
+def _code(text: str | None) -> str:
+    if text is None:
+        return "—"
+    return f"`{_cell(text)}`" if text != "" else '`""`'
+
+
+def behavior_markdown(record: Any) -> str:
+    """One behavior: heading, description, plugin and its ports table."""
+    lines = [f"### {record.behavior_id}", ""]
+    description = str(record.metadata.get("description", "")).strip()
+    if description:
+        lines += [description, ""]
+    lines += [f"Plugin: `{record.plugin}`.", ""]
+    ports = list(record.ports)
+    if not ports:
+        lines += ["No ports.", ""]
+        return "\n".join(lines)
+    lines += ["| Port | Direction | Type | Default | Description |", "|---|---|---|---|---|"]
+    for port in ports:
+        direction = port.direction.xml_tag.replace("_port", "")
+        lines.append(
+            f"| `{port.name}` | {direction} | `{_cell(port.type_name)}` | {_code(port.default_str)} "
+            f"| {_cell(port.description)} |"
+        )
+    lines.append("")
+    return "\n".join(lines)
+
+
+def reference_markdown(records: Iterable[Any], header: str = HEADER) -> str:
+    """The whole reference: ``header``, a table of contents by subcategory, then every behavior."""
+    by_subcategory: dict[str, list[Any]] = {}
+    for record in records:
+        subcategory = str(record.metadata.get("subcategory", "")) or "Uncategorized"
+        by_subcategory.setdefault(subcategory, []).append(record)
+    parts = [header.rstrip(), ""]
+    for subcategory in sorted(by_subcategory, key=str.lower):
+        ids = ", ".join(f"`{r.behavior_id}`" for r in sorted(by_subcategory[subcategory], key=_id))
+        parts += [f"- **{subcategory}**: {ids}"]
+    parts.append("")
+    for subcategory in sorted(by_subcategory, key=str.lower):
+        parts += [f"## {subcategory}", ""]
+        parts += [behavior_markdown(r) for r in sorted(by_subcategory[subcategory], key=_id)]
+    return "\n".join(parts).rstrip() + "\n"
+
+
+def _id(record: Any) -> str:
+    return str(record.behavior_id).lower()

@@ -1,0 +1,252 @@
+"""The files family: MoveIt Pro's YAML layouts, path resolution in the objectives folder, atomic saves."""
+
+from __future__ import annotations
+
+import shutil
+import time
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+import pytest
+
+from kinema.behaviors import BehaviorContext
+from kinema.bt import NodeStatus
+from kinema.testing import tick_behavior
+
+CORPUS = (
+    Path(__file__).resolve().parents[3].parent / "shared" / "compat" / "moveit_pro" / "lab_sim" / "objectives"
+)
+
+
+@pytest.fixture
+def folder(tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> Path:
+    """An objectives folder: offline contexts (no config) resolve relative paths in the working directory."""
+    monkeypatch.chdir(tmp_path)
+    return tmp_path
+
+
+@pytest.fixture
+def offline(node: Any) -> BehaviorContext:
+    return BehaviorContext(node)
+
+
+def _corpus_file(name: str, folder: Path) -> Path:
+    source = CORPUS / name
+    if not source.is_file():
+        pytest.skip(f"{source} (MoveIt Pro's lab_sim files) is not beside this checkout")
+    return Path(shutil.copy(source, folder / name))
+
+
+def test_moveit_pros_yaml_files_load(behavior: Any, offline: BehaviorContext, folder: Path) -> None:
+    _corpus_file("joint_trajectory.yaml", folder)
+    _corpus_file("robot_joint_state.yaml", folder)
+    _corpus_file("pill_bottle_place_poses.yaml", folder)
+    _corpus_file("relative_grasp_pose.yaml", folder)
+    run = tick_behavior(
+        behavior("LoadJointTrajectoryFromYaml"), {"file_path": "joint_trajectory.yaml"}, context=offline
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    trajectory = run.outputs["output"]
+    assert trajectory.joint_names[0] == "linear_rail_joint" and len(trajectory.points) > 10
+    state = tick_behavior(
+        behavior("LoadRobotJointStateFromYaml"), {"file_path": "robot_joint_state.yaml"}, context=offline
+    ).outputs["output"]
+    assert state.joint_state.position[2] == pytest.approx(-1.8849, abs=1e-4)
+    poses = tick_behavior(
+        behavior("LoadPoseStampedVectorFromYaml"),
+        {"file_path": "pill_bottle_place_poses.yaml"},
+        context=offline,
+    ).outputs["output"]
+    assert len(poses) > 1 and poses[0].pose.position.x == pytest.approx(0.9806297649587842)
+    pose = tick_behavior(
+        behavior("LoadPoseStampedFromYaml"), {"file_path": "relative_grasp_pose.yaml"}, context=offline
+    ).outputs["output"]
+    assert pose.header.frame_id == "world"
+
+
+def test_saved_files_load_back_and_keep_an_old_file_unless_told(
+    behavior: Any, offline: BehaviorContext, folder: Path
+) -> None:
+    pose = tick_behavior(
+        behavior("CreatePoseStamped"), {"position_xyz": [0.1, 0.2, 0.3]}, context=offline
+    ).outputs["pose_stamped"]
+    save = behavior("SavePoseStampedToYaml")
+    assert (
+        tick_behavior(save, {"message": pose, "yaml_filename": "grasp"}, context=offline).status
+        == NodeStatus.SUCCESS
+    )
+    assert (folder / "grasp.yaml").is_file()
+    loaded = tick_behavior(behavior("LoadPoseStampedFromYaml"), {"file_path": "grasp.yaml"}, context=offline)
+    assert loaded.outputs["output"].pose.position.z == pytest.approx(0.3)
+    before = (folder / "grasp.yaml").read_text()
+    moved = tick_behavior(
+        behavior("CreatePoseStamped"), {"position_xyz": [9.0, 9.0, 9.0]}, context=offline
+    ).outputs["pose_stamped"]
+    kept = tick_behavior(
+        save, {"message": moved, "yaml_filename": "grasp", "overwrite": False}, context=offline
+    )
+    assert kept.status == NodeStatus.SUCCESS
+    assert (folder / "grasp.yaml").read_text() == before
+    assert len(list(folder.glob("grasp_*.yaml"))) == 1
+    replaced = tick_behavior(
+        save, {"message": moved, "yaml_filename": "grasp", "overwrite": True}, context=offline
+    )
+    assert replaced.status == NodeStatus.SUCCESS and "9.0" in (folder / "grasp.yaml").read_text()
+    assert not list(folder.glob("*.tmp*")) and not list(folder.glob(".*"))
+
+
+def test_a_save_never_leaves_its_folder(behavior: Any, offline: BehaviorContext, folder: Path) -> None:
+    pose = tick_behavior(behavior("CreatePoseStamped"), {}, context=offline).outputs["pose_stamped"]
+    run = tick_behavior(
+        behavior("SavePoseStampedToYaml"), {"message": pose, "yaml_filename": "../escaped"}, context=offline
+    )
+    assert run.status == NodeStatus.FAILURE
+    assert "port [yaml_filename]" in run.toasts[-1] and "leaves the folder" in run.toasts[-1]
+    assert not (folder.parent / "escaped.yaml").exists()
+
+
+@pytest.mark.parametrize(
+    ("content", "expected"),
+    [
+        (None, "no such file"),
+        ("header: [unclosed", "is not valid YAML"),
+        ("header: {frame_id: world}\nposition: {x: 1}\n", "is not a geometry_msgs/msg/PoseStamped"),
+        ("- 1\n- 2\n", "holds list"),
+    ],
+)
+def test_missing_and_malformed_yaml_fail_naming_the_file(
+    behavior: Any, offline: BehaviorContext, folder: Path, content: str | None, expected: str
+) -> None:
+    if content is not None:
+        (folder / "pose.yaml").write_text(content)
+    run = tick_behavior(behavior("LoadPoseStampedFromYaml"), {"file_path": "pose.yaml"}, context=offline)
+    assert run.status == NodeStatus.FAILURE
+    assert "port [file_path]" in run.toasts[-1] and expected in run.toasts[-1], run.toasts[-1]
+
+
+def test_text_and_image_files(behavior: Any, offline: BehaviorContext, folder: Path) -> None:
+    (folder / "note.txt").write_text("hello\nworld\n")
+    text = tick_behavior(behavior("ReadTextFileAsString"), {"text_filename": "note.txt"}, context=offline)
+    assert text.outputs["string_file_contents"] == "hello\nworld\n"
+    from kinema.transport import from_dict
+
+    pixels = np.zeros((4, 6, 3), dtype=np.uint8)
+    pixels[1, 2] = [255, 10, 20]
+    image = from_dict(
+        "sensor_msgs/msg/Image",
+        {"height": 4, "width": 6, "encoding": "rgb8", "step": 18, "data": pixels.reshape(-1)},
+    )
+    saved = tick_behavior(behavior("SaveImageToFile"), {"image": image, "file_path": "shot"}, context=offline)
+    assert saved.status == NodeStatus.SUCCESS, saved.toasts
+    loaded = tick_behavior(behavior("LoadImageFromFile"), {"file_path": "shot.png"}, context=offline)
+    back = loaded.outputs["image"]
+    assert (back.width, back.height, back.encoding) == (6, 4, "rgb8")
+    assert np.array_equal(np.asarray(back.data).reshape(4, 6, 3), pixels)
+
+
+def test_paths_resolve_in_the_configs_objective_folders(behavior: Any, node: Any, tmp_path: Path) -> None:
+    """Saves go to the config's own objectives; reads also find inherited ones; MoveIt Pro's
+    ``~/user_ws/src/lab_sim/objectives/...`` names the config's own objectives, not the installed lab_sim."""
+    import yaml
+
+    from kinema.config import Workspace, resolve_config
+
+    package = tmp_path / "ws" / "src" / "my_cell"
+    (package / "config").mkdir(parents=True)
+    (package / "objectives").mkdir()
+    (package / "package.xml").write_text(
+        '<?xml version="1.0"?><package format="3"><name>my_cell</name><version>0.0.0</version>'
+        "<description>t</description><maintainer email='t@example.com'>t</maintainer>"
+        "<license>BSD-3-Clause</license></package>"
+    )
+    config = {
+        "based_on_package": "lab_sim",
+        "objectives": {
+            "objective_library_paths": {
+                "my_objectives": {"package_name": "my_cell", "relative_path": "objectives"}
+            }
+        },
+    }
+    (package / "config" / "config.yaml").write_text(yaml.safe_dump(config))
+    resolved = resolve_config("my_cell", Workspace.discover(tmp_path / "ws"))
+    context = BehaviorContext(node, config=resolved)
+    installed = {p.name for p in resolved.package_dir("lab_sim").joinpath("objectives").iterdir()}
+
+    from kinema.transport import from_dict
+
+    trajectory = from_dict(
+        "trajectory_msgs/msg/JointTrajectory",
+        {"joint_names": ["elbow_joint"], "points": [{"positions": [0.5], "time_from_start": {"sec": 1}}]},
+    )
+    saved = tick_behavior(
+        behavior("SaveJointTrajectoryToYaml"),
+        {"message": trajectory, "yaml_filename": "~/user_ws/src/lab_sim/objectives/joint_trajectory"},
+        context=context,
+    )
+    assert saved.status == NodeStatus.SUCCESS, saved.toasts
+    assert (package / "objectives" / "joint_trajectory.yaml").is_file()
+    assert {p.name for p in resolved.package_dir("lab_sim").joinpath("objectives").iterdir()} == installed
+    loaded = tick_behavior(
+        behavior("LoadJointTrajectoryFromYaml"), {"file_path": "joint_trajectory.yaml"}, context=context
+    )
+    assert loaded.outputs["output"].points[0].positions[0] == 0.5
+    inherited = tick_behavior(
+        behavior("ReadTextFileAsString"), {"text_filename": "close_gripper.xml"}, context=context
+    )
+    assert (
+        inherited.status == NodeStatus.SUCCESS
+        and "Close Gripper" in inherited.outputs["string_file_contents"]
+    )
+
+
+def test_package_paths_into_the_chains_objectives_find_the_configs_copy(
+    behavior: Any, node: Any, tmp_path: Path
+) -> None:
+    """``package://lab_sim/objectives/x`` and ``package_name=lab_sim, objectives/x`` in a config based on
+    lab_sim name the x beside the config's objectives (where a copy of MoveIt Pro's lab_sim files has it)."""
+    import yaml
+
+    from kinema.config import Workspace, resolve_config
+
+    package = tmp_path / "ws" / "src" / "my_cell"
+    (package / "config").mkdir(parents=True)
+    (package / "objectives").mkdir()
+    (package / "package.xml").write_text(
+        '<?xml version="1.0"?><package format="3"><name>my_cell</name><version>0.0.0</version>'
+        "<description>t</description><maintainer email='t@example.com'>t</maintainer>"
+        "<license>BSD-3-Clause</license></package>"
+    )
+    libraries = {"lab_sim_objectives": {"package_name": "my_cell", "relative_path": "objectives"}}
+    config = {"based_on_package": "lab_sim", "objectives": {"objective_library_paths": libraries}}
+    (package / "config" / "config.yaml").write_text(yaml.safe_dump(config))
+    (package / "objectives" / "token.stl").write_text("solid t\nendsolid t\n")
+    from PIL import Image
+
+    Image.new("RGB", (3, 2), (10, 20, 30)).save(package / "objectives" / "lab.png")
+    resolved = resolve_config("my_cell", Workspace.discover(tmp_path / "ws"))
+    context = BehaviorContext(node, config=resolved)
+    image = tick_behavior(
+        behavior("LoadImageFromFile"),
+        {"file_path": "objectives/lab.png", "package_name": "lab_sim"},
+        context=context,
+    )
+    assert image.status == NodeStatus.SUCCESS, image.toasts
+    assert (image.outputs["image"].width, image.outputs["image"].height) == (3, 2)
+    received: list[Any] = []
+    node.create_subscription(
+        "visualization_msgs/msg/MarkerArray",
+        "/visualization_marker_array",
+        lambda m: received.extend(m.markers),
+    )
+    pose = tick_behavior(behavior("CreatePoseStamped"), {}, context=context).outputs["pose_stamped"]
+    mesh = tick_behavior(
+        behavior("VisualizeMesh"),
+        {"mesh_path": "package://lab_sim/objectives/token.stl", "mesh_pose": pose},
+        context=context,
+    )
+    assert mesh.status == NodeStatus.SUCCESS, mesh.toasts
+    deadline = time.monotonic() + 10
+    while not received and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert received and received[0].mesh_resource == (package / "objectives" / "token.stl").resolve().as_uri()

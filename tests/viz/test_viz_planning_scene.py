@@ -1,0 +1,57 @@
+"""Collision objects of the planning scene become translucent shapes in the view, replaced on each update."""
+
+from __future__ import annotations
+
+import numpy as np
+import umsgpack
+
+from kinema.transport import from_dict
+from kinema.viz.planning_scene import PlanningSceneLayer
+
+
+def _scene(objects: list[dict]) -> object:
+    return from_dict("moveit_msgs/msg/PlanningScene", {"world": {"collision_objects": objects}})
+
+
+def _box(object_id: str, frame: str = "world") -> dict:
+    return {
+        "id": object_id,
+        "header": {"frame_id": frame},
+        "pose": {"position": {"x": 1.0, "y": 0.0, "z": 0.5}, "orientation": {"w": 1.0}},
+        "primitives": [{"type": 1, "dimensions": [2.0, 1.0, 0.1]}, {"type": 3, "dimensions": [0.2, 0.05]}],
+        "primitive_poses": [{"orientation": {"w": 1.0}}, {"position": {"z": 0.3}, "orientation": {"w": 1.0}}],
+    }
+
+
+def test_a_box_and_a_cylinder_are_drawn_where_the_object_is() -> None:
+    layer = PlanningSceneLayer("/kinema/planning_scene")
+    commands = layer.update(_scene([_box("virtual_table_top")]))
+    assert commands[0][0] == "delete" and commands[0][1] == "/kinema/planning_scene"
+    drawn = {path: umsgpack.unpackb(payload) for kind, path, payload in commands if kind == "set_object"}
+    assert set(drawn) == {
+        "/kinema/planning_scene/virtual_table_top/0",
+        "/kinema/planning_scene/virtual_table_top/1",
+    }
+    box = drawn["/kinema/planning_scene/virtual_table_top/0"]["object"]
+    assert box["geometries"][0]["type"] == "BoxGeometry"
+    assert [box["geometries"][0][k] for k in ("width", "height", "depth")] == [2.0, 1.0, 0.1]
+    assert box["materials"][0]["transparent"] is True
+    moves = {
+        path: umsgpack.unpackb(payload)["matrix"]
+        for kind, path, payload in commands
+        if kind == "set_transform"
+    }
+    box_pose = np.array(moves["/kinema/planning_scene/virtual_table_top/0"]).reshape(4, 4).T
+    assert np.allclose(box_pose[:3, 3], [1.0, 0.0, 0.5])
+    cylinder_pose = np.array(moves["/kinema/planning_scene/virtual_table_top/1"]).reshape(4, 4).T
+    assert np.allclose(cylinder_pose[:3, 3], [1.0, 0.0, 0.8])
+    assert np.allclose(cylinder_pose[:3, 1], [0, 0, 1])  # meshcat's cylinder axis (y) along the object's z
+
+
+def test_an_update_replaces_what_was_drawn_and_unknown_frames_are_skipped() -> None:
+    layer = PlanningSceneLayer("/root")
+    layer.update(_scene([_box("a")]))
+    commands = layer.update(_scene([_box("b", frame="nowhere"), _box("c")]), lambda frame: None)
+    assert layer.object_ids == ["c"]
+    assert [c[1] for c in commands if c[0] == "delete"] == ["/root"]
+    assert not any(path.startswith("/root/b") for _, path, _ in commands)
