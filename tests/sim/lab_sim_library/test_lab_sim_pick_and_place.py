@@ -1,8 +1,9 @@
-"""MoveIt Pro's "Pick from Pose" (MTC task planning), unchanged, really picks lab_sim's cube in MuJoCo.
+"""MoveIt Pro's MTC objectives, unchanged, on lab_sim in MuJoCo: "Pick from Pose" lifts the cube, "Place
+at Pose" sets it down where asked, "Move Along Square" traces its square.
 
-The objective is the corpus's own; the test only supplies the grasp pose, as MoveIt Pro's objectives do
-(a PoseStamped in the world: above the cube's centre, gripper pointing down), and reads the outcome from
-the simulator, not from the plan.
+The objectives are the corpus's own; the tests only supply the poses, as MoveIt Pro's objectives do (a
+PoseStamped in the world, gripper pointing down), and read the outcome from the simulator (MuJoCo's cube,
+the joint states it publishes), not from the plan.
 """
 
 from __future__ import annotations
@@ -30,6 +31,19 @@ PICK = """<root BTCPP_format="4" main_tree_to_execute="Pick the Cube">
 </root>"""
 
 
+PLACE = """<root BTCPP_format="4" main_tree_to_execute="Place the Cube">
+  <BehaviorTree ID="Place the Cube">
+    <Sequence>
+      <Action ID="CreatePoseStamped" reference_frame="world" position_xyz="{x};{y};{z}"
+              orientation_xyzw="0;1;0;0" pose_stamped="{{place_pose}}" />
+      <SubTree ID="Place at Pose" place_pose="{{place_pose}}" approach_distance="0.1"
+               retract_xyz="0;0;-0.1" />
+    </Sequence>
+  </BehaviorTree>
+</root>"""
+GRASP_ABOVE_CENTRE = 0.02  # the grasp link sits 2 cm above the cube's centre, as at lab_sim's pick waypoint
+
+
 def cube_position(cell: LibraryCell) -> tuple[float, float, float]:
     bodies = cell.node.create_client("kinema_msgs/srv/GetSimBodies", "/mujoco/bodies")
     p = next(b for b in bodies.call({}, timeout=10.0).bodies if b.name == "cube").pose.position
@@ -49,11 +63,21 @@ def settled_cube(cell: LibraryCell) -> tuple[float, float, float]:
     return previous
 
 
-def test_pick_from_pose_lifts_the_cube_off_the_table(library_cell: LibraryCell) -> None:
+def test_pick_from_pose_lifts_the_cube_and_place_at_pose_sets_it_down_where_asked(
+    library_cell: LibraryCell,
+) -> None:
     x, y, z = cube_position(library_cell)
-    # The grasp link sits 2 cm above the cube's centre, as in lab_sim's own pick waypoint.
-    result: Any = library_cell.client.start(xml=PICK.format(x=x, y=y, z=z + 0.02)).result(RUN_TIMEOUT)
+    pick = PICK.format(x=x, y=y, z=z + GRASP_ABOVE_CENTRE)
+    result: Any = library_cell.client.start(xml=pick).result(RUN_TIMEOUT)
     assert result.succeeded, result
     after = settled_cube(library_cell)
     lifted = after[2] - z
     assert lifted >= 0.05, f"the cube went from {(x, y, z)} to {after}: lifted {lifted:.3f} m"
+
+    asked = (x + 0.05, y - 0.15, z)  # on the table, 15 cm to the side
+    place = PLACE.format(x=asked[0], y=asked[1], z=asked[2] + GRASP_ABOVE_CENTRE)
+    result = library_cell.client.start(xml=place).result(RUN_TIMEOUT)
+    assert result.succeeded, result
+    down = settled_cube(library_cell)
+    error = max(abs(a - b) for a, b in zip(down, asked, strict=True))
+    assert error <= 0.02, f"asked to place the cube at {asked}, it is at {down} ({error:.3f} m off)"
