@@ -81,3 +81,38 @@ def test_pick_from_pose_lifts_the_cube_and_place_at_pose_sets_it_down_where_aske
     down = settled_cube(library_cell)
     error = max(abs(a - b) for a, b in zip(down, asked, strict=True))
     assert error <= 0.02, f"asked to place the cube at {asked}, it is at {down} ({error:.3f} m off)"
+
+
+def test_move_along_square_traces_a_square_through_its_corners(library_cell: LibraryCell) -> None:
+    import numpy as np
+
+    from kinema.motion import RobotDescription, fk
+
+    model = RobotDescription.lab_sim().load_model()
+    assert library_cell.client.execute("Look at Table", timeout=RUN_TIMEOUT).succeeded
+    states = library_cell.listen("sensor_msgs/msg/JointState", "/joint_states")
+    _fresh(states)
+    seen = len(states)
+    start = _tool(model, states[-1], fk)
+    result = library_cell.client.execute("Move Along Square", timeout=RUN_TIMEOUT)
+    assert result.succeeded, result
+    _fresh(states)
+    path = np.array([_tool(model, message, fk) for message in states[seen:]])
+    corners = start + np.array([[0, 0.2, 0], [0.2, 0.2, 0], [0.2, 0, 0], [0, 0, 0]])
+    misses = [float(np.linalg.norm(path - corner, axis=1).min()) for corner in corners]
+    assert max(misses) <= 0.005, f"closest passes by the corners (m): {np.round(misses, 4).tolist()}"
+
+
+def _fresh(states: list[Any], timeout: float = 10.0) -> None:
+    """Wait for a joint state newer than the ones already received."""
+    seen = len(states)
+    deadline = time.monotonic() + timeout
+    while len(states) <= seen:
+        assert time.monotonic() < deadline, f"no joint state within {timeout} s"
+        time.sleep(0.02)
+
+
+def _tool(model: Any, message: Any, fk: Any) -> Any:
+    positions = dict(zip(message.name, message.position, strict=True))
+    q = model.configuration({n: v for n, v in positions.items() if n in model.joint_names})
+    return fk(model, q, "tool0")[:3, 3]
