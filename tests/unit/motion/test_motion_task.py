@@ -169,7 +169,7 @@ def test_a_square_of_moves_along_world_axes_closes(
     assert np.abs(np.array(corners) - expected).max() < 1e-3, np.round(corners, 4)
 
 
-def test_plan_to_pose_and_to_joint_state_go_forwards_around_the_scene(
+def test_plan_to_pose_and_to_joint_state_go_forwards_and_a_pose_inside_an_obstacle_fails(
     model: RobotModel, checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray, arm_goal
 ) -> None:
     above = grasp.copy()
@@ -191,7 +191,7 @@ def test_plan_to_pose_and_to_joint_state_go_forwards_around_the_scene(
     for name, value in home.items():
         assert solution.end[model.index(name)] == pytest.approx(value, abs=1e-6)
 
-    # A box where the arm would pass: the joint-space move goes around it (or fails saying so).
+    # A box added to the planning scene around the target: no collision-free IK solution there.
     checker.scene.add(CollisionObject("wall", "box", (0.3, 0.02, 0.3), _at(0.62, 0.3, 1.2)))
     with pytest.raises(TaskPlanningError) as failure:
         plan_task(
@@ -264,3 +264,18 @@ def test_badly_built_tasks_fail_naming_the_stage(
         with pytest.raises(TaskPlanningError) as failure:
             plan_task(task, checker)
         assert expected in str(failure.value), str(failure.value)
+
+
+def test_link_padding_is_honoured_per_stage(
+    checker: CollisionChecker, start: np.ndarray, arm_goal: Callable[[str], dict[str, float]]
+) -> None:
+    home = arm_goal("Home")
+    plan_task(
+        Task("tight", [CurrentState(start), PlanToJointState(home, MotionSettings(link_padding=0.0))]),
+        checker,
+    )
+    wide = Task("wide", [CurrentState(start), PlanToJointState(home, MotionSettings(link_padding=0.5))])
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(wide, checker)
+    assert "stage 2 of 2 ('plan to joint state')" in str(failure.value) and "collision" in str(failure.value)
+    assert checker.padding == 0.01, "planning restores the checker's own padding"

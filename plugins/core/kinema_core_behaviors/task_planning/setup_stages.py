@@ -118,7 +118,13 @@ class SetupMTCConnectWithProRRT(_SetupStage):
         return [
             _task_port(),
             *_planning_ports(),
-            input_port("seed", int, 0, "Random seed of the planner (the same seed plans the same motion)."),
+            input_port(
+                "seed",
+                int,
+                0,
+                "Seed of the IK restarts (the same seed gives the same solutions); OMPL's RNG is seeded once "
+                "per process, so a connect that needs OMPL may take another path in another process.",
+            ),
         ]
 
     def stage(self, task: MtcTask) -> Any:
