@@ -116,3 +116,53 @@ def _tool(model: Any, message: Any, fk: Any) -> Any:
     positions = dict(zip(message.name, message.position, strict=True))
     q = model.configuration({n: v for n, v in positions.items() if n in model.joint_names})
     return fk(model, q, "tool0")[:3, 3]
+
+
+# Yaw-equivalent top-down grasps (0, 90, 180, 270 degrees about the world z axis), as "Pick from Pose
+# Vector" expects them: batch IK takes the one closest to where the arm is.
+YAWS = ("0;1;0;0", "-0.7071068;0.7071068;0;0", "-1;0;0;0", "-0.7071068;-0.7071068;0;0")
+
+
+def _pose_vector(key: str, x: float, y: float, z: float) -> str:
+    lines = [f'<Action ID="ResetPoseStampedVector" vector="{{{key}}}" />']
+    for yaw in YAWS:
+        lines.append(
+            f'<Action ID="CreatePoseStamped" reference_frame="world" position_xyz="{x};{y};{z}" '
+            f'orientation_xyzw="{yaw}" pose_stamped="{{candidate}}" />'
+        )
+        lines.append(
+            f'<Action ID="PushBackVector" input_vector="{{{key}}}" element="{{candidate}}" '
+            f'output_vector="{{{key}}}" />'
+        )
+    return "\n".join(lines)
+
+
+def test_pick_from_pose_vector_and_place_with_approval_move_the_cube_headless(
+    library_cell: LibraryCell,
+) -> None:
+    """Nobody is attached to approve: "Wait for Trajectory Approval if User Available" goes on without
+    asking (the headless rule), so MoveIt Pro's "Place at Pose with Approval" runs through."""
+    x, y, z = cube_position(library_cell)
+    pick = f"""<root BTCPP_format="4" main_tree_to_execute="Pick Any Yaw">
+      <BehaviorTree ID="Pick Any Yaw"><Sequence>
+        <SubTree ID="Open Gripper" />
+        {_pose_vector("grasp_poses", x, y, z + GRASP_ABOVE_CENTRE)}
+        <SubTree ID="Pick from Pose Vector" grasp_poses="{{grasp_poses}}" approach_distance="0.1"
+                 retract_xyz="0;0;-0.1" />
+      </Sequence></BehaviorTree></root>"""
+    result: Any = library_cell.client.start(xml=pick).result(RUN_TIMEOUT)
+    assert result.succeeded, result
+    held = settled_cube(library_cell)
+    assert held[2] - z >= 0.05, f"the cube went from {(x, y, z)} to {held}"
+
+    asked = (x - 0.05, y + 0.1, z)
+    place = f"""<root BTCPP_format="4" main_tree_to_execute="Place Any Yaw">
+      <BehaviorTree ID="Place Any Yaw"><Sequence>
+        {_pose_vector("place_poses", asked[0], asked[1], asked[2] + GRASP_ABOVE_CENTRE)}
+        <SubTree ID="Place at Pose with Approval" place_poses="{{place_poses}}" />
+      </Sequence></BehaviorTree></root>"""
+    result = library_cell.client.start(xml=place).result(RUN_TIMEOUT)
+    assert result.succeeded, result
+    down = settled_cube(library_cell)
+    error = max(abs(a - b) for a, b in zip(down, asked, strict=True))
+    assert error <= 0.02, f"asked to place the cube at {asked}, it is at {down} ({error:.3f} m off)"
