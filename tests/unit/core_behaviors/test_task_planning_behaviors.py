@@ -152,3 +152,39 @@ def test_setup_behaviors_need_a_task_and_valid_values(behavior: Any, context: Be
     assert run.status == NodeStatus.FAILURE and "velocity scale factor must be in (0, 1]" in run.toasts[-1]
     run = tick_behavior(behavior("ConvertMtcSolutionToJointTrajectory"), {"solution": task}, context=context)
     assert run.status == NodeStatus.FAILURE and "needs a solution PlanMTCTask planned" in run.toasts[-1]
+
+
+def test_a_solution_is_replayed_only_from_where_it_starts(
+    registry: Any, behavior: Any, context: BehaviorContext, look_at_table: dict[str, float]
+) -> None:
+    result = run_objective(PICK_PLAN, registry=registry, context=context, timeout=120.0)
+    assert result.status == NodeStatus.SUCCESS, result.toasts
+    pick = result.blackboard["mtc_solution"]
+    task = tick_behavior(behavior("InitializeMTCTask"), {"task_id": "replay"}, context=context).outputs[
+        "task"
+    ]
+    run = tick_behavior(behavior("SetupMTCFromSolution"), {"task": task, "solution": pick}, context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    run = tick_behavior(behavior("PlanMTCTask"), {"task": task}, context=context, timeout=60.0)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    assert run.outputs["solution"].joined().duration == pytest.approx(pick.joined().duration)
+
+    # A solution that starts elsewhere (the robot is at "Look at Table", this one starts at the grasp).
+    task = tick_behavior(behavior("InitializeMTCTask"), {"task_id": "retreat"}, context=context).outputs[
+        "task"
+    ]
+    from kinema.motion import CollisionChecker
+    from kinema.motion.task import Task, plan_task
+    from kinema.motion.task_stages import CurrentState, MoveAlongFrameAxis
+
+    checker = CollisionChecker(context.robot_model)
+    elsewhere = plan_task(
+        Task(
+            "up", [CurrentState(pick.end), MoveAlongFrameAxis((0, 0, 1), "world", "grasp_link", 0.05, 0.05)]
+        ),
+        checker,
+    )
+    tick_behavior(behavior("SetupMTCFromSolution"), {"task": task, "solution": elsewhere}, context=context)
+    run = tick_behavior(behavior("PlanMTCTask"), {"task": task}, context=context, timeout=60.0)
+    assert run.status == NodeStatus.FAILURE
+    assert "the robot is not where that solution starts" in run.toasts[-1], run.toasts

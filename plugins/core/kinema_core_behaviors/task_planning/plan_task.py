@@ -24,6 +24,20 @@ def _stage_summary(reports: Any) -> str:
     return "; ".join(f"{r.index + 1}. {r.name}: {marks.get(r.status, r.status)}" for r in reports)
 
 
+START_TOLERANCE = 0.01  # rad or m: how far the robot may be from a replayed solution's start
+
+
+def _away_from(model: Any, q: Any, solution: Any) -> str:
+    """The joints a replayed solution moves that are not where it starts ('' when all are)."""
+    moved = {n for sub in solution.sub_trajectories for n in sub.trajectory.joint_names}
+    off = [
+        f"{n} at {q[i]:.3f}, not {solution.start[i]:.3f}"
+        for i, n in enumerate(model.joint_names)
+        if n in moved and abs(q[i] - solution.start[i]) > START_TOLERANCE
+    ]
+    return ", ".join(off[:3]) + (f" and {len(off) - 3} more" if len(off) > 3 else "")
+
+
 class PlanMTCTask(AsyncBehavior):
     """Plans ``task`` from the robot's current state into ``solution``, against the planning scene.
 
@@ -50,7 +64,7 @@ class PlanMTCTask(AsyncBehavior):
 
     def do_work(self) -> bool:
         from kinema.motion.task import Task, TaskPlanningError, plan_task
-        from kinema.motion.task_stages import CurrentState
+        from kinema.motion.task_stages import CurrentState, FromSolution
 
         try:
             mtc = task_input(self)
@@ -62,6 +76,14 @@ class PlanMTCTask(AsyncBehavior):
             robot_frames = {frame.name for frame in model.pin_model.frames}
             fixed = {n: tree.world_T(n) for n in tree.names() if n not in robot_frames and n != "world"}
             stages = [CurrentState(q) if isinstance(s, CurrentStateMarker) else s for s in mtc.stages]
+            if stages and isinstance(stages[0], FromSolution):
+                away = _away_from(model, q, stages[0].solution)
+                if away:
+                    return self._fail(
+                        f"the task starts with the solution of {stages[0].name!r}, but the robot is not "
+                        f"where that solution starts ({away}); executing it would jump. Start the task with "
+                        "SetupMTCCurrentState and SetupMTCConnectWithProRRT to move there first"
+                    )
             checker = collision_checker(self.context, "PlanMTCTask", DEFAULT_PADDING)
             deadline = time.monotonic() + mtc.timeout if mtc.timeout > 0 else float("inf")
             solution = plan_task(
