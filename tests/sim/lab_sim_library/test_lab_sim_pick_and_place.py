@@ -9,11 +9,12 @@ the joint states it publishes), not from the plan.
 from __future__ import annotations
 
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import pytest
 
-from conftest import LibraryCell
+if TYPE_CHECKING:  # annotations only: importing conftest by name clashes with other test folders'
+    from conftest import LibraryCell
 
 pytestmark = pytest.mark.slow
 
