@@ -105,6 +105,26 @@ class TaskSolution:
     reports: tuple[StageReport, ...]
     planning_seconds: float = 0.0
 
+    def tool_paths(self, model: RobotModel, frame: str) -> list[tuple[str, np.ndarray]]:
+        """Where ``frame`` goes during each sub-trajectory: (stage name, positions ``(N, 3)`` in the world).
+
+        For drawing a solution stage by stage before it runs.
+        """
+        from kinema.motion.kinematics import fk
+
+        data = model.new_data()
+        index = {n: i for i, n in enumerate(self.joint_names)}
+        q = self.start.copy()
+        paths = []
+        for sub in self.sub_trajectories:
+            cols = [index[n] for n in sub.trajectory.joint_names]
+            points = []
+            for row in sub.trajectory.positions:
+                q[cols] = row
+                points.append(fk(model, q, frame, data)[:3, 3])
+            paths.append((sub.stage, np.array(points)))
+        return paths
+
     def joined(self) -> JointTrajectory:
         """All sub-trajectories as one trajectory over the joints any of them moves (in model order).
 

@@ -188,3 +188,25 @@ def test_a_solution_is_replayed_only_from_where_it_starts(
     run = tick_behavior(behavior("PlanMTCTask"), {"task": task}, context=context, timeout=60.0)
     assert run.status == NodeStatus.FAILURE
     assert "the robot is not where that solution starts" in run.toasts[-1], run.toasts
+
+
+def test_a_planned_task_is_drawn_in_the_view_stage_by_stage(
+    registry: Any, context: BehaviorContext, node: Any, look_at_table: dict[str, float]
+) -> None:
+    import threading
+
+    arrays: list[Any] = []
+    got = threading.Event()
+
+    def keep(message: Any) -> None:
+        arrays.append(message)
+        got.set()
+
+    node.create_subscription("visualization_msgs/msg/MarkerArray", "/visualization_marker_array", keep)
+    result = run_objective(PICK_PLAN, registry=registry, context=context, timeout=120.0)
+    assert result.status == NodeStatus.SUCCESS, result.toasts
+    assert got.wait(10.0), "no MarkerArray published"
+    lines = [m for a in arrays for m in a.markers if m.ns == "mtc_solution" and m.type == 4 and m.action == 0]
+    assert [m.text for m in lines] == ["connect", "move along frame axis"], [m.text for m in lines]
+    end = lines[-1].points[-1]
+    assert np.linalg.norm(np.array([end.x, end.y, end.z]) - CUBE) < 1e-3

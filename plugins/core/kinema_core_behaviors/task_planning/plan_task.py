@@ -42,9 +42,10 @@ class PlanMTCTask(AsyncBehavior):
     """Plans ``task`` from the robot's current state into ``solution``, against the planning scene.
 
     Poses are resolved in the frames of the cell when planning starts (robot links at the current state,
-    simulated objects, scene objects). The planned motion is published for ``kinema view`` and the stages'
-    outcome is logged; a failure names the stage and why (no IK for pose 2 of 3, the Cartesian path
-    stopped at 43 %, no path within the planning time).
+    simulated objects, scene objects). The planned motion is published for ``kinema view``, which also
+    draws the tool's path of each stage as a coloured line, and the stages' outcome is logged; a failure
+    names the stage and why (no IK for pose 2 of 3, the Cartesian path stopped at 43 %, no path within the
+    planning time).
     """
 
     subcategory = SUBCATEGORY
@@ -103,11 +104,64 @@ class PlanMTCTask(AsyncBehavior):
         )
         self.set_output("solution", solution)
         publish_planned_trajectory(self, trajectory_message(solution.joined()))
+        publish_stage_paths(self, solution, model)
         return True
 
     def _fail(self, reason: str) -> bool:
         self.logger.publish_failure(f"PlanMTCTask: planning failed: {reason}")
         return False
+
+
+STAGE_COLORS = ((0.1, 0.6, 1.0), (1.0, 0.6, 0.1), (0.2, 0.8, 0.3), (0.9, 0.2, 0.6), (0.6, 0.4, 1.0))
+STAGE_PATHS_NAMESPACE = "mtc_solution"
+MAX_STAGE_LINES = 32
+
+
+def publish_stage_paths(behavior: Any, solution: Any, model: Any) -> None:
+    """Draw the tool's path of each stage in ``kinema view`` (one coloured line per moving stage).
+
+    The tool is the tip link of the first moving stage's group (``grasp_link`` on lab_sim). Only for
+    display: without a transport node nothing is published.
+    """
+    from kinema.transport import from_dict
+
+    from ..ui.visualize_pose import MARKER_ARRAY_TYPE, MARKER_TOPIC
+
+    node = behavior.context.node
+    if node is None or not solution.sub_trajectories:
+        return
+    first = solution.sub_trajectories[0].trajectory.joint_names
+    group = next((g for g in model.groups.values() if tuple(g.joint_names) == tuple(first)), None)
+    frame = getattr(group, "tip_link", None) or model.link_names[-1]
+    markers: list[dict[str, Any]] = []
+    for index, (stage, points) in enumerate(solution.tool_paths(model, frame)):
+        if len(points) < 2:
+            continue
+        r, g, b = STAGE_COLORS[index % len(STAGE_COLORS)]
+        markers.append(
+            {
+                "header": {"frame_id": "world"},
+                "ns": STAGE_PATHS_NAMESPACE,
+                "id": index + 1,
+                "type": 4,  # LINE_STRIP
+                "action": 0,
+                "pose": {"orientation": {"w": 1.0}},
+                "scale": {"x": 0.005},
+                "color": {"r": r, "g": g, "b": b, "a": 1.0},
+                "points": [{"x": float(x), "y": float(y), "z": float(z)} for x, y, z in points],
+                "text": stage,
+            }
+        )
+    drawn = {m["id"] for m in markers}
+    # Remove the lines of an earlier, longer solution (only this namespace: the user's markers stay).
+    markers += [
+        {"header": {"frame_id": "world"}, "ns": STAGE_PATHS_NAMESPACE, "id": i, "action": 2}
+        for i in range(1, MAX_STAGE_LINES + 1)
+        if i not in drawn
+    ]
+    behavior.context.publisher(node, MARKER_ARRAY_TYPE, MARKER_TOPIC).publish(
+        from_dict(MARKER_ARRAY_TYPE, {"markers": markers})
+    )
 
 
 class ConvertMtcSolutionToJointTrajectory(SyncBehavior):
