@@ -18,6 +18,7 @@ from . import (
     motion,
     planning_scene,
     poses,
+    task_planning,
     ui,
     vectors,
     waiting,
@@ -25,6 +26,7 @@ from . import (
 )
 
 FAMILIES = (controllers, files, io, messages, motion, planning_scene, poses, ui, vectors, waiting, waypoints)
+FAMILIES += (task_planning,)  # issue 13's family, kept on its own line
 
 BEHAVIORS = tuple(behavior for family in FAMILIES for behavior in family.BEHAVIORS)
 

@@ -37,6 +37,10 @@ _EXPORTS = {
     "plan_cartesian_path": "cartesian",
     "CartesianResult": "cartesian",
     "time_parameterize": "timing",
+    "Task": "task",
+    "TaskSolution": "task",
+    "TaskPlanningError": "task",
+    "plan_task": "task",
     "JointPath": "trajectory",
     "JointTrajectory": "trajectory",
 }

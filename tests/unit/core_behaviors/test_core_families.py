@@ -14,6 +14,7 @@ FAMILIES = (
     "motion",
     "planning_scene",
     "poses",
+    "task_planning",
     "ui",
     "vectors",
     "waiting",

@@ -1,0 +1,204 @@
+"""PlanMTCTask plans a task into a solution; ConvertMtcSolutionToJointTrajectory makes it one trajectory."""
+
+from __future__ import annotations
+
+import time
+from typing import Any
+
+from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, SyncBehavior, input_port, output_port
+from kinema.errors import KinemaError
+
+from ..messages.conversions import trajectory_message
+from ..motion.joint_states import joint_state_monitor
+from ..motion.planned_trajectory import publish_planned_trajectory
+from ..motion.planning_resources import collision_checker, robot_model
+from ..poses.frame_tree import current_frame_tree
+from .mtc_task import CurrentStateMarker, task_input
+from .setup_stages import SUBCATEGORY
+
+DEFAULT_PADDING = 0.01
+
+
+def _stage_summary(reports: Any) -> str:
+    marks = {"planned": "ok", "failed": "FAILED", "not planned": "-"}
+    return "; ".join(f"{r.index + 1}. {r.name}: {marks.get(r.status, r.status)}" for r in reports)
+
+
+START_TOLERANCE = 0.01  # rad or m: how far the robot may be from a replayed solution's start
+
+
+def _away_from(model: Any, q: Any, solution: Any) -> str:
+    """The joints a replayed solution moves that are not where it starts ('' when all are)."""
+    moved = {n for sub in solution.sub_trajectories for n in sub.trajectory.joint_names}
+    off = [
+        f"{n} at {q[i]:.3f}, not {solution.start[i]:.3f}"
+        for i, n in enumerate(model.joint_names)
+        if n in moved and abs(q[i] - solution.start[i]) > START_TOLERANCE
+    ]
+    return ", ".join(off[:3]) + (f" and {len(off) - 3} more" if len(off) > 3 else "")
+
+
+class PlanMTCTask(AsyncBehavior):
+    """Plans ``task`` from the robot's current state into ``solution``, against the planning scene.
+
+    Poses are resolved in the frames of the cell when planning starts (robot links at the current state,
+    simulated objects, scene objects). The planned motion is published for ``kinema view``, which also
+    draws the tool's path of each stage as a coloured line, and the stages' outcome is logged; a failure
+    names the stage and why (no IK for pose 2 of 3, the Cartesian path stopped at 43 %, no path within the
+    planning time).
+    """
+
+    subcategory = SUBCATEGORY
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            input_port("task", None, "{mtc_task}", "The task to plan (InitializeMTCTask, SetupMTC*)."),
+            output_port("solution", None, "{mtc_solution}", "The planned solution."),
+            input_port(
+                "max_solutions",
+                int,
+                1,
+                "How many solutions to look for; Kinema returns the first that plans.",
+            ),
+        ]
+
+    def do_work(self) -> bool:
+        from kinema.motion.task import Task, TaskPlanningError, plan_task
+        from kinema.motion.task_stages import CurrentState, FromSolution
+
+        try:
+            mtc = task_input(self)
+            if int(self.get_input("max_solutions")) < 1:
+                return self._fail(f"max_solutions must be at least 1, got {self.get_input('max_solutions')}")
+            model = robot_model(self.context, "PlanMTCTask")
+            q = joint_state_monitor(self.context, "PlanMTCTask").positions(model.joint_names)
+            tree = current_frame_tree(self)
+            robot_frames = {frame.name for frame in model.pin_model.frames}
+            fixed = {n: tree.world_T(n) for n in tree.names() if n not in robot_frames and n != "world"}
+            stages = [CurrentState(q) if isinstance(s, CurrentStateMarker) else s for s in mtc.stages]
+            if stages and isinstance(stages[0], FromSolution):
+                away = _away_from(model, q, stages[0].solution)
+                if away:
+                    return self._fail(
+                        f"the task starts with the solution of {stages[0].name!r}, but the robot is not "
+                        f"where that solution starts ({away}); executing it would jump. Start the task with "
+                        "SetupMTCCurrentState and SetupMTCConnectWithProRRT to move there first"
+                    )
+            checker = collision_checker(self.context, "PlanMTCTask", DEFAULT_PADDING)
+            deadline = time.monotonic() + mtc.timeout if mtc.timeout > 0 else float("inf")
+            solution = plan_task(
+                Task(mtc.task_id, stages),
+                checker,
+                frames=fixed,
+                stop=lambda: self.stop_requested() or time.monotonic() > deadline,
+            )
+        except TaskPlanningError as error:
+            self.logger.publish_info(f"PlanMTCTask: stages: {_stage_summary(error.reports)}")
+            return self._fail(str(error))
+        except KinemaError as error:
+            return self._fail(str(error))
+        self.logger.publish_info(
+            f"PlanMTCTask: planned task {mtc.task_id!r} in {solution.planning_seconds:.2f} s: "
+            f"{_stage_summary(solution.reports)}"
+        )
+        self.set_output("solution", solution)
+        publish_planned_trajectory(self, trajectory_message(solution.joined()))
+        publish_stage_paths(self, solution, model)
+        return True
+
+    def _fail(self, reason: str) -> bool:
+        self.logger.publish_failure(f"PlanMTCTask: planning failed: {reason}")
+        return False
+
+
+STAGE_COLORS = ((0.1, 0.6, 1.0), (1.0, 0.6, 0.1), (0.2, 0.8, 0.3), (0.9, 0.2, 0.6), (0.6, 0.4, 1.0))
+STAGE_PATHS_NAMESPACE = "mtc_solution"
+MAX_STAGE_LINES = 32
+
+
+def publish_stage_paths(behavior: Any, solution: Any, model: Any) -> None:
+    """Draw the tool's path of each stage in ``kinema view`` (one coloured line per moving stage).
+
+    The tool is the tip link of the first moving stage's group (``grasp_link`` on lab_sim). Only for
+    display: without a transport node nothing is published.
+    """
+    from kinema.transport import from_dict
+
+    from ..ui.visualize_pose import MARKER_ARRAY_TYPE, MARKER_TOPIC
+
+    node = behavior.context.node
+    if node is None or not solution.sub_trajectories:
+        return
+    first = solution.sub_trajectories[0].trajectory.joint_names
+    group = next((g for g in model.groups.values() if tuple(g.joint_names) == tuple(first)), None)
+    frame = getattr(group, "tip_link", None) or model.link_names[-1]
+    markers: list[dict[str, Any]] = []
+    for index, (stage, points) in enumerate(solution.tool_paths(model, frame)):
+        if len(points) < 2:
+            continue
+        r, g, b = STAGE_COLORS[index % len(STAGE_COLORS)]
+        markers.append(
+            {
+                "header": {"frame_id": "world"},
+                "ns": STAGE_PATHS_NAMESPACE,
+                "id": index + 1,
+                "type": 4,  # LINE_STRIP
+                "action": 0,
+                "pose": {"orientation": {"w": 1.0}},
+                "scale": {"x": 0.005},
+                "color": {"r": r, "g": g, "b": b, "a": 1.0},
+                "points": [{"x": float(x), "y": float(y), "z": float(z)} for x, y, z in points],
+                "text": stage,
+            }
+        )
+    drawn = {m["id"] for m in markers}
+    # Remove the lines of an earlier, longer solution (only this namespace: the user's markers stay).
+    markers += [
+        {"header": {"frame_id": "world"}, "ns": STAGE_PATHS_NAMESPACE, "id": i, "action": 2}
+        for i in range(1, MAX_STAGE_LINES + 1)
+        if i not in drawn
+    ]
+    behavior.context.publisher(node, MARKER_ARRAY_TYPE, MARKER_TOPIC).publish(
+        from_dict(MARKER_ARRAY_TYPE, {"markers": markers})
+    )
+
+
+class ConvertMtcSolutionToJointTrajectory(SyncBehavior):
+    """Joins the motions of ``solution`` into one ``trajectory_msgs/JointTrajectory``.
+
+    The stages' motions follow one another (each starts where the previous ended, at rest).
+    """
+
+    subcategory = SUBCATEGORY
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            input_port("solution", None, "{mtc_solution}", "A solution PlanMTCTask planned."),
+            output_port(
+                "joint_trajectory",
+                None,
+                "{joint_trajectory_msg}",
+                "The whole motion (trajectory_msgs/JointTrajectory).",
+            ),
+        ]
+
+    def tick(self) -> NodeStatus:
+        from kinema.motion.task import TaskSolution
+
+        solution = self.get_input_or("solution", None)
+        if not isinstance(solution, TaskSolution):
+            got = "nothing" if solution is None else type(solution).__name__
+            self.logger.publish_failure(
+                f"ConvertMtcSolutionToJointTrajectory: port [solution] needs a solution PlanMTCTask "
+                f"planned, got {got}"
+            )
+            return NodeStatus.FAILURE
+        try:
+            joined = solution.joined()
+        except KinemaError as error:
+            self.logger.publish_failure(f"ConvertMtcSolutionToJointTrajectory: {error}")
+            return NodeStatus.FAILURE
+        self.set_output("joint_trajectory", trajectory_message(joined))
+        return NodeStatus.SUCCESS

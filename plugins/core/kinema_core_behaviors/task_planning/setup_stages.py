@@ -1,0 +1,327 @@
+"""InitializeMTCTask and the SetupMTC* behaviors: create a task and append stages to it.
+
+Each SetupMTC* behavior appends one stage to the task on its ``task`` port and succeeds; nothing is
+planned until PlanMTCTask. Bad values (an axis of zeros, a scale factor outside (0, 1], a pose that is
+not a PoseStamped) fail the behavior naming the port.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, bidirectional_port, input_port, output_port
+from kinema.errors import KinemaError
+
+from ..messages.conversions import joint_positions, pose_matrix
+from ..messages.ports import message_input, message_vector_input
+from .mtc_task import CurrentStateMarker, MtcTask, stage_name, task_input
+
+SUBCATEGORY = "Motion - Task Planning"
+
+
+def _task_port() -> PortInfo:
+    return bidirectional_port("task", None, "{mtc_task}", "The MTC task to add the stage to.")
+
+
+def _rate_to_period(rate: Any) -> float:
+    rate = float(rate)
+    if not rate > 0:
+        raise KinemaError(f"trajectory_sampling_rate must be positive (points per second), got {rate}")
+    return 1.0 / rate
+
+
+class _SetupStage(SyncBehavior):
+    """Append the stage :meth:`stage` builds; fail naming the reason when it cannot."""
+
+    subcategory = SUBCATEGORY
+
+    def stage(self, task: MtcTask) -> Any:
+        raise NotImplementedError
+
+    def tick(self) -> NodeStatus:
+        try:
+            task = task_input(self)
+            stage = self.stage(task)
+        except KinemaError as error:
+            self.logger.publish_failure(f"{self.registration_id}: {error}")
+            return NodeStatus.FAILURE
+        task.stages.append(stage)
+        self.set_output("task", task)
+        return NodeStatus.SUCCESS
+
+
+class InitializeMTCTask(SyncBehavior):
+    """Creates an empty MTC task on ``task``; SetupMTC* behaviors add its stages, PlanMTCTask plans it."""
+
+    subcategory = SUBCATEGORY
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            output_port("task", None, "{mtc_task}", "The new task."),
+            input_port("task_id", str, "", "A name for the task (shown while it is planned)."),
+            input_port("timeout", float, -1.0, "Seconds planning may take in all; -1: no limit."),
+        ]
+
+    def tick(self) -> NodeStatus:
+        self.set_output("task", MtcTask(str(self.get_input("task_id")), float(self.get_input("timeout"))))
+        return NodeStatus.SUCCESS
+
+
+class SetupMTCCurrentState(_SetupStage):
+    """Adds the robot's state when the task is planned as the task's start."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [_task_port()]
+
+    def stage(self, task: MtcTask) -> Any:
+        return CurrentStateMarker()
+
+
+def _motion(behavior: Any, velocity: str, acceleration: str, padding: float, **extra: Any) -> Any:
+    from kinema.motion.task_stages import MotionSettings
+
+    return MotionSettings(
+        group=str(behavior.get_input("planning_group_name")),
+        velocity_scale=float(behavior.get_input(velocity)),
+        acceleration_scale=float(behavior.get_input(acceleration)),
+        link_padding=padding,
+        **extra,
+    )
+
+
+def _planning_ports() -> list[PortInfo]:
+    return [
+        input_port("planning_group_name", str, "manipulator", "The planning group that moves."),
+        input_port("velocity_scale_factor", float, 1.0, "Fraction of the joints' velocity limits, (0, 1]."),
+        input_port(
+            "acceleration_scale_factor", float, 1.0, "Fraction of the joints' acceleration limits, (0, 1]."
+        ),
+        input_port("link_padding", float, 0.01, "Clearance (m) kept between the robot and the scene."),
+        input_port("trajectory_sampling_rate", int, 100, "Points per second of the planned trajectory."),
+        input_port(
+            "max_iterations",
+            int,
+            5000,
+            "MoveIt Pro's RRT iteration cap; Kinema's OMPL planner is bounded by time instead (1 s), so "
+            "it is accepted and has no effect.",
+        ),
+    ]
+
+
+class SetupMTCConnectWithProRRT(_SetupStage):
+    """Adds a connect stage: a collision-free joint-space motion between the stages around it."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            _task_port(),
+            *_planning_ports(),
+            input_port(
+                "seed",
+                int,
+                0,
+                "Seed of the IK restarts (the same seed gives the same solutions); OMPL's RNG is seeded once "
+                "per process, so a connect that needs OMPL may take another path in another process.",
+            ),
+        ]
+
+    def stage(self, task: MtcTask) -> Any:
+        from kinema.motion.task_stages import Connect
+
+        motion = _motion(
+            self,
+            "velocity_scale_factor",
+            "acceleration_scale_factor",
+            float(self.get_input("link_padding")),
+            sample_period=_rate_to_period(self.get_input("trajectory_sampling_rate")),
+            seed=int(self.get_input("seed")),
+        )
+        return Connect(motion, name=stage_name(task, "connect"))
+
+
+class SetupMTCPlanToPose(_SetupStage):
+    """Adds a stage that moves ``ik_frame`` to ``target_pose`` (IK from several seeds, then a free motion)."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            _task_port(),
+            message_input(
+                "target_pose", "geometry_msgs/msg/PoseStamped", "{target_pose}", "Where ik_frame goes."
+            ),
+            input_port("ik_frame", str, "grasp_link", "The robot frame placed at the target pose."),
+            input_port(
+                "monitored_stage",
+                str,
+                "current state",
+                "The stage whose state frames are resolved at (Kinema: the state before this stage).",
+            ),
+            *_planning_ports(),
+        ]
+
+    def stage(self, task: MtcTask) -> Any:
+        from kinema.motion.task_stages import PlanToPose
+
+        target = pose_matrix(self.get_input("target_pose"), "target_pose")
+        motion = _motion(
+            self,
+            "velocity_scale_factor",
+            "acceleration_scale_factor",
+            float(self.get_input("link_padding")),
+            sample_period=_rate_to_period(self.get_input("trajectory_sampling_rate")),
+        )
+        return PlanToPose(
+            target, str(self.get_input("ik_frame")), motion, name=stage_name(task, "plan to pose")
+        )
+
+
+class SetupMTCPlanToRobotState(_SetupStage):
+    """Adds a stage that moves the planning group to ``joint_state`` (a collision-free motion)."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            _task_port(),
+            input_port(
+                "joint_state",
+                None,
+                "{target_joint_state}",
+                "The goal (sensor_msgs/JointState, e.g. from RetrieveWaypoint).",
+            ),
+            input_port("planning_group_name", str, "manipulator", "The planning group that moves."),
+        ]
+
+    def stage(self, task: MtcTask) -> Any:
+        from kinema.motion.task_stages import MotionSettings, PlanToJointState
+
+        goal = joint_positions(self.get_input("joint_state"), "joint_state")
+        if not goal:
+            raise KinemaError("port [joint_state] names no joint")
+        motion = MotionSettings(group=str(self.get_input("planning_group_name")))
+        return PlanToJointState(goal, motion, name=stage_name(task, "plan to joint state"))
+
+
+class SetupMTCMoveAlongFrameAxis(_SetupStage):
+    """Adds a straight-line motion of ``hand_frame`` along an axis of ``axis_frame``.
+
+    It moves ``max_distance`` when it can and fails when less than ``min_distance`` is reachable. Before
+    a pose IK stage (an approach) it is planned backwards, so it ends at the pose.
+    """
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            _task_port(),
+            input_port("axis_frame", str, "grasp_link", "The frame the axis is given in."),
+            input_port("axis_x", float, 0.0, "Axis x component."),
+            input_port("axis_y", float, 0.0, "Axis y component."),
+            input_port("axis_z", float, 1.0, "Axis z component."),
+            input_port("hand_frame", str, "grasp_link", "The robot frame that moves along the axis."),
+            input_port("min_distance", float, 0.1, "Least distance (m) the motion must cover."),
+            input_port("max_distance", float, 0.1, "Distance (m) to cover when reachable."),
+            input_port("planning_group_name", str, "manipulator", "The planning group that moves."),
+            input_port("velocity_scale", float, 1.0, "Fraction of the joints' velocity limits, (0, 1]."),
+            input_port(
+                "acceleration_scale", float, 1.0, "Fraction of the joints' acceleration limits, (0, 1]."
+            ),
+            input_port(
+                "ignore_environment_collisions",
+                bool,
+                False,
+                "Plan through the planning scene's objects (the robot still must not hit itself).",
+            ),
+        ]
+
+    def stage(self, task: MtcTask) -> Any:
+        from kinema.motion.task_stages import MoveAlongFrameAxis
+
+        motion = _motion(self, "velocity_scale", "acceleration_scale", 0.0)
+        return MoveAlongFrameAxis(
+            (
+                float(self.get_input("axis_x")),
+                float(self.get_input("axis_y")),
+                float(self.get_input("axis_z")),
+            ),
+            str(self.get_input("axis_frame")),
+            str(self.get_input("hand_frame")),
+            float(self.get_input("min_distance")),
+            float(self.get_input("max_distance")),
+            motion,
+            bool(self.get_input("ignore_environment_collisions")),
+            name=stage_name(task, "move along frame axis"),
+        )
+
+
+class SetupMTCBatchPoseIK(_SetupStage):
+    """Adds a stage that solves IK for each of ``target_poses`` and keeps the solutions closest to the
+    state before (up to ``max_ik_solutions``); the stages around it plan to or from the closest that works.
+    """
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            _task_port(),
+            message_vector_input(
+                "target_poses", "geometry_msgs/msg/PoseStamped", "{target_poses}", "Candidate poses."
+            ),
+            input_port("ik_group", str, "manipulator", "The planning group IK moves."),
+            input_port("end_effector_link", str, "grasp_link", "The robot frame placed at a pose."),
+            input_port(
+                "end_effector_group",
+                str,
+                "moveit_ee",
+                "MoveIt's end-effector group (Kinema checks the whole robot for collisions).",
+            ),
+            input_port("max_ik_solutions", int, 4, "How many solutions later stages may try."),
+            input_port(
+                "ik_timeout_s",
+                float,
+                0.01,
+                "MoveIt Pro's IK timeout per pose; Kinema bounds IK by seeds (20 per pose) instead.",
+            ),
+            input_port(
+                "monitored_stage",
+                str,
+                "current state",
+                "The stage whose state IK starts from (Kinema: the state before this stage).",
+            ),
+        ]
+
+    def stage(self, task: MtcTask) -> Any:
+        from kinema.motion.task_stages import BatchPoseIK
+
+        value = self.get_input("target_poses")
+        items = list(value) if isinstance(value, list | tuple) else [value]
+        if not items:
+            raise KinemaError("port [target_poses] is an empty vector")
+        targets = [pose_matrix(item, f"target_poses[{i}]") for i, item in enumerate(items)]
+        return BatchPoseIK(
+            targets,
+            str(self.get_input("end_effector_link")),
+            str(self.get_input("ik_group")),
+            int(self.get_input("max_ik_solutions")),
+            name=stage_name(task, "batch pose IK"),
+        )
+
+
+class SetupMTCFromSolution(_SetupStage):
+    """Adds an earlier ``solution``'s motions; the task goes on from where it ended."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            _task_port(),
+            input_port("solution", None, "{solution}", "A solution PlanMTCTask planned."),
+        ]
+
+    def stage(self, task: MtcTask) -> Any:
+        from kinema.motion.task import TaskSolution
+        from kinema.motion.task_stages import FromSolution
+
+        solution = self.get_input_or("solution", None)
+        if not isinstance(solution, TaskSolution):
+            got = "nothing" if solution is None else type(solution).__name__
+            raise KinemaError(f"port [solution] needs a solution PlanMTCTask planned, got {got}")
+        return FromSolution(solution, name=stage_name(task, "from solution"))

@@ -1,0 +1,588 @@
+"""Task planning: an ordered list of stages planned into one solution, MoveIt Task Constructor's way.
+
+A :class:`Task` holds stages (:mod:`kinema.motion.task_stages`). :func:`plan_task` splits it at its
+:class:`~kinema.motion.task_stages.Connect` stages into segments; each segment has at most one generator
+(a state fixed on its own); the stages before the generator are planned backwards from it, those after
+it forwards, and each connect joins the segment before it to the one after it with a collision-free
+joint-space motion (a straight line when free, OMPL otherwise). A generator with several candidates
+(:class:`~kinema.motion.task_stages.BatchPoseIK`) tries them in order of closeness to the state before.
+
+The solution is a list of sub-trajectories, one per moving stage, each timed with toppra (at rest at both
+ends, within the stage's scaled limits), each starting exactly where the one before ended. Planning fails
+with a :class:`TaskPlanningError` naming the stage and why.
+
+Example::
+
+    task = Task("pick", [CurrentState(q), Connect(), MoveAlongFrameAxis((0, 0, 1), "grasp_link",
+                "grasp_link", 0.1, 0.1), BatchPoseIK([("world", world_T_grasp)], "grasp_link")])
+    solution = plan_task(task, checker)
+    trajectory = solution.joined()
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from kinema.errors import MotionError
+from kinema.motion.task_stages import (
+    GENERATORS,
+    BatchPoseIK,
+    Connect,
+    CurrentState,
+    FromSolution,
+    MotionSettings,
+    MoveAlongFrameAxis,
+    PlanToJointState,
+    PlanToPose,
+    Stage,
+    Target,
+    stage_kind,
+)
+from kinema.motion.trajectory import JointPath, JointTrajectory
+
+if TYPE_CHECKING:
+    from kinema.motion.collision import CollisionChecker
+    from kinema.motion.robot_model import RobotModel
+
+JOIN_TOLERANCE = 1e-6  # rad or m: sub-trajectories must meet this closely
+
+
+@dataclass
+class Task:
+    """A task being built: an id and its stages, in order."""
+
+    task_id: str
+    stages: list[Stage] = field(default_factory=list)
+
+    def add(self, stage: Stage) -> None:
+        """Append ``stage``."""
+        self.stages.append(stage)
+
+
+@dataclass(frozen=True)
+class StageReport:
+    """How a stage fared: ``status`` is ``planned``, ``failed`` or ``not planned``; ``comment`` says why."""
+
+    index: int
+    name: str
+    kind: str
+    status: str
+    comment: str = ""
+
+
+@dataclass(frozen=True, eq=False)
+class SubTrajectory:
+    """The timed motion of one stage, over its group's joints."""
+
+    stage: str
+    trajectory: JointTrajectory
+
+
+@dataclass(frozen=True, eq=False)
+class TaskSolution:
+    """A planned task.
+
+    Attributes:
+        task_id: the task's id.
+        joint_names: the model's joints, the columns of ``start`` and ``end``.
+        start: the full configuration the solution starts from.
+        end: the full configuration it ends at.
+        sub_trajectories: the stages' motions in order; each starts where the previous ended.
+        reports: one per stage, all ``planned``.
+        planning_seconds: how long planning took.
+    """
+
+    task_id: str
+    joint_names: tuple[str, ...]
+    start: np.ndarray
+    end: np.ndarray
+    sub_trajectories: tuple[SubTrajectory, ...]
+    reports: tuple[StageReport, ...]
+    planning_seconds: float = 0.0
+
+    def tool_paths(self, model: RobotModel, frame: str) -> list[tuple[str, np.ndarray]]:
+        """Where ``frame`` goes during each sub-trajectory: (stage name, positions ``(N, 3)`` in the world).
+
+        For drawing a solution stage by stage before it runs.
+        """
+        from kinema.motion.kinematics import fk
+
+        data = model.new_data()
+        index = {n: i for i, n in enumerate(self.joint_names)}
+        q = self.start.copy()
+        paths = []
+        for sub in self.sub_trajectories:
+            cols = [index[n] for n in sub.trajectory.joint_names]
+            points = []
+            for row in sub.trajectory.positions:
+                q[cols] = row
+                points.append(fk(model, q, frame, data)[:3, 3])
+            paths.append((sub.stage, np.array(points)))
+        return paths
+
+    def joined(self) -> JointTrajectory:
+        """All sub-trajectories as one trajectory over the joints any of them moves (in model order).
+
+        Joints a sub-trajectory does not move hold their value; each sub-trajectory starts and ends at
+        rest, so the joined motion is continuous in position and velocity.
+
+        Raises:
+            MotionError: two sub-trajectories do not meet (a jump between stages).
+        """
+        moving = {name for sub in self.sub_trajectories for name in sub.trajectory.joint_names}
+        names = tuple(n for n in self.joint_names if n in moving)
+        if not names:
+            names = self.joint_names
+        index = {n: i for i, n in enumerate(self.joint_names)}
+        cols = [index[n] for n in names]
+        held = self.start.copy()
+        zeros = np.zeros((1, len(cols)))
+        times: list[np.ndarray] = [np.zeros(1)]
+        positions: list[np.ndarray] = [held[cols][None, :]]
+        velocities: list[np.ndarray] = [zeros]
+        accelerations: list[np.ndarray] = [zeros]
+        offset = 0.0
+        previous = "the start"
+        for sub in self.sub_trajectories:
+            traj = sub.trajectory
+            sub_cols = [index[n] for n in traj.joint_names]
+            jump = float(np.abs(traj.positions[0] - held[sub_cols]).max()) if sub_cols else 0.0
+            if jump > JOIN_TOLERANCE:
+                raise MotionError(
+                    f"task {self.task_id!r}: stage {sub.stage!r} starts {jump:.4f} rad/m away from where "
+                    f"{previous} ended"
+                )
+            if len(traj.times) > 1:
+                k = len(traj.times) - 1
+                full = np.repeat(held[None, :], k, axis=0)
+                full[:, sub_cols] = traj.positions[1:]
+                local = [cols.index(c) for c in sub_cols]
+                qd = np.zeros((k, len(cols)))
+                qdd = np.zeros((k, len(cols)))
+                qd[:, local] = traj.velocities[1:]
+                qdd[:, local] = traj.accelerations[1:]
+                times.append(offset + traj.times[1:])
+                positions.append(full[:, cols])
+                velocities.append(qd)
+                accelerations.append(qdd)
+                offset += traj.duration
+                held = full[-1].copy()
+            previous = f"stage {sub.stage!r}"
+        return JointTrajectory(
+            names,
+            np.concatenate(times),
+            np.concatenate(positions),
+            np.concatenate(velocities),
+            np.concatenate(accelerations),
+        )
+
+
+class TaskPlanningError(MotionError):
+    """A task could not be planned: the message names the stage and why; ``reports`` has every stage."""
+
+    def __init__(self, message: str, reports: Sequence[StageReport] = ()) -> None:
+        super().__init__(message)
+        self.reports = tuple(reports)
+
+
+class _StageFailure(Exception):
+    def __init__(self, index: int, reason: str) -> None:
+        super().__init__(reason)
+        self.index = index
+        self.reason = reason
+
+
+@dataclass
+class _Piece:
+    index: int
+    rows: np.ndarray  # full configurations along the motion
+    motion: MotionSettings
+    timed: JointTrajectory | None = None  # already timed (from an earlier solution)
+
+
+class _Planner:
+    def __init__(
+        self,
+        task: Task,
+        checker: CollisionChecker,
+        frames: Mapping[str, np.ndarray],
+        stop: Callable[[], bool],
+    ) -> None:
+        self.task = task
+        self.checker = checker
+        self.model: RobotModel = checker.model
+        self.frames = frames
+        self.stop = stop
+        self.default_padding = checker.padding
+        self._free_checker: CollisionChecker | None = None
+        self.status: dict[int, tuple[str, str]] = {}
+
+    # ----------------------------------------------------------------------------------- helpers
+    def label(self, index: int) -> str:
+        if not self.task.stages:
+            return "the task"
+        stage = self.task.stages[index]
+        return f"stage {index + 1} of {len(self.task.stages)} ({stage.name!r})"
+
+    def check(self, padding: float, ignore_environment: bool = False) -> CollisionChecker:
+        if ignore_environment:
+            if self._free_checker is None:
+                from kinema.motion.collision import CollisionChecker
+
+                self._free_checker = CollisionChecker(self.model, None, padding=padding)
+            self._free_checker.padding = padding
+            return self._free_checker
+        self.checker.padding = padding
+        return self.checker
+
+    def world_T(self, target: Target, q: np.ndarray) -> np.ndarray:
+        from kinema.motion.frames import FrameTree
+
+        frame, pose = target
+        return FrameTree(self.model, q, self.frames).world_T(frame) @ np.asarray(pose, dtype=float)
+
+    def group(self, index: int, name: str):
+        if name not in self.model.groups:
+            from kinema.errors import did_you_mean
+
+            raise _StageFailure(
+                index, f"unknown planning group {name!r}; {did_you_mean(name, list(self.model.groups))}"
+            )
+        return self.model.group(name)
+
+    # ---------------------------------------------------------------------------------- stages
+    def generate(
+        self, index: int, before: np.ndarray | None
+    ) -> list[tuple[np.ndarray, np.ndarray, list[_Piece]]]:
+        """Candidates of a generator: (start state, end state, its own pieces)."""
+        stage = self.task.stages[index]
+        if isinstance(stage, CurrentState):
+            q = np.asarray(stage.state, dtype=float)
+            if q.shape != (len(self.model.joint_names),):
+                raise _StageFailure(index, f"the state must have {len(self.model.joint_names)} joint values")
+            return [(q, q, [])]
+        if isinstance(stage, FromSolution):
+            solution = stage.solution
+            if tuple(solution.joint_names) != tuple(self.model.joint_names):
+                raise _StageFailure(index, "the solution was planned for another robot model")
+            pieces = [
+                _Piece(index, np.array([solution.start]), MotionSettings(), sub.trajectory)
+                for sub in solution.sub_trajectories
+            ]
+            return [(solution.start.copy(), solution.end.copy(), pieces)]
+        assert isinstance(stage, BatchPoseIK)
+        return self.batch_ik(index, stage, before)
+
+    def batch_ik(
+        self, index: int, stage: BatchPoseIK, before: np.ndarray | None
+    ) -> list[tuple[np.ndarray, np.ndarray, list[_Piece]]]:
+        from kinema.motion.inverse_kinematics import IkOptions, ik
+
+        if before is None:
+            raise _StageFailure(
+                index, "batch pose IK needs a state before it to solve from (a current state)"
+            )
+        self.group(index, stage.group)
+        checker = self.check(stage.link_padding)
+        options = IkOptions(attempts=stage.ik_attempts, rng_seed=stage.seed)
+        found: list[np.ndarray] = []
+        reasons: list[str] = []
+        n = len(stage.targets)
+        for i, target in enumerate(stage.targets):
+            try:
+                world_T_target = self.world_T(target, before)
+                q = ik(
+                    self.model,
+                    world_T_target,
+                    before,
+                    stage.group,
+                    stage.ik_frame,
+                    options=options,
+                    accept=checker.is_valid,
+                )
+            except MotionError as error:
+                reasons.append(f"pose {i + 1} of {n}: {error}")
+                continue
+            found.append(q)
+        if not found:
+            raise _StageFailure(
+                index, f"no IK solution for any of the {n} target poses: " + "; ".join(reasons)
+            )
+        found.sort(key=lambda q: float(np.linalg.norm(q - before)))
+        return [(q, q, []) for q in found[: stage.max_ik_solutions]]
+
+    def forward(self, index: int, q_from: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Plan a propagator from ``q_from``: (rows, end state)."""
+        stage = self.task.stages[index]
+        try:
+            if isinstance(stage, MoveAlongFrameAxis):
+                return self.along_axis(index, stage, q_from, backwards=False)
+            if isinstance(stage, PlanToJointState):
+                return self.joint_motion(index, stage.motion, q_from, dict(stage.goal))
+            if isinstance(stage, PlanToPose):
+                from kinema.motion.inverse_kinematics import IkOptions, ik
+
+                self.group(index, stage.motion.group)
+                checker = self.check(stage.motion.link_padding)
+                world_T_target = self.world_T(stage.target, q_from)
+                q_goal = ik(
+                    self.model,
+                    world_T_target,
+                    q_from,
+                    stage.motion.group,
+                    stage.ik_frame,
+                    options=IkOptions(attempts=stage.ik_attempts, rng_seed=stage.motion.seed),
+                    accept=checker.is_valid,
+                )
+                return self.joint_motion(index, stage.motion, q_from, q_goal)
+        except MotionError as error:
+            raise _StageFailure(index, str(error)) from error
+        raise _StageFailure(index, f"a {type(stage).__name__} stage cannot follow a state here")
+
+    def backward(self, index: int, q_to: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Plan a propagator that must end at ``q_to``: (rows, start state)."""
+        stage = self.task.stages[index]
+        if not isinstance(stage, MoveAlongFrameAxis):
+            raise _StageFailure(
+                index,
+                f"{stage.name!r} plans forwards only, but a state-fixing stage follows it; put a connect "
+                "stage between them, or move it after that stage",
+            )
+        try:
+            return self.along_axis(index, stage, q_to, backwards=True)
+        except MotionError as error:
+            raise _StageFailure(index, str(error)) from error
+
+    def joint_motion(
+        self, index: int, motion: MotionSettings, q_from: np.ndarray, goal: Mapping[str, float] | np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        from kinema.motion.planner import PlanningOptions, plan_joint_goal
+
+        g = self.group(index, motion.group)
+        checker = self.check(motion.link_padding)
+        path = plan_joint_goal(
+            checker, q_from, goal, motion.group, PlanningOptions(timeout=motion.planning_time)
+        )
+        rows = np.repeat(q_from[None, :], len(path.positions), axis=0)
+        rows[:, list(g.indices)] = path.positions
+        return rows, rows[-1].copy()
+
+    def along_axis(
+        self, index: int, stage: MoveAlongFrameAxis, q: np.ndarray, *, backwards: bool
+    ) -> tuple[np.ndarray, np.ndarray]:
+        from kinema.motion.cartesian import plan_cartesian_path
+        from kinema.motion.kinematics import fk
+
+        g = self.group(index, stage.motion.group)
+        world_T_axis = self.world_T((stage.axis_frame, np.eye(4)), q)
+        axis = np.asarray(stage.axis, dtype=float)
+        direction = world_T_axis[:3, :3] @ (axis / np.linalg.norm(axis))
+        hand = fk(self.model, q, stage.hand_frame)
+        target = hand.copy()
+        sign = -1.0 if backwards else 1.0
+        target[:3, 3] += sign * stage.max_distance * direction
+        checker = self.check(stage.motion.link_padding, stage.ignore_environment_collisions)
+        result = plan_cartesian_path(checker, q, [target], stage.motion.group, stage.hand_frame)
+        reached = result.fraction * stage.max_distance
+        if reached < stage.min_distance - 1e-4:
+            why = f": {result.reason}" if result.reason else ""
+            raise _StageFailure(
+                index,
+                f"Cartesian path stopped at {100 * result.fraction:.0f} % ({reached:.3f} m of "
+                f"{stage.max_distance:.3f} m; at least {stage.min_distance:.3f} m needed){why}",
+            )
+        rows = np.repeat(q[None, :], len(result.path.positions), axis=0)
+        rows[:, list(g.indices)] = result.path.positions
+        if backwards:
+            rows = rows[::-1].copy()
+            return rows, rows[0].copy()
+        return rows, rows[-1].copy()
+
+    # ---------------------------------------------------------------------------------- the task
+    def segments(self) -> list[tuple[int | None, list[int]]]:
+        """(index of the connect before, indices of the segment's stages)."""
+        out: list[tuple[int | None, list[int]]] = [(None, [])]
+        for i, stage in enumerate(self.task.stages):
+            if isinstance(stage, Connect):
+                out.append((i, []))
+            else:
+                out[-1][1].append(i)
+        return out
+
+    def plan_segment(
+        self, members: list[int], before: np.ndarray | None
+    ) -> tuple[np.ndarray, np.ndarray, list[_Piece]]:
+        """Plan one segment: (start state, end state, pieces)."""
+        generators = [i for i in members if isinstance(self.task.stages[i], GENERATORS)]
+        if len(generators) > 1:
+            raise _StageFailure(
+                generators[1],
+                f"it fixes a state, but {self.task.stages[generators[0]].name!r} already did without a "
+                "connect stage between them",
+            )
+        if not generators:
+            if before is None:
+                first = members[0] if members else 0
+                raise _StageFailure(first, "a task starts with a state: a current state or a solution")
+            return self.propagate(members, [], before)
+        g = generators[0]
+        failures: list[_StageFailure] = []
+        candidates = self.generate(g, before)
+        for start, end, own in candidates:
+            try:
+                pieces: list[_Piece] = []
+                q = start
+                for i in reversed([m for m in members if m < g]):
+                    rows, q = self.backward(i, q)
+                    pieces.insert(0, _Piece(i, rows, self.task.stages[i].motion))
+                    self.status[i] = ("planned", "")
+                first = q
+                _, last, after = self.propagate([m for m in members if m > g], [], end)
+                self.status[g] = ("planned", f"{len(candidates)} candidate(s)" if len(candidates) > 1 else "")
+                return first, last, pieces + own + after
+            except _StageFailure as failure:
+                failures.append(failure)
+                if self.stop():
+                    break
+        if len(failures) == 1:
+            raise failures[0]
+        worst = failures[0]
+        raise _StageFailure(
+            worst.index,
+            f"{worst.reason} (each of the {len(failures)} solutions of {self.task.stages[g].name!r} failed "
+            "here or later)",
+        )
+
+    def propagate(
+        self, members: list[int], pieces: list[_Piece], q: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray, list[_Piece]]:
+        start = q
+        for i in members:
+            rows, q = self.forward(i, q)
+            pieces.append(_Piece(i, rows, self.task.stages[i].motion))
+            self.status[i] = ("planned", "")
+        return start, q, pieces
+
+    def connect(self, index: int, q_from: np.ndarray, q_to: np.ndarray) -> _Piece:
+        stage = self.task.stages[index]
+        assert isinstance(stage, Connect)
+        g = self.group(index, stage.motion.group)
+        others = [i for i in range(len(q_from)) if i not in set(g.indices)]
+        differ = [self.model.joint_names[i] for i in others if abs(q_from[i] - q_to[i]) > JOIN_TOLERANCE]
+        if differ:
+            raise _StageFailure(
+                index,
+                f"the states before and after differ in joints outside group {stage.motion.group!r}: "
+                f"{', '.join(differ)}",
+            )
+        try:
+            rows, _ = self.joint_motion(index, stage.motion, q_from, q_to)
+        except MotionError as error:
+            raise _StageFailure(index, str(error)) from error
+        self.status[index] = ("planned", "")
+        return _Piece(index, rows, stage.motion)
+
+    def run(self) -> tuple[np.ndarray, np.ndarray, list[_Piece]]:
+        if not self.task.stages:
+            raise _StageFailure(0, "the task has no stages")
+        start: np.ndarray | None = None
+        end: np.ndarray | None = None
+        pieces: list[_Piece] = []
+        for connect, members in self.segments():
+            if self.stop():
+                raise _StageFailure(members[0] if members else connect or 0, "planning was stopped")
+            if connect is not None and not members:
+                raise _StageFailure(connect, "a connect needs a stage after it to connect to")
+            if connect is not None and end is None:
+                raise _StageFailure(connect, "a connect needs a state before it (a current state first)")
+            seg_start, seg_end, seg_pieces = self.plan_segment(members, end)
+            if connect is not None:
+                assert end is not None
+                pieces.append(self.connect(connect, end, seg_start))
+            elif end is not None and np.abs(seg_start - end).max() > JOIN_TOLERANCE:
+                raise _StageFailure(members[0], "it starts away from where the stage before ended")
+            if start is None:
+                start = seg_start
+            pieces.extend(seg_pieces)
+            end = seg_end
+        assert start is not None and end is not None
+        return start, end, pieces
+
+
+def plan_task(
+    task: Task,
+    checker: CollisionChecker,
+    *,
+    frames: Mapping[str, np.ndarray] | None = None,
+    stop: Callable[[], bool] | None = None,
+) -> TaskSolution:
+    """Plan ``task`` into a solution against ``checker``'s planning scene.
+
+    Args:
+        task: the stages, in order.
+        checker: collision checker (robot model and planning scene); its padding is the default for
+            stages without their own, and is restored afterwards.
+        frames: named fixed frames (objects, cameras) target poses may be given in, besides the robot's
+            links and ``world``.
+        stop: called between steps; planning stops with an error when it returns True.
+
+    Raises:
+        TaskPlanningError: naming the stage that failed and why; ``reports`` holds every stage's status.
+    """
+    from kinema.motion.timing import time_parameterize
+
+    began = time.monotonic()
+    planner = _Planner(task, checker, frames or {}, stop or (lambda: False))
+    padding = checker.padding
+    try:
+        start, end, pieces = planner.run()
+        subs: list[SubTrajectory] = []
+        for piece in pieces:
+            stage = task.stages[piece.index]
+            if piece.timed is not None:
+                subs.append(SubTrajectory(stage.name, piece.timed))
+                continue
+            g = planner.model.group(piece.motion.group)
+            path = JointPath(g.joint_names, piece.rows[:, list(g.indices)])
+            try:
+                trajectory = time_parameterize(
+                    path,
+                    planner.model,
+                    piece.motion.velocity_scale,
+                    piece.motion.acceleration_scale,
+                    sample_period=piece.motion.sample_period,
+                )
+            except MotionError as error:
+                raise _StageFailure(piece.index, f"timing failed: {error}") from error
+            subs.append(SubTrajectory(stage.name, trajectory))
+    except _StageFailure as failure:
+        planner.status[failure.index] = ("failed", failure.reason)
+        reports = _reports(task, planner.status)
+        raise TaskPlanningError(
+            f"task {task.task_id!r}: {planner.label(failure.index)} failed: {failure.reason}", reports
+        ) from None
+    finally:
+        checker.padding = padding
+    solution = TaskSolution(
+        task.task_id,
+        tuple(planner.model.joint_names),
+        start,
+        end,
+        tuple(subs),
+        _reports(task, planner.status),
+        time.monotonic() - began,
+    )
+    solution.joined()  # proves the sub-trajectories meet
+    return solution
+
+
+def _reports(task: Task, status: Mapping[int, tuple[str, str]]) -> tuple[StageReport, ...]:
+    return tuple(
+        StageReport(i, stage.name, stage_kind(stage), *status.get(i, ("not planned", "")))
+        for i, stage in enumerate(task.stages)
+    )

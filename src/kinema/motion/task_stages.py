@@ -1,0 +1,179 @@
+"""The stages a task is built from: what each asks for, as plain data (planning is in :mod:`.task`).
+
+A task (MoveIt Task Constructor's model, which MoveIt Pro's MTC behaviors use) is an ordered list of
+stages. Three kinds:
+
+- **generators** fix a robot state on their own: :class:`CurrentState`, :class:`BatchPoseIK` (the IK
+  solution of one of several candidate poses) and :class:`FromSolution` (an earlier solution, replayed);
+- **propagators** move from the state before them (or, when a generator follows them, back from the
+  state after them): :class:`MoveAlongFrameAxis` always; :class:`PlanToJointState` and :class:`PlanToPose`
+  only forwards;
+- **connectors** (:class:`Connect`) join the state before them to the state after them with a
+  collision-free joint-space motion.
+
+Poses are ``(frame, frame_T_pose)`` pairs: the frame (``world``, a robot link such as ``grasp_link``, or
+another named frame) is resolved when the task is planned, at the state the stage starts from.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from kinema.errors import MotionError
+
+if TYPE_CHECKING:
+    from kinema.motion.task import TaskSolution
+
+Target = tuple[str, np.ndarray]
+
+
+@dataclass(frozen=True)
+class MotionSettings:
+    """How a stage's motion is planned and timed.
+
+    Attributes:
+        group: the planning group that moves.
+        velocity_scale: fraction of the joints' velocity limits, (0, 1].
+        acceleration_scale: fraction of the joints' acceleration limits, (0, 1].
+        link_padding: clearance (m) kept between the robot and the planning scene.
+        sample_period: spacing of the timed trajectory's points, seconds.
+        planning_time: seconds OMPL may search when a straight joint-space move collides.
+        seed: random seed of the IK restarts (the same seed gives the same solution).
+    """
+
+    group: str = "manipulator"
+    velocity_scale: float = 1.0
+    acceleration_scale: float = 1.0
+    link_padding: float = 0.01
+    sample_period: float = 0.01
+    planning_time: float = 1.0
+    seed: int = 0
+
+    def __post_init__(self) -> None:
+        for label, value in (("velocity", self.velocity_scale), ("acceleration", self.acceleration_scale)):
+            if not 0.0 < value <= 1.0:
+                raise MotionError(f"{label} scale factor must be in (0, 1], got {value}")
+        if not np.isfinite(self.link_padding) or self.link_padding < 0:
+            raise MotionError(f"link padding must be a non-negative distance (m), got {self.link_padding}")
+        if not self.sample_period > 0:
+            raise MotionError(f"the trajectory's sample period must be positive, got {self.sample_period} s")
+        if not self.planning_time > 0:
+            raise MotionError(f"planning time must be positive, got {self.planning_time} s")
+
+
+@dataclass(frozen=True, eq=False)
+class CurrentState:
+    """Generator: the robot's state when the task is planned (a configuration over the model's joints)."""
+
+    state: np.ndarray
+    name: str = "current state"
+
+
+@dataclass(frozen=True, eq=False)
+class FromSolution:
+    """Generator: replay an earlier solution's motions; the task goes on from where it ended."""
+
+    solution: TaskSolution
+    name: str = "from solution"
+
+
+@dataclass(frozen=True, eq=False)
+class PlanToJointState:
+    """Propagator (forwards only): plan from the state before to ``goal`` (joint name -> position)."""
+
+    goal: Mapping[str, float]
+    motion: MotionSettings = field(default_factory=MotionSettings)
+    name: str = "plan to joint state"
+
+
+@dataclass(frozen=True, eq=False)
+class PlanToPose:
+    """Propagator (forwards only): put ``ik_frame`` at ``target`` (IK from several seeds, then OMPL)."""
+
+    target: Target
+    ik_frame: str
+    motion: MotionSettings = field(default_factory=MotionSettings)
+    ik_attempts: int = 20
+    name: str = "plan to pose"
+
+
+@dataclass(frozen=True, eq=False)
+class Connect:
+    """Connector: a collision-free joint-space motion from the state before to the state after."""
+
+    motion: MotionSettings = field(default_factory=MotionSettings)
+    name: str = "connect"
+
+
+@dataclass(frozen=True, eq=False)
+class MoveAlongFrameAxis:
+    """Propagator: move ``hand_frame`` in a straight line along ``axis`` of ``axis_frame``.
+
+    It moves ``max_distance`` when it can and fails when less than ``min_distance`` is reachable. Planned
+    backwards (a generator follows it, as an approach before a grasp) it ends at that generator's state.
+    """
+
+    axis: Sequence[float]
+    axis_frame: str
+    hand_frame: str
+    min_distance: float
+    max_distance: float
+    motion: MotionSettings = field(default_factory=lambda: MotionSettings(link_padding=0.0))
+    ignore_environment_collisions: bool = False
+    name: str = "move along frame axis"
+
+    def __post_init__(self) -> None:
+        axis = np.asarray(self.axis, dtype=float)
+        if axis.shape != (3,) or not np.all(np.isfinite(axis)) or np.linalg.norm(axis) < 1e-9:
+            raise MotionError(
+                f"{self.name}: the axis must be 3 finite numbers, not all zero; got {self.axis}"
+            )
+        if not (0 <= self.min_distance <= self.max_distance) or not np.isfinite(self.max_distance):
+            raise MotionError(
+                f"{self.name}: distances must satisfy 0 <= min_distance <= max_distance; got "
+                f"min {self.min_distance}, max {self.max_distance}"
+            )
+
+
+@dataclass(frozen=True, eq=False)
+class BatchPoseIK:
+    """Generator: of the candidate ``targets`` for ``ik_frame``, the IK solution closest to the state before.
+
+    ``max_ik_solutions`` bounds how many solutions (in order of closeness) later stages may try before the
+    task fails.
+    """
+
+    targets: Sequence[Target]
+    ik_frame: str
+    group: str = "manipulator"
+    max_ik_solutions: int = 4
+    ik_attempts: int = 20
+    seed: int = 0
+    link_padding: float = 0.0
+    name: str = "batch pose IK"
+
+    def __post_init__(self) -> None:
+        if not self.targets:
+            raise MotionError(f"{self.name}: no target poses to solve IK for")
+        if self.max_ik_solutions < 1:
+            raise MotionError(
+                f"{self.name}: max_ik_solutions must be at least 1, got {self.max_ik_solutions}"
+            )
+
+
+Stage = (
+    CurrentState | FromSolution | PlanToJointState | PlanToPose | Connect | MoveAlongFrameAxis | BatchPoseIK
+)
+
+GENERATORS = (CurrentState, FromSolution, BatchPoseIK)
+
+
+def stage_kind(stage: Stage) -> str:
+    """A short word for the stage's role: ``generator``, ``propagator`` or ``connector``."""
+    if isinstance(stage, GENERATORS):
+        return "generator"
+    return "connector" if isinstance(stage, Connect) else "propagator"

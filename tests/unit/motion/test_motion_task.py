@@ -1,0 +1,281 @@
+"""The task planner: MTC-style stages planned into one timed solution on lab_sim's robot and scene."""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+import pytest
+
+from kinema.motion import CollisionChecker, RobotModel, fk
+from kinema.motion.planning_scene import CollisionObject
+from kinema.motion.task import Task, TaskPlanningError, TaskSolution, plan_task
+from kinema.motion.task_stages import (
+    BatchPoseIK,
+    Connect,
+    CurrentState,
+    FromSolution,
+    MotionSettings,
+    MoveAlongFrameAxis,
+    PlanToJointState,
+    PlanToPose,
+)
+
+CUBE = np.array([0.62, 0.3, 0.78])  # lab_sim's cube, where the gripper grasps it
+
+
+@pytest.fixture
+def start(waypoint_q: Callable[[str], np.ndarray]) -> np.ndarray:
+    return waypoint_q("Look at Table")
+
+
+@pytest.fixture
+def grasp(model: RobotModel, waypoint_q: Callable[[str], np.ndarray]) -> np.ndarray:
+    """A top-down grasp of the cube (the pick waypoint's gripper orientation)."""
+    pose = np.eye(4)
+    pose[:3, :3] = fk(model, waypoint_q("3 Waypoint Pick Pose"), "grasp_link")[:3, :3]
+    pose[:3, 3] = CUBE
+    return pose
+
+
+def pick_task(start: np.ndarray, poses: list[np.ndarray], velocity_scale: float = 1.0) -> Task:
+    return Task(
+        "pick",
+        [
+            CurrentState(start),
+            Connect(MotionSettings(link_padding=0.0, velocity_scale=velocity_scale)),
+            MoveAlongFrameAxis(
+                (0, 0, 1),
+                "grasp_link",
+                "grasp_link",
+                0.1,
+                0.1,
+                MotionSettings(link_padding=0.0),
+                name="approach",
+            ),
+            BatchPoseIK([("world", p) for p in poses], "grasp_link", name="grasp pose IK"),
+        ],
+    )
+
+
+def tool_path(model: RobotModel, solution: TaskSolution, stage: str, frame: str) -> np.ndarray:
+    sub = next(s for s in solution.sub_trajectories if s.stage == stage)
+    q = solution.start.copy()
+    idx = [model.index(n) for n in sub.trajectory.joint_names]
+    out = []
+    for row in sub.trajectory.positions:
+        q[idx] = row
+        out.append(fk(model, q, frame)[:3, 3])
+    return np.array(out)
+
+
+def test_a_pick_task_approaches_the_grasp_in_a_straight_line_and_ends_there(
+    model: RobotModel, checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray
+) -> None:
+    solution = plan_task(pick_task(start, [grasp]), checker)
+    assert [s.stage for s in solution.sub_trajectories] == ["connect", "approach"]
+    assert [r.status for r in solution.reports] == ["planned"] * 4, solution.reports
+    end = fk(model, solution.end, "grasp_link")
+    assert np.linalg.norm(end[:3, 3] - CUBE) < 1e-3, end[:3, 3]
+    # The approach: 10 cm along the grasp's z axis, on a straight line.
+    path = tool_path(model, solution, "approach", "grasp_link")
+    z = grasp[:3, 2]
+    assert np.linalg.norm(path[0] - (CUBE - 0.1 * z)) < 2e-3, path[0]
+    off_line = np.linalg.norm(np.cross(path - CUBE, z), axis=1)
+    assert off_line.max() < 2e-3, f"the approach leaves its line by {off_line.max():.4f} m"
+    # Joined without jumps: the arm's joints move at most a few centiradians between 10 ms samples.
+    joined = solution.joined()
+    assert np.abs(np.diff(joined.positions, axis=0)).max() < 0.05
+    assert np.allclose(joined.positions[0], solution.start[[model.index(n) for n in joined.joint_names]])
+    assert np.allclose(joined.velocities[[0, -1]], 0.0)
+    assert joined.duration == pytest.approx(sum(s.trajectory.duration for s in solution.sub_trajectories))
+    # The planning scene (lab_sim's table) is honoured all along.
+    full = np.repeat(solution.start[None, :], len(joined.times), axis=0)
+    full[:, [model.index(n) for n in joined.joint_names]] = joined.positions
+    checker.padding = 0.0
+    assert checker.first_invalid(full, 0.01) is None
+
+
+def test_velocity_scaling_slows_the_stage_it_is_set_on(
+    checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray
+) -> None:
+    fast = plan_task(pick_task(start, [grasp]), checker)
+    slow = plan_task(pick_task(start, [grasp], velocity_scale=0.25), checker)
+    assert slow.sub_trajectories[0].trajectory.duration > 1.5 * fast.sub_trajectories[0].trajectory.duration
+    assert slow.sub_trajectories[1].trajectory.duration == pytest.approx(
+        fast.sub_trajectories[1].trajectory.duration, rel=0.05
+    )
+
+
+def test_batch_pose_ik_takes_the_reachable_pose_closest_to_the_state_before(
+    model: RobotModel, checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray
+) -> None:
+    unreachable = grasp.copy()
+    unreachable[:3, 3] = [4.0, 3.0, 0.8]
+    farther = grasp.copy()
+    farther[:3, 3] = CUBE + np.array([0.0, -0.25, 0.0])
+    solution = plan_task(pick_task(start, [unreachable, farther, grasp]), checker)
+    near = fk(model, solution.end, "grasp_link")[:3, 3]
+    distances = {}
+    for label, pose in (("cube", grasp), ("farther", farther)):
+        only = plan_task(pick_task(start, [pose]), checker)
+        distances[label] = float(np.linalg.norm(only.end - start))
+    expected = CUBE if distances["cube"] <= distances["farther"] else farther[:3, 3]
+    assert np.linalg.norm(near - expected) < 1e-3, (near, distances)
+
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(pick_task(start, [unreachable, unreachable]), checker)
+    message = str(failure.value)
+    assert (
+        "stage 4 of 4 ('grasp pose IK')" in message and "pose 1 of 2" in message and "pose 2 of 2" in message
+    )
+    assert [r.status for r in failure.value.reports] == ["planned", "not planned", "not planned", "failed"]
+
+
+def test_moving_along_a_frame_axis_fails_below_min_distance_with_the_share_reached(
+    checker: CollisionChecker, start: np.ndarray, model: RobotModel
+) -> None:
+    task = Task("reach", [CurrentState(start), MoveAlongFrameAxis((1, 0, 0), "world", "tool0", 2.5, 3.0)])
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(task, checker)
+    message = str(failure.value)
+    assert "stage 2 of 2 ('move along frame axis')" in message and "Cartesian path stopped at" in message
+    assert "%" in message and "at least 2.500 m needed" in message
+    # With a lower minimum the same stage succeeds and goes as far as it can.
+    partial = plan_task(
+        Task("reach", [CurrentState(start), MoveAlongFrameAxis((1, 0, 0), "world", "tool0", 0.05, 3.0)]),
+        checker,
+    )
+    moved = fk(model, partial.end, "tool0")[:3, 3] - fk(model, start, "tool0")[:3, 3]
+    assert 0.05 <= moved[0] < 3.0 and abs(moved[1]) < 1e-3 and abs(moved[2]) < 1e-3, moved
+
+
+def test_a_square_of_moves_along_world_axes_closes(
+    model: RobotModel, checker: CollisionChecker, start: np.ndarray
+) -> None:
+    sides = [(0, 1, 0), (1, 0, 0), (0, -1, 0), (-1, 0, 0)]
+    task = Task(
+        "square", [CurrentState(start), *(MoveAlongFrameAxis(a, "world", "tool0", 0.2, 0.2) for a in sides)]
+    )
+    solution = plan_task(task, checker)
+    origin = fk(model, start, "tool0")[:3, 3]
+    # Stage names repeat: read each sub-trajectory's corner in order.
+    q = start.copy()
+    corners = []
+    for sub in solution.sub_trajectories:
+        q[[model.index(n) for n in sub.trajectory.joint_names]] = sub.trajectory.positions[-1]
+        corners.append(fk(model, q, "tool0")[:3, 3] - origin)
+    expected = np.array([[0, 0.2, 0], [0.2, 0.2, 0], [0.2, 0, 0], [0, 0, 0]])
+    assert np.abs(np.array(corners) - expected).max() < 1e-3, np.round(corners, 4)
+
+
+def test_plan_to_pose_and_to_joint_state_go_forwards_and_a_pose_inside_an_obstacle_fails(
+    model: RobotModel, checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray, arm_goal
+) -> None:
+    above = grasp.copy()
+    above[:3, 3] = CUBE + np.array([0.0, 0.0, 0.15])
+    home = arm_goal("Home")
+    task = Task(
+        "moves",
+        [
+            CurrentState(start),
+            PlanToPose(("world", above), "grasp_link"),
+            PlanToJointState(home),
+        ],
+    )
+    solution = plan_task(task, checker)
+    q = start.copy()
+    first = solution.sub_trajectories[0].trajectory
+    q[[model.index(n) for n in first.joint_names]] = first.positions[-1]
+    assert np.linalg.norm(fk(model, q, "grasp_link")[:3, 3] - above[:3, 3]) < 1e-3
+    for name, value in home.items():
+        assert solution.end[model.index(name)] == pytest.approx(value, abs=1e-6)
+
+    # A box added to the planning scene around the target: no collision-free IK solution there.
+    checker.scene.add(CollisionObject("wall", "box", (0.3, 0.02, 0.3), _at(0.62, 0.3, 1.2)))
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(
+            Task(
+                "into the wall",
+                [CurrentState(start), PlanToPose(("world", _at(0.62, 0.3, 1.2, grasp)), "grasp_link")],
+            ),
+            checker,
+        )
+    assert "stage 2 of 2 ('plan to pose')" in str(failure.value) and "no IK solution" in str(failure.value)
+
+
+def _at(x: float, y: float, z: float, like: np.ndarray | None = None) -> np.ndarray:
+    pose = np.eye(4) if like is None else like.copy()
+    pose[:3, 3] = [x, y, z]
+    return pose
+
+
+def test_a_task_can_go_on_from_an_earlier_solution(
+    model: RobotModel, checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray
+) -> None:
+    pick = plan_task(pick_task(start, [grasp]), checker)
+    retreat = Task(
+        "retreat", [FromSolution(pick), MoveAlongFrameAxis((0, 0, 1), "world", "grasp_link", 0.1, 0.1)]
+    )
+    solution = plan_task(retreat, checker)
+    assert len(solution.sub_trajectories) == 3
+    assert np.allclose(solution.start, pick.start)
+    rise = fk(model, solution.end, "grasp_link")[:3, 3] - fk(model, pick.end, "grasp_link")[:3, 3]
+    assert np.allclose(rise, [0, 0, 0.1], atol=1e-3), rise
+    solution.joined()
+
+
+def test_the_same_seed_plans_the_same_solution(
+    checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray
+) -> None:
+    a = plan_task(pick_task(start, [grasp]), checker).joined()
+    b = plan_task(pick_task(start, [grasp]), checker).joined()
+    assert a.positions.shape == b.positions.shape and np.allclose(a.positions, b.positions)
+
+
+def test_badly_built_tasks_fail_naming_the_stage(
+    checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray
+) -> None:
+    cases = [
+        (Task("empty"), "the task has no stages"),
+        (
+            Task("no start", [MoveAlongFrameAxis((0, 0, 1), "world", "tool0", 0.1, 0.1)]),
+            "starts with a state",
+        ),
+        (Task("dangling", [CurrentState(start), Connect()]), "needs a stage after it"),
+        (
+            Task(
+                "backwards",
+                [
+                    CurrentState(start),
+                    Connect(),
+                    PlanToPose(("world", grasp), "grasp_link"),
+                    BatchPoseIK([("world", grasp)], "grasp_link"),
+                ],
+            ),
+            "stage 3 of 4 ('plan to pose')",
+        ),
+        (
+            Task("group", [CurrentState(start), PlanToJointState({}, MotionSettings(group="arm"))]),
+            "unknown planning group 'arm'",
+        ),
+    ]
+    for task, expected in cases:
+        with pytest.raises(TaskPlanningError) as failure:
+            plan_task(task, checker)
+        assert expected in str(failure.value), str(failure.value)
+
+
+def test_link_padding_is_honoured_per_stage(
+    checker: CollisionChecker, start: np.ndarray, arm_goal: Callable[[str], dict[str, float]]
+) -> None:
+    home = arm_goal("Home")
+    plan_task(
+        Task("tight", [CurrentState(start), PlanToJointState(home, MotionSettings(link_padding=0.0))]),
+        checker,
+    )
+    wide = Task("wide", [CurrentState(start), PlanToJointState(home, MotionSettings(link_padding=0.5))])
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(wide, checker)
+    assert "stage 2 of 2 ('plan to joint state')" in str(failure.value) and "collision" in str(failure.value)
+    assert checker.padding == 0.01, "planning restores the checker's own padding"
