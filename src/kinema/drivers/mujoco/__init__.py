@@ -6,7 +6,8 @@
   ``MujocoDriverSettings.from_config("lab_sim", sim_speed=math.inf)``;
 * :func:`parse_sim_speed` — ``"1"``, ``"4"``, ``"max"`` → a factor;
 * :mod:`kinema.drivers.mujoco.names` — the topic, service and action names it serves;
-* ``python -m kinema.drivers.mujoco --help`` — the driver as a process.
+* ``python -m kinema.drivers.mujoco --help`` — the driver as a process;
+* ``cameras.py`` — the scene's cameras rendered offscreen and served while someone subscribes.
 
 Names are imported lazily, so importing this package (or ``names``) does not load mujoco.
 """
@@ -14,7 +15,13 @@ Names are imported lazily, so importing this package (or ``names``) does not loa
 from __future__ import annotations
 
 import importlib
+import os
 from typing import Any
+
+# MuJoCo picks its OpenGL backend when it is first imported, defaulting to GLFW, which needs a display.
+# Without one, render headless through EGL (the libegl1 package); a user's own MUJOCO_GL wins.
+if "MUJOCO_GL" not in os.environ and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
+    os.environ["MUJOCO_GL"] = "egl"
 
 _EXPORTS = {
     "MujocoDriver": "driver",
