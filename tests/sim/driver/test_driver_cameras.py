@@ -177,3 +177,31 @@ def test_cloud_is_stamped_with_sim_time(camera_sim: Sim) -> None:
     stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
     now = camera_sim.driver.simulation.call(lambda: SimState.of(camera_sim.driver.data).time)
     assert 0.0 < stamp <= now
+
+
+def test_without_opengl_the_driver_runs_on_and_says_cameras_are_unavailable(
+    start_sim: Callable[..., Sim], monkeypatch: pytest.MonkeyPatch, caplog: pytest.LogCaptureFixture
+) -> None:
+    """No OpenGL context (simulated): the physics still runs, the log names the packages to install and
+    the camera topics are withdrawn rather than left silent."""
+    from kinema.drivers.mujoco import cameras as cameras_module
+
+    def no_gl(_model: Any) -> Any:
+        raise RuntimeError("Cannot initialize a EGL device display")
+
+    monkeypatch.setattr(cameras_module, "CameraRenderer", no_gl)
+    with caplog.at_level("WARNING", logger="kinema.drivers.mujoco.cameras"):
+        sim = start_sim()
+        cameras = sim.driver.cameras
+        assert cameras is not None and cameras.ready.wait(30)
+    assert cameras.unavailable is not None and "EGL" in cameras.unavailable
+    assert "apt-get install -y libegl1" in caplog.text, caplog.text
+    start = sim.driver.sim_time
+    wait_for(lambda: sim.driver.sim_time > start + 1.0, 30, "the simulation to keep running")
+    served = {i.name for i in sim.driver.interfaces()}
+    assert n.JOINT_STATES_TOPIC in served and "/scene_camera/points" not in served
+    wait_for(
+        lambda: not sim.node.graph().publishers("/scene_camera/points"),
+        10,
+        "the camera topics to be withdrawn",
+    )
