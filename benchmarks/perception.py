@@ -12,7 +12,7 @@ Prints:
   interleaved rounds (target: under 20 % of the real-time factor lost).
 
 No assertions: numbers only. Run: ``python benchmarks/perception.py [--seconds S] [--rounds N]``.
-Needs OpenGL (headless: ``sudo apt-get install -y libegl1 libgl1``).
+Needs OpenGL (headless: ``sudo apt-get install -y libegl1 libgl1 libgl1-mesa-dri``).
 """
 
 from __future__ import annotations

@@ -205,3 +205,39 @@ def test_without_opengl_the_driver_runs_on_and_says_cameras_are_unavailable(
         10,
         "the camera topics to be withdrawn",
     )
+
+
+def test_a_driver_process_without_opengl_simulates_and_logs_what_to_install(router_endpoint: str) -> None:
+    """``MUJOCO_GL=disable`` is what Kinema sets when libEGL cannot be loaded (``import mujoco`` would fail
+    with egl): the driver process still serves /clock and its log names the packages."""
+    import os
+    import select
+    import subprocess
+
+    from kinema.drivers import driver_spec
+    from kinema.transport import Node, open_session
+
+    read_fd, write_fd = os.pipe()
+    argv = driver_spec("mujoco").command(
+        config="lab_sim", connect=router_endpoint, sim_speed="max", ready_fd=write_fd
+    )
+    env = {**os.environ, "MUJOCO_GL": "disable"}
+    process = subprocess.Popen(argv, pass_fds=(write_fd,), stderr=subprocess.PIPE, env=env)
+    os.close(write_fd)
+    try:
+        ready = select.select([read_fd], [], [], 60.0)[0]
+        assert ready, "the driver did not report ready within 60 s"
+        with open_session(router_endpoint) as session:
+            node = Node(session, "test_client")
+            clock: list[float] = []
+            node.create_subscription(
+                n.CLOCK_TYPE, n.CLOCK_TOPIC, lambda m: clock.append(m.clock.sec + m.clock.nanosec * 1e-9)
+            )
+            wait_for(lambda: len(clock) > 10 and clock[-1] > clock[0], 30, "/clock from the driver process")
+    finally:
+        os.close(read_fd)
+        process.terminate()
+        _, stderr = process.communicate(timeout=20)
+    log = stderr.decode()
+    assert "cameras unavailable" in log and "apt-get install -y libegl1" in log, log
+    assert "Traceback" not in log, log

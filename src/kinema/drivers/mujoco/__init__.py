@@ -16,12 +16,38 @@ from __future__ import annotations
 
 import importlib
 import os
+import sys
 from typing import Any
 
-# MuJoCo picks its OpenGL backend when it is first imported, defaulting to GLFW, which needs a display.
-# Without one, render headless through EGL (the libegl1 package); a user's own MUJOCO_GL wins.
-if "MUJOCO_GL" not in os.environ and not (os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")):
-    os.environ["MUJOCO_GL"] = "egl"
+
+def _choose_gl_backend() -> None:
+    """Pick MuJoCo's OpenGL backend before mujoco is first imported (it reads MUJOCO_GL then).
+
+    MuJoCo defaults to GLFW, which needs a display. Without one, render headless through EGL — but only
+    when its libraries load: ``import mujoco`` itself fails with MUJOCO_GL=egl and no libEGL. Without
+    them rendering is disabled, so the simulation still runs and the cameras say what to install. A
+    MUJOCO_GL the user set is left alone.
+    """
+    if "MUJOCO_GL" in os.environ or sys.platform != "linux":
+        return
+    if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
+        return
+    import ctypes
+
+    def loads(*names: str) -> bool:
+        for name in names:
+            try:
+                ctypes.CDLL(name)
+            except OSError:
+                continue
+            return True
+        return False
+
+    usable = loads("libEGL.so.1", "libEGL.so") and loads("libOpenGL.so.0", "libGL.so.1", "libGL.so")
+    os.environ["MUJOCO_GL"] = "egl" if usable else "disable"
+
+
+_choose_gl_backend()
 
 _EXPORTS = {
     "MujocoDriver": "driver",

@@ -14,8 +14,9 @@ own OpenGL context. Nobody subscribed means nothing rendered, so a simulation no
 as without cameras.
 
 OpenGL: headless, MuJoCo renders through EGL (``MUJOCO_GL=egl``, set by :mod:`kinema.drivers.mujoco`
-when there is no display) or OSMesa (``MUJOCO_GL=osmesa``). When no context can be made, the driver runs
-on without cameras and logs why and the package to install (:data:`GL_HELP`).
+when there is no display and libEGL loads; ``disable`` when it does not, since ``import mujoco`` fails
+with a backend whose library is missing) or OSMesa (``MUJOCO_GL=osmesa``). When no context can be made,
+the driver runs on without cameras and logs why and the packages to install (:data:`GL_HELP`).
 """
 
 from __future__ import annotations
@@ -40,10 +41,13 @@ from kinema.transport import Node, Session
 
 log = logging.getLogger("kinema.drivers.mujoco.cameras")
 
+# libegl1 brings Mesa's EGL, libgl1 the GL library PyOpenGL loads, libgl1-mesa-dri the software
+# rasteriser (llvmpipe) used where there is no GPU.
 GL_HELP = (
-    "MuJoCo needs OpenGL to render cameras. Headless: sudo apt-get install -y libegl1 libgl1 "
+    "MuJoCo needs OpenGL to render cameras. Headless: "
+    "sudo apt-get install -y libegl1 libgl1 libgl1-mesa-dri "
     "(and MUJOCO_GL=egl, Kinema's default without a display), or sudo apt-get install -y libosmesa6 "
-    "and MUJOCO_GL=osmesa (slower, software only)"
+    "and MUJOCO_GL=osmesa (slower)"
 )
 # How often the camera thread looks for new subscribers, s of wall time.
 POLL_PERIOD = 0.02
@@ -146,6 +150,12 @@ class CameraRenderer:
     """
 
     def __init__(self, model: Any) -> None:
+        backend = os.environ.get("MUJOCO_GL", "").lower()
+        if backend in ("disable", "disabled", "off", "false", "0"):
+            raise RuntimeError(
+                f"MuJoCo's rendering is off (MUJOCO_GL={backend}; Kinema sets this when there is no display "
+                "and libEGL.so.1 or libOpenGL.so.0 cannot be loaded)"
+            )
         import mujoco
 
         self.model = model
