@@ -126,10 +126,11 @@ def _quat_from_axes(
 # the robot: image x (right) runs along +y of the world, image y (down) mostly along -z.
 SCENE_CAMERA_POS = (2.1, 0.0, 1.9)
 SCENE_CAMERA_QUAT = _quat_from_axes((0.0, 1.0, 0.0), (-1.6, 0.0, -1.05))
-# The wrist camera rides on the gripper coupling, 7.5 cm off the tool axis along tool0's x (clear of the
-# fingers, which close along y), looking out of the flange and tilted 15 degrees toward the tool axis so
-# the fingertips and what lies between them are in view.
-WRIST_CAMERA_POS = (0.075, 0.0, 0.03)
+# The wrist camera rides beside the gripper, 7.5 cm off the tool axis along tool0's x (clear of the
+# fingers, which close along y) and level with the palm's face (so the palm stays out of the picture),
+# looking out of the flange, tilted 15 degrees toward the tool axis: the fingertips show at the image's
+# left edge and what lies between them in front.
+WRIST_CAMERA_POS = (0.075, 0.0, 0.08)
 WRIST_CAMERA_QUAT = (math.cos(-math.radians(15) / 2), 0.0, math.sin(-math.radians(15) / 2), 0.0)
 
 LINKS: tuple[Link, ...] = (

@@ -241,3 +241,25 @@ def test_a_driver_process_without_opengl_simulates_and_logs_what_to_install(rout
     log = stderr.decode()
     assert "cameras unavailable" in log and "apt-get install -y libegl1" in log, log
     assert "Traceback" not in log, log
+
+
+@pytest.mark.parametrize("camera", CAMERAS)
+def test_the_planning_frame_tree_knows_each_camera_frame_where_the_simulator_has_it(
+    camera_sim: Sim, camera: str
+) -> None:
+    """The clouds' frame is a link of the URDF, so frame lookups (TransformPoseFrame, TF) can resolve it."""
+    from kinema.motion import RobotDescription, frame_poses
+
+    model = RobotDescription.lab_sim().load_model()
+    positions = camera_sim.driver.simulation.call(
+        lambda: {
+            name: float(camera_sim.driver.data.joint(name).qpos[0])
+            for name in model.joint_names
+            if name in camera_sim.driver.index.joint_names
+        }
+    )
+    q = np.array([positions.get(name, 0.0) for name in model.joint_names])
+    frame = f"{camera}_optical_frame"
+    planned = frame_poses(model, q)[frame]
+    simulated = _world_T_body(camera_sim, frame)
+    np.testing.assert_allclose(planned, simulated, atol=1e-4, err_msg=f"{frame}: URDF vs MuJoCo")
