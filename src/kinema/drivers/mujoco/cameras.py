@@ -38,6 +38,7 @@ from kinema.perception.intrinsics import CameraIntrinsics
 from kinema.perception.point_cloud import PointCloud
 from kinema.perception.ros_messages import camera_info_message, image_message, to_point_cloud2
 from kinema.transport import Node, Session
+from kinema.transport.keys import EntityKind
 
 log = logging.getLogger("kinema.drivers.mujoco.cameras")
 
@@ -178,6 +179,10 @@ class CameraRenderer:
         renderer = self._renderers.get(size)
         if renderer is None:
             renderer = mujoco.Renderer(self.model, intrinsics.height, intrinsics.width)
+            # Shadows and reflections are extra render passes that cost about 40 % of a colour frame
+            # in software OpenGL; a depth camera's picture does not need them.
+            renderer.scene.flags[mujoco.mjtRndFlag.mjRND_SHADOW] = False
+            renderer.scene.flags[mujoco.mjtRndFlag.mjRND_REFLECTION] = False
             self._renderers[size] = renderer
         return renderer
 
@@ -225,8 +230,8 @@ class _ServedCamera:
         }
         self.next_due = 0.0
 
-    def wanted(self) -> set[str]:
-        return {stream for stream, pub in self.publishers.items() if pub.subscription_count() > 0}
+    def wanted(self, subscribed: set[str]) -> set[str]:
+        return {stream for stream, pub in self.publishers.items() if pub.name in subscribed}
 
 
 class CameraServer:
@@ -291,24 +296,29 @@ class CameraServer:
             ", ".join(s.name for s in self.specs),
             self.rate,
         )
+        graph = self.session.graph_cache()
         try:
             while not self._stop.wait(POLL_PERIOD):
-                for camera in self._cameras:
+                now = time.perf_counter()
+                due = [camera for camera in self._cameras if now >= camera.next_due]
+                if not due:
+                    continue
+                # One look at the graph per poll for all cameras: this runs 50 times a second while the
+                # physics thread wants the GIL.
+                subscribed = {e.name for e in graph.snapshot().of_kind(EntityKind.SUBSCRIPTION)}
+                for camera in due:
                     if self._stop.is_set():
                         break
-                    self._serve(camera, renderer)
+                    wanted = camera.wanted(subscribed)
+                    if wanted:
+                        self._serve(camera, wanted, renderer)
         except Exception:
             log.exception("the camera thread stopped after an error")
         finally:
             renderer.close()
 
-    def _serve(self, camera: _ServedCamera, renderer: CameraRenderer) -> None:
+    def _serve(self, camera: _ServedCamera, wanted: set[str], renderer: CameraRenderer) -> None:
         now = time.perf_counter()
-        if now < camera.next_due:
-            return
-        wanted = camera.wanted()
-        if not wanted:
-            return
         state = self._snapshot()
         if state is None:
             return
