@@ -111,8 +111,9 @@ def image_message(
 ) -> Any:
     """``sensor_msgs/Image`` of an HxWx3 ``rgb8`` or an HxW ``32FC1`` array."""
     pixels = np.ascontiguousarray(pixels)
+    dtype: np.dtype[Any]
     if encoding == "rgb8":
-        channels, dtype = 3, np.uint8
+        channels, dtype = 3, np.dtype(np.uint8)
     elif encoding == "32FC1":
         channels, dtype = 1, np.dtype("<f4")
     else:
@@ -125,7 +126,7 @@ def image_message(
         width=width,
         encoding=encoding,
         is_bigendian=0,
-        step=width * channels * np.dtype(dtype).itemsize,
+        step=width * channels * dtype.itemsize,
         data=data,
     )
 
