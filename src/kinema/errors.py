@@ -60,6 +60,10 @@ class DriverError(KinemaError):
     """A driver (simulation or hardware) failed or refused a command."""
 
 
+class PerceptionError(KinemaError):
+    """Bad input to perception maths: array shapes, sizes, point cloud or mesh files."""
+
+
 class ScaffoldError(KinemaError):
     """A template could not be generated (bad name, existing folder, ...)."""
 

@@ -3,7 +3,9 @@
 The robot (a UR5e-sized arm on a linear rail with a parallel two-finger gripper) is described once, below,
 as links with their joint, origin and primitive collision geoms. This script renders that table twice:
 as URDF (for planning with pinocchio) and as the robot part of the MuJoCo scene, which also holds the lab
-table, the tray, the object to pick, a camera, actuators and keyframes. Run it after editing the table::
+table, the tray, the object to pick, actuators and keyframes. The two cameras' optical frames are links
+of the table too (the wrist camera's on tool0, the scene camera's on the world), so the frame tree knows
+them; the MuJoCo ``<camera>`` elements sit in those links' bodies. Run it after editing the table::
 
     python configs/lab_sim/description/generate.py
 
@@ -35,6 +37,28 @@ CUBE_HALF = 0.025
 CUBE_START = (0.62, 0.30, TABLE_TOP + CUBE_HALF)
 TRAY_CENTER = (0.62, -0.30)
 TRAY_FLOOR = 0.004  # thickness of the tray bottom: thin, so placing and re-picking stay level
+
+# Cameras, named as MoveIt Pro's lab_sim names them (topics /<name>/color, depth, camera_info, points).
+# Each sits in a link of its own whose frame follows the ROS optical convention (z forward, x right,
+# y down), so that link is the frame_id of the camera's images and clouds and the frame tree knows it.
+# MuJoCo cameras look along their -z with y up: the camera inside the link is turned half a turn about x.
+CAMERA_IN_OPTICAL = (0.0, 1.0, 0.0, 0.0)  # w x y z
+CAMERA_RESOLUTION = (640, 480)
+
+
+@dataclass(frozen=True)
+class Camera:
+    """A camera: its optical-frame link (in :data:`LINKS`) and its vertical field of view, degrees."""
+
+    name: str
+    link: str
+    fovy: float
+
+
+CAMERAS = (
+    Camera("scene_camera", "scene_camera_optical_frame", 55.0),
+    Camera("wrist_camera", "wrist_camera_optical_frame", 58.0),
+)
 
 
 @dataclass(frozen=True)
@@ -77,6 +101,37 @@ DARK = "0.15 0.15 0.17 1"
 ACCENT = "0.1 0.45 0.8 1"
 PAD = 'friction="1.5 0.02 0.0005" condim="4" solref="0.004 1" solmix="1000" solimp="0.95 0.99 0.001"'
 R_TOOL = (math.sqrt(0.5), -math.sqrt(0.5), 0.0, 0.0)  # Rx(-pi/2): tool0 z = wrist_3 y
+
+
+def _quat_from_axes(
+    x: tuple[float, float, float], z: tuple[float, float, float]
+) -> tuple[float, float, float, float]:
+    """The rotation (w x y z) whose x and z axes point along ``x`` and ``z`` (made orthonormal)."""
+    zn = math.sqrt(sum(c * c for c in z))
+    z = (z[0] / zn, z[1] / zn, z[2] / zn)
+    dot = sum(a * b for a, b in zip(x, z, strict=True))
+    x = (x[0] - dot * z[0], x[1] - dot * z[1], x[2] - dot * z[2])
+    xn = math.sqrt(sum(c * c for c in x))
+    x = (x[0] / xn, x[1] / xn, x[2] / xn)
+    y = (z[1] * x[2] - z[2] * x[1], z[2] * x[0] - z[0] * x[2], z[0] * x[1] - z[1] * x[0])
+    m = ((x[0], y[0], z[0]), (x[1], y[1], z[1]), (x[2], y[2], z[2]))
+    w = math.sqrt(max(0.0, 1.0 + m[0][0] + m[1][1] + m[2][2])) / 2
+    qx = math.copysign(math.sqrt(max(0.0, 1.0 + m[0][0] - m[1][1] - m[2][2])) / 2, m[2][1] - m[1][2])
+    qy = math.copysign(math.sqrt(max(0.0, 1.0 - m[0][0] + m[1][1] - m[2][2])) / 2, m[0][2] - m[2][0])
+    qz = math.copysign(math.sqrt(max(0.0, 1.0 - m[0][0] - m[1][1] + m[2][2])) / 2, m[1][0] - m[0][1])
+    return (w, qx, qy, qz)
+
+
+# The scene camera stands beyond the far edge of the table, 1.9 m up, looking down across the table at
+# the robot: image x (right) runs along +y of the world, image y (down) mostly along -z.
+SCENE_CAMERA_POS = (2.1, 0.0, 1.9)
+SCENE_CAMERA_QUAT = _quat_from_axes((0.0, 1.0, 0.0), (-1.6, 0.0, -1.05))
+# The wrist camera rides beside the gripper, 7.5 cm off the tool axis along tool0's x (clear of the
+# fingers, which close along y) and level with the palm's face (so the palm stays out of the picture),
+# looking out of the flange, tilted 15 degrees toward the tool axis: the fingertips show at the image's
+# left edge and what lies between them in front.
+WRIST_CAMERA_POS = (0.075, 0.0, 0.08)
+WRIST_CAMERA_QUAT = (math.cos(-math.radians(15) / 2), 0.0, math.sin(-math.radians(15) / 2), 0.0)
 
 LINKS: tuple[Link, ...] = (
     Link(
@@ -247,6 +302,8 @@ LINKS: tuple[Link, ...] = (
     Link("grasp_link", "robotiq_85_base_link", xyz=(0.0, 0.0, TCP_DEPTH)),
     # MoveIt Pro's lab_sim calls the point between the fingertips "pinch" too.
     Link("pinch", "grasp_link"),
+    Link("wrist_camera_optical_frame", "tool0", xyz=WRIST_CAMERA_POS, quat=WRIST_CAMERA_QUAT),
+    Link("scene_camera_optical_frame", "world", xyz=SCENE_CAMERA_POS, quat=SCENE_CAMERA_QUAT),
 )
 
 MIMIC = {
@@ -408,6 +465,12 @@ def _mjcf_body(link: Link, depth: int) -> list[str]:
         out.append(_mjcf_geom(g, ind + "  "))
     if link.name == "grasp_link":
         out.append(f'{ind}  <site name="grasp_site" size="0.005" rgba="1 0 0 1"/>')
+    for camera in CAMERAS:
+        if camera.link == link.name:
+            out.append(
+                f'{ind}  <camera name="{camera.name}" quat="{_vec(CAMERA_IN_OPTICAL)}" '
+                f'fovy="{_f(camera.fovy)}" resolution="{_vec(CAMERA_RESOLUTION)}"/>'
+            )
     for child in LINKS:
         if child.parent == link.name:
             out.extend(_mjcf_body(child, depth + 1))
@@ -422,7 +485,7 @@ def _keyframe_qpos(arm: tuple[float, ...], knuckle: float) -> str:
 
 
 def render_scene() -> str:
-    """Return the MuJoCo scene: the robot from the link table plus table, tray, cube, camera, actuators."""
+    """Return the MuJoCo scene: robot and cameras from the link table, table, tray, cube, actuators."""
     tx, ty = TRAY_CENTER
     robot = []
     for link in LINKS:
@@ -444,7 +507,7 @@ def render_scene() -> str:
         '  <compiler angle="radian" autolimits="true"/>',
         '  <option timestep="0.002" integrator="implicitfast" cone="elliptic" impratio="10"/>',
         "  <visual>",
-        '    <global offwidth="640" offheight="480"/>',
+        f'    <global offwidth="{CAMERA_RESOLUTION[0]}" offheight="{CAMERA_RESOLUTION[1]}"/>',
         '    <quality shadowsize="2048"/>',
         "  </visual>",
         "  <asset>",
@@ -457,7 +520,6 @@ def render_scene() -> str:
         "  <worldbody>",
         '    <light name="top" pos="0.5 0 3" dir="0 0 -1" directional="true"/>',
         '    <geom name="floor" type="plane" size="4 4 0.05" material="floor"/>',
-        '    <camera name="scene_camera" pos="2.1 0 1.9" xyaxes="0 1 0 -1.05 0 1.6" fovy="55"/>',
         f'    <geom name="table" type="box" size="0.35 1.2 {_f(TABLE_TOP / 2)}" '
         f'pos="0.7 0 {_f(TABLE_TOP / 2)}" rgba="0.76 0.7 0.6 1"/>',
         *robot,

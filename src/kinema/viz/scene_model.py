@@ -247,14 +247,23 @@ class SceneModel:
     # -- camera --------------------------------------------------------------------------------------
 
     def camera_view(self) -> dict[str, Any]:
-        """Where the page puts its camera: the model's first world-fixed camera, else MuJoCo's free camera."""
+        """Where the page puts its camera: the model's first world-fixed camera, else MuJoCo's free camera.
+
+        World-fixed: on the world body or a body welded to it (lab_sim's scene camera sits in its optical
+        frame's body), whose pose no joint changes, so a fresh state gives it.
+        """
+        import mujoco
+
         model = self.model
         center = np.asarray(model.stat.center, dtype=float)
         for cam in range(model.ncam):
-            if int(model.cam_bodyid[cam]) != 0:
+            if int(model.body_weldid[int(model.cam_bodyid[cam])]) != 0:
                 continue
-            position = np.asarray(model.cam_pos[cam], dtype=float)
-            rotation = np.asarray(model.cam_mat0[cam], dtype=float).reshape(3, 3)
+            posed = mujoco.MjData(model)
+            mujoco.mj_kinematics(model, posed)
+            mujoco.mj_camlight(model, posed)
+            position = np.asarray(posed.cam_xpos[cam], dtype=float)
+            rotation = np.asarray(posed.cam_xmat[cam], dtype=float).reshape(3, 3)
             forward = -rotation[:, 2]  # MuJoCo cameras look along their -z axis
             distance = max(float(np.dot(center - position, forward)), 0.5)
             return {

@@ -30,7 +30,8 @@ def _parser() -> argparse.ArgumentParser:
         description=(
             "Simulate a config package's MuJoCo scene headless and serve its controllers "
             "(/joint_trajectory_controller/follow_joint_trajectory, /robotiq_gripper_controller/gripper_cmd, "
-            "/controller_manager/*, /mujoco/*) with /clock and /joint_states."
+            "/controller_manager/*, /mujoco/*) with /clock and /joint_states, and its cameras "
+            "(/<camera>/color, depth, camera_info, points) while they have subscribers."
         ),
     )
     parser.add_argument("-c", "--config", required=True, metavar="NAME", help="config package to simulate")
@@ -62,6 +63,15 @@ def _parser() -> argparse.ArgumentParser:
         default=100.0,
         help="Hz of sim time for /clock and /joint_states (default 100)",
     )
+    parser.add_argument(
+        "--camera-rate",
+        type=float,
+        default=10.0,
+        help="most frames per camera per wall second while subscribed (default 10)",
+    )
+    parser.add_argument(
+        "--no-cameras", action="store_true", help="serve no cameras (no OpenGL context is made)"
+    )
     parser.add_argument("--log-file", type=Path, default=None, help="write the log there (default: stderr)")
     parser.add_argument(
         "--ready-fd", type=int, default=None, help="write 'ready' to this file descriptor when serving"
@@ -72,7 +82,10 @@ def _parser() -> argparse.ArgumentParser:
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the driver until SIGINT/SIGTERM; return the exit code."""
-    args = _parser().parse_args(argv)
+    parser = _parser()
+    args = parser.parse_args(argv)
+    if not args.camera_rate > 0:
+        parser.error(f"--camera-rate must be a positive number of frames a second, got {args.camera_rate:g}")
     from kinema.runtime import lifeline
     from kinema.runtime.log_files import configure_process_logging
 
@@ -104,6 +117,8 @@ def _run(args: argparse.Namespace, stop: threading.Event) -> int:
     overrides: dict[str, object] = {
         "sim_speed": parse_sim_speed(args.sim_speed),
         "publish_rate": args.publish_rate,
+        "cameras": not args.no_cameras,
+        "camera_rate": args.camera_rate,
     }
     if args.keyframe:
         overrides["keyframe"] = args.keyframe

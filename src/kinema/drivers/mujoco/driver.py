@@ -16,7 +16,9 @@ What it serves (names in :mod:`kinema.drivers.mujoco.names`): ``/clock`` and ``/
 publish rate of sim time; ``/joint_trajectory_controller/follow_joint_trajectory`` and
 ``/robotiq_gripper_controller/gripper_cmd``; ``/controller_manager/list_controllers`` and
 ``/controller_manager/switch_controller(s)``; ``/mujoco/set_state`` (keyframe and/or joint positions),
-``/mujoco/bodies`` (free body poses), ``/mujoco/keyframes`` and the ``/mujoco/scene_state`` topic.
+``/mujoco/bodies`` (free body poses), ``/mujoco/keyframes`` and the ``/mujoco/scene_state`` topic; per
+camera of the scene ``/<camera>/color``, ``/depth``, ``/camera_info`` and ``/points``, rendered only while
+subscribed (see :mod:`kinema.drivers.mujoco.cameras`).
 """
 
 from __future__ import annotations
@@ -30,6 +32,7 @@ from typing import Any
 import numpy as np
 
 from kinema.drivers.mujoco import names
+from kinema.drivers.mujoco.cameras import CameraServer, SimState
 from kinema.drivers.mujoco.cdr_templates import ClockEncoder, JointStateEncoder, generic_serializers
 from kinema.drivers.mujoco.controller_manager import Controller, ControllerManager, JointStateBroadcaster
 from kinema.drivers.mujoco.execution import Execution
@@ -132,6 +135,9 @@ class MujocoDriver:
         self._goals_running = 0
         self._goals_lock = threading.Condition()
         self._last_scene_publish = 0.0
+        self.cameras: CameraServer | None = None
+        if settings.cameras and self.model.ncam > 0:
+            self.cameras = CameraServer(session, self.model, self._camera_snapshot, settings.camera_rate)
         self._started = False
         self._stopped = False
 
@@ -166,6 +172,8 @@ class MujocoDriver:
             # Before the physics thread owns the data: from then on only it may read it.
             self._publish_scene_state()
             self.simulation.start()
+            if self.cameras is not None:
+                self.cameras.start()
         except BaseException:
             self.stop()
             raise
@@ -185,6 +193,8 @@ class MujocoDriver:
         if self._stopped:
             return
         self._stopped = True
+        if self.cameras is not None:
+            self.cameras.stop()
         self.simulation.stop()
         for controller in self._goal_controllers:
             controller.shutdown("the MuJoCo driver stopped")
@@ -246,6 +256,14 @@ class MujocoDriver:
                     "action", names.GRIPPER_COMMAND_ACTION, names.GRIPPER_COMMAND_TYPE, "move the gripper"
                 )
             )
+        if self.cameras is not None and self.cameras.unavailable is None:
+            for spec in self.cameras.specs:
+                for stream, type_name in names.CAMERA_STREAMS.items():
+                    served.append(
+                        ServedInterface(
+                            "topic", names.camera_topic(spec.name, stream), type_name, f"{spec.name} {stream}"
+                        )
+                    )
         return served
 
     def __enter__(self) -> MujocoDriver:
@@ -349,6 +367,12 @@ class MujocoDriver:
                 self._execute_gripper,
                 cancel_callback=self._cancel_goal,
             )
+
+    def _camera_snapshot(self) -> SimState | None:
+        try:
+            return self.simulation.call(lambda: SimState.of(self.data), timeout=1.0)
+        except DriverError:
+            return None
 
     def _node(self, name: str) -> Node:
         node = Node(self.session, name)

@@ -35,3 +35,20 @@ SCENE_STATE_TYPE = "kinema_msgs/msg/SceneState"
 JOINT_TRAJECTORY_CONTROLLER = "joint_trajectory_controller"
 GRIPPER_CONTROLLER = "robotiq_gripper_controller"
 JOINT_STATE_BROADCASTER = "joint_state_broadcaster"
+
+# Each MuJoCo camera is served as MoveIt Pro's lab_sim serves it: /<camera>/color, /<camera>/depth,
+# /<camera>/camera_info and /<camera>/points (an organised cloud in the camera's optical frame).
+IMAGE_TYPE = "sensor_msgs/msg/Image"
+CAMERA_INFO_TYPE = "sensor_msgs/msg/CameraInfo"
+POINT_CLOUD_TYPE = "sensor_msgs/msg/PointCloud2"
+CAMERA_STREAMS = {
+    "color": IMAGE_TYPE,
+    "depth": IMAGE_TYPE,
+    "camera_info": CAMERA_INFO_TYPE,
+    "points": POINT_CLOUD_TYPE,
+}
+
+
+def camera_topic(camera: str, stream: str) -> str:
+    """The topic of ``stream`` (color, depth, camera_info, points) of ``camera``: ``/<camera>/<stream>``."""
+    return f"/{camera}/{stream}"

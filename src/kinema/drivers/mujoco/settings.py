@@ -36,6 +36,9 @@ class MujocoDriverSettings:
         sim_speed: sim seconds per wall second; ``math.inf`` for as fast as possible.
         publish_rate: rate of ``/clock``, ``/joint_states`` and action feedback, Hz of sim time.
         scene_state_rate: rate of the scene-state topic for viewers, Hz of wall time.
+        cameras: serve the scene's cameras (rendered only while someone subscribes).
+        camera_rate: most frames per camera per wall second while subscribed (MoveIt Pro's lab_sim
+            renders at 10 Hz).
         active_controllers: controllers active at start.
         inactive_controllers: controllers loaded but inactive at start.
         gripper_joint: the joint the gripper controller commands (None: no gripper controller).
@@ -49,6 +52,8 @@ class MujocoDriverSettings:
     sim_speed: float = 1.0
     publish_rate: float = 100.0
     scene_state_rate: float = 30.0
+    cameras: bool = True
+    camera_rate: float = 10.0
     active_controllers: tuple[str, ...] = DEFAULT_CONTROLLERS
     inactive_controllers: tuple[str, ...] = ()
     gripper_joint: str | None = "robotiq_85_left_knuckle_joint"

@@ -1,0 +1,44 @@
+"""Perception maths on point clouds and camera images, as numpy arrays; no behavior tree, no transport.
+
+* :class:`PointCloud` (``point_cloud.py``) — points (Nx3, m), optional colours, frame id, organised shape;
+  ``transformed``, ``centroid``, ``finite``;
+* :class:`CameraIntrinsics` (``intrinsics.py``) — a pinhole camera, from a vertical field of view;
+* :func:`depth_to_cloud` (``depth.py``) — a depth image → an organised cloud in the optical frame;
+* :func:`crop_box`, :func:`remove_box` (``box_filter.py``) — keep / drop the points inside a posed box;
+* :func:`voxel_downsample`, :func:`merge_clouds` (``voxel_grid.py``) — one point per occupied voxel;
+* :func:`register_icp` (``icp.py``) — point-to-point ICP (nearest neighbours with scipy's cKDTree);
+* :func:`load_pcd`, :func:`save_pcd` (``pcd.py``) — PCL's .pcd files;
+* :func:`sample_mesh_surface` (``mesh_sampling.py``) — points spread evenly over an STL's surface;
+* ``ros_messages.py`` — the edge: ``sensor_msgs`` PointCloud2 / Image / CameraInfo ↔ the above.
+
+Heavy dependencies (scipy, trimesh) load inside the functions that need them.
+"""
+
+from __future__ import annotations
+
+import importlib
+from typing import Any
+
+_EXPORTS = {
+    "PointCloud": "point_cloud",
+    "CameraIntrinsics": "intrinsics",
+    "depth_to_cloud": "depth",
+    "crop_box": "box_filter",
+    "remove_box": "box_filter",
+    "voxel_downsample": "voxel_grid",
+    "merge_clouds": "voxel_grid",
+    "register_icp": "icp",
+    "IcpResult": "icp",
+    "load_pcd": "pcd",
+    "save_pcd": "pcd",
+    "sample_mesh_surface": "mesh_sampling",
+}
+
+__all__ = sorted(_EXPORTS)
+
+
+def __getattr__(name: str) -> Any:
+    module = _EXPORTS.get(name)
+    if module is None:
+        raise AttributeError(f"module 'kinema.perception' has no attribute {name!r}")
+    return getattr(importlib.import_module(f"kinema.perception.{module}"), name)
