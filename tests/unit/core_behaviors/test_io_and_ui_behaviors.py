@@ -86,6 +86,9 @@ def test_record_joint_trajectory_between_start_and_stop(behavior: Any, context: 
         start.wait_for_service(10.0)
         for step in range(3):
             publish(step)  # before start: not recorded
+        # Those must reach the recorder before the start call does (its subscription dispatches on a
+        # thread of its own, which lags under load), or they are rightly taken as after the start.
+        time.sleep(1.0)
         assert start.call({}, 5.0).success
         time.sleep(0.2)
         for step in range(3, 30):
