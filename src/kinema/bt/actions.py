@@ -118,11 +118,14 @@ class ScriptNode(_ScriptCode, SyncActionNode):
 
     def tick(self) -> NodeStatus:
         # A literal code was parsed at construction; only a {pointer} is re-read every tick.
-        code = self._code if self._literal else self.get_input("code", str)
-        if code != self._code:
-            self._set_code(code)
-        if self._script is not None:
-            self._script.run(self.config.blackboard, self.config.enums)
+        if not self._literal:
+            code = self.get_input("code", str)
+            if code != self._code:
+                self._set_code(code)
+        script = self._script
+        if script is not None:
+            config = self.config
+            script.run(config.blackboard, config.enums)
         return SUCCESS
 
 
@@ -143,14 +146,19 @@ class ScriptConditionNode(_ScriptCode, ConditionNode):
 
     def tick(self) -> NodeStatus:
         # A literal code was parsed at construction; only a {pointer} is re-read every tick.
-        code = self._code if self._literal else self.get_input("code", str)
-        if code != self._code:
-            self._set_code(code)
-        if self._script is None:
+        if not self._literal:
+            code = self.get_input("code", str)
+            if code != self._code:
+                self._set_code(code)
+        script = self._script
+        if script is None:
             raise BTRuntimeError(
                 f"ScriptCondition '{self.full_path}' has an empty script (bad_function_call)"
             )
-        value = self._script.run(self.config.blackboard, self.config.enums)
+        config = self.config
+        value = script.run(config.blackboard, config.enums)
+        if value.__class__ is float:  # what comparisons return; script_bool's first case
+            return SUCCESS if value != 0.0 else FAILURE
         return SUCCESS if script_bool(value) else FAILURE
 
 
