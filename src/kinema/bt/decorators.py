@@ -29,15 +29,21 @@ class InverterNode(DecoratorNode):
     """SUCCESS <-> FAILURE; RUNNING and SKIPPED pass through."""
 
     def tick(self) -> NodeStatus:
-        _set_status_unchecked(self, RUNNING)
-        assert self.child is not None
-        status = self.child.execute_tick()
-        if status is SUCCESS:
-            self.reset_child()
-            return FAILURE
-        if status is FAILURE:
-            self.reset_child()
-            return SUCCESS
+        if self._status is not RUNNING:
+            if self._observers:
+                _set_status_unchecked(self, RUNNING)
+            else:
+                self._status = RUNNING
+        child = self.child
+        assert child is not None
+        status = child.execute_tick()
+        if status is SUCCESS or status is FAILURE:
+            # reset_child() inlined for the common case: a completed child without observers
+            if child._status is RUNNING or child._observers:
+                self.reset_child()
+            else:
+                child._status = IDLE
+            return FAILURE if status is SUCCESS else SUCCESS
         if status is RUNNING or status is SKIPPED:
             return status
         raise _idle_child(self)
@@ -49,11 +55,19 @@ class ForceSuccessNode(DecoratorNode):
     _forced = SUCCESS
 
     def tick(self) -> NodeStatus:
-        _set_status_unchecked(self, RUNNING)
-        assert self.child is not None
-        status = self.child.execute_tick()
+        if self._status is not RUNNING:
+            if self._observers:
+                _set_status_unchecked(self, RUNNING)
+            else:
+                self._status = RUNNING
+        child = self.child
+        assert child is not None
+        status = child.execute_tick()
         if status is SUCCESS or status is FAILURE:
-            self.reset_child()
+            if child._status is RUNNING or child._observers:
+                self.reset_child()
+            else:
+                child._status = IDLE
             return self._forced
         if status is RUNNING or status is SKIPPED:
             return status
@@ -527,10 +541,16 @@ class SubTreeNode(DecoratorNode):
 
     def tick(self) -> NodeStatus:
         if self._status is IDLE:
-            _set_status_unchecked(self, RUNNING)
+            if self._observers:
+                _set_status_unchecked(self, RUNNING)
+            else:
+                self._status = RUNNING
         child = self.child
         assert child is not None
         status = child.execute_tick()
         if status is SUCCESS or status is FAILURE:
-            self.reset_child()
+            if child._status is RUNNING or child._observers:
+                self.reset_child()
+            else:
+                child._status = IDLE
         return status
