@@ -179,7 +179,7 @@ def _int_step(key: str, op: str, step: int, slow: Evaluator) -> Evaluator:
                 new = apply(dst, step)
                 if -_MAX_EXACT_INT <= new <= _MAX_EXACT_INT:
                     entry.value = new
-                    bb.notify_written(key, entry)
+                    bb._written(key, entry)  # notify_written without the extra call
                     return new
         return slow(bb, enums)
 
@@ -203,7 +203,7 @@ def _compound(key: str, op: str, rhs: Evaluator, general: Evaluator) -> Evaluato
                 else:
                     return general(bb, enums)  # raises BT.CPP's conversion error
                 entry.value = new
-                bb.notify_written(key, entry)
+                bb._written(key, entry)  # notify_written without the extra call
                 return new
         return general(bb, enums)
 
