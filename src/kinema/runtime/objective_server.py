@@ -118,6 +118,51 @@ class NodeStatusChange(NamedTuple):
     status: int
 
 
+_new_tuple = tuple.__new__
+
+
+class NodeStatusRecorder:
+    """The server's status observer: one :class:`NodeStatusChange` per transition, kept until the
+    tick is flushed, and the leaves that failed (the failure message names the last one).
+
+    It runs for every transition on the tick thread, so a node's fixed fields (uid, path, ID,
+    name, whether it is a leaf) are looked up once per node and each change is built with
+    ``tuple.__new__`` (a NamedTuple's own constructor is a Python function).
+    """
+
+    __slots__ = ("_nodes", "failures", "pending")
+
+    def __init__(self) -> None:
+        self.pending: list[NodeStatusChange] = []
+        self.failures: list[tuple[str, str]] = []
+        self._nodes: dict[Any, tuple[tuple[int, str, str, str], tuple[str, str] | None]] = {}
+
+    def __call__(self, timestamp: float, node: Any, previous: Any, status: Any) -> None:
+        known = self._nodes.get(node)
+        if known is None:
+            known = self._nodes[node] = self._describe(node)
+        fields, leaf = known
+        self.pending.append(
+            _new_tuple(NodeStatusChange, (timestamp, *fields, _STATUS_INT[previous], _STATUS_INT[status]))
+        )
+        if leaf is not None and status is NodeStatus.FAILURE:
+            self.failures.append(leaf)
+
+    @staticmethod
+    def _describe(node: Any) -> tuple[tuple[int, str, str, str], tuple[str, str] | None]:
+        path = node.full_path
+        fields = (int(node.uid), path, node.registration_id, node.name)
+        return fields, None if node_children(node) else (path, node.registration_id)
+
+    def take(self) -> list[NodeStatusChange]:
+        """The changes since the last call (the list is handed over, not copied)."""
+        changes, self.pending = self.pending, []
+        return changes
+
+
+_STATUS_INT = {status: int(status) for status in NodeStatus}
+
+
 class ServerListener(Protocol):
     """Receives what happens in the server. Every method runs on the tick thread and must not block."""
 
@@ -370,9 +415,8 @@ class ObjectiveServer:
         # that replaces an abandoned one.
         self._in_hand: list[ObjectiveRun | _Cancel | _Call] = []
         self._in_hand_start: ObjectiveRun | None = None
-        self._pending_changes: list[NodeStatusChange] = []
+        self._recorder = NodeStatusRecorder()
         self._last_snapshot = 0.0
-        self._failures: list[tuple[str, str]] = []
         self._failure_notes: dict[str, str] = {}
         self._notes_lock = threading.Lock()
         # Read by any thread (a consistent pair, replaced atomically):
@@ -873,12 +917,11 @@ class ObjectiveServer:
             return
         run.release_xml()
         self._tree = tree
-        self._failures = []
+        self._recorder = NodeStatusRecorder()
         with self._notes_lock:
             self._failure_notes = {}
-        self._pending_changes = []
         self._last_snapshot = 0.0
-        tree.add_status_observer(self._on_node_status)
+        tree.add_status_observer(self._recorder)
         tree.wake_up.listener = self._wake_up
         for listener in self._listeners:
             loaded = getattr(listener, "on_tree_loaded", None)
@@ -998,20 +1041,10 @@ class ObjectiveServer:
 
     # -- observation (tick thread) --------------------------------------------------------------
 
-    def _on_node_status(self, timestamp: float, node: Any, previous: Any, status: Any) -> None:
-        path = node.full_path
-        self._pending_changes.append(
-            NodeStatusChange(
-                timestamp, int(node.uid), path, node.registration_id, node.name, int(previous), int(status)
-            )
-        )
-        if status is NodeStatus.FAILURE and not node_children(node):
-            self._failures.append((path, node.registration_id))
-
     def _flush_node_changes(self, run: ObjectiveRun) -> None:
-        if not self._pending_changes:
+        if not self._recorder.pending:
             return
-        changes, self._pending_changes = self._pending_changes, []
+        changes = self._recorder.take()
         for listener in self._listeners:
             try:
                 listener.on_node_status(run.objective_name, changes)
@@ -1033,9 +1066,10 @@ class ObjectiveServer:
                 log.exception("a blackboard listener raised")
 
     def _failure_message(self, run: ObjectiveRun) -> str:
-        if not self._failures:
+        failures = self._recorder.failures
+        if not failures:
             return f"objective {run.objective_name!r} returned FAILURE"
-        path, registration_id = self._failures[-1]
+        path, registration_id = failures[-1]
         with self._notes_lock:
             message = self._failure_notes.get(path, "")
         detail = f": {message}" if message else " returned FAILURE"
