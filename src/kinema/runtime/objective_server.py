@@ -125,9 +125,9 @@ class NodeStatusRecorder:
     """The server's status observer: one :class:`NodeStatusChange` per transition, kept until the
     tick is flushed, and the leaves that failed (the failure message names the last one).
 
-    It runs for every transition on the tick thread, so a node's fixed fields (uid, path, ID,
-    name, whether it is a leaf) are looked up once per node and each change is built with
-    ``tuple.__new__`` (a NamedTuple's own constructor is a Python function).
+    It runs for every transition on the tick thread, so everything but the timestamp is prepared
+    once per node and transition (a table indexed by previous and new status) and each change is
+    built with ``tuple.__new__`` (a NamedTuple's own constructor is a Python function).
     """
 
     __slots__ = ("_nodes", "failures", "pending")
@@ -135,24 +135,19 @@ class NodeStatusRecorder:
     def __init__(self) -> None:
         self.pending: list[NodeStatusChange] = []
         self.failures: list[tuple[str, str]] = []
-        self._nodes: dict[Any, tuple[tuple[int, str, str, str], tuple[str, str] | None]] = {}
+        self._nodes: dict[Any, _NodeRows] = {}
 
     def __call__(self, timestamp: float, node: Any, previous: Any, status: Any) -> None:
-        known = self._nodes.get(node)
-        if known is None:
-            known = self._nodes[node] = self._describe(node)
-        fields, leaf = known
-        self.pending.append(
-            _new_tuple(NodeStatusChange, (timestamp, *fields, _STATUS_INT[previous], _STATUS_INT[status]))
-        )
-        if leaf is not None and status is NodeStatus.FAILURE:
-            self.failures.append(leaf)
-
-    @staticmethod
-    def _describe(node: Any) -> tuple[tuple[int, str, str, str], tuple[str, str] | None]:
-        path = node.full_path
-        fields = (int(node.uid), path, node.registration_id, node.name)
-        return fields, None if node_children(node) else (path, node.registration_id)
+        rows = self._nodes.get(node)
+        if rows is None:
+            rows = self._nodes[node] = _NodeRows(node)
+        row = rows.by_previous[previous]
+        rest = row[status]
+        if rest is None:
+            rest = row[status] = (*rows.fields, int(previous), int(status))
+        self.pending.append(_new_tuple(NodeStatusChange, (timestamp,) + rest))  # noqa: RUF005 - faster
+        if status is _FAILURE and rows.leaf is not None:
+            self.failures.append(rows.leaf)
 
     def take(self) -> list[NodeStatusChange]:
         """The changes since the last call (the list is handed over, not copied)."""
@@ -160,7 +155,20 @@ class NodeStatusRecorder:
         return changes
 
 
-_STATUS_INT = {status: int(status) for status in NodeStatus}
+class _NodeRows:
+    """What :class:`NodeStatusRecorder` knows of one node."""
+
+    __slots__ = ("by_previous", "fields", "leaf")
+
+    def __init__(self, node: Any) -> None:
+        path = node.full_path
+        self.fields = (int(node.uid), path, node.registration_id, node.name)
+        self.leaf = None if node_children(node) else (path, node.registration_id)
+        n = len(NodeStatus)
+        self.by_previous: list[list[tuple[Any, ...] | None]] = [[None] * n for _ in range(n)]
+
+
+_FAILURE = NodeStatus.FAILURE
 
 
 class ServerListener(Protocol):
