@@ -667,7 +667,12 @@ class ControlNode(TreeNode):
                     child.halt_node()
                     child.reset_status()
                 elif child._observers:
-                    child.reset_status()
+                    # reset_status() inlined: an observed tree resets every completed child
+                    child._status = IDLE
+                    clock = child.config.clock
+                    now = clock.now() if clock is not None else 0.0
+                    for callback in child._observers:
+                        callback(now, child, status, IDLE)
                 else:
                     child._status = IDLE
 
