@@ -14,8 +14,8 @@ them. Structures:
   (a Python callback in both engines), with Scripts passing values as the real ones pass poses;
 * building the sequence and the mixed tree from XML.
 
-Kinema is also measured "as objectives run": with the objective server's status observer (one
-NodeStatusChange per transition, like ``ObjectiveServer._on_node_status``) and a blackboard
+Kinema is also measured "as objectives run": with the objective server's status observer (its
+``NodeStatusRecorder``: one NodeStatusChange per transition) and a blackboard
 snapshot at 10 Hz attached. Rates are ticks per CPU second (``time.process_time``), median of
 ``--rounds`` rounds; ratios are Kinema's time over BT.CPP's (lower is better; 1.0 = parity).
 Targets (issue 17): sequence <= 1.0x, mixed <= 1.5x, XML build <= 2x, observers <= +20 %.
@@ -154,31 +154,23 @@ def btcpp_tree(xml: str) -> Any:
 
 
 class ObjectiveObservers:
-    """What the objective server attaches to a running tree: a NodeStatusChange per transition
-    (flushed after every tick) and a blackboard snapshot at 10 Hz."""
+    """What the objective server attaches to a running tree: its NodeStatusRecorder (a
+    NodeStatusChange per transition, taken after every tick) and a blackboard snapshot at 10 Hz."""
 
     def __init__(self, tree: Any) -> None:
-        from kinema.runtime.objective_server import NodeStatusChange, blackboard_entries
+        from kinema.runtime.objective_server import NodeStatusRecorder, blackboard_entries
 
         self.tree = tree
-        self.pending: list[Any] = []
+        self.recorder = NodeStatusRecorder()
         self.published = 0
         self.snapshots = 0
         self._last = 0.0
         self._entries = blackboard_entries
-        change = NodeStatusChange
-
-        def on_status(timestamp: float, node: Any, previous: Any, status: Any) -> None:
-            self.pending.append(
-                change(timestamp, int(node.uid), node.full_path, node.registration_id, node.name,
-                       int(previous), int(status))
-            )  # fmt: skip
-
-        self._handle = tree.add_status_observer(on_status)
+        self._handle = tree.add_status_observer(self.recorder)
 
     def tick(self) -> None:
         self.tree.tick_once()
-        changes, self.pending = self.pending, []
+        changes = self.recorder.take()
         self.published += len(changes)
         now = time.monotonic()
         if now - self._last >= 0.1:

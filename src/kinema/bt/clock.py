@@ -103,8 +103,9 @@ class WallClock:
         self._cond = threading.Condition()
         self._thread: threading.Thread | None = None
 
-    def now(self) -> float:
-        return time.monotonic()
+    # time.monotonic itself (a builtin does not bind, so clock.now() calls it directly): every
+    # observed status change and every blackboard write reads the clock.
+    now: Callable[[], float] = staticmethod(time.monotonic)  # type: ignore[assignment]
 
     def call_later(self, delay: float, callback: Callable[[], None]) -> _Timer:
         timer = _Timer(time.monotonic() + max(delay, 0.0), callback)

@@ -44,7 +44,10 @@ class SequenceNode(_ResumingControl):
         if self._status is not RUNNING:
             if self._status is IDLE:
                 self._skipped = 0
-            _set_status_unchecked(self, RUNNING)
+            if self._observers:
+                _set_status_unchecked(self, RUNNING)
+            else:
+                self._status = RUNNING
         idx = self._idx
         if self._asynch:
             return self._tick_async(children, n, idx)
@@ -133,7 +136,10 @@ class SequenceWithMemoryNode(ControlNode):
         if self._status is not RUNNING:
             if self._status is IDLE:
                 self._skipped = 0
-            _set_status_unchecked(self, RUNNING)
+            if self._observers:
+                _set_status_unchecked(self, RUNNING)
+            else:
+                self._status = RUNNING
         while self._idx < n:
             child = children[self._idx]
             prev = child._status
@@ -172,7 +178,10 @@ class FallbackNode(_ResumingControl):
         if self._status is not RUNNING:
             if self._status is IDLE:
                 self._skipped = 0
-            _set_status_unchecked(self, RUNNING)
+            if self._observers:
+                _set_status_unchecked(self, RUNNING)
+            else:
+                self._status = RUNNING
         idx = self._idx
         while idx < n:
             child = children[idx]
@@ -234,12 +243,18 @@ class ReactiveSequenceNode(_RunningChildControl):
 
     def tick(self) -> NodeStatus:
         all_skipped = True
-        if self._status is IDLE:
-            self._running_child = -1
-        if self._status is not RUNNING:
-            _set_status_unchecked(self, RUNNING)
+        prev = self._status
+        if prev is not RUNNING:
+            if prev is IDLE:
+                self._running_child = -1
+            if self._observers:
+                _set_status_unchecked(self, RUNNING)
+            else:
+                self._status = RUNNING
         children = self.children
-        for index, child in enumerate(children):
+        index = -1
+        for child in children:
+            index += 1
             status = child.execute_tick()
             if status is SUCCESS:
                 all_skipped = False
@@ -259,7 +274,13 @@ class ReactiveSequenceNode(_RunningChildControl):
                 self.reset_children()
                 return FAILURE
             raise _idle_child(self)
-        self.reset_children()
+        # reset_children() inlined: after a pass that succeeded no child is RUNNING
+        for child in children:
+            if child._status is not IDLE:
+                if child._status is RUNNING or child._observers:
+                    self.reset_children()
+                    break
+                child._status = IDLE
         return SKIPPED if all_skipped else SUCCESS
 
 

@@ -25,45 +25,53 @@ def _required(node: DecoratorNode, port: str, node_kind: str) -> Any:
         raise BTRuntimeError(f"Missing parameter [{port}] in {node_kind}: {error.message}") from None
 
 
-class InverterNode(DecoratorNode):
+class _ResultMappingDecorator(DecoratorNode):
+    """Ticks the child and maps a completed result (Inverter, ForceSuccess, ForceFailure);
+    RUNNING and SKIPPED pass through."""
+
+    _on_success = SUCCESS
+    _on_failure = FAILURE
+
+    def tick(self) -> NodeStatus:
+        if self._status is not RUNNING:
+            if self._observers:
+                _set_status_unchecked(self, RUNNING)
+            else:
+                self._status = RUNNING
+        child = self.child
+        assert child is not None
+        status = child.execute_tick()
+        if status is SUCCESS or status is FAILURE:
+            # reset_child() inlined for the common case: a completed child without observers
+            if child._status is RUNNING or child._observers:
+                self.reset_child()
+            else:
+                child._status = IDLE
+            return self._on_success if status is SUCCESS else self._on_failure
+        if status is RUNNING or status is SKIPPED:
+            return status
+        raise _idle_child(self)
+
+
+class InverterNode(_ResultMappingDecorator):
     """SUCCESS <-> FAILURE; RUNNING and SKIPPED pass through."""
 
-    def tick(self) -> NodeStatus:
-        _set_status_unchecked(self, RUNNING)
-        assert self.child is not None
-        status = self.child.execute_tick()
-        if status is SUCCESS:
-            self.reset_child()
-            return FAILURE
-        if status is FAILURE:
-            self.reset_child()
-            return SUCCESS
-        if status is RUNNING or status is SKIPPED:
-            return status
-        raise _idle_child(self)
+    _on_success = FAILURE
+    _on_failure = SUCCESS
 
 
-class ForceSuccessNode(DecoratorNode):
+class ForceSuccessNode(_ResultMappingDecorator):
     """A completed child becomes SUCCESS; RUNNING and SKIPPED pass through."""
 
-    _forced = SUCCESS
-
-    def tick(self) -> NodeStatus:
-        _set_status_unchecked(self, RUNNING)
-        assert self.child is not None
-        status = self.child.execute_tick()
-        if status is SUCCESS or status is FAILURE:
-            self.reset_child()
-            return self._forced
-        if status is RUNNING or status is SKIPPED:
-            return status
-        raise _idle_child(self)
+    _on_success = SUCCESS
+    _on_failure = SUCCESS
 
 
-class ForceFailureNode(ForceSuccessNode):
+class ForceFailureNode(_ResultMappingDecorator):
     """A completed child becomes FAILURE; RUNNING and SKIPPED pass through."""
 
-    _forced = FAILURE
+    _on_success = FAILURE
+    _on_failure = FAILURE
 
 
 class KeepRunningUntilFailureNode(DecoratorNode):
@@ -527,10 +535,16 @@ class SubTreeNode(DecoratorNode):
 
     def tick(self) -> NodeStatus:
         if self._status is IDLE:
-            _set_status_unchecked(self, RUNNING)
+            if self._observers:
+                _set_status_unchecked(self, RUNNING)
+            else:
+                self._status = RUNNING
         child = self.child
         assert child is not None
         status = child.execute_tick()
         if status is SUCCESS or status is FAILURE:
-            self.reset_child()
+            if child._status is RUNNING or child._observers:
+                self.reset_child()
+            else:
+                child._status = IDLE
         return status

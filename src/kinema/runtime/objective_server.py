@@ -118,6 +118,59 @@ class NodeStatusChange(NamedTuple):
     status: int
 
 
+_new_tuple = tuple.__new__
+
+
+class NodeStatusRecorder:
+    """The server's status observer: one :class:`NodeStatusChange` per transition, kept until the
+    tick is flushed, and the leaves that failed (the failure message names the last one).
+
+    It runs for every transition on the tick thread, so everything but the timestamp is prepared
+    once per node and transition (a table indexed by previous and new status) and each change is
+    built with ``tuple.__new__`` (a NamedTuple's own constructor is a Python function).
+    """
+
+    __slots__ = ("_nodes", "failures", "pending")
+
+    def __init__(self) -> None:
+        self.pending: list[NodeStatusChange] = []
+        self.failures: list[tuple[str, str]] = []
+        self._nodes: dict[Any, _NodeRows] = {}
+
+    def __call__(self, timestamp: float, node: Any, previous: Any, status: Any) -> None:
+        rows = self._nodes.get(node)
+        if rows is None:
+            rows = self._nodes[node] = _NodeRows(node)
+        row = rows.by_previous[previous]
+        rest = row[status]
+        if rest is None:
+            rest = row[status] = (*rows.fields, int(previous), int(status))
+        self.pending.append(_new_tuple(NodeStatusChange, (timestamp,) + rest))  # noqa: RUF005 - faster
+        if status is _FAILURE and rows.leaf is not None:
+            self.failures.append(rows.leaf)
+
+    def take(self) -> list[NodeStatusChange]:
+        """The changes since the last call (the list is handed over, not copied)."""
+        changes, self.pending = self.pending, []
+        return changes
+
+
+class _NodeRows:
+    """What :class:`NodeStatusRecorder` knows of one node."""
+
+    __slots__ = ("by_previous", "fields", "leaf")
+
+    def __init__(self, node: Any) -> None:
+        path = node.full_path
+        self.fields = (int(node.uid), path, node.registration_id, node.name)
+        self.leaf = None if node_children(node) else (path, node.registration_id)
+        n = len(NodeStatus)
+        self.by_previous: list[list[tuple[Any, ...] | None]] = [[None] * n for _ in range(n)]
+
+
+_FAILURE = NodeStatus.FAILURE
+
+
 class ServerListener(Protocol):
     """Receives what happens in the server. Every method runs on the tick thread and must not block."""
 
@@ -370,9 +423,8 @@ class ObjectiveServer:
         # that replaces an abandoned one.
         self._in_hand: list[ObjectiveRun | _Cancel | _Call] = []
         self._in_hand_start: ObjectiveRun | None = None
-        self._pending_changes: list[NodeStatusChange] = []
+        self._recorder = NodeStatusRecorder()
         self._last_snapshot = 0.0
-        self._failures: list[tuple[str, str]] = []
         self._failure_notes: dict[str, str] = {}
         self._notes_lock = threading.Lock()
         # Read by any thread (a consistent pair, replaced atomically):
@@ -873,12 +925,11 @@ class ObjectiveServer:
             return
         run.release_xml()
         self._tree = tree
-        self._failures = []
+        self._recorder = NodeStatusRecorder()
         with self._notes_lock:
             self._failure_notes = {}
-        self._pending_changes = []
         self._last_snapshot = 0.0
-        tree.add_status_observer(self._on_node_status)
+        tree.add_status_observer(self._recorder)
         tree.wake_up.listener = self._wake_up
         for listener in self._listeners:
             loaded = getattr(listener, "on_tree_loaded", None)
@@ -998,20 +1049,10 @@ class ObjectiveServer:
 
     # -- observation (tick thread) --------------------------------------------------------------
 
-    def _on_node_status(self, timestamp: float, node: Any, previous: Any, status: Any) -> None:
-        path = node.full_path
-        self._pending_changes.append(
-            NodeStatusChange(
-                timestamp, int(node.uid), path, node.registration_id, node.name, int(previous), int(status)
-            )
-        )
-        if status is NodeStatus.FAILURE and not node_children(node):
-            self._failures.append((path, node.registration_id))
-
     def _flush_node_changes(self, run: ObjectiveRun) -> None:
-        if not self._pending_changes:
+        if not self._recorder.pending:
             return
-        changes, self._pending_changes = self._pending_changes, []
+        changes = self._recorder.take()
         for listener in self._listeners:
             try:
                 listener.on_node_status(run.objective_name, changes)
@@ -1033,9 +1074,10 @@ class ObjectiveServer:
                 log.exception("a blackboard listener raised")
 
     def _failure_message(self, run: ObjectiveRun) -> str:
-        if not self._failures:
+        failures = self._recorder.failures
+        if not failures:
             return f"objective {run.objective_name!r} returned FAILURE"
-        path, registration_id = self._failures[-1]
+        path, registration_id = failures[-1]
         with self._notes_lock:
             message = self._failure_notes.get(path, "")
         detail = f": {message}" if message else " returned FAILURE"

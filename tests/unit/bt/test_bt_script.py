@@ -233,3 +233,64 @@ def test_deep_nesting_is_a_parse_error_not_a_crash() -> None:
         parse_script("(" * 5000 + "1" + ")" * 5000)
     with pytest.raises(ScriptParseError):
         parse_script("-" * 5000 + "1")
+
+
+_EDGE_VALUES = [
+    0,
+    1,
+    -1,
+    7,
+    2**53 - 2,
+    2**53 - 1,
+    2**53,
+    -(2**53 - 1),
+    -(2**53),
+    2**62,
+    0.5,
+    -2.5,
+    1e300,
+    True,
+    "3",
+    None,
+]
+
+
+@pytest.mark.parametrize(
+    "code",
+    [
+        "x += 1",
+        "x -= 1",
+        "x *= 3",
+        "x *= 2",
+        "x += 0",
+        "x >= 0",
+        "x < 1",
+        "x == 1",
+        "x != 7",
+        "x > 2.5",
+        "x <= -1",
+    ],
+)
+@pytest.mark.parametrize("start", _EDGE_VALUES, ids=repr)
+def test_compiled_fast_paths_match_the_tree_walking_evaluator(code: str, start: object) -> None:
+    """The closures for `name op= int` and `name cmp number` give what the AST evaluator gives:
+    the same value, the same entry afterwards, or the same error (2**53 limits, types, empty)."""
+    script = parse_script(code)
+    results = []
+    for evaluate in (script.run, lambda bb, enums: script.statements[0].evaluate(bb, enums)):
+        bb = Blackboard.create()
+        bb.set("x", start)
+        try:
+            outcome: object = ("value", evaluate(bb, {}))
+        except Exception as error:  # compared below
+            outcome = ("error", str(error).splitlines()[-1])
+        entry = bb.get_entry("x")
+        results.append((outcome, entry.value if entry is not None else None))
+    assert results[0] == results[1], f"{code} with x={start!r}: compiled {results[0]}, evaluator {results[1]}"
+
+
+def test_compiled_comparison_reads_an_enum_before_the_blackboard() -> None:
+    bb = Blackboard.create()
+    bb.set("RED", 5)
+    assert run("RED == 2", bb, {"RED": 2}) == 1.0
+    assert run("RED == 5", bb, {"BLUE": 1}) == 1.0

@@ -10,6 +10,7 @@ other expression is its own ``evaluate``.
 
 from __future__ import annotations
 
+import operator
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
@@ -37,11 +38,22 @@ _NUMBERS = (int, float)  # exact classes: bools and enums take the general path
 _FLOAT_COMPARE: dict[str, Callable[[float, float], bool]] = {
     "==": lambda a, b: abs(a - b) <= FLT_EPSILON,
     "!=": lambda a, b: not abs(a - b) <= FLT_EPSILON,
-    "<": lambda a, b: a < b,
-    ">": lambda a, b: a > b,
-    "<=": lambda a, b: a <= b,
-    ">=": lambda a, b: a >= b,
+    "<": operator.lt,
+    ">": operator.gt,
+    "<=": operator.le,
+    ">=": operator.ge,
 }
+
+_MAX_EXACT_INT = 2**53 - 1  # to_double's limit: integers up to it are exact doubles
+
+
+def _number_literal(expr: Expr) -> float | int | None:
+    """The value of a literal int/float a double holds exactly, else None."""
+    if type(expr) is Literal and expr.value.__class__ in _NUMBERS:  # type: ignore[attr-defined]
+        value = expr.value  # type: ignore[attr-defined]
+        if value.__class__ is float or -_MAX_EXACT_INT <= value <= _MAX_EXACT_INT:
+            return value
+    return None
 
 
 def compile_expr(expr: Expr) -> Evaluator:
@@ -97,6 +109,30 @@ def _binary(expr: Binary) -> Evaluator:
 
 
 def _comparison(expr: Comparison) -> Evaluator:
+    general = _comparison_general(expr)
+    lhs_expr, rhs_expr = expr.operands
+    literal = _number_literal(rhs_expr)
+    if type(lhs_expr) is not Name or literal is None:
+        return general
+    # `name op number`, the usual condition: the entry is read inline; an int within the exact
+    # range compares with the same result as its double; anything else takes the general path.
+    name = lhs_expr.name  # type: ignore[attr-defined]
+    floats = _FLOAT_COMPARE[expr.ops[0]]
+
+    def name_vs_number(bb: Blackboard, enums: dict[str, int] | None) -> Any:
+        if not enums or name not in enums:
+            entry = bb.get_entry(name)
+            if entry is not None:
+                value = entry.value
+                kind = value.__class__
+                if kind is float or (kind is int and -_MAX_EXACT_INT <= value <= _MAX_EXACT_INT):
+                    return 1.0 if floats(value, literal) else 0.0
+        return general(bb, enums)
+
+    return name_vs_number
+
+
+def _comparison_general(expr: Comparison) -> Evaluator:
     left = compile_expr(expr.operands[0])
     right = compile_expr(expr.operands[1])
     op = expr.ops[0]
@@ -124,7 +160,33 @@ def _compound_assignment(expr: Assignment) -> Evaluator | None:
     rhs = compile_expr(expr.rhs)
     op = expr.op
     general = expr.evaluate
+    step = _number_literal(expr.rhs)
+    if step is not None and step.__class__ is int:
+        return _int_step(key, op, step, _compound(key, op, rhs, general))
+    return _compound(key, op, rhs, general)
 
+
+def _int_step(key: str, op: str, step: int, slow: Evaluator) -> Evaluator:
+    """``counter += 1`` on an int entry in integer arithmetic: while operands and result stay
+    within 2**53 - 1 the double arithmetic BT.CPP does is exact, so the result is the same."""
+    apply = operator.add if op == "+=" else operator.sub if op == "-=" else operator.mul
+
+    def int_step(bb: Blackboard, enums: dict[str, int] | None) -> Any:
+        entry = bb.get_entry(key)
+        if entry is not None:
+            dst = entry.value
+            if dst.__class__ is int and -_MAX_EXACT_INT <= dst <= _MAX_EXACT_INT:
+                new = apply(dst, step)
+                if -_MAX_EXACT_INT <= new <= _MAX_EXACT_INT:
+                    entry.value = new
+                    bb._written(key, entry)  # notify_written without the extra call
+                    return new
+        return slow(bb, enums)
+
+    return int_step
+
+
+def _compound(key: str, op: str, rhs: Evaluator, general: Evaluator) -> Evaluator:
     def compound(bb: Blackboard, enums: dict[str, int] | None) -> Any:
         entry = bb.get_entry(key)
         if entry is not None:
@@ -141,7 +203,7 @@ def _compound_assignment(expr: Assignment) -> Evaluator | None:
                 else:
                     return general(bb, enums)  # raises BT.CPP's conversion error
                 entry.value = new
-                bb.notify_written(key, entry)
+                bb._written(key, entry)  # notify_written without the extra call
                 return new
         return general(bb, enums)
 
