@@ -48,9 +48,13 @@ def stuck_code(thread_id: int | None, fallback: str) -> StuckCode:
     while frame is not None:
         owner = frame.f_locals.get("self")
         if isinstance(owner, TreeNode):
+            try:
+                path = str(owner.full_path)
+            except AttributeError:  # a node still being built has no config (path) yet
+                path = ""
             return StuckCode(
                 str(getattr(owner, "registration_id", type(owner).__name__)),
-                str(owner.full_path),
+                path,
                 _method_name(frame.f_code.co_name, fallback),
             )
         frame = frame.f_back
