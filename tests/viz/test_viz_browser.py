@@ -66,10 +66,12 @@ def _changed(a: bytes, b: bytes) -> np.ndarray:
     return np.abs(_pixels(a) - _pixels(b)).max(axis=2) > PIXEL_DELTA
 
 
-def _trajectory(goal: np.ndarray, duration: float, points: int = 31) -> dict[str, Any]:
+def _trajectory(goal: np.ndarray, duration: float, points: int = 31, legs: int = 1) -> dict[str, Any]:
+    """HOME to ``goal`` in ``duration`` s (minimum jerk); with ``legs`` > 1, back and forth that often."""
     rows = []
-    for t in np.linspace(0.0, duration, points):
-        s = t / duration
+    for t in np.linspace(0.0, duration * legs, points * legs - (legs - 1)):
+        leg, within = divmod(t, duration) if t < duration * legs else (legs - 1, duration)
+        s = within / duration if int(leg) % 2 == 0 else 1.0 - within / duration
         shape = 10 * s**3 - 15 * s**4 + 6 * s**5
         nanoseconds = round(t * 1e9)
         rows.append(
@@ -193,7 +195,10 @@ def test_the_arm_moves_while_a_trajectory_executes(
             names.FOLLOW_JOINT_TRAJECTORY_TYPE, names.FOLLOW_JOINT_TRAJECTORY_ACTION
         )
         goal = HOME + np.array([0.0, 1.4, 0.5, -0.6, 0.0, 0.0, 0.0])
-        handle = client.send_goal(_trajectory(goal, 8.0), timeout=10.0)
+        # Back and forth for 32 s, so that two screenshots fit inside it on a busy machine (each can
+        # take seconds) while the arm keeps moving; cancelled once they are taken.
+        moving = _trajectory(goal, 8.0, legs=4)
+        handle = client.send_goal(moving, timeout=10.0)
         assert handle.accepted
         time.sleep(1.5)
         first = page.screenshot()
@@ -263,8 +268,8 @@ def test_a_visualize_pose_triad_appears_and_expires_after_its_lifetime(
             publisher.publish(message)
             time.sleep(0.3)
         assert page.evaluate(shown), "the triad did not appear in the page"
+        appeared = time.monotonic()  # before the screenshot, which takes seconds on a busy machine
         _keep("marker", _settled_screenshot(page))
-        appeared = time.monotonic()
         page.wait_for(gone, timeout=10)
         assert time.monotonic() - appeared > 1.5, "the triad went away long before its 3 s lifetime"
     finally:
