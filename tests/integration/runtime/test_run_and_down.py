@@ -14,6 +14,7 @@ from pathlib import Path
 
 import pytest
 
+from failure_report import describe_process, log_tail
 from kinema.runtime.instance import pid_alive
 from kinema.sdk import ObjectiveClient, ObjectiveStatus
 
@@ -120,18 +121,9 @@ sys.exit(Launcher(options).run())
 
 
 def _describe(pids: list[int], state_home: Path) -> str:
-    """What a failing orphan test saw: each child's state and command line, and the end of every log."""
-    lines = []
-    for pid in pids:
-        try:
-            status = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
-            cmdline = Path(f"/proc/{pid}/cmdline").read_bytes().replace(b"\0", b" ").decode()
-            lines.append(f"pid {pid} state {status}: {cmdline}")
-        except OSError:
-            lines.append(f"pid {pid}: gone")
-    for log_file in sorted(state_home.rglob("*.log")):
-        tail = log_file.read_text(errors="replace").splitlines()[-6:]
-        lines.append(f"--- {log_file.name}:\n" + "\n".join(tail))
+    """What a failing orphan test saw: each child still there, and the end of every log."""
+    lines = [describe_process(pid) or f"{pid:>7} gone" for pid in pids]
+    lines += [f"--- {log.name}:\n{log_tail(log, 6)}" for log in sorted(state_home.rglob("*.log"))]
     return "\n".join(lines)
 
 
