@@ -165,7 +165,9 @@ def test_the_app_runs_an_objective_on_a_real_runtime_and_follows_a_restart(agent
 
             # The runtime goes away: shown as disconnected; it comes back: reconnected by itself.
             agent.stop()
-            await wait_for(pilot, lambda: app.status.state is ConnectionState.DISCONNECTED, "the disconnect")
+            await wait_for(
+                pilot, lambda: app.status.state is ConnectionState.DISCONNECTED, "the disconnect", 60
+            )
             agent.start()
             await wait_for(pilot, lambda: app.status.state is ConnectionState.CONNECTED, "the reconnect", 30)
             await pilot.press("r")
