@@ -302,15 +302,43 @@ def test_the_next_plan_avoids_an_added_box_and_validation_names_it(
     assert valid.status == NodeStatus.SUCCESS, valid.toasts
 
 
+def test_validation_ignores_a_finger_a_hair_past_its_stop_and_names_an_arm_joint_past_its_limit(
+    behavior: Any, context: BehaviorContext, lab_sim_model: Any
+) -> None:
+    """The simulated gripper can rest micro-units past its limit; only the trajectory's joints are judged."""
+    finger = lab_sim_model.lower[lab_sim_model.joint_names.index(GRIPPER)] - 5e-6
+    state = {"name": [*ARM, GRIPPER], "position": [*HOME, finger]}
+    with publish_repeatedly(context.node, "sensor_msgs/msg/JointState", "/joint_states", state):
+        turn = [*HOME[:6], 0.5]
+        valid = tick_behavior(
+            behavior("ValidateTrajectory"),
+            {"joint_trajectory_msg": _trajectory_through(HOME, turn)},
+            context=context,
+            timeout=30.0,
+        )
+        assert valid.status == NodeStatus.SUCCESS, valid.toasts
+        elbow = lab_sim_model.upper[lab_sim_model.joint_names.index("elbow_joint")] + 0.01
+        outside = _trajectory_through([*HOME[:3], elbow, *HOME[4:]], HOME)
+        check = tick_behavior(
+            behavior("ValidateTrajectory"), {"joint_trajectory_msg": outside}, context=context, timeout=30.0
+        )
+    assert check.status == NodeStatus.FAILURE, check.toasts
+    assert "elbow_joint=" in check.toasts[-1] and "outside the joint limits" in check.toasts[-1], check.toasts
+
+
 # -- trajectories ----------------------------------------------------------------------------------
 
 
-def _trajectory() -> Any:
+def _trajectory_through(start: list[float], end: list[float]) -> Any:
     points = [
-        {"positions": HOME, "time_from_start": {"sec": 0, "nanosec": 0}},
-        {"positions": MID, "time_from_start": {"sec": 2, "nanosec": 0}},
+        {"positions": start, "time_from_start": {"sec": 0, "nanosec": 0}},
+        {"positions": end, "time_from_start": {"sec": 2, "nanosec": 0}},
     ]
     return from_dict("trajectory_msgs/msg/JointTrajectory", {"joint_names": ARM, "points": points})
+
+
+def _trajectory() -> Any:
+    return _trajectory_through(HOME, MID)
 
 
 @pytest.mark.parametrize(
