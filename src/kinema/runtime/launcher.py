@@ -123,6 +123,7 @@ class Launcher:
         self._stop = threading.Event()
         self._stop_reason = ""
         self._echo_stop = threading.Event()
+        self._config: Any = None
 
     # -- start --------------------------------------------------------------------------------------
 
@@ -136,6 +137,8 @@ class Launcher:
         from kinema.runtime.log_files import configure_process_logging
 
         options = self.options
+        # A config that does not resolve is refused before anything exists: no run folder, no router.
+        self._resolved()
         self.run_folder = RunFolder.create(options.config)
         supervisor_log = self.run_folder.log_file("supervisor")
         configure_process_logging(supervisor_log, verbose=options.verbose, echo=options.verbose)
@@ -168,10 +171,13 @@ class Launcher:
             raise
 
     def _resolved(self) -> Any:
-        from kinema.config import Workspace, resolve_config
+        """The resolved config package (resolved once per launcher)."""
+        if self._config is None:
+            from kinema.config import Workspace, resolve_config
 
-        workspace = Workspace.discover(self.options.workspace) if self.options.workspace else None
-        return resolve_config(self.options.config, workspace)
+            workspace = Workspace.discover(self.options.workspace) if self.options.workspace else None
+            self._config = resolve_config(self.options.config, workspace)
+        return self._config
 
     def _start_drivers(self) -> list[tuple[Child, Any]]:
         """Spawn the drivers the config wants; returns each with the read end of its ready pipe."""

@@ -221,3 +221,13 @@ def test_init_where_no_folder_can_be_made_is_one_line_not_a_traceback(
     assert main(["init", str(blocker / "ws")]) == 1
     err = capsys.readouterr().err
     assert "cannot create the workspace" in err and "Traceback" not in err
+
+
+def test_run_with_an_unknown_config_is_refused_before_a_run_folder_or_router_exists(capsys):
+    from kinema.runtime.run_folder import runs_dir
+
+    before = sorted(runs_dir().iterdir())
+    code, _, err = run(capsys, "run", "-c", "nope", "--headless")
+    assert code == 1 and err.startswith("error: ") and "no config package named 'nope'" in err, err
+    after = sorted(runs_dir().iterdir())
+    assert after == before, f"new run folders: {set(after) - set(before)}"
