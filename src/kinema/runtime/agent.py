@@ -159,25 +159,27 @@ class _Streams:
     def publish_heartbeat(self) -> None:
         from kinema.transport.messages import msg
 
-        status, name = self._status
-        now = time.time()
-        clock_now = self._clock.now() if self._clock is not None and not _is_wall(self._clock) else now
-        message = msg(
-            names.HEARTBEAT_TYPE,
-            process_timestamp=_stamp(now),
-            ros_timestamp=_stamp(clock_now),
-            objective_name=name,
-            objective_status=str(status),
-        )
         health = self._server.health()
-        report = msg(
-            names.HEALTH_TYPE,
-            stamp=_stamp(now),
-            tick_thread_alive=health.tick_thread_alive,
-            tick_thread_replacements=health.replacements,
-            warnings=list(health.warnings),
-        )
         with self._lock:
+            # The status is read where it is published, under the lock on_status takes to change it:
+            # a beat read before a run ended and sent after it would tell subscribers the run restarted.
+            status, name = self._status
+            now = time.time()
+            clock_now = self._clock.now() if self._clock is not None and not _is_wall(self._clock) else now
+            message = msg(
+                names.HEARTBEAT_TYPE,
+                process_timestamp=_stamp(now),
+                ros_timestamp=_stamp(clock_now),
+                objective_name=name,
+                objective_status=str(status),
+            )
+            report = msg(
+                names.HEALTH_TYPE,
+                stamp=_stamp(now),
+                tick_thread_alive=health.tick_thread_alive,
+                tick_thread_replacements=health.replacements,
+                warnings=list(health.warnings),
+            )
             self._heartbeat.publish(message)
             self._health.publish(report)
             seen = {_topic(old) for old in self._last_warnings}
@@ -197,7 +199,8 @@ class _Streams:
 
     # ServerListener
     def on_status(self, status: ObjectiveStatus, objective_name: str) -> None:
-        self._status = (status, objective_name)
+        with self._lock:
+            self._status = (status, objective_name)
         log.info("objective %r: %s", objective_name, status)
         self.publish_heartbeat()
 

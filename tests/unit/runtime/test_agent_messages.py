@@ -66,3 +66,47 @@ def test_long_values_are_cut() -> None:
 def test_results_become_moveit_error_codes() -> None:
     message = result_message(ObjectiveResult.failure("node 'x' returned FAILURE", "Pick"))
     assert message == {"val": 99999, "message": "node 'x' returned FAILURE", "source": "objective_server"}
+
+
+def test_a_heartbeat_never_reports_a_status_older_than_the_one_published_before_it() -> None:
+    """A beat prepared while a run was active and sent after it ended made the TUI see a new run start
+    (and wipe the failed node it had just marked). The last beat sent must show how the run ended."""
+    import threading
+
+    from kinema.runtime.agent import _Streams
+    from kinema.runtime.objective_status import ObjectiveStatus
+
+    beats: list[str] = []
+
+    class Publisher:
+        def __init__(self, topic: str) -> None:
+            self.topic = topic
+
+        def publish(self, message: Any) -> None:
+            if "heartbeat" in self.topic:
+                beats.append(str(message.objective_status))
+
+    node = SimpleNamespace(create_publisher=lambda _type, topic, **_: Publisher(topic))
+    in_health, release = threading.Event(), threading.Event()
+
+    class Server:
+        stall = False
+
+        def health(self) -> Any:
+            if Server.stall:  # the periodic beat stalls here once (preempted, under load)
+                Server.stall = False
+                in_health.set()
+                release.wait(10)
+            return SimpleNamespace(tick_thread_alive=True, replacements=0, warnings=())
+
+    streams = _Streams(node, None, Server())  # type: ignore[arg-type]
+    streams.on_status(ObjectiveStatus.RUNNING, "Add Numbers")
+    Server.stall = True
+    beats.clear()
+    periodic = threading.Thread(target=streams.publish_heartbeat)
+    periodic.start()
+    assert in_health.wait(10)
+    streams.on_status(ObjectiveStatus.FAILURE, "Add Numbers")  # the run ends meanwhile
+    release.set()
+    periodic.join(10)
+    assert beats and beats[-1] == str(ObjectiveStatus.FAILURE), beats
