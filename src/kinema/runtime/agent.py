@@ -53,6 +53,10 @@ LOG_ERROR, LOG_WARN, LOG_INFO = 1, 2, 3
 DO_OBJECTIVE_RESULT_KEEP_S = 60.0
 
 
+# Most node status changes in one ``/objective_server/node_status`` message (about 100 kB).
+NODE_STATUS_CHUNK = 1000
+
+
 def _stamp(seconds: float) -> dict[str, int]:
     sec = int(seconds)
     return {"sec": sec, "nanosec": int((seconds - sec) * 1e9)}
@@ -220,7 +224,13 @@ class _Streams:
             }
             for change in changes
         ]
-        self._node_status.publish(msg(names.NODE_STATUS_TYPE, changes=items))
+        # In messages of at most NODE_STATUS_CHUNK changes: the stream is best effort (rmw_zenoh's
+        # KEEP_LAST: dropped when the link is congested), and a 60,000-node tick sent as one 10 MB message
+        # was lost whole on a loaded machine; in chunks, what gets through is applied.
+        for start in range(0, len(items), NODE_STATUS_CHUNK):
+            self._node_status.publish(
+                msg(names.NODE_STATUS_TYPE, changes=items[start : start + NODE_STATUS_CHUNK])
+            )
 
     def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
         from kinema.transport.messages import msg

@@ -83,10 +83,18 @@ def test_trees_past_65535_nodes_are_refused_at_load_and_trees_at_the_limit_run(
 
     refused = client.do_xml(sequence(65_535), timeout=300)
     assert refused.failed and "more than 65,535 nodes" in refused.error_message, refused
-    # Building and running 65,534 nodes takes tens of seconds on a busy machine: the stream waits.
+    # 65,535 nodes: an outer Sequence, an inner one with 65,532 leaves, and a Sleep with the last uid.
+    # The stream is best effort: the first tick's 130,000 changes may be dropped on a loaded machine,
+    # but the Sleep's end comes later, in a message of a few changes, and must carry uid 65,535.
+    leaves = "<AlwaysSuccess/>" * 65_532
+    at_limit = (
+        f'<root BTCPP_format="4"><BehaviorTree ID="Big"><Sequence><Sequence>{leaves}</Sequence>'
+        '<Sleep msec="1500"/></Sequence></BehaviorTree></root>'
+    )
+    # Building and running 65,535 nodes takes tens of seconds on a busy machine: the stream waits.
     stream = client.node_statuses(timeout=60)
     time.sleep(0.5)  # let the subscription reach the agent
-    assert client.do_xml(sequence(65_534), timeout=300).succeeded  # minutes when overloaded
+    assert client.do_xml(at_limit, timeout=300).succeeded  # minutes when overloaded
     uids = set()
     for message in stream:
         uids.update(change.uid for change in message.changes)

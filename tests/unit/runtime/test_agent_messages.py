@@ -110,3 +110,35 @@ def test_a_heartbeat_never_reports_a_status_older_than_the_one_published_before_
     release.set()
     periodic.join(10)
     assert beats and beats[-1] == str(ObjectiveStatus.FAILURE), beats
+
+
+def test_a_large_tick_is_published_as_several_node_status_messages_in_order() -> None:
+    from kinema.runtime.agent import NODE_STATUS_CHUNK, _Streams
+
+    sent: list[list[int]] = []
+
+    class Publisher:
+        def __init__(self, topic: str) -> None:
+            self.topic = topic
+
+        def publish(self, message: Any) -> None:
+            if self.topic.endswith("node_status"):
+                sent.append([change.uid for change in message.changes])
+
+    node = SimpleNamespace(create_publisher=lambda _type, topic, **_: Publisher(topic))
+    streams = _Streams(node, None, SimpleNamespace())  # type: ignore[arg-type]
+    changes = [
+        SimpleNamespace(
+            timestamp=1.0,
+            uid=uid,
+            node_path=f"Big/n{uid}",
+            node_id="AlwaysSuccess",
+            node_name="",
+            previous=0,
+            status=2,
+        )
+        for uid in range(1, 2 * NODE_STATUS_CHUNK + 501)
+    ]
+    streams.on_node_status("Big", changes)  # type: ignore[arg-type]
+    assert [len(batch) for batch in sent] == [NODE_STATUS_CHUNK, NODE_STATUS_CHUNK, 500]
+    assert [uid for batch in sent for uid in batch] == list(range(1, 2 * NODE_STATUS_CHUNK + 501))
