@@ -11,6 +11,10 @@ The solution is a list of sub-trajectories, one per moving stage, each timed wit
 ends, within the stage's scaled limits), each starting exactly where the one before ended. Planning fails
 with a :class:`TaskPlanningError` naming the stage and why.
 
+While it plans, each stage is ``waiting``, ``planning``, ``solved`` or ``failed`` (:data:`STAGE_STATES`);
+``plan_task(..., progress=...)`` is told every change, with the seconds each stage has taken so far, so a
+UI can show the task as it is planned.
+
 Example::
 
     task = Task("pick", [CurrentState(q), Connect(), MoveAlongFrameAxis((0, 0, 1), "grasp_link",
@@ -64,15 +68,31 @@ class Task:
         self.stages.append(stage)
 
 
+STAGE_STATES = ("waiting", "planning", "solved", "failed")
+
+
 @dataclass(frozen=True)
 class StageReport:
-    """How a stage fared: ``status`` is ``planned``, ``failed`` or ``not planned``; ``comment`` says why."""
+    """How a stage fares.
+
+    Attributes:
+        index: its place in the task (0-based).
+        name: its name (``connect``, ``approach``).
+        kind: ``generator``, ``propagator`` or ``connector``.
+        status: one of :data:`STAGE_STATES`.
+        comment: why it failed (``no IK solution for any of the 8 target poses: pose 3 of 8: ...``), or how
+            a candidate fared; "" when there is nothing to say.
+        seconds: time spent planning (and timing) it so far.
+        stage_type: the stage's class (``MoveAlongFrameAxis``), MTC's stage type.
+    """
 
     index: int
     name: str
     kind: str
     status: str
     comment: str = ""
+    seconds: float = 0.0
+    stage_type: str = ""
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,7 +113,7 @@ class TaskSolution:
         start: the full configuration the solution starts from.
         end: the full configuration it ends at.
         sub_trajectories: the stages' motions in order; each starts where the previous ended.
-        reports: one per stage, all ``planned``.
+        reports: one per stage, all ``solved``, with the seconds each took.
         planning_seconds: how long planning took.
     """
 
@@ -212,15 +232,68 @@ class _Planner:
         checker: CollisionChecker,
         frames: Mapping[str, np.ndarray],
         stop: Callable[[], bool],
+        progress: Callable[[tuple[StageReport, ...]], None] | None = None,
     ) -> None:
         self.task = task
         self.checker = checker
         self.model: RobotModel = checker.model
         self.frames = frames
         self.stop = stop
+        self.progress = progress
         self.default_padding = checker.padding
         self._free_checker: CollisionChecker | None = None
         self.status: dict[int, tuple[str, str]] = {}
+        self.seconds: dict[int, float] = {}
+        self.since: dict[int, float] = {}  # stage -> when its current planning began
+
+    # ------------------------------------------------------------------------------ progress
+    def reports(self) -> tuple[StageReport, ...]:
+        now = time.monotonic()
+        out = []
+        for i, stage in enumerate(self.task.stages):
+            status, comment = self.status.get(i, ("waiting", ""))
+            seconds = self.seconds.get(i, 0.0) + (now - self.since[i] if i in self.since else 0.0)
+            out.append(
+                StageReport(i, stage.name, stage_kind(stage), status, comment, seconds, type(stage).__name__)
+            )
+        return tuple(out)
+
+    def _tell(self) -> None:
+        if self.progress is not None:
+            self.progress(self.reports())
+
+    def _stop_clock(self, index: int) -> None:
+        began = self.since.pop(index, None)
+        if began is not None:
+            self.seconds[index] = self.seconds.get(index, 0.0) + time.monotonic() - began
+
+    def begin(self, index: int) -> None:
+        """Stage ``index`` starts planning (again, for another candidate)."""
+        self.since[index] = time.monotonic()
+        self.status[index] = ("planning", self.status.get(index, ("", ""))[1])
+        self._tell()
+
+    def solved(self, index: int, comment: str = "") -> None:
+        self._stop_clock(index)
+        self.status[index] = ("solved", comment)
+        self._tell()
+
+    def gave_up(self, index: int, comment: str) -> None:
+        """Stage ``index`` failed for one candidate; another may follow (it stays ``planning``)."""
+        self._stop_clock(index)
+        self.status[index] = ("planning", comment)
+        self._tell()
+
+    def failed(self, index: int, reason: str) -> None:
+        for running in list(self.since):
+            self._stop_clock(running)
+            if running != index:
+                self.status[running] = ("waiting", self.status[running][1])
+        self.status[index] = ("failed", reason)
+        self._tell()
+
+    def add_seconds(self, index: int, seconds: float) -> None:
+        self.seconds[index] = self.seconds.get(index, 0.0) + seconds
 
     # ----------------------------------------------------------------------------------- helpers
     def label(self, index: int) -> str:
@@ -261,6 +334,7 @@ class _Planner:
     ) -> list[tuple[np.ndarray, np.ndarray, list[_Piece]]]:
         """Candidates of a generator: (start state, end state, its own pieces)."""
         stage = self.task.stages[index]
+        self.begin(index)
         if isinstance(stage, CurrentState):
             q = np.asarray(stage.state, dtype=float)
             if q.shape != (len(self.model.joint_names),):
@@ -319,6 +393,7 @@ class _Planner:
     def forward(self, index: int, q_from: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Plan a propagator from ``q_from``: (rows, end state)."""
         stage = self.task.stages[index]
+        self.begin(index)
         try:
             if isinstance(stage, MoveAlongFrameAxis):
                 return self.along_axis(index, stage, q_from, backwards=False)
@@ -347,6 +422,7 @@ class _Planner:
     def backward(self, index: int, q_to: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Plan a propagator that must end at ``q_to``: (rows, start state)."""
         stage = self.task.stages[index]
+        self.begin(index)
         if not isinstance(stage, MoveAlongFrameAxis):
             raise _StageFailure(
                 index,
@@ -433,20 +509,29 @@ class _Planner:
         g = generators[0]
         failures: list[_StageFailure] = []
         candidates = self.generate(g, before)
-        for start, end, own in candidates:
+        self.solved(g, f"{len(candidates)} solutions" if len(candidates) > 1 else "")
+        for k, (start, end, own) in enumerate(candidates, start=1):
             try:
                 pieces: list[_Piece] = []
                 q = start
                 for i in reversed([m for m in members if m < g]):
                     rows, q = self.backward(i, q)
                     pieces.insert(0, _Piece(i, rows, self.task.stages[i].motion))
-                    self.status[i] = ("planned", "")
+                    self.solved(i)
                 first = q
                 _, last, after = self.propagate([m for m in members if m > g], [], end)
-                self.status[g] = ("planned", f"{len(candidates)} candidate(s)" if len(candidates) > 1 else "")
+                if len(candidates) > 1:
+                    self.status[g] = ("solved", f"solution {k} of {len(candidates)} used")
+                    self._tell()
                 return first, last, pieces + own + after
             except _StageFailure as failure:
                 failures.append(failure)
+                if len(candidates) > 1:
+                    self.gave_up(
+                        failure.index,
+                        f"with solution {k} of {len(candidates)} of {self.task.stages[g].name!r}: "
+                        f"{failure.reason}",
+                    )
                 if self.stop():
                     break
         if len(failures) == 1:
@@ -465,12 +550,13 @@ class _Planner:
         for i in members:
             rows, q = self.forward(i, q)
             pieces.append(_Piece(i, rows, self.task.stages[i].motion))
-            self.status[i] = ("planned", "")
+            self.solved(i)
         return start, q, pieces
 
     def connect(self, index: int, q_from: np.ndarray, q_to: np.ndarray) -> _Piece:
         stage = self.task.stages[index]
         assert isinstance(stage, Connect)
+        self.begin(index)
         g = self.group(index, stage.motion.group)
         others = [i for i in range(len(q_from)) if i not in set(g.indices)]
         differ = [self.model.joint_names[i] for i in others if abs(q_from[i] - q_to[i]) > JOIN_TOLERANCE]
@@ -484,7 +570,7 @@ class _Planner:
             rows, _ = self.joint_motion(index, stage.motion, q_from, q_to)
         except MotionError as error:
             raise _StageFailure(index, str(error)) from error
-        self.status[index] = ("planned", "")
+        self.solved(index)
         return _Piece(index, rows, stage.motion)
 
     def run(self) -> tuple[np.ndarray, np.ndarray, list[_Piece]]:
@@ -520,6 +606,7 @@ def plan_task(
     *,
     frames: Mapping[str, np.ndarray] | None = None,
     stop: Callable[[], bool] | None = None,
+    progress: Callable[[tuple[StageReport, ...]], None] | None = None,
 ) -> TaskSolution:
     """Plan ``task`` into a solution against ``checker``'s planning scene.
 
@@ -530,6 +617,8 @@ def plan_task(
         frames: named fixed frames (objects, cameras) target poses may be given in, besides the robot's
             links and ``world``.
         stop: called between steps; planning stops with an error when it returns True.
+        progress: called (on the planning thread) whenever a stage's state changes, with every stage's
+            report; it must not block.
 
     Raises:
         TaskPlanningError: naming the stage that failed and why; ``reports`` holds every stage's status.
@@ -537,7 +626,7 @@ def plan_task(
     from kinema.motion.timing import time_parameterize
 
     began = time.monotonic()
-    planner = _Planner(task, checker, frames or {}, stop or (lambda: False))
+    planner = _Planner(task, checker, frames or {}, stop or (lambda: False), progress)
     padding = checker.padding
     try:
         start, end, pieces = planner.run()
@@ -549,6 +638,7 @@ def plan_task(
                 continue
             g = planner.model.group(piece.motion.group)
             path = JointPath(g.joint_names, piece.rows[:, list(g.indices)])
+            timing_began = time.monotonic()
             try:
                 trajectory = time_parameterize(
                     path,
@@ -559,10 +649,11 @@ def plan_task(
                 )
             except MotionError as error:
                 raise _StageFailure(piece.index, f"timing failed: {error}") from error
+            planner.add_seconds(piece.index, time.monotonic() - timing_began)
             subs.append(SubTrajectory(stage.name, trajectory))
     except _StageFailure as failure:
-        planner.status[failure.index] = ("failed", failure.reason)
-        reports = _reports(task, planner.status)
+        planner.failed(failure.index, failure.reason)
+        reports = planner.reports()
         raise TaskPlanningError(
             f"task {task.task_id!r}: {planner.label(failure.index)} failed: {failure.reason}", reports
         ) from None
@@ -574,15 +665,8 @@ def plan_task(
         start,
         end,
         tuple(subs),
-        _reports(task, planner.status),
+        planner.reports(),
         time.monotonic() - began,
     )
     solution.joined()  # proves the sub-trajectories meet
     return solution
-
-
-def _reports(task: Task, status: Mapping[int, tuple[str, str]]) -> tuple[StageReport, ...]:
-    return tuple(
-        StageReport(i, stage.name, stage_kind(stage), *status.get(i, ("not planned", "")))
-        for i, stage in enumerate(task.stages)
-    )

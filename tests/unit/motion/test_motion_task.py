@@ -74,7 +74,7 @@ def test_a_pick_task_approaches_the_grasp_in_a_straight_line_and_ends_there(
 ) -> None:
     solution = plan_task(pick_task(start, [grasp]), checker)
     assert [s.stage for s in solution.sub_trajectories] == ["connect", "approach"]
-    assert [r.status for r in solution.reports] == ["planned"] * 4, solution.reports
+    assert [r.status for r in solution.reports] == ["solved"] * 4, solution.reports
     end = fk(model, solution.end, "grasp_link")
     assert np.linalg.norm(end[:3, 3] - CUBE) < 1e-3, end[:3, 3]
     # The approach: 10 cm along the grasp's z axis, on a straight line.
@@ -129,7 +129,45 @@ def test_batch_pose_ik_takes_the_reachable_pose_closest_to_the_state_before(
     assert (
         "stage 4 of 4 ('grasp pose IK')" in message and "pose 1 of 2" in message and "pose 2 of 2" in message
     )
-    assert [r.status for r in failure.value.reports] == ["planned", "not planned", "not planned", "failed"]
+    assert [r.status for r in failure.value.reports] == ["solved", "waiting", "waiting", "failed"]
+
+
+def test_progress_reports_each_stage_waiting_planning_then_solved_or_failed(
+    checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray
+) -> None:
+    seen: list[tuple[tuple[str, str, float, str], ...]] = []
+
+    def keep(reports: tuple) -> None:  # type: ignore[type-arg]
+        seen.append(tuple((r.name, r.status, r.seconds, r.comment) for r in reports))
+
+    solution = plan_task(pick_task(start, [grasp]), checker, progress=keep)
+    names = ["current state", "connect", "approach", "grasp pose IK"]
+    assert [s[0] for s in seen[0]] == names
+    assert seen[0][-1][1] == "waiting", seen[0]  # the IK stage waits while the start is read
+    for i, name in enumerate(names):
+        states = [snapshot[i][1] for snapshot in seen]
+        # Each stage is waiting until it is planned, then planning, then solved for good.
+        first_planning = states.index("planning")
+        assert set(states[:first_planning]) <= {"waiting"}, (name, states)
+        assert states[-1] == "solved" and "failed" not in states, (name, states)
+    assert [r.stage_type for r in solution.reports] == [
+        "CurrentState",
+        "Connect",
+        "MoveAlongFrameAxis",
+        "BatchPoseIK",
+    ]
+    connect = solution.reports[1]
+    assert connect.seconds > 0 and sum(r.seconds for r in solution.reports) <= solution.planning_seconds
+
+    unreachable = grasp.copy()
+    unreachable[:3, 3] = [4.0, 3.0, 0.8]
+    seen.clear()
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(pick_task(start, [unreachable, unreachable]), checker, progress=keep)
+    last = {name: (status, comment) for name, status, _, comment in seen[-1]}
+    assert last["grasp pose IK"][0] == "failed" and "pose 2 of 2" in last["grasp pose IK"][1], last
+    assert last["connect"][0] == "waiting" and last["approach"][0] == "waiting", last
+    assert [r.status for r in failure.value.reports] == [s[1] for s in seen[-1]]
 
 
 def test_moving_along_a_frame_axis_fails_below_min_distance_with_the_share_reached(

@@ -20,7 +20,7 @@ DEFAULT_PADDING = 0.01
 
 
 def _stage_summary(reports: Any) -> str:
-    marks = {"planned": "ok", "failed": "FAILED", "not planned": "-"}
+    marks = {"solved": "ok", "failed": "FAILED", "waiting": "-", "planning": "…"}
     return "; ".join(f"{r.index + 1}. {r.name}: {marks.get(r.status, r.status)}" for r in reports)
 
 
