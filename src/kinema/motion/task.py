@@ -279,9 +279,9 @@ class _Planner:
         self._tell()
 
     def gave_up(self, index: int, comment: str) -> None:
-        """Stage ``index`` failed for one candidate; another may follow (it stays ``planning``)."""
+        """Stage ``index`` failed for one candidate; it waits for the next (the comment says why)."""
         self._stop_clock(index)
-        self.status[index] = ("planning", comment)
+        self.status[index] = ("waiting", comment)
         self._tell()
 
     def failed(self, index: int, reason: str) -> None:
