@@ -272,12 +272,20 @@ class KinemaApp(App[None]):
                 view.show_status(self.status)
 
     def ask_approval(self, request: ApprovalRequested) -> None:
-        """Show a behavior's question (approve a motion, resume a breakpoint); the answer goes back to it."""
+        """Show a behavior's question (approve a motion, resume a breakpoint); the answer goes back to it.
+
+        A question about a planned motion lists its steps (stage, duration, joints, gripper changes).
+        """
 
         def answered(approved: bool | None) -> None:
             request.answer(bool(approved), "" if approved else "declined in the TUI")
 
         question = f"{request.prompt}\n({request.behavior} at {request.node_path})"
+        if request.steps:
+            from kinema.tui.dialogs.approval import ApprovalDialog
+
+            self.push_screen(ApprovalDialog(question, request.steps, request.duration), answered)
+            return
         self.push_screen(ConfirmDialog(question, confirm_label="Approve"), answered)
 
     def add_log(self, entry: LogEntry, *, toast: bool = False) -> None:
