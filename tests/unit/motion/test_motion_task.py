@@ -38,12 +38,18 @@ def grasp(model: RobotModel, waypoint_q: Callable[[str], np.ndarray]) -> np.ndar
     return pose
 
 
-def pick_task(start: np.ndarray, poses: list[np.ndarray], velocity_scale: float = 1.0) -> Task:
+def pick_task(
+    start: np.ndarray, poses: list[np.ndarray], velocity_scale: float = 1.0, acceleration_scale: float = 1.0
+) -> Task:
     return Task(
         "pick",
         [
             CurrentState(start),
-            Connect(MotionSettings(link_padding=0.0, velocity_scale=velocity_scale)),
+            Connect(
+                MotionSettings(
+                    link_padding=0.0, velocity_scale=velocity_scale, acceleration_scale=acceleration_scale
+                )
+            ),
             MoveAlongFrameAxis(
                 (0, 0, 1),
                 "grasp_link",
@@ -96,7 +102,7 @@ def test_a_pick_task_approaches_the_grasp_in_a_straight_line_and_ends_there(
     assert checker.first_invalid(full, 0.01) is None
 
 
-def test_velocity_scaling_slows_the_stage_it_is_set_on(
+def test_velocity_and_acceleration_scaling_slow_the_stage_they_are_set_on(
     checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray
 ) -> None:
     fast = plan_task(pick_task(start, [grasp]), checker)
@@ -105,6 +111,10 @@ def test_velocity_scaling_slows_the_stage_it_is_set_on(
     assert slow.sub_trajectories[1].trajectory.duration == pytest.approx(
         fast.sub_trajectories[1].trajectory.duration, rel=0.05
     )
+    gentle = plan_task(pick_task(start, [grasp], acceleration_scale=0.05), checker)
+    fast_connect, gentle_connect = fast.sub_trajectories[0].trajectory, gentle.sub_trajectories[0].trajectory
+    assert gentle_connect.duration > 1.5 * fast_connect.duration
+    assert np.abs(gentle_connect.accelerations).max() < 0.5 * np.abs(fast_connect.accelerations).max()
 
 
 def test_batch_pose_ik_takes_the_reachable_pose_closest_to_the_state_before(
@@ -240,6 +250,35 @@ def test_plan_to_pose_and_to_joint_state_go_forwards_and_a_pose_inside_an_obstac
             checker,
         )
     assert "stage 2 of 2 ('plan to pose')" in str(failure.value) and "no IK solution" in str(failure.value)
+
+
+def test_a_connect_with_no_way_through_fails_naming_it_after_its_planning_time(
+    model: RobotModel, checker: CollisionChecker, waypoint_q: Callable[[str], np.ndarray]
+) -> None:
+    """A wall across the rail (above its pedestal, everywhere else) parts two states of the carriage."""
+    home = waypoint_q("Home")
+    rail = model.index("linear_rail_joint")
+    here, there = home.copy(), home.copy()
+    here[rail], there[rail] = model.lower[rail] + 0.1, model.upper[rail] - 0.1
+    a, b = fk(model, here, "base_link")[:3, 3], fk(model, there, "base_link")[:3, 3]
+    along = (b - a) / np.linalg.norm(b - a)  # the rail's direction in the world, whichever it is
+    pedestal_top = fk(model, here, "linear_rail_carriage_link")[2, 3]
+    wall = np.eye(4)
+    wall[:3, :3] = np.column_stack([along, np.cross([0.0, 0.0, 1.0], along), [0.0, 0.0, 1.0]])
+    wall[:3, 3] = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, pedestal_top + 0.02 + 2.0]
+    checker.scene.add(CollisionObject("wall", "box", (0.01, 4.0, 2.0), wall))
+    assert checker.is_valid(here) and checker.is_valid(there), checker.describe(here) + checker.describe(
+        there
+    )
+    task = Task(
+        "cross",
+        [CurrentState(here), Connect(MotionSettings(planning_time=0.2)), CurrentState(there, name="there")],
+    )
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(task, checker)
+    message = str(failure.value)
+    assert "stage 2 of 3 ('connect')" in message and "no collision-free path found within 0.20 s" in message
+    assert [r.status for r in failure.value.reports] == ["solved", "failed", "solved"], failure.value.reports
 
 
 def _at(x: float, y: float, z: float, like: np.ndarray | None = None) -> np.ndarray:
