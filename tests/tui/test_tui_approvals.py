@@ -85,6 +85,7 @@ def test_an_attached_tui_is_the_user_the_approval_behaviors_ask(monkeypatch: Any
 
 PICK_STEPS = (
     SolutionStep("connect", 2.41, ("linear_rail_joint", "shoulder_pan_joint", "shoulder_lift_joint")),
+    SolutionStep("touch the cube", 0.0, (), "", "collisions allowed: gripper - cube"),
     SolutionStep(
         "close gripper",
         0.62,
@@ -112,7 +113,15 @@ def test_a_motion_to_approve_is_listed_step_by_step(fake: FakeConnection) -> Non
         await settle(pilot)
         assert isinstance(app.screen, ApprovalDialog)
         text = " ".join(rendered_steps(app.screen).split())
-        for expected in ("connect", "2.41 s", "close gripper", "0.000 -> 0.793 (closes)", "lift", "3.88 s"):
+        for expected in (
+            "connect",
+            "2.41 s",
+            "collisions allowed: gripper - cube",
+            "close gripper",
+            "0.000 -> 0.793 (closes)",
+            "lift",
+            "3 motions, 3.88 s in all",
+        ):
             assert expected in text, text
         assert "the gripper moves in 1 of them" in text, text
         await pilot.press("y")
@@ -144,7 +153,13 @@ def test_approving_a_planned_task_shows_its_motions_and_draws_it_in_the_view(mon
     from kinema.bt import NodeStatus
     from kinema.motion import CollisionChecker, RobotDescription
     from kinema.motion.task import Task, plan_task
-    from kinema.motion.task_stages import CurrentState, MotionSettings, MoveAlongFrameAxis, PlanToJointState
+    from kinema.motion.task_stages import (
+        AllowCollisions,
+        CurrentState,
+        MotionSettings,
+        MoveAlongFrameAxis,
+        PlanToJointState,
+    )
     from kinema.plugins import BehaviorHost
     from kinema.resources import bundled_dir
     from kinema.testing import tick_behavior
@@ -164,6 +179,7 @@ def test_approving_a_planned_task_shows_its_motions_and_draws_it_in_the_view(mon
             "grab",
             [
                 CurrentState(start),
+                AllowCollisions(["gripper"], ["wrist_3_link"], name="allow"),
                 PlanToJointState(closed, MotionSettings(group="gripper"), name="close gripper"),
                 MoveAlongFrameAxis((0, 0, 1), "world", "grasp_link", 0.05, 0.05, name="lift"),
             ],
@@ -211,10 +227,11 @@ def test_approving_a_planned_task_shows_its_motions_and_draws_it_in_the_view(mon
         assert run.status == NodeStatus.SUCCESS, run.toasts
         assert len(asked) == 1
         request = asked[0]
-        assert [s.stage for s in request.steps] == ["close gripper", "lift"]
-        assert request.steps[0].gripper.endswith("(closes)"), request.steps
-        assert request.steps[0].joint_names == ("robotiq_85_left_knuckle_joint",)
-        assert request.steps[1].gripper == "", request.steps
+        assert [s.stage for s in request.steps] == ["allow", "close gripper", "lift"]
+        assert request.steps[0].note == "collisions allowed: gripper - wrist_3_link", request.steps
+        assert request.steps[1].gripper.endswith("(closes)"), request.steps
+        assert request.steps[1].joint_names == ("robotiq_85_left_knuckle_joint",)
+        assert request.steps[2].gripper == "" and request.steps[2].note == "", request.steps
         assert request.duration == pytest.approx(solution.joined().duration, rel=1e-6)
         assert drawn_before_answer == [True], (len(drawn), len(markers))
         last = drawn[-1]

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -35,6 +35,7 @@ import numpy as np
 from kinema.errors import MotionError
 from kinema.motion.task_stages import (
     GENERATORS,
+    AllowCollisions,
     BatchPoseIK,
     Connect,
     CurrentState,
@@ -103,6 +104,23 @@ class SubTrajectory:
     trajectory: JointTrajectory
 
 
+@dataclass(frozen=True)
+class SceneChange:
+    """A change of the collision rules between two motions of a solution.
+
+    Attributes:
+        stage: the stage that made it.
+        before: how many sub-trajectories come before it.
+        description: what changed, for a person (``collisions allowed: gripper - cube``).
+        allowed: the pairs whose contact is allowed from here on (the rules in force after it).
+    """
+
+    stage: str
+    before: int
+    description: str
+    allowed: frozenset[frozenset[str]] = frozenset()
+
+
 @dataclass(frozen=True, eq=False)
 class TaskSolution:
     """A planned task.
@@ -115,6 +133,7 @@ class TaskSolution:
         sub_trajectories: the stages' motions in order; each starts where the previous ended.
         reports: one per stage, all ``solved``, with the seconds each took.
         planning_seconds: how long planning took.
+        scene_changes: the collision-rule changes between the motions, in order.
     """
 
     task_id: str
@@ -124,6 +143,7 @@ class TaskSolution:
     sub_trajectories: tuple[SubTrajectory, ...]
     reports: tuple[StageReport, ...]
     planning_seconds: float = 0.0
+    scene_changes: tuple[SceneChange, ...] = ()
 
     def tool_paths(self, model: RobotModel, frame: str) -> list[tuple[str, np.ndarray]]:
         """Where ``frame`` goes during each sub-trajectory: (stage name, positions ``(N, 3)`` in the world).
@@ -223,6 +243,7 @@ class _Piece:
     rows: np.ndarray  # full configurations along the motion
     motion: MotionSettings
     timed: JointTrajectory | None = None  # already timed (from an earlier solution)
+    change: SceneChange | None = None  # a scene change instead of a motion
 
 
 class _Planner:
@@ -245,6 +266,8 @@ class _Planner:
         self.status: dict[int, tuple[str, str]] = {}
         self.seconds: dict[int, float] = {}
         self.since: dict[int, float] = {}  # stage -> when its current planning began
+        self.default_allowed = checker.allowed_collisions
+        self.rules: list[frozenset[frozenset[str]]] = []  # stage -> the collisions allowed while planning it
 
     # ------------------------------------------------------------------------------ progress
     def reports(self) -> tuple[StageReport, ...]:
@@ -302,16 +325,63 @@ class _Planner:
         stage = self.task.stages[index]
         return f"stage {index + 1} of {len(self.task.stages)} ({stage.name!r})"
 
-    def check(self, padding: float, ignore_environment: bool = False) -> CollisionChecker:
+    def check(self, index: int, padding: float, ignore_environment: bool = False) -> CollisionChecker:
+        """The checker for stage ``index``: its padding, and the collisions allowed where it stands."""
         if ignore_environment:
             if self._free_checker is None:
                 from kinema.motion.collision import CollisionChecker
 
                 self._free_checker = CollisionChecker(self.model, None, padding=padding)
             self._free_checker.padding = padding
+            self._free_checker.allowed_collisions = self.rules[index]
             return self._free_checker
         self.checker.padding = padding
+        self.checker.allowed_collisions = self.rules[index]
         return self.checker
+
+    def resolve_rules(self) -> None:
+        """The collisions allowed at each stage: the defaults, changed by each AllowCollisions before it."""
+        allowed = set(self.default_allowed)
+        for index, stage in enumerate(self.task.stages):
+            self.rules.append(frozenset(allowed))
+            if isinstance(stage, AllowCollisions):
+                pairs = {
+                    frozenset((a, b))
+                    for a in self.names(index, stage.first)
+                    for b in self.names(index, stage.second)
+                    if a != b
+                }
+                allowed = allowed | pairs if stage.allow else allowed - pairs
+
+    def names(self, index: int, names: Sequence[str]) -> list[str]:
+        """Robot links and scene object names that ``names`` (links, SRDF groups, object ids) stand for."""
+        from kinema.errors import did_you_mean
+
+        scene = self.checker.scene
+        out: list[str] = []
+        for name in names:
+            if name in self.model.link_names or name in scene.objects:
+                out.append(name)
+            elif name in scene.world:
+                out.extend(scene.world[name])
+            elif name in self.model.semantic.groups and self.model.semantic.groups[name].links:
+                out.extend(self.model.semantic.groups[name].links)
+            else:
+                known = [*self.model.link_names, *scene.world, *scene.objects, *self.model.semantic.groups]
+                raise _StageFailure(
+                    index,
+                    f"{name!r} is no robot link, planning group listing its links, or planning-scene "
+                    f"object; {did_you_mean(name, known)}",
+                )
+        return out
+
+    def piece(self, index: int, rows: np.ndarray) -> _Piece:
+        stage = self.task.stages[index]
+        if isinstance(stage, AllowCollisions):
+            after = self.rules[index + 1] if index + 1 < len(self.rules) else self.rules[index]
+            change = SceneChange(stage.name, 0, stage.describe(), after)
+            return _Piece(index, rows, MotionSettings(), change=change)
+        return _Piece(index, rows, stage.motion)
 
     def world_T(self, target: Target, q: np.ndarray) -> np.ndarray:
         from kinema.motion.frames import FrameTree
@@ -344,10 +414,15 @@ class _Planner:
             solution = stage.solution
             if tuple(solution.joint_names) != tuple(self.model.joint_names):
                 raise _StageFailure(index, "the solution was planned for another robot model")
-            pieces = [
-                _Piece(index, np.array([solution.start]), MotionSettings(), sub.trajectory)
-                for sub in solution.sub_trajectories
-            ]
+            pieces = []
+            for k, sub in enumerate([*solution.sub_trajectories, None]):
+                pieces += [
+                    _Piece(index, np.array([solution.start]), MotionSettings(), change=change)
+                    for change in solution.scene_changes
+                    if change.before == k
+                ]
+                if sub is not None:
+                    pieces.append(_Piece(index, np.array([solution.start]), MotionSettings(), sub.trajectory))
             return [(solution.start.copy(), solution.end.copy(), pieces)]
         assert isinstance(stage, BatchPoseIK)
         return self.batch_ik(index, stage, before)
@@ -362,7 +437,7 @@ class _Planner:
                 index, "batch pose IK needs a state before it to solve from (a current state)"
             )
         self.group(index, stage.group)
-        checker = self.check(stage.link_padding)
+        checker = self.check(index, stage.link_padding)
         options = IkOptions(attempts=stage.ik_attempts, rng_seed=stage.seed)
         found: list[np.ndarray] = []
         reasons: list[str] = []
@@ -394,6 +469,8 @@ class _Planner:
         """Plan a propagator from ``q_from``: (rows, end state)."""
         stage = self.task.stages[index]
         self.begin(index)
+        if isinstance(stage, AllowCollisions):
+            return q_from[None, :].copy(), q_from
         try:
             if isinstance(stage, MoveAlongFrameAxis):
                 return self.along_axis(index, stage, q_from, backwards=False)
@@ -403,7 +480,7 @@ class _Planner:
                 from kinema.motion.inverse_kinematics import IkOptions, ik
 
                 self.group(index, stage.motion.group)
-                checker = self.check(stage.motion.link_padding)
+                checker = self.check(index, stage.motion.link_padding)
                 world_T_target = self.world_T(stage.target, q_from)
                 q_goal = ik(
                     self.model,
@@ -423,6 +500,8 @@ class _Planner:
         """Plan a propagator that must end at ``q_to``: (rows, start state)."""
         stage = self.task.stages[index]
         self.begin(index)
+        if isinstance(stage, AllowCollisions):
+            return q_to[None, :].copy(), q_to
         if not isinstance(stage, MoveAlongFrameAxis):
             raise _StageFailure(
                 index,
@@ -440,7 +519,7 @@ class _Planner:
         from kinema.motion.planner import PlanningOptions, plan_joint_goal
 
         g = self.group(index, motion.group)
-        checker = self.check(motion.link_padding)
+        checker = self.check(index, motion.link_padding)
         path = plan_joint_goal(
             checker, q_from, goal, motion.group, PlanningOptions(timeout=motion.planning_time)
         )
@@ -462,7 +541,7 @@ class _Planner:
         target = hand.copy()
         sign = -1.0 if backwards else 1.0
         target[:3, 3] += sign * stage.max_distance * direction
-        checker = self.check(stage.motion.link_padding, stage.ignore_environment_collisions)
+        checker = self.check(index, stage.motion.link_padding, stage.ignore_environment_collisions)
         result = plan_cartesian_path(checker, q, [target], stage.motion.group, stage.hand_frame)
         reached = result.fraction * stage.max_distance
         if reached < stage.min_distance - 1e-4:
@@ -516,7 +595,7 @@ class _Planner:
                 q = start
                 for i in reversed([m for m in members if m < g]):
                     rows, q = self.backward(i, q)
-                    pieces.insert(0, _Piece(i, rows, self.task.stages[i].motion))
+                    pieces.insert(0, self.piece(i, rows))
                     self.solved(i)
                 first = q
                 _, last, after = self.propagate([m for m in members if m > g], [], end)
@@ -549,7 +628,7 @@ class _Planner:
         start = q
         for i in members:
             rows, q = self.forward(i, q)
-            pieces.append(_Piece(i, rows, self.task.stages[i].motion))
+            pieces.append(self.piece(i, rows))
             self.solved(i)
         return start, q, pieces
 
@@ -576,6 +655,7 @@ class _Planner:
     def run(self) -> tuple[np.ndarray, np.ndarray, list[_Piece]]:
         if not self.task.stages:
             raise _StageFailure(0, "the task has no stages")
+        self.resolve_rules()
         start: np.ndarray | None = None
         end: np.ndarray | None = None
         pieces: list[_Piece] = []
@@ -631,8 +711,12 @@ def plan_task(
     try:
         start, end, pieces = planner.run()
         subs: list[SubTrajectory] = []
+        changes: list[SceneChange] = []
         for piece in pieces:
             stage = task.stages[piece.index]
+            if piece.change is not None:
+                changes.append(replace(piece.change, before=len(subs)))
+                continue
             if piece.timed is not None:
                 subs.append(SubTrajectory(stage.name, piece.timed))
                 continue
@@ -659,6 +743,7 @@ def plan_task(
         ) from None
     finally:
         checker.padding = padding
+        checker.allowed_collisions = planner.default_allowed
     solution = TaskSolution(
         task.task_id,
         tuple(planner.model.joint_names),
@@ -667,6 +752,7 @@ def plan_task(
         tuple(subs),
         planner.reports(),
         time.monotonic() - began,
+        tuple(changes),
     )
     solution.joined()  # proves the sub-trajectories meet
     return solution

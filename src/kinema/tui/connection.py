@@ -263,12 +263,14 @@ class SolutionStep:
         duration: seconds.
         joint_names: the joints it moves.
         gripper: what the gripper does during it ("" when it holds still).
+        note: for a change between motions (collision rules) instead of a motion, what changed.
     """
 
     stage: str
     duration: float
     joint_names: tuple[str, ...] = ()
     gripper: str = ""
+    note: str = ""
 
 
 @dataclass(frozen=True)

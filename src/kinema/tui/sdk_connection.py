@@ -258,6 +258,7 @@ class SdkConnection:
                 float(step.duration),
                 tuple(str(n) for n in step.joint_names),
                 str(step.gripper),
+                str(step.note),
             )
             for step in request.steps
         )

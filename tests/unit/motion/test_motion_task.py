@@ -11,6 +11,7 @@ from kinema.motion import CollisionChecker, RobotModel, fk
 from kinema.motion.planning_scene import CollisionObject
 from kinema.motion.task import Task, TaskPlanningError, TaskSolution, plan_task
 from kinema.motion.task_stages import (
+    AllowCollisions,
     BatchPoseIK,
     Connect,
     CurrentState,
@@ -279,6 +280,42 @@ def test_a_connect_with_no_way_through_fails_naming_it_after_its_planning_time(
     message = str(failure.value)
     assert "stage 2 of 3 ('connect')" in message and "no collision-free path found within 0.20 s" in message
     assert [r.status for r in failure.value.reports] == ["solved", "failed", "solved"], failure.value.reports
+
+
+def test_collisions_allowed_by_a_scene_change_hold_for_the_stages_after_it_only(
+    model: RobotModel, checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray
+) -> None:
+    # A box the gripper closes around: at the grasp, the gripper's links touch it.
+    checker.scene.add(CollisionObject("box", "box", (0.06, 0.06, 0.06), _at(*grasp[:3, 3])))
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(pick_task(start, [grasp]), checker)
+    assert "('grasp pose IK')" in str(failure.value), str(failure.value)
+
+    stages = pick_task(start, [grasp]).stages
+    allow = AllowCollisions(["gripper"], ["box"], name="touch the box")
+    solution = plan_task(Task("pick", [*stages[:2], allow, *stages[2:]]), checker)
+    assert [s.stage for s in solution.sub_trajectories] == ["connect", "approach"]
+    (change,) = solution.scene_changes
+    assert change.stage == "touch the box" and change.before == 1, change
+    assert change.description == "collisions allowed: gripper - box"
+    assert frozenset(("robotiq_85_left_finger_link", "box")) in change.allowed
+    assert checker.allowed_collisions == frozenset(), "planning restores the checker's rules"
+    # The connect, planned before the change, keeps clear of the box; the grasp touches it.
+    checker.padding = 0.0
+    connect = solution.sub_trajectories[0].trajectory
+    rows = np.repeat(solution.start[None, :], len(connect.times), axis=0)
+    rows[:, [model.index(n) for n in connect.joint_names]] = connect.positions
+    assert checker.first_invalid(rows, 0.01) is None
+    assert "box" in checker.describe(solution.end)
+    # Replayed, the change comes along in its place.
+    replay = plan_task(Task("replay", [FromSolution(solution)]), checker)
+    assert [(c.description, c.before) for c in replay.scene_changes] == [(change.description, 1)]
+
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(Task("typo", [CurrentState(start), AllowCollisions(["griper"], ["box"])]), checker)
+    message = str(failure.value)
+    assert "stage 2 of 2 ('allow collisions')" in message and "'griper'" in message, message
+    assert "gripper" in message.split("'griper'")[1], message  # the likely name is suggested
 
 
 def _at(x: float, y: float, z: float, like: np.ndarray | None = None) -> np.ndarray:

@@ -19,6 +19,9 @@ MOVED = 1e-4  # rad or m: a gripper joint that changes less holds still
 def solution_steps(solution: Any, model: Any = None) -> tuple[list[dict[str, Any]], float]:
     """The motions of ``solution`` (``kinema_msgs/SolutionStep`` fields) and its whole duration, seconds.
 
+    An MTC solution's collision-rule changes come in their place between the motions, as steps with a
+    ``note``, no joints and no duration.
+
     ``model`` (the robot model) names the gripper joints (its SRDF end effectors' joints); without it no
     gripper change is reported. Anything else than a solution or a trajectory has no steps.
     """
@@ -26,21 +29,34 @@ def solution_steps(solution: Any, model: Any = None) -> tuple[list[dict[str, Any
 
     if isinstance(solution, TaskSolution):
         grippers = _gripper_joints(model)
-        steps = [
-            {
-                "stage": sub.stage,
-                "duration": float(sub.trajectory.duration),
-                "joint_names": list(sub.trajectory.joint_names),
-                "gripper": _gripper_change(
-                    sub.trajectory.joint_names,
-                    sub.trajectory.positions[0],
-                    sub.trajectory.positions[-1],
-                    grippers,
-                    model,
-                ),
-            }
-            for sub in solution.sub_trajectories
-        ]
+        steps: list[dict[str, Any]] = []
+        for k, sub in enumerate([*solution.sub_trajectories, None]):
+            steps += [
+                {
+                    "stage": change.stage,
+                    "duration": 0.0,
+                    "joint_names": [],
+                    "gripper": "",
+                    "note": change.description,
+                }
+                for change in solution.scene_changes
+                if change.before == k
+            ]
+            if sub is None:
+                continue
+            trajectory = sub.trajectory
+            gripper = _gripper_change(
+                trajectory.joint_names, trajectory.positions[0], trajectory.positions[-1], grippers, model
+            )
+            steps.append(
+                {
+                    "stage": sub.stage,
+                    "duration": float(trajectory.duration),
+                    "joint_names": list(trajectory.joint_names),
+                    "gripper": gripper,
+                    "note": "",
+                }
+            )
         return steps, float(sum(step["duration"] for step in steps))
     if getattr(solution, "__msgtype__", None) == JOINT_TRAJECTORY and solution.points:
         last = solution.points[-1].time_from_start

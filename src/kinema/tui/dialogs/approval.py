@@ -14,14 +14,18 @@ from kinema.tui.dialogs.confirm import ConfirmDialog
 
 
 def steps_table(steps: tuple[SolutionStep, ...], duration: float) -> Group:
-    """One row per motion, then the whole duration and whether the gripper moves at all."""
+    """One row per motion (or change between motions), then the whole duration and whether the gripper
+    moves at all."""
     table = Table(box=None, pad_edge=False, expand=True, show_edge=False, header_style="bold dim")
     table.add_column("#", justify="right", no_wrap=True)
     table.add_column("Motion", no_wrap=True)
     table.add_column("Time", justify="right", no_wrap=True)
     table.add_column("Joints", justify="right", no_wrap=True)
-    table.add_column("Gripper", ratio=1)
+    table.add_column("Gripper / change", ratio=1)
     for number, step in enumerate(steps, start=1):
+        if step.note:
+            table.add_row(str(number), step.stage, "", "", Text(step.note, style="italic"))
+            continue
         table.add_row(
             str(number),
             step.stage,
@@ -29,11 +33,11 @@ def steps_table(steps: tuple[SolutionStep, ...], duration: float) -> Group:
             str(len(step.joint_names)),
             Text(step.gripper or "holds still", style="bold" if step.gripper else "dim"),
         )
-    moves = sum(1 for step in steps if step.gripper)
+    motions = [step for step in steps if not step.note]
+    moves = sum(1 for step in motions if step.gripper)
     total = Text()
-    total.append(
-        f"{len(steps)} motion{'s' if len(steps) != 1 else ''}, {duration:.2f} s in all", style="bold"
-    )
+    plural = "s" if len(motions) != 1 else ""
+    total.append(f"{len(motions)} motion{plural}, {duration:.2f} s in all", style="bold")
     total.append(
         f"; the gripper moves in {moves} of them" if moves else "; the gripper holds still throughout",
         style="dim",
