@@ -254,8 +254,11 @@ class _Planner:
         frames: Mapping[str, np.ndarray],
         stop: Callable[[], bool],
         progress: Callable[[tuple[StageReport, ...]], None] | None = None,
+        timeout: float | None = None,
     ) -> None:
         self.task = task
+        self.timeout = timeout
+        self.deadline = time.monotonic() + timeout if timeout is not None else float("inf")
         self.checker = checker
         self.model: RobotModel = checker.model
         self.frames = frames
@@ -291,7 +294,13 @@ class _Planner:
             self.seconds[index] = self.seconds.get(index, 0.0) + time.monotonic() - began
 
     def begin(self, index: int) -> None:
-        """Stage ``index`` starts planning (again, for another candidate)."""
+        """Stage ``index`` starts planning (again, for another candidate).
+
+        Raises:
+            _StageFailure: the task's timeout ran out.
+        """
+        if time.monotonic() >= self.deadline:
+            raise _StageFailure(index, f"the task's planning timeout of {self.timeout:.2f} s ran out")
         self.since[index] = time.monotonic()
         self.status[index] = ("planning", self.status.get(index, ("", ""))[1])
         self._tell()
@@ -520,8 +529,12 @@ class _Planner:
 
         g = self.group(index, motion.group)
         checker = self.check(index, motion.link_padding)
+        # The search gets its own planning time, or what is left of the task's timeout when that is less.
+        left = self.deadline - time.monotonic()
+        if left <= 0:
+            raise _StageFailure(index, f"the task's planning timeout of {self.timeout:.2f} s ran out")
         path = plan_joint_goal(
-            checker, q_from, goal, motion.group, PlanningOptions(timeout=motion.planning_time)
+            checker, q_from, goal, motion.group, PlanningOptions(timeout=min(motion.planning_time, left))
         )
         rows = np.repeat(q_from[None, :], len(path.positions), axis=0)
         rows[:, list(g.indices)] = path.positions
@@ -611,7 +624,7 @@ class _Planner:
                         f"with solution {k} of {len(candidates)} of {self.task.stages[g].name!r}: "
                         f"{failure.reason}",
                     )
-                if self.stop():
+                if self.stop() or time.monotonic() >= self.deadline:
                     break
         if len(failures) == 1:
             raise failures[0]
@@ -687,6 +700,7 @@ def plan_task(
     frames: Mapping[str, np.ndarray] | None = None,
     stop: Callable[[], bool] | None = None,
     progress: Callable[[tuple[StageReport, ...]], None] | None = None,
+    timeout: float | None = None,
 ) -> TaskSolution:
     """Plan ``task`` into a solution against ``checker``'s planning scene.
 
@@ -699,6 +713,8 @@ def plan_task(
         stop: called between steps; planning stops with an error when it returns True.
         progress: called (on the planning thread) whenever a stage's state changes, with every stage's
             report; it must not block.
+        timeout: seconds the whole task may take (MTC's task timeout): no stage starts after it, and a
+            search for a collision-free motion gets at most what is left of it.
 
     Raises:
         TaskPlanningError: naming the stage that failed and why; ``reports`` holds every stage's status.
@@ -706,7 +722,7 @@ def plan_task(
     from kinema.motion.timing import time_parameterize
 
     began = time.monotonic()
-    planner = _Planner(task, checker, frames or {}, stop or (lambda: False), progress)
+    planner = _Planner(task, checker, frames or {}, stop or (lambda: False), progress, timeout)
     padding = checker.padding
     try:
         start, end, pieces = planner.run()

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 
 import numpy as np
@@ -280,6 +281,16 @@ def test_a_connect_with_no_way_through_fails_naming_it_after_its_planning_time(
     message = str(failure.value)
     assert "stage 2 of 3 ('connect')" in message and "no collision-free path found within 0.20 s" in message
     assert [r.status for r in failure.value.reports] == ["solved", "failed", "solved"], failure.value.reports
+
+    # The task's timeout cuts a longer search short: the connect searches only what is left of it.
+    patient = Task(
+        "cross", [CurrentState(here), Connect(MotionSettings(planning_time=30.0)), CurrentState(there)]
+    )
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(patient, checker, timeout=0.3)
+    message = str(failure.value)
+    assert "stage 2 of 3 ('connect')" in message, message
+    assert re.search(r"within 0\.[0-3]\d s|planning timeout of 0\.30 s ran out", message), message
 
 
 def test_collisions_allowed_by_a_scene_change_hold_for_the_stages_after_it_only(

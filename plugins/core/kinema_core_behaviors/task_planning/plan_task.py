@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from typing import Any
 
 from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, SyncBehavior, input_port, output_port
@@ -99,13 +98,13 @@ class PlanMTCTask(AsyncBehavior):
                         progress,
                     )
             checker = collision_checker(self.context, "PlanMTCTask", DEFAULT_PADDING)
-            deadline = time.monotonic() + mtc.timeout if mtc.timeout > 0 else float("inf")
             solution = plan_task(
                 Task(mtc.task_id, stages),
                 checker,
                 frames=fixed,
-                stop=lambda: self.stop_requested() or time.monotonic() > deadline,
+                stop=self.stop_requested,
                 progress=progress.update,
+                timeout=mtc.timeout if mtc.timeout > 0 else None,
             )
         except TaskPlanningError as error:
             self.logger.publish_info(f"PlanMTCTask: stages: {_stage_summary(error.reports)}")
