@@ -171,3 +171,55 @@ def test_objectives_screen_after_a_failed_run(snap_compare) -> None:  # type: ig
         await settle(pilot)
 
     assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+
+
+def test_objectives_screen_while_a_task_plans(snap_compare) -> None:  # type: ignore[no-untyped-def]
+    from test_tui_task_planning import PLANNING
+
+    app, fake = app_on("objectives")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
+        fake.emit(PLANNING)
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+
+
+def test_objectives_screen_after_a_task_failed_to_plan(snap_compare) -> None:  # type: ignore[no-untyped-def]
+    from test_tui_task_planning import FAILED
+
+    app, fake = app_on("objectives")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
+        fake.emit(FAILED)
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+
+
+def test_approval_of_a_planned_motion(snap_compare) -> None:  # type: ignore[no-untyped-def]
+    from test_tui_approvals import PICK_STEPS
+
+    from kinema.tui.connection import ApprovalRequested
+
+    app, fake = app_on("objectives")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        fake.emit(
+            ApprovalRequested(
+                "Approve the planned motion?",
+                "WaitForMTCSolutionApproval",
+                "Pick from Pose With Approval/ask for approval",
+                lambda *_: None,
+                PICK_STEPS,
+                3.88,
+            )
+        )
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)

@@ -8,6 +8,7 @@ folded but valid poses, and the gripper's own fingers, "collide").
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -35,7 +36,9 @@ class CollisionChecker:
     """Answers "is configuration ``q`` in collision?" for one robot model and one planning scene.
 
     Not thread-safe (it owns pinocchio scratch data); make one per thread. Changes to the scene are
-    picked up on the next check (the scene's ``version`` is compared).
+    picked up on the next check (the scene's ``version`` is compared). Pairs in
+    :attr:`allowed_collisions` (a link and a scene object, or two links) are not checked, as MoveIt's
+    allowed collision matrix does for a gripper closing on the object it grasps.
 
     Args:
         model: the robot model (its URDF collision geometry is used).
@@ -57,6 +60,7 @@ class CollisionChecker:
             raise MotionError(f"cannot build collision geometry from {model.urdf_path}: {exc}") from exc
         self._data = model.new_data()
         self._scene_version = -1
+        self._allowed: frozenset[frozenset[str]] = frozenset()
         self._build()
 
     @property
@@ -107,7 +111,30 @@ class CollisionChecker:
         self._scene_pairs = scene_pairs
         for k in scene_pairs:
             self._geom_data.collisionRequests[k].security_margin = self._padding
+        self._pair_names = [
+            frozenset((self._link_of(pair.first), self._link_of(pair.second))) for pair in gm.collisionPairs
+        ]
+        self._apply_allowed()
         self._scene_version = self.scene.version
+
+    @property
+    def allowed_collisions(self) -> frozenset[frozenset[str]]:
+        """Pairs of names (robot links, scene object names) whose contact is allowed: never checked."""
+        return self._allowed
+
+    @allowed_collisions.setter
+    def allowed_collisions(self, pairs: Iterable[Iterable[str]]) -> None:
+        allowed = frozenset(frozenset(pair) for pair in pairs)
+        if allowed != self._allowed:
+            self._allowed = allowed
+            self._apply_allowed()
+
+    def _apply_allowed(self) -> None:
+        for k, names in enumerate(self._pair_names):
+            if names in self._allowed:
+                self._geom_data.deactivateCollisionPair(k)
+            else:
+                self._geom_data.activateCollisionPair(k)
 
     def _link_of_obj(self, geom) -> str:
         return self.model.pin_model.frames[geom.parentFrame].name
@@ -153,8 +180,9 @@ class CollisionChecker:
             False,
         )
         pairs = []
+        active = self._geom_data.activeCollisionPairs
         for k, pair in enumerate(self._geom_model.collisionPairs):
-            if self._geom_data.collisionResults[k].isCollision():
+            if active[k] and self._geom_data.collisionResults[k].isCollision():
                 names = (self._link_of(pair.first), self._link_of(pair.second))
                 if names not in pairs:
                     pairs.append(names)

@@ -11,6 +11,10 @@ The solution is a list of sub-trajectories, one per moving stage, each timed wit
 ends, within the stage's scaled limits), each starting exactly where the one before ended. Planning fails
 with a :class:`TaskPlanningError` naming the stage and why.
 
+While it plans, each stage is ``waiting``, ``planning``, ``solved`` or ``failed`` (:data:`STAGE_STATES`);
+``plan_task(..., progress=...)`` is told every change, with the seconds each stage has taken so far, so a
+UI can show the task as it is planned.
+
 Example::
 
     task = Task("pick", [CurrentState(q), Connect(), MoveAlongFrameAxis((0, 0, 1), "grasp_link",
@@ -23,7 +27,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable, Mapping, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -31,6 +35,7 @@ import numpy as np
 from kinema.errors import MotionError
 from kinema.motion.task_stages import (
     GENERATORS,
+    AllowCollisions,
     BatchPoseIK,
     Connect,
     CurrentState,
@@ -64,15 +69,31 @@ class Task:
         self.stages.append(stage)
 
 
+STAGE_STATES = ("waiting", "planning", "solved", "failed")
+
+
 @dataclass(frozen=True)
 class StageReport:
-    """How a stage fared: ``status`` is ``planned``, ``failed`` or ``not planned``; ``comment`` says why."""
+    """How a stage fares.
+
+    Attributes:
+        index: its place in the task (0-based).
+        name: its name (``connect``, ``approach``).
+        kind: ``generator``, ``propagator`` or ``connector``.
+        status: one of :data:`STAGE_STATES`.
+        comment: why it failed (``no IK solution for any of the 8 target poses: pose 3 of 8: ...``), or how
+            a candidate fared; "" when there is nothing to say.
+        seconds: time spent planning (and timing) it so far.
+        stage_type: the stage's class (``MoveAlongFrameAxis``), MTC's stage type.
+    """
 
     index: int
     name: str
     kind: str
     status: str
     comment: str = ""
+    seconds: float = 0.0
+    stage_type: str = ""
 
 
 @dataclass(frozen=True, eq=False)
@@ -81,6 +102,23 @@ class SubTrajectory:
 
     stage: str
     trajectory: JointTrajectory
+
+
+@dataclass(frozen=True)
+class SceneChange:
+    """A change of the collision rules between two motions of a solution.
+
+    Attributes:
+        stage: the stage that made it.
+        before: how many sub-trajectories come before it.
+        description: what changed, for a person (``collisions allowed: gripper - cube``).
+        allowed: the pairs whose contact is allowed from here on (the rules in force after it).
+    """
+
+    stage: str
+    before: int
+    description: str
+    allowed: frozenset[frozenset[str]] = frozenset()
 
 
 @dataclass(frozen=True, eq=False)
@@ -93,8 +131,9 @@ class TaskSolution:
         start: the full configuration the solution starts from.
         end: the full configuration it ends at.
         sub_trajectories: the stages' motions in order; each starts where the previous ended.
-        reports: one per stage, all ``planned``.
+        reports: one per stage, all ``solved``, with the seconds each took.
         planning_seconds: how long planning took.
+        scene_changes: the collision-rule changes between the motions, in order.
     """
 
     task_id: str
@@ -104,6 +143,7 @@ class TaskSolution:
     sub_trajectories: tuple[SubTrajectory, ...]
     reports: tuple[StageReport, ...]
     planning_seconds: float = 0.0
+    scene_changes: tuple[SceneChange, ...] = ()
 
     def tool_paths(self, model: RobotModel, frame: str) -> list[tuple[str, np.ndarray]]:
         """Where ``frame`` goes during each sub-trajectory: (stage name, positions ``(N, 3)`` in the world).
@@ -203,6 +243,7 @@ class _Piece:
     rows: np.ndarray  # full configurations along the motion
     motion: MotionSettings
     timed: JointTrajectory | None = None  # already timed (from an earlier solution)
+    change: SceneChange | None = None  # a scene change instead of a motion
 
 
 class _Planner:
@@ -212,15 +253,79 @@ class _Planner:
         checker: CollisionChecker,
         frames: Mapping[str, np.ndarray],
         stop: Callable[[], bool],
+        progress: Callable[[tuple[StageReport, ...]], None] | None = None,
+        timeout: float | None = None,
     ) -> None:
         self.task = task
+        self.timeout = timeout
+        self.deadline = time.monotonic() + timeout if timeout is not None else float("inf")
         self.checker = checker
         self.model: RobotModel = checker.model
         self.frames = frames
         self.stop = stop
+        self.progress = progress
         self.default_padding = checker.padding
         self._free_checker: CollisionChecker | None = None
         self.status: dict[int, tuple[str, str]] = {}
+        self.seconds: dict[int, float] = {}
+        self.since: dict[int, float] = {}  # stage -> when its current planning began
+        self.default_allowed = checker.allowed_collisions
+        self.rules: list[frozenset[frozenset[str]]] = []  # stage -> the collisions allowed while planning it
+
+    # ------------------------------------------------------------------------------ progress
+    def reports(self) -> tuple[StageReport, ...]:
+        now = time.monotonic()
+        out = []
+        for i, stage in enumerate(self.task.stages):
+            status, comment = self.status.get(i, ("waiting", ""))
+            seconds = self.seconds.get(i, 0.0) + (now - self.since[i] if i in self.since else 0.0)
+            out.append(
+                StageReport(i, stage.name, stage_kind(stage), status, comment, seconds, type(stage).__name__)
+            )
+        return tuple(out)
+
+    def _tell(self) -> None:
+        if self.progress is not None:
+            self.progress(self.reports())
+
+    def _stop_clock(self, index: int) -> None:
+        began = self.since.pop(index, None)
+        if began is not None:
+            self.seconds[index] = self.seconds.get(index, 0.0) + time.monotonic() - began
+
+    def begin(self, index: int) -> None:
+        """Stage ``index`` starts planning (again, for another candidate).
+
+        Raises:
+            _StageFailure: the task's timeout ran out.
+        """
+        if time.monotonic() >= self.deadline:
+            raise _StageFailure(index, f"the task's planning timeout of {self.timeout:.2f} s ran out")
+        self.since[index] = time.monotonic()
+        self.status[index] = ("planning", self.status.get(index, ("", ""))[1])
+        self._tell()
+
+    def solved(self, index: int, comment: str = "") -> None:
+        self._stop_clock(index)
+        self.status[index] = ("solved", comment)
+        self._tell()
+
+    def gave_up(self, index: int, comment: str) -> None:
+        """Stage ``index`` failed for one candidate; it waits for the next (the comment says why)."""
+        self._stop_clock(index)
+        self.status[index] = ("waiting", comment)
+        self._tell()
+
+    def failed(self, index: int, reason: str) -> None:
+        for running in list(self.since):
+            self._stop_clock(running)
+            if running != index:
+                self.status[running] = ("waiting", self.status[running][1])
+        self.status[index] = ("failed", reason)
+        self._tell()
+
+    def add_seconds(self, index: int, seconds: float) -> None:
+        self.seconds[index] = self.seconds.get(index, 0.0) + seconds
 
     # ----------------------------------------------------------------------------------- helpers
     def label(self, index: int) -> str:
@@ -229,16 +334,63 @@ class _Planner:
         stage = self.task.stages[index]
         return f"stage {index + 1} of {len(self.task.stages)} ({stage.name!r})"
 
-    def check(self, padding: float, ignore_environment: bool = False) -> CollisionChecker:
+    def check(self, index: int, padding: float, ignore_environment: bool = False) -> CollisionChecker:
+        """The checker for stage ``index``: its padding, and the collisions allowed where it stands."""
         if ignore_environment:
             if self._free_checker is None:
                 from kinema.motion.collision import CollisionChecker
 
                 self._free_checker = CollisionChecker(self.model, None, padding=padding)
             self._free_checker.padding = padding
+            self._free_checker.allowed_collisions = self.rules[index]
             return self._free_checker
         self.checker.padding = padding
+        self.checker.allowed_collisions = self.rules[index]
         return self.checker
+
+    def resolve_rules(self) -> None:
+        """The collisions allowed at each stage: the defaults, changed by each AllowCollisions before it."""
+        allowed = set(self.default_allowed)
+        for index, stage in enumerate(self.task.stages):
+            self.rules.append(frozenset(allowed))
+            if isinstance(stage, AllowCollisions):
+                pairs = {
+                    frozenset((a, b))
+                    for a in self.names(index, stage.first)
+                    for b in self.names(index, stage.second)
+                    if a != b
+                }
+                allowed = allowed | pairs if stage.allow else allowed - pairs
+
+    def names(self, index: int, names: Sequence[str]) -> list[str]:
+        """Robot links and scene object names that ``names`` (links, SRDF groups, object ids) stand for."""
+        from kinema.errors import did_you_mean
+
+        scene = self.checker.scene
+        out: list[str] = []
+        for name in names:
+            if name in self.model.link_names or name in scene.objects:
+                out.append(name)
+            elif name in scene.world:
+                out.extend(scene.world[name])
+            elif name in self.model.semantic.groups and self.model.semantic.groups[name].links:
+                out.extend(self.model.semantic.groups[name].links)
+            else:
+                known = [*self.model.link_names, *scene.world, *scene.objects, *self.model.semantic.groups]
+                raise _StageFailure(
+                    index,
+                    f"{name!r} is no robot link, planning group listing its links, or planning-scene "
+                    f"object; {did_you_mean(name, known)}",
+                )
+        return out
+
+    def piece(self, index: int, rows: np.ndarray) -> _Piece:
+        stage = self.task.stages[index]
+        if isinstance(stage, AllowCollisions):
+            after = self.rules[index + 1] if index + 1 < len(self.rules) else self.rules[index]
+            change = SceneChange(stage.name, 0, stage.describe(), after)
+            return _Piece(index, rows, MotionSettings(), change=change)
+        return _Piece(index, rows, stage.motion)
 
     def world_T(self, target: Target, q: np.ndarray) -> np.ndarray:
         from kinema.motion.frames import FrameTree
@@ -261,6 +413,7 @@ class _Planner:
     ) -> list[tuple[np.ndarray, np.ndarray, list[_Piece]]]:
         """Candidates of a generator: (start state, end state, its own pieces)."""
         stage = self.task.stages[index]
+        self.begin(index)
         if isinstance(stage, CurrentState):
             q = np.asarray(stage.state, dtype=float)
             if q.shape != (len(self.model.joint_names),):
@@ -270,10 +423,15 @@ class _Planner:
             solution = stage.solution
             if tuple(solution.joint_names) != tuple(self.model.joint_names):
                 raise _StageFailure(index, "the solution was planned for another robot model")
-            pieces = [
-                _Piece(index, np.array([solution.start]), MotionSettings(), sub.trajectory)
-                for sub in solution.sub_trajectories
-            ]
+            pieces = []
+            for k, sub in enumerate([*solution.sub_trajectories, None]):
+                pieces += [
+                    _Piece(index, np.array([solution.start]), MotionSettings(), change=change)
+                    for change in solution.scene_changes
+                    if change.before == k
+                ]
+                if sub is not None:
+                    pieces.append(_Piece(index, np.array([solution.start]), MotionSettings(), sub.trajectory))
             return [(solution.start.copy(), solution.end.copy(), pieces)]
         assert isinstance(stage, BatchPoseIK)
         return self.batch_ik(index, stage, before)
@@ -288,7 +446,7 @@ class _Planner:
                 index, "batch pose IK needs a state before it to solve from (a current state)"
             )
         self.group(index, stage.group)
-        checker = self.check(stage.link_padding)
+        checker = self.check(index, stage.link_padding)
         options = IkOptions(attempts=stage.ik_attempts, rng_seed=stage.seed)
         found: list[np.ndarray] = []
         reasons: list[str] = []
@@ -319,6 +477,9 @@ class _Planner:
     def forward(self, index: int, q_from: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Plan a propagator from ``q_from``: (rows, end state)."""
         stage = self.task.stages[index]
+        self.begin(index)
+        if isinstance(stage, AllowCollisions):
+            return q_from[None, :].copy(), q_from
         try:
             if isinstance(stage, MoveAlongFrameAxis):
                 return self.along_axis(index, stage, q_from, backwards=False)
@@ -328,7 +489,7 @@ class _Planner:
                 from kinema.motion.inverse_kinematics import IkOptions, ik
 
                 self.group(index, stage.motion.group)
-                checker = self.check(stage.motion.link_padding)
+                checker = self.check(index, stage.motion.link_padding)
                 world_T_target = self.world_T(stage.target, q_from)
                 q_goal = ik(
                     self.model,
@@ -347,6 +508,9 @@ class _Planner:
     def backward(self, index: int, q_to: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Plan a propagator that must end at ``q_to``: (rows, start state)."""
         stage = self.task.stages[index]
+        self.begin(index)
+        if isinstance(stage, AllowCollisions):
+            return q_to[None, :].copy(), q_to
         if not isinstance(stage, MoveAlongFrameAxis):
             raise _StageFailure(
                 index,
@@ -364,9 +528,13 @@ class _Planner:
         from kinema.motion.planner import PlanningOptions, plan_joint_goal
 
         g = self.group(index, motion.group)
-        checker = self.check(motion.link_padding)
+        checker = self.check(index, motion.link_padding)
+        # The search gets its own planning time, or what is left of the task's timeout when that is less.
+        left = self.deadline - time.monotonic()
+        if left <= 0:
+            raise _StageFailure(index, f"the task's planning timeout of {self.timeout:.2f} s ran out")
         path = plan_joint_goal(
-            checker, q_from, goal, motion.group, PlanningOptions(timeout=motion.planning_time)
+            checker, q_from, goal, motion.group, PlanningOptions(timeout=min(motion.planning_time, left))
         )
         rows = np.repeat(q_from[None, :], len(path.positions), axis=0)
         rows[:, list(g.indices)] = path.positions
@@ -386,7 +554,7 @@ class _Planner:
         target = hand.copy()
         sign = -1.0 if backwards else 1.0
         target[:3, 3] += sign * stage.max_distance * direction
-        checker = self.check(stage.motion.link_padding, stage.ignore_environment_collisions)
+        checker = self.check(index, stage.motion.link_padding, stage.ignore_environment_collisions)
         result = plan_cartesian_path(checker, q, [target], stage.motion.group, stage.hand_frame)
         reached = result.fraction * stage.max_distance
         if reached < stage.min_distance - 1e-4:
@@ -433,21 +601,30 @@ class _Planner:
         g = generators[0]
         failures: list[_StageFailure] = []
         candidates = self.generate(g, before)
-        for start, end, own in candidates:
+        self.solved(g, f"{len(candidates)} solutions" if len(candidates) > 1 else "")
+        for k, (start, end, own) in enumerate(candidates, start=1):
             try:
                 pieces: list[_Piece] = []
                 q = start
                 for i in reversed([m for m in members if m < g]):
                     rows, q = self.backward(i, q)
-                    pieces.insert(0, _Piece(i, rows, self.task.stages[i].motion))
-                    self.status[i] = ("planned", "")
+                    pieces.insert(0, self.piece(i, rows))
+                    self.solved(i)
                 first = q
                 _, last, after = self.propagate([m for m in members if m > g], [], end)
-                self.status[g] = ("planned", f"{len(candidates)} candidate(s)" if len(candidates) > 1 else "")
+                if len(candidates) > 1:
+                    self.status[g] = ("solved", f"solution {k} of {len(candidates)} used")
+                    self._tell()
                 return first, last, pieces + own + after
             except _StageFailure as failure:
                 failures.append(failure)
-                if self.stop():
+                if len(candidates) > 1:
+                    self.gave_up(
+                        failure.index,
+                        f"with solution {k} of {len(candidates)} of {self.task.stages[g].name!r}: "
+                        f"{failure.reason}",
+                    )
+                if self.stop() or time.monotonic() >= self.deadline:
                     break
         if len(failures) == 1:
             raise failures[0]
@@ -464,13 +641,14 @@ class _Planner:
         start = q
         for i in members:
             rows, q = self.forward(i, q)
-            pieces.append(_Piece(i, rows, self.task.stages[i].motion))
-            self.status[i] = ("planned", "")
+            pieces.append(self.piece(i, rows))
+            self.solved(i)
         return start, q, pieces
 
     def connect(self, index: int, q_from: np.ndarray, q_to: np.ndarray) -> _Piece:
         stage = self.task.stages[index]
         assert isinstance(stage, Connect)
+        self.begin(index)
         g = self.group(index, stage.motion.group)
         others = [i for i in range(len(q_from)) if i not in set(g.indices)]
         differ = [self.model.joint_names[i] for i in others if abs(q_from[i] - q_to[i]) > JOIN_TOLERANCE]
@@ -484,12 +662,13 @@ class _Planner:
             rows, _ = self.joint_motion(index, stage.motion, q_from, q_to)
         except MotionError as error:
             raise _StageFailure(index, str(error)) from error
-        self.status[index] = ("planned", "")
+        self.solved(index)
         return _Piece(index, rows, stage.motion)
 
     def run(self) -> tuple[np.ndarray, np.ndarray, list[_Piece]]:
         if not self.task.stages:
             raise _StageFailure(0, "the task has no stages")
+        self.resolve_rules()
         start: np.ndarray | None = None
         end: np.ndarray | None = None
         pieces: list[_Piece] = []
@@ -520,6 +699,8 @@ def plan_task(
     *,
     frames: Mapping[str, np.ndarray] | None = None,
     stop: Callable[[], bool] | None = None,
+    progress: Callable[[tuple[StageReport, ...]], None] | None = None,
+    timeout: float | None = None,
 ) -> TaskSolution:
     """Plan ``task`` into a solution against ``checker``'s planning scene.
 
@@ -530,6 +711,10 @@ def plan_task(
         frames: named fixed frames (objects, cameras) target poses may be given in, besides the robot's
             links and ``world``.
         stop: called between steps; planning stops with an error when it returns True.
+        progress: called (on the planning thread) whenever a stage's state changes, with every stage's
+            report; it must not block.
+        timeout: seconds the whole task may take (MTC's task timeout): no stage starts after it, and a
+            search for a collision-free motion gets at most what is left of it.
 
     Raises:
         TaskPlanningError: naming the stage that failed and why; ``reports`` holds every stage's status.
@@ -537,18 +722,23 @@ def plan_task(
     from kinema.motion.timing import time_parameterize
 
     began = time.monotonic()
-    planner = _Planner(task, checker, frames or {}, stop or (lambda: False))
+    planner = _Planner(task, checker, frames or {}, stop or (lambda: False), progress, timeout)
     padding = checker.padding
     try:
         start, end, pieces = planner.run()
         subs: list[SubTrajectory] = []
+        changes: list[SceneChange] = []
         for piece in pieces:
             stage = task.stages[piece.index]
+            if piece.change is not None:
+                changes.append(replace(piece.change, before=len(subs)))
+                continue
             if piece.timed is not None:
                 subs.append(SubTrajectory(stage.name, piece.timed))
                 continue
             g = planner.model.group(piece.motion.group)
             path = JointPath(g.joint_names, piece.rows[:, list(g.indices)])
+            timing_began = time.monotonic()
             try:
                 trajectory = time_parameterize(
                     path,
@@ -559,30 +749,26 @@ def plan_task(
                 )
             except MotionError as error:
                 raise _StageFailure(piece.index, f"timing failed: {error}") from error
+            planner.add_seconds(piece.index, time.monotonic() - timing_began)
             subs.append(SubTrajectory(stage.name, trajectory))
     except _StageFailure as failure:
-        planner.status[failure.index] = ("failed", failure.reason)
-        reports = _reports(task, planner.status)
+        planner.failed(failure.index, failure.reason)
+        reports = planner.reports()
         raise TaskPlanningError(
             f"task {task.task_id!r}: {planner.label(failure.index)} failed: {failure.reason}", reports
         ) from None
     finally:
         checker.padding = padding
+        checker.allowed_collisions = planner.default_allowed
     solution = TaskSolution(
         task.task_id,
         tuple(planner.model.joint_names),
         start,
         end,
         tuple(subs),
-        _reports(task, planner.status),
+        planner.reports(),
         time.monotonic() - began,
+        tuple(changes),
     )
     solution.joined()  # proves the sub-trajectories meet
     return solution
-
-
-def _reports(task: Task, status: Mapping[int, tuple[str, str]]) -> tuple[StageReport, ...]:
-    return tuple(
-        StageReport(i, stage.name, stage_kind(stage), *status.get(i, ("not planned", "")))
-        for i, stage in enumerate(task.stages)
-    )

@@ -9,7 +9,10 @@ stages. Three kinds:
   state after them): :class:`MoveAlongFrameAxis` always; :class:`PlanToJointState` and :class:`PlanToPose`
   only forwards;
 - **connectors** (:class:`Connect`) join the state before them to the state after them with a
-  collision-free joint-space motion.
+  collision-free joint-space motion;
+- **scene changes** (:class:`AllowCollisions`) move nothing: they change the collision rules of the
+  stages after them (a gripper may touch the object it grasps), and the solution records them between
+  its motions.
 
 Poses are ``(frame, frame_T_pose)`` pairs: the frame (``world``, a robot link such as ``grasp_link``, or
 another named frame) is resolved when the task is planned, at the state the stage starts from.
@@ -165,15 +168,48 @@ class BatchPoseIK:
             )
 
 
+@dataclass(frozen=True, eq=False)
+class AllowCollisions:
+    """Scene change: contacts between ``first`` and ``second`` are allowed (or, with ``allow=False``,
+    checked again) in the stages after this one.
+
+    Names are robot links, planning groups that list their links in the SRDF (``gripper`` on lab_sim),
+    or planning-scene objects (an object's id stands for all its shapes).
+    """
+
+    first: Sequence[str]
+    second: Sequence[str]
+    allow: bool = True
+    name: str = "allow collisions"
+
+    def __post_init__(self) -> None:
+        if not self.first or not self.second:
+            raise MotionError(f"{self.name}: name what may touch what: both sides need at least one name")
+
+    def describe(self) -> str:
+        """One line for a person: ``collisions allowed: gripper - cube``."""
+        verb = "allowed" if self.allow else "checked again"
+        return f"collisions {verb}: {', '.join(self.first)} - {', '.join(self.second)}"
+
+
 Stage = (
-    CurrentState | FromSolution | PlanToJointState | PlanToPose | Connect | MoveAlongFrameAxis | BatchPoseIK
+    CurrentState
+    | FromSolution
+    | PlanToJointState
+    | PlanToPose
+    | Connect
+    | MoveAlongFrameAxis
+    | BatchPoseIK
+    | AllowCollisions
 )
 
 GENERATORS = (CurrentState, FromSolution, BatchPoseIK)
 
 
 def stage_kind(stage: Stage) -> str:
-    """A short word for the stage's role: ``generator``, ``propagator`` or ``connector``."""
+    """A short word for the stage's role: ``generator``, ``propagator``, ``connector`` or ``scene``."""
     if isinstance(stage, GENERATORS):
         return "generator"
+    if isinstance(stage, AllowCollisions):
+        return "scene"
     return "connector" if isinstance(stage, Connect) else "propagator"

@@ -27,6 +27,9 @@ BLACKBOARD = "/objective_server/blackboard"
 BLACKBOARD_TYPE = "kinema_msgs/msg/BlackboardSnapshot"
 LOG = "/objective_server/log"
 LOG_TYPE = "moveit_studio_agent_msgs/msg/Log"
+# The task PlanMTCTask plans, stage by stage, while it plans (the TUI's task panel).
+TASK_PLANNING = "/kinema/task_planning"
+TASK_PLANNING_TYPE = "kinema_msgs/msg/TaskPlanningStatus"
 
 LIST_OBJECTIVES = "/objective_server/list_objectives"
 LIST_OBJECTIVES_TYPE = "kinema_msgs/srv/ListObjectives"

@@ -38,6 +38,7 @@ from kinema.tui.connection import (
     ReloadNotice,
     RuntimeConnection,
     RuntimeEvent,
+    TaskPlanning,
 )
 from kinema.tui.dialogs.confirm import ConfirmDialog
 from kinema.tui.messages import ModeSelected, RuntimeCallFailed, RuntimeCallSucceeded, RuntimeEventsArrived
@@ -69,6 +70,7 @@ class EventInbox:
     heartbeat_key: tuple[str, str] = ("", "")
     clock: ClockSample | None = None
     blackboard: BlackboardSnapshot | None = None
+    task_planning: TaskPlanning | None = None
     signalled: bool = False
 
     def put(self, event: RuntimeEvent) -> bool:
@@ -88,6 +90,8 @@ class EventInbox:
                 self.clock = event
             elif isinstance(event, BlackboardSnapshot):
                 self.blackboard = event
+            elif isinstance(event, TaskPlanning):
+                self.task_planning = event
             else:
                 self.ordered.append(event)
             wake = not self.signalled
@@ -95,14 +99,14 @@ class EventInbox:
             return wake
 
     def drain(self) -> list[RuntimeEvent]:
-        """Take everything queued, in order, with the newest heartbeat/clock/blackboard last."""
+        """Take everything queued, in order, with the newest heartbeat/clock/blackboard/task last."""
         with self.lock:
             events: list[RuntimeEvent] = self.ordered
             self.ordered = []
-            for latest in (self.heartbeat, self.clock, self.blackboard):
+            for latest in (self.heartbeat, self.clock, self.blackboard, self.task_planning):
                 if latest is not None:
                     events.append(latest)
-            self.heartbeat = self.clock = self.blackboard = None
+            self.heartbeat = self.clock = self.blackboard = self.task_planning = None
             self.signalled = False
             return events
 
@@ -165,6 +169,8 @@ class KinemaApp(App[None]):
         self.node_statuses: dict[str, dict[tuple[int, str], NodeStatusUpdate]] = {}
         # The last run of each objective that failed or was cancelled, until it runs again.
         self.outcomes: dict[str, RunOutcome] = {}
+        # The task PlanMTCTask plans (or planned last) in the current run; None before one.
+        self.task_planning: TaskPlanning | None = None
         self.inbox = EventInbox()
         self.views: list[KinemaScreen] = []
         self.sub_title = connection.endpoint + ("  (closing stops the runtime)" if owns_runtime else "")
@@ -228,6 +234,7 @@ class KinemaApp(App[None]):
                 if self.status.apply_heartbeat(event):
                     self.node_statuses.pop(event.objective_name, None)
                     self.outcomes.pop(event.objective_name, None)
+                    self.task_planning = None
                     name = event.objective_name
                     self._views_call(lambda view: view.runtime_run_started(name))  # noqa: B023 - called now
                 if not was_connected:
@@ -257,17 +264,28 @@ class KinemaApp(App[None]):
                 self._views_call(lambda view: view.runtime_objectives_changed())
             elif isinstance(event, ApprovalRequested):
                 self.ask_approval(event)
+            elif isinstance(event, TaskPlanning):
+                self.task_planning = event
+                self._views_call(lambda view: view.runtime_task_planning(event))  # noqa: B023 - called now
         if status_changed:
             for view in self.views:
                 view.show_status(self.status)
 
     def ask_approval(self, request: ApprovalRequested) -> None:
-        """Show a behavior's question (approve a motion, resume a breakpoint); the answer goes back to it."""
+        """Show a behavior's question (approve a motion, resume a breakpoint); the answer goes back to it.
+
+        A question about a planned motion lists its steps (stage, duration, joints, gripper changes).
+        """
 
         def answered(approved: bool | None) -> None:
             request.answer(bool(approved), "" if approved else "declined in the TUI")
 
         question = f"{request.prompt}\n({request.behavior} at {request.node_path})"
+        if request.steps:
+            from kinema.tui.dialogs.approval import ApprovalDialog
+
+            self.push_screen(ApprovalDialog(question, request.steps, request.duration), answered)
+            return
         self.push_screen(ConfirmDialog(question, confirm_label="Approve"), answered)
 
     def add_log(self, entry: LogEntry, *, toast: bool = False) -> None:

@@ -213,6 +213,67 @@ class ObjectivesChanged:
 
 
 @dataclass(frozen=True)
+class TaskStage:
+    """A stage of a task being planned (``kinema_msgs/TaskStageStatus``).
+
+    Attributes:
+        name: the stage's name (``connect``, ``approach``).
+        type: its type (``MoveAlongFrameAxis``).
+        kind: ``generator``, ``propagator`` or ``connector``.
+        state: ``waiting``, ``planning``, ``solved`` or ``failed``.
+        seconds: time spent planning it so far.
+        comment: why it failed, or how a candidate fared.
+    """
+
+    name: str
+    type: str = ""
+    kind: str = ""
+    state: str = "waiting"
+    seconds: float = 0.0
+    comment: str = ""
+
+
+@dataclass(frozen=True)
+class TaskPlanning:
+    """The task PlanMTCTask plans, stage by stage (``/kinema/task_planning``); the newest replaces the last.
+
+    Attributes:
+        task_id: the task's id.
+        node_path: the PlanMTCTask node planning it.
+        state: ``planning``, ``solved`` or ``failed``.
+        seconds: since planning started.
+        message: why it failed ("" otherwise).
+        stages: the stages, in order.
+    """
+
+    task_id: str
+    node_path: str
+    state: str
+    seconds: float
+    message: str = ""
+    stages: tuple[TaskStage, ...] = ()
+
+
+@dataclass(frozen=True)
+class SolutionStep:
+    """One motion of a solution shown for approval (``kinema_msgs/SolutionStep``).
+
+    Attributes:
+        stage: the stage that planned it.
+        duration: seconds.
+        joint_names: the joints it moves.
+        gripper: what the gripper does during it ("" when it holds still).
+        note: for a change between motions (collision rules) instead of a motion, what changed.
+    """
+
+    stage: str
+    duration: float
+    joint_names: tuple[str, ...] = ()
+    gripper: str = ""
+    note: str = ""
+
+
+@dataclass(frozen=True)
 class ApprovalRequested:
     """A behavior asks the user (WaitForMTCSolutionApproval, BreakpointSubscriber) and waits for the answer.
 
@@ -221,12 +282,16 @@ class ApprovalRequested:
         behavior: the behavior ID that asks.
         node_path: its node in the running tree.
         answer: call once with ``(approved, message)``; any thread.
+        steps: the planned motion being approved, motion by motion (empty when it is not a motion).
+        duration: the whole motion's duration, seconds.
     """
 
     prompt: str
     behavior: str
     node_path: str
     answer: Callable[[bool, str], None] = field(compare=False, repr=False)
+    steps: tuple[SolutionStep, ...] = ()
+    duration: float = 0.0
 
 
 RuntimeEvent = (
@@ -239,6 +304,7 @@ RuntimeEvent = (
     | ReloadNotice
     | ObjectivesChanged
     | ApprovalRequested
+    | TaskPlanning
 )
 EventListener = Callable[[RuntimeEvent], None]
 

@@ -40,6 +40,9 @@ from kinema.tui.connection import (
     PortSummary,
     ReloadNotice,
     RuntimeEvent,
+    SolutionStep,
+    TaskPlanning,
+    TaskStage,
     WaypointSummary,
 )
 
@@ -219,6 +222,7 @@ class SdkConnection:
             )
             node.create_subscription(names.LOG_TYPE, names.LOG, self._on_log)
             node.create_subscription(names.CLOCK_TYPE, names.CLOCK, self._on_clock)
+            node.create_subscription(names.TASK_PLANNING_TYPE, names.TASK_PLANNING, self._on_task_planning)
             # While the TUI is attached it is the user the approval behaviors ask (see ui/approval.py
             # of the core behaviors): each request waits for the dialog's answer.
             node.create_service(
@@ -248,8 +252,41 @@ class SdkConnection:
             if not responder.done:
                 responder.reply({"approved": approved, "message": message})
 
+        steps = tuple(
+            SolutionStep(
+                str(step.stage),
+                float(step.duration),
+                tuple(str(n) for n in step.joint_names),
+                str(step.gripper),
+                str(step.note),
+            )
+            for step in request.steps
+        )
         self._emit(
-            ApprovalRequested(str(request.prompt), str(request.behavior), str(request.node_path), answer)
+            ApprovalRequested(
+                str(request.prompt),
+                str(request.behavior),
+                str(request.node_path),
+                answer,
+                steps,
+                float(request.duration),
+            )
+        )
+
+    def _on_task_planning(self, message: Any) -> None:
+        stages = tuple(
+            TaskStage(str(s.name), str(s.type), str(s.kind), str(s.state), float(s.seconds), str(s.comment))
+            for s in message.stages
+        )
+        self._emit(
+            TaskPlanning(
+                str(message.task_id),
+                str(message.node_path),
+                str(message.state),
+                float(message.seconds),
+                str(message.message),
+                stages,
+            )
         )
 
     def _on_heartbeat(self, message: Any) -> None:

@@ -154,6 +154,46 @@ def test_setup_behaviors_need_a_task_and_valid_values(behavior: Any, context: Be
     assert run.status == NodeStatus.FAILURE and "needs a solution PlanMTCTask planned" in run.toasts[-1]
 
 
+@pytest.mark.parametrize(
+    ("behavior_id", "ports", "expected"),
+    [
+        (
+            "SetupMTCConnectWithProRRT",
+            {"velocity_scale_factor": 0.5, "link_padding": 0.02, "trajectory_sampling_rate": 50, "seed": 7},
+            {"velocity_scale": 0.5, "link_padding": 0.02, "sample_period": 0.02, "seed": 7},
+        ),
+        (
+            "SetupMTCMoveAlongFrameAxis",
+            {"velocity_scale": 0.3, "acceleration_scale": 0.4, "planning_group_name": "manipulator"},
+            {"velocity_scale": 0.3, "acceleration_scale": 0.4, "link_padding": 0.0},
+        ),
+        (
+            "SetupMTCPlanToRobotState",
+            {
+                "joint_state": {"robotiq_85_left_knuckle_joint": 0.7},
+                "planning_group_name": "gripper",
+            },
+            {"group": "gripper", "velocity_scale": 1.0, "link_padding": 0.01},
+        ),
+    ],
+)
+def test_setup_behaviors_read_their_motion_ports_into_the_stage(
+    behavior: Any, context: BehaviorContext, behavior_id: str, ports: dict[str, Any], expected: dict[str, Any]
+) -> None:
+    task = tick_behavior(behavior("InitializeMTCTask"), {"task_id": "t"}, context=context).outputs["task"]
+    run = tick_behavior(behavior(behavior_id), {"task": task, **ports}, context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    motion = run.outputs["task"].stages[-1].motion
+    assert {key: getattr(motion, key) for key in expected} == pytest.approx(expected)
+    if "trajectory_sampling_rate" in ports:
+        bad = tick_behavior(
+            behavior(behavior_id), {"task": task, "trajectory_sampling_rate": 0}, context=context
+        )
+        assert (
+            bad.status == NodeStatus.FAILURE and "trajectory_sampling_rate must be positive" in bad.toasts[-1]
+        )
+
+
 def test_a_solution_is_replayed_only_from_where_it_starts(
     registry: Any, behavior: Any, context: BehaviorContext, look_at_table: dict[str, float]
 ) -> None:

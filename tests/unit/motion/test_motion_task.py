@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from collections.abc import Callable
 
 import numpy as np
@@ -11,6 +12,7 @@ from kinema.motion import CollisionChecker, RobotModel, fk
 from kinema.motion.planning_scene import CollisionObject
 from kinema.motion.task import Task, TaskPlanningError, TaskSolution, plan_task
 from kinema.motion.task_stages import (
+    AllowCollisions,
     BatchPoseIK,
     Connect,
     CurrentState,
@@ -38,12 +40,18 @@ def grasp(model: RobotModel, waypoint_q: Callable[[str], np.ndarray]) -> np.ndar
     return pose
 
 
-def pick_task(start: np.ndarray, poses: list[np.ndarray], velocity_scale: float = 1.0) -> Task:
+def pick_task(
+    start: np.ndarray, poses: list[np.ndarray], velocity_scale: float = 1.0, acceleration_scale: float = 1.0
+) -> Task:
     return Task(
         "pick",
         [
             CurrentState(start),
-            Connect(MotionSettings(link_padding=0.0, velocity_scale=velocity_scale)),
+            Connect(
+                MotionSettings(
+                    link_padding=0.0, velocity_scale=velocity_scale, acceleration_scale=acceleration_scale
+                )
+            ),
             MoveAlongFrameAxis(
                 (0, 0, 1),
                 "grasp_link",
@@ -74,7 +82,7 @@ def test_a_pick_task_approaches_the_grasp_in_a_straight_line_and_ends_there(
 ) -> None:
     solution = plan_task(pick_task(start, [grasp]), checker)
     assert [s.stage for s in solution.sub_trajectories] == ["connect", "approach"]
-    assert [r.status for r in solution.reports] == ["planned"] * 4, solution.reports
+    assert [r.status for r in solution.reports] == ["solved"] * 4, solution.reports
     end = fk(model, solution.end, "grasp_link")
     assert np.linalg.norm(end[:3, 3] - CUBE) < 1e-3, end[:3, 3]
     # The approach: 10 cm along the grasp's z axis, on a straight line.
@@ -96,7 +104,7 @@ def test_a_pick_task_approaches_the_grasp_in_a_straight_line_and_ends_there(
     assert checker.first_invalid(full, 0.01) is None
 
 
-def test_velocity_scaling_slows_the_stage_it_is_set_on(
+def test_velocity_and_acceleration_scaling_slow_the_stage_they_are_set_on(
     checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray
 ) -> None:
     fast = plan_task(pick_task(start, [grasp]), checker)
@@ -105,6 +113,10 @@ def test_velocity_scaling_slows_the_stage_it_is_set_on(
     assert slow.sub_trajectories[1].trajectory.duration == pytest.approx(
         fast.sub_trajectories[1].trajectory.duration, rel=0.05
     )
+    gentle = plan_task(pick_task(start, [grasp], acceleration_scale=0.05), checker)
+    fast_connect, gentle_connect = fast.sub_trajectories[0].trajectory, gentle.sub_trajectories[0].trajectory
+    assert gentle_connect.duration > 1.5 * fast_connect.duration
+    assert np.abs(gentle_connect.accelerations).max() < 0.5 * np.abs(fast_connect.accelerations).max()
 
 
 def test_batch_pose_ik_takes_the_reachable_pose_closest_to_the_state_before(
@@ -129,7 +141,45 @@ def test_batch_pose_ik_takes_the_reachable_pose_closest_to_the_state_before(
     assert (
         "stage 4 of 4 ('grasp pose IK')" in message and "pose 1 of 2" in message and "pose 2 of 2" in message
     )
-    assert [r.status for r in failure.value.reports] == ["planned", "not planned", "not planned", "failed"]
+    assert [r.status for r in failure.value.reports] == ["solved", "waiting", "waiting", "failed"]
+
+
+def test_progress_reports_each_stage_waiting_planning_then_solved_or_failed(
+    checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray
+) -> None:
+    seen: list[tuple[tuple[str, str, float, str], ...]] = []
+
+    def keep(reports: tuple) -> None:  # type: ignore[type-arg]
+        seen.append(tuple((r.name, r.status, r.seconds, r.comment) for r in reports))
+
+    solution = plan_task(pick_task(start, [grasp]), checker, progress=keep)
+    names = ["current state", "connect", "approach", "grasp pose IK"]
+    assert [s[0] for s in seen[0]] == names
+    assert seen[0][-1][1] == "waiting", seen[0]  # the IK stage waits while the start is read
+    for i, name in enumerate(names):
+        states = [snapshot[i][1] for snapshot in seen]
+        # Each stage is waiting until it is planned, then planning, then solved for good.
+        first_planning = states.index("planning")
+        assert set(states[:first_planning]) <= {"waiting"}, (name, states)
+        assert states[-1] == "solved" and "failed" not in states, (name, states)
+    assert [r.stage_type for r in solution.reports] == [
+        "CurrentState",
+        "Connect",
+        "MoveAlongFrameAxis",
+        "BatchPoseIK",
+    ]
+    connect = solution.reports[1]
+    assert connect.seconds > 0 and sum(r.seconds for r in solution.reports) <= solution.planning_seconds
+
+    unreachable = grasp.copy()
+    unreachable[:3, 3] = [4.0, 3.0, 0.8]
+    seen.clear()
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(pick_task(start, [unreachable, unreachable]), checker, progress=keep)
+    last = {name: (status, comment) for name, status, _, comment in seen[-1]}
+    assert last["grasp pose IK"][0] == "failed" and "pose 2 of 2" in last["grasp pose IK"][1], last
+    assert last["connect"][0] == "waiting" and last["approach"][0] == "waiting", last
+    assert [r.status for r in failure.value.reports] == [s[1] for s in seen[-1]]
 
 
 def test_moving_along_a_frame_axis_fails_below_min_distance_with_the_share_reached(
@@ -202,6 +252,81 @@ def test_plan_to_pose_and_to_joint_state_go_forwards_and_a_pose_inside_an_obstac
             checker,
         )
     assert "stage 2 of 2 ('plan to pose')" in str(failure.value) and "no IK solution" in str(failure.value)
+
+
+def test_a_connect_with_no_way_through_fails_naming_it_after_its_planning_time(
+    model: RobotModel, checker: CollisionChecker, waypoint_q: Callable[[str], np.ndarray]
+) -> None:
+    """A wall across the rail (above its pedestal, everywhere else) parts two states of the carriage."""
+    home = waypoint_q("Home")
+    rail = model.index("linear_rail_joint")
+    here, there = home.copy(), home.copy()
+    here[rail], there[rail] = model.lower[rail] + 0.1, model.upper[rail] - 0.1
+    a, b = fk(model, here, "base_link")[:3, 3], fk(model, there, "base_link")[:3, 3]
+    along = (b - a) / np.linalg.norm(b - a)  # the rail's direction in the world, whichever it is
+    pedestal_top = fk(model, here, "linear_rail_carriage_link")[2, 3]
+    wall = np.eye(4)
+    wall[:3, :3] = np.column_stack([along, np.cross([0.0, 0.0, 1.0], along), [0.0, 0.0, 1.0]])
+    wall[:3, 3] = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2, pedestal_top + 0.02 + 2.0]
+    checker.scene.add(CollisionObject("wall", "box", (0.01, 4.0, 2.0), wall))
+    assert checker.is_valid(here) and checker.is_valid(there), checker.describe(here) + checker.describe(
+        there
+    )
+    task = Task(
+        "cross",
+        [CurrentState(here), Connect(MotionSettings(planning_time=0.2)), CurrentState(there, name="there")],
+    )
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(task, checker)
+    message = str(failure.value)
+    assert "stage 2 of 3 ('connect')" in message and "no collision-free path found within 0.20 s" in message
+    assert [r.status for r in failure.value.reports] == ["solved", "failed", "solved"], failure.value.reports
+
+    # The task's timeout cuts a longer search short: the connect searches only what is left of it.
+    patient = Task(
+        "cross", [CurrentState(here), Connect(MotionSettings(planning_time=30.0)), CurrentState(there)]
+    )
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(patient, checker, timeout=0.3)
+    message = str(failure.value)
+    assert "stage 2 of 3 ('connect')" in message, message
+    assert re.search(r"within 0\.[0-3]\d s|planning timeout of 0\.30 s ran out", message), message
+
+
+def test_collisions_allowed_by_a_scene_change_hold_for_the_stages_after_it_only(
+    model: RobotModel, checker: CollisionChecker, start: np.ndarray, grasp: np.ndarray
+) -> None:
+    # A box the gripper closes around: at the grasp, the gripper's links touch it.
+    checker.scene.add(CollisionObject("box", "box", (0.06, 0.06, 0.06), _at(*grasp[:3, 3])))
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(pick_task(start, [grasp]), checker)
+    assert "('grasp pose IK')" in str(failure.value), str(failure.value)
+
+    stages = pick_task(start, [grasp]).stages
+    allow = AllowCollisions(["gripper"], ["box"], name="touch the box")
+    solution = plan_task(Task("pick", [*stages[:2], allow, *stages[2:]]), checker)
+    assert [s.stage for s in solution.sub_trajectories] == ["connect", "approach"]
+    (change,) = solution.scene_changes
+    assert change.stage == "touch the box" and change.before == 1, change
+    assert change.description == "collisions allowed: gripper - box"
+    assert frozenset(("robotiq_85_left_finger_link", "box")) in change.allowed
+    assert checker.allowed_collisions == frozenset(), "planning restores the checker's rules"
+    # The connect, planned before the change, keeps clear of the box; the grasp touches it.
+    checker.padding = 0.0
+    connect = solution.sub_trajectories[0].trajectory
+    rows = np.repeat(solution.start[None, :], len(connect.times), axis=0)
+    rows[:, [model.index(n) for n in connect.joint_names]] = connect.positions
+    assert checker.first_invalid(rows, 0.01) is None
+    assert "box" in checker.describe(solution.end)
+    # Replayed, the change comes along in its place.
+    replay = plan_task(Task("replay", [FromSolution(solution)]), checker)
+    assert [(c.description, c.before) for c in replay.scene_changes] == [(change.description, 1)]
+
+    with pytest.raises(TaskPlanningError) as failure:
+        plan_task(Task("typo", [CurrentState(start), AllowCollisions(["griper"], ["box"])]), checker)
+    message = str(failure.value)
+    assert "stage 2 of 2 ('allow collisions')" in message and "'griper'" in message, message
+    assert "gripper" in message.split("'griper'")[1], message  # the likely name is suggested
 
 
 def _at(x: float, y: float, z: float, like: np.ndarray | None = None) -> np.ndarray:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import time
 from typing import Any
 
 from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, SyncBehavior, input_port, output_port
@@ -14,13 +13,14 @@ from ..motion.planned_trajectory import publish_planned_trajectory
 from ..motion.planning_resources import collision_checker, robot_model
 from ..poses.frame_tree import current_frame_tree
 from .mtc_task import CurrentStateMarker, task_input
+from .progress import TaskProgress
 from .setup_stages import SUBCATEGORY
 
 DEFAULT_PADDING = 0.01
 
 
 def _stage_summary(reports: Any) -> str:
-    marks = {"planned": "ok", "failed": "FAILED", "not planned": "-"}
+    marks = {"solved": "ok", "failed": "FAILED", "waiting": "-", "planning": "…"}
     return "; ".join(f"{r.index + 1}. {r.name}: {marks.get(r.status, r.status)}" for r in reports)
 
 
@@ -43,7 +43,9 @@ class PlanMTCTask(AsyncBehavior):
 
     Poses are resolved in the frames of the cell when planning starts (robot links at the current state,
     simulated objects, scene objects). The planned motion is published for ``kinema view``, which also
-    draws the tool's path of each stage as a coloured line, and the stages' outcome is logged; a failure
+    draws the tool's path of each stage as a coloured line, and the stages' outcome is logged. While it
+    plans, each stage's state (waiting, planning, solved, failed) and time are published on
+    ``/kinema/task_planning`` for the TUI's task panel. A failure
     names the stage and why (no IK for pose 2 of 3, the Cartesian path stopped at 43 %, no path within the
     planning time).
     """
@@ -64,13 +66,22 @@ class PlanMTCTask(AsyncBehavior):
         ]
 
     def do_work(self) -> bool:
+        try:
+            mtc = task_input(self)
+        except KinemaError as error:
+            return self._fail(str(error))
+        with TaskProgress(self, mtc.task_id, self.full_path) as progress:
+            return self._plan(mtc, progress)
+
+    def _plan(self, mtc: Any, progress: TaskProgress) -> bool:
         from kinema.motion.task import Task, TaskPlanningError, plan_task
         from kinema.motion.task_stages import CurrentState, FromSolution
 
         try:
-            mtc = task_input(self)
             if int(self.get_input("max_solutions")) < 1:
-                return self._fail(f"max_solutions must be at least 1, got {self.get_input('max_solutions')}")
+                return self._fail(
+                    f"max_solutions must be at least 1, got {self.get_input('max_solutions')}", progress
+                )
             model = robot_model(self.context, "PlanMTCTask")
             q = joint_state_monitor(self.context, "PlanMTCTask").positions(model.joint_names)
             tree = current_frame_tree(self)
@@ -83,21 +94,25 @@ class PlanMTCTask(AsyncBehavior):
                     return self._fail(
                         f"the task starts with the solution of {stages[0].name!r}, but the robot is not "
                         f"where that solution starts ({away}); executing it would jump. Start the task with "
-                        "SetupMTCCurrentState and SetupMTCConnectWithProRRT to move there first"
+                        "SetupMTCCurrentState and SetupMTCConnectWithProRRT to move there first",
+                        progress,
                     )
             checker = collision_checker(self.context, "PlanMTCTask", DEFAULT_PADDING)
-            deadline = time.monotonic() + mtc.timeout if mtc.timeout > 0 else float("inf")
             solution = plan_task(
                 Task(mtc.task_id, stages),
                 checker,
                 frames=fixed,
-                stop=lambda: self.stop_requested() or time.monotonic() > deadline,
+                stop=self.stop_requested,
+                progress=progress.update,
+                timeout=mtc.timeout if mtc.timeout > 0 else None,
             )
         except TaskPlanningError as error:
             self.logger.publish_info(f"PlanMTCTask: stages: {_stage_summary(error.reports)}")
+            progress.finish("failed", error.reports, str(error))
             return self._fail(str(error))
         except KinemaError as error:
-            return self._fail(str(error))
+            return self._fail(str(error), progress)
+        progress.finish("solved", solution.reports)
         self.logger.publish_info(
             f"PlanMTCTask: planned task {mtc.task_id!r} in {solution.planning_seconds:.2f} s: "
             f"{_stage_summary(solution.reports)}"
@@ -107,7 +122,9 @@ class PlanMTCTask(AsyncBehavior):
         publish_stage_paths(self, solution, model)
         return True
 
-    def _fail(self, reason: str) -> bool:
+    def _fail(self, reason: str, progress: TaskProgress | None = None) -> bool:
+        if progress is not None:
+            progress.finish("failed", (), reason)
         self.logger.publish_failure(f"PlanMTCTask: planning failed: {reason}")
         return False
 

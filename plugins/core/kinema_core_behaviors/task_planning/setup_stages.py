@@ -7,6 +7,7 @@ not a PoseStamped) fail the behavior naming the port.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
 from typing import Any
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, bidirectional_port, input_port, output_port
@@ -19,21 +20,127 @@ from .mtc_task import CurrentStateMarker, MtcTask, stage_name, task_input
 SUBCATEGORY = "Motion - Task Planning"
 
 
-def _task_port() -> PortInfo:
-    return bidirectional_port("task", None, "{mtc_task}", "The MTC task to add the stage to.")
+@dataclass(frozen=True)
+class MotionPorts:
+    """The ports a stage's motion settings come from, declared once: :meth:`ports` lists them and
+    :meth:`read` builds the :class:`~kinema.motion.task_stages.MotionSettings` from the same names.
 
+    MoveIt Pro names them differently per behavior (``velocity_scale_factor`` on the planning stages,
+    ``velocity_scale`` on SetupMTCMoveAlongFrameAxis), and not every stage has every one.
 
-def _rate_to_period(rate: Any) -> float:
-    rate = float(rate)
-    if not rate > 0:
-        raise KinemaError(f"trajectory_sampling_rate must be positive (points per second), got {rate}")
-    return 1.0 / rate
+    Attributes:
+        velocity: the velocity scale port, or None (full speed).
+        acceleration: the acceleration scale port, or None.
+        planning: the ports of a planned motion: ``link_padding``, ``trajectory_sampling_rate`` and
+            ``max_iterations``; without them the padding is ``padding`` and the sampling period 10 ms.
+        seed: a ``seed`` port (the IK restarts' random seed).
+        padding: the link padding (m) of a stage without a ``link_padding`` port.
+    """
+
+    velocity: str | None = "velocity_scale_factor"
+    acceleration: str | None = "acceleration_scale_factor"
+    planning: bool = True
+    seed: bool = False
+    padding: float = 0.01
+
+    def ports(self) -> list[PortInfo]:
+        ports = [input_port("planning_group_name", str, "manipulator", "The planning group that moves.")]
+        if self.velocity:
+            ports.append(
+                input_port(self.velocity, float, 1.0, "Fraction of the joints' velocity limits, (0, 1].")
+            )
+        if self.acceleration:
+            ports.append(
+                input_port(
+                    self.acceleration, float, 1.0, "Fraction of the joints' acceleration limits, (0, 1]."
+                )
+            )
+        if self.planning:
+            ports += [
+                input_port(
+                    "link_padding", float, 0.01, "Clearance (m) kept between the robot and the scene."
+                ),
+                input_port(
+                    "trajectory_sampling_rate", int, 100, "Points per second of the planned trajectory."
+                ),
+                input_port(
+                    "max_iterations",
+                    int,
+                    5000,
+                    "MoveIt Pro's RRT iteration cap; Kinema's OMPL planner is bounded by time instead (1 s), "
+                    "so it is accepted and has no effect.",
+                ),
+            ]
+        if self.seed:
+            ports.append(
+                input_port(
+                    "seed",
+                    int,
+                    0,
+                    "Seed of the IK restarts (the same seed gives the same solutions); OMPL's RNG is seeded "
+                    "once per process, so a connect that needs OMPL may take another path in another "
+                    "process.",
+                )
+            )
+        return ports
+
+    def read(self, behavior: Any) -> Any:
+        """The motion settings ``behavior``'s ports ask for.
+
+        Raises:
+            KinemaError: a value out of range (a scale factor outside (0, 1], a rate that is not positive).
+        """
+        from kinema.motion.task_stages import MotionSettings
+
+        settings: dict[str, Any] = {"group": str(behavior.get_input("planning_group_name"))}
+        if self.velocity:
+            settings["velocity_scale"] = float(behavior.get_input(self.velocity))
+        if self.acceleration:
+            settings["acceleration_scale"] = float(behavior.get_input(self.acceleration))
+        settings["link_padding"] = (
+            float(behavior.get_input("link_padding")) if self.planning else self.padding
+        )
+        if self.planning:
+            rate = float(behavior.get_input("trajectory_sampling_rate"))
+            if not rate > 0:
+                raise KinemaError(
+                    f"trajectory_sampling_rate must be positive (points per second), got {rate}"
+                )
+            settings["sample_period"] = 1.0 / rate
+        if self.seed:
+            settings["seed"] = int(behavior.get_input("seed"))
+        return MotionSettings(**settings)
 
 
 class _SetupStage(SyncBehavior):
-    """Append the stage :meth:`stage` builds; fail naming the reason when it cannot."""
+    """Append the stage :meth:`stage` builds; fail naming the reason when it cannot.
+
+    A subclass declares its own ports in :meth:`stage_ports` and, when its stage moves the robot, where
+    its motion settings come from in :attr:`MOTION` (read with ``self.motion()``); the ``task`` port and
+    the motion ports are added here.
+    """
 
     subcategory = SUBCATEGORY
+    MOTION: MotionPorts | None = None
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        motion = cls.MOTION.ports() if cls.MOTION is not None else []
+        return [
+            bidirectional_port("task", None, "{mtc_task}", "The MTC task to add the stage to."),
+            *cls.stage_ports(),
+            *motion,
+        ]
+
+    @classmethod
+    def stage_ports(cls) -> list[PortInfo]:
+        """The ports of this stage besides ``task`` and the motion ports."""
+        return []
+
+    def motion(self) -> Any:
+        """The stage's motion settings, read from the ports :attr:`MOTION` declares."""
+        assert self.MOTION is not None, f"{type(self).__name__} declares no motion ports"
+        return self.MOTION.read(self)
 
     def stage(self, task: MtcTask) -> Any:
         raise NotImplementedError
@@ -71,83 +178,29 @@ class InitializeMTCTask(SyncBehavior):
 class SetupMTCCurrentState(_SetupStage):
     """Adds the robot's state when the task is planned as the task's start."""
 
-    @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return [_task_port()]
-
     def stage(self, task: MtcTask) -> Any:
         return CurrentStateMarker()
-
-
-def _motion(behavior: Any, velocity: str, acceleration: str, padding: float, **extra: Any) -> Any:
-    from kinema.motion.task_stages import MotionSettings
-
-    return MotionSettings(
-        group=str(behavior.get_input("planning_group_name")),
-        velocity_scale=float(behavior.get_input(velocity)),
-        acceleration_scale=float(behavior.get_input(acceleration)),
-        link_padding=padding,
-        **extra,
-    )
-
-
-def _planning_ports() -> list[PortInfo]:
-    return [
-        input_port("planning_group_name", str, "manipulator", "The planning group that moves."),
-        input_port("velocity_scale_factor", float, 1.0, "Fraction of the joints' velocity limits, (0, 1]."),
-        input_port(
-            "acceleration_scale_factor", float, 1.0, "Fraction of the joints' acceleration limits, (0, 1]."
-        ),
-        input_port("link_padding", float, 0.01, "Clearance (m) kept between the robot and the scene."),
-        input_port("trajectory_sampling_rate", int, 100, "Points per second of the planned trajectory."),
-        input_port(
-            "max_iterations",
-            int,
-            5000,
-            "MoveIt Pro's RRT iteration cap; Kinema's OMPL planner is bounded by time instead (1 s), so "
-            "it is accepted and has no effect.",
-        ),
-    ]
 
 
 class SetupMTCConnectWithProRRT(_SetupStage):
     """Adds a connect stage: a collision-free joint-space motion between the stages around it."""
 
-    @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return [
-            _task_port(),
-            *_planning_ports(),
-            input_port(
-                "seed",
-                int,
-                0,
-                "Seed of the IK restarts (the same seed gives the same solutions); OMPL's RNG is seeded once "
-                "per process, so a connect that needs OMPL may take another path in another process.",
-            ),
-        ]
+    MOTION = MotionPorts(seed=True)
 
     def stage(self, task: MtcTask) -> Any:
         from kinema.motion.task_stages import Connect
 
-        motion = _motion(
-            self,
-            "velocity_scale_factor",
-            "acceleration_scale_factor",
-            float(self.get_input("link_padding")),
-            sample_period=_rate_to_period(self.get_input("trajectory_sampling_rate")),
-            seed=int(self.get_input("seed")),
-        )
-        return Connect(motion, name=stage_name(task, "connect"))
+        return Connect(self.motion(), name=stage_name(task, "connect"))
 
 
 class SetupMTCPlanToPose(_SetupStage):
     """Adds a stage that moves ``ik_frame`` to ``target_pose`` (IK from several seeds, then a free motion)."""
 
+    MOTION = MotionPorts()
+
     @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
+    def stage_ports(cls) -> list[PortInfo]:
         return [
-            _task_port(),
             message_input(
                 "target_pose", "geometry_msgs/msg/PoseStamped", "{target_pose}", "Where ik_frame goes."
             ),
@@ -158,49 +211,40 @@ class SetupMTCPlanToPose(_SetupStage):
                 "current state",
                 "The stage whose state frames are resolved at (Kinema: the state before this stage).",
             ),
-            *_planning_ports(),
         ]
 
     def stage(self, task: MtcTask) -> Any:
         from kinema.motion.task_stages import PlanToPose
 
         target = pose_matrix(self.get_input("target_pose"), "target_pose")
-        motion = _motion(
-            self,
-            "velocity_scale_factor",
-            "acceleration_scale_factor",
-            float(self.get_input("link_padding")),
-            sample_period=_rate_to_period(self.get_input("trajectory_sampling_rate")),
-        )
         return PlanToPose(
-            target, str(self.get_input("ik_frame")), motion, name=stage_name(task, "plan to pose")
+            target, str(self.get_input("ik_frame")), self.motion(), name=stage_name(task, "plan to pose")
         )
 
 
 class SetupMTCPlanToRobotState(_SetupStage):
     """Adds a stage that moves the planning group to ``joint_state`` (a collision-free motion)."""
 
+    MOTION = MotionPorts(velocity=None, acceleration=None, planning=False)
+
     @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
+    def stage_ports(cls) -> list[PortInfo]:
         return [
-            _task_port(),
             input_port(
                 "joint_state",
                 None,
                 "{target_joint_state}",
                 "The goal (sensor_msgs/JointState, e.g. from RetrieveWaypoint).",
             ),
-            input_port("planning_group_name", str, "manipulator", "The planning group that moves."),
         ]
 
     def stage(self, task: MtcTask) -> Any:
-        from kinema.motion.task_stages import MotionSettings, PlanToJointState
+        from kinema.motion.task_stages import PlanToJointState
 
         goal = joint_positions(self.get_input("joint_state"), "joint_state")
         if not goal:
             raise KinemaError("port [joint_state] names no joint")
-        motion = MotionSettings(group=str(self.get_input("planning_group_name")))
-        return PlanToJointState(goal, motion, name=stage_name(task, "plan to joint state"))
+        return PlanToJointState(goal, self.motion(), name=stage_name(task, "plan to joint state"))
 
 
 class SetupMTCMoveAlongFrameAxis(_SetupStage):
@@ -210,10 +254,11 @@ class SetupMTCMoveAlongFrameAxis(_SetupStage):
     a pose IK stage (an approach) it is planned backwards, so it ends at the pose.
     """
 
+    MOTION = MotionPorts("velocity_scale", "acceleration_scale", planning=False, padding=0.0)
+
     @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
+    def stage_ports(cls) -> list[PortInfo]:
         return [
-            _task_port(),
             input_port("axis_frame", str, "grasp_link", "The frame the axis is given in."),
             input_port("axis_x", float, 0.0, "Axis x component."),
             input_port("axis_y", float, 0.0, "Axis y component."),
@@ -221,11 +266,6 @@ class SetupMTCMoveAlongFrameAxis(_SetupStage):
             input_port("hand_frame", str, "grasp_link", "The robot frame that moves along the axis."),
             input_port("min_distance", float, 0.1, "Least distance (m) the motion must cover."),
             input_port("max_distance", float, 0.1, "Distance (m) to cover when reachable."),
-            input_port("planning_group_name", str, "manipulator", "The planning group that moves."),
-            input_port("velocity_scale", float, 1.0, "Fraction of the joints' velocity limits, (0, 1]."),
-            input_port(
-                "acceleration_scale", float, 1.0, "Fraction of the joints' acceleration limits, (0, 1]."
-            ),
             input_port(
                 "ignore_environment_collisions",
                 bool,
@@ -237,7 +277,6 @@ class SetupMTCMoveAlongFrameAxis(_SetupStage):
     def stage(self, task: MtcTask) -> Any:
         from kinema.motion.task_stages import MoveAlongFrameAxis
 
-        motion = _motion(self, "velocity_scale", "acceleration_scale", 0.0)
         return MoveAlongFrameAxis(
             (
                 float(self.get_input("axis_x")),
@@ -248,7 +287,7 @@ class SetupMTCMoveAlongFrameAxis(_SetupStage):
             str(self.get_input("hand_frame")),
             float(self.get_input("min_distance")),
             float(self.get_input("max_distance")),
-            motion,
+            self.motion(),
             bool(self.get_input("ignore_environment_collisions")),
             name=stage_name(task, "move along frame axis"),
         )
@@ -260,9 +299,8 @@ class SetupMTCBatchPoseIK(_SetupStage):
     """
 
     @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
+    def stage_ports(cls) -> list[PortInfo]:
         return [
-            _task_port(),
             message_vector_input(
                 "target_poses", "geometry_msgs/msg/PoseStamped", "{target_poses}", "Candidate poses."
             ),
@@ -310,11 +348,8 @@ class SetupMTCFromSolution(_SetupStage):
     """Adds an earlier ``solution``'s motions; the task goes on from where it ended."""
 
     @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return [
-            _task_port(),
-            input_port("solution", None, "{solution}", "A solution PlanMTCTask planned."),
-        ]
+    def stage_ports(cls) -> list[PortInfo]:
+        return [input_port("solution", None, "{solution}", "A solution PlanMTCTask planned.")]
 
     def stage(self, task: MtcTask) -> Any:
         from kinema.motion.task import TaskSolution

@@ -24,9 +24,9 @@ import time
 from typing import Any
 
 from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, StatefulBehavior, input_port
-from kinema.errors import TransportError
+from kinema.errors import KinemaError, TransportError
 
-from ..motion.planned_trajectory import publish_planned_trajectory
+from ..task_planning.solution_summary import show_solution, solution_steps
 
 APPROVAL_SERVICE = "/kinema/user_approval"
 APPROVAL_TYPE = "kinema_msgs/srv/RequestApproval"
@@ -103,11 +103,17 @@ class _AskUser(AsyncBehavior):
         )
         return False
 
-    async def ask(self) -> bool:
+    async def ask(self, details: dict[str, Any] | None = None) -> bool:
+        """Ask the user; ``details`` adds request fields (the steps and duration of a motion)."""
         client = approval_client(self)
         if client is None or not await asyncio.to_thread(client.wait_for_service, DISCOVERY_SECONDS):
             return self.granted_without_user()
-        request = {"behavior": self.registration_id, "node_path": self.full_path, "prompt": self.prompt()}
+        request = {
+            "behavior": self.registration_id,
+            "node_path": self.full_path,
+            "prompt": self.prompt(),
+            **(details or {}),
+        }
         try:
             # The user may take their time (an hour at most); halting the node stops waiting for them.
             response = await asyncio.wrap_future(client.call_async(request, ANSWER_SECONDS))
@@ -124,8 +130,10 @@ class _AskUser(AsyncBehavior):
 class WaitForMTCSolutionApproval(_AskUser):
     """Asks the user to approve the planned ``solution`` and succeeds only if they do.
 
-    When the solution is a joint trajectory, it is published for ``kinema view``, which draws the tool's
-    path while the question is open; see the headless rule above.
+    The solution (an MTC solution or a joint trajectory) is drawn in ``kinema view`` while the question is
+    open: its motion, and for an MTC solution each stage's tool path. The TUI's question lists the
+    solution's motions (stage, duration, joints, what the gripper does) and its whole duration. See the
+    headless rule above.
     """
 
     subcategory = "User Input"
@@ -143,10 +151,16 @@ class WaitForMTCSolutionApproval(_AskUser):
 
     async def do_work(self) -> bool:
         solution = self.get_input_or("solution", None)
-        if getattr(solution, "__msgtype__", None) == "trajectory_msgs/msg/JointTrajectory":
-            # Show what is being approved: kinema view draws the tool's path along it.
-            publish_planned_trajectory(self, solution)
-        return await self.ask()
+        try:
+            model = self.context.robot_model
+        except KinemaError as error:  # the question still goes out, without the gripper's changes
+            self.logger.publish_warn(
+                f"{self.registration_id}: no robot model to describe the motion: {error}"
+            )
+            model = None
+        steps, duration = solution_steps(solution, model)
+        show_solution(self, solution, model)
+        return await self.ask({"steps": steps, "duration": duration} if steps else None)
 
 
 class BreakpointSubscriber(_AskUser):

@@ -20,7 +20,7 @@ from kinema.tui.widgets.status_bar import StatusBar
 if TYPE_CHECKING:
     from kinema.tui.app import KinemaApp
     from kinema.tui.blackboard_model import BlackboardDiff
-    from kinema.tui.connection import LogEntry, NodeStatusBatch, ReloadNotice
+    from kinema.tui.connection import LogEntry, NodeStatusBatch, ReloadNotice, TaskPlanning
     from kinema.tui.run_outcome import RunOutcome
     from kinema.tui.runtime_status import RuntimeStatus
 
@@ -137,6 +137,9 @@ class KinemaScreen(Screen[None]):
 
     def runtime_run_ended(self, outcome: RunOutcome) -> None:
         """An objective run failed or was cancelled (its message stays shown until dismissed)."""
+
+    def runtime_task_planning(self, task: TaskPlanning) -> None:
+        """A task is being planned (PlanMTCTask): its stages' states changed."""
 
     def runtime_reload(self, notice: ReloadNotice) -> None:
         """A hot reload happened."""

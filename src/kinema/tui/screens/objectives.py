@@ -1,4 +1,7 @@
-"""Objectives: the library with search and filters, an objective's ports, live tree, XML; Run and Cancel."""
+"""Objectives: the library with search and filters, an objective's ports, live tree, XML; Run and Cancel.
+
+While PlanMTCTask plans a task, a panel above the tree shows its stages live (state, time, why one failed).
+"""
 
 from __future__ import annotations
 
@@ -20,12 +23,19 @@ from textual.widgets import (
 from textual.widgets.option_list import Option
 
 from kinema.errors import KinemaError
-from kinema.tui.connection import ConnectionState, NodeStatusBatch, ObjectiveSummary, RuntimeConnection
+from kinema.tui.connection import (
+    ConnectionState,
+    NodeStatusBatch,
+    ObjectiveSummary,
+    RuntimeConnection,
+    TaskPlanning,
+)
 from kinema.tui.messages import ObjectiveOutlineLoaded, ObjectiveRunRequested, ObjectivesLoaded
 from kinema.tui.run_outcome import RunOutcome
 from kinema.tui.screens.base import LOAD_ATTEMPTS, KinemaScreen
 from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
 from kinema.tui.widgets.override_form import OverrideForm
+from kinema.tui.widgets.task_panel import TaskPanel
 
 ALL = "__all__"
 
@@ -108,6 +118,7 @@ class ObjectivesScreen(KinemaScreen):
                 yield Static("", id="objective-title", classes="pane-title")
                 yield Static("", id="objective-description")
                 yield Static("", id="failure-panel")
+                yield TaskPanel("", id="task-panel")
                 with TabbedContent(initial="tree", id="objective-tabs"):
                     with TabPane("Tree", id="tree"):
                         yield BehaviorTreeView(id="behavior-tree")
@@ -129,6 +140,7 @@ class ObjectivesScreen(KinemaScreen):
         self.query_one("#objective-list", OptionList).focus()
         if self.kinema.outcomes:
             self._show_outcome(list(self.kinema.outcomes.values())[-1])
+        self.query_one(TaskPanel).show_task(self.kinema.task_planning)
         if self.kinema.status.state is ConnectionState.CONNECTED:
             self.action_reload()
 
@@ -292,6 +304,7 @@ class ObjectivesScreen(KinemaScreen):
     # -- live status -------------------------------------------------------------------------------
 
     def runtime_run_started(self, objective_name: str) -> None:
+        self.query_one(TaskPanel).show_task(None)
         if self.selected is not None and self.selected.name == objective_name:
             self.query_one(BehaviorTreeView).reset_statuses()
 
@@ -316,6 +329,9 @@ class ObjectivesScreen(KinemaScreen):
     def action_dismiss_failure(self) -> None:
         self.query_one("#failure-panel", Static).set_class(False, "shown")
         self.failure_shown = None
+
+    def runtime_task_planning(self, task: TaskPlanning) -> None:
+        self.query_one(TaskPanel).show_task(task)
 
     def runtime_node_statuses(self, batch: NodeStatusBatch) -> None:
         if self.selected is not None and self.selected.name == batch.objective_name:
