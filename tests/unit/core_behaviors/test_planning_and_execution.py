@@ -49,7 +49,7 @@ def test_plan_to_joint_goal_times_a_path_from_the_current_state(
         behavior("PlanToJointGoal"),
         {"joint_goal": _goal(MID), "velocity_scale_factor": 0.5},
         context=context,
-        timeout=30.0,
+        timeout=120.0,  # the first plan of the module loads the robot model and collision geometry
     )
     assert run.status == NodeStatus.SUCCESS, run.toasts
     trajectory = run.outputs["joint_trajectory_msg"]
