@@ -15,7 +15,8 @@ them. Structures:
 * building the sequence and the mixed tree from XML.
 
 Kinema is also measured "as objectives run": with the objective server's status observer (its
-``NodeStatusRecorder``: one NodeStatusChange per transition) and a blackboard
+``NodeStatusRecorder`` reading the tree's transition log: one NodeStatusChange per transition,
+taken after every tick) and a blackboard
 snapshot at 10 Hz attached. Rates are ticks per CPU second (``time.process_time``), median of
 ``--rounds`` rounds; ratios are Kinema's time over BT.CPP's (lower is better; 1.0 = parity).
 Targets (issue 17): sequence <= 1.0x, mixed <= 1.5x, XML build <= 2x, observers <= +20 %.
@@ -166,7 +167,7 @@ class ObjectiveObservers:
         self.snapshots = 0
         self._last = 0.0
         self._entries = blackboard_entries
-        self._handle = tree.add_status_observer(self.recorder)
+        self.recorder.attach(tree)
 
     def tick(self) -> None:
         self.tree.tick_once()

@@ -34,7 +34,7 @@ class _ResultMappingDecorator(DecoratorNode):
 
     def tick(self) -> NodeStatus:
         if self._status is not RUNNING:
-            if self._observers:
+            if self._watched:
                 _set_status_unchecked(self, RUNNING)
             else:
                 self._status = RUNNING
@@ -43,7 +43,7 @@ class _ResultMappingDecorator(DecoratorNode):
         status = child.execute_tick()
         if status is SUCCESS or status is FAILURE:
             # reset_child() inlined for the common case: a completed child without observers
-            if child._status is RUNNING or child._observers:
+            if child._status is RUNNING or child._watched:
                 self.reset_child()
             else:
                 child._status = IDLE
@@ -535,7 +535,7 @@ class SubTreeNode(DecoratorNode):
 
     def tick(self) -> NodeStatus:
         if self._status is IDLE:
-            if self._observers:
+            if self._watched:
                 _set_status_unchecked(self, RUNNING)
             else:
                 self._status = RUNNING
@@ -543,7 +543,7 @@ class SubTreeNode(DecoratorNode):
         assert child is not None
         status = child.execute_tick()
         if status is SUCCESS or status is FAILURE:
-            if child._status is RUNNING or child._observers:
+            if child._status is RUNNING or child._watched:
                 self.reset_child()
             else:
                 child._status = IDLE
