@@ -338,6 +338,7 @@ def find_structure_problems(
         problems.append((line, message))
         return first_only
 
+    fine: set[tuple[object, ...]] = set()
     models = root.findall("TreeNodesModel")
     if len(models) > 1 and report(line_of(models[1]), "Only a single node <TreeNodesModel> is supported"):
         return problems
@@ -367,9 +368,19 @@ def find_structure_problems(
         stack = [(child, 1) for child in reversed(element_children(element))]
         while stack:
             node, depth = stack.pop()
-            if _verify_node(node, depth, manifests, report, known_trees):
-                return problems
-            stack.extend((child, depth + 1) for child in reversed(element_children(node)))
+            children = element_children(node)
+            # Whether a node is fine depends only on its tag, ID and number of children (and its
+            # depth, and for a ReactiveSequence its children's tags): check each such kind once.
+            kind = (node.tag, node.get("ID"), len(children))
+            if depth > MAX_DEPTH or kind not in fine:
+                found = len(problems)
+                if _verify_node(node, depth, manifests, report, known_trees, children):
+                    return problems
+                if len(problems) == found and kind[0] != "ReactiveSequence":
+                    fine.add(kind)
+            if children:
+                children.reverse()
+                stack.extend([(child, depth + 1) for child in children])
     return problems
 
 
@@ -379,6 +390,7 @@ def _verify_node(
     manifests: dict[str, NodeManifest],
     report: Callable[[int, str], bool],
     known_trees: set[str] | None,
+    children: list[etree._Element],
 ) -> bool:
     """Check one node element; return True to stop (first_only and a problem was found)."""
     line = line_of(node)
@@ -388,7 +400,6 @@ def _verify_node(
         )
     name = str(node.tag)
     node_id = node.get("ID") or ""
-    children = element_children(node)
     explicit = name in EXPLICIT_TAGS
     if explicit and not node_id:
         return report(line, f"The tag <{name}> must have the attribute [ID]")
