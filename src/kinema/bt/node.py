@@ -365,7 +365,11 @@ class TreeNode:
             return
         self._status = IDLE
         if self._watched:
-            self._notify(prev, IDLE)
+            log = self._log
+            if log is not None:
+                log(self._log_base + prev * 5)  # IDLE is 0
+            if self._observers:
+                self._notify_observers(prev, IDLE)
 
     def halt_node(self) -> None:
         """``halt()`` followed by the ``_onHalted`` script."""
@@ -653,7 +657,11 @@ def _set_status_unchecked(node: TreeNode, new: NodeStatus) -> None:
         return
     node._status = new
     if node._watched:
-        node._notify(prev, new)
+        log = node._log
+        if log is not None:
+            log(node._log_base + prev * 5 + new)
+        if node._observers:
+            node._notify_observers(prev, new)
 
 
 # -- composites -------------------------------------------------------------------------------------
