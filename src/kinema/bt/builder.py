@@ -53,6 +53,8 @@ class TreeBuilder:
         self.tree = Tree(factory.clock, self.manifests)
         # Plans compiled for another factory or registry generation are not reused.
         self.plan_key = factory.plan_key()
+        self._enums = factory.enums
+        self._clock = factory.clock
         # (tag, attributes...) -> what that element compiles to (valid for this registry only)
         self.kinds: dict[tuple[Any, ...], NodeKind] = {}
 
@@ -359,18 +361,18 @@ class TreeBuilder:
         config.blackboard = blackboard
         uid = config.uid = tree.next_uid()
         instance_name = spec.instance_name
-        config.path = prefix + instance_name + (f"::{uid}" if spec.unnamed else "")
+        config.path = prefix + instance_name + f"::{uid}" if spec.unnamed else prefix + instance_name
         config.manifest = spec.manifest
-        config.enums = self.factory.enums
-        config.other_attributes = dict(spec.other) if spec.other else {}
+        config.enums = self._enums
+        config.other_attributes = spec.other.copy()
         config.wake_up = tree.wake_up
-        config.clock = self.factory.clock
+        config.clock = self._clock
         config.source_file = filename
         config.source_line = line
-        config.input_ports = dict(spec.input_ports)
-        config.output_ports = dict(spec.output_ports) if spec.output_ports else {}
-        config.pre_conditions = dict(spec.pre_conditions) if spec.pre_conditions else {}
-        config.post_conditions = dict(spec.post_conditions) if spec.post_conditions else {}
+        config.input_ports = spec.input_ports.copy()
+        config.output_ports = spec.output_ports.copy()
+        config.pre_conditions = spec.pre_conditions.copy()
+        config.post_conditions = spec.post_conditions.copy()
         if spec.is_subtree:
             node = self.factory.instantiate_node("SubTree", instance_name, config)
             assert isinstance(node, SubTreeNode)
