@@ -39,8 +39,12 @@ class _ConstantNode(SyncActionNode):
         prev = self._status
         if prev is not result:
             self._status = result
-            if self._observers:
-                self._notify(prev, result)
+            if self._watched:
+                log = self._log
+                if log is not None:
+                    log(self._log_base + prev * 5 + result)
+                if self._observers:
+                    self._notify_observers(prev, result)
         return result
 
 
@@ -143,8 +147,12 @@ class ScriptNode(_ScriptCode, SyncActionNode):
         prev = self._status
         if prev is not SUCCESS:
             self._status = SUCCESS
-            if self._observers:
-                self._notify(prev, SUCCESS)
+            if self._watched:
+                log = self._log
+                if log is not None:
+                    log(self._log_base + prev * 5 + SUCCESS)
+                if self._observers:
+                    self._notify_observers(prev, SUCCESS)
         return SUCCESS
 
 
@@ -198,8 +206,12 @@ class ScriptConditionNode(_ScriptCode, ConditionNode):
         prev = self._status
         if prev is not status:
             self._status = status
-            if self._observers:
-                self._notify(prev, status)
+            if self._watched:
+                log = self._log
+                if log is not None:
+                    log(self._log_base + prev * 5 + status)
+                if self._observers:
+                    self._notify_observers(prev, status)
         return status
 
 

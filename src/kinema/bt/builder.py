@@ -51,6 +51,12 @@ class TreeBuilder:
         self.library = factory.library
         self.manifests = factory.manifests()
         self.tree = Tree(factory.clock, self.manifests)
+        # Plans compiled for another factory or registry generation are not reused.
+        self.plan_key = factory.plan_key()
+        self._enums = factory.enums
+        self._clock = factory.clock
+        # (tag, attributes...) -> what that element compiles to (valid for this registry only)
+        self.kinds: dict[tuple[Any, ...], NodeKind] = {}
 
     def build(self, tree_id: str, blackboard: Blackboard) -> Tree:
         """Instantiate ``tree_id`` with ``blackboard`` as the root scope."""
@@ -91,44 +97,96 @@ class TreeBuilder:
         self.tree.subtrees.append(subtree)
         ancestors.append(tree_id)
         filename = definition.filename
-        # Iterative depth-first walk (pre-order, uids in creation order) so deep trees cannot
-        # exhaust the Python stack.
-        stack: list[tuple[etree._Element, TreeNode | None]] = [(root_element, parent)]
+        plan = definition.plan if definition.plan_key == self.plan_key else None
+        if plan is None:
+            # First instance with this registry: compile each element as it is reached (so the
+            # first error is the one a plain walk meets first) and keep the plan for the next ones.
+            plan = self._compile_and_instantiate(
+                root_element, blackboard, parent, prefix, subtree, ancestors, filename
+            )
+            definition.plan = plan
+            definition.plan_key = self.plan_key
+        else:
+            self._instantiate_plan(plan, blackboard, parent, prefix, subtree, ancestors, filename)
+        ancestors.pop()
+
+    def _compile_and_instantiate(
+        self,
+        root_element: etree._Element,
+        blackboard: Blackboard,
+        parent: TreeNode | None,
+        prefix: str,
+        subtree: Subtree,
+        ancestors: list[str],
+        filename: str,
+    ) -> NodeSpec:
+        stack: list[tuple[etree._Element, TreeNode | None, NodeSpec | None]] = [(root_element, parent, None)]
+        nodes = subtree.nodes
+        root_spec: NodeSpec | None = None
         while stack:
-            element, parent_node = stack.pop()
-            node = self._create_node(element, blackboard, parent_node, prefix, filename)
-            subtree.nodes.append(node)
-            if isinstance(node, SubTreeNode):
-                self._enter_subtree(node, element, subtree, blackboard, filename, ancestors)
+            element, parent_node, parent_spec = stack.pop()
+            spec = self._compile_node(element, filename, prefix)
+            if parent_spec is None:
+                root_spec = spec
+            else:
+                parent_spec.children.append(spec)
+            node = self._create_node(spec, blackboard, parent_node, prefix, filename)
+            nodes.append(node)
+            if spec.kind.is_subtree:
+                self._enter_subtree(node, spec, subtree, blackboard, filename, ancestors)  # type: ignore[arg-type]
             else:
                 for child in reversed(element_children(element)):
+                    stack.append((child, node, spec))
+        assert root_spec is not None
+        return root_spec
+
+    def _instantiate_plan(
+        self,
+        plan: NodeSpec,
+        blackboard: Blackboard,
+        parent: TreeNode | None,
+        prefix: str,
+        subtree: Subtree,
+        ancestors: list[str],
+        filename: str,
+    ) -> None:
+        # Iterative depth-first walk (pre-order, uids in creation order) so deep trees cannot
+        # exhaust the Python stack.
+        stack: list[tuple[NodeSpec, TreeNode | None]] = [(plan, parent)]
+        nodes = subtree.nodes
+        while stack:
+            spec, parent_node = stack.pop()
+            node = self._create_node(spec, blackboard, parent_node, prefix, filename)
+            nodes.append(node)
+            if spec.kind.is_subtree:
+                self._enter_subtree(node, spec, subtree, blackboard, filename, ancestors)  # type: ignore[arg-type]
+            else:
+                for child in reversed(spec.children):
                     stack.append((child, node))
-        ancestors.pop()
 
     def _enter_subtree(
         self,
         node: SubTreeNode,
-        element: etree._Element,
+        spec: NodeSpec,
         subtree: Subtree,
         blackboard: Blackboard,
         filename: str,
         ancestors: list[str],
     ) -> None:
-        subtree_id = element.get("ID") or ""
+        kind = spec.kind
+        subtree_id = kind.type_id
         new_bb = Blackboard.create(blackboard)
         remapping: dict[str, str] = {}
         autoremap = False
-        for attr_name, attr_value in element.attrib.items():
-            attr_name = str(attr_name)
+        for attr_name, attr_value in kind.attributes:
             if attr_value == "{=}":
                 attr_value = "{" + attr_name + "}"
             if attr_name == "_autoremap":
                 try:
                     autoremap = convert_from_string(bool, attr_value)
                 except BTError as error:
-                    raise BTRuntimeError(
-                        error.message, location=SourceLocation(filename, line_of(element))
-                    ) from None
+                    location = SourceLocation(filename, spec.line)
+                    raise BTRuntimeError(error.message, location=location) from None
                 new_bb.enable_auto_remapping(autoremap)
                 continue
             if not is_allowed_port_name(attr_name):
@@ -143,7 +201,7 @@ class TreeBuilder:
                             f'In the <TreeNodesModel> the <Subtree ID="{subtree_id}"> is defining '
                             "a mandatory "
                             f"port called [{port_name}], but you are not remapping it",
-                            location=SourceLocation(filename, line_of(element)),
+                            location=SourceLocation(filename, spec.line),
                         )
                     remapping[port_name] = port_info.default_str
         for attr_name, attr_value in remapping.items():
@@ -158,7 +216,7 @@ class TreeBuilder:
         path = subtree.instance_name
         if path:
             path += "/"
-        name = element.get("name")
+        name = kind.explicit_name
         path += name if name is not None else f"{subtree_id}::{node.uid}"
         for existing in self.tree.subtrees:
             if existing.instance_name == path:
@@ -166,20 +224,21 @@ class TreeBuilder:
                     f"Duplicate SubTree path detected: '{path}'. Multiple SubTree nodes with the same 'name' "
                     "attribute under the same parent are not allowed. Please use unique names or omit the "
                     "'name' attribute to auto-generate unique paths.",
-                    location=SourceLocation(filename, line_of(element)),
+                    location=SourceLocation(filename, spec.line),
                 )
         self._create_subtree(subtree_id, path, path + "/", new_bb, node, ancestors)
 
-    def _create_node(
-        self,
-        element: etree._Element,
-        blackboard: Blackboard,
-        parent: TreeNode | None,
-        prefix: str,
-        filename: str,
-    ) -> TreeNode:
-        tag = str(element.tag)
+    def _compile_node(self, element: etree._Element, filename: str, prefix: str) -> NodeSpec:
+        """What building ``element`` needs that depends only on the XML and the registry."""
         line = line_of(element)
+        signature = (element.tag, *element.attrib.items())
+        kind = self.kinds.get(signature)
+        if kind is None:
+            kind = self.kinds[signature] = self._compile_kind(element, filename, prefix, line)
+        return NodeSpec(kind, line)
+
+    def _compile_kind(self, element: etree._Element, filename: str, prefix: str, line: int) -> NodeKind:
+        tag = str(element.tag)
         location = _LazyLocation(filename, line)
         element_id = element.get("ID")
         if tag in EXPLICIT_TAGS:
@@ -202,8 +261,8 @@ class TreeBuilder:
         manifest = None if is_subtree else self.manifests.get(type_id)
         port_remap: dict[str, str] = {}
         other: dict[str, str] = {}
-        for attr_name, attr_value in element.attrib.items():
-            attr_name = str(attr_name)
+        attributes = [(str(name), value) for name, value in element.attrib.items()]
+        for attr_name, attr_value in attributes:
             if is_allowed_port_name(attr_name):
                 if manifest is not None:
                     port_info = manifest.ports.get(attr_name)
@@ -237,53 +296,95 @@ class TreeBuilder:
                 port_remap[attr_name] = attr_value
             elif attr_name not in RESERVED_ATTRIBUTES:
                 other[attr_name] = attr_value
-        config = NodeConfig(blackboard)
-        config.uid = self.tree.next_uid()
-        config.path = prefix + instance_name + (f"::{config.uid}" if instance_name == type_id else "")
-        config.manifest = manifest
-        config.enums = self.factory.enums
-        config.other_attributes = other
-        config.wake_up = self.tree.wake_up
-        config.clock = self.factory.clock
-        config.source_file = filename
-        config.source_line = line
-        if other or len(element.attrib) > len(port_remap):
-            # Only elements with reserved attributes can carry pre/post-conditions.
+        spec = NodeKind()
+        spec.type_id = type_id
+        spec.instance_name = instance_name
+        spec.explicit_name = explicit_name
+        spec.is_subtree = is_subtree
+        spec.other = other
+        spec.attributes = attributes
+        # The path gets "::uid" when the node has no name of its own.
+        spec.unnamed = instance_name == type_id
+        if other or len(attributes) > len(port_remap):
+            # The path the node is about to get (for messages only).
+            path = prefix + instance_name + (f"::{self.tree._uid + 1}" if spec.unnamed else "")
+            # Only elements with reserved attributes can carry pre/post-conditions; the parsed
+            # scripts are stateless and shared by every instance.
             for key in PRE_CONDITIONS:
                 code = element.get(key)
                 if code is not None:
-                    config.pre_conditions[key] = _parse_condition(code, key, config.path, location)
+                    spec.pre_conditions[key] = _parse_condition(code, key, path, location)
             for key in POST_CONDITIONS:
                 code = element.get(key)
                 if code is not None:
-                    config.post_conditions[key] = _parse_condition(code, key, config.path, location)
+                    spec.post_conditions[key] = _parse_condition(code, key, path, location)
         if is_subtree:
-            config.input_ports = dict(port_remap)
-            config.manifest = self.manifests.get("SubTree")
+            spec.input_ports = dict(port_remap)
+            spec.manifest = self.manifests.get("SubTree")
+            return spec
+        if manifest is None:
+            from kinema.errors import did_you_mean
+
+            raise BTRuntimeError(
+                f"Node not recognized: {type_id}; {did_you_mean(type_id, self.manifests)}",
+                location=location,
+            )
+        spec.manifest = manifest
+        for port_name, port_info in manifest.ports.items():
+            value = port_remap.get(port_name)
+            if value is None:
+                continue
+            key = blackboard_pointer(value, port_name)
+            if key is not None:
+                spec.entries.append((key, port_info))
+        for port_name, value in port_remap.items():
+            direction = manifest.ports[port_name].direction
+            if direction is not PortDirection.OUTPUT:
+                spec.input_ports[port_name] = value
+            if direction is not PortDirection.INPUT:
+                spec.output_ports[port_name] = value
+        _apply_defaults(manifest, spec)
+        return spec
+
+    def _create_node(
+        self,
+        spec: NodeSpec,
+        blackboard: Blackboard,
+        parent: TreeNode | None,
+        prefix: str,
+        filename: str,
+    ) -> TreeNode:
+        tree = self.tree
+        line = spec.line
+        spec = spec.kind  # type: ignore[assignment]
+        config = _new_config(NodeConfig)
+        config.blackboard = blackboard
+        uid = config.uid = tree.next_uid()
+        instance_name = spec.instance_name
+        config.path = prefix + instance_name + f"::{uid}" if spec.unnamed else prefix + instance_name
+        config.manifest = spec.manifest
+        config.enums = self._enums
+        config.other_attributes = spec.other.copy()
+        config.wake_up = tree.wake_up
+        config.clock = self._clock
+        config.source_file = filename
+        config.source_line = line
+        config.input_ports = spec.input_ports.copy()
+        config.output_ports = spec.output_ports.copy()
+        config.pre_conditions = spec.pre_conditions.copy()
+        config.post_conditions = spec.post_conditions.copy()
+        if spec.is_subtree:
             node = self.factory.instantiate_node("SubTree", instance_name, config)
             assert isinstance(node, SubTreeNode)
-            node.subtree_id = type_id
+            node.subtree_id = spec.type_id
         else:
-            if manifest is None:
-                from kinema.errors import did_you_mean
-
-                raise BTRuntimeError(
-                    f"Node not recognized: {type_id}; {did_you_mean(type_id, self.manifests)}",
-                    location=location,
-                )
-            self._precreate_entries(manifest, port_remap, blackboard, location)
-            for port_name, value in port_remap.items():
-                direction = manifest.ports[port_name].direction
-                if direction is not PortDirection.OUTPUT:
-                    config.input_ports[port_name] = value
-                if direction is not PortDirection.INPUT:
-                    config.output_ports[port_name] = value
-            _apply_defaults(manifest, config)
+            if spec.entries:
+                self._precreate_entries(spec.entries, blackboard, _LazyLocation(filename, line))
             try:
-                node = self.factory.instantiate_node(type_id, instance_name, config)
+                node = self.factory.instantiate_node(spec.type_id, instance_name, config)
             except BTError as error:
                 if error.location is None:
-                    error.location = location
+                    error.location = _LazyLocation(filename, line)
                 raise
         if parent is not None:
             if isinstance(parent, ControlNode):
@@ -293,15 +394,9 @@ class TreeBuilder:
         return node
 
     def _precreate_entries(
-        self, manifest: Any, port_remap: dict[str, str], blackboard: Blackboard, location: SourceLocation
+        self, entries: list[tuple[str, Any]], blackboard: Blackboard, location: SourceLocation
     ) -> None:
-        for port_name, port_info in manifest.ports.items():
-            value = port_remap.get(port_name)
-            if value is None:
-                continue
-            key = blackboard_pointer(value, port_name)
-            if key is None:
-                continue
+        for key, port_info in entries:
             existing = blackboard.get_entry(key)
             if existing is not None:
                 mismatch = (
@@ -329,6 +424,61 @@ class TreeBuilder:
                     raise BTRuntimeError(error.message, location=location) from None
 
 
+class NodeSpec:
+    """One element of a tree definition as the builder needs it: its kind, line and children.
+
+    Plans (a spec per element, children in order) are kept on the :class:`TreeDefinition` with the
+    registry generation they were made for, so SubTree instances and later builds skip the XML.
+    """
+
+    __slots__ = ("children", "kind", "line")
+
+    def __init__(self, kind: NodeKind, line: int) -> None:
+        self.kind = kind
+        self.line = line
+        self.children: list[NodeSpec] = []
+
+
+class NodeKind:
+    """What an element compiles to against a registry, shared by every element written the same
+    way (same tag and attributes) and by every instance of it."""
+
+    __slots__ = (
+        "attributes",
+        "entries",
+        "explicit_name",
+        "input_ports",
+        "instance_name",
+        "is_subtree",
+        "manifest",
+        "other",
+        "output_ports",
+        "post_conditions",
+        "pre_conditions",
+        "type_id",
+        "unnamed",
+    )
+
+    def __init__(self) -> None:
+        self.type_id = ""
+        self.instance_name = ""
+        self.explicit_name: str | None = None
+        self.is_subtree = False
+        self.unnamed = False
+        self.manifest: Any = None
+        self.attributes: list[tuple[str, str]] = []
+        self.other: dict[str, str] = {}
+        self.input_ports: dict[str, Any] = {}
+        self.output_ports: dict[str, Any] = {}
+        self.pre_conditions: dict[str, Any] = {}
+        self.post_conditions: dict[str, Any] = {}
+        # (blackboard key, port info) of every port given as a {pointer}, in the manifest's order
+        self.entries: list[tuple[str, Any]] = []
+
+
+_new_config = object.__new__
+
+
 class _LazyLocation(SourceLocation):
     """A SourceLocation for error paths; built per node, so it skips the frozen-dataclass init."""
 
@@ -337,7 +487,7 @@ class _LazyLocation(SourceLocation):
         object.__setattr__(self, "line", line)
 
 
-def _apply_defaults(manifest: Any, config: NodeConfig) -> None:
+def _apply_defaults(manifest: Any, config: NodeSpec) -> None:
     """Declared defaults for ports the XML omits (an empty default is not applied, as in BT.CPP)."""
     for port_name, port_info in manifest.ports.items():
         if not port_info.has_default or not port_info.default_str:

@@ -44,7 +44,7 @@ class SequenceNode(_ResumingControl):
         if self._status is not RUNNING:
             if self._status is IDLE:
                 self._skipped = 0
-            if self._observers:
+            if self._watched:
                 _set_status_unchecked(self, RUNNING)
             else:
                 self._status = RUNNING
@@ -136,7 +136,7 @@ class SequenceWithMemoryNode(ControlNode):
         if self._status is not RUNNING:
             if self._status is IDLE:
                 self._skipped = 0
-            if self._observers:
+            if self._watched:
                 _set_status_unchecked(self, RUNNING)
             else:
                 self._status = RUNNING
@@ -178,7 +178,7 @@ class FallbackNode(_ResumingControl):
         if self._status is not RUNNING:
             if self._status is IDLE:
                 self._skipped = 0
-            if self._observers:
+            if self._watched:
                 _set_status_unchecked(self, RUNNING)
             else:
                 self._status = RUNNING
@@ -247,7 +247,7 @@ class ReactiveSequenceNode(_RunningChildControl):
         if prev is not RUNNING:
             if prev is IDLE:
                 self._running_child = -1
-            if self._observers:
+            if self._watched:
                 _set_status_unchecked(self, RUNNING)
             else:
                 self._status = RUNNING
@@ -277,7 +277,7 @@ class ReactiveSequenceNode(_RunningChildControl):
         # reset_children() inlined: after a pass that succeeded no child is RUNNING
         for child in children:
             if child._status is not IDLE:
-                if child._status is RUNNING or child._observers:
+                if child._status is RUNNING or child._watched:
                     self.reset_children()
                     break
                 child._status = IDLE

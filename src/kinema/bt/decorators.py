@@ -34,7 +34,7 @@ class _ResultMappingDecorator(DecoratorNode):
 
     def tick(self) -> NodeStatus:
         if self._status is not RUNNING:
-            if self._observers:
+            if self._watched:
                 _set_status_unchecked(self, RUNNING)
             else:
                 self._status = RUNNING
@@ -42,11 +42,18 @@ class _ResultMappingDecorator(DecoratorNode):
         assert child is not None
         status = child.execute_tick()
         if status is SUCCESS or status is FAILURE:
-            # reset_child() inlined for the common case: a completed child without observers
-            if child._status is RUNNING or child._observers:
+            # reset_child() inlined for the common case: a completed child
+            done = child._status
+            if done is RUNNING:
                 self.reset_child()
             else:
                 child._status = IDLE
+                if child._watched and done is not IDLE:
+                    log = child._log
+                    if log is not None:
+                        log(child._log_base + done * 5)  # IDLE is 0
+                    if child._observers:
+                        child._notify_observers(done, IDLE)
             return self._on_success if status is SUCCESS else self._on_failure
         if status is RUNNING or status is SKIPPED:
             return status
@@ -535,7 +542,7 @@ class SubTreeNode(DecoratorNode):
 
     def tick(self) -> NodeStatus:
         if self._status is IDLE:
-            if self._observers:
+            if self._watched:
                 _set_status_unchecked(self, RUNNING)
             else:
                 self._status = RUNNING
@@ -543,8 +550,15 @@ class SubTreeNode(DecoratorNode):
         assert child is not None
         status = child.execute_tick()
         if status is SUCCESS or status is FAILURE:
-            if child._status is RUNNING or child._observers:
+            done = child._status
+            if done is RUNNING:
                 self.reset_child()
             else:
                 child._status = IDLE
+                if child._watched and done is not IDLE:
+                    log = child._log
+                    if log is not None:
+                        log(child._log_base + done * 5)  # IDLE is 0
+                    if child._observers:
+                        child._notify_observers(done, IDLE)
         return status

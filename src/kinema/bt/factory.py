@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import enum
 import inspect
+import itertools
 from collections.abc import Callable, Iterable
 from pathlib import Path
 
@@ -27,6 +28,9 @@ from kinema.bt.status import NodeStatus
 from kinema.bt.tree import Tree
 from kinema.bt.xmlparser import TreeDefinition, TreeLibrary
 from kinema.errors import did_you_mean
+
+# A serial per factory (never reused, unlike id()): part of the key of compiled tree plans.
+_FACTORY_SERIALS = itertools.count(1)
 
 NodeBuilder = Callable[[str, NodeConfig], TreeNode]
 
@@ -69,6 +73,9 @@ class BehaviorTreeFactory:
         self._manifests: dict[str, NodeManifest] = {}
         self.enums: dict[str, int] = {}
         self.library = TreeLibrary()
+        # Bumped by every change of the node types or enums: compiled tree plans depend on them.
+        self._generation = 0
+        self._serial = next(_FACTORY_SERIALS)
         if register_builtins:
             from kinema.bt.builtins import register_builtin_nodes
 
@@ -90,6 +97,7 @@ class BehaviorTreeFactory:
             raise BTLogicError(f"ID [{node_id}] already registered")
         self._builders[node_id] = builder
         self._manifests[node_id] = manifest
+        self._generation += 1
 
     def register_node_type(
         self,
@@ -144,7 +152,12 @@ class BehaviorTreeFactory:
     def unregister(self, id: str) -> bool:
         """Forget node type ``id``; False if it was not registered."""
         self._manifests.pop(id, None)
+        self._generation += 1
         return self._builders.pop(id, None) is not None
+
+    def plan_key(self) -> tuple[int, int]:
+        """Identifies this factory's registry as it is now (tree plans compiled for it are valid)."""
+        return (self._serial, self._generation)
 
     def is_registered(self, id: str) -> bool:
         """True if ``id`` is a registered node type."""
@@ -188,6 +201,7 @@ class BehaviorTreeFactory:
                 f"first {previous} and later {int(value)}"
             )
         self.enums[name] = int(value)
+        self._generation += 1
 
     def register_scripting_enums(self, enum_type: type[enum.Enum]) -> None:
         """Register every member of an int-valued ``Enum`` by name."""
@@ -198,7 +212,7 @@ class BehaviorTreeFactory:
 
     def register_behavior_tree_from_text(self, xml: str, filename: str = "<string>") -> None:
         """Load every ``<BehaviorTree>`` of an XML text (includes resolve against the current path)."""
-        self.library.load_text(xml, filename, self._manifests)
+        self.library.load_text(xml, filename, self._manifests, registry=self.plan_key())
 
     def register_behavior_tree_from_file(self, path: str | Path) -> None:
         """Load every ``<BehaviorTree>`` of an XML file."""
@@ -234,7 +248,7 @@ class BehaviorTreeFactory:
     ) -> Tree:
         """Load ``xml`` and instantiate its main tree (``main_tree_to_execute`` or BT.CPP's fallbacks)."""
         before = set(self.library.trees)
-        root = self.library.load_text(xml, filename, self._manifests)
+        root = self.library.load_text(xml, filename, self._manifests, registry=self.plan_key())
         return self.create_tree(self.library.main_tree_of(root, before), blackboard)
 
     def create_tree_from_file(self, path: str | Path, blackboard: Blackboard | None = None) -> Tree:

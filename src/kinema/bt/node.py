@@ -138,10 +138,13 @@ class TreeNode:
         "_bindings",
         "_hooked",
         "_literal_cache",
+        "_log",
+        "_log_base",
         "_observers",
         "_post_tick",
         "_pre_tick",
         "_status",
+        "_watched",
         "config",
         "name",
         "registration_id",
@@ -156,6 +159,12 @@ class TreeNode:
         self._status = IDLE
         # A tuple, replaced on (un)subscribe: notifying iterates it without copying it.
         self._observers: tuple[StatusObserver, ...] = ()
+        # The tree's transition log (``TransitionLog.codes.append``) while one is attached, and
+        # this node's base code in it.
+        self._log: Callable[[int], None] | None = None
+        self._log_base = 0
+        # True while anything observes the node (a callback or a log): the one test on the hot path.
+        self._watched = False
         self._bindings: dict[str, tuple[str | None, Any, Any]] = {}
         self._literal_cache: dict[tuple[str, Any], Any] = {}
         manifest = self.config.manifest
@@ -235,8 +244,12 @@ class TreeNode:
             if status is SUCCESS or status is FAILURE:
                 # Inlined _set_status for the common case: this is the hot path of every tick.
                 self._status = status
-                if self._observers:
-                    self._notify(prev, status)
+                if self._watched:
+                    log = self._log
+                    if log is not None:
+                        log(self._log_base + prev * 5 + status)
+                    if self._observers:
+                        self._notify_observers(prev, status)
             elif status is not SKIPPED:
                 self._set_status(status)
         elif status is IDLE or (status is RUNNING and self._forbid_running):
@@ -244,6 +257,18 @@ class TreeNode:
         return status
 
     def _notify(self, prev: NodeStatus, new: NodeStatus) -> None:
+        """Report a change already stored: one code in the tree's log, then each callback.
+
+        The hot paths inline the log's half and call :meth:`_notify_observers` only when there are
+        callbacks.
+        """
+        log = self._log
+        if log is not None:
+            log(self._log_base + prev * 5 + new)
+        if self._observers:
+            self._notify_observers(prev, new)
+
+    def _notify_observers(self, prev: NodeStatus, new: NodeStatus) -> None:
         clock = self.config.clock
         now = clock.now() if clock is not None else 0.0
         for callback in self._observers:
@@ -326,11 +351,8 @@ class TreeNode:
         if prev is new:
             return
         self._status = new
-        if self._observers:
-            clock = self.config.clock
-            now = clock.now() if clock is not None else 0.0
-            for callback in self._observers:
-                callback(now, self, prev, new)
+        if self._watched:
+            self._notify(prev, new)
 
     def set_status(self, new: NodeStatus) -> None:
         """Store a status (never IDLE; use :meth:`reset_status`)."""
@@ -342,11 +364,12 @@ class TreeNode:
         if prev is IDLE:
             return
         self._status = IDLE
-        if self._observers:
-            clock = self.config.clock
-            now = clock.now() if clock is not None else 0.0
-            for callback in self._observers:
-                callback(now, self, prev, IDLE)
+        if self._watched:
+            log = self._log
+            if log is not None:
+                log(self._log_base + prev * 5)  # IDLE is 0
+            if self._observers:
+                self._notify_observers(prev, IDLE)
 
     def halt_node(self) -> None:
         """``halt()`` followed by the ``_onHalted`` script."""
@@ -367,12 +390,14 @@ class TreeNode:
     def subscribe_to_status_change(self, callback: StatusObserver) -> Callable[[], None]:
         """Call ``callback(timestamp, node, prev, new)`` on every status change; returns an unsubscriber."""
         self._observers = (*self._observers, callback)
+        self._watched = True
 
         def unsubscribe() -> None:
             if callback in self._observers:
                 observers = list(self._observers)
                 observers.remove(callback)
                 self._observers = tuple(observers)
+                self._watched = bool(observers) or self._log is not None
 
         return unsubscribe
 
@@ -631,11 +656,12 @@ def _set_status_unchecked(node: TreeNode, new: NodeStatus) -> None:
     if prev is new:
         return
     node._status = new
-    if node._observers:
-        clock = node.config.clock
-        now = clock.now() if clock is not None else 0.0
-        for callback in node._observers:
-            callback(now, node, prev, new)
+    if node._watched:
+        log = node._log
+        if log is not None:
+            log(node._log_base + prev * 5 + new)
+        if node._observers:
+            node._notify_observers(prev, new)
 
 
 # -- composites -------------------------------------------------------------------------------------
@@ -666,13 +692,14 @@ class ControlNode(TreeNode):
                 if status is RUNNING:
                     child.halt_node()
                     child.reset_status()
-                elif child._observers:
+                elif child._watched:
                     # reset_status() inlined: an observed tree resets every completed child
                     child._status = IDLE
-                    clock = child.config.clock
-                    now = clock.now() if clock is not None else 0.0
-                    for callback in child._observers:
-                        callback(now, child, status, IDLE)
+                    log = child._log
+                    if log is not None:
+                        log(child._log_base + status * 5)  # IDLE is 0
+                    if child._observers:
+                        child._notify_observers(status, IDLE)
                 else:
                     child._status = IDLE
 
@@ -724,8 +751,12 @@ class DecoratorNode(TreeNode):
             if status is not prev:
                 if status is SUCCESS or status is FAILURE:
                     self._status = status
-                    if self._observers:
-                        self._notify(prev, status)
+                    if self._watched:
+                        log = self._log
+                        if log is not None:
+                            log(self._log_base + prev * 5 + status)
+                        if self._observers:
+                            self._notify_observers(prev, status)
                 elif status is not SKIPPED:
                     self._set_status(status)
             elif status is IDLE or (status is RUNNING and self._forbid_running):

@@ -16,6 +16,7 @@ from kinema.bt.status import FAILURE, IDLE, RUNNING, SKIPPED, SUCCESS, NodeStatu
 if TYPE_CHECKING:
     from kinema.bt.blackboard import Blackboard, Entry
     from kinema.bt.factory import NodeManifest
+    from kinema.bt.transitions import TransitionLog
 
 
 class WakeUpSignal:
@@ -120,6 +121,8 @@ class Tree:
         self._next_handle = 1
         # True when the last tick_once stopped at its ``until`` with a re-tick still owed.
         self.retick_due = False
+        # The log attached by record_transitions(), marked at every root tick.
+        self.transition_log: TransitionLog | None = None
 
     def next_uid(self) -> int:
         """Allocate the next node uid (1-based, used by the builder).
@@ -204,7 +207,10 @@ class Tree:
         wake_up = self.wake_up
         status = IDLE
         self.retick_due = False
+        log = self.transition_log
         while status is IDLE or (mode == 2 and status is RUNNING):
+            if log is not None:
+                log.mark()
             status = root.execute_tick()
             while mode != 0 and status is RUNNING and wake_up.consume():
                 if until is not None and until():
@@ -212,6 +218,8 @@ class Tree:
                     # tick_once starts with it, so the sequence of root ticks is BT.CPP's.
                     self.retick_due = True
                     return status
+                if log is not None:
+                    log.mark()
                 status = root.execute_tick()
             if status is SUCCESS or status is FAILURE:
                 root.reset_status()
@@ -297,6 +305,16 @@ class Tree:
         self._next_handle += 1
         self._observer_handles[handle] = [node.subscribe_to_status_change(callback) for node in self.nodes()]
         return handle
+
+    def record_transitions(self) -> TransitionLog:
+        """Append every status change of every node to a :class:`~kinema.bt.transitions.TransitionLog`.
+
+        The same changes an observer callback gets, at a fraction of the cost: no call per
+        transition; read them once per tick with ``take()``. One log per tree at a time.
+        """
+        from kinema.bt.transitions import TransitionLog
+
+        return TransitionLog(self)
 
     def remove_status_observer(self, handle: int) -> None:
         """Stop the observer registered with ``handle`` (unknown handles are ignored)."""

@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 from collections.abc import Callable
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from lxml import etree
 
@@ -24,6 +24,12 @@ from kinema.errors import SourceLocation
 
 if TYPE_CHECKING:
     from kinema.bt.manifest import NodeManifest
+
+# Documents loaded from text, by (text, filename, verify, registry): a factory that loads the same
+# objective again (a hot reload of an unchanged file, /do_objective with the same XML) skips parsing,
+# verifying and compiling it. Oldest first; the trees are read-only once loaded.
+_DOCUMENTS: dict[tuple[object, ...], tuple[etree._Element, list[TreeDefinition]]] = {}
+_MAX_CACHED_DOCUMENTS = 32
 
 EXPLICIT_TAGS = frozenset({"Action", "Condition", "Control", "Decorator", "SubTree"})
 _PORT_TAGS = {
@@ -50,12 +56,15 @@ class TreeDefinition:
     an objective can be written back unchanged in meaning.
     """
 
-    __slots__ = ("element", "filename", "id")
+    __slots__ = ("element", "filename", "id", "plan", "plan_key")
 
     def __init__(self, tree_id: str, element: etree._Element, filename: str) -> None:
         self.id = tree_id
         self.element = element
         self.filename = filename
+        # The builder's compiled plan (kinema.bt.builder.NodeSpec) and the registry it is valid for.
+        self.plan: Any = None
+        self.plan_key: Any = None
 
     @property
     def attributes(self) -> dict[str, str]:
@@ -129,14 +138,40 @@ class TreeLibrary:
     # -- loading ---------------------------------------------------------------------------------
 
     def load_text(
-        self, text: str, filename: str, manifests: dict[str, NodeManifest], *, verify: bool = True
+        self,
+        text: str,
+        filename: str,
+        manifests: dict[str, NodeManifest],
+        *,
+        verify: bool = True,
+        registry: object = None,
     ) -> etree._Element:
         """Load XML text; relative includes resolve against the library's current path.
 
         ``verify=False`` skips BT.CPP's structural checks (the validator reports them itself).
+        ``registry`` identifies the node types ``manifests`` holds (the factory's ``plan_key()``):
+        with it, loading the same text again for the same registry reuses the parsed, verified
+        document and its trees' compiled plans (a document with ``<include>`` is always re-read).
         """
+        key = (text, filename, verify, registry) if registry is not None else None
+        cached = _DOCUMENTS.get(key) if key is not None else None
+        if cached is not None:
+            root, definitions = cached
+            self._read_models(root, filename)
+            if self.documents_loaded == 0 and self.first_main_tree is None:
+                self.first_main_tree = root.get("main_tree_to_execute")
+            self.documents_loaded += 1
+            for definition in definitions:
+                self.trees[definition.id] = definition
+            return root
         root = parse_xml(text, filename)
         self._load_document(root, filename, manifests, include_stack=[], verify=verify)
+        if key is not None and root.find("include") is None:
+            ids = [element.get("ID") for element in root.findall("BehaviorTree")]
+            if all(ids):
+                if len(_DOCUMENTS) >= _MAX_CACHED_DOCUMENTS:
+                    del _DOCUMENTS[next(iter(_DOCUMENTS))]
+                _DOCUMENTS[key] = (root, [self.trees[tree_id] for tree_id in ids if tree_id is not None])
         return root
 
     def load_file(
@@ -303,6 +338,7 @@ def find_structure_problems(
         problems.append((line, message))
         return first_only
 
+    fine: set[tuple[object, ...]] = set()
     models = root.findall("TreeNodesModel")
     if len(models) > 1 and report(line_of(models[1]), "Only a single node <TreeNodesModel> is supported"):
         return problems
@@ -332,9 +368,19 @@ def find_structure_problems(
         stack = [(child, 1) for child in reversed(element_children(element))]
         while stack:
             node, depth = stack.pop()
-            if _verify_node(node, depth, manifests, report, known_trees):
-                return problems
-            stack.extend((child, depth + 1) for child in reversed(element_children(node)))
+            children = element_children(node)
+            # Whether a node is fine depends only on its tag, ID and number of children (and its
+            # depth, and for a ReactiveSequence its children's tags): check each such kind once.
+            kind = (node.tag, node.get("ID"), len(children))
+            if depth > MAX_DEPTH or kind not in fine:
+                found = len(problems)
+                if _verify_node(node, depth, manifests, report, known_trees, children):
+                    return problems
+                if len(problems) == found and kind[0] != "ReactiveSequence":
+                    fine.add(kind)
+            if children:
+                children.reverse()
+                stack.extend([(child, depth + 1) for child in children])
     return problems
 
 
@@ -344,6 +390,7 @@ def _verify_node(
     manifests: dict[str, NodeManifest],
     report: Callable[[int, str], bool],
     known_trees: set[str] | None,
+    children: list[etree._Element],
 ) -> bool:
     """Check one node element; return True to stop (first_only and a problem was found)."""
     line = line_of(node)
@@ -353,7 +400,6 @@ def _verify_node(
         )
     name = str(node.tag)
     node_id = node.get("ID") or ""
-    children = element_children(node)
     explicit = name in EXPLICIT_TAGS
     if explicit and not node_id:
         return report(line, f"The tag <{name}> must have the attribute [ID]")

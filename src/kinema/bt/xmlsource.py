@@ -118,6 +118,10 @@ def parse_xml(text: str | bytes, filename: str = "<string>") -> etree._Element:
 
 
 def _check_depth(root: etree._Element, filename: str) -> None:
+    # libxml2 answers "is any element deeper than MAX_DEPTH?" without a Python step per element;
+    # only a document that has one is walked, to name the first such element in walk order.
+    if not root.xpath("/*" * (MAX_DEPTH + 1)):
+        return
     stack = [(root, 1)]
     while stack:
         element, depth = stack.pop()

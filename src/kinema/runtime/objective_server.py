@@ -51,6 +51,7 @@ from kinema.runtime.watchdog import StuckCode, stuck_code
 
 if TYPE_CHECKING:
     from kinema.bt import BehaviorTreeFactory, Tree
+    from kinema.bt.transitions import TransitionLog
 
 log = logging.getLogger("kinema.objective_server")
 
@@ -125,19 +126,44 @@ class NodeStatusRecorder:
     """The server's status observer: one :class:`NodeStatusChange` per transition, kept until the
     tick is flushed, and the leaves that failed (the failure message names the last one).
 
-    It runs for every transition on the tick thread, so everything but the timestamp is prepared
-    once per node and transition (a table indexed by previous and new status) and each change is
-    built with ``tuple.__new__`` (a NamedTuple's own constructor is a Python function).
+    Attached to a tree (:meth:`attach`) it reads the tree's transition log once per tick instead
+    of being called for every transition; it can also be registered as a plain status observer.
+    Everything but the timestamp is prepared once per node and transition (a table indexed by
+    previous and new status) and each change is built with ``tuple.__new__`` (a NamedTuple's own
+    constructor is a Python function).
     """
 
-    __slots__ = ("_nodes", "failures", "pending")
+    __slots__ = ("_failures", "_leaf_failures", "_log", "_nodes", "_pending", "_rows")
 
     def __init__(self) -> None:
-        self.pending: list[NodeStatusChange] = []
-        self.failures: list[tuple[str, str]] = []
+        self._pending: list[NodeStatusChange] = []
+        self._failures: list[tuple[str, str]] = []
         self._nodes: dict[Any, _NodeRows] = {}
+        self._log: TransitionLog | None = None
+        # transition log code -> the fields of its NodeStatusChange after the timestamp
+        self._rows: dict[int, tuple[Any, ...]] = {}
+        # codes of a leaf turning FAILURE -> (path, registration ID)
+        self._leaf_failures: dict[int, tuple[str, str]] = {}
+
+    def attach(self, tree: Tree) -> None:
+        """Record the transitions of ``tree`` through its transition log (one per tree)."""
+        self.detach()
+        self._rows.clear()
+        self._leaf_failures.clear()
+        self._log = tree.record_transitions()
+
+    def detach(self) -> None:
+        """Stop recording the attached tree (what was recorded stays readable)."""
+        log = self._log
+        if log is not None:
+            self._drain()
+            log.close()
+            self._log = None
 
     def __call__(self, timestamp: float, node: Any, previous: Any, status: Any) -> None:
+        self._record(node, previous, status, timestamp)
+
+    def _record(self, node: Any, previous: Any, status: Any, timestamp: float) -> None:
         rows = self._nodes.get(node)
         if rows is None:
             rows = self._nodes[node] = _NodeRows(node)
@@ -145,13 +171,54 @@ class NodeStatusRecorder:
         rest = row[status]
         if rest is None:
             rest = row[status] = (*rows.fields, int(previous), int(status))
-        self.pending.append(_new_tuple(NodeStatusChange, (timestamp,) + rest))  # noqa: RUF005 - faster
+        self._pending.append(_new_tuple(NodeStatusChange, (timestamp,) + rest))  # noqa: RUF005 - faster
         if status is _FAILURE and rows.leaf is not None:
-            self.failures.append(rows.leaf)
+            self._failures.append(rows.leaf)
+
+    def _drain(self) -> None:
+        log = self._log
+        if log is None or not log.codes:
+            return
+        rows = self._rows
+        pending = self._pending
+        for stamp, codes in log.take_codes():
+            try:
+                # One dict lookup per change: a code names the node and both statuses.
+                pending.extend([_new_tuple(NodeStatusChange, (stamp,) + rows[code]) for code in codes])
+            except KeyError:  # a change not seen yet: fill its row
+                for code in codes:
+                    rest = rows.get(code)
+                    if rest is None:
+                        rest = rows[code] = self._row(log, code)
+                    pending.append(_new_tuple(NodeStatusChange, (stamp,) + rest))  # noqa: RUF005
+            failed = self._leaf_failures
+            if failed:
+                self._failures.extend([failed[code] for code in codes if code in failed])
+
+    def _row(self, log: TransitionLog, code: int) -> tuple[Any, ...]:
+        node = log.nodes[code // 25]
+        previous, status = code // 5 % 5, code % 5
+        path = node.full_path
+        if status == _FAILURE and not node_children(node):
+            self._leaf_failures[code] = (path, node.registration_id)
+        return (int(node.uid), path, node.registration_id, node.name, previous, status)
+
+    @property
+    def pending(self) -> list[NodeStatusChange]:
+        """The changes not taken yet."""
+        self._drain()
+        return self._pending
+
+    @property
+    def failures(self) -> list[tuple[str, str]]:
+        """``(path, registration ID)`` of every leaf that failed, oldest first."""
+        self._drain()
+        return self._failures
 
     def take(self) -> list[NodeStatusChange]:
         """The changes since the last call (the list is handed over, not copied)."""
-        changes, self.pending = self.pending, []
+        self._drain()
+        changes, self._pending = self._pending, []
         return changes
 
 
@@ -925,11 +992,12 @@ class ObjectiveServer:
             return
         run.release_xml()
         self._tree = tree
+        self._recorder.detach()
         self._recorder = NodeStatusRecorder()
         with self._notes_lock:
             self._failure_notes = {}
         self._last_snapshot = 0.0
-        tree.add_status_observer(self._recorder)
+        self._recorder.attach(tree)
         tree.wake_up.listener = self._wake_up
         for listener in self._listeners:
             loaded = getattr(listener, "on_tree_loaded", None)

@@ -38,13 +38,24 @@ def test_recorder_reports_what_a_plain_observer_sees() -> None:
 
     recorder = NodeStatusRecorder()
     tree.add_status_observer(plain)
-    tree.add_status_observer(recorder)
+    recorder.attach(tree)  # as the objective server does: through the tree's transition log
     assert tree.tick_once() is NodeStatus.FAILURE
     changes = recorder.take()
-    assert changes == seen, f"recorder {changes}\nplain observer {seen}"
+    # The log stamps each change with the time of its root tick, not of the change itself.
+    assert [c[1:] for c in changes] == [c[1:] for c in seen], f"recorder {changes}\nplain observer {seen}"
+    assert all(abs(c.timestamp - s.timestamp) < 1.0 for c, s in zip(changes, seen, strict=True))
     assert all(type(change) is NodeStatusChange for change in changes)
     assert all(type(change.status) is int and type(change.previous) is int for change in changes)
     assert len(changes) > 8
     assert recorder.take() == []
     # the leaves that failed (the Inverter fails too but is no leaf): the failure message names the last one
+    assert recorder.failures == [("first try", "AlwaysFailure")], recorder.failures
+
+
+def test_recorder_as_a_plain_observer_still_works() -> None:
+    tree = BehaviorTreeFactory().create_tree_from_text(XML)
+    recorder = NodeStatusRecorder()
+    tree.add_status_observer(recorder)
+    assert tree.tick_once() is NodeStatus.FAILURE
+    assert len(recorder.take()) > 8
     assert recorder.failures == [("first try", "AlwaysFailure")], recorder.failures
