@@ -16,6 +16,7 @@ from kinema.interfaces.typed_codegen import TARGET, generate
 
 ROOT = Path(__file__).resolve().parents[3]
 EXAMPLE = ROOT / "plugins" / "examples" / "kinema_example_behaviors" / "my_add_two_ints_service_client.py"
+TEMPLATE = ROOT / "cookiecutters" / "behavior_package" / "templates" / "service_client" / "behavior.py.jinja"
 
 # A behavior that calls a service through the context and a transport node, and reads the response.
 CALLER = """
@@ -105,6 +106,9 @@ def test_mypy_strict_knows_the_fields_of_responses_in_behaviors(tmp_path: Path) 
     checked = mypy_strict(tmp_path, "caller.py", CALLER)
     assert checked.returncode == 0, checked.stdout + checked.stderr
     checked = mypy_strict(tmp_path, "example.py", example)
+    assert checked.returncode == 0, checked.stdout + checked.stderr
+    baked = TEMPLATE.read_text(encoding="utf-8").replace("{{ cookiecutter.behavior_id }}", "AddClient")
+    checked = mypy_strict(tmp_path, "add_client.py", baked)  # what `kinema new behavior` writes
     assert checked.returncode == 0, checked.stdout + checked.stderr
 
     misspelt = mypy_strict(tmp_path, "misspelt.py", CALLER.replace("response.sum", "response.summ"))
