@@ -41,7 +41,6 @@ if TYPE_CHECKING:
         unique_identifier_msgs__msg__UUID,
     )
 
-
     @dataclass
     class action_msgs__msg__GoalInfo:
         """action_msgs/msg/GoalInfo."""
@@ -49,7 +48,6 @@ if TYPE_CHECKING:
         goal_id: unique_identifier_msgs__msg__UUID
         stamp: builtin_interfaces__msg__Time
         __msgtype__: ClassVar[str] = "action_msgs/msg/GoalInfo"
-
 
     @dataclass
     class action_msgs__msg__GoalStatus:
@@ -66,7 +64,6 @@ if TYPE_CHECKING:
         STATUS_ABORTED: ClassVar[int] = 6
         __msgtype__: ClassVar[str] = "action_msgs/msg/GoalStatus"
 
-
     @dataclass
     class action_msgs__msg__GoalStatusArray:
         """action_msgs/msg/GoalStatusArray."""
@@ -74,14 +71,12 @@ if TYPE_CHECKING:
         status_list: list[action_msgs__msg__GoalStatus]
         __msgtype__: ClassVar[str] = "action_msgs/msg/GoalStatusArray"
 
-
     @dataclass
     class action_msgs__srv__CancelGoal_Request:
         """action_msgs/srv/CancelGoal_Request."""
 
         goal_info: action_msgs__msg__GoalInfo
         __msgtype__: ClassVar[str] = "action_msgs/srv/CancelGoal_Request"
-
 
     @dataclass
     class action_msgs__srv__CancelGoal_Response:
@@ -94,7 +89,6 @@ if TYPE_CHECKING:
         ERROR_UNKNOWN_GOAL_ID: ClassVar[int] = 2
         ERROR_GOAL_TERMINATED: ClassVar[int] = 3
         __msgtype__: ClassVar[str] = "action_msgs/srv/CancelGoal_Response"
-
 
     @dataclass
     class control_msgs__action__FollowJointTrajectory_Feedback:
@@ -111,7 +105,6 @@ if TYPE_CHECKING:
         multi_dof_error: trajectory_msgs__msg__MultiDOFJointTrajectoryPoint
         __msgtype__: ClassVar[str] = "control_msgs/action/FollowJointTrajectory_Feedback"
 
-
     @dataclass
     class control_msgs__action__FollowJointTrajectory_FeedbackMessage:
         """control_msgs/action/FollowJointTrajectory_FeedbackMessage."""
@@ -120,14 +113,12 @@ if TYPE_CHECKING:
         feedback: control_msgs__action__FollowJointTrajectory_Feedback
         __msgtype__: ClassVar[str] = "control_msgs/action/FollowJointTrajectory_FeedbackMessage"
 
-
     @dataclass
     class control_msgs__action__FollowJointTrajectory_GetResult_Request:
         """control_msgs/action/FollowJointTrajectory_GetResult_Request."""
 
         goal_id: unique_identifier_msgs__msg__UUID
         __msgtype__: ClassVar[str] = "control_msgs/action/FollowJointTrajectory_GetResult_Request"
-
 
     @dataclass
     class control_msgs__action__FollowJointTrajectory_GetResult_Response:
@@ -136,7 +127,6 @@ if TYPE_CHECKING:
         status: int
         result: control_msgs__action__FollowJointTrajectory_Result
         __msgtype__: ClassVar[str] = "control_msgs/action/FollowJointTrajectory_GetResult_Response"
-
 
     @dataclass
     class control_msgs__action__FollowJointTrajectory_Goal:
@@ -150,7 +140,6 @@ if TYPE_CHECKING:
         component_goal_tolerance: list[control_msgs__msg__JointComponentTolerance]
         goal_time_tolerance: builtin_interfaces__msg__Duration
         __msgtype__: ClassVar[str] = "control_msgs/action/FollowJointTrajectory_Goal"
-
 
     @dataclass
     class control_msgs__action__FollowJointTrajectory_Result:
@@ -166,7 +155,6 @@ if TYPE_CHECKING:
         GOAL_TOLERANCE_VIOLATED: ClassVar[int] = -5
         __msgtype__: ClassVar[str] = "control_msgs/action/FollowJointTrajectory_Result"
 
-
     @dataclass
     class control_msgs__action__FollowJointTrajectory_SendGoal_Request:
         """control_msgs/action/FollowJointTrajectory_SendGoal_Request."""
@@ -175,7 +163,6 @@ if TYPE_CHECKING:
         goal: control_msgs__action__FollowJointTrajectory_Goal
         __msgtype__: ClassVar[str] = "control_msgs/action/FollowJointTrajectory_SendGoal_Request"
 
-
     @dataclass
     class control_msgs__action__FollowJointTrajectory_SendGoal_Response:
         """control_msgs/action/FollowJointTrajectory_SendGoal_Response."""
@@ -183,7 +170,6 @@ if TYPE_CHECKING:
         accepted: bool
         stamp: builtin_interfaces__msg__Time
         __msgtype__: ClassVar[str] = "control_msgs/action/FollowJointTrajectory_SendGoal_Response"
-
 
     @dataclass
     class control_msgs__action__GripperCommand_Feedback:
@@ -195,7 +181,6 @@ if TYPE_CHECKING:
         reached_goal: bool
         __msgtype__: ClassVar[str] = "control_msgs/action/GripperCommand_Feedback"
 
-
     @dataclass
     class control_msgs__action__GripperCommand_FeedbackMessage:
         """control_msgs/action/GripperCommand_FeedbackMessage."""
@@ -204,14 +189,12 @@ if TYPE_CHECKING:
         feedback: control_msgs__action__GripperCommand_Feedback
         __msgtype__: ClassVar[str] = "control_msgs/action/GripperCommand_FeedbackMessage"
 
-
     @dataclass
     class control_msgs__action__GripperCommand_GetResult_Request:
         """control_msgs/action/GripperCommand_GetResult_Request."""
 
         goal_id: unique_identifier_msgs__msg__UUID
         __msgtype__: ClassVar[str] = "control_msgs/action/GripperCommand_GetResult_Request"
-
 
     @dataclass
     class control_msgs__action__GripperCommand_GetResult_Response:
@@ -221,14 +204,12 @@ if TYPE_CHECKING:
         result: control_msgs__action__GripperCommand_Result
         __msgtype__: ClassVar[str] = "control_msgs/action/GripperCommand_GetResult_Response"
 
-
     @dataclass
     class control_msgs__action__GripperCommand_Goal:
         """control_msgs/action/GripperCommand_Goal."""
 
         command: control_msgs__msg__GripperCommand
         __msgtype__: ClassVar[str] = "control_msgs/action/GripperCommand_Goal"
-
 
     @dataclass
     class control_msgs__action__GripperCommand_Result:
@@ -240,7 +221,6 @@ if TYPE_CHECKING:
         reached_goal: bool
         __msgtype__: ClassVar[str] = "control_msgs/action/GripperCommand_Result"
 
-
     @dataclass
     class control_msgs__action__GripperCommand_SendGoal_Request:
         """control_msgs/action/GripperCommand_SendGoal_Request."""
@@ -248,7 +228,6 @@ if TYPE_CHECKING:
         goal_id: unique_identifier_msgs__msg__UUID
         goal: control_msgs__action__GripperCommand_Goal
         __msgtype__: ClassVar[str] = "control_msgs/action/GripperCommand_SendGoal_Request"
-
 
     @dataclass
     class control_msgs__action__GripperCommand_SendGoal_Response:
@@ -258,7 +237,6 @@ if TYPE_CHECKING:
         stamp: builtin_interfaces__msg__Time
         __msgtype__: ClassVar[str] = "control_msgs/action/GripperCommand_SendGoal_Response"
 
-
     @dataclass
     class control_msgs__msg__GripperCommand:
         """control_msgs/msg/GripperCommand."""
@@ -266,7 +244,6 @@ if TYPE_CHECKING:
         position: float
         max_effort: float
         __msgtype__: ClassVar[str] = "control_msgs/msg/GripperCommand"
-
 
     @dataclass
     class control_msgs__msg__JointComponentTolerance:
@@ -284,7 +261,6 @@ if TYPE_CHECKING:
         ROTATION: ClassVar[int] = 5
         __msgtype__: ClassVar[str] = "control_msgs/msg/JointComponentTolerance"
 
-
     @dataclass
     class control_msgs__msg__JointTolerance:
         """control_msgs/msg/JointTolerance."""
@@ -295,7 +271,6 @@ if TYPE_CHECKING:
         acceleration: float
         __msgtype__: ClassVar[str] = "control_msgs/msg/JointTolerance"
 
-
     @dataclass
     class controller_manager_msgs__msg__ChainConnection:
         """controller_manager_msgs/msg/ChainConnection."""
@@ -303,7 +278,6 @@ if TYPE_CHECKING:
         name: str
         reference_interfaces: list[str]
         __msgtype__: ClassVar[str] = "controller_manager_msgs/msg/ChainConnection"
-
 
     @dataclass
     class controller_manager_msgs__msg__ControllerState:
@@ -323,7 +297,6 @@ if TYPE_CHECKING:
         chain_connections: list[controller_manager_msgs__msg__ChainConnection]
         __msgtype__: ClassVar[str] = "controller_manager_msgs/msg/ControllerState"
 
-
     @dataclass
     class controller_manager_msgs__srv__ListControllers_Request:
         """controller_manager_msgs/srv/ListControllers_Request."""
@@ -331,14 +304,12 @@ if TYPE_CHECKING:
         structure_needs_at_least_one_member: int
         __msgtype__: ClassVar[str] = "controller_manager_msgs/srv/ListControllers_Request"
 
-
     @dataclass
     class controller_manager_msgs__srv__ListControllers_Response:
         """controller_manager_msgs/srv/ListControllers_Response."""
 
         controller: list[controller_manager_msgs__msg__ControllerState]
         __msgtype__: ClassVar[str] = "controller_manager_msgs/srv/ListControllers_Response"
-
 
     @dataclass
     class controller_manager_msgs__srv__SwitchController_Request:
@@ -353,7 +324,6 @@ if TYPE_CHECKING:
         STRICT: ClassVar[int] = 2
         __msgtype__: ClassVar[str] = "controller_manager_msgs/srv/SwitchController_Request"
 
-
     @dataclass
     class controller_manager_msgs__srv__SwitchController_Response:
         """controller_manager_msgs/srv/SwitchController_Response."""
@@ -362,14 +332,12 @@ if TYPE_CHECKING:
         message: str
         __msgtype__: ClassVar[str] = "controller_manager_msgs/srv/SwitchController_Response"
 
-
     @dataclass
     class example_interfaces__action__Fibonacci_Feedback:
         """example_interfaces/action/Fibonacci_Feedback."""
 
         sequence: np.ndarray[tuple[int, ...], np.dtype[np.int32]]
         __msgtype__: ClassVar[str] = "example_interfaces/action/Fibonacci_Feedback"
-
 
     @dataclass
     class example_interfaces__action__Fibonacci_FeedbackMessage:
@@ -379,14 +347,12 @@ if TYPE_CHECKING:
         feedback: example_interfaces__action__Fibonacci_Feedback
         __msgtype__: ClassVar[str] = "example_interfaces/action/Fibonacci_FeedbackMessage"
 
-
     @dataclass
     class example_interfaces__action__Fibonacci_GetResult_Request:
         """example_interfaces/action/Fibonacci_GetResult_Request."""
 
         goal_id: unique_identifier_msgs__msg__UUID
         __msgtype__: ClassVar[str] = "example_interfaces/action/Fibonacci_GetResult_Request"
-
 
     @dataclass
     class example_interfaces__action__Fibonacci_GetResult_Response:
@@ -396,7 +362,6 @@ if TYPE_CHECKING:
         result: example_interfaces__action__Fibonacci_Result
         __msgtype__: ClassVar[str] = "example_interfaces/action/Fibonacci_GetResult_Response"
 
-
     @dataclass
     class example_interfaces__action__Fibonacci_Goal:
         """example_interfaces/action/Fibonacci_Goal."""
@@ -404,14 +369,12 @@ if TYPE_CHECKING:
         order: int
         __msgtype__: ClassVar[str] = "example_interfaces/action/Fibonacci_Goal"
 
-
     @dataclass
     class example_interfaces__action__Fibonacci_Result:
         """example_interfaces/action/Fibonacci_Result."""
 
         sequence: np.ndarray[tuple[int, ...], np.dtype[np.int32]]
         __msgtype__: ClassVar[str] = "example_interfaces/action/Fibonacci_Result"
-
 
     @dataclass
     class example_interfaces__action__Fibonacci_SendGoal_Request:
@@ -421,7 +384,6 @@ if TYPE_CHECKING:
         goal: example_interfaces__action__Fibonacci_Goal
         __msgtype__: ClassVar[str] = "example_interfaces/action/Fibonacci_SendGoal_Request"
 
-
     @dataclass
     class example_interfaces__action__Fibonacci_SendGoal_Response:
         """example_interfaces/action/Fibonacci_SendGoal_Response."""
@@ -429,7 +391,6 @@ if TYPE_CHECKING:
         accepted: bool
         stamp: builtin_interfaces__msg__Time
         __msgtype__: ClassVar[str] = "example_interfaces/action/Fibonacci_SendGoal_Response"
-
 
     @dataclass
     class example_interfaces__srv__AddTwoInts_Request:
@@ -439,14 +400,12 @@ if TYPE_CHECKING:
         b: int
         __msgtype__: ClassVar[str] = "example_interfaces/srv/AddTwoInts_Request"
 
-
     @dataclass
     class example_interfaces__srv__AddTwoInts_Response:
         """example_interfaces/srv/AddTwoInts_Response."""
 
         sum: int
         __msgtype__: ClassVar[str] = "example_interfaces/srv/AddTwoInts_Response"
-
 
     @dataclass
     class kinema_msgs__msg__BlackboardEntry:
@@ -458,7 +417,6 @@ if TYPE_CHECKING:
         value_yaml: str
         __msgtype__: ClassVar[str] = "kinema_msgs/msg/BlackboardEntry"
 
-
     @dataclass
     class kinema_msgs__msg__BlackboardSnapshot:
         """kinema_msgs/msg/BlackboardSnapshot."""
@@ -467,7 +425,6 @@ if TYPE_CHECKING:
         objective_name: str
         entries: list[kinema_msgs__msg__BlackboardEntry]
         __msgtype__: ClassVar[str] = "kinema_msgs/msg/BlackboardSnapshot"
-
 
     @dataclass
     class kinema_msgs__msg__NodeStatusChange:
@@ -488,14 +445,12 @@ if TYPE_CHECKING:
         SKIPPED: ClassVar[int] = 4
         __msgtype__: ClassVar[str] = "kinema_msgs/msg/NodeStatusChange"
 
-
     @dataclass
     class kinema_msgs__msg__NodeStatusChanges:
         """kinema_msgs/msg/NodeStatusChanges."""
 
         changes: list[kinema_msgs__msg__NodeStatusChange]
         __msgtype__: ClassVar[str] = "kinema_msgs/msg/NodeStatusChanges"
-
 
     @dataclass
     class kinema_msgs__msg__ObjectiveInfo:
@@ -511,7 +466,6 @@ if TYPE_CHECKING:
         ports: list[kinema_msgs__msg__ObjectivePort]
         __msgtype__: ClassVar[str] = "kinema_msgs/msg/ObjectiveInfo"
 
-
     @dataclass
     class kinema_msgs__msg__ObjectivePort:
         """kinema_msgs/msg/ObjectivePort."""
@@ -526,7 +480,6 @@ if TYPE_CHECKING:
         INOUT: ClassVar[int] = 2
         __msgtype__: ClassVar[str] = "kinema_msgs/msg/ObjectivePort"
 
-
     @dataclass
     class kinema_msgs__msg__ObjectiveServerHealth:
         """kinema_msgs/msg/ObjectiveServerHealth."""
@@ -537,7 +490,6 @@ if TYPE_CHECKING:
         warnings: list[str]
         __msgtype__: ClassVar[str] = "kinema_msgs/msg/ObjectiveServerHealth"
 
-
     @dataclass
     class kinema_msgs__msg__SceneState:
         """kinema_msgs/msg/SceneState."""
@@ -547,7 +499,6 @@ if TYPE_CHECKING:
         bodies: list[kinema_msgs__msg__SimBody]
         __msgtype__: ClassVar[str] = "kinema_msgs/msg/SceneState"
 
-
     @dataclass
     class kinema_msgs__msg__SimBody:
         """kinema_msgs/msg/SimBody."""
@@ -556,14 +507,12 @@ if TYPE_CHECKING:
         pose: geometry_msgs__msg__Pose
         __msgtype__: ClassVar[str] = "kinema_msgs/msg/SimBody"
 
-
     @dataclass
     class kinema_msgs__srv__GetObjectiveXml_Request:
         """kinema_msgs/srv/GetObjectiveXml_Request."""
 
         objective_name: str
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/GetObjectiveXml_Request"
-
 
     @dataclass
     class kinema_msgs__srv__GetObjectiveXml_Response:
@@ -573,14 +522,12 @@ if TYPE_CHECKING:
         xml: str
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/GetObjectiveXml_Response"
 
-
     @dataclass
     class kinema_msgs__srv__GetSimBodies_Request:
         """kinema_msgs/srv/GetSimBodies_Request."""
 
         structure_needs_at_least_one_member: int
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/GetSimBodies_Request"
-
 
     @dataclass
     class kinema_msgs__srv__GetSimBodies_Response:
@@ -590,14 +537,12 @@ if TYPE_CHECKING:
         bodies: list[kinema_msgs__msg__SimBody]
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/GetSimBodies_Response"
 
-
     @dataclass
     class kinema_msgs__srv__ListKeyframes_Request:
         """kinema_msgs/srv/ListKeyframes_Request."""
 
         structure_needs_at_least_one_member: int
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/ListKeyframes_Request"
-
 
     @dataclass
     class kinema_msgs__srv__ListKeyframes_Response:
@@ -607,14 +552,12 @@ if TYPE_CHECKING:
         initial: str
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/ListKeyframes_Response"
 
-
     @dataclass
     class kinema_msgs__srv__ListObjectives_Request:
         """kinema_msgs/srv/ListObjectives_Request."""
 
         subcategory: str
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/ListObjectives_Request"
-
 
     @dataclass
     class kinema_msgs__srv__ListObjectives_Response:
@@ -623,7 +566,6 @@ if TYPE_CHECKING:
         status: moveit_studio_sdk_msgs__msg__RequestStatus
         objectives: list[kinema_msgs__msg__ObjectiveInfo]
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/ListObjectives_Response"
-
 
     @dataclass
     class kinema_msgs__srv__RequestApproval_Request:
@@ -634,7 +576,6 @@ if TYPE_CHECKING:
         prompt: str
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/RequestApproval_Request"
 
-
     @dataclass
     class kinema_msgs__srv__RequestApproval_Response:
         """kinema_msgs/srv/RequestApproval_Response."""
@@ -642,7 +583,6 @@ if TYPE_CHECKING:
         approved: bool
         message: str
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/RequestApproval_Response"
-
 
     @dataclass
     class kinema_msgs__srv__SetMujocoState_Request:
@@ -652,7 +592,6 @@ if TYPE_CHECKING:
         joint_state: sensor_msgs__msg__JointState
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/SetMujocoState_Request"
 
-
     @dataclass
     class kinema_msgs__srv__SetMujocoState_Response:
         """kinema_msgs/srv/SetMujocoState_Response."""
@@ -661,14 +600,12 @@ if TYPE_CHECKING:
         message: str
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/SetMujocoState_Response"
 
-
     @dataclass
     class moveit_msgs__msg__AllowedCollisionEntry:
         """moveit_msgs/msg/AllowedCollisionEntry."""
 
         enabled: np.ndarray[tuple[int, ...], np.dtype[np.bool_]]
         __msgtype__: ClassVar[str] = "moveit_msgs/msg/AllowedCollisionEntry"
-
 
     @dataclass
     class moveit_msgs__msg__AllowedCollisionMatrix:
@@ -680,7 +617,6 @@ if TYPE_CHECKING:
         default_entry_values: np.ndarray[tuple[int, ...], np.dtype[np.bool_]]
         __msgtype__: ClassVar[str] = "moveit_msgs/msg/AllowedCollisionMatrix"
 
-
     @dataclass
     class moveit_msgs__msg__AttachedCollisionObject:
         """moveit_msgs/msg/AttachedCollisionObject."""
@@ -691,7 +627,6 @@ if TYPE_CHECKING:
         detach_posture: trajectory_msgs__msg__JointTrajectory
         weight: float
         __msgtype__: ClassVar[str] = "moveit_msgs/msg/AttachedCollisionObject"
-
 
     @dataclass
     class moveit_msgs__msg__CollisionObject:
@@ -716,7 +651,6 @@ if TYPE_CHECKING:
         MOVE: ClassVar[int] = 3
         __msgtype__: ClassVar[str] = "moveit_msgs/msg/CollisionObject"
 
-
     @dataclass
     class moveit_msgs__msg__LinkPadding:
         """moveit_msgs/msg/LinkPadding."""
@@ -725,7 +659,6 @@ if TYPE_CHECKING:
         padding: float
         __msgtype__: ClassVar[str] = "moveit_msgs/msg/LinkPadding"
 
-
     @dataclass
     class moveit_msgs__msg__LinkScale:
         """moveit_msgs/msg/LinkScale."""
@@ -733,7 +666,6 @@ if TYPE_CHECKING:
         link_name: str
         scale: float
         __msgtype__: ClassVar[str] = "moveit_msgs/msg/LinkScale"
-
 
     @dataclass
     class moveit_msgs__msg__MoveItErrorCodes:
@@ -775,7 +707,6 @@ if TYPE_CHECKING:
         NO_IK_SOLUTION: ClassVar[int] = -31
         __msgtype__: ClassVar[str] = "moveit_msgs/msg/MoveItErrorCodes"
 
-
     @dataclass
     class moveit_msgs__msg__ObjectColor:
         """moveit_msgs/msg/ObjectColor."""
@@ -783,7 +714,6 @@ if TYPE_CHECKING:
         id: str
         color: std_msgs__msg__ColorRGBA
         __msgtype__: ClassVar[str] = "moveit_msgs/msg/ObjectColor"
-
 
     @dataclass
     class moveit_msgs__msg__PlanningScene:
@@ -800,7 +730,6 @@ if TYPE_CHECKING:
         world: moveit_msgs__msg__PlanningSceneWorld
         is_diff: bool
         __msgtype__: ClassVar[str] = "moveit_msgs/msg/PlanningScene"
-
 
     @dataclass
     class moveit_msgs__msg__PlanningSceneComponents:
@@ -819,7 +748,6 @@ if TYPE_CHECKING:
         OBJECT_COLORS: ClassVar[int] = 512
         __msgtype__: ClassVar[str] = "moveit_msgs/msg/PlanningSceneComponents"
 
-
     @dataclass
     class moveit_msgs__msg__PlanningSceneWorld:
         """moveit_msgs/msg/PlanningSceneWorld."""
@@ -827,7 +755,6 @@ if TYPE_CHECKING:
         collision_objects: list[moveit_msgs__msg__CollisionObject]
         octomap: octomap_msgs__msg__OctomapWithPose
         __msgtype__: ClassVar[str] = "moveit_msgs/msg/PlanningSceneWorld"
-
 
     @dataclass
     class moveit_msgs__msg__RobotState:
@@ -839,7 +766,6 @@ if TYPE_CHECKING:
         is_diff: bool
         __msgtype__: ClassVar[str] = "moveit_msgs/msg/RobotState"
 
-
     @dataclass
     class moveit_msgs__srv__GetPlanningScene_Request:
         """moveit_msgs/srv/GetPlanningScene_Request."""
@@ -847,14 +773,12 @@ if TYPE_CHECKING:
         components: moveit_msgs__msg__PlanningSceneComponents
         __msgtype__: ClassVar[str] = "moveit_msgs/srv/GetPlanningScene_Request"
 
-
     @dataclass
     class moveit_msgs__srv__GetPlanningScene_Response:
         """moveit_msgs/srv/GetPlanningScene_Response."""
 
         scene: moveit_msgs__msg__PlanningScene
         __msgtype__: ClassVar[str] = "moveit_msgs/srv/GetPlanningScene_Response"
-
 
     @dataclass
     class moveit_studio_agent_msgs__msg__Log:
@@ -866,7 +790,6 @@ if TYPE_CHECKING:
         WARN: ClassVar[int] = 2
         INFO: ClassVar[int] = 3
         __msgtype__: ClassVar[str] = "moveit_studio_agent_msgs/msg/Log"
-
 
     @dataclass
     class moveit_studio_agent_msgs__msg__ObjectiveServerStatus:
@@ -885,7 +808,6 @@ if TYPE_CHECKING:
         OBJECTIVE_STATUS_LOADING: ClassVar[str] = "Loading"
         __msgtype__: ClassVar[str] = "moveit_studio_agent_msgs/msg/ObjectiveServerStatus"
 
-
     @dataclass
     class moveit_studio_agent_msgs__msg__RobotJointState:
         """moveit_studio_agent_msgs/msg/RobotJointState."""
@@ -893,7 +815,6 @@ if TYPE_CHECKING:
         joint_state: sensor_msgs__msg__JointState
         multi_dof_joint_state: sensor_msgs__msg__MultiDOFJointState
         __msgtype__: ClassVar[str] = "moveit_studio_agent_msgs/msg/RobotJointState"
-
 
     @dataclass
     class moveit_studio_agent_msgs__msg__Waypoint:
@@ -906,7 +827,6 @@ if TYPE_CHECKING:
         multi_dof_joint_state: sensor_msgs__msg__MultiDOFJointState
         joint_group_names: list[str]
         __msgtype__: ClassVar[str] = "moveit_studio_agent_msgs/msg/Waypoint"
-
 
     @dataclass
     class moveit_studio_agent_msgs__srv__EditWaypoints_Request:
@@ -921,7 +841,6 @@ if TYPE_CHECKING:
         ERASE: ClassVar[int] = 2
         __msgtype__: ClassVar[str] = "moveit_studio_agent_msgs/srv/EditWaypoints_Request"
 
-
     @dataclass
     class moveit_studio_agent_msgs__srv__EditWaypoints_Response:
         """moveit_studio_agent_msgs/srv/EditWaypoints_Response."""
@@ -930,14 +849,12 @@ if TYPE_CHECKING:
         new_waypoint: moveit_studio_agent_msgs__msg__Waypoint
         __msgtype__: ClassVar[str] = "moveit_studio_agent_msgs/srv/EditWaypoints_Response"
 
-
     @dataclass
     class moveit_studio_agent_msgs__srv__GetWaypoints_Request:
         """moveit_studio_agent_msgs/srv/GetWaypoints_Request."""
 
         structure_needs_at_least_one_member: int
         __msgtype__: ClassVar[str] = "moveit_studio_agent_msgs/srv/GetWaypoints_Request"
-
 
     @dataclass
     class moveit_studio_agent_msgs__srv__GetWaypoints_Response:
@@ -947,14 +864,12 @@ if TYPE_CHECKING:
         waypoints: list[moveit_studio_agent_msgs__msg__Waypoint]
         __msgtype__: ClassVar[str] = "moveit_studio_agent_msgs/srv/GetWaypoints_Response"
 
-
     @dataclass
     class moveit_studio_sdk_msgs__action__DoObjectiveSequence_Feedback:
         """moveit_studio_sdk_msgs/action/DoObjectiveSequence_Feedback."""
 
         structure_needs_at_least_one_member: int
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/action/DoObjectiveSequence_Feedback"
-
 
     @dataclass
     class moveit_studio_sdk_msgs__action__DoObjectiveSequence_FeedbackMessage:
@@ -964,14 +879,12 @@ if TYPE_CHECKING:
         feedback: moveit_studio_sdk_msgs__action__DoObjectiveSequence_Feedback
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/action/DoObjectiveSequence_FeedbackMessage"
 
-
     @dataclass
     class moveit_studio_sdk_msgs__action__DoObjectiveSequence_GetResult_Request:
         """moveit_studio_sdk_msgs/action/DoObjectiveSequence_GetResult_Request."""
 
         goal_id: unique_identifier_msgs__msg__UUID
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/action/DoObjectiveSequence_GetResult_Request"
-
 
     @dataclass
     class moveit_studio_sdk_msgs__action__DoObjectiveSequence_GetResult_Response:
@@ -980,7 +893,6 @@ if TYPE_CHECKING:
         status: int
         result: moveit_studio_sdk_msgs__action__DoObjectiveSequence_Result
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/action/DoObjectiveSequence_GetResult_Response"
-
 
     @dataclass
     class moveit_studio_sdk_msgs__action__DoObjectiveSequence_Goal:
@@ -991,7 +903,6 @@ if TYPE_CHECKING:
         parameter_overrides: list[moveit_studio_sdk_msgs__msg__BehaviorParameter]
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/action/DoObjectiveSequence_Goal"
 
-
     @dataclass
     class moveit_studio_sdk_msgs__action__DoObjectiveSequence_Result:
         """moveit_studio_sdk_msgs/action/DoObjectiveSequence_Result."""
@@ -999,7 +910,6 @@ if TYPE_CHECKING:
         error_code: moveit_msgs__msg__MoveItErrorCodes
         error_message: str
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/action/DoObjectiveSequence_Result"
-
 
     @dataclass
     class moveit_studio_sdk_msgs__action__DoObjectiveSequence_SendGoal_Request:
@@ -1009,7 +919,6 @@ if TYPE_CHECKING:
         goal: moveit_studio_sdk_msgs__action__DoObjectiveSequence_Goal
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/action/DoObjectiveSequence_SendGoal_Request"
 
-
     @dataclass
     class moveit_studio_sdk_msgs__action__DoObjectiveSequence_SendGoal_Response:
         """moveit_studio_sdk_msgs/action/DoObjectiveSequence_SendGoal_Response."""
@@ -1017,7 +926,6 @@ if TYPE_CHECKING:
         accepted: bool
         stamp: builtin_interfaces__msg__Time
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/action/DoObjectiveSequence_SendGoal_Response"
-
 
     @dataclass
     class moveit_studio_sdk_msgs__msg__BehaviorParameter:
@@ -1033,7 +941,6 @@ if TYPE_CHECKING:
         behavior_namespaces: list[str]
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/msg/BehaviorParameter"
 
-
     @dataclass
     class moveit_studio_sdk_msgs__msg__BehaviorParameterDescription:
         """moveit_studio_sdk_msgs/msg/BehaviorParameterDescription."""
@@ -1048,7 +955,6 @@ if TYPE_CHECKING:
         TYPE_JOINT_STATE: ClassVar[int] = 5
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/msg/BehaviorParameterDescription"
 
-
     @dataclass
     class moveit_studio_sdk_msgs__msg__RequestStatus:
         """moveit_studio_sdk_msgs/msg/RequestStatus."""
@@ -1057,7 +963,6 @@ if TYPE_CHECKING:
         error_message: str
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/msg/RequestStatus"
 
-
     @dataclass
     class moveit_studio_sdk_msgs__srv__CancelObjective_Request:
         """moveit_studio_sdk_msgs/srv/CancelObjective_Request."""
@@ -1065,14 +970,12 @@ if TYPE_CHECKING:
         structure_needs_at_least_one_member: int
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/srv/CancelObjective_Request"
 
-
     @dataclass
     class moveit_studio_sdk_msgs__srv__CancelObjective_Response:
         """moveit_studio_sdk_msgs/srv/CancelObjective_Response."""
 
         status: moveit_studio_sdk_msgs__msg__RequestStatus
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/srv/CancelObjective_Response"
-
 
     @dataclass
     class moveit_studio_sdk_msgs__srv__ExecuteObjective_Request:
@@ -1082,14 +985,12 @@ if TYPE_CHECKING:
         parameter_overrides: list[moveit_studio_sdk_msgs__msg__BehaviorParameter]
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/srv/ExecuteObjective_Request"
 
-
     @dataclass
     class moveit_studio_sdk_msgs__srv__ExecuteObjective_Response:
         """moveit_studio_sdk_msgs/srv/ExecuteObjective_Response."""
 
         error_code: moveit_msgs__msg__MoveItErrorCodes
         __msgtype__: ClassVar[str] = "moveit_studio_sdk_msgs/srv/ExecuteObjective_Response"
-
 
     @dataclass
     class moveit_studio_vision_msgs__msg__GraspableObject:
@@ -1100,7 +1001,6 @@ if TYPE_CHECKING:
         grasp_info: str
         __msgtype__: ClassVar[str] = "moveit_studio_vision_msgs/msg/GraspableObject"
 
-
     @dataclass
     class object_recognition_msgs__msg__ObjectType:
         """object_recognition_msgs/msg/ObjectType."""
@@ -1108,7 +1008,6 @@ if TYPE_CHECKING:
         key: str
         db: str
         __msgtype__: ClassVar[str] = "object_recognition_msgs/msg/ObjectType"
-
 
     @dataclass
     class octomap_msgs__msg__Octomap:
@@ -1121,7 +1020,6 @@ if TYPE_CHECKING:
         data: np.ndarray[tuple[int, ...], np.dtype[np.int8]]
         __msgtype__: ClassVar[str] = "octomap_msgs/msg/Octomap"
 
-
     @dataclass
     class octomap_msgs__msg__OctomapWithPose:
         """octomap_msgs/msg/OctomapWithPose."""
@@ -1131,14 +1029,12 @@ if TYPE_CHECKING:
         octomap: octomap_msgs__msg__Octomap
         __msgtype__: ClassVar[str] = "octomap_msgs/msg/OctomapWithPose"
 
-
     @dataclass
     class std_srvs__srv__Trigger_Request:
         """std_srvs/srv/Trigger_Request."""
 
         structure_needs_at_least_one_member: int
         __msgtype__: ClassVar[str] = "std_srvs/srv/Trigger_Request"
-
 
     @dataclass
     class std_srvs__srv__Trigger_Response:
@@ -1148,11 +1044,10 @@ if TYPE_CHECKING:
         message: str
         __msgtype__: ClassVar[str] = "std_srvs/srv/Trigger_Response"
 
-
     class CancelGoal(
         ServiceDefinition[
-        action_msgs__srv__CancelGoal_Request,
-        action_msgs__srv__CancelGoal_Response,
+            action_msgs__srv__CancelGoal_Request,
+            action_msgs__srv__CancelGoal_Response,
         ]
     ):
         """action_msgs/srv/CancelGoal."""
@@ -1161,11 +1056,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = action_msgs__srv__CancelGoal_Request
         Response: TypeAlias = action_msgs__srv__CancelGoal_Response
 
-
     class ListControllers(
         ServiceDefinition[
-        controller_manager_msgs__srv__ListControllers_Request,
-        controller_manager_msgs__srv__ListControllers_Response,
+            controller_manager_msgs__srv__ListControllers_Request,
+            controller_manager_msgs__srv__ListControllers_Response,
         ]
     ):
         """controller_manager_msgs/srv/ListControllers."""
@@ -1174,11 +1068,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = controller_manager_msgs__srv__ListControllers_Request
         Response: TypeAlias = controller_manager_msgs__srv__ListControllers_Response
 
-
     class SwitchController(
         ServiceDefinition[
-        controller_manager_msgs__srv__SwitchController_Request,
-        controller_manager_msgs__srv__SwitchController_Response,
+            controller_manager_msgs__srv__SwitchController_Request,
+            controller_manager_msgs__srv__SwitchController_Response,
         ]
     ):
         """controller_manager_msgs/srv/SwitchController."""
@@ -1187,11 +1080,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = controller_manager_msgs__srv__SwitchController_Request
         Response: TypeAlias = controller_manager_msgs__srv__SwitchController_Response
 
-
     class AddTwoInts(
         ServiceDefinition[
-        example_interfaces__srv__AddTwoInts_Request,
-        example_interfaces__srv__AddTwoInts_Response,
+            example_interfaces__srv__AddTwoInts_Request,
+            example_interfaces__srv__AddTwoInts_Response,
         ]
     ):
         """example_interfaces/srv/AddTwoInts."""
@@ -1200,11 +1092,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = example_interfaces__srv__AddTwoInts_Request
         Response: TypeAlias = example_interfaces__srv__AddTwoInts_Response
 
-
     class GetObjectiveXml(
         ServiceDefinition[
-        kinema_msgs__srv__GetObjectiveXml_Request,
-        kinema_msgs__srv__GetObjectiveXml_Response,
+            kinema_msgs__srv__GetObjectiveXml_Request,
+            kinema_msgs__srv__GetObjectiveXml_Response,
         ]
     ):
         """kinema_msgs/srv/GetObjectiveXml."""
@@ -1213,11 +1104,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = kinema_msgs__srv__GetObjectiveXml_Request
         Response: TypeAlias = kinema_msgs__srv__GetObjectiveXml_Response
 
-
     class GetSimBodies(
         ServiceDefinition[
-        kinema_msgs__srv__GetSimBodies_Request,
-        kinema_msgs__srv__GetSimBodies_Response,
+            kinema_msgs__srv__GetSimBodies_Request,
+            kinema_msgs__srv__GetSimBodies_Response,
         ]
     ):
         """kinema_msgs/srv/GetSimBodies."""
@@ -1226,11 +1116,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = kinema_msgs__srv__GetSimBodies_Request
         Response: TypeAlias = kinema_msgs__srv__GetSimBodies_Response
 
-
     class ListKeyframes(
         ServiceDefinition[
-        kinema_msgs__srv__ListKeyframes_Request,
-        kinema_msgs__srv__ListKeyframes_Response,
+            kinema_msgs__srv__ListKeyframes_Request,
+            kinema_msgs__srv__ListKeyframes_Response,
         ]
     ):
         """kinema_msgs/srv/ListKeyframes."""
@@ -1239,11 +1128,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = kinema_msgs__srv__ListKeyframes_Request
         Response: TypeAlias = kinema_msgs__srv__ListKeyframes_Response
 
-
     class ListObjectives(
         ServiceDefinition[
-        kinema_msgs__srv__ListObjectives_Request,
-        kinema_msgs__srv__ListObjectives_Response,
+            kinema_msgs__srv__ListObjectives_Request,
+            kinema_msgs__srv__ListObjectives_Response,
         ]
     ):
         """kinema_msgs/srv/ListObjectives."""
@@ -1252,11 +1140,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = kinema_msgs__srv__ListObjectives_Request
         Response: TypeAlias = kinema_msgs__srv__ListObjectives_Response
 
-
     class RequestApproval(
         ServiceDefinition[
-        kinema_msgs__srv__RequestApproval_Request,
-        kinema_msgs__srv__RequestApproval_Response,
+            kinema_msgs__srv__RequestApproval_Request,
+            kinema_msgs__srv__RequestApproval_Response,
         ]
     ):
         """kinema_msgs/srv/RequestApproval."""
@@ -1265,11 +1152,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = kinema_msgs__srv__RequestApproval_Request
         Response: TypeAlias = kinema_msgs__srv__RequestApproval_Response
 
-
     class SetMujocoState(
         ServiceDefinition[
-        kinema_msgs__srv__SetMujocoState_Request,
-        kinema_msgs__srv__SetMujocoState_Response,
+            kinema_msgs__srv__SetMujocoState_Request,
+            kinema_msgs__srv__SetMujocoState_Response,
         ]
     ):
         """kinema_msgs/srv/SetMujocoState."""
@@ -1278,11 +1164,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = kinema_msgs__srv__SetMujocoState_Request
         Response: TypeAlias = kinema_msgs__srv__SetMujocoState_Response
 
-
     class GetPlanningScene(
         ServiceDefinition[
-        moveit_msgs__srv__GetPlanningScene_Request,
-        moveit_msgs__srv__GetPlanningScene_Response,
+            moveit_msgs__srv__GetPlanningScene_Request,
+            moveit_msgs__srv__GetPlanningScene_Response,
         ]
     ):
         """moveit_msgs/srv/GetPlanningScene."""
@@ -1291,11 +1176,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = moveit_msgs__srv__GetPlanningScene_Request
         Response: TypeAlias = moveit_msgs__srv__GetPlanningScene_Response
 
-
     class EditWaypoints(
         ServiceDefinition[
-        moveit_studio_agent_msgs__srv__EditWaypoints_Request,
-        moveit_studio_agent_msgs__srv__EditWaypoints_Response,
+            moveit_studio_agent_msgs__srv__EditWaypoints_Request,
+            moveit_studio_agent_msgs__srv__EditWaypoints_Response,
         ]
     ):
         """moveit_studio_agent_msgs/srv/EditWaypoints."""
@@ -1304,11 +1188,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = moveit_studio_agent_msgs__srv__EditWaypoints_Request
         Response: TypeAlias = moveit_studio_agent_msgs__srv__EditWaypoints_Response
 
-
     class GetWaypoints(
         ServiceDefinition[
-        moveit_studio_agent_msgs__srv__GetWaypoints_Request,
-        moveit_studio_agent_msgs__srv__GetWaypoints_Response,
+            moveit_studio_agent_msgs__srv__GetWaypoints_Request,
+            moveit_studio_agent_msgs__srv__GetWaypoints_Response,
         ]
     ):
         """moveit_studio_agent_msgs/srv/GetWaypoints."""
@@ -1317,11 +1200,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = moveit_studio_agent_msgs__srv__GetWaypoints_Request
         Response: TypeAlias = moveit_studio_agent_msgs__srv__GetWaypoints_Response
 
-
     class CancelObjective(
         ServiceDefinition[
-        moveit_studio_sdk_msgs__srv__CancelObjective_Request,
-        moveit_studio_sdk_msgs__srv__CancelObjective_Response,
+            moveit_studio_sdk_msgs__srv__CancelObjective_Request,
+            moveit_studio_sdk_msgs__srv__CancelObjective_Response,
         ]
     ):
         """moveit_studio_sdk_msgs/srv/CancelObjective."""
@@ -1330,11 +1212,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = moveit_studio_sdk_msgs__srv__CancelObjective_Request
         Response: TypeAlias = moveit_studio_sdk_msgs__srv__CancelObjective_Response
 
-
     class ExecuteObjective(
         ServiceDefinition[
-        moveit_studio_sdk_msgs__srv__ExecuteObjective_Request,
-        moveit_studio_sdk_msgs__srv__ExecuteObjective_Response,
+            moveit_studio_sdk_msgs__srv__ExecuteObjective_Request,
+            moveit_studio_sdk_msgs__srv__ExecuteObjective_Response,
         ]
     ):
         """moveit_studio_sdk_msgs/srv/ExecuteObjective."""
@@ -1343,11 +1224,10 @@ if TYPE_CHECKING:
         Request: TypeAlias = moveit_studio_sdk_msgs__srv__ExecuteObjective_Request
         Response: TypeAlias = moveit_studio_sdk_msgs__srv__ExecuteObjective_Response
 
-
     class Trigger(
         ServiceDefinition[
-        std_srvs__srv__Trigger_Request,
-        std_srvs__srv__Trigger_Response,
+            std_srvs__srv__Trigger_Request,
+            std_srvs__srv__Trigger_Response,
         ]
     ):
         """std_srvs/srv/Trigger."""
@@ -1356,12 +1236,11 @@ if TYPE_CHECKING:
         Request: TypeAlias = std_srvs__srv__Trigger_Request
         Response: TypeAlias = std_srvs__srv__Trigger_Response
 
-
     class FollowJointTrajectory(
         ActionDefinition[
-        control_msgs__action__FollowJointTrajectory_Goal,
-        control_msgs__action__FollowJointTrajectory_Result,
-        control_msgs__action__FollowJointTrajectory_Feedback,
+            control_msgs__action__FollowJointTrajectory_Goal,
+            control_msgs__action__FollowJointTrajectory_Result,
+            control_msgs__action__FollowJointTrajectory_Feedback,
         ]
     ):
         """control_msgs/action/FollowJointTrajectory."""
@@ -1371,12 +1250,11 @@ if TYPE_CHECKING:
         Result: TypeAlias = control_msgs__action__FollowJointTrajectory_Result
         Feedback: TypeAlias = control_msgs__action__FollowJointTrajectory_Feedback
 
-
     class GripperCommand(
         ActionDefinition[
-        control_msgs__action__GripperCommand_Goal,
-        control_msgs__action__GripperCommand_Result,
-        control_msgs__action__GripperCommand_Feedback,
+            control_msgs__action__GripperCommand_Goal,
+            control_msgs__action__GripperCommand_Result,
+            control_msgs__action__GripperCommand_Feedback,
         ]
     ):
         """control_msgs/action/GripperCommand."""
@@ -1386,12 +1264,11 @@ if TYPE_CHECKING:
         Result: TypeAlias = control_msgs__action__GripperCommand_Result
         Feedback: TypeAlias = control_msgs__action__GripperCommand_Feedback
 
-
     class Fibonacci(
         ActionDefinition[
-        example_interfaces__action__Fibonacci_Goal,
-        example_interfaces__action__Fibonacci_Result,
-        example_interfaces__action__Fibonacci_Feedback,
+            example_interfaces__action__Fibonacci_Goal,
+            example_interfaces__action__Fibonacci_Result,
+            example_interfaces__action__Fibonacci_Feedback,
         ]
     ):
         """example_interfaces/action/Fibonacci."""
@@ -1401,12 +1278,11 @@ if TYPE_CHECKING:
         Result: TypeAlias = example_interfaces__action__Fibonacci_Result
         Feedback: TypeAlias = example_interfaces__action__Fibonacci_Feedback
 
-
     class DoObjectiveSequence(
         ActionDefinition[
-        moveit_studio_sdk_msgs__action__DoObjectiveSequence_Goal,
-        moveit_studio_sdk_msgs__action__DoObjectiveSequence_Result,
-        moveit_studio_sdk_msgs__action__DoObjectiveSequence_Feedback,
+            moveit_studio_sdk_msgs__action__DoObjectiveSequence_Goal,
+            moveit_studio_sdk_msgs__action__DoObjectiveSequence_Result,
+            moveit_studio_sdk_msgs__action__DoObjectiveSequence_Feedback,
         ]
     ):
         """moveit_studio_sdk_msgs/action/DoObjectiveSequence."""
@@ -1427,7 +1303,7 @@ else:
 
         registry = load_interfaces()
         if name in _MESSAGES:
-            made: Any = registry.message_class(_MESSAGES[name])
+            made: Any = registry.message_class(name.replace("__", "/"))
         elif name in _SERVICES:
             type_name = _SERVICES[name]
             made = type(
@@ -1461,112 +1337,115 @@ else:
         return made
 
 
-_MESSAGES: dict[str, str] = {
-    "action_msgs__msg__GoalInfo": "action_msgs/msg/GoalInfo",
-    "action_msgs__msg__GoalStatus": "action_msgs/msg/GoalStatus",
-    "action_msgs__msg__GoalStatusArray": "action_msgs/msg/GoalStatusArray",
-    "action_msgs__srv__CancelGoal_Request": "action_msgs/srv/CancelGoal_Request",
-    "action_msgs__srv__CancelGoal_Response": "action_msgs/srv/CancelGoal_Response",
-    "control_msgs__action__FollowJointTrajectory_Feedback": "control_msgs/action/FollowJointTrajectory_Feedback",
-    "control_msgs__action__FollowJointTrajectory_FeedbackMessage": "control_msgs/action/FollowJointTrajectory_FeedbackMessage",
-    "control_msgs__action__FollowJointTrajectory_GetResult_Request": "control_msgs/action/FollowJointTrajectory_GetResult_Request",
-    "control_msgs__action__FollowJointTrajectory_GetResult_Response": "control_msgs/action/FollowJointTrajectory_GetResult_Response",
-    "control_msgs__action__FollowJointTrajectory_Goal": "control_msgs/action/FollowJointTrajectory_Goal",
-    "control_msgs__action__FollowJointTrajectory_Result": "control_msgs/action/FollowJointTrajectory_Result",
-    "control_msgs__action__FollowJointTrajectory_SendGoal_Request": "control_msgs/action/FollowJointTrajectory_SendGoal_Request",
-    "control_msgs__action__FollowJointTrajectory_SendGoal_Response": "control_msgs/action/FollowJointTrajectory_SendGoal_Response",
-    "control_msgs__action__GripperCommand_Feedback": "control_msgs/action/GripperCommand_Feedback",
-    "control_msgs__action__GripperCommand_FeedbackMessage": "control_msgs/action/GripperCommand_FeedbackMessage",
-    "control_msgs__action__GripperCommand_GetResult_Request": "control_msgs/action/GripperCommand_GetResult_Request",
-    "control_msgs__action__GripperCommand_GetResult_Response": "control_msgs/action/GripperCommand_GetResult_Response",
-    "control_msgs__action__GripperCommand_Goal": "control_msgs/action/GripperCommand_Goal",
-    "control_msgs__action__GripperCommand_Result": "control_msgs/action/GripperCommand_Result",
-    "control_msgs__action__GripperCommand_SendGoal_Request": "control_msgs/action/GripperCommand_SendGoal_Request",
-    "control_msgs__action__GripperCommand_SendGoal_Response": "control_msgs/action/GripperCommand_SendGoal_Response",
-    "control_msgs__msg__GripperCommand": "control_msgs/msg/GripperCommand",
-    "control_msgs__msg__JointComponentTolerance": "control_msgs/msg/JointComponentTolerance",
-    "control_msgs__msg__JointTolerance": "control_msgs/msg/JointTolerance",
-    "controller_manager_msgs__msg__ChainConnection": "controller_manager_msgs/msg/ChainConnection",
-    "controller_manager_msgs__msg__ControllerState": "controller_manager_msgs/msg/ControllerState",
-    "controller_manager_msgs__srv__ListControllers_Request": "controller_manager_msgs/srv/ListControllers_Request",
-    "controller_manager_msgs__srv__ListControllers_Response": "controller_manager_msgs/srv/ListControllers_Response",
-    "controller_manager_msgs__srv__SwitchController_Request": "controller_manager_msgs/srv/SwitchController_Request",
-    "controller_manager_msgs__srv__SwitchController_Response": "controller_manager_msgs/srv/SwitchController_Response",
-    "example_interfaces__action__Fibonacci_Feedback": "example_interfaces/action/Fibonacci_Feedback",
-    "example_interfaces__action__Fibonacci_FeedbackMessage": "example_interfaces/action/Fibonacci_FeedbackMessage",
-    "example_interfaces__action__Fibonacci_GetResult_Request": "example_interfaces/action/Fibonacci_GetResult_Request",
-    "example_interfaces__action__Fibonacci_GetResult_Response": "example_interfaces/action/Fibonacci_GetResult_Response",
-    "example_interfaces__action__Fibonacci_Goal": "example_interfaces/action/Fibonacci_Goal",
-    "example_interfaces__action__Fibonacci_Result": "example_interfaces/action/Fibonacci_Result",
-    "example_interfaces__action__Fibonacci_SendGoal_Request": "example_interfaces/action/Fibonacci_SendGoal_Request",
-    "example_interfaces__action__Fibonacci_SendGoal_Response": "example_interfaces/action/Fibonacci_SendGoal_Response",
-    "example_interfaces__srv__AddTwoInts_Request": "example_interfaces/srv/AddTwoInts_Request",
-    "example_interfaces__srv__AddTwoInts_Response": "example_interfaces/srv/AddTwoInts_Response",
-    "kinema_msgs__msg__BlackboardEntry": "kinema_msgs/msg/BlackboardEntry",
-    "kinema_msgs__msg__BlackboardSnapshot": "kinema_msgs/msg/BlackboardSnapshot",
-    "kinema_msgs__msg__NodeStatusChange": "kinema_msgs/msg/NodeStatusChange",
-    "kinema_msgs__msg__NodeStatusChanges": "kinema_msgs/msg/NodeStatusChanges",
-    "kinema_msgs__msg__ObjectiveInfo": "kinema_msgs/msg/ObjectiveInfo",
-    "kinema_msgs__msg__ObjectivePort": "kinema_msgs/msg/ObjectivePort",
-    "kinema_msgs__msg__ObjectiveServerHealth": "kinema_msgs/msg/ObjectiveServerHealth",
-    "kinema_msgs__msg__SceneState": "kinema_msgs/msg/SceneState",
-    "kinema_msgs__msg__SimBody": "kinema_msgs/msg/SimBody",
-    "kinema_msgs__srv__GetObjectiveXml_Request": "kinema_msgs/srv/GetObjectiveXml_Request",
-    "kinema_msgs__srv__GetObjectiveXml_Response": "kinema_msgs/srv/GetObjectiveXml_Response",
-    "kinema_msgs__srv__GetSimBodies_Request": "kinema_msgs/srv/GetSimBodies_Request",
-    "kinema_msgs__srv__GetSimBodies_Response": "kinema_msgs/srv/GetSimBodies_Response",
-    "kinema_msgs__srv__ListKeyframes_Request": "kinema_msgs/srv/ListKeyframes_Request",
-    "kinema_msgs__srv__ListKeyframes_Response": "kinema_msgs/srv/ListKeyframes_Response",
-    "kinema_msgs__srv__ListObjectives_Request": "kinema_msgs/srv/ListObjectives_Request",
-    "kinema_msgs__srv__ListObjectives_Response": "kinema_msgs/srv/ListObjectives_Response",
-    "kinema_msgs__srv__RequestApproval_Request": "kinema_msgs/srv/RequestApproval_Request",
-    "kinema_msgs__srv__RequestApproval_Response": "kinema_msgs/srv/RequestApproval_Response",
-    "kinema_msgs__srv__SetMujocoState_Request": "kinema_msgs/srv/SetMujocoState_Request",
-    "kinema_msgs__srv__SetMujocoState_Response": "kinema_msgs/srv/SetMujocoState_Response",
-    "moveit_msgs__msg__AllowedCollisionEntry": "moveit_msgs/msg/AllowedCollisionEntry",
-    "moveit_msgs__msg__AllowedCollisionMatrix": "moveit_msgs/msg/AllowedCollisionMatrix",
-    "moveit_msgs__msg__AttachedCollisionObject": "moveit_msgs/msg/AttachedCollisionObject",
-    "moveit_msgs__msg__CollisionObject": "moveit_msgs/msg/CollisionObject",
-    "moveit_msgs__msg__LinkPadding": "moveit_msgs/msg/LinkPadding",
-    "moveit_msgs__msg__LinkScale": "moveit_msgs/msg/LinkScale",
-    "moveit_msgs__msg__MoveItErrorCodes": "moveit_msgs/msg/MoveItErrorCodes",
-    "moveit_msgs__msg__ObjectColor": "moveit_msgs/msg/ObjectColor",
-    "moveit_msgs__msg__PlanningScene": "moveit_msgs/msg/PlanningScene",
-    "moveit_msgs__msg__PlanningSceneComponents": "moveit_msgs/msg/PlanningSceneComponents",
-    "moveit_msgs__msg__PlanningSceneWorld": "moveit_msgs/msg/PlanningSceneWorld",
-    "moveit_msgs__msg__RobotState": "moveit_msgs/msg/RobotState",
-    "moveit_msgs__srv__GetPlanningScene_Request": "moveit_msgs/srv/GetPlanningScene_Request",
-    "moveit_msgs__srv__GetPlanningScene_Response": "moveit_msgs/srv/GetPlanningScene_Response",
-    "moveit_studio_agent_msgs__msg__Log": "moveit_studio_agent_msgs/msg/Log",
-    "moveit_studio_agent_msgs__msg__ObjectiveServerStatus": "moveit_studio_agent_msgs/msg/ObjectiveServerStatus",
-    "moveit_studio_agent_msgs__msg__RobotJointState": "moveit_studio_agent_msgs/msg/RobotJointState",
-    "moveit_studio_agent_msgs__msg__Waypoint": "moveit_studio_agent_msgs/msg/Waypoint",
-    "moveit_studio_agent_msgs__srv__EditWaypoints_Request": "moveit_studio_agent_msgs/srv/EditWaypoints_Request",
-    "moveit_studio_agent_msgs__srv__EditWaypoints_Response": "moveit_studio_agent_msgs/srv/EditWaypoints_Response",
-    "moveit_studio_agent_msgs__srv__GetWaypoints_Request": "moveit_studio_agent_msgs/srv/GetWaypoints_Request",
-    "moveit_studio_agent_msgs__srv__GetWaypoints_Response": "moveit_studio_agent_msgs/srv/GetWaypoints_Response",
-    "moveit_studio_sdk_msgs__action__DoObjectiveSequence_Feedback": "moveit_studio_sdk_msgs/action/DoObjectiveSequence_Feedback",
-    "moveit_studio_sdk_msgs__action__DoObjectiveSequence_FeedbackMessage": "moveit_studio_sdk_msgs/action/DoObjectiveSequence_FeedbackMessage",
-    "moveit_studio_sdk_msgs__action__DoObjectiveSequence_GetResult_Request": "moveit_studio_sdk_msgs/action/DoObjectiveSequence_GetResult_Request",
-    "moveit_studio_sdk_msgs__action__DoObjectiveSequence_GetResult_Response": "moveit_studio_sdk_msgs/action/DoObjectiveSequence_GetResult_Response",
-    "moveit_studio_sdk_msgs__action__DoObjectiveSequence_Goal": "moveit_studio_sdk_msgs/action/DoObjectiveSequence_Goal",
-    "moveit_studio_sdk_msgs__action__DoObjectiveSequence_Result": "moveit_studio_sdk_msgs/action/DoObjectiveSequence_Result",
-    "moveit_studio_sdk_msgs__action__DoObjectiveSequence_SendGoal_Request": "moveit_studio_sdk_msgs/action/DoObjectiveSequence_SendGoal_Request",
-    "moveit_studio_sdk_msgs__action__DoObjectiveSequence_SendGoal_Response": "moveit_studio_sdk_msgs/action/DoObjectiveSequence_SendGoal_Response",
-    "moveit_studio_sdk_msgs__msg__BehaviorParameter": "moveit_studio_sdk_msgs/msg/BehaviorParameter",
-    "moveit_studio_sdk_msgs__msg__BehaviorParameterDescription": "moveit_studio_sdk_msgs/msg/BehaviorParameterDescription",
-    "moveit_studio_sdk_msgs__msg__RequestStatus": "moveit_studio_sdk_msgs/msg/RequestStatus",
-    "moveit_studio_sdk_msgs__srv__CancelObjective_Request": "moveit_studio_sdk_msgs/srv/CancelObjective_Request",
-    "moveit_studio_sdk_msgs__srv__CancelObjective_Response": "moveit_studio_sdk_msgs/srv/CancelObjective_Response",
-    "moveit_studio_sdk_msgs__srv__ExecuteObjective_Request": "moveit_studio_sdk_msgs/srv/ExecuteObjective_Request",
-    "moveit_studio_sdk_msgs__srv__ExecuteObjective_Response": "moveit_studio_sdk_msgs/srv/ExecuteObjective_Response",
-    "moveit_studio_vision_msgs__msg__GraspableObject": "moveit_studio_vision_msgs/msg/GraspableObject",
-    "object_recognition_msgs__msg__ObjectType": "object_recognition_msgs/msg/ObjectType",
-    "octomap_msgs__msg__Octomap": "octomap_msgs/msg/Octomap",
-    "octomap_msgs__msg__OctomapWithPose": "octomap_msgs/msg/OctomapWithPose",
-    "std_srvs__srv__Trigger_Request": "std_srvs/srv/Trigger_Request",
-    "std_srvs__srv__Trigger_Response": "std_srvs/srv/Trigger_Response",
-}
+_MESSAGES = frozenset(
+    {
+        "action_msgs__msg__GoalInfo",
+        "action_msgs__msg__GoalStatus",
+        "action_msgs__msg__GoalStatusArray",
+        "action_msgs__srv__CancelGoal_Request",
+        "action_msgs__srv__CancelGoal_Response",
+        "control_msgs__action__FollowJointTrajectory_Feedback",
+        "control_msgs__action__FollowJointTrajectory_FeedbackMessage",
+        "control_msgs__action__FollowJointTrajectory_GetResult_Request",
+        "control_msgs__action__FollowJointTrajectory_GetResult_Response",
+        "control_msgs__action__FollowJointTrajectory_Goal",
+        "control_msgs__action__FollowJointTrajectory_Result",
+        "control_msgs__action__FollowJointTrajectory_SendGoal_Request",
+        "control_msgs__action__FollowJointTrajectory_SendGoal_Response",
+        "control_msgs__action__GripperCommand_Feedback",
+        "control_msgs__action__GripperCommand_FeedbackMessage",
+        "control_msgs__action__GripperCommand_GetResult_Request",
+        "control_msgs__action__GripperCommand_GetResult_Response",
+        "control_msgs__action__GripperCommand_Goal",
+        "control_msgs__action__GripperCommand_Result",
+        "control_msgs__action__GripperCommand_SendGoal_Request",
+        "control_msgs__action__GripperCommand_SendGoal_Response",
+        "control_msgs__msg__GripperCommand",
+        "control_msgs__msg__JointComponentTolerance",
+        "control_msgs__msg__JointTolerance",
+        "controller_manager_msgs__msg__ChainConnection",
+        "controller_manager_msgs__msg__ControllerState",
+        "controller_manager_msgs__srv__ListControllers_Request",
+        "controller_manager_msgs__srv__ListControllers_Response",
+        "controller_manager_msgs__srv__SwitchController_Request",
+        "controller_manager_msgs__srv__SwitchController_Response",
+        "example_interfaces__action__Fibonacci_Feedback",
+        "example_interfaces__action__Fibonacci_FeedbackMessage",
+        "example_interfaces__action__Fibonacci_GetResult_Request",
+        "example_interfaces__action__Fibonacci_GetResult_Response",
+        "example_interfaces__action__Fibonacci_Goal",
+        "example_interfaces__action__Fibonacci_Result",
+        "example_interfaces__action__Fibonacci_SendGoal_Request",
+        "example_interfaces__action__Fibonacci_SendGoal_Response",
+        "example_interfaces__srv__AddTwoInts_Request",
+        "example_interfaces__srv__AddTwoInts_Response",
+        "kinema_msgs__msg__BlackboardEntry",
+        "kinema_msgs__msg__BlackboardSnapshot",
+        "kinema_msgs__msg__NodeStatusChange",
+        "kinema_msgs__msg__NodeStatusChanges",
+        "kinema_msgs__msg__ObjectiveInfo",
+        "kinema_msgs__msg__ObjectivePort",
+        "kinema_msgs__msg__ObjectiveServerHealth",
+        "kinema_msgs__msg__SceneState",
+        "kinema_msgs__msg__SimBody",
+        "kinema_msgs__srv__GetObjectiveXml_Request",
+        "kinema_msgs__srv__GetObjectiveXml_Response",
+        "kinema_msgs__srv__GetSimBodies_Request",
+        "kinema_msgs__srv__GetSimBodies_Response",
+        "kinema_msgs__srv__ListKeyframes_Request",
+        "kinema_msgs__srv__ListKeyframes_Response",
+        "kinema_msgs__srv__ListObjectives_Request",
+        "kinema_msgs__srv__ListObjectives_Response",
+        "kinema_msgs__srv__RequestApproval_Request",
+        "kinema_msgs__srv__RequestApproval_Response",
+        "kinema_msgs__srv__SetMujocoState_Request",
+        "kinema_msgs__srv__SetMujocoState_Response",
+        "moveit_msgs__msg__AllowedCollisionEntry",
+        "moveit_msgs__msg__AllowedCollisionMatrix",
+        "moveit_msgs__msg__AttachedCollisionObject",
+        "moveit_msgs__msg__CollisionObject",
+        "moveit_msgs__msg__LinkPadding",
+        "moveit_msgs__msg__LinkScale",
+        "moveit_msgs__msg__MoveItErrorCodes",
+        "moveit_msgs__msg__ObjectColor",
+        "moveit_msgs__msg__PlanningScene",
+        "moveit_msgs__msg__PlanningSceneComponents",
+        "moveit_msgs__msg__PlanningSceneWorld",
+        "moveit_msgs__msg__RobotState",
+        "moveit_msgs__srv__GetPlanningScene_Request",
+        "moveit_msgs__srv__GetPlanningScene_Response",
+        "moveit_studio_agent_msgs__msg__Log",
+        "moveit_studio_agent_msgs__msg__ObjectiveServerStatus",
+        "moveit_studio_agent_msgs__msg__RobotJointState",
+        "moveit_studio_agent_msgs__msg__Waypoint",
+        "moveit_studio_agent_msgs__srv__EditWaypoints_Request",
+        "moveit_studio_agent_msgs__srv__EditWaypoints_Response",
+        "moveit_studio_agent_msgs__srv__GetWaypoints_Request",
+        "moveit_studio_agent_msgs__srv__GetWaypoints_Response",
+        "moveit_studio_sdk_msgs__action__DoObjectiveSequence_Feedback",
+        "moveit_studio_sdk_msgs__action__DoObjectiveSequence_FeedbackMessage",
+        "moveit_studio_sdk_msgs__action__DoObjectiveSequence_GetResult_Request",
+        "moveit_studio_sdk_msgs__action__DoObjectiveSequence_GetResult_Response",
+        "moveit_studio_sdk_msgs__action__DoObjectiveSequence_Goal",
+        "moveit_studio_sdk_msgs__action__DoObjectiveSequence_Result",
+        "moveit_studio_sdk_msgs__action__DoObjectiveSequence_SendGoal_Request",
+        "moveit_studio_sdk_msgs__action__DoObjectiveSequence_SendGoal_Response",
+        "moveit_studio_sdk_msgs__msg__BehaviorParameter",
+        "moveit_studio_sdk_msgs__msg__BehaviorParameterDescription",
+        "moveit_studio_sdk_msgs__msg__RequestStatus",
+        "moveit_studio_sdk_msgs__srv__CancelObjective_Request",
+        "moveit_studio_sdk_msgs__srv__CancelObjective_Response",
+        "moveit_studio_sdk_msgs__srv__ExecuteObjective_Request",
+        "moveit_studio_sdk_msgs__srv__ExecuteObjective_Response",
+        "moveit_studio_vision_msgs__msg__GraspableObject",
+        "object_recognition_msgs__msg__ObjectType",
+        "octomap_msgs__msg__Octomap",
+        "octomap_msgs__msg__OctomapWithPose",
+        "std_srvs__srv__Trigger_Request",
+        "std_srvs__srv__Trigger_Response",
+    }
+)
+
 _SERVICES: dict[str, str] = {
     "CancelGoal": "action_msgs/srv/CancelGoal",
     "ListControllers": "controller_manager_msgs/srv/ListControllers",
@@ -1585,6 +1464,7 @@ _SERVICES: dict[str, str] = {
     "ExecuteObjective": "moveit_studio_sdk_msgs/srv/ExecuteObjective",
     "Trigger": "std_srvs/srv/Trigger",
 }
+
 _ACTIONS: dict[str, str] = {
     "FollowJointTrajectory": "control_msgs/action/FollowJointTrajectory",
     "GripperCommand": "control_msgs/action/GripperCommand",

@@ -60,7 +60,7 @@ else:
 
         registry = load_interfaces()
         if name in _MESSAGES:
-            made: Any = registry.message_class(_MESSAGES[name])
+            made: Any = registry.message_class(name.replace("__", "/"))
         elif name in _SERVICES:
             type_name = _SERVICES[name]
             made = type(
@@ -128,7 +128,7 @@ def _message_class(type_name: str, constants: list[Any], fields: list[Any]) -> l
 
 
 def _definition(short: str, base: str, type_name: str, parts: dict[str, str]) -> list[str]:
-    arguments = [f"    {_python_name(message)}," for message in parts.values()]
+    arguments = [f"        {_python_name(message)}," for message in parts.values()]
     lines = [f"class {short}(", f"    {base}[", *arguments, "    ]", "):", f'    """{type_name}."""', ""]
     lines.append(f"    type_name: ClassVar[str] = {_literal(type_name)}")
     lines += [f"    {alias}: TypeAlias = {_python_name(message)}" for alias, message in parts.items()]
@@ -136,7 +136,7 @@ def _definition(short: str, base: str, type_name: str, parts: dict[str, str]) ->
 
 
 def _table(name: str, entries: dict[str, str]) -> list[str]:
-    return [f"{name}: dict[str, str] = {{", *(f'    "{k}": "{v}",' for k, v in entries.items()), "}"]
+    return [f"{name}: dict[str, str] = {{", *(f'    "{k}": "{v}",' for k, v in entries.items()), "}", ""]
 
 
 def _indent(lines: list[str]) -> list[str]:
@@ -160,7 +160,7 @@ def generate(registry: TypeRegistry | None = None) -> str:
         declarations.append(")")
     for name in own:
         constants, fields = fielddefs[name][:2]
-        declarations += ["", "", *_message_class(name, constants, fields)]
+        declarations += ["", *_message_class(name, constants, fields)]
     services: dict[str, str] = {}
     actions: dict[str, str] = {}
     for kind, table in (("srv", services), ("action", actions)):
@@ -171,13 +171,14 @@ def generate(registry: TypeRegistry | None = None) -> str:
             table[short] = type_name
     for short, service in services.items():
         parts = {"Request": f"{service}_Request", "Response": f"{service}_Response"}
-        declarations += ["", "", *_definition(short, "ServiceDefinition", service, parts)]
+        declarations += ["", *_definition(short, "ServiceDefinition", service, parts)]
     for short, action in actions.items():
         parts = {"Goal": f"{action}_Goal", "Result": f"{action}_Result", "Feedback": f"{action}_Feedback"}
-        declarations += ["", "", *_definition(short, "ActionDefinition", action, parts)]
-    tables = _table("_MESSAGES", {_python_name(name): name for name in own})
+        declarations += ["", *_definition(short, "ActionDefinition", action, parts)]
+    messages = [f'        "{_python_name(name)}",' for name in own]
+    tables = ["", "", "_MESSAGES = frozenset(", "    {", *messages, "    }", ")", ""]
     tables += _table("_SERVICES", services) + _table("_ACTIONS", actions)
-    source = "\n".join(HEADER.splitlines() + _indent(declarations)) + RUNTIME + "\n\n" + "\n".join(tables)
+    source = "\n".join(HEADER.splitlines() + _indent(declarations)) + RUNTIME + "\n".join(tables)
     return source.rstrip() + "\n"
 
 
