@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-from typing import Any
-
 from kinema.behaviors import PortInfo, ServiceClientBehavior, input_port, output_port
+from kinema.interfaces.typed import AddTwoInts
 
 
-class MyAddTwoIntsServiceClient(ServiceClientBehavior["example_interfaces/srv/AddTwoInts"]):
+class MyAddTwoIntsServiceClient(ServiceClientBehavior[AddTwoInts.Request, AddTwoInts.Response]):
     """Asks an AddTwoInts service for ``addend1 + addend2``, writes the sum to ``result`` and shows it.
 
     Run `kinema example add-two-ints-server` to have a server on ``/add_two_ints``.
@@ -24,11 +23,11 @@ class MyAddTwoIntsServiceClient(ServiceClientBehavior["example_interfaces/srv/Ad
             output_port("result", int, "{result}", "The sum the service returned."),
         ]
 
-    def create_request(self) -> dict[str, Any]:
+    def create_request(self) -> AddTwoInts.Request:
         addend1, addend2 = self.get_required_inputs("addend1", "addend2")
-        return {"a": addend1, "b": addend2}
+        return AddTwoInts.Request(a=int(addend1), b=int(addend2))
 
-    def process_response(self, response: Any) -> bool:
+    def process_response(self, response: AddTwoInts.Response) -> bool:
         self.set_output("result", response.sum)
         self.logger.publish_info(f"Sum: {response.sum}")
         return True

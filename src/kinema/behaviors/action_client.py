@@ -4,19 +4,25 @@ from __future__ import annotations
 
 import asyncio
 import concurrent.futures
-from typing import Any, ClassVar
+from typing import TYPE_CHECKING, Any, ClassVar, Generic
 
 from kinema.behaviors.asynchronous import AsyncBehavior
 from kinema.behaviors.faults import BehaviorExecutionError, behavior_fault
 from kinema.behaviors.interface_type import parametrize
 from kinema.behaviors.work_runner import RUNNER
 from kinema.errors import TransportError
+from kinema.interfaces.definition import FeedbackT, GoalT, ResultT
+
+if TYPE_CHECKING:
+    from kinema.transport import GoalResult
 
 
-class ActionClientBehavior(AsyncBehavior):
+class ActionClientBehavior(AsyncBehavior, Generic[GoalT, ResultT, FeedbackT]):
     """Sends one goal per run: ``create_goal`` → feedback → ``process_result``.
 
-    Derive from ``ActionClientBehavior["pkg/action/Name"]`` (or set :attr:`action_type`) and override
+    Derive from ``ActionClientBehavior[Fibonacci.Goal, Fibonacci.Result, Fibonacci.Feedback]`` (the
+    interface's classes from ``kinema.interfaces.typed``, which types the hooks below), from
+    ``ActionClientBehavior["pkg/action/Name"]`` (untyped), or set :attr:`action_type`; override
     :meth:`create_goal` and :meth:`process_result` (and :meth:`process_feedback` to follow progress);
     :meth:`get_action_name` reads the ``action_name`` port by default. Halting the node cancels the goal
     on the server. A rejected goal, a failed call or a result timeout publishes a failure toast and
@@ -28,8 +34,8 @@ class ActionClientBehavior(AsyncBehavior):
     action_type: ClassVar[str] = ""
     """The ROS action type, e.g. ``example_interfaces/action/Fibonacci``."""
 
-    def __class_getitem__(cls, action_type: str) -> type:
-        return parametrize(cls, "action_type", "action", action_type)
+    def __class_getitem__(cls, action_type: Any) -> Any:
+        return parametrize(cls, "action_type", "action", action_type, ("Goal", "Result", "Feedback"))
 
     def __init__(self, name: str, config: Any = None) -> None:
         super().__init__(name, config)
@@ -39,17 +45,17 @@ class ActionClientBehavior(AsyncBehavior):
         """The action to call; default: the ``action_name`` input port. Called off the tick thread."""
         return str(self.get_input("action_name"))
 
-    def create_goal(self) -> Any:
+    def create_goal(self) -> GoalT | dict[str, Any]:
         """Build the goal: a message or a dict of its fields. Called off the tick thread at each start."""
         raise NotImplementedError(f"{type(self).__name__}.create_goal() is not implemented")
 
-    def process_feedback(self, feedback: Any) -> None:
+    def process_feedback(self, feedback: FeedbackT) -> None:
         """Follow progress (e.g. ``set_output`` or a toast); default: ignore it.
 
         Called on a transport thread for each feedback message while the goal runs. Must not block.
         """
 
-    def process_result(self, result: Any) -> bool:
+    def process_result(self, result: GoalResult[ResultT]) -> bool:
         """Act on the finished goal; return True for SUCCESS.
 
         ``result`` is a :class:`kinema.transport.GoalResult`: ``result.status``/``status_name``,

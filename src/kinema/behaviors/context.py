@@ -10,13 +10,23 @@ from __future__ import annotations
 
 import threading
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, overload
 
 from kinema.behaviors.logger import BehaviorLogger, LogSink
 from kinema.errors import ObjectiveError
 
 if TYPE_CHECKING:
     from kinema.bt import Clock
+    from kinema.interfaces.definition import (
+        ActionDefinition,
+        FeedbackT,
+        GoalT,
+        RequestT,
+        ResponseT,
+        ResultT,
+        ServiceDefinition,
+    )
+    from kinema.transport import ActionClient, ServiceClient
 
 
 class BehaviorContext:
@@ -87,16 +97,45 @@ class BehaviorContext:
             )
         return self.node
 
-    def service_client(self, node: Any, service_type: str, name: str) -> Any:
-        """A service client shared by every behavior of this context (created on first use)."""
-        return self._endpoint(
-            ("client", id(node), service_type, name), lambda: node.create_client(service_type, name)
+    @overload
+    def service_client(
+        self, node: Any, service_type: type[ServiceDefinition[RequestT, ResponseT]], name: str
+    ) -> ServiceClient[RequestT, ResponseT]: ...
+
+    @overload
+    def service_client(self, node: Any, service_type: str, name: str) -> ServiceClient[Any, Any]: ...
+
+    def service_client(self, node: Any, service_type: Any, name: str) -> ServiceClient[Any, Any]:
+        """A service client shared by every behavior of this context (created on first use).
+
+        ``service_type`` is ``pkg/srv/Name`` or a definition class from ``kinema.interfaces.typed``
+        (typed responses).
+        """
+        from kinema.interfaces.definition import interface_type_name
+
+        type_name = interface_type_name(service_type, "srv")
+        return self._endpoint(  # type: ignore[no-any-return]
+            ("client", id(node), type_name, name), lambda: node.create_client(type_name, name)
         )
 
-    def action_client(self, node: Any, action_type: str, name: str) -> Any:
-        """An action client shared by every behavior of this context (created on first use)."""
-        return self._endpoint(
-            ("action", id(node), action_type, name), lambda: node.create_action_client(action_type, name)
+    @overload
+    def action_client(
+        self, node: Any, action_type: type[ActionDefinition[GoalT, ResultT, FeedbackT]], name: str
+    ) -> ActionClient[GoalT, ResultT, FeedbackT]: ...
+
+    @overload
+    def action_client(self, node: Any, action_type: str, name: str) -> ActionClient[Any, Any, Any]: ...
+
+    def action_client(self, node: Any, action_type: Any, name: str) -> ActionClient[Any, Any, Any]:
+        """An action client shared by every behavior of this context (created on first use).
+
+        ``action_type`` is ``pkg/action/Name`` or a definition class from ``kinema.interfaces.typed``.
+        """
+        from kinema.interfaces.definition import interface_type_name
+
+        type_name = interface_type_name(action_type, "action")
+        return self._endpoint(  # type: ignore[no-any-return]
+            ("action", id(node), type_name, name), lambda: node.create_action_client(type_name, name)
         )
 
     def publisher(self, node: Any, message_type: str, topic: str, *, latched: bool = False) -> Any:

@@ -3,18 +3,22 @@
 from __future__ import annotations
 
 import asyncio
-from typing import Any, ClassVar
+from typing import Any, ClassVar, Generic
 
 from kinema.behaviors.asynchronous import AsyncBehavior
 from kinema.behaviors.faults import BehaviorExecutionError, behavior_fault
 from kinema.behaviors.interface_type import parametrize
 from kinema.errors import TransportError
+from kinema.interfaces.definition import RequestT, ResponseT
 
 
-class ServiceClientBehavior(AsyncBehavior):
+class ServiceClientBehavior(AsyncBehavior, Generic[RequestT, ResponseT]):
     """Calls one service per run: ``create_request`` → call → ``process_response``.
 
-    Derive from ``ServiceClientBehavior["pkg/srv/Name"]`` (or set :attr:`service_type`) and override
+    Derive from ``ServiceClientBehavior[AddTwoInts.Request, AddTwoInts.Response]`` (the interface's
+    classes from ``kinema.interfaces.typed``: ``process_response`` then gets a typed response that
+    ``mypy --strict`` and editors know the fields of), or from ``ServiceClientBehavior["pkg/srv/Name"]``
+    (untyped), or set :attr:`service_type`; override
     :meth:`create_request` and :meth:`process_response`; :meth:`get_service_name` reads the
     ``service_name`` port by default. The call runs off the tick thread; halting the node abandons it.
     A call that fails (no server, timeout, server error) publishes a failure toast and returns FAILURE.
@@ -25,8 +29,8 @@ class ServiceClientBehavior(AsyncBehavior):
     service_type: ClassVar[str] = ""
     """The ROS service type, e.g. ``example_interfaces/srv/AddTwoInts``."""
 
-    def __class_getitem__(cls, service_type: str) -> type:
-        return parametrize(cls, "service_type", "srv", service_type)
+    def __class_getitem__(cls, service_type: Any) -> Any:
+        return parametrize(cls, "service_type", "srv", service_type, ("Request", "Response"))
 
     def get_service_name(self) -> str:
         """The service to call; default: the ``service_name`` input port.
@@ -35,14 +39,14 @@ class ServiceClientBehavior(AsyncBehavior):
         """
         return str(self.get_input("service_name"))
 
-    def create_request(self) -> Any:
+    def create_request(self) -> RequestT | dict[str, Any]:
         """Build the request: a message, or a dict of its fields (missing fields take defaults).
 
         Called at the start of each run, off the tick thread, after :meth:`get_service_name`.
         """
         raise NotImplementedError(f"{type(self).__name__}.create_request() is not implemented")
 
-    def process_response(self, response: Any) -> bool:
+    def process_response(self, response: ResponseT) -> bool:
         """Act on the response (write outputs, publish a toast); return True for SUCCESS.
 
         Called once per successful call, off the tick thread. Must not block for long.

@@ -223,6 +223,10 @@ def main(argv: list[str] | None = None) -> int:
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     signal.signal(signal.SIGINT, lambda *_: stop.set())
     lifeline.hold()
+    # Before zenoh's threads start: a refused 50 MB request must not stay resident in their heaps.
+    from kinema.transport.heap import bound_heap_growth
+
+    bound_heap_growth()
     options = AgentOptions(
         config=args.config,
         workspace=args.workspace,

@@ -396,7 +396,9 @@ class Launcher:
         """Host (or join) the router as planned from ``--connect``; say what listens beyond loopback."""
         from kinema.runtime.router_plan import open_router, plan_router
         from kinema.transport.exposure import insecure_warning
+        from kinema.transport.heap import bound_heap_growth
 
+        bound_heap_growth()  # the router reassembles large messages too; see kinema.transport.heap
         plan = plan_router(self.options.endpoint, self.options.security_dir)
         session = open_router(plan, insecure=self.options.insecure)
         self.endpoint = plan.local

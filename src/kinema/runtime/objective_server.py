@@ -21,7 +21,7 @@ Cancel always wins, whatever the tree does:
   if the tick thread dies nonetheless, the health report says so and a fresh one serves the next request.
 
 The tick thread owns the server's state (the tree, the run) except while it is inside behavior code;
-the watchdog takes the state over only then, under the same lock.
+the watchdog (:mod:`kinema.runtime.tick_watchdog`) takes the state over only then, under the same lock.
 
 The server knows nothing about the transport: :mod:`kinema.runtime.agent` serves it over zenoh and a
 :class:`ServerListener` receives what the streams publish (status, node status changes, blackboard
@@ -47,6 +47,13 @@ from kinema.errors import KinemaError, ObjectiveError, did_you_mean
 from kinema.runtime.objective_status import ObjectiveStatus
 from kinema.runtime.overrides import ParameterOverride, apply_overrides
 from kinema.runtime.result import ObjectiveResult
+from kinema.runtime.tick_watchdog import (
+    WATCHDOG_PERIOD_S,
+    Abandoned,
+    TickWatchdog,
+    TickWorker,
+    release_stuck_tree,
+)
 from kinema.runtime.watchdog import StuckCode, stuck_code
 
 if TYPE_CHECKING:
@@ -69,14 +76,9 @@ WATCHDOG_REPORT_S = 1.0
 # A cancel, a newer request or a stop waiting this long for a tick thread stuck in behavior code makes the
 # server abandon that thread. With the watchdog's period, cancel wins within a tick period plus 100 ms.
 ABANDON_AFTER_S = 0.07
-WATCHDOG_PERIOD_S = 0.02
-# The halt of an abandoned tree waits this long for its thread to come back from behavior code first.
-HALT_WAITS_FOR_ABANDONED_S = 0.5
 # A tree that re-ticks itself for a whole tick period pauses this long before the tick it owes, so that
 # it cannot starve the transport and a simulator running in the same process.
 RETICK_PAUSE_S = 0.005
-# A stuck behavior is logged again this often while it stays stuck.
-WATCHDOG_LOG_EVERY_S = 10.0
 
 
 @dataclass(frozen=True)
@@ -397,35 +399,6 @@ class ServerHealth:
 _CALL_STAGE = "a hot-reload request"
 
 
-class _Abandoned(BaseException):
-    """Raised in a tick thread returning from behavior code after the watchdog abandoned it."""
-
-
-class _Worker:
-    """One tick thread. ``busy_since`` is set while it runs behavior code (the server lock released)."""
-
-    def __init__(self, generation: int) -> None:
-        self.generation = generation
-        self.thread: threading.Thread | None = None
-        self.abandoned = False
-        self.abandoned_at = 0.0
-        self.busy_since: float | None = None
-        self.busy_stage = ""
-        self.stuck: StuckCode | None = None
-        self.stuck_since = 0.0
-        self.logged_at = 0.0
-        # Set while the thread is outside behavior code (set again before it waits for the state lock).
-        self.returned = threading.Event()
-        self.returned.set()
-
-    @property
-    def name(self) -> str:
-        return "kinema-tick" if self.generation == 1 else f"kinema-tick-{self.generation}"
-
-    def alive(self) -> bool:
-        return self.thread is not None and self.thread.is_alive()
-
-
 class ObjectiveServer:
     """Runs one objective at a time on its own tick thread.
 
@@ -472,20 +445,18 @@ class ObjectiveServer:
         # The tick thread holds this lock while it touches the state below; it releases it only while it
         # runs behavior code, which is when the watchdog may take the state over.
         self._state_lock = threading.RLock()
-        self._worker: _Worker | None = None
+        self._worker: TickWorker | None = None
         self._generations = itertools.count(1)
-        self._abandoned: list[_Worker] = []
+        self._abandoned: list[TickWorker] = []
         self._replacements = 0
         self._last_death = ""
         self._stopped = threading.Event()
-        self._watchdog: threading.Thread | None = None
-        # What blocked each retired event loop of async behaviors (by thread id).
-        self._loop_codes: dict[int | None, StuckCode] = {}
+        self._watchdog: TickWatchdog | None = None
         # Owned by the tick thread:
         self._tree: Tree | None = None
         self._run: ObjectiveRun | None = None
         # Set when the current run's tick thread was abandoned in its behavior code.
-        self._run_stuck: _Worker | None = None
+        self._run_stuck: TickWorker | None = None
         # Requests taken from the inbox and not yet done; the watchdog queues them again for the thread
         # that replaces an abandoned one.
         self._in_hand: list[ObjectiveRun | _Cancel | _Call] = []
@@ -508,7 +479,12 @@ class ObjectiveServer:
         self._stopped.clear()
         with self._state_lock:
             self._start_worker()
-        self._watchdog = threading.Thread(target=self._watch, name="kinema-tick-watchdog", daemon=True)
+        self._watchdog = TickWatchdog(
+            self,
+            self._stopped,
+            report_after_s=self._watchdog_report,
+            abandon_after_s=self._abandon_after,
+        )
         self._watchdog.start()
 
     def stop(self, timeout: float = 5.0) -> None:
@@ -556,25 +532,10 @@ class ObjectiveServer:
 
     def health(self) -> ServerHealth:
         """What the watchdog sees now (safe from any thread)."""
-        now = time.monotonic()
-        warnings: list[str] = []
         worker = self._worker
         alive = worker is not None and worker.alive()
-        if worker is not None and worker.stuck is not None and worker.busy_since is not None:
-            warnings.append(worker.stuck.describe(now - worker.busy_since))
-        for old in list(self._abandoned):
-            stuck = old.stuck or StuckCode("", "", old.busy_stage)
-            since = old.stuck_since
-            warnings.append(
-                f"abandoned tick thread {old.name}: {stuck.describe(now - since)} "
-                f"(abandoned {now - old.abandoned_at:.1f} s ago)"
-            )
-        warnings.extend(_halted_work_warnings(self._watchdog_report))
-        runner = _work_runner()
-        if runner is not None:
-            for seconds, ident in runner.retired_loops():
-                code = self._loop_codes.get(ident) or StuckCode("", "", "a coroutine")
-                warnings.append(f"{code.describe(seconds)}, {_LOOP_BLOCKED}")
+        watchdog = self._watchdog
+        warnings = watchdog.warnings(worker, self._abandoned) if watchdog is not None else []
         if self._last_death:
             warnings.append(self._last_death)
         if not alive and self._watchdog is not None and not self._stopping:
@@ -658,13 +619,13 @@ class ObjectiveServer:
 
     def _start_worker(self) -> None:
         """Start a tick thread (the state lock held)."""
-        worker = _Worker(next(self._generations))
+        worker = TickWorker(next(self._generations))
         worker.thread = threading.Thread(target=self._serve, args=(worker,), name=worker.name, daemon=True)
         self._worker = worker
         worker.thread.start()
 
     @contextmanager
-    def _behavior_code(self, worker: _Worker, stage: str) -> Iterator[None]:
+    def _behavior_code(self, worker: TickWorker, stage: str) -> Iterator[None]:
         """Run behavior code with the state lock released, so that the watchdog can take over."""
         worker.busy_stage = stage
         worker.busy_since = time.monotonic()
@@ -678,13 +639,13 @@ class ObjectiveServer:
             worker.busy_since = None
             worker.stuck = None
             if worker.abandoned:
-                raise _Abandoned
+                raise Abandoned
 
-    def _serve(self, worker: _Worker) -> None:
+    def _serve(self, worker: TickWorker) -> None:
         self._state_lock.acquire()
         try:
             self._loop(worker)
-        except _Abandoned:
+        except Abandoned:
             seconds = time.monotonic() - worker.abandoned_at
             log.warning(
                 "abandoned tick thread %s returned %.1f s after it was abandoned", worker.name, seconds
@@ -696,7 +657,7 @@ class ObjectiveServer:
                 self._abandoned.remove(worker)
             self._state_lock.release()
 
-    def _tick_thread_died(self, worker: _Worker, error: BaseException) -> None:
+    def _tick_thread_died(self, worker: TickWorker, error: BaseException) -> None:
         where = _location_of(error)
         self._last_death = (
             f"the tick thread {worker.name} died: {type(error).__name__}: {error}{where}; "
@@ -708,7 +669,7 @@ class ObjectiveServer:
             run, tree = self._run, self._tree
             if tree is not None:
                 # Whatever its nodes run (a motion) must still stop.
-                self._release_stuck_tree(tree, worker)
+                release_stuck_tree(tree, worker)
             if run is not None:
                 message = f"objective {run.objective_name!r} stopped: {self._last_death}"
                 self._end(run, ObjectiveResult.failure(message, run.objective_name), ObjectiveStatus.FAILURE)
@@ -718,59 +679,30 @@ class ObjectiveServer:
             else:
                 self._stopped.set()
 
-    def _watch(self) -> None:
-        """The watchdog: reports stuck behavior code, abandons stuck tick threads, replaces dead ones."""
-        while not self._stopped.wait(WATCHDOG_PERIOD_S):
-            try:
-                self._watch_once()
-            except Exception:
-                log.exception("the tick watchdog raised")
+    # What the watchdog (kinema.runtime.tick_watchdog) reads and asks of the server.
 
-    def _watch_event_loop(self) -> None:
-        """A coroutine that blocks the async behaviors' event loop: report it, move on to a fresh loop."""
-        runner = _work_runner()
-        blocked = runner.blocked_loop() if runner is not None else None
-        if blocked is None or blocked[0] < self._watchdog_report:
-            return
-        seconds, ident = blocked
-        code = stuck_code(ident, "a coroutine")
-        self._loop_codes[ident] = code
-        runner.retire_blocked_loop()
-        log.error("watchdog: %s, %s", code.describe(seconds), _LOOP_BLOCKED)
+    def watched_worker(self) -> TickWorker | None:
+        """The tick thread serving requests now."""
+        return self._worker
 
-    def _watch_once(self) -> None:
-        self._watch_event_loop()
-        now = time.monotonic()
-        worker = self._worker
-        if worker is None:
-            return
-        busy_since = worker.busy_since
-        if busy_since is not None and worker.thread is not None:
-            if now - busy_since >= self._watchdog_report:
-                stuck = stuck_code(worker.thread.ident, worker.busy_stage)
-                if worker.busy_since == busy_since:
-                    worker.stuck = stuck
-                    if now - worker.logged_at >= WATCHDOG_LOG_EVERY_S:
-                        worker.logged_at = now
-                        log.warning("watchdog: %s", stuck.describe(now - busy_since))
-            waiting = self._waiting_since
-            if waiting is not None and now - max(waiting, busy_since) >= self._abandon_after:
-                self._abandon(worker, busy_since)
-            return
-        if not worker.alive() and not self._stopped.is_set():
-            # Died without reaching its own handler (or before it could start a successor).
-            with self._state_lock:
-                if self._worker is worker and not worker.alive():
-                    self._replacements += 1
-                    if not self._last_death:
-                        self._last_death = f"the tick thread {worker.name} died; a new one took over"
-                    log.critical("%s", self._last_death)
-                    if self._stopping:
-                        self._stopped.set()
-                    else:
-                        self._start_worker()
+    def waiting_since(self) -> float | None:
+        """When the oldest request the tick thread has yet to serve was posted."""
+        return self._waiting_since
 
-    def _abandon(self, worker: _Worker, busy_since: float) -> None:
+    def replace_dead_worker(self, worker: TickWorker) -> None:
+        """A tick thread died without reaching its own handler (or before it could start a successor)."""
+        with self._state_lock:
+            if self._worker is worker and not worker.alive():
+                self._replacements += 1
+                if not self._last_death:
+                    self._last_death = f"the tick thread {worker.name} died; a new one took over"
+                log.critical("%s", self._last_death)
+                if self._stopping:
+                    self._stopped.set()
+                else:
+                    self._start_worker()
+
+    def abandon(self, worker: TickWorker, busy_since: float) -> None:
         """Give up on a tick thread stuck in behavior code: a fresh one serves the pending requests."""
         if not self._state_lock.acquire(timeout=WATCHDOG_PERIOD_S):
             return
@@ -810,33 +742,9 @@ class ObjectiveServer:
         finally:
             self._state_lock.release()
 
-    def _release_stuck_tree(self, tree: Tree, worker: _Worker) -> None:
-        """Disarm a tree whose thread was abandoned and halt it on a thread of its own.
-
-        Every node of it fails at once from now on, so the stuck call, if it returns, cannot start
-        anything new (a motion, a goal) after the cancel; the halt stops what its other nodes run. It
-        waits a moment for the abandoned thread to come back, so that a tick that was only slow (a
-        loaded machine) is never halted while it still runs.
-        """
-
-        def refuse(_node: Any) -> NodeStatus:
-            return NodeStatus.FAILURE
-
-        for node in tree.nodes():
-            node.set_pre_tick_callback(refuse)
-
-        def halt() -> None:
-            worker.returned.wait(HALT_WAITS_FOR_ABANDONED_S)
-            try:
-                tree.halt_tree()
-            except BaseException:
-                log.exception("halting the tree of an abandoned tick thread raised")
-
-        threading.Thread(target=halt, name="kinema-halt-abandoned", daemon=True).start()
-
     # -- tick thread ------------------------------------------------------------------------------
 
-    def _loop(self, worker: _Worker) -> None:
+    def _loop(self, worker: TickWorker) -> None:
         next_tick = time.monotonic()
         while True:
             with self._wake:
@@ -916,7 +824,7 @@ class ObjectiveServer:
             item.done.set()
 
     def _take_requests(
-        self, worker: _Worker, inbox: list[ObjectiveRun | _Cancel | _Call]
+        self, worker: TickWorker, inbox: list[ObjectiveRun | _Cancel | _Call]
     ) -> ObjectiveRun | None:
         """Apply queued requests in order; returns the newest start request still wanted.
 
@@ -947,7 +855,7 @@ class ObjectiveServer:
                 try:
                     with self._behavior_code(worker, _CALL_STAGE):
                         item.value = item.fn()
-                except _Abandoned:
+                except Abandoned:
                     raise
                 except BaseException as error:
                     item.error = error
@@ -965,7 +873,7 @@ class ObjectiveServer:
             except Exception:
                 log.exception("a status listener raised")
 
-    def _load(self, worker: _Worker, run: ObjectiveRun) -> None:
+    def _load(self, worker: TickWorker, run: ObjectiveRun) -> None:
         """Build the tree of ``run`` (preempting what runs now) and apply its overrides."""
         if self._run is not None:
             self._finish_current(worker, ObjectiveResult.preempted, "preempted by a newer objective request")
@@ -977,7 +885,7 @@ class ObjectiveServer:
                 tree, name = self._build(run.request)
                 run.objective_name = name
                 apply_overrides(tree, run.request.overrides, objective_name=name)
-        except _Abandoned:
+        except Abandoned:
             raise
         except KinemaError as error:
             self._end(run, ObjectiveResult.failure(str(error), run.objective_name), ObjectiveStatus.FAILURE)
@@ -1023,14 +931,15 @@ class ObjectiveServer:
         xml = request.objective_xml
         if not xml.strip():
             raise ObjectiveError("the request names no objective and carries no objective XML")
-        size = len(xml.encode("utf-8", "surrogatepass"))
+        # An ASCII string's length is its UTF-8 size (isascii is a flag check): no copy of a 50 MB request.
+        size = len(xml) if xml.isascii() else len(xml.encode("utf-8", "surrogatepass"))
         if size > MAX_OBJECTIVE_XML_BYTES:
             limit = MAX_OBJECTIVE_XML_BYTES / 1e6
             raise ObjectiveError(f"the objective XML is {size / 1e6:.1f} MB; the limit is {limit:.1f} MB")
         name = main_tree_id(xml)
         return _create_from_scratch_text(factory, xml), name
 
-    def _tick(self, worker: _Worker) -> None:
+    def _tick(self, worker: TickWorker) -> None:
         tree, run = self._tree, self._run
         assert tree is not None and run is not None
         deadline = time.monotonic() + self._period
@@ -1043,7 +952,7 @@ class ObjectiveServer:
         try:
             with self._behavior_code(worker, "tick"):
                 status = tree.tick_once(interrupted)
-        except _Abandoned:
+        except Abandoned:
             raise
         except KinemaError as error:
             self._halt_quietly(worker, tree)
@@ -1067,17 +976,17 @@ class ObjectiveServer:
                 ObjectiveStatus.FAILURE,
             )
 
-    def _halt_quietly(self, worker: _Worker, tree: Tree) -> None:
+    def _halt_quietly(self, worker: TickWorker, tree: Tree) -> None:
         try:
             with self._behavior_code(worker, "halt"):
                 tree.halt_tree()
-        except _Abandoned:
+        except Abandoned:
             raise
         except BaseException:
             log.exception("halting the tree raised")
 
     def _finish_current(
-        self, worker: _Worker, make: Callable[[str, str], ObjectiveResult], reason: str
+        self, worker: TickWorker, make: Callable[[str, str], ObjectiveResult], reason: str
     ) -> None:
         run, tree, stuck = self._run, self._tree, self._run_stuck
         if run is None:
@@ -1085,7 +994,7 @@ class ObjectiveServer:
         if stuck is not None:
             # Its tick thread was abandoned in behavior code: never wait for that tree again.
             if tree is not None:
-                self._release_stuck_tree(tree, stuck)
+                release_stuck_tree(tree, stuck)
             code = stuck.stuck or StuckCode("", "", stuck.busy_stage)
             seconds = time.monotonic() - stuck.stuck_since
             reason = f"{reason} ({code.describe(seconds)}; its tick thread was abandoned)"
@@ -1211,26 +1120,3 @@ def _location_of(error: BaseException) -> str:
 
     location = author_location(error)
     return f" at {location}" if location is not None else ""
-
-
-_LOOP_BLOCKED = "blocking the event loop async behaviors share (new ones run on a fresh loop)"
-
-
-def _work_runner() -> Any:
-    """The runner of AsyncBehavior work, or None while no behavior ever ran work off the tick thread."""
-    import sys
-
-    module = sys.modules.get("kinema.behaviors.work_runner")
-    return module.RUNNER if module is not None else None
-
-
-def _halted_work_warnings(after_s: float) -> list[str]:
-    """Behaviors whose ``do_work`` still runs ``after_s`` after they were halted."""
-    runner = _work_runner()
-    if runner is None:
-        return []
-    return [
-        f"behavior '{behavior}' ({path}) has ignored a halt for {seconds:.1f} s: its do_work still runs"
-        for behavior, path, seconds in runner.halted_still_running()
-        if seconds >= after_s
-    ]

@@ -18,12 +18,13 @@ import time
 import uuid
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Generic
 
 import numpy as np
 
 from kinema.errors import TransportError
 from kinema.interfaces import ActionType
+from kinema.interfaces.definition import FeedbackT, GoalT, ResultT
 from kinema.transport.keys import LATCHED_QOS, QoS, fully_qualified
 from kinema.transport.messages import from_dict, type_of
 from kinema.transport.pubsub import Publisher, Subscription
@@ -87,11 +88,11 @@ def _action_names(node: Node, name: str) -> str:
 
 
 @dataclass(frozen=True)
-class GoalResult:
+class GoalResult(Generic[ResultT]):
     """How a goal ended: its final status (``STATUS_*``) and the result message."""
 
     status: int
-    result: Any
+    result: ResultT
 
     @property
     def status_name(self) -> str:
@@ -445,11 +446,14 @@ def _ns(stamp: Any) -> int:
     return int(stamp.sec) * 1_000_000_000 + int(stamp.nanosec)
 
 
-class ClientGoalHandle:
+class ClientGoalHandle(Generic[ResultT, FeedbackT]):
     """A goal sent by an :class:`ActionClient`: its status, feedback, cancel and result."""
 
     def __init__(
-        self, client: ActionClient, goal_id: bytes, feedback_callback: Callable[[Any], Any] | None
+        self,
+        client: ActionClient[Any, ResultT, FeedbackT],
+        goal_id: bytes,
+        feedback_callback: Callable[[FeedbackT], Any] | None,
     ) -> None:
         self.client = client
         self.goal_id = goal_id
@@ -458,10 +462,10 @@ class ClientGoalHandle:
         self.status = STATUS_UNKNOWN
         self._feedback_callback = feedback_callback
         self._done = threading.Event()
-        self._outcome: GoalResult | None = None
+        self._outcome: GoalResult[ResultT] | None = None
         self._error: TransportError | None = None
         self.finished_at: float | None = None
-        self._callbacks: list[Callable[[ClientGoalHandle], Any]] = []
+        self._callbacks: list[Callable[[ClientGoalHandle[ResultT, FeedbackT]], Any]] = []
         self._lock = threading.Lock()
 
     @property
@@ -478,7 +482,7 @@ class ClientGoalHandle:
         """True once the result (or a failure to get it) arrived."""
         return self._done.is_set()
 
-    def add_done_callback(self, callback: Callable[[ClientGoalHandle], Any]) -> None:
+    def add_done_callback(self, callback: Callable[[ClientGoalHandle[ResultT, FeedbackT]], Any]) -> None:
         """Call ``callback(handle)`` when the goal ends (at once if it already has)."""
         with self._lock:
             if not self._done.is_set():
@@ -493,7 +497,7 @@ class ClientGoalHandle:
         )
         return any(_uuid_bytes(info.goal_id) == self.goal_id for info in response.goals_canceling)
 
-    def result(self, timeout: float | None = None) -> GoalResult:
+    def result(self, timeout: float | None = None) -> GoalResult[ResultT]:
         """Wait for the goal to end and return its status and result.
 
         Raises:
@@ -516,7 +520,7 @@ class ClientGoalHandle:
         if self._feedback_callback is not None:
             self._feedback_callback(feedback)
 
-    def _finish(self, outcome: GoalResult | None, error: TransportError | None) -> None:
+    def _finish(self, outcome: GoalResult[ResultT] | None, error: TransportError | None) -> None:
         with self._lock:
             if self._done.is_set():
                 return
@@ -533,22 +537,28 @@ class ClientGoalHandle:
                 log.exception("done callback of goal %s raised", self.goal_uuid)
 
 
-class ActionClient:
-    """Sends goals to one action. Create with ``Node.create_action_client``; thread-safe."""
+class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
+    """Sends goals to one action. Create with ``Node.create_action_client``; thread-safe.
+
+    Created from a :class:`~kinema.interfaces.definition.ActionDefinition` (``Fibonacci``), it is typed
+    with its goal, result and feedback classes; from a type name string, all are ``Any``.
+    """
 
     def __init__(self, node: Node, action_type: str, name: str) -> None:
         self.node = node
         self.action: ActionType = node.session.registry.action(action_type)
         self.name = _action_names(node, name)
         self.type_name = self.action.name
-        self._handles: dict[bytes, ClientGoalHandle] = {}
+        self._handles: dict[bytes, ClientGoalHandle[ResultT, FeedbackT]] = {}
         self._lock = threading.Lock()
         self._closed = False
         base = f"{self.name}/_action"
         action = self.action
-        self._send_goal = ServiceClient(node, action.send_goal, f"{base}/send_goal")
-        self._cancel = ServiceClient(node, action.cancel_goal, f"{base}/cancel_goal")
-        self._get_result = ServiceClient(node, action.get_result, f"{base}/get_result")
+        self._send_goal: ServiceClient[Any, Any] = ServiceClient(node, action.send_goal, f"{base}/send_goal")
+        self._cancel: ServiceClient[Any, Any] = ServiceClient(node, action.cancel_goal, f"{base}/cancel_goal")
+        self._get_result: ServiceClient[Any, Any] = ServiceClient(
+            node, action.get_result, f"{base}/get_result"
+        )
         self._feedback_sub = Subscription(
             node, action.feedback_message, f"{base}/feedback", self._on_feedback, QoS()
         )
@@ -564,11 +574,11 @@ class ActionClient:
 
     def send_goal(
         self,
-        goal: Any = None,
-        feedback_callback: Callable[[Any], Any] | None = None,
+        goal: GoalT | dict[str, Any] | None = None,
+        feedback_callback: Callable[[FeedbackT], Any] | None = None,
         *,
         timeout: float = 5.0,
-    ) -> ClientGoalHandle:
+    ) -> ClientGoalHandle[ResultT, FeedbackT]:
         """Send a goal (message, dict of fields, or None for defaults) and return its handle.
 
         ``feedback_callback(feedback)`` is called on a zenoh thread for each feedback message.
@@ -607,7 +617,7 @@ class ActionClient:
         ).start()
         return handle
 
-    def _wait_result(self, handle: ClientGoalHandle) -> None:
+    def _wait_result(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
         request = self._get_result.registry.serialize(
             from_dict(self.action.get_result.request, {"goal_id": _uuid_dict(handle.goal_id)}),
             self.action.get_result.request,

@@ -1,11 +1,22 @@
 """Give the memory freed after a large message back to the operating system.
 
-glibc's allocator keeps freed memory in the process heap: after a 50 MB request (decoded by
-Python, reassembled by zenoh) is handled and dropped, the process stays 50-150 MB larger for good,
-and a few such requests (refused ones included) grow a long-running agent without bound. After a
-message of at least :data:`LARGE_MESSAGE_BYTES` arrives, :func:`note_message_size` has a
-background thread call ``malloc_trim(0)`` a little later (once every reference to the message is
-gone) and once more after that, which returns those pages. Elsewhere than glibc it does nothing.
+glibc's allocator keeps freed memory in the process: after a 50 MB request (decoded by Python,
+reassembled by zenoh) is handled and dropped, the process stays 50-150 MB larger for good, and a few
+such requests (refused ones included) grow a long-running agent without bound. Two things keep it:
+
+* Free pages inside the heaps. After a message of at least :data:`LARGE_MESSAGE_BYTES` arrives,
+  :func:`note_message_size` has a background thread call ``malloc_trim(0)`` a little later (once every
+  reference to the message is gone) and once more after that, which returns those pages.
+* The top of the heaps of other threads' arenas (zenoh's runtime threads, the service handler
+  threads), which ``malloc_trim`` never shrinks (it trims only the main heap's top). glibc frees that
+  top on ``free`` once it passes the trim threshold, but by default it raises that threshold to twice
+  the largest mmapped block freed so far (up to 64 MB, a whole arena heap), and its mmap threshold
+  with it (up to 32 MB), so after a few 10-30 MB messages every 10-30 MB copy lands in an arena and
+  stays resident there. :func:`bound_heap_growth` fixes both thresholds (``mallopt``): blocks from
+  :data:`MMAP_THRESHOLD_BYTES` on are mapped and unmapped on their own, and a heap's free top is
+  returned past :data:`TRIM_THRESHOLD_BYTES`. Long-running processes call it once at start.
+
+Elsewhere than glibc both do nothing.
 """
 
 from __future__ import annotations
@@ -26,23 +37,60 @@ LARGE_MESSAGE_BYTES = 1 << 20
 #: more for a handler that a busy machine kept from finishing sooner.
 TRIM_DELAYS_S = (0.5, 3.0, 15.0)
 
+#: Blocks from this size on get pages of their own, returned to the system when freed (glibc's default
+#: starts at 128 kB and grows up to 32 MB, which is what lets large messages settle in arena heaps).
+MMAP_THRESHOLD_BYTES = LARGE_MESSAGE_BYTES
+
+#: A heap whose free top passes this size gives it back on ``free`` (glibc's default follows the mmap
+#: threshold up to 64 MB: an arena heap the size of a refused request stays resident).
+TRIM_THRESHOLD_BYTES = 2 * LARGE_MESSAGE_BYTES
+
+# glibc's mallopt parameters (malloc.h).
+_M_TRIM_THRESHOLD = -1
+_M_MMAP_THRESHOLD = -3
+
 _cond = threading.Condition()
 _due: list[float] = []  # monotonic times of the trims still to run
 _thread: threading.Thread | None = None
-_trim: Callable[[int], int] | None = None
+_glibc: ctypes.CDLL | None = None
 _resolved = False
 
 
-def _malloc_trim() -> Callable[[int], int] | None:
-    global _trim, _resolved
+def _libc() -> ctypes.CDLL | None:
+    global _glibc, _resolved
     if not _resolved:
         _resolved = True
         name = ctypes.util.find_library("c")
         try:
-            _trim = ctypes.CDLL(name).malloc_trim if name else None
-        except (OSError, AttributeError):
-            _trim = None  # not glibc: nothing to do
-    return _trim
+            libc = ctypes.CDLL(name) if name else None
+        except OSError:
+            libc = None
+        # malloc_trim is glibc's: with another C library (musl, macOS) there is nothing to do.
+        if libc is not None and hasattr(libc, "malloc_trim") and hasattr(libc, "mallopt"):
+            _glibc = libc
+    return _glibc
+
+
+def _malloc_trim() -> Callable[[int], int] | None:
+    libc = _libc()
+    return libc.malloc_trim if libc is not None else None
+
+
+def bound_heap_growth() -> bool:
+    """Fix glibc's mmap and trim thresholds so large blocks never stay resident once freed.
+
+    Call once, early, in a long-running process that receives large messages (the agent, the
+    router); it changes how every later allocation of the process is placed. Returns False where
+    the C library is not glibc or refused a setting.
+    """
+    libc = _libc()
+    if libc is None:
+        return False
+    mmap_ok = libc.mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD_BYTES) == 1
+    trim_ok = libc.mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD_BYTES) == 1
+    if not (mmap_ok and trim_ok):
+        log.warning("glibc refused the heap thresholds (mallopt); large messages may stay resident")
+    return mmap_ok and trim_ok
 
 
 def release_free_memory() -> None:

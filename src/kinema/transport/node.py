@@ -6,9 +6,19 @@ import logging
 import re
 import threading
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, overload
 
 from kinema.errors import TransportError
+from kinema.interfaces.definition import (
+    ActionDefinition,
+    FeedbackT,
+    GoalT,
+    RequestT,
+    ResponseT,
+    ResultT,
+    ServiceDefinition,
+    interface_type_name,
+)
 from kinema.transport.action import ActionClient, ActionServer, CancelCallback, ExecuteCallback, GoalCallback
 from kinema.transport.graph import Graph, query_graph
 from kinema.transport.keys import LATCHED_QOS, QoS, fully_qualified, node_token, normalize_namespace
@@ -138,10 +148,25 @@ class Node:
             self, service, self.resolve(name), handler, max_concurrent=max_concurrent, deferred=deferred
         )
 
-    def create_client(self, srv_type: str, name: str) -> ServiceClient:
-        """A client of the service ``name`` of type ``srv_type``; ``.call(request, timeout)``."""
+    @overload
+    def create_client(
+        self, srv_type: type[ServiceDefinition[RequestT, ResponseT]], name: str
+    ) -> ServiceClient[RequestT, ResponseT]: ...
+
+    @overload
+    def create_client(self, srv_type: str, name: str) -> ServiceClient[Any, Any]: ...
+
+    def create_client(
+        self, srv_type: str | type[ServiceDefinition[Any, Any]], name: str
+    ) -> ServiceClient[Any, Any]:
+        """A client of the service ``name`` of type ``srv_type``; ``.call(request, timeout)``.
+
+        ``srv_type`` is ``pkg/srv/Name`` or, for a typed client, the interface's definition class
+        (``kinema.interfaces.typed.AddTwoInts``): ``call`` then returns an ``AddTwoInts.Response``.
+        """
         self._check_open()
-        return ServiceClient(self, self.session.registry.service(srv_type), self.resolve(name))
+        service = self.session.registry.service(_type_name(srv_type, "srv"))
+        return ServiceClient(self, service, self.resolve(name))
 
     # -- actions ---------------------------------------------------------------------------------
 
@@ -173,10 +198,24 @@ class Node:
             max_finished_goals=max_finished_goals,
         )
 
-    def create_action_client(self, action_type: str, name: str) -> ActionClient:
-        """A client of the action ``name``; ``.send_goal(goal, feedback_callback)``."""
+    @overload
+    def create_action_client(
+        self, action_type: type[ActionDefinition[GoalT, ResultT, FeedbackT]], name: str
+    ) -> ActionClient[GoalT, ResultT, FeedbackT]: ...
+
+    @overload
+    def create_action_client(self, action_type: str, name: str) -> ActionClient[Any, Any, Any]: ...
+
+    def create_action_client(
+        self, action_type: str | type[ActionDefinition[Any, Any, Any]], name: str
+    ) -> ActionClient[Any, Any, Any]:
+        """A client of the action ``name``; ``.send_goal(goal, feedback_callback)``.
+
+        ``action_type`` is ``pkg/action/Name`` or, for a typed client, the interface's definition
+        class (``kinema.interfaces.typed.Fibonacci``), which types goals, feedback and results.
+        """
         self._check_open()
-        return ActionClient(self, action_type, name)
+        return ActionClient(self, _type_name(action_type, "action"), name)
 
     # -- graph -----------------------------------------------------------------------------------
 
@@ -212,6 +251,13 @@ class Node:
 
     def __repr__(self) -> str:
         return f"<Node {self.fully_qualified_name}>"
+
+
+def _type_name(interface: Any, kind: str) -> str:
+    try:
+        return interface_type_name(interface, kind)
+    except TypeError as error:
+        raise TransportError(str(error)) from None
 
 
 def _qos(qos: QoS | None, latched: bool) -> QoS:

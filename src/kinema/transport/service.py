@@ -15,12 +15,13 @@ import queue
 import threading
 import time
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Generic
 
 import zenoh
 
 from kinema.errors import TransportError
 from kinema.interfaces import ServiceType
+from kinema.interfaces.definition import RequestT, ResponseT
 from kinema.transport.attachment import Attachment
 from kinema.transport.dispatch import channel, dispatch
 from kinema.transport.heap import note_message_size
@@ -230,8 +231,12 @@ class ServiceServer(Entity):
             self._pool.shutdown()
 
 
-class ServiceClient(Entity):
-    """Calls one service. Create with ``Node.create_client``; thread-safe."""
+class ServiceClient(Entity, Generic[RequestT, ResponseT]):
+    """Calls one service. Create with ``Node.create_client``; thread-safe.
+
+    Created from a :class:`~kinema.interfaces.definition.ServiceDefinition` (``AddTwoInts``), it is
+    typed with its request and response classes; from a type name string, both are ``Any``.
+    """
 
     kind = EntityKind.SERVICE_CLIENT
 
@@ -255,7 +260,7 @@ class ServiceClient(Entity):
         """True when a server is on the graph now."""
         return self.wait_for_service(0.0)
 
-    def call(self, request: Any = None, timeout: float = 5.0) -> Any:
+    def call(self, request: RequestT | dict[str, Any] | None = None, timeout: float = 5.0) -> ResponseT:
         """Send ``request`` (message, dict of fields, or None for defaults) and return the response.
 
         While no server matches (it may still be starting or being discovered) the call is retried
@@ -281,7 +286,7 @@ class ServiceClient(Entity):
                     raise TransportError(f"service {self.name} did not answer within {timeout:g} s") from None
                 outcome = None
             if outcome is not None:
-                return outcome
+                return outcome  # type: ignore[no-any-return]  # deserialized as service.response
             if time.monotonic() + _RETRY_PAUSE >= deadline:
                 raise TransportError(
                     f"no server for service {self.name} [{self.type_name}] answered within {timeout:g} s"
@@ -346,7 +351,9 @@ class ServiceClient(Entity):
             raise TransportError(message)
         return response if answered else None
 
-    def call_async(self, request: Any = None, timeout: float = 5.0) -> concurrent.futures.Future[Any]:
+    def call_async(
+        self, request: RequestT | dict[str, Any] | None = None, timeout: float = 5.0
+    ) -> concurrent.futures.Future[ResponseT]:
         """Like :meth:`call` on a worker thread; the future holds the response or the TransportError."""
         with self._lock:
             if self._pool is None:

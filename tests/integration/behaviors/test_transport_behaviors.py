@@ -98,6 +98,32 @@ def test_the_action_client_gets_the_result(node: Any) -> None:
     assert (run.status, run.outputs["sequence"]) == (NodeStatus.SUCCESS, [0, 1, 1, 2, 3])
 
 
+def test_an_action_client_typed_by_its_interface_classes_gets_typed_feedback_and_result(node: Any) -> None:
+    from kinema.interfaces.typed import Fibonacci as Fib
+    from kinema.transport import GoalResult
+
+    class TypedFibonacci(ActionClientBehavior[Fib.Goal, Fib.Result, Fib.Feedback]):
+        @classmethod
+        def provided_ports(cls):
+            return [
+                input_port("action_name", str, "/fibonacci"),
+                output_port("sequence", list[int], "{sequence}"),
+            ]
+
+        def create_goal(self) -> Fib.Goal:
+            return Fib.Goal(order=4)
+
+        def process_result(self, result: GoalResult[Fib.Result]) -> bool:
+            assert isinstance(result.result, Fib.Result)
+            self.set_output("sequence", [int(n) for n in result.result.sequence])
+            return result.succeeded
+
+    assert TypedFibonacci.action_type == "example_interfaces/action/Fibonacci"
+    _Server(node)
+    run = tick_behavior(TypedFibonacci, node=node)
+    assert (run.status, run.outputs["sequence"]) == (NodeStatus.SUCCESS, [0, 1, 1, 2])
+
+
 def test_a_rejected_goal_fails_with_a_toast(node: Any) -> None:
     _Server(node, accept=False)
     run = tick_behavior(Fibonacci, node=node)

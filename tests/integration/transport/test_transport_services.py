@@ -32,6 +32,19 @@ def test_server_and_client_in_the_same_session(connect: Callable[[], Session]) -
     assert node.create_client(ADD, "add_two_ints").call({"a": 1, "b": 2}, timeout=5).sum == 3
 
 
+def test_a_client_made_from_a_typed_interface_returns_its_response_class(
+    connect: Callable[[], Session],
+) -> None:
+    from kinema.interfaces.typed import AddTwoInts
+
+    _adder(Node(connect(), "server"))
+    client = Node(connect(), "caller").create_client(AddTwoInts, "/add_two_ints")
+    response = client.call(AddTwoInts.Request(a=40, b=2), timeout=5)
+    assert isinstance(response, AddTwoInts.Response) and response.sum == 42
+    with pytest.raises(TransportError, match="ServiceDefinition class"):
+        Node(connect(), "wrong").create_client(AddTwoInts.Request, "/add_two_ints")  # type: ignore[call-overload]
+
+
 def test_router_session_serves_and_calls_like_a_peer(router: Session, connect: Callable[[], Session]) -> None:
     _adder(Node(router, "in_router"))
     assert Node(connect(), "caller").create_client(ADD, "/add_two_ints").call({"a": 2, "b": 2}).sum == 4
