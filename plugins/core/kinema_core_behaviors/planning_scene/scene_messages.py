@@ -22,7 +22,13 @@ from ..poses.frame_tree import pose_of
 if TYPE_CHECKING:
     from kinema.motion import CollisionObject, FrameTree, PlanningScene
 
-__all__ = ["PLANNING_SCENE_TOPIC", "PLANNING_SCENE_TYPE", "planning_scene_message", "primitives_of"]
+__all__ = [
+    "PLANNING_SCENE_TOPIC",
+    "PLANNING_SCENE_TYPE",
+    "object_pose_of",
+    "planning_scene_message",
+    "primitives_of",
+]
 
 COLLISION_OBJECT_TYPE = "moveit_msgs/msg/CollisionObject"
 BOX, SPHERE, CYLINDER, CONE = 1, 2, 3, 4
@@ -54,15 +60,24 @@ def primitive(shape_type: int, dimensions: list[float], world_T: np.ndarray, wha
     return CollisionObject("", "cylinder", (radius, 0.5 * height), world_T)
 
 
+def object_pose_of(message: Any, frames: FrameTree | None) -> np.ndarray:
+    """The world pose of a ``moveit_msgs/CollisionObject``'s own ``pose`` (given in ``header.frame_id``).
+
+    Raises:
+        ObjectiveError: a frame the tree does not know.
+    """
+    frame = str(message.header.frame_id)
+    world_T_frame = np.eye(4) if frames is None else frames.world_T(frame)
+    return world_T_frame @ pose_of(message.pose.position, message.pose.orientation)
+
+
 def primitives_of(message: Any, frames: FrameTree | None) -> list[CollisionObject]:
     """The world-placed primitives of a ``moveit_msgs/CollisionObject``.
 
     Raises:
         ObjectiveError: unsupported shapes, mismatched pose lists, or a frame the tree does not know.
     """
-    frame = str(message.header.frame_id)
-    world_T_frame = np.eye(4) if frames is None else frames.world_T(frame)
-    world_T_object = world_T_frame @ pose_of(message.pose.position, message.pose.orientation)
+    world_T_object = object_pose_of(message, frames)
     shapes: list[CollisionObject] = []
     name = str(message.id)
     if len(message.primitive_poses) != len(message.primitives):
