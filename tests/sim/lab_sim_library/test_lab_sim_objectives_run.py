@@ -93,6 +93,29 @@ def test_add_table_puts_the_box_in_the_planning_scene_and_clear_previous_obstacl
     wait_for(lambda: not scene_objects(library_cell), 10.0, "the planning scene to be empty again")
 
 
+def test_get_planning_scene_answers_from_the_scene_objectives_change(library_cell: LibraryCell) -> None:
+    """/get_planning_scene (moveit_msgs/srv/GetPlanningScene), as move_group serves it: the box an objective
+    added with its geometry, only the names when asked for names, the robot state; gone after a clear."""
+    service = library_cell.node.create_client("moveit_msgs/srv/GetPlanningScene", "/get_planning_scene")
+
+    def ask(components: int) -> Any:
+        return service.call({"components": {"components": components}}, timeout=10.0).scene
+
+    assert run(library_cell, "Add Table to Planning Scene").succeeded
+    everything = ask(0)
+    (table,) = [o for o in everything.world.collision_objects if o.id == "virtual_table_top"]
+    assert list(table.primitives[0].dimensions) == pytest.approx([2.0, 1.0, 0.1])
+    p = table.primitive_poses[0].position
+    assert [p.x, p.y, p.z] == pytest.approx([-0.076413, 0.97, 0.42], abs=1e-6)
+    assert everything.robot_model_name == "lab_sim", everything.robot_model_name
+    assert set(ARM) <= set(everything.robot_state.joint_state.name), everything.robot_state
+    names = ask(8)  # WORLD_OBJECT_NAMES only
+    assert [o.id for o in names.world.collision_objects] == ["virtual_table_top"]
+    assert not names.world.collision_objects[0].primitives and not names.robot_state.joint_state.name
+    assert run(library_cell, "Clear Previous Obstacles").succeeded
+    assert not ask(0).world.collision_objects
+
+
 def test_load_and_execute_joint_trajectory_ends_where_the_file_ends(library_cell: LibraryCell) -> None:
     result = run(library_cell, "Load and Execute Joint Trajectory")
     assert result.succeeded, result
