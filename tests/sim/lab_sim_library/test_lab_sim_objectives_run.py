@@ -15,19 +15,10 @@ from typing import Any
 import numpy as np
 import pytest
 import yaml
-from lab_sim_library_cell import LibraryCell
+from lab_sim_library_cell import ARM, LibraryCell, lab_sim_model
 
 pytestmark = pytest.mark.slow
 
-ARM = (
-    "linear_rail_joint",
-    "shoulder_pan_joint",
-    "shoulder_lift_joint",
-    "elbow_joint",
-    "wrist_1_joint",
-    "wrist_2_joint",
-    "wrist_3_joint",
-)
 RUN_TIMEOUT = 240.0
 
 
@@ -170,7 +161,7 @@ def test_vector_and_string_example_publishes_the_secret_message(library_cell: Li
 
 
 def test_visualize_grasp_link_draws_a_pose_at_the_grasp_link(library_cell: LibraryCell) -> None:
-    from kinema.motion import RobotDescription, fk
+    from kinema.motion import fk
 
     markers = library_cell.listen("visualization_msgs/msg/MarkerArray", "/visualization_marker_array")
     seen = len(markers)
@@ -180,7 +171,7 @@ def test_visualize_grasp_link_draws_a_pose_at_the_grasp_link(library_cell: Libra
     wait_for(lambda: len(markers) > seen, 10.0, "the grasp pose drawn")
     arrows = [m for array in markers[seen:] for m in array.markers if m.type == 0 and len(m.points) == 2]
     assert arrows, [m.type for array in markers[seen:] for m in array.markers]
-    model = RobotDescription.lab_sim().load_model()
+    model = lab_sim_model()
     q = np.array([arm.get(j, 0.0) for j in model.joint_names])
     origin = arrows[0].points[0]
     expected = fk(model, q, "grasp_link")[:3, 3]
@@ -202,9 +193,9 @@ POSE_VECTOR = (
 
 def grasp_poses(points: np.ndarray) -> np.ndarray:
     """grasp_link's pose (4x4) at each row of arm joint values."""
-    from kinema.motion import RobotDescription, fk
+    from kinema.motion import fk
 
-    model = RobotDescription.lab_sim().load_model()
+    model = lab_sim_model()
     columns = [model.joint_names.index(j) for j in ARM]
     poses = []
     for row in points:
