@@ -66,11 +66,14 @@ class PlanningScene:
         objects: every primitive the planner checks (environment and world objects), by unique name.
         world: the world objects added at run time: id -> names of its primitives in :attr:`objects`.
         version: incremented on every change.
+        world_poses: each world object's own pose (MoveIt's ``CollisionObject.pose``), in the world; a
+            MOVE carries its primitives along with it.
     """
 
     objects: dict[str, CollisionObject] = field(default_factory=dict)
     version: int = 0
     world: dict[str, tuple[str, ...]] = field(default_factory=dict)
+    world_poses: dict[str, np.ndarray] = field(default_factory=dict)
     _listeners: list[Callable[[PlanningScene], None]] = field(default_factory=list, repr=False)
     _lock: threading.RLock = field(default_factory=threading.RLock, repr=False)
 
@@ -89,7 +92,12 @@ class PlanningScene:
     # -- world objects -----------------------------------------------------------------------------
 
     def add_world_object(
-        self, object_id: str, primitives: Sequence[CollisionObject], *, replace: bool = True
+        self,
+        object_id: str,
+        primitives: Sequence[CollisionObject],
+        *,
+        replace: bool = True,
+        pose: np.ndarray | None = None,
     ) -> None:
         """Add world object ``object_id`` made of ``primitives`` (their names are ignored).
 
@@ -97,6 +105,8 @@ class PlanningScene:
             object_id: the object's id (MoveIt's ``CollisionObject.id``).
             primitives: its shapes, each placed in the world.
             replace: replace an object of the same id; when False an existing id is an error.
+            pose: the object's own pose in the world (identity by default); :meth:`move_world_object`
+                moves the primitives with it.
 
         Raises:
             MotionError: empty id, no primitive, a bad shape, an id taken by the environment, or an
@@ -106,6 +116,70 @@ class PlanningScene:
             raise MotionError("a collision object needs a non-empty id")
         if not primitives:
             raise MotionError(f"collision object {object_id!r} has no shape")
+        with self._lock:
+            if object_id in self.world and not replace:
+                raise MotionError(
+                    f"collision object {object_id!r} is already in the planning scene "
+                    "(overwrite it to replace it)"
+                )
+            self._store(object_id, list(primitives), np.eye(4) if pose is None else pose)
+        self._changed()
+
+    def append_to_world_object(
+        self, object_id: str, primitives: Sequence[CollisionObject], pose: np.ndarray | None = None
+    ) -> None:
+        """Add ``primitives`` to world object ``object_id`` (MoveIt's APPEND); a new id is created.
+
+        Args:
+            object_id: the object's id.
+            primitives: the shapes to add, each placed in the world.
+            pose: the object's pose when it is created here (an existing object keeps its own).
+
+        Raises:
+            MotionError: empty id, no primitive, a bad shape or an id taken by the environment.
+        """
+        if not object_id:
+            raise MotionError("a collision object needs a non-empty id")
+        if not primitives:
+            raise MotionError(f"collision object {object_id!r}: APPEND needs at least one shape")
+        with self._lock:
+            before = [self.objects[n] for n in self.world.get(object_id, ())]
+            own = self.world_poses.get(object_id, np.eye(4) if pose is None else pose)
+            self._store(object_id, [*before, *primitives], own)
+        self._changed()
+
+    def move_world_object(self, object_id: str, world_T_object: np.ndarray) -> None:
+        """Put world object ``object_id`` at ``world_T_object``, its primitives moving rigidly with it
+        (MoveIt's MOVE).
+
+        Raises:
+            MotionError: no such world object (the message lists those there are), or a non-finite pose.
+        """
+        target = np.asarray(world_T_object, dtype=float)
+        if target.shape != (4, 4) or not np.all(np.isfinite(target)):
+            raise MotionError(f"the new pose of {object_id!r} must be a finite 4x4 transform")
+        with self._lock:
+            if object_id not in self.world:
+                raise MotionError(
+                    f"no collision object {object_id!r} in the planning scene to move; "
+                    f"{did_you_mean(object_id, self.world)}"
+                )
+            delta = target @ np.linalg.inv(self.world_poses.get(object_id, np.eye(4)))
+            moved = [
+                CollisionObject(p.name, p.shape, p.size, delta @ p.world_T_object)
+                for p in (self.objects[n] for n in self.world[object_id])
+            ]
+            self._store(object_id, moved, target)
+        self._changed()
+
+    def world_object_pose(self, object_id: str) -> np.ndarray | None:
+        """The own pose of world object ``object_id`` (None when there is no such object)."""
+        with self._lock:
+            pose = self.world_poses.get(object_id) if object_id in self.world else None
+            return None if pose is None else pose.copy()
+
+    def _store(self, object_id: str, primitives: list[CollisionObject], pose: np.ndarray) -> None:
+        """Replace world object ``object_id`` by ``primitives`` at ``pose`` (the caller holds the lock)."""
         names = [object_id] if len(primitives) == 1 else [f"{object_id}/{k}" for k in range(len(primitives))]
         placed = [
             CollisionObject(
@@ -115,26 +189,23 @@ class PlanningScene:
         ]
         for obj in placed:
             check_shape(obj)
-        with self._lock:
-            if object_id in self.world:
-                if not replace:
-                    raise MotionError(
-                        f"collision object {object_id!r} is already in the planning scene "
-                        "(overwrite it to replace it)"
-                    )
-                for name in self.world[object_id]:
-                    self.objects.pop(name, None)
-            taken = [n for n in names if n in self.objects]
-            if taken:
-                raise MotionError(
-                    f"collision object id {object_id!r} is the name of part of the cell's environment; "
-                    "pick another id"
-                )
-            for obj in placed:
-                self.objects[obj.name] = obj
-            self.world[object_id] = tuple(names)
-            self.version += 1
-        self._changed()
+        own = np.asarray(pose, dtype=float)
+        if own.shape != (4, 4) or not np.all(np.isfinite(own)):
+            raise MotionError(f"the pose of {object_id!r} must be a finite 4x4 transform")
+        old = self.world.get(object_id, ())
+        taken = [n for n in names if n in self.objects and n not in old]
+        if taken:
+            raise MotionError(
+                f"collision object id {object_id!r} is the name of part of the cell's environment; "
+                "pick another id"
+            )
+        for name in old:
+            self.objects.pop(name, None)
+        for obj in placed:
+            self.objects[obj.name] = obj
+        self.world[object_id] = tuple(names)
+        self.world_poses[object_id] = own.copy()
+        self.version += 1
 
     def remove_world_object(self, object_id: str) -> None:
         """Remove world object ``object_id``.
@@ -150,6 +221,7 @@ class PlanningScene:
                 )
             for name in self.world.pop(object_id):
                 self.objects.pop(name, None)
+            self.world_poses.pop(object_id, None)
             self.version += 1
         self._changed()
 
@@ -173,6 +245,7 @@ class PlanningScene:
                 for name in names:
                     self.objects.pop(name, None)
             self.world.clear()
+            self.world_poses.clear()
             self.version += 1
         self._changed()
         return count
@@ -215,6 +288,7 @@ class PlanningScene:
                         self.world[object_id] = rest
                     else:
                         del self.world[object_id]
+                        self.world_poses.pop(object_id, None)
             self.version += 1
         self._changed()
 

@@ -89,6 +89,9 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
     context = BehaviorContext(
         node, clock=clock, log_sink=sink, robot_model=_robot_model_provider(resolved), config=resolved
     )
+    from kinema.runtime.planning_scene_service import serve_planning_scene
+
+    serve_planning_scene(node, context)  # as move_group serves it, from the scene the behaviors plan in
     host = build_host(resolved) if resolved is not None else None
     extra = [Path(folder) for folder in options.objective_dirs]
 

@@ -2,10 +2,23 @@
 
 from __future__ import annotations
 
+import functools
 import threading
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+
+@functools.cache
+def lab_sim_model() -> Any:
+    """lab_sim's robot model (URDF, SRDF), loaded once."""
+    from kinema.motion import RobotDescription
+
+    return RobotDescription.lab_sim().load_model()
+
+
+# The arm's joints (rail first), as MoveIt Pro's files list them: lab_sim's "manipulator" group.
+ARM: tuple[str, ...] = tuple(lab_sim_model().group("manipulator").joint_names)
 
 
 @dataclass

@@ -264,6 +264,63 @@ def test_add_collision_object_adds_and_removes_and_refuses_cones(
     assert cone.status == NodeStatus.FAILURE and "CONE" in cone.toasts[-1] and "BOX (1)" in cone.toasts[-1]
 
 
+def _object_message(object_id: str, operation: int, xyz: tuple[float, float, float], **extra: Any) -> Any:
+    return from_dict(
+        "moveit_msgs/msg/CollisionObject",
+        {
+            "id": object_id,
+            "header": {"frame_id": "world"},
+            "pose": {
+                "position": dict(zip("xyz", xyz, strict=True)),
+                "orientation": extra.pop("q", {"w": 1.0}),
+            },
+            "operation": operation,
+            **extra,
+        },
+    )
+
+
+def _centres(behavior: Any, context: BehaviorContext, object_id: str) -> list[float]:
+    """The centres of the object's primitives, flattened (x, y, z, x, y, z, ...), in the world."""
+    _, scene = _scene_ids(behavior, context)
+    (obj,) = [o for o in scene.world.collision_objects if o.id == object_id]
+    return [v for p in obj.primitive_poses for v in (p.position.x, p.position.y, p.position.z)]
+
+
+def test_add_collision_object_appends_and_moves_as_moveit_does(
+    behavior: Any, context: BehaviorContext, at_home: Any
+) -> None:
+    def apply(message: Any) -> Any:
+        return tick_behavior(behavior("AddCollisionObject"), {"collision_object": message}, context=context)
+
+    cylinder = {"primitives": [{"type": 3, "dimensions": [0.2, 0.05]}], "primitive_poses": [{}]}
+    assert apply(_object_message("rack", 0, (0.7, 0.0, 1.0), **cylinder)).status == NodeStatus.SUCCESS
+    # APPEND: a box 10 cm along the object's x joins the cylinder; the object is now both.
+    box = {
+        "primitives": [{"type": 1, "dimensions": [0.05, 0.05, 0.05]}],
+        "primitive_poses": [{"position": {"x": 0.1}}],
+    }
+    appended = apply(_object_message("rack", 2, (0.7, 0.0, 1.0), **box))
+    assert appended.status == NodeStatus.SUCCESS, appended.toasts
+    assert _centres(behavior, context, "rack") == pytest.approx([0.7, 0.0, 1.0, 0.8, 0.0, 1.0])
+    # MOVE: the whole object goes to the new pose, a quarter turn about z: the box swings round with it.
+    quarter = {"z": 0.7071068, "w": 0.7071068}
+    moved = apply(_object_message("rack", 3, (0.2, 0.5, 0.9), q=quarter))
+    assert moved.status == NodeStatus.SUCCESS, moved.toasts
+    assert _centres(behavior, context, "rack") == pytest.approx([0.2, 0.5, 0.9, 0.2, 0.6, 0.9], abs=1e-6)
+    # APPEND to an id nobody added creates it, as in MoveIt.
+    assert apply(_object_message("new", 2, (0.5, 0.5, 1.0), **box)).status == NodeStatus.SUCCESS
+    assert _centres(behavior, context, "new") == pytest.approx([0.6, 0.5, 1.0])
+    # MOVE of an unknown id, and an unknown operation, fail with what there is.
+    lost = apply(_object_message("missing", 3, (0.0, 0.0, 1.0)))
+    assert lost.status == NodeStatus.FAILURE and "'missing'" in lost.toasts[-1], lost.toasts
+    assert "rack" in lost.toasts[-1] or "new" in lost.toasts[-1], lost.toasts
+    odd = apply(_object_message("rack", 7, (0.0, 0.0, 1.0)))
+    assert odd.status == NodeStatus.FAILURE and "APPEND (2), MOVE (3)" in odd.toasts[-1], odd.toasts
+    for object_id in ("rack", "new"):
+        assert apply(_object_message(object_id, 1, (0.0, 0.0, 0.0))).status == NodeStatus.SUCCESS
+
+
 def test_the_next_plan_avoids_an_added_box_and_validation_names_it(
     behavior: Any, context: BehaviorContext, at_home: Any, lab_sim_model: Any
 ) -> None:
@@ -508,4 +565,4 @@ def test_a_camera_of_the_scene_is_a_frame(behavior: Any, context: BehaviorContex
         context=context,
     )
     assert run.status == NodeStatus.SUCCESS, run.toasts
-    np.testing.assert_allclose(_xyz(run.outputs["output_pose"]), [2.1, 0.0, 1.9], atol=1e-6)
+    np.testing.assert_allclose(_xyz(run.outputs["output_pose"]), [0.0, 2.1, 1.624], atol=1e-6)

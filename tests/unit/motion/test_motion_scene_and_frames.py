@@ -61,6 +61,28 @@ def test_removing_an_unknown_world_object_names_those_there_are() -> None:
         scene.remove_world_object("table")
 
 
+def test_append_adds_shapes_and_move_carries_them_rigidly() -> None:
+    scene = PlanningScene()
+    scene.append_to_world_object("rack", [CollisionObject("", "sphere", (0.05,), _at(1, 0, 1))], _at(1, 0, 1))
+    assert scene.world == {"rack": ("rack",)}  # APPEND to a new id creates it
+    scene.append_to_world_object("rack", [CollisionObject("", "box", (0.1, 0.1, 0.1), _at(1.2, 0, 1))])
+    assert scene.world["rack"] == ("rack/0", "rack/1")
+    quarter = _at(0, 1, 0.5)
+    quarter[:3, :3] = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]
+    scene.move_world_object("rack", quarter)
+    centres = [p.world_T_object[:3, 3] for p in scene.world_object("rack")]
+    np.testing.assert_allclose(centres, [[0, 1, 0.5], [0, 1.2, 0.5]], atol=1e-12)
+    np.testing.assert_allclose(scene.world_object_pose("rack"), quarter)
+    version = scene.version
+    with pytest.raises(MotionError, match=r"'gone'.*rack"):
+        scene.move_world_object("gone", quarter)
+    with pytest.raises(MotionError, match="must be finite"):
+        scene.append_to_world_object("rack", [CollisionObject("", "box", (0.1, -1, 0.1), np.eye(4))])
+    assert scene.version == version and len(scene.world_object("rack")) == 2  # refused: nothing changed
+    scene.remove_world_object("rack")
+    assert scene.world_object_pose("rack") is None
+
+
 def test_a_box_added_at_the_tool_puts_that_configuration_in_collision(
     model, lab_scene: PlanningScene, waypoints: dict[str, dict[str, float]]
 ) -> None:
@@ -79,14 +101,14 @@ def test_a_box_added_at_the_tool_puts_that_configuration_in_collision(
 
 def test_frame_tree_resolves_links_objects_and_world(model, waypoints: dict[str, dict[str, float]]) -> None:
     q = model.configuration(waypoints["Look at Table"])
-    tree = FrameTree(model, q, {"cube": _at(0.62, 0.3, 0.775)})
+    tree = FrameTree(model, q, {"cube": _at(-0.3, 0.62, 0.499)})
     assert np.allclose(tree.world_T("world"), np.eye(4)) and np.allclose(tree.world_T(""), np.eye(4))
     assert np.allclose(tree.world_T("grasp_link"), fk(model, q, "grasp_link"))
     for name in ("base_link", "tool0", "grasp_link", "cube"):
         assert name in tree.names() and name in tree
     # the cube's centre seen from the grasp link, and back
     in_grasp = tree.transform(np.eye(4), "cube", "grasp_link")
-    assert np.allclose(tree.transform(in_grasp, "grasp_link", "world"), _at(0.62, 0.3, 0.775))
+    assert np.allclose(tree.transform(in_grasp, "grasp_link", "world"), _at(-0.3, 0.62, 0.499))
 
 
 def test_an_unknown_frame_names_the_closest_ones(model) -> None:

@@ -115,137 +115,141 @@ def _save_ports(ros_type: str, what: str, overwrite: bool = True) -> list[PortIn
             input_port(
                 "overwrite",
                 bool,
-                False,
+                True,
                 "Replace an existing file. When false and the file exists, the message is saved beside it "
-                "with a time stamp in the name (MoveIt Pro's default is not public; keeping the old file "
-                "is Kinema's choice).",
+                "with a time stamp in the name. (MoveIt Pro's default is not public; the corpus implies "
+                "true: 'Record and Replay Scanning Motion' replays the joint_trajectory.yaml that 'Plan and "
+                "Save Trajectory' saves over the shipped one without setting overwrite.)",
             )
         )
     return ports
 
 
-class LoadPoseStampedFromYaml(AsyncBehavior):
+class _LoadFromYaml(AsyncBehavior):
+    """Reads ``ros_type`` messages from a YAML file into ``output``: the shape every loader shares.
+
+    Subclasses set the message type, whether the file holds one message or a vector, what the output
+    is, and may check the loaded message (:meth:`check`).
+    """
+
+    subcategory = SUBCATEGORY
+    ros_type = ""
+    vector = False
+    what = ""
+    several_hint = "expected 1"  # the valid alternative when a one-message file holds several documents
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return _load_ports(cls.ros_type, cls.vector, cls.what)
+
+    def check(self, message: Any, path: Path) -> None:
+        """Raise :func:`port_error` when the loaded ``message`` is unusable (nothing to check by default)."""
+
+    @fails_on_bad_input
+    def do_work(self) -> bool:
+        path = file_to_read(self, "file_path", str(read_input(self, "file_path")))
+        documents = read_documents(self, "file_path", path)
+        if self.vector:
+            messages = [
+                message_from(self, "file_path", path, self.ros_type, doc, i + 1)
+                for i, doc in enumerate(documents)
+            ]
+            self.set_output("output", messages)
+            return True
+        if len(documents) != 1:
+            raise port_error(
+                self, "file_path", f"file {path} holds {len(documents)} documents", self.several_hint
+            )
+        message = message_from(self, "file_path", path, self.ros_type, documents[0], 0)
+        self.check(message, path)
+        self.set_output("output", message)
+        return True
+
+
+class _SaveToYaml(AsyncBehavior):
+    """Writes the ``message`` input (a ``ros_type``) to a YAML file, atomically: the shape every saver
+    shares. Subclasses set the type and what is saved, and may convert the input (:meth:`messages`)."""
+
+    subcategory = SUBCATEGORY
+    ros_type = ""
+    what = ""
+    has_overwrite = True
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return _save_ports(cls.ros_type, cls.what, overwrite=cls.has_overwrite)
+
+    def messages(self) -> list[Any]:
+        """The messages to write (one document each)."""
+        return [read_message(self, "message", self.ros_type)]
+
+    @fails_on_bad_input
+    def do_work(self) -> bool:
+        messages = self.messages()
+        overwrite = bool(read_input(self, "overwrite")) if self.has_overwrite else True
+        save(self, "yaml_filename", str(read_input(self, "yaml_filename")), messages, overwrite)
+        return True
+
+
+class LoadPoseStampedFromYaml(_LoadFromYaml):
     """Reads a ``geometry_msgs/PoseStamped`` from a YAML file into ``output``."""
 
-    subcategory = SUBCATEGORY
-
-    @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return _load_ports(POSE_STAMPED, False, "The pose.")
-
-    @fails_on_bad_input
-    def do_work(self) -> bool:
-        path = file_to_read(self, "file_path", str(read_input(self, "file_path")))
-        documents = read_documents(self, "file_path", path)
-        if len(documents) != 1:
-            problem = f"file {path} holds {len(documents)} documents"
-            raise port_error(
-                self, "file_path", problem, "use LoadPoseStampedVectorFromYaml for several poses"
-            )
-        self.set_output("output", message_from(self, "file_path", path, POSE_STAMPED, documents[0], 0))
-        return True
+    ros_type = POSE_STAMPED
+    what = "The pose."
+    several_hint = "use LoadPoseStampedVectorFromYaml for several poses"
 
 
-class LoadPoseStampedVectorFromYaml(AsyncBehavior):
+class LoadPoseStampedVectorFromYaml(_LoadFromYaml):
     """Reads a vector of ``geometry_msgs/PoseStamped`` (YAML documents split by ``---``) into ``output``."""
 
-    subcategory = SUBCATEGORY
-
-    @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return _load_ports(POSE_STAMPED, True, "The poses, in file order.")
-
-    @fails_on_bad_input
-    def do_work(self) -> bool:
-        path = file_to_read(self, "file_path", str(read_input(self, "file_path")))
-        documents = read_documents(self, "file_path", path)
-        poses = [
-            message_from(self, "file_path", path, POSE_STAMPED, doc, i + 1) for i, doc in enumerate(documents)
-        ]
-        self.set_output("output", poses)
-        return True
+    ros_type = POSE_STAMPED
+    vector = True
+    what = "The poses, in file order."
 
 
-class SavePoseStampedToYaml(AsyncBehavior):
+class SavePoseStampedToYaml(_SaveToYaml):
     """Writes a ``geometry_msgs/PoseStamped`` to a YAML file, atomically."""
 
-    subcategory = SUBCATEGORY
-
-    @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return _save_ports(POSE_STAMPED, "The pose to save")
-
-    @fails_on_bad_input
-    def do_work(self) -> bool:
-        message = read_message(self, "message", POSE_STAMPED)
-        name = str(read_input(self, "yaml_filename"))
-        save(self, "yaml_filename", name, [message], bool(read_input(self, "overwrite")))
-        return True
+    ros_type = POSE_STAMPED
+    what = "The pose to save"
 
 
-class SavePoseStampedVectorToYaml(AsyncBehavior):
+class SavePoseStampedVectorToYaml(_SaveToYaml):
     """Writes a vector of ``geometry_msgs/PoseStamped`` to a YAML file (one document each), atomically."""
 
-    subcategory = SUBCATEGORY
+    ros_type = POSE_STAMPED
+    what = "The poses to save"
 
-    @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return _save_ports(POSE_STAMPED, "The poses to save")
-
-    @fails_on_bad_input
-    def do_work(self) -> bool:
+    def messages(self) -> list[Any]:
         poses = read_vector(self, "message")
         wrong = [i for i, pose in enumerate(poses) if getattr(pose, "__msgtype__", None) != POSE_STAMPED]
         if wrong:
             raise port_error(self, "message", f"element {wrong[0]} is not a {POSE_STAMPED}", "")
-        name = str(read_input(self, "yaml_filename"))
-        save(self, "yaml_filename", name, poses, bool(read_input(self, "overwrite")))
-        return True
+        return list(poses)
 
 
-class LoadJointTrajectoryFromYaml(AsyncBehavior):
+class LoadJointTrajectoryFromYaml(_LoadFromYaml):
     """Reads a ``trajectory_msgs/JointTrajectory`` from a YAML file into ``output``."""
 
-    subcategory = SUBCATEGORY
+    ros_type = TRAJECTORY
+    what = "The trajectory."
 
-    @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return _load_ports(TRAJECTORY, False, "The trajectory.")
-
-    @fails_on_bad_input
-    def do_work(self) -> bool:
-        path = file_to_read(self, "file_path", str(read_input(self, "file_path")))
-        documents = read_documents(self, "file_path", path)
-        if len(documents) != 1:
-            raise port_error(self, "file_path", f"file {path} holds {len(documents)} documents", "expected 1")
-        trajectory = message_from(self, "file_path", path, TRAJECTORY, documents[0], 0)
-        if not len(trajectory.points):
+    def check(self, message: Any, path: Path) -> None:
+        if not len(message.points):
             raise port_error(self, "file_path", f"file {path} has a trajectory without points", "")
-        self.set_output("output", trajectory)
-        return True
 
 
-class SaveJointTrajectoryToYaml(AsyncBehavior):
+class SaveJointTrajectoryToYaml(_SaveToYaml):
     """Writes a ``trajectory_msgs/JointTrajectory`` to a YAML file, atomically."""
 
-    subcategory = SUBCATEGORY
-
-    @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return _save_ports(TRAJECTORY, "The trajectory to save")
-
-    @fails_on_bad_input
-    def do_work(self) -> bool:
-        message = read_message(self, "message", TRAJECTORY)
-        name = str(read_input(self, "yaml_filename"))
-        save(self, "yaml_filename", name, [message], bool(read_input(self, "overwrite")))
-        return True
+    ros_type = TRAJECTORY
+    what = "The trajectory to save"
 
 
-class LoadRobotJointStateFromYaml(AsyncBehavior):
+class LoadRobotJointStateFromYaml(_LoadFromYaml):
     """Reads a robot state (``RobotJointState``: joint state and multi-DOF state) from a YAML file."""
 
-    subcategory = SUBCATEGORY
+    ros_type = ROBOT_STATE
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
@@ -254,33 +258,20 @@ class LoadRobotJointStateFromYaml(AsyncBehavior):
             output_port("output", None, "{output}", f"The robot state ({ROBOT_STATE})."),
         ]
 
-    @fails_on_bad_input
-    def do_work(self) -> bool:
-        path = file_to_read(self, "file_path", str(read_input(self, "file_path")))
-        documents = read_documents(self, "file_path", path)
-        if len(documents) != 1:
-            raise port_error(self, "file_path", f"file {path} holds {len(documents)} documents", "expected 1")
-        state = message_from(self, "file_path", path, ROBOT_STATE, documents[0], 0)
-        if not len(state.joint_state.name):
+    def check(self, message: Any, path: Path) -> None:
+        if not len(message.joint_state.name):
             raise port_error(self, "file_path", f"file {path} names no joints", "expected joint_state.name")
-        self.set_output("output", state)
-        return True
 
 
-class SaveRobotJointStateToYaml(AsyncBehavior):
+class SaveRobotJointStateToYaml(_SaveToYaml):
     """Writes a robot state (or a joint state) to a YAML file as a ``RobotJointState``, atomically.
 
     An existing file is replaced (this behavior has no ``overwrite`` port in MoveIt Pro).
     """
 
-    subcategory = SUBCATEGORY
+    ros_type = ROBOT_STATE
+    what = "The robot or joint state to save"
+    has_overwrite = False
 
-    @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return _save_ports(ROBOT_STATE, "The robot or joint state to save", overwrite=False)
-
-    @fails_on_bad_input
-    def do_work(self) -> bool:
-        state = as_robot_state(self, "message", read_input(self, "message"))
-        save(self, "yaml_filename", str(read_input(self, "yaml_filename")), [state], True)
-        return True
+    def messages(self) -> list[Any]:
+        return [as_robot_state(self, "message", read_input(self, "message"))]

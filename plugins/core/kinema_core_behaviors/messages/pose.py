@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
+from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
 from .ports import fails_on_bad_input, message_input, message_output, read_input, read_message
+from .unpacking import Field, UnpackMessage
 
 
 class CreatePoseMessage(SyncBehavior):
@@ -36,27 +37,16 @@ class CreatePoseMessage(SyncBehavior):
         return NodeStatus.SUCCESS
 
 
-class UnpackPoseMessage(SyncBehavior):
+class UnpackPoseMessage(UnpackMessage):
     """Splits a ``geometry_msgs/Pose`` into its ``position`` (Point) and ``orientation`` (Quaternion)."""
 
-    subcategory = "Messages"
-
-    @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return [
-            message_input("pose", "geometry_msgs/msg/Pose", "{pose}", "The pose to unpack."),
-            message_output("position", "geometry_msgs/msg/Point", "{position}", "Its position."),
-            message_output(
-                "orientation", "geometry_msgs/msg/Quaternion", "{orientation}", "Its orientation."
-            ),
-        ]
-
-    @fails_on_bad_input
-    def tick(self) -> NodeStatus:
-        pose = read_message(self, "pose")
-        self.set_output("position", pose.position)
-        self.set_output("orientation", pose.orientation)
-        return NodeStatus.SUCCESS
+    message_port = "pose"
+    message_type = "geometry_msgs/msg/Pose"
+    message_description = "The pose to unpack."
+    fields = (
+        Field("position", "geometry_msgs/msg/Point", "Its position."),
+        Field("orientation", "geometry_msgs/msg/Quaternion", "Its orientation."),
+    )
 
 
 class CreatePointMessage(SyncBehavior):
@@ -82,23 +72,10 @@ class CreatePointMessage(SyncBehavior):
         return NodeStatus.SUCCESS
 
 
-class UnpackPointMessage(SyncBehavior):
+class UnpackPointMessage(UnpackMessage):
     """Splits a ``geometry_msgs/Point`` into ``x``, ``y`` and ``z``."""
 
-    subcategory = "Messages"
-
-    @classmethod
-    def provided_ports(cls) -> list[PortInfo]:
-        return [
-            message_input("point", "geometry_msgs/msg/Point", "{point}", "The point to unpack."),
-            output_port("x", float, "{x}", "x (m)."),
-            output_port("y", float, "{y}", "y (m)."),
-            output_port("z", float, "{z}", "z (m)."),
-        ]
-
-    @fails_on_bad_input
-    def tick(self) -> NodeStatus:
-        point = read_message(self, "point")
-        for axis in "xyz":
-            self.set_output(axis, float(getattr(point, axis)))
-        return NodeStatus.SUCCESS
+    message_port = "point"
+    message_type = "geometry_msgs/msg/Point"
+    message_description = "The point to unpack."
+    fields = (Field("x", "", "x (m)."), Field("y", "", "y (m)."), Field("z", "", "z (m)."))

@@ -9,7 +9,6 @@ its own, rebuilt when the scene changes.
 from __future__ import annotations
 
 import threading
-import weakref
 from typing import TYPE_CHECKING, Any
 
 from kinema.errors import ObjectiveError
@@ -17,8 +16,6 @@ from kinema.errors import ObjectiveError
 if TYPE_CHECKING:
     from kinema.motion import CollisionChecker, PlanningScene, RobotModel
 
-_SCENES: weakref.WeakKeyDictionary[Any, PlanningScene] = weakref.WeakKeyDictionary()
-_SCENES_LOCK = threading.Lock()
 _THREAD = threading.local()
 
 
@@ -39,45 +36,20 @@ def robot_model(context: Any, behavior: str) -> RobotModel:
 
 def set_planning_scene(context: Any, scene: PlanningScene) -> None:
     """Plan against ``scene`` in every behavior of ``context`` from now on."""
-    with _SCENES_LOCK:
-        _SCENES[context] = scene
+    from kinema.runtime.planning_scene_service import set_scene
+
+    set_scene(context, scene)
 
 
 def planning_scene(context: Any, model: RobotModel) -> PlanningScene:
     """The planning scene of ``context``: the static geometry of its config's MuJoCo scene by default.
 
-    With a transport node, every change of the scene is published (latched) on
-    ``/monitored_planning_scene`` for ``kinema view`` and other subscribers.
+    It is the agent's: published on ``/monitored_planning_scene`` and served on ``/get_planning_scene``
+    (:mod:`kinema.runtime.planning_scene_service`).
     """
-    from kinema.motion import PlanningScene
+    from kinema.runtime.planning_scene_service import scene_of
 
-    with _SCENES_LOCK:
-        scene = _SCENES.get(context)
-        if scene is None:
-            config = getattr(context, "config", None)
-            path = getattr(config, "mujoco_model_path", None) if config is not None else None
-            scene = PlanningScene.from_mjcf(path, model.link_names) if path is not None else PlanningScene()
-            _SCENES[context] = scene
-            if getattr(context, "node", None) is not None:
-                _publish_changes(context, scene, model)
-        return scene
-
-
-def _publish_changes(context: Any, scene: PlanningScene, model: RobotModel) -> None:
-    from ..planning_scene.scene_messages import (
-        PLANNING_SCENE_TOPIC,
-        PLANNING_SCENE_TYPE,
-        planning_scene_message,
-    )
-
-    publisher = context.publisher(context.node, PLANNING_SCENE_TYPE, PLANNING_SCENE_TOPIC, latched=True)
-    name = model.name if hasattr(model, "name") else ""
-
-    def publish(changed: PlanningScene) -> None:
-        publisher.publish(planning_scene_message(changed, str(name)))
-
-    scene.subscribe(publish)
-    publish(scene)
+    return scene_of(context, model)
 
 
 def collision_checker(context: Any, behavior: str, padding: float) -> CollisionChecker:

@@ -8,15 +8,20 @@ from kinema.errors import KinemaError
 from ..messages.ports import PortValueError, fails_on_bad_input, message_input, port_error, read_message
 from ..motion.planning_resources import planning_scene, robot_model
 from ..poses.frame_tree import current_frame_tree
-from .scene_messages import ADD, COLLISION_OBJECT_TYPE, REMOVE, primitives_of
+from .scene_messages import ADD, APPEND, COLLISION_OBJECT_TYPE, MOVE, REMOVE, object_pose_of, primitives_of
+
+OPERATIONS = "ADD (0), REMOVE (1), APPEND (2), MOVE (3)"
 
 
 class AddCollisionObject(SyncBehavior):
-    """Adds ``collision_object`` (its primitives and meshes, in any frame of the cell) to the planning scene.
+    """Applies ``collision_object`` (in any frame of the cell) to the planning scene, as MoveIt does.
 
-    An object whose ``operation`` is REMOVE removes the object of that id instead. Boxes, spheres and
-    cylinders are checked exactly, meshes as their bounding box; cones and planes fail the behavior. With
-    ``overwrite`` false an existing object of the same id fails the behavior.
+    The message's ``operation``: ADD puts the object there (with ``overwrite`` false an existing object of
+    the same id fails the behavior); REMOVE removes the object of that id; APPEND adds the message's
+    shapes to the object of that id (creating it when there is none); MOVE puts the existing object at
+    the message's ``pose``, its shapes moving with it (shapes in a MOVE message are ignored, with a
+    warning, as MoveIt ignores them). Boxes, spheres and cylinders are checked exactly, meshes as their
+    bounding box; cones and planes fail the behavior.
     """
 
     subcategory = "Perception - Planning Scene"
@@ -40,20 +45,32 @@ class AddCollisionObject(SyncBehavior):
         try:
             model = robot_model(self.context, "AddCollisionObject")
             scene = planning_scene(self.context, model)
+            if operation not in (ADD, REMOVE, APPEND, MOVE):
+                raise port_error(
+                    self, "collision_object", f"has operation {operation}", f"valid operations: {OPERATIONS}"
+                )
             if operation == REMOVE:
                 scene.remove_world_object(object_id)
                 return NodeStatus.SUCCESS
-            if operation != ADD:
-                raise port_error(
-                    self,
-                    "collision_object",
-                    f"has operation {operation} (APPEND or MOVE)",
-                    "Kinema applies ADD (0) and REMOVE (1); send the whole object with ADD and overwrite",
-                )
             frame = str(message.header.frame_id)
             frames = None if frame in ("", "world") else current_frame_tree(self)
+            if operation == MOVE:
+                if len(message.primitives) or len(message.meshes) or len(message.planes):
+                    self.logger.publish_warn(
+                        f"AddCollisionObject: MOVE of {object_id!r} ignores the shapes in the message"
+                    )
+                scene.move_world_object(object_id, object_pose_of(message, frames))
+                return NodeStatus.SUCCESS
+            if operation == APPEND:
+                scene.append_to_world_object(
+                    object_id, primitives_of(message, frames), object_pose_of(message, frames)
+                )
+                return NodeStatus.SUCCESS
             scene.add_world_object(
-                object_id, primitives_of(message, frames), replace=bool(self.get_input("overwrite"))
+                object_id,
+                primitives_of(message, frames),
+                replace=bool(self.get_input("overwrite")),
+                pose=object_pose_of(message, frames),
             )
         except PortValueError:
             raise

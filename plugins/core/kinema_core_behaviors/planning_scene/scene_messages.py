@@ -15,14 +15,22 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 
 from kinema.errors import ObjectiveError
+from kinema.runtime.planning_scene_service import collision_object_dict, planning_scene_message
 from kinema.viz.topics import PLANNING_SCENE_TOPIC, PLANNING_SCENE_TYPE
 
 from ..poses.frame_tree import pose_of
 
 if TYPE_CHECKING:
-    from kinema.motion import CollisionObject, FrameTree, PlanningScene
+    from kinema.motion import CollisionObject, FrameTree
 
-__all__ = ["PLANNING_SCENE_TOPIC", "PLANNING_SCENE_TYPE", "planning_scene_message", "primitives_of"]
+__all__ = [
+    "PLANNING_SCENE_TOPIC",
+    "PLANNING_SCENE_TYPE",
+    "collision_object_dict",
+    "object_pose_of",
+    "planning_scene_message",
+    "primitives_of",
+]
 
 COLLISION_OBJECT_TYPE = "moveit_msgs/msg/CollisionObject"
 BOX, SPHERE, CYLINDER, CONE = 1, 2, 3, 4
@@ -54,15 +62,24 @@ def primitive(shape_type: int, dimensions: list[float], world_T: np.ndarray, wha
     return CollisionObject("", "cylinder", (radius, 0.5 * height), world_T)
 
 
+def object_pose_of(message: Any, frames: FrameTree | None) -> np.ndarray:
+    """The world pose of a ``moveit_msgs/CollisionObject``'s own ``pose`` (given in ``header.frame_id``).
+
+    Raises:
+        ObjectiveError: a frame the tree does not know.
+    """
+    frame = str(message.header.frame_id)
+    world_T_frame = np.eye(4) if frames is None else frames.world_T(frame)
+    return world_T_frame @ pose_of(message.pose.position, message.pose.orientation)
+
+
 def primitives_of(message: Any, frames: FrameTree | None) -> list[CollisionObject]:
     """The world-placed primitives of a ``moveit_msgs/CollisionObject``.
 
     Raises:
         ObjectiveError: unsupported shapes, mismatched pose lists, or a frame the tree does not know.
     """
-    frame = str(message.header.frame_id)
-    world_T_frame = np.eye(4) if frames is None else frames.world_T(frame)
-    world_T_object = world_T_frame @ pose_of(message.pose.position, message.pose.orientation)
+    world_T_object = object_pose_of(message, frames)
     shapes: list[CollisionObject] = []
     name = str(message.id)
     if len(message.primitive_poses) != len(message.primitives):
@@ -97,57 +114,3 @@ def primitives_of(message: Any, frames: FrameTree | None) -> list[CollisionObjec
             f"collision object {name!r} has planes, which Kinema cannot check; supported: {_SUPPORTED}"
         )
     return shapes
-
-
-def _pose_dict(matrix: np.ndarray) -> dict[str, Any]:
-    from scipy.spatial.transform import Rotation
-
-    x, y, z, w = Rotation.from_matrix(matrix[:3, :3]).as_quat()
-    px, py, pz = (float(v) for v in matrix[:3, 3])
-    return {"position": {"x": px, "y": py, "z": pz}, "orientation": {"x": x, "y": y, "z": z, "w": w}}
-
-
-def _primitive_dict(obj: CollisionObject) -> dict[str, Any]:
-    if obj.shape == "box":
-        return {"type": BOX, "dimensions": [2 * float(v) for v in obj.size]}
-    if obj.shape == "sphere":
-        return {"type": SPHERE, "dimensions": [float(obj.size[0])]}
-    # cylinders, and capsules drawn as the cylinder around them
-    extra = float(obj.size[0]) if obj.shape == "capsule" else 0.0
-    return {"type": CYLINDER, "dimensions": [2 * float(obj.size[1]) + 2 * extra, float(obj.size[0])]}
-
-
-def collision_object_dict(object_id: str, primitives: list[CollisionObject]) -> dict[str, Any]:
-    """A ``moveit_msgs/CollisionObject`` dict of a world object, in ``world``."""
-    return {
-        "header": {"frame_id": "world"},
-        "pose": {"orientation": {"w": 1.0}},
-        "id": object_id,
-        "primitives": [_primitive_dict(p) for p in primitives],
-        "primitive_poses": [_pose_dict(np.asarray(p.world_T_object, float)) for p in primitives],
-        "operation": ADD,
-    }
-
-
-def planning_scene_message(scene: PlanningScene, robot_model_name: str = "", joint_state: Any = None) -> Any:
-    """A full ``moveit_msgs/PlanningScene`` (``is_diff`` false) of ``scene``'s world objects."""
-    from kinema.transport import from_dict
-
-    data: dict[str, Any] = {
-        "name": "kinema",
-        "robot_model_name": robot_model_name,
-        "world": {
-            "collision_objects": [
-                collision_object_dict(oid, prims) for oid, prims in sorted(scene.world_objects().items())
-            ]
-        },
-        "is_diff": False,
-    }
-    if joint_state is not None:
-        data["robot_state"] = {
-            "joint_state": {
-                "name": [str(n) for n in joint_state.name],
-                "position": [float(p) for p in joint_state.position],
-            }
-        }
-    return from_dict(PLANNING_SCENE_TYPE, data)
