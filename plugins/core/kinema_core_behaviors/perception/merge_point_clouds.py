@@ -10,7 +10,6 @@ from kinema.errors import PerceptionError
 from ..messages.ports import (
     fails_on_bad_input,
     message_output,
-    message_vector_input,
     port_error,
     read_input,
     read_vector,
@@ -35,7 +34,10 @@ class MergePointClouds(SyncBehavior):
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
         return [
-            message_vector_input("point_clouds", POINT_CLOUD, "{point_clouds}", "The clouds to merge."),
+            # Untyped, as PlanCartesianPath's path: vectors built by ResetVector/PushBackVector hold Any.
+            input_port(
+                "point_clouds", None, "{point_clouds}", "The clouds to merge (std::vector<PointCloud2>)."
+            ),
             input_port("grid_resolution_meters", float, 0.01, "Side of the voxel grid's cubes (m)."),
             input_port(
                 "align_point_clouds", bool, False, "Align each cloud to the previous ones by ICP first."
