@@ -2,7 +2,8 @@
 
 The view draws markers, so a cloud is drawn as a POINTS marker (at most ``MAX_DRAWN_POINTS``, evenly
 sub-sampled) in the ``snapshot`` namespace; the cloud itself is also published on its topic for other
-subscribers. ClearSnapshot deletes the drawn snapshots.
+subscribers. ClearSnapshot deletes the drawn snapshots and, as MoveIt Pro's clears its octomap, the
+obstacles UpdatePlanningSceneService made of a cloud.
 """
 
 from __future__ import annotations
@@ -15,7 +16,11 @@ from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
 from ..messages.conversions import point_cloud_xyz
 from ..messages.ports import fails_on_bad_input, message_input, port_error, read_input, read_message
+from ..motion.planning_resources import existing_planning_scene
 from .markers import publish_markers
+
+# UpdatePlanningSceneService's world object (named here to keep ui free of the perception family).
+OCTOMAP_ID = "octomap"
 
 POINT_CLOUD = "sensor_msgs/msg/PointCloud2"
 SNAPSHOT_NAMESPACE = "snapshot"
@@ -104,7 +109,8 @@ class PublishPointCloud(SyncBehavior):
 
 
 class ClearSnapshot(SyncBehavior):
-    """Removes the point cloud snapshots SendPointCloudToUI drew in ``kinema view``."""
+    """Removes the point cloud snapshots SendPointCloudToUI drew in ``kinema view``, and the obstacles
+    UpdatePlanningSceneService added from a cloud (the ``octomap`` world object)."""
 
     subcategory = "User Interface"
 
@@ -116,4 +122,7 @@ class ClearSnapshot(SyncBehavior):
         count = _SNAPSHOT_IDS.pop(id(self.context), -1) + 1
         markers = [{"ns": SNAPSHOT_NAMESPACE, "id": i, "action": 2} for i in range(max(count, 1))]
         publish_markers(self, markers)
+        scene = existing_planning_scene(self.context)
+        if scene is not None and OCTOMAP_ID in scene.world:
+            scene.remove_world_object(OCTOMAP_ID)
         return NodeStatus.SUCCESS
