@@ -141,3 +141,19 @@ def test_octomap_example_adds_the_scene_to_the_planning_scene_until_resumed(cell
     assert outcome and outcome[0].succeeded, outcome
     # Its last step, Clear Snapshot, clears the octomap too, as MoveIt Pro's does.
     wait_for(lambda: octomap_boxes() == 0, 30.0, "the octomap to leave the planning scene")
+
+
+def test_scan_scene_merges_three_wrist_views_into_one_thinned_cloud(cell: LibraryCell) -> None:
+    captures = cell.listen("sensor_msgs/msg/PointCloud2", CAPTURES)
+    seen = len(captures)
+    result = cell.client.execute("Scan Scene - Multiple Point Clouds", timeout=RUN_TIMEOUT)
+    assert result.succeeded, result
+    merged = wait_for(lambda: captures[-1] if len(captures) > seen else None, 30.0, f"a cloud on {CAPTURES}")
+    cloud = from_point_cloud2(merged)
+    assert cloud.frame_id == "world" and cloud.colors is not None
+    points = cloud.points.astype(float)
+    cells = np.unique(np.floor(points / 0.01).astype(np.int64), axis=0)
+    assert len(cells) == len(points) > 10000, f"{len(points)} points in {len(cells)} cells of 1 cm"
+    span = np.ptp(points[:, :2], axis=0).max()
+    # The views are 0.8 m to either side of the centre one: together they cover far more than one view.
+    assert span > 1.5, f"the merged cloud spans only {span:.2f} m horizontally"
