@@ -381,3 +381,112 @@ def test_a_cloud_in_the_planning_scene_is_avoided_and_the_robot_is_not_its_own_o
         timeout=30.0,
     )
     assert valid.status == NodeStatus.SUCCESS, valid.toasts
+
+
+def _mask(x: int, y: int, rows: int, cols: int) -> Any:
+    """A Mask2D of ``rows`` x ``cols`` object pixels whose top-left pixel is (x, y)."""
+    image = {
+        "height": rows,
+        "width": cols,
+        "encoding": "mono8",
+        "step": cols,
+        "data": np.full(rows * cols, 255, np.uint8),
+    }
+    return from_dict("moveit_studio_vision_msgs/msg/Mask2D", {"x": x, "y": y, "mask": image})
+
+
+def _camera_info(width: int, height: int) -> Any:
+    from kinema.perception import CameraIntrinsics
+    from kinema.perception.ros_messages import camera_info_message
+
+    return camera_info_message(CameraIntrinsics.from_fovy(width, height, 60.0), "world", 0.0, _types())
+
+
+def test_image_masks_pick_the_points_of_each_object(behavior: Any, context: BehaviorContext) -> None:
+    grid = np.arange(16 * 3, dtype=np.float32).reshape(16, 3)
+    grid[0] = np.nan  # a pixel the camera did not see
+    cloud = cloud_message(grid, "world", shape=(4, 4))
+    masks = tick_behavior(
+        behavior("GetMasks3DFromMasks2D"),
+        {
+            "point_cloud": cloud,
+            "camera_info": _camera_info(4, 4),
+            "masks2d": [_mask(1, 1, 2, 2), _mask(0, 0, 1, 2)],
+        },
+        context=context,
+    )
+    assert masks.status == NodeStatus.SUCCESS, masks.toasts
+    first, second = masks.outputs["masks3d"]
+    assert list(first.point_indices) == [5, 6, 9, 10] and list(second.point_indices) == [1]
+    fragment = tick_behavior(
+        behavior("GetPointCloudFromMask3D"), {"point_cloud": cloud, "mask3d": first}, context=context
+    )
+    assert fragment.status == NodeStatus.SUCCESS, fragment.toasts
+    assert np.allclose(points_of(fragment.outputs["point_cloud_fragment"]), grid[[5, 6, 9, 10]])
+    other_size = tick_behavior(
+        behavior("GetMasks3DFromMasks2D"),
+        {"point_cloud": cloud, "camera_info": _camera_info(8, 6), "masks2d": [_mask(1, 1, 2, 2)]},
+        context=context,
+    )
+    assert other_size.status == NodeStatus.FAILURE and "8x6" in other_size.toasts[-1], other_size.toasts
+    small = tick_behavior(
+        behavior("GetPointCloudFromMask3D"),
+        {"point_cloud": cloud_message(grid[:4]), "mask3d": first},
+        context=context,
+    )
+    assert small.status == NodeStatus.FAILURE and "lists point 10" in small.toasts[-1], small.toasts
+
+
+def test_find_masked_objects_fits_a_box_to_each_masked_object(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    # A 40x40 camera looking down on a 0.10 x 0.04 x 0.03 block (its top at z = 0.03, table at z = 0).
+    u, v = np.meshgrid(np.linspace(-0.2, 0.2, 40), np.linspace(-0.2, 0.2, 40))
+    z = np.zeros_like(u)
+    on_block = (np.abs(u) <= 0.05) & (np.abs(v) <= 0.02)
+    z[on_block] = 0.03
+    points = np.stack([u.ravel(), v.ravel(), z.ravel()], axis=1)
+    rows, cols = np.nonzero(on_block)
+    mask = _mask(int(cols.min()), int(rows.min()), int(np.ptp(rows)) + 1, int(np.ptp(cols)) + 1)
+    side = np.array([[0.05, 0.0, 0.0], [-0.05, 0.0, 0.0]])  # what the camera sees of the block's sides
+    points[np.flatnonzero(on_block.ravel())[:2]] = side
+    run = tick_behavior(
+        behavior("FindMaskedObjects"),
+        {
+            "point_cloud": cloud_message(points, shape=(40, 40)),
+            "camera_info": _camera_info(40, 40),
+            "masks2d": [mask],
+        },
+        context=context,
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    (found,) = run.outputs["detected_shapes"]
+    dimensions = sorted(found.object.primitives[0].dimensions, reverse=True)
+    assert dimensions[0] == pytest.approx(0.0842, abs=0.02) and dimensions[2] == pytest.approx(
+        0.03, abs=0.005
+    )
+    assert found.object.header.frame_id == "world"
+
+
+def test_collision_spheres_at_the_points_nearest_the_reference(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    line = np.stack([np.linspace(0.0, 1.0, 11), np.zeros(11), np.zeros(11)], axis=1)
+    run = tick_behavior(
+        behavior("CreateCollisionSpheresAtClosestPoints"),
+        {
+            "point_cloud": cloud_message(line),
+            "reference_pose": pose("world", (0.52, 0.0, 0.0)),
+            "closest_point_count": 3,
+            "sphere_radius": 0.02,
+            "filter_cylinder_radius": 1.0,
+            "filter_cylinder_height": 1.0,
+            "debug_output_markers": True,
+        },
+        context=context,
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    spheres = run.outputs["collision_object"]
+    centres = sorted(p.position.x for p in spheres.primitive_poses)
+    assert centres == pytest.approx([0.4, 0.5, 0.6]) and spheres.primitives[0].dimensions[0] == 0.02
+    assert len(run.outputs["marker_poses"]) == 3 and run.outputs["marker_scale_xyz"] == [0.04] * 3

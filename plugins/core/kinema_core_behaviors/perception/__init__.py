@@ -1,5 +1,5 @@
 """Perception: camera messages onto the blackboard, point clouds transformed, cropped, merged, registered,
-loaded from files and turned into planning-scene obstacles.
+loaded from files, cut out by image masks and turned into obstacles (planning scene, collision spheres).
 
 Ports hold ``sensor_msgs`` messages as MoveIt Pro's do; the work is done on numpy arrays by
 :mod:`kinema.perception`, with the conversions in :mod:`.clouds`.
@@ -10,7 +10,10 @@ from __future__ import annotations
 from .box_filters import CropPointsInBox, RemovePointsInBox
 from .camera_topics import GetCameraInfo, GetImage, GetPointCloud
 from .centroid import GetCentroidFromPointCloud
+from .collision_spheres import CreateCollisionSpheresAtClosestPoints
+from .find_masked_objects import FindMaskedObjects
 from .load_point_cloud_from_file import LoadPointCloudFromFile
+from .masks import GetMasks3DFromMasks2D, GetPointCloudFromMask3D
 from .merge_point_clouds import MergePointClouds
 from .register_point_clouds import RegisterPointClouds
 from .transform_point_cloud import TransformPointCloud, TransformPointCloudFrame
@@ -29,4 +32,8 @@ BEHAVIORS = (
     RegisterPointClouds,
     LoadPointCloudFromFile,
     UpdatePlanningSceneService,
+    GetMasks3DFromMasks2D,
+    GetPointCloudFromMask3D,
+    FindMaskedObjects,
+    CreateCollisionSpheresAtClosestPoints,
 )
