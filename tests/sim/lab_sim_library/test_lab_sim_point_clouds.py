@@ -81,7 +81,24 @@ def _geometry_errors(
     return np.array(errors), names
 
 
+def settle(cell: LibraryCell) -> None:
+    """Wait until the arm stands still (a snapshot of a moving arm cannot match the geometry of later)."""
+    states = cell.listen("sensor_msgs/msg/JointState", "/joint_states")
+    previous = None
+    deadline = time.monotonic() + 30.0
+    while time.monotonic() < deadline:
+        seen = len(states)
+        wait_for(lambda seen=seen: len(states) > seen, 10.0, "a joint state")
+        current = np.array(states[-1].position, dtype=float)
+        if previous is not None and np.abs(current - previous).max() < 1e-5:
+            return
+        previous = current
+        time.sleep(0.2)
+    raise AssertionError("the arm kept moving for 30 s")
+
+
 def test_take_snap_cloud_lies_on_the_table_and_the_objects(cell: LibraryCell) -> None:
+    settle(cell)
     captures = cell.listen("sensor_msgs/msg/PointCloud2", CAPTURES)
     seen = len(captures)
     result = cell.client.execute("Take Scene Camera Snapshot", timeout=RUN_TIMEOUT)
