@@ -40,12 +40,31 @@ def fit_box(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return pose, upper - lower
 
 
+# Width (pixels) of the ring around a mask whose points give the surface the object stands on.
+SUPPORT_RING_PIXELS = 6
+
+
+def down_to_support(
+    pose: np.ndarray, size: np.ndarray, support: float | None, tolerance: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """The box extended down to height ``support`` (z of the frame) when its bottom is above it."""
+    bottom = pose[2, 3] - size[2] / 2
+    if support is None or support >= bottom - tolerance:
+        return pose, size
+    top = pose[2, 3] + size[2] / 2
+    pose, size = pose.copy(), size.copy()
+    pose[2, 3], size[2] = (top + support) / 2, top - support
+    return pose, size
+
+
 class FindMaskedObjects(SyncBehavior):
     """For each 2D mask of ``masks2d``, the points of ``point_cloud`` on it, in ``base_frame``, as a
     GraspableObject: a box around them aligned with their principal horizontal axes and the frame's z.
 
     Points further than ``plane_inlier_threshold`` beyond the 2nd-98th percentile of the object's extent
-    are dropped as stray depth at its edges. A mask whose box has a largest face smaller than
+    are dropped as stray depth at its edges. A camera looking down sees only an object's top, so the box
+    reaches down to the surface around the mask (the median height of the pixels just outside it) when
+    that surface is lower. A mask whose box has a largest face smaller than
     ``minimum_face_area`` is skipped. ``face_separation_threshold`` is accepted for MoveIt Pro's files;
     Kinema fits one box an object rather than separating its faces.
     """
@@ -98,6 +117,7 @@ class FindMaskedObjects(SyncBehavior):
             low, high = np.percentile(points, 2, axis=0), np.percentile(points, 98, axis=0)
             points = points[np.all((points >= low - tolerance) & (points <= high + tolerance), axis=1)]
             pose, size = fit_box(points)
+            pose, size = down_to_support(pose, size, self._support_height(moved, pixels, camera), tolerance)
             largest_face = max(size[0] * size[1], size[1] * size[2], size[0] * size[2])
             if largest_face < minimum_area:
                 continue
@@ -120,3 +140,13 @@ class FindMaskedObjects(SyncBehavior):
             )
         write_output(self, "detected_shapes", objects)
         return NodeStatus.SUCCESS
+
+    @staticmethod
+    def _support_height(cloud: Any, pixels: np.ndarray, camera: Any) -> float | None:
+        from scipy.ndimage import binary_dilation
+
+        mask = pixels.reshape(camera.height, camera.width)
+        ring = binary_dilation(mask, iterations=SUPPORT_RING_PIXELS) & ~mask
+        heights = cloud.points[ring.reshape(-1), 2].astype(float)
+        heights = heights[np.isfinite(heights)]
+        return float(np.median(heights)) if len(heights) else None

@@ -2,6 +2,11 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+from typing import Any
+
+import numpy as np
+
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port
 from kinema.errors import PerceptionError
 
@@ -16,6 +21,34 @@ from ..messages.ports import (
 )
 from .clouds import POINT_CLOUD, frame_of, read_cloud, target_T_source
 
+# The refinement pairs each target point closer than this (m) to the aligned base with the base.
+REFINE_DISTANCE = 0.02
+
+
+def refine_from_the_target(base: Any, target: Any, coarse: Any, iterations: int) -> Any:
+    """Refine ``coarse`` (base onto target) by registering the target's points near the aligned base onto it.
+
+    A CAD model (base) is complete while a camera sees only part of the object (target): pairing model
+    points with the seen ones pulls the unseen faces onto seen ones, a bias of a centimetre or more. Every
+    seen point, though, has its true partner on the model, so the reverse match is unbiased once the two
+    are close. Returns ``coarse`` when too few target points are near the base to refine with.
+    """
+    from scipy.spatial import cKDTree
+
+    from kinema.perception import register_icp
+
+    moved = base.transformed(coarse.target_T_source)
+    near, _ = cKDTree(moved.finite().points).query(
+        target.finite().points, distance_upper_bound=REFINE_DISTANCE
+    )
+    close = target.finite().select(np.isfinite(near))
+    if len(close) < 10:
+        return coarse
+    reverse = register_icp(
+        close, moved, max_correspondence_distance=REFINE_DISTANCE, max_iterations=iterations
+    )
+    return replace(coarse, target_T_source=np.linalg.inv(reverse.target_T_source) @ coarse.target_T_source)
+
 
 class RegisterPointClouds(AsyncBehavior):
     """Finds by point-to-point ICP the transform that moves ``base_point_cloud`` onto
@@ -25,6 +58,10 @@ class RegisterPointClouds(AsyncBehavior):
     and registered gives ``T``; the object is at ``T * G`` (TransformPoseWithPose with input_pose ``G``,
     transform_pose ``T``). The base cloud is brought into the target's frame first. Fails when the clouds
     do not overlap within ``max_correspondence_distance`` or one has fewer than 3 points.
+
+    Point-to-point ICP of the base onto the target comes first (what PCL does, MoveIt Pro's engine); it is
+    then refined the other way round with the target points near the aligned base, which removes the
+    pull of model faces the camera did not see.
     """
 
     subcategory = "Perception - 3D Point Cloud"
@@ -71,6 +108,7 @@ class RegisterPointClouds(AsyncBehavior):
             result = register_icp(
                 base, target, max_correspondence_distance=distance, max_iterations=iterations
             )
+            result = refine_from_the_target(base, target, result, iterations)
         except PerceptionError as error:
             self.logger.publish_failure(f"RegisterPointClouds: {error}")
             return False
