@@ -16,7 +16,7 @@ from kinema.transport import STATUS_ABORTED
 # "Reset MuJoCo Robot" (MoveIt Pro's lab_sim objective) sets exactly this state.
 RESET_STATE = dict(zip(ARM, (0.0, 0.0, -1.57, 0.0, 0.0, 0.0, 0.0), strict=True))
 DEFAULT_ARM = np.array([0.0, 0.0, -2.0, 2.0, -1.5708, -1.5708, 0.0])
-CUBE_START = np.array([0.62, 0.30, 0.775])
+CUBE_START = np.array([-0.30, 0.62, 0.499])
 
 
 def bodies(sim: Sim) -> dict[str, np.ndarray]:
