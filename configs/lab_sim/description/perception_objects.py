@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
-TABLE_TOP = 0.75
+TABLE_TOP = 0.474  # generate.py's table top (MoveIt Pro's desk height)
 # Facets of a cylinder in the STL: the flat-sided mesh stays within 0.1 mm of the simulated cylinder.
 CYLINDER_SECTIONS = 64
 
@@ -71,11 +71,15 @@ class Placed:
     yaw_deg: float = 0.0
 
 
+# Where MoveIt Pro's objectives look: its "Look at Microscope" waypoint points the wrist camera at
+# (-1.32, 0.48) on the table plane and "Register CAD Part" guesses the microscope at (-1.0, 0.5); its
+# "Look at Objects" waypoints look around (-0.37, 0.67) and "Register CAD Part Subtree" guesses a bottle
+# at (-0.15, 0.5). The cube (-0.30, 0.62) and its way to the tray stay clear.
 PLACED = (
-    Placed("microscope", MICROSCOPE, (0.85, -0.85), 90.0),
-    Placed("bottle_1", BOTTLE, (0.92, 0.02)),
-    Placed("bottle_2", BOTTLE, (0.97, 0.1)),
-    Placed("bottle_3", BOTTLE, (0.9, -0.09)),
+    Placed("microscope", MICROSCOPE, (-1.05, 0.5), 90.0),
+    Placed("bottle_1", BOTTLE, (-0.16, 0.5)),
+    Placed("bottle_2", BOTTLE, (-0.48, 0.74)),
+    Placed("bottle_3", BOTTLE, (-0.5, 0.52)),
 )
 
 

@@ -174,3 +174,68 @@ def test_scan_scene_merges_three_wrist_views_into_one_thinned_cloud(cell: Librar
     span = np.ptp(points[:, :2], axis=0).max()
     # The views are 0.8 m to either side of the centre one: together they cover far more than one view.
     assert span > 1.5, f"the merged cloud spans only {span:.2f} m horizontally"
+
+
+def _model_distances(cell: LibraryCell, cloud: Any, body: str, stl: str) -> np.ndarray:
+    """Distance (m) of each point of ``cloud`` (world) to CAD model ``stl`` placed at MuJoCo's ``body``."""
+    from scipy.spatial import cKDTree
+
+    from kinema.perception import sample_mesh_surface
+    from kinema.resources import bundled_dir
+
+    model = sample_mesh_surface(
+        bundled_dir("configs") / "lab_sim" / "description" / "assets" / stl, 50000, seed=0
+    )
+    on_body = model.transformed(_world_T_body(cell, body))
+    distances, _ = cKDTree(on_body.points).query(cloud.finite().points)
+    return distances
+
+
+def test_register_cad_part_lays_the_microscope_model_onto_the_simulated_microscope(cell: LibraryCell) -> None:
+    captures = cell.listen("sensor_msgs/msg/PointCloud2", CAPTURES)
+    seen = len(captures)
+    result = cell.client.execute("Register CAD Part", timeout=RUN_TIMEOUT)
+    assert result.succeeded, result
+    # It shows the model at the guess (red), the live cloud, then the registered model (green).
+    sent = wait_for(lambda: captures[seen:] if len(captures) >= seen + 3 else None, 30.0, "three clouds")
+    guess, aligned = from_point_cloud2(sent[0]), from_point_cloud2(sent[-1])
+    assert (aligned.colors == [0, 255, 0]).all() and (guess.colors == [255, 0, 0]).all()
+    before = np.median(_model_distances(cell, guess, "microscope", "microscope.stl"))
+    after = np.median(_model_distances(cell, aligned, "microscope", "microscope.stl"))
+    assert after < 0.008 < 0.05 < before, (
+        f"median distance of the model cloud to the simulated microscope: {before * 1000:.0f} mm at the "
+        f"guess, {after * 1000:.1f} mm after registration"
+    )
+
+
+def test_register_cad_part_subtree_finds_the_bottle_beside_its_guess(cell: LibraryCell) -> None:
+    captures = cell.listen("sensor_msgs/msg/PointCloud2", CAPTURES)
+    seen = len(captures)
+    result = cell.client.execute("Register CAD Part Subtree", timeout=RUN_TIMEOUT)
+    assert result.succeeded, result
+    aligned = wait_for(
+        lambda: (
+            captures[-1]
+            if len(captures) > seen and (from_point_cloud2(captures[-1]).colors == [0, 255, 0]).all()
+            else None
+        ),
+        30.0,
+        "the registered (green) bottle cloud",
+    )
+    after = np.median(_model_distances(cell, from_point_cloud2(aligned), "bottle_1", "bottle.stl"))
+    assert after < 0.005, f"the registered bottle model is {after * 1000:.1f} mm (median) from bottle_1"
+
+
+def test_grasp_planning_moves_the_gripper_to_its_first_candidate(cell: LibraryCell) -> None:
+    from kinema.motion import RobotDescription, fk
+
+    result = cell.client.execute("Grasp Planning", timeout=RUN_TIMEOUT)
+    assert result.succeeded, result
+    settle(cell)
+    states = cell.listen("sensor_msgs/msg/JointState", "/joint_states")
+    model = RobotDescription.lab_sim().load_model()
+    latest = dict(zip(states[-1].name, states[-1].position, strict=True))
+    q = np.array([latest.get(name, 0.0) for name in model.joint_names])
+    grasp = fk(model, q, "grasp_link")
+    assert np.linalg.norm(grasp[:3, 3] - [-0.04, 0.575, 0.58]) < 0.01, grasp[:3, 3]
+    assert grasp[2, 2] < -0.98, f"the gripper does not point down: its z axis is {grasp[:3, 2]}"

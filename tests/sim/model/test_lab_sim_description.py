@@ -45,6 +45,7 @@ def _mujoco_qpos(cell, model, q):
 
 def test_committed_perception_objects_are_what_their_generator_writes(tmp_path):
     objects = runpy.run_path(str(LAB_SIM / "description" / "perception_objects.py"))
+    assert objects["TABLE_TOP"] == runpy.run_path(str(LAB_SIM / "description" / "generate.py"))["TABLE_TOP"]
     included = LAB_SIM / "description" / "lab_sim_perception_objects.xml"
     assert included.read_text() == objects["render_objects"](), (
         "run configs/lab_sim/description/perception_objects.py"
