@@ -3,8 +3,9 @@ microscope (the CAD part ``register_cad_part`` registers), each made of primitiv
 
 One table below gives each object's shape once; this script writes both what the simulator shows
 (``lab_sim_perception_objects.xml``, included by ``lab_sim_scene.xml``) and the CAD files the objectives
-load (``assets/bottle.stl``, ``assets/microscope.stl``, origin at the object's base, metres), so a cloud
-sampled from the STL matches what the cameras see. The objects are fixed to the table: they are planning
+load (``assets/bottle.stl``, ``assets/microscope.stl``, origin at the object's base, and
+``assets/cube_0_5.stl``, the cube to pick; metres), so a cloud sampled from the STL matches what the
+cameras see. The objects are fixed to the table: they are planning
 obstacles and camera targets, not things to pick. Run this script after editing it; ``tests/sim/model``
 checks the committed files are its output.
 """
@@ -58,6 +59,12 @@ MICROSCOPE = Shape(
         Primitive("head", "cylinder", (0.022, 0.09), (0.03, 0.0, 0.195)),
     ),
     "0.2 0.22 0.25 1",
+)
+
+# The cube to pick (generate.py's), as the CAD file "Load and Visualize Point Cloud" loads; origin at its
+# centre, as the cube body's.
+CUBE = Shape(
+    "cube_0_5.stl", (Primitive("cube", "box", (0.05, 0.05, 0.05), (0.0, 0.0, 0.0)),), "0.85 0.2 0.2 1"
 )
 
 
@@ -138,7 +145,7 @@ def write_stl(shape: Shape, path: Path) -> None:
 def main() -> None:
     (HERE / "lab_sim_perception_objects.xml").write_text(render_objects())
     (HERE / "assets").mkdir(exist_ok=True)
-    for shape in (BOTTLE, MICROSCOPE):
+    for shape in (BOTTLE, MICROSCOPE, CUBE):
         write_stl(shape, HERE / "assets" / shape.stl)
 
 

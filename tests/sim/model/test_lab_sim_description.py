@@ -50,7 +50,7 @@ def test_committed_perception_objects_are_what_their_generator_writes(tmp_path):
     assert included.read_text() == objects["render_objects"](), (
         "run configs/lab_sim/description/perception_objects.py"
     )
-    for shape in (objects["BOTTLE"], objects["MICROSCOPE"]):
+    for shape in (objects["BOTTLE"], objects["MICROSCOPE"], objects["CUBE"]):
         fresh = tmp_path / shape.stl
         objects["write_stl"](shape, fresh)
         committed = LAB_SIM / "description" / "assets" / shape.stl
