@@ -47,6 +47,10 @@ def cloud_marker(
         xyz = xyz[keep]
         colors = None if colors is None else colors[keep]
     shades = height_colors(xyz) if colors is None else np.asarray(colors, dtype=float) / 255.0
+    from kinema.interfaces import load_interfaces
+
+    types = load_interfaces().typestore.types
+    point, color = types["geometry_msgs/msg/Point"], types["std_msgs/msg/ColorRGBA"]
     return {
         "header": {"frame_id": frame_id},
         "ns": SNAPSHOT_NAMESPACE,
@@ -56,8 +60,9 @@ def cloud_marker(
         "pose": {"orientation": {"w": 1.0}},
         "scale": {"x": 0.005, "y": 0.005},
         "color": {"r": 0.9, "g": 0.9, "b": 0.9, "a": 1.0},
-        "points": [{"x": float(x), "y": float(y), "z": float(z)} for x, y, z in xyz],
-        "colors": [{"r": float(r), "g": float(g), "b": float(b), "a": 1.0} for r, g, b in shades],
+        # Message objects rather than dicts: converting 20,000 point dicts took 1.5 s, these 0.1 s.
+        "points": [point(x=x, y=y, z=z) for x, y, z in np.asarray(xyz, dtype=float).tolist()],
+        "colors": [color(r=r, g=g, b=b, a=1.0) for r, g, b in shades.tolist()],
     }
 
 
