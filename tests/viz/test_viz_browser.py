@@ -287,3 +287,63 @@ def test_the_page_says_when_the_runtime_goes_away_and_recovers(
     _keep("runtime_lost", page.screenshot())
     runtime.start_driver()
     page.wait_for(f"{banner}.textContent === ''", timeout=20)
+
+
+def _three(path: list[str]) -> str:
+    """JavaScript: the three.js object meshcat holds at ``path`` (null when none)."""
+    return (
+        "(function(p){let n=viewer.scene_tree;for(const k of p){n=n.children[k];if(!n)return null;}"
+        f"const o=n.children['<object>'];return o?o.object:null;}})({json.dumps(path)})"
+    )
+
+
+def test_a_point_cloud_snapshot_is_drawn_coloured_and_decimated_and_cleared(
+    runtime: Runtime, page: HeadlessChromium
+) -> None:
+    """SendPointCloudToUI draws the cloud in its own colours, at most MAX_DRAWN_POINTS of it; ClearSnapshot
+    removes it."""
+    from kinema.behaviors import BehaviorContext
+    from kinema.bt import NodeStatus
+    from kinema.interfaces import load_interfaces
+    from kinema.perception import PointCloud
+    from kinema.perception.ros_messages import to_point_cloud2
+    from kinema.plugins import BehaviorHost
+    from kinema.testing import tick_behavior
+    from kinema.transport import Node
+
+    host = BehaviorHost(["kinema::CoreBehaviorsLoader"])
+    host.load().raise_for_errors()
+    ticks = 240  # a 0.4 m square of 240 x 240 = 57,600 points at z = 1 m: left half red, right half green
+    u, v = np.meshgrid(np.linspace(-0.2, 0.2, ticks), np.linspace(-0.2, 0.2, ticks))
+    points = np.stack([0.6 + u.ravel(), v.ravel(), np.full(u.size, 1.0)], axis=1).astype(np.float32)
+    colors = np.where((v.ravel() < 0)[:, None], [230, 20, 20], [20, 200, 20]).astype(np.uint8)
+    cloud = to_point_cloud2(PointCloud(points, colors, "world"), load_interfaces().typestore.types)
+    snapshot = ["kinema", "markers", "snapshot", "0", "points"]
+    before = _settled_screenshot(page)
+    node = Node(runtime.router, "viz_test_point_cloud")
+    context = BehaviorContext(node)
+    try:
+        send = tick_behavior(host.registry["SendPointCloudToUI"].cls, {"point_cloud": cloud}, context=context)
+        assert send.status == NodeStatus.SUCCESS, send.toasts
+        page.wait_for(f"{_three(snapshot)} !== null", timeout=30)
+        count = page.evaluate(f"{_three(snapshot)}.geometry.attributes.position.count")
+        assert count == 20000, f"the view holds {count} points of the 57,600-point cloud, not 20,000"
+        colour_array = f"{_three(snapshot)}.geometry.attributes.color.array"
+        shades = page.evaluate(
+            "(function(c){let r=0,g=0;for(let i=0;i<c.length;i+=3){if(c[i]>0.8&&c[i+1]<0.2)r++;"
+            f"if(c[i+1]>0.7&&c[i]<0.2)g++;}}return [r,g];}})({colour_array})"
+        )
+        assert min(shades) > 8000, f"red and green points drawn: {shades}; the cloud's colours are lost"
+        drawn = _settled_screenshot(page)
+        _keep("point_cloud", drawn)
+        pixels = _pixels(drawn)
+        reddish = (pixels[..., 0] > 150) & (pixels[..., 1] < 90) & (pixels[..., 2] < 90)
+        assert _changed(before, drawn).sum() > 500 and reddish.sum() > 200, (
+            f"{_changed(before, drawn).sum()} pixels changed, {reddish.sum()} red: the cloud is not on screen"
+        )
+        clear = tick_behavior(host.registry["ClearSnapshot"].cls, {}, context=context)
+        assert clear.status == NodeStatus.SUCCESS, clear.toasts
+        page.wait_for(f"{_three(snapshot)} === null", timeout=30)
+    finally:
+        context.close()
+        node.close()

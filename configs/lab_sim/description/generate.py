@@ -581,6 +581,8 @@ def render_scene() -> str:
         f'      <geom name="cube" type="box" size="{_vec([CUBE_HALF] * 3)}" mass="0.08" '
         'friction="1 0.01 0.0001" condim="4" rgba="0.85 0.2 0.2 1"/>',
         "    </body>",
+        # The bottles and microscope the point-cloud objectives look at (perception_objects.py).
+        '    <include file="lab_sim_perception_objects.xml"/>',
         "  </worldbody>",
         "  <contact>",
         # The rail base is welded to the world, so MuJoCo's parent filter does not cover its children.

@@ -188,6 +188,33 @@ class CollisionChecker:
                     pairs.append(names)
         return pairs
 
+    def robot_bounds(self, q: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
+        """World-axis-aligned bounds ``(lower, upper)`` of each robot collision geometry at ``q`` (m).
+
+        Loose for tilted shapes; meant for filtering the robot out of what its cameras see.
+        """
+        import pinocchio as pin
+
+        pin.updateGeometryPlacements(
+            self.model.pin_model,
+            self._data,
+            self._geom_model,
+            self._geom_data,
+            self.model.pin_configuration(np.asarray(q, dtype=float)),
+        )
+        bounds = []
+        for index in range(self._n_robot):
+            geometry = self._geom_model.geometryObjects[index].geometry
+            geometry.computeLocalAABB()
+            box = geometry.aabb_local
+            lower, upper = np.asarray(box.min_), np.asarray(box.max_)
+            centre, half = (lower + upper) / 2, (upper - lower) / 2
+            placement = self._geom_data.oMg[index]
+            world_centre = placement.rotation @ centre + placement.translation
+            reach = np.abs(placement.rotation) @ half
+            bounds.append((world_centre - reach, world_centre + reach))
+        return bounds
+
     def describe(self, q: np.ndarray) -> str:
         """A short sentence naming what collides at ``q`` ("wrist_3_link - table, ...")."""
         pairs = self.colliding_pairs(q)

@@ -6,6 +6,7 @@
 * :func:`depth_to_cloud` (``depth.py``) — a depth image → an organised cloud in the optical frame;
 * :func:`crop_box`, :func:`remove_box` (``box_filter.py``) — keep / drop the points inside a posed box;
 * :func:`voxel_downsample`, :func:`merge_clouds` (``voxel_grid.py``) — one point per occupied voxel;
+* :func:`occupied_cells`, :func:`outside_boxes` (``occupancy.py``) — a cloud as occupied grid cubes;
 * :func:`register_icp` (``icp.py``) — point-to-point ICP (nearest neighbours with scipy's cKDTree);
 * :func:`load_pcd`, :func:`save_pcd` (``pcd.py``) — PCL's .pcd files;
 * :func:`sample_mesh_surface` (``mesh_sampling.py``) — points spread evenly over an STL's surface;
@@ -27,6 +28,8 @@ _EXPORTS = {
     "remove_box": "box_filter",
     "voxel_downsample": "voxel_grid",
     "merge_clouds": "voxel_grid",
+    "occupied_cells": "occupancy",
+    "outside_boxes": "occupancy",
     "register_icp": "icp",
     "IcpResult": "icp",
     "load_pcd": "pcd",

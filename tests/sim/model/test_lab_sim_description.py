@@ -43,6 +43,22 @@ def _mujoco_qpos(cell, model, q):
     return qpos
 
 
+def test_committed_perception_objects_are_what_their_generator_writes(tmp_path):
+    objects = runpy.run_path(str(LAB_SIM / "description" / "perception_objects.py"))
+    assert objects["TABLE_TOP"] == runpy.run_path(str(LAB_SIM / "description" / "generate.py"))["TABLE_TOP"]
+    included = LAB_SIM / "description" / "lab_sim_perception_objects.xml"
+    assert included.read_text() == objects["render_objects"](), (
+        "run configs/lab_sim/description/perception_objects.py"
+    )
+    for shape in (objects["BOTTLE"], objects["MICROSCOPE"], objects["CUBE"]):
+        fresh = tmp_path / shape.stl
+        objects["write_stl"](shape, fresh)
+        committed = LAB_SIM / "description" / "assets" / shape.stl
+        assert committed.read_bytes() == fresh.read_bytes(), (
+            f"run perception_objects.py ({shape.stl} differs)"
+        )
+
+
 def test_forward_kinematics_of_urdf_and_mjcf_agree(description, cell):
     """100 random configurations: every link's pose from pinocchio (URDF) matches MuJoCo (MJCF) to 1e-6."""
     import mujoco

@@ -41,6 +41,12 @@ def set_planning_scene(context: Any, scene: PlanningScene) -> None:
     set_scene(context, scene)
 
 
+def existing_planning_scene(context: Any) -> PlanningScene | None:
+    """The context's planning scene if a behavior has made or set one, else None (nothing is loaded)."""
+    with _SCENES_LOCK:
+        return _SCENES.get(context)
+
+
 def planning_scene(context: Any, model: RobotModel) -> PlanningScene:
     """The planning scene of ``context``: the static geometry of its config's MuJoCo scene by default.
 

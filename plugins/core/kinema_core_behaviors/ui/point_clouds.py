@@ -1,8 +1,10 @@
 """Point clouds in ``kinema view``: SendPointCloudToUI, PublishPointCloud and ClearSnapshot.
 
 The view draws markers, so a cloud is drawn as a POINTS marker (at most ``MAX_DRAWN_POINTS``, evenly
-sub-sampled) in the ``snapshot`` namespace; the cloud itself is also published on its topic for other
-subscribers. ClearSnapshot deletes the drawn snapshots.
+sub-sampled, each point in the cloud's colour or, without colours, coloured by height) in the
+``snapshot`` namespace; the cloud itself is also published on its topic for other subscribers.
+ClearSnapshot deletes the drawn snapshots and, as MoveIt Pro's clears its octomap, the obstacles
+UpdatePlanningSceneService made of a cloud.
 """
 
 from __future__ import annotations
@@ -13,9 +15,12 @@ import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
-from ..messages.conversions import point_cloud_xyz
 from ..messages.ports import fails_on_bad_input, message_input, port_error, read_input, read_message
+from ..motion.planning_resources import existing_planning_scene
 from .markers import publish_markers
+
+# UpdatePlanningSceneService's world object (named here to keep ui free of the perception family).
+OCTOMAP_ID = "octomap"
 
 POINT_CLOUD = "sensor_msgs/msg/PointCloud2"
 SNAPSHOT_NAMESPACE = "snapshot"
@@ -23,10 +28,29 @@ MAX_DRAWN_POINTS = 20000
 _SNAPSHOT_IDS: dict[int, int] = {}
 
 
-def cloud_marker(xyz: np.ndarray, frame_id: str, marker_id: int) -> dict[str, Any]:
-    """A POINTS marker of the cloud (sub-sampled to at most MAX_DRAWN_POINTS)."""
+def height_colors(xyz: np.ndarray) -> np.ndarray:
+    """Nx3 colours (0..1) for a cloud without its own: blue at its lowest point to yellow at its highest."""
+    z = xyz[:, 2] if len(xyz) else np.zeros(0)
+    span = float(z.max() - z.min()) if len(z) else 0.0
+    t = (z - z.min()) / span if span > 0 else np.zeros_like(z)
+    low, high = np.array([0.15, 0.35, 0.95]), np.array([1.0, 0.85, 0.1])
+    return low + np.outer(t, high - low)
+
+
+def cloud_marker(
+    xyz: np.ndarray, frame_id: str, marker_id: int, colors: np.ndarray | None = None
+) -> dict[str, Any]:
+    """A POINTS marker of the cloud, sub-sampled evenly to at most MAX_DRAWN_POINTS so the view stays
+    smooth, each point in its own colour (``colors``: Nx3 uint8 RGB; by height when None)."""
     if len(xyz) > MAX_DRAWN_POINTS:
-        xyz = xyz[np.linspace(0, len(xyz) - 1, MAX_DRAWN_POINTS).astype(int)]
+        keep = np.linspace(0, len(xyz) - 1, MAX_DRAWN_POINTS).astype(int)
+        xyz = xyz[keep]
+        colors = None if colors is None else colors[keep]
+    shades = height_colors(xyz) if colors is None else np.asarray(colors, dtype=float) / 255.0
+    from kinema.interfaces import load_interfaces
+
+    types = load_interfaces().typestore.types
+    point, color = types["geometry_msgs/msg/Point"], types["std_msgs/msg/ColorRGBA"]
     return {
         "header": {"frame_id": frame_id},
         "ns": SNAPSHOT_NAMESPACE,
@@ -36,7 +60,9 @@ def cloud_marker(xyz: np.ndarray, frame_id: str, marker_id: int) -> dict[str, An
         "pose": {"orientation": {"w": 1.0}},
         "scale": {"x": 0.005, "y": 0.005},
         "color": {"r": 0.9, "g": 0.9, "b": 0.9, "a": 1.0},
-        "points": [{"x": float(x), "y": float(y), "z": float(z)} for x, y, z in xyz],
+        # Message objects rather than dicts: converting 20,000 point dicts took 1.5 s, these 0.1 s.
+        "points": [point(x=x, y=y, z=z) for x, y, z in np.asarray(xyz, dtype=float).tolist()],
+        "colors": [color(r=r, g=g, b=b, a=1.0) for r, g, b in shades.tolist()],
     }
 
 
@@ -46,14 +72,17 @@ def _publish_cloud(behavior: Any, cloud: Any, topic: str) -> None:
 
 
 def _draw(behavior: Any, cloud: Any, *, keep_previous: bool) -> None:
+    from kinema.perception.ros_messages import from_point_cloud2
+
     try:
-        xyz = point_cloud_xyz(cloud)
+        points = from_point_cloud2(cloud).finite()
     except Exception as error:
         raise port_error(behavior, "point_cloud", str(error), "") from None
     context_key = id(behavior.context)
     marker_id = _SNAPSHOT_IDS.get(context_key, -1) + 1 if keep_previous else 0
     _SNAPSHOT_IDS[context_key] = marker_id
-    publish_markers(behavior, [cloud_marker(xyz, str(cloud.header.frame_id) or "world", marker_id)])
+    marker = cloud_marker(points.points, str(cloud.header.frame_id) or "world", marker_id, points.colors)
+    publish_markers(behavior, [marker])
 
 
 class SendPointCloudToUI(SyncBehavior):
@@ -104,7 +133,8 @@ class PublishPointCloud(SyncBehavior):
 
 
 class ClearSnapshot(SyncBehavior):
-    """Removes the point cloud snapshots SendPointCloudToUI drew in ``kinema view``."""
+    """Removes the point cloud snapshots SendPointCloudToUI drew in ``kinema view``, and the obstacles
+    UpdatePlanningSceneService added from a cloud (the ``octomap`` world object)."""
 
     subcategory = "User Interface"
 
@@ -116,4 +146,7 @@ class ClearSnapshot(SyncBehavior):
         count = _SNAPSHOT_IDS.pop(id(self.context), -1) + 1
         markers = [{"ns": SNAPSHOT_NAMESPACE, "id": i, "action": 2} for i in range(max(count, 1))]
         publish_markers(self, markers)
+        scene = existing_planning_scene(self.context)
+        if scene is not None and OCTOMAP_ID in scene.world:
+            scene.remove_world_object(OCTOMAP_ID)
         return NodeStatus.SUCCESS

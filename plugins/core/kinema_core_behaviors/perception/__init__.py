@@ -1,0 +1,39 @@
+"""Perception: camera messages onto the blackboard, point clouds transformed, cropped, merged, registered,
+loaded from files, cut out by image masks and turned into obstacles (planning scene, collision spheres).
+
+Ports hold ``sensor_msgs`` messages as MoveIt Pro's do; the work is done on numpy arrays by
+:mod:`kinema.perception`, with the conversions in :mod:`.clouds`.
+"""
+
+from __future__ import annotations
+
+from .box_filters import CropPointsInBox, RemovePointsInBox
+from .camera_topics import GetCameraInfo, GetImage, GetPointCloud
+from .centroid import GetCentroidFromPointCloud
+from .collision_spheres import CreateCollisionSpheresAtClosestPoints
+from .find_masked_objects import FindMaskedObjects
+from .load_point_cloud_from_file import LoadPointCloudFromFile
+from .masks import GetMasks3DFromMasks2D, GetPointCloudFromMask3D
+from .merge_point_clouds import MergePointClouds
+from .register_point_clouds import RegisterPointClouds
+from .transform_point_cloud import TransformPointCloud, TransformPointCloudFrame
+from .update_planning_scene import UpdatePlanningSceneService
+
+BEHAVIORS = (
+    GetPointCloud,
+    GetImage,
+    GetCameraInfo,
+    TransformPointCloud,
+    TransformPointCloudFrame,
+    CropPointsInBox,
+    RemovePointsInBox,
+    GetCentroidFromPointCloud,
+    MergePointClouds,
+    RegisterPointClouds,
+    LoadPointCloudFromFile,
+    UpdatePlanningSceneService,
+    GetMasks3DFromMasks2D,
+    GetPointCloudFromMask3D,
+    FindMaskedObjects,
+    CreateCollisionSpheresAtClosestPoints,
+)

@@ -1,0 +1,138 @@
+"""GetPointCloud, GetImage and GetCameraInfo: the next message of a camera topic, onto the blackboard.
+
+The MuJoCo driver renders a camera only while someone subscribes, so these behaviors subscribe, wait for
+a publisher (``publisher_timeout_sec``) and then for one message (``message_timeout_sec``). A message
+arrives after the subscription, so it shows the scene as it is now, not before the last motion.
+"""
+
+from __future__ import annotations
+
+import asyncio
+import threading
+import time
+from typing import Any, ClassVar
+
+from kinema.behaviors import AsyncBehavior, PortInfo, input_port
+
+from ..messages.ports import fails_on_bad_input, message_output, port_error, read_input
+from .clouds import CAMERA_INFO, IMAGE, POINT_CLOUD
+
+# How often the graph is looked at while waiting for a publisher, s.
+_PUBLISHER_POLL = 0.05
+
+
+class _GetCameraMessage(AsyncBehavior):
+    message_type: ClassVar[str] = ""
+    default_topic: ClassVar[str] = ""
+    default_output: ClassVar[str] = ""
+    subcategory = "Perception - Camera"
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            input_port("topic_name", str, cls.default_topic, "The topic to take a message from."),
+            input_port(
+                "message_timeout_sec",
+                float,
+                5.0,
+                "Seconds to wait for a message once a publisher is there (0 or less: forever).",
+            ),
+            input_port(
+                "publisher_timeout_sec",
+                float,
+                5.0,
+                "Seconds to wait for a publisher on the topic (0 or less: forever).",
+            ),
+            message_output("message_out", cls.message_type, cls.default_output, "The message received."),
+        ]
+
+    @fails_on_bad_input
+    async def do_work(self) -> bool:
+        topic = str(read_input(self, "topic_name")).strip()
+        if not topic.startswith("/"):
+            raise port_error(
+                self, "topic_name", f"= {topic!r}", "give an absolute topic, e.g. /wrist_camera/points"
+            )
+        message_timeout = float(read_input(self, "message_timeout_sec"))
+        publisher_timeout = float(read_input(self, "publisher_timeout_sec"))
+        node = self.context.require_node(self.registration_id)
+        received: list[Any] = []
+        arrived = threading.Event()
+
+        def on_message(message: Any) -> None:
+            if not arrived.is_set():
+                received.append(message)
+                arrived.set()
+
+        subscription = node.create_subscription(self.message_type, topic, on_message)
+        try:
+            found = await asyncio.to_thread(self._wait_for_publisher, node, topic, publisher_timeout, arrived)
+            if not found:
+                others = self._topics_of_type(node)
+                hint = (
+                    f"topics of this type: {', '.join(others)}" if others else "nothing publishes this type"
+                )
+                self.logger.publish_failure(
+                    f"{self.registration_id}: no publisher on {topic} within {publisher_timeout:g} s "
+                    f"(publisher_timeout_sec); {hint}"
+                )
+                return False
+            got = await asyncio.to_thread(arrived.wait, None if message_timeout <= 0 else message_timeout)
+        finally:
+            subscription.close()
+        if not got:
+            self.logger.publish_failure(
+                f"{self.registration_id}: no message on {topic} within {message_timeout:g} s "
+                "(message_timeout_sec)"
+            )
+            return False
+        self.set_output("message_out", received[0])
+        return True
+
+    def _wait_for_publisher(self, node: Any, topic: str, timeout: float, arrived: threading.Event) -> bool:
+        graph = node.session.graph_cache()
+        deadline = None if timeout <= 0 else time.monotonic() + timeout
+        while not self.stop_requested():
+            if arrived.is_set() or graph.snapshot().publishers(topic):
+                return True
+            if deadline is not None and time.monotonic() >= deadline:
+                return False
+            time.sleep(_PUBLISHER_POLL)
+        return False
+
+    def _topics_of_type(self, node: Any) -> list[str]:
+        topics = node.session.graph_cache().snapshot().topics()
+        return sorted(name for name, types in topics.items() if self.message_type in types)[:6]
+
+
+class GetPointCloud(_GetCameraMessage):
+    """Waits for the next ``sensor_msgs/PointCloud2`` on ``topic_name`` and writes it to ``message_out``.
+
+    lab_sim's cameras publish ``/scene_camera/points`` and ``/wrist_camera/points`` (organised clouds in
+    the camera's optical frame). Fails when nothing publishes on the topic within
+    ``publisher_timeout_sec`` (naming the topics that carry clouds) or no cloud comes within
+    ``message_timeout_sec``.
+    """
+
+    message_type = POINT_CLOUD
+    default_topic = "/wrist_camera/points"
+    default_output = "{point_cloud}"
+    subcategory = "Perception - 3D Point Cloud"
+
+
+class GetImage(_GetCameraMessage):
+    """Waits for the next ``sensor_msgs/Image`` on ``topic_name`` (``/wrist_camera/color``, say)."""
+
+    message_type = IMAGE
+    default_topic = "/wrist_camera/color"
+    default_output = "{image}"
+    subcategory = "Perception - 2D Image"
+
+
+class GetCameraInfo(_GetCameraMessage):
+    """Waits for the next ``sensor_msgs/CameraInfo`` on ``topic_name`` (a camera's intrinsics)."""
+
+    message_type = CAMERA_INFO
+    default_topic = "/wrist_camera/camera_info"
+    default_output = "{camera_info}"
+    subcategory = "Perception - 2D Image"
