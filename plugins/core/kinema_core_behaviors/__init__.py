@@ -16,6 +16,7 @@ from . import (
     io,
     messages,
     motion,
+    perception,
     planning_scene,
     poses,
     task_planning,
@@ -27,6 +28,7 @@ from . import (
 
 FAMILIES = (controllers, files, io, messages, motion, planning_scene, poses, ui, vectors, waiting, waypoints)
 FAMILIES += (task_planning,)  # issue 13's family, kept on its own line
+FAMILIES += (perception,)  # issue 14's family, kept on its own line
 
 BEHAVIORS = tuple(behavior for family in FAMILIES for behavior in family.BEHAVIORS)
 

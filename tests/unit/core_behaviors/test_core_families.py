@@ -12,6 +12,7 @@ FAMILIES = (
     "io",
     "messages",
     "motion",
+    "perception",
     "planning_scene",
     "poses",
     "task_planning",

@@ -2,8 +2,8 @@
 
 The 83 public lab_sim objectives (and picknik_ur_base_config's, which their SubTrees reach) are copied
 into a config package based on Kinema's lab_sim, then every objective is validated with its SubTree
-closure against the config's behaviors. Issue 12 requires 27 of them; ``kinema objective list`` must say
-in one line why each of the others cannot load.
+closure against the config's behaviors. Issue 12 requires 27 of them, issue 14's AprilTag half 7 more;
+``kinema objective list`` must say in one line why each of the others cannot load.
 """
 
 from __future__ import annotations
@@ -51,6 +51,16 @@ ADDED = {
     "save_robot_joint_state",
     "vector_and_string_example",
     "visualize_grasp_link",
+}
+# Issue 14's AprilTag half: detection, tag picks, and the camera subtrees they reach.
+APRILTAGS = {
+    "apriltag_pick_object",
+    "get_april_tag_pose_from_image",
+    "grasp_pose_using_yaml",
+    "pick_april_tag_object_with_approval",
+    "pick_up_cube",
+    "take_picture_with_wrist_camera",
+    "wrist_snap",
 }
 
 
@@ -100,10 +110,10 @@ def test_the_required_lab_sim_objectives_validate_with_their_subtrees(corpus_wor
     problems = {path.stem: file_problem(library, path, factory) for path in files}
     valid = {stem for stem, problem in problems.items() if problem is None}
     failing = {stem: problem for stem, problem in problems.items() if problem is not None}
-    missing = sorted((BEFORE | ADDED) - valid)
+    missing = sorted((BEFORE | ADDED | APRILTAGS) - valid)
     report = "\n".join(f"  {stem}: {failing.get(stem, '?')}" for stem in missing)
     assert not missing, f"{len(valid)} of 83 validate; these required ones do not:\n{report}"
-    assert len(valid) >= 27
+    assert len(valid) >= len(BEFORE | ADDED | APRILTAGS)
 
 
 def test_objective_list_says_why_each_objective_cannot_load(corpus_workspace: Path) -> None:
@@ -117,16 +127,16 @@ def test_objective_list_says_why_each_objective_cannot_load(corpus_workspace: Pa
     reasons = lines[header + 1 : header + 1 + count]
     assert len(reasons) == count > 0, result.output
     # One line each: the objective, then file:line: the first problem.
-    take_snap = next(line for line in reasons if line.strip().startswith("Take Scene Camera Snapshot:"))
-    assert "take_snap.xml:" in take_snap and "Node not recognized: GetPointCloud" in take_snap, take_snap
+    mpc = next(line for line in reasons if line.strip().startswith("MPC Pose Tracking:"))
+    assert "mpc_pose_tracking.xml:" in mpc and "Node not recognized: MPCPoseTracking" in mpc, mpc
     table = {line[4:].split("  ")[0].strip(): line[:3] for line in lines[:header] if line[:1] in "R-"}
-    assert table["Take Scene Camera Snapshot"].endswith("!")
+    assert table["MPC Pose Tracking"].endswith("!")
     assert not table["Vector and String Example"].endswith("!")
     as_json = CliRunner().invoke(
         cli, ["objective", "list", "-w", str(corpus_workspace), "-c", CONFIG, "--json"]
     )
     cannot_load = json.loads(as_json.output)["cannot_load"]
-    assert len(cannot_load) == count and "GetPointCloud" in cannot_load["Take Scene Camera Snapshot"]
+    assert len(cannot_load) == count and "MPCPoseTracking" in cannot_load["MPC Pose Tracking"]
 
 
 def test_every_port_the_corpus_sets_on_a_kinema_behavior_is_declared(registry: Any) -> None:
