@@ -14,7 +14,7 @@ import re
 import threading
 import time
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 from xml.sax.saxutils import quoteattr
@@ -30,6 +30,7 @@ from kinema.tui.connection import (
     ConnectionState,
     EventListener,
     Heartbeat,
+    ImageListener,
     LogEntry,
     LogLevel,
     NodeStatus,
@@ -438,6 +439,32 @@ class SdkConnection:
                     )
                 )
         return catalog
+
+    def image_topics(self) -> list[str]:
+        from kinema.tui.camera_image import IMAGE_TYPE
+
+        client = self._require_client()
+        topics = client.node.graph().topics()
+        return sorted(name for name, types in topics.items() if IMAGE_TYPE in types)
+
+    def watch_images(self, topic: str, listener: ImageListener) -> Callable[[], None]:
+        from kinema.tui.camera_image import IMAGE_TYPE, camera_image
+
+        client = self._require_client()
+        problems: list[str] = []
+
+        def on_image(message: Any) -> None:
+            try:
+                image = camera_image(topic, message)
+            except KinemaError as error:
+                if not problems:  # say it once, not at every frame
+                    problems.append(str(error))
+                    self._emit(LogEntry(f"{topic}: {error}", LogLevel.WARN, time.time(), "camera view"))
+                return
+            listener(image)
+
+        subscription = client.node.create_subscription(IMAGE_TYPE, topic, on_image)
+        return subscription.close
 
     def _selection(self) -> tuple[Workspace, str | None]:
         if self._selection_cache is None:
