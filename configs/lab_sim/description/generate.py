@@ -522,13 +522,15 @@ TAGGED_OBJECTS = (
         "tag_block",
         0,
         TAG_BLOCK_HALF,
-        (0.43, 0.02, TABLE_TOP + TAG_BLOCK_HALF[2]),
+        (0.52, 0.12, TABLE_TOP + TAG_BLOCK_HALF[2]),
         math.radians(20.0),
     ),
 )
-# The tray's tag lies on the table beside the tray's -y wall (Kinema's tray is smaller than MoveIt
-# Pro's, whose tag is 0.125 m from the tray's centre).
-TRAY_TAG_CENTER = (TRAY_CENTER[0], TRAY_CENTER[1] - 0.2, TABLE_TOP)
+# The block stands where the wrist camera sees it from "Look at Table" at about 0.5 m (its tag 40 px
+# wide). The tray's tag lies on the table off the tray's corner nearest the robot, outside that view, so
+# that a detection of "any tag" from there is the block's (Kinema's tray is smaller than MoveIt Pro's,
+# whose tag is 0.125 m from the tray's centre).
+TRAY_TAG_CENTER = (TRAY_CENTER[0] - 0.17, TRAY_CENTER[1] - 0.32, TABLE_TOP)
 
 
 def _yaw_quat(yaw: float) -> tuple[float, float, float, float]:

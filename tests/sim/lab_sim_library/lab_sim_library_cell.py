@@ -15,6 +15,7 @@ class LibraryCell:
     client: Any
     node: Any
     objectives: Path
+    driver: Any = None
     _topics: dict[str, list[Any]] = field(default_factory=dict)
     _lock: threading.Lock = field(default_factory=threading.Lock)
 
