@@ -118,8 +118,9 @@ def test_bad_set_state_requests_fail_with_a_reason(
 
 def test_bodies_lists_the_free_objects_with_their_world_positions(sim: Sim) -> None:
     found = bodies(sim)
-    assert set(found) == {"cube"}
+    assert {"cube", "tag_block"} <= set(found), sorted(found)
     np.testing.assert_allclose(found["cube"], CUBE_START, atol=2e-3)
+    assert found["tag_block"][2] == pytest.approx(0.79, abs=2e-3), "the tagged block stands on the table"
 
 
 def test_keyframes_lists_the_models_keyframes(sim: Sim) -> None:

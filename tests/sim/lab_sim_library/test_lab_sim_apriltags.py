@@ -131,3 +131,38 @@ def test_apriltag_pick_object_lifts_the_block(cell: LibraryCell) -> None:
     assert held[2] > rest[2] + 0.05, (
         f"the block fell back: rested at z={rest[2]:.3f}, lifted to {lifted:.3f}, now {held}"
     )
+
+
+def reset_scene(cell: LibraryCell) -> None:
+    """Robot and objects back to the "default" keyframe (the block on the table, the gripper open)."""
+    from kinema.drivers.mujoco import names
+
+    client = cell.node.create_client(names.SET_STATE_TYPE, names.SET_STATE_SERVICE)
+    response = client.call({"keyframe": "default"}, timeout=10.0)
+    assert response.success, response.message
+
+
+def test_the_approval_variant_picks_with_approvals_granted_headless(
+    cell: LibraryCell, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Headless with ``--auto-approve`` (KINEMA_AUTO_APPROVE=1 in the agent's process): the approval the
+    objective asks for is granted and the block is picked."""
+    reset_scene(cell)
+    rest = np.array(
+        wait_for(
+            lambda: (p := body_pose(cell, "tag_block")[:3, 3])[2] < 0.8 and tuple(p),
+            10.0,
+            "the block back on the table",
+        )
+    )
+    monkeypatch.setenv("KINEMA_AUTO_APPROVE", "1")
+    result = cell.client.execute("Pick April Tag Labeled Object With Approval", timeout=RUN_TIMEOUT)
+    assert result.success, f"Pick April Tag Labeled Object With Approval failed: {result.message}"
+    held = np.array(
+        wait_for(
+            lambda: (p := body_pose(cell, "tag_block")[:3, 3])[2] > rest[2] + 0.05 and tuple(p),
+            10.0,
+            "the block lifted",
+        )
+    )
+    assert np.linalg.norm(held[:2] - rest[:2]) < 0.05, f"picked up from {rest}, now at {held}"
