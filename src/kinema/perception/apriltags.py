@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import ctypes
 import functools
+import threading
 from dataclasses import dataclass
 from typing import Any
 
@@ -88,6 +89,16 @@ class TagDetection:
     pose_error: float
 
 
+# One C detector per settings, each used by one thread at a time (the library keeps scratch state in it).
+_DETECTOR_LOCKS: dict[DetectorSettings, threading.Lock] = {}
+_LOCKS_LOCK = threading.Lock()
+
+
+def _detector_lock(settings: DetectorSettings) -> threading.Lock:
+    with _LOCKS_LOCK:
+        return _DETECTOR_LOCKS.setdefault(settings, threading.Lock())
+
+
 @functools.lru_cache(maxsize=8)
 def _detector(settings: DetectorSettings) -> Any:
     from pupil_apriltags import Detector
@@ -130,13 +141,13 @@ def detect_tags(
             f"the image is {image.shape[1]}x{image.shape[0]} but the camera info is "
             f"{intrinsics.width}x{intrinsics.height}"
         )
-    detector = _detector(settings)
-    found = detector.detect(
-        image,
-        estimate_tag_pose=True,
-        camera_params=(intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy),
-        tag_size=float(tag_size),
-    )
+    with _detector_lock(settings):
+        found = _detector(settings).detect(
+            image,
+            estimate_tag_pose=True,
+            camera_params=(intrinsics.fx, intrinsics.fy, intrinsics.cx, intrinsics.cy),
+            tag_size=float(tag_size),
+        )
     detections = []
     for tag in found:
         if int(tag.hamming) > int(settings.max_hamming):

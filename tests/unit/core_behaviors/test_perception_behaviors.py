@@ -94,9 +94,9 @@ def test_get_messages_fail_naming_the_topic_nobody_publishes(behavior: Any, cont
         context=context,
     )
     assert run.status == NodeStatus.FAILURE
-    assert "nobody published on /nobody/points within 0.3 s" in run.toasts[-1], run.toasts
+    assert "/nobody/points" in run.toasts[-1] and "0.3 s" in run.toasts[-1], run.toasts
     run = tick_behavior(behavior("GetImage"), {"topic_name": " "}, context=context)
-    assert run.status == NodeStatus.FAILURE and "port [topic_name] is empty" in run.toasts[-1]
+    assert run.status == NodeStatus.FAILURE and "port [topic_name]" in run.toasts[-1], run.toasts
 
 
 def test_detect_april_tags_finds_each_tag_at_its_pose(behavior: Any, context: BehaviorContext) -> None:

@@ -98,3 +98,21 @@ def test_bad_settings_name_what_is_valid() -> None:
         detect_tags(image, CAMERA, 0.0, DetectorSettings())
     with pytest.raises(PerceptionError, match="320x240 but the camera info is 640x480"):
         detect_tags(image[:240, :320], CAMERA, TAG_SIZE, DetectorSettings())
+
+
+def test_detections_from_several_threads_at_once_are_each_right() -> None:
+    """Behaviors detect on worker threads; the library's detector keeps scratch state, so calls queue."""
+    from concurrent.futures import ThreadPoolExecutor
+
+    images = {
+        tag_id: draw_tag(tag_image("36h11", tag_id), TAG_SIZE, pose((0.0, 0.0, 0.25), (0, 0, 10)), CAMERA)
+        for tag_id in (2, 4, 6, 8)
+    }
+
+    def ids(tag_id: int) -> list[int]:
+        return [t.tag_id for t in detect_tags(images[tag_id], CAMERA, TAG_SIZE, DetectorSettings())]
+
+    asked = list(images) * 3
+    with ThreadPoolExecutor(4) as pool:
+        found = list(pool.map(ids, asked))
+    assert found == [[tag_id] for tag_id in asked]
