@@ -53,6 +53,8 @@ log = logging.getLogger("kinema.tui")
 #: The runtime counts as gone when no heartbeat (10 Hz) arrived for this long. Generous: a runtime busy
 #: planning on a loaded machine delays heartbeats by a second or more without being gone.
 HEARTBEAT_TIMEOUT_S = 3.0
+#: How long image_topics() waits for the network's answer about its topics.
+GRAPH_QUERY_S = 1.0
 #: After this long without heartbeats the session is dropped and a new one is opened.
 RECONNECT_AFTER_S = 6.0
 RETRY_PERIOD_S = 1.0
@@ -444,7 +446,8 @@ class SdkConnection:
         from kinema.tui.camera_image import IMAGE_TYPE
 
         client = self._require_client()
-        topics = client.node.graph().topics()
+        # A fresh look at the whole network: a session's graph cache may not know every publisher yet.
+        topics = client.node.graph(timeout=GRAPH_QUERY_S).topics()
         return sorted(name for name, types in topics.items() if IMAGE_TYPE in types)
 
     def watch_images(self, topic: str, listener: ImageListener) -> Callable[[], None]:

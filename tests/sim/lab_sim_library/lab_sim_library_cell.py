@@ -16,6 +16,7 @@ class LibraryCell:
     node: Any
     objectives: Path
     driver: Any = None
+    endpoint: str = ""
     _topics: dict[str, list[Any]] = field(default_factory=dict)
     _lock: threading.Lock = field(default_factory=threading.Lock)
 

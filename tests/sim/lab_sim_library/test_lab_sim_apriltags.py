@@ -166,3 +166,28 @@ def test_the_approval_variant_picks_with_approvals_granted_headless(
         )
     )
     assert np.linalg.norm(held[:2] - rest[:2]) < 0.05, f"picked up from {rest}, now at {held}"
+
+
+def test_the_tui_connection_lists_and_watches_the_wrist_camera(cell: LibraryCell) -> None:
+    """What the TUI's camera view gets from a real runtime: the image topics, then RGB pictures."""
+    from kinema.tui.connection import ConnectionChanged, ConnectionState
+    from kinema.tui.sdk_connection import SdkConnection
+
+    states: list[ConnectionState] = []
+    connection = SdkConnection(endpoint=cell.endpoint, config="lab_sim")
+    connection.open(lambda event: isinstance(event, ConnectionChanged) and states.append(event.state))
+    try:
+        wait_for(lambda: ConnectionState.CONNECTED in states, 30.0, "the TUI connection to connect")
+        topics = connection.image_topics()
+        assert {"/wrist_camera/color", "/scene_camera/color", "/wrist_camera/depth"} <= set(topics), topics
+        pictures: list[Any] = []
+        stop = connection.watch_images("/wrist_camera/depth", pictures.append)
+        try:
+            picture = wait_for(lambda: pictures and pictures[-1], 30.0, "a depth picture for the TUI")
+        finally:
+            stop()
+        assert picture.pixels.shape == (480, 640, 3) and picture.encoding == "32FC1"
+        assert picture.frame_id == "wrist_camera_optical_frame"
+        assert len(np.unique(picture.pixels[:, :, 0])) > 10, "depth is shaded, not flat"
+    finally:
+        connection.close()
