@@ -99,11 +99,35 @@ def _detector_lock(settings: DetectorSettings) -> threading.Lock:
         return _DETECTOR_LOCKS.setdefault(settings, threading.Lock())
 
 
-@functools.lru_cache(maxsize=8)
-def _detector(settings: DetectorSettings) -> Any:
+def _detector_class() -> type:
+    """pupil-apriltags' Detector, destroyed in the order the C library needs.
+
+    Its ``__del__`` frees the tag families before the detector, whose destructor then reads and writes
+    those freed families (``apriltag_detector_destroy`` → ``quick_decode_uninit``): heap corruption that
+    surfaced as ``malloc(): mismatching next->prev_size`` at the end of a test run. Destroying the
+    detector first, then the families, is the library's intended order.
+    """
     from pupil_apriltags import Detector
 
-    return Detector(
+    class OrderedDetector(Detector):  # type: ignore[misc]
+        def __del__(self) -> None:
+            pointer = getattr(self, "tag_detector_ptr", None)
+            if pointer is None:
+                return
+            self.tag_detector_ptr = None
+            self.libc.apriltag_detector_destroy.restype = None
+            self.libc.apriltag_detector_destroy(pointer)
+            for family, table in self.tag_families.items():
+                destroy = getattr(self.libc, f"{family}_destroy")
+                destroy.restype = None
+                destroy(table)
+
+    return OrderedDetector
+
+
+@functools.lru_cache(maxsize=8)
+def _detector(settings: DetectorSettings) -> Any:
+    return _detector_class()(
         families=settings.family,
         nthreads=max(1, int(settings.n_threads)),
         quad_decimate=float(settings.quad_decimate),
@@ -179,23 +203,28 @@ def tag_image(family: str, tag_id: int) -> np.ndarray:
     Raises:
         PerceptionError: an unknown family, or an id the family does not have.
     """
-    from pupil_apriltags import Detector
     from pupil_apriltags.bindings import _ApriltagFamily
 
     name = family_name(family)
-    library = Detector(families=name).libc
+    library = _detector(DetectorSettings(name)).libc  # the cached detector's library: none is destroyed
     create = getattr(library, f"{name}_create")
     create.restype = ctypes.POINTER(_ApriltagFamily)
-    table = create().contents
-    if not 0 <= tag_id < int(table.ncodes):
-        raise PerceptionError(f"{name} has tags 0..{int(table.ncodes) - 1}, not {tag_id}")
-    size = int(table.total_width)
-    image = np.zeros((size, size), dtype=np.uint8)
-    if not table.reversed_border:
-        image[0, :] = image[-1, :] = image[:, 0] = image[:, -1] = 255
-    start = (size - int(table.width_at_border)) // 2
-    code, bits = int(table.codes[tag_id]), int(table.nbits)
-    for i in range(bits):
-        if (code >> (bits - 1 - i)) & 1:
-            image[int(table.bit_y[i]) + start, int(table.bit_x[i]) + start] = 255
+    destroy = getattr(library, f"{name}_destroy")
+    destroy.restype = None
+    pointer = create()
+    try:
+        table = pointer.contents
+        if not 0 <= tag_id < int(table.ncodes):
+            raise PerceptionError(f"{name} has tags 0..{int(table.ncodes) - 1}, not {tag_id}")
+        size = int(table.total_width)
+        image = np.zeros((size, size), dtype=np.uint8)
+        if not table.reversed_border:
+            image[0, :] = image[-1, :] = image[:, 0] = image[:, -1] = 255
+        start = (size - int(table.width_at_border)) // 2
+        code, bits = int(table.codes[tag_id]), int(table.nbits)
+        for i in range(bits):
+            if (code >> (bits - 1 - i)) & 1:
+                image[int(table.bit_y[i]) + start, int(table.bit_x[i]) + start] = 255
+    finally:
+        destroy(pointer)  # never added to a detector, so nothing else refers to it
     return image

@@ -116,3 +116,30 @@ def test_detections_from_several_threads_at_once_are_each_right() -> None:
     with ThreadPoolExecutor(4) as pool:
         found = list(pool.map(ids, asked))
     assert found == [[tag_id] for tag_id in asked]
+
+
+def test_a_detector_is_destroyed_before_its_tag_families() -> None:
+    """The C detector's destructor still reads its families: freeing them first corrupts the heap."""
+    from kinema.perception.apriltags import _detector_class
+
+    calls: list[str] = []
+
+    class Library:
+        def __getattr__(self, name: str) -> object:
+            class Call:
+                restype = None
+
+                def __call__(self, *args: object) -> None:
+                    calls.append(name)
+
+            value = Call()
+            setattr(self, name, value)
+            return value
+
+    detector = object.__new__(_detector_class())
+    detector.libc, detector.tag_detector_ptr = Library(), object()
+    detector.tag_families = {"tag36h11": object(), "tag25h9": object()}
+    detector.__del__()
+    assert calls == ["apriltag_detector_destroy", "tag36h11_destroy", "tag25h9_destroy"]
+    detector.__del__()  # a second call does nothing
+    assert len(calls) == 3
