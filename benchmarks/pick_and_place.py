@@ -41,7 +41,7 @@ PICK = "3 Waypoint Pick Pose"
 PLACE = "3 Waypoint Place Pose"
 MID = "3 Waypoint Mid Point"
 CLOSED, OPEN = 0.7929, 0.0
-CUBE_START = np.array([0.62, 0.30, 0.775])
+CUBE_START = np.array([-0.30, 0.62, 0.499])
 SHARED_OBJECTIVES = (
     Path(__file__).resolve().parents[1].parent / "shared" / "compat" / "moveit_pro" / "objectives"
 )

@@ -36,7 +36,7 @@ from kinema.motion.task_stages import BatchPoseIK, Connect, CurrentState, Motion
 from kinema.motion.trajectory import JointPath
 from kinema.resources import bundled_dir
 
-CUBE = np.array([0.62, 0.3, 0.775])
+CUBE = np.array([-0.3, 0.62, 0.499])
 GRASP_ABOVE_CENTRE = 0.02
 APPROACH = 0.1
 
@@ -81,7 +81,7 @@ def main() -> None:
         return out
 
     grasp = pose(CUBE + np.array([0.0, 0.0, GRASP_ABOVE_CENTRE]))
-    place = pose(CUBE + np.array([0.05, -0.15, GRASP_ABOVE_CENTRE]))
+    place = pose(CUBE + np.array([0.15, 0.05, GRASP_ABOVE_CENTRE]))
     # "Pick from Pose Vector" hands batch IK yaw-equivalent candidates; two unreachable ones make it work.
     far = pose(np.array([3.0, 3.0, 0.8]))
 

@@ -15,9 +15,9 @@ def test_the_view_starts_where_the_scene_camera_stands_looking_where_it_looks() 
     assert path is not None
     model = mujoco.MjModel.from_xml_path(str(path))
     view = SceneModel(model).camera_view()["camera"]
-    np.testing.assert_allclose(view["position"], [2.1, 0.0, 1.9], atol=1e-9)
+    np.testing.assert_allclose(view["position"], [0.0, 2.1, 1.624], atol=1e-9)
     forward = np.subtract(view["target"], view["position"])
     forward /= np.linalg.norm(forward)
-    # The scene camera looks down across the table at the robot: along (-1.6, 0, -1.05).
-    np.testing.assert_allclose(forward, np.array([-1.6, 0.0, -1.05]) / np.hypot(1.6, 1.05), atol=1e-6)
+    # The scene camera looks down across the table at the robot: along (0, -1.6, -1.05).
+    np.testing.assert_allclose(forward, np.array([0.0, -1.6, -1.05]) / np.hypot(1.6, 1.05), atol=1e-6)
     assert view["fov"] == 55.0

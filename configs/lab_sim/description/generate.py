@@ -12,8 +12,12 @@ them; the MuJoCo ``<camera>`` elements sit in those links' bodies. Run it after 
 ``tests/sim/model`` checks that the two files agree (forward kinematics to 1e-6, identical collision
 geoms) and that the committed files are what this script writes.
 
-Conventions: SI units, every link frame is world-aligned when all joints are zero (so joint origins are
-pure translations) except ``tool0`` and the gripper below it, whose z axis points out of the flange.
+Conventions: SI units. The world frame is MoveIt Pro's lab_sim's: z up, the rail along world x, the table
+toward +y, its top at z = 0.474 (MoveIt Pro's desk height; the floor is below z = 0). The cell is placed in
+it by one rigid transform, :data:`CELL_YAW` and :data:`CELL_ORIGIN` (the rail base link's pose), so joint
+values mean the same as before the cell was placed. Within the robot every link frame is aligned with
+``linear_rail_base_link`` when all joints are zero (so joint origins are pure translations) except
+``tool0`` and the gripper below it, whose z axis points out of the flange.
 """
 
 from __future__ import annotations
@@ -32,10 +36,20 @@ FINGER_PER_KNUCKLE = FINGER_TRAVEL / KNUCKLE_CLOSED
 FINGER_HALF_THICKNESS = 0.01
 TCP_DEPTH = 0.13  # grasp_link along the gripper z axis, from tool0
 
-TABLE_TOP = 0.75
+# The cell in the world: MoveIt Pro's lab_sim runs its rail along world x (rail joint + toward -x) with the
+# work surface at +y, 0.474 m up. The cell (rail pedestal, table, tray, cube, scene camera) is built 0.75 m
+# tall from the floor and turned a quarter turn about z, so the rail base frame's y axis is world -x.
+TABLE_TOP = 0.474
+TABLE_HEIGHT = 0.75  # floor to table top
+FLOOR = TABLE_TOP - TABLE_HEIGHT
+CELL_YAW = math.pi / 2
+CELL_QUAT = (math.cos(CELL_YAW / 2), 0.0, 0.0, math.sin(CELL_YAW / 2))  # w x y z
+CELL_ORIGIN = (0.0, 0.0, FLOOR)  # linear_rail_base_link in the world
+TABLE_CENTER = (0.0, 0.7)  # the table: 2.4 m along the rail, 0.7 m deep, from y = 0.35 to 1.05
+TABLE_HALF = (1.2, 0.35)
 CUBE_HALF = 0.025
-CUBE_START = (0.62, 0.30, TABLE_TOP + CUBE_HALF)
-TRAY_CENTER = (0.62, -0.30)
+CUBE_START = (-0.30, 0.62, TABLE_TOP + CUBE_HALF)
+TRAY_CENTER = (0.30, 0.62)
 TRAY_FLOOR = 0.004  # thickness of the tray bottom: thin, so placing and re-picking stay level
 
 # Cameras, named as MoveIt Pro's lab_sim names them (topics /<name>/color, depth, camera_info, points).
@@ -122,10 +136,34 @@ def _quat_from_axes(
     return (w, qx, qy, qz)
 
 
-# The scene camera stands beyond the far edge of the table, 1.9 m up, looking down across the table at
-# the robot: image x (right) runs along +y of the world, image y (down) mostly along -z.
-SCENE_CAMERA_POS = (2.1, 0.0, 1.9)
-SCENE_CAMERA_QUAT = _quat_from_axes((0.0, 1.0, 0.0), (-1.6, 0.0, -1.05))
+Quat = tuple[float, float, float, float]
+
+
+def _quat_mul(a: Quat, b: Quat) -> Quat:
+    """The rotation ``a`` then ``b`` in ``a``'s frame (Hamilton product, w x y z)."""
+    aw, ax, ay, az = a
+    bw, bx, by, bz = b
+    product = (
+        aw * bw - ax * bx - ay * by - az * bz,
+        aw * bx + ax * bw + ay * bz - az * by,
+        aw * by - ax * bz + ay * bw + az * bx,
+        aw * bz + ax * by - ay * bx + az * bw,
+    )
+    return (round(product[0], 12), round(product[1], 12), round(product[2], 12), round(product[3], 12))
+
+
+def _cell_to_world(xyz: tuple[float, float, float]) -> tuple[float, float, float]:
+    """A point given in the rail base's frame (the cell as built), in the world."""
+    c, s = math.cos(CELL_YAW), math.sin(CELL_YAW)
+    x, y, z = xyz
+    world = (c * x - s * y + CELL_ORIGIN[0], s * x + c * y + CELL_ORIGIN[1], z + CELL_ORIGIN[2])
+    return (round(world[0], 12), round(world[1], 12), round(world[2], 12))  # no 1e-16 in the files
+
+
+# The scene camera stands beyond the far edge of the table, 1.9 m above the floor, looking down across the
+# table at the robot (given in the cell's frame: image x along the rail, image y mostly down).
+SCENE_CAMERA_POS = _cell_to_world((2.1, 0.0, 1.9))
+SCENE_CAMERA_QUAT = _quat_mul(CELL_QUAT, _quat_from_axes((0.0, 1.0, 0.0), (-1.6, 0.0, -1.05)))
 # The wrist camera rides beside the gripper, 7.5 cm off the tool axis along tool0's x (clear of the
 # fingers, which close along y) and level with the palm's face (so the palm stays out of the picture),
 # looking out of the flange, tilted 15 degrees toward the tool axis: the fingertips show at the image's
@@ -137,6 +175,8 @@ LINKS: tuple[Link, ...] = (
     Link(
         "linear_rail_base_link",
         "world",
+        xyz=CELL_ORIGIN,
+        quat=CELL_QUAT,
         geoms=(Geom("rail_pedestal", "box", (0.12, 1.4, 0.36), pos=(0.0, 0.0, 0.36), rgba=DARK),),
     ),
     Link(
@@ -522,15 +562,15 @@ TAGGED_OBJECTS = (
         "tag_block",
         0,
         TAG_BLOCK_HALF,
-        (0.52, 0.12, TABLE_TOP + TAG_BLOCK_HALF[2]),
-        math.radians(20.0),
+        (-0.12, 0.52, TABLE_TOP + TAG_BLOCK_HALF[2]),
+        CELL_YAW + math.radians(20.0),
     ),
 )
 # The block stands where the wrist camera sees it from "Look at Table" at about 0.5 m (its tag 40 px
 # wide). The tray's tag lies on the table off the tray's corner nearest the robot, outside that view, so
 # that a detection of "any tag" from there is the block's (Kinema's tray is smaller than MoveIt Pro's,
 # whose tag is 0.125 m from the tray's centre).
-TRAY_TAG_CENTER = (TRAY_CENTER[0] - 0.17, TRAY_CENTER[1] - 0.32, TABLE_TOP)
+TRAY_TAG_CENTER = (TRAY_CENTER[0] + 0.32, TRAY_CENTER[1] - 0.17, TABLE_TOP)
 
 
 def _yaw_quat(yaw: float) -> tuple[float, float, float, float]:
@@ -642,12 +682,13 @@ def render_scene() -> str:
         '    <material name="floor" texture="grid" texrepeat="6 6"/>',
         "  </asset>",
         "  <worldbody>",
-        '    <light name="top" pos="0.5 0 3" dir="0 0 -1" directional="true"/>',
-        '    <geom name="floor" type="plane" size="4 4 0.05" material="floor"/>',
-        f'    <geom name="table" type="box" size="0.35 1.2 {_f(TABLE_TOP / 2)}" '
-        f'pos="0.7 0 {_f(TABLE_TOP / 2)}" rgba="0.76 0.7 0.6 1"/>',
+        f'    <light name="top" pos="0 0.5 {_f(FLOOR + 3)}" dir="0 0 -1" directional="true"/>',
+        f'    <geom name="floor" type="plane" size="4 4 0.05" pos="0 0 {_f(FLOOR)}" material="floor"/>',
+        f'    <geom name="table" type="box" size="{_vec([*TABLE_HALF, TABLE_HEIGHT / 2])}" '
+        f'pos="{_vec([*TABLE_CENTER, FLOOR + TABLE_HEIGHT / 2])}" rgba="0.76 0.7 0.6 1"/>',
         *robot,
-        f'    <body name="tray" pos="{_f(tx)} {_f(ty)} {_f(TABLE_TOP)}">',
+        # The tray turns with the cell: its walls are given in the rail base's axes.
+        f'    <body name="tray" pos="{_f(tx)} {_f(ty)} {_f(TABLE_TOP)}" quat="{_vec(CELL_QUAT)}">',
         f'      <geom name="tray_floor" type="box" size="0.12 0.14 {_f(TRAY_FLOOR / 2)}" '
         f'pos="0 0 {_f(TRAY_FLOOR / 2)}" rgba="0.3 0.5 0.35 1"/>',
         '      <geom name="tray_wall_front" type="box" size="0.125 0.005 0.02" pos="0 0.145 0.02" '

@@ -26,8 +26,8 @@ from kinema.resources import bundled_dir
 CONFIG = "compat_lab_sim"
 # Where "3 Waypoints Pick and Place" puts the cube: its start on the table, and the tray (the grasp
 # point at the place waypoint, 20 mm above the cube's centre; see configs/lab_sim/description/README.md).
-PICK_POSITION = np.array([0.62, 0.30, 0.775])
-PLACE_POSITION = np.array([0.62, -0.30, 0.779])
+PICK_POSITION = np.array([-0.30, 0.62, 0.499])
+PLACE_POSITION = np.array([0.30, 0.62, 0.503])
 TOLERANCE = 0.02
 ARM = (
     "linear_rail_joint",

@@ -112,7 +112,7 @@ def test_scene_camera_sees_the_table_and_the_cube_where_they_are(camera_sim: Sim
     )
     red = world.colors[on_cube]
     assert np.median(red[:, 0]) > 2 * np.median(red[:, 1]), f"the cube's points are not red: {red[:5]}"
-    table = points[(points[:, 0] > 0.4) & (points[:, 0] < 1.0) & (np.abs(points[:, 2] - 0.75) < 0.01)]
+    table = points[(points[:, 1] > 0.4) & (points[:, 1] < 1.0) & (np.abs(points[:, 2] - 0.474) < 0.01)]
     assert len(table) > 10000, f"only {len(table)} points on the table top"
 
 

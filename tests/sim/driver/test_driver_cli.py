@@ -30,7 +30,7 @@ def test_sim_bodies_prints_each_free_body_and_its_position(
     code, output = run("sim", "bodies", "--connect", router_endpoint)
     assert code == 0, output
     (row,) = [line for line in output.splitlines() if line.startswith("cube")]
-    assert [float(v) for v in row.split()[1:]] == pytest.approx([0.62, 0.30, 0.775], abs=2e-3)
+    assert [float(v) for v in row.split()[1:]] == pytest.approx([-0.30, 0.62, 0.499], abs=2e-3)
 
 
 def test_sim_bodies_json(sim: Sim, router_endpoint: str, run: Callable[..., tuple[int, str]]) -> None:
@@ -40,7 +40,7 @@ def test_sim_bodies_json(sim: Sim, router_endpoint: str, run: Callable[..., tupl
     assert data["sim_time"] > 0
     names = [b["name"] for b in data["bodies"]]
     assert names[0] == "cube" and "tag_block" in names, names
-    assert data["bodies"][0]["position"] == pytest.approx([0.62, 0.30, 0.775], abs=2e-3)
+    assert data["bodies"][0]["position"] == pytest.approx([-0.30, 0.62, 0.499], abs=2e-3)
     assert len(data["bodies"][0]["orientation"]) == 4
 
 

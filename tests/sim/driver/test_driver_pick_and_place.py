@@ -10,8 +10,8 @@ from kinema.config import WaypointStore, resolve_config
 from kinema.drivers.mujoco import names as n
 
 CLOSED = 0.7929
-PICK_SPOT = np.array([0.62, 0.30])
-TRAY_SPOT = np.array([0.62, -0.30])
+PICK_SPOT = np.array([-0.30, 0.62])
+TRAY_SPOT = np.array([0.30, 0.62])
 
 
 def cube_xy(sim: Sim) -> np.ndarray:

@@ -16,7 +16,7 @@ from kinema.transport import STATUS_ABORTED
 # "Reset MuJoCo Robot" (MoveIt Pro's lab_sim objective) sets exactly this state.
 RESET_STATE = dict(zip(ARM, (0.0, 0.0, -1.57, 0.0, 0.0, 0.0, 0.0), strict=True))
 DEFAULT_ARM = np.array([0.0, 0.0, -2.0, 2.0, -1.5708, -1.5708, 0.0])
-CUBE_START = np.array([0.62, 0.30, 0.775])
+CUBE_START = np.array([-0.30, 0.62, 0.499])
 
 
 def bodies(sim: Sim) -> dict[str, np.ndarray]:
@@ -120,7 +120,7 @@ def test_bodies_lists_the_free_objects_with_their_world_positions(sim: Sim) -> N
     found = bodies(sim)
     assert {"cube", "tag_block"} <= set(found), sorted(found)
     np.testing.assert_allclose(found["cube"], CUBE_START, atol=2e-3)
-    assert found["tag_block"][2] == pytest.approx(0.79, abs=2e-3), "the tagged block stands on the table"
+    assert found["tag_block"][2] == pytest.approx(0.514, abs=2e-3), "the tagged block stands on the table"
 
 
 def test_keyframes_lists_the_models_keyframes(sim: Sim) -> None:

@@ -150,7 +150,7 @@ def test_the_approval_variant_picks_with_approvals_granted_headless(
     reset_scene(cell)
     rest = np.array(
         wait_for(
-            lambda: (p := body_pose(cell, "tag_block")[:3, 3])[2] < 0.8 and tuple(p),
+            lambda: (p := body_pose(cell, "tag_block")[:3, 3])[2] < BLOCK.start[2] + 0.01 and tuple(p),
             10.0,
             "the block back on the table",
         )

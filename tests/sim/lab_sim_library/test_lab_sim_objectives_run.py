@@ -7,6 +7,7 @@ box now in the planning scene, the message it published, the pose it drew.
 
 from __future__ import annotations
 
+import itertools
 import time
 from collections.abc import Callable
 from typing import Any
@@ -163,24 +164,88 @@ def test_visualize_grasp_link_draws_a_pose_at_the_grasp_link(library_cell: Libra
     assert [origin.x, origin.y, origin.z] == pytest.approx(expected.tolist(), abs=0.01)
 
 
-def test_plan_and_save_trajectory_stops_at_kinemas_table_and_saves_nothing(library_cell: LibraryCell) -> None:
-    """MoveIt Pro's pose vector runs through where Kinema's cell has its table: the Cartesian plan says so."""
+# create_pose_vector.xml: grasp_link pointing down (orientation 0;-1;0;0) at y = 0.5, world frame.
+POSE_VECTOR = (
+    (0.75, 0.5, 0.9),
+    (0.5, 0.5, 0.8),
+    (0.25, 0.5, 0.7),
+    (0.0, 0.5, 0.6),
+    (-0.25, 0.5, 0.7),
+    (-0.5, 0.5, 0.8),
+    (-0.75, 0.5, 0.9),
+    (-1.0, 0.5, 1.0),
+)
+
+
+def grasp_poses(points: np.ndarray) -> np.ndarray:
+    """grasp_link's pose (4x4) at each row of arm joint values."""
+    from kinema.motion import RobotDescription, fk
+
+    model = RobotDescription.lab_sim().load_model()
+    columns = [model.joint_names.index(j) for j in ARM]
+    poses = []
+    for row in points:
+        q = np.zeros(len(model.joint_names))
+        q[columns] = row
+        poses.append(fk(model, q, "grasp_link"))
+    return np.array(poses)
+
+
+def saved_trajectory(cell: LibraryCell) -> np.ndarray:
+    """The arm's joint values at every point of the saved joint_trajectory.yaml (columns in ARM order)."""
+    data = yaml.safe_load((cell.objectives / "joint_trajectory.yaml").read_text())
+    columns = [data["joint_names"].index(j) for j in ARM]
+    times = [p["time_from_start"]["sec"] + 1e-9 * p["time_from_start"]["nanosec"] for p in data["points"]]
+    assert all(b > a for a, b in itertools.pairwise(times)), "time_from_start must increase"
+    return np.array([[p["positions"][c] for c in columns] for p in data["points"]])
+
+
+def check_passes_through_the_pose_vector(points: np.ndarray) -> None:
+    poses = grasp_poses(points)
+    for target in POSE_VECTOR:
+        gap = np.linalg.norm(poses[:, :3, 3] - np.array(target), axis=1).min()
+        # blending_radius is 0.02: corners may be cut by that much, the ends are reached.
+        assert gap < 0.025, f"the saved trajectory passes {gap:.3f} m from {target}"
+    end = poses[-1]
+    assert end[:3, 3] == pytest.approx(POSE_VECTOR[-1], abs=0.005), end[:3, 3]
+    assert end[:3, 2] == pytest.approx([0.0, 0.0, -1.0], abs=0.01), "grasp_link must point down"
+    assert np.abs(poses[:, 2, 2] + 1.0).max() < 0.01, "grasp_link leaves the downward orientation"
+
+
+def test_plan_and_save_trajectory_saves_a_trajectory_through_the_pose_vector(
+    library_cell: LibraryCell, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """MoveIt Pro's objective, unchanged: from "Workspace Right" through create_pose_vector.xml's poses,
+    approved by the headless rule, saved over the shipped joint_trajectory.yaml."""
+    monkeypatch.setenv("KINEMA_AUTO_APPROVE", "1")
     saved = library_cell.objectives / "joint_trajectory.yaml"
-    before = saved.read_text()
+    saved.unlink()
     result = run(library_cell, "Plan and Save Trajectory")
-    assert result.failed, result
-    assert "PlanCartesianPath" in result.error_message and "table" in result.error_message, result
-    assert saved.read_text() == before
+    assert result.succeeded, result
+    assert saved.is_file(), sorted(p.name for p in library_cell.objectives.glob("joint_trajectory*"))
+    points = saved_trajectory(library_cell)
+    waypoints_file = library_cell.objectives.parent / "waypoints" / "lab_sim_waypoints.yaml"
+    waypoints = yaml.safe_load(waypoints_file.read_text())
+    start = next(w for w in waypoints if w["name"] == "Workspace Right")["joint_state"]
+    expected = dict(zip(start["name"], start["position"], strict=True))
+    assert np.abs(points[0] - np.array([expected[j] for j in ARM])).max() < 0.02, points[0].round(3)
+    check_passes_through_the_pose_vector(points)
 
 
-def test_record_and_replay_scanning_motion_stops_where_plan_and_save_does(library_cell: LibraryCell) -> None:
-    """Its first half is "Plan and Save Trajectory": the same table is in the way, so nothing is replayed."""
+def test_record_and_replay_scanning_motion_ends_where_the_saved_file_ends(
+    library_cell: LibraryCell, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Plan and save (as above), then load the saved file and execute it: the arm ends where it ends."""
+    monkeypatch.setenv("KINEMA_AUTO_APPROVE", "1")
     saved = library_cell.objectives / "joint_trajectory.yaml"
-    before = saved.read_text()
+    saved.unlink()
     result = run(library_cell, "Record and Replay Scanning Motion")
-    assert result.failed, result
-    assert "PlanCartesianPath" in result.error_message and "table" in result.error_message, result
-    assert saved.read_text() == before
+    assert result.succeeded, result
+    points = saved_trajectory(library_cell)
+    check_passes_through_the_pose_vector(points)
+    end = settled_arm(library_cell)
+    assert np.abs(end - points[-1]).max() < 0.02, f"arm at {end.round(3)}, file ends at {points[-1].round(3)}"
+    assert grasp_poses(end[None])[0][:3, 3] == pytest.approx(POSE_VECTOR[-1], abs=0.01)
 
 
 FRAME_OBJECTIVE = """<root BTCPP_format="4" main_tree_to_execute="Box On The Cube">
@@ -212,52 +277,3 @@ def test_pose_subtrees_run_on_their_own(library_cell: LibraryCell, name: str) ->
     "MPC Pose Tracking" waypoint and forward kinematics are there."""
     result = run(library_cell, name)
     assert result.succeeded, result
-
-
-RECORD_IN_KINEMAS_CELL = """<root BTCPP_format="4" main_tree_to_execute="Plan and Save Over the Table">
-  <BehaviorTree ID="Plan and Save Over the Table">
-    <Sequence>
-      <SubTree ID="Move to Waypoint" waypoint_name="Workspace Right" joint_group_name="manipulator" />
-      <Action ID="ResetPoseStampedVector" vector="{target_poses}" />
-      <Action ID="CreatePoseStamped" reference_frame="world" position_xyz="0.6; -0.3; 1.1"
-              orientation_xyzw="0;-1;0;0" pose_stamped="{pose}" />
-      <Action ID="PushBackVector" input_vector="{target_poses}" element="{pose}"
-              output_vector="{target_poses}" />
-      <Action ID="CreatePoseStamped" reference_frame="world" position_xyz="0.6; 0.3; 1.0"
-              orientation_xyzw="0;-1;0;0" pose_stamped="{pose}" />
-      <Action ID="PushBackVector" input_vector="{target_poses}" element="{pose}"
-              output_vector="{target_poses}" />
-      <Action ID="PlanCartesianPath" path="{target_poses}" planning_group_name="manipulator"
-              tip_links="grasp_link" ik_cartesian_space_density="0.01" ik_joint_space_density="0.1"
-              blending_radius="0.02" trajectory_timing="[{mode: time_optimal}]"
-              joint_trajectory_msg="{joint_trajectory_msg}" debug_solution="{debug_solution}" />
-      <Action ID="WaitForMTCSolutionApproval" solution="{debug_solution}" />
-      <Action ID="SaveJointTrajectoryToYaml" yaml_filename="~/user_ws/src/lab_sim/objectives/joint_trajectory"
-              message="{joint_trajectory_msg}" overwrite="true" />
-    </Sequence>
-  </BehaviorTree>
-</root>"""
-
-
-def test_a_trajectory_saved_the_way_plan_and_save_does_is_replayed_by_load_and_execute(
-    library_cell: LibraryCell, monkeypatch: pytest.MonkeyPatch
-) -> None:
-    """A "Plan and Save Trajectory" with poses over Kinema's table (approved by the headless rule), then
-    MoveIt Pro's unchanged "Load and Execute Joint Trajectory": the arm ends where the new plan ends.
-    (overwrite is set here: Kinema's SaveJointTrajectoryToYaml keeps an existing file by default.)"""
-    from kinema.motion import RobotDescription, fk
-
-    monkeypatch.setenv("KINEMA_AUTO_APPROVE", "1")
-    saved = library_cell.objectives / "joint_trajectory.yaml"
-    before = saved.read_text()
-    result = library_cell.client.start(xml=RECORD_IN_KINEMAS_CELL).result(RUN_TIMEOUT)
-    assert result.succeeded, result
-    assert saved.read_text() != before
-    result = run(library_cell, "Load and Execute Joint Trajectory")
-    assert result.succeeded, result
-    end = settled_arm(library_cell)
-    assert np.abs(end - last_point(library_cell, "joint_trajectory.yaml")).max() < 0.02
-    model = RobotDescription.lab_sim().load_model()
-    q = np.zeros(len(model.joint_names))
-    q[[model.joint_names.index(j) for j in ARM]] = end
-    assert fk(model, q, "grasp_link")[:3, 3] == pytest.approx([0.6, 0.3, 1.0], abs=0.01)

@@ -508,4 +508,4 @@ def test_a_camera_of_the_scene_is_a_frame(behavior: Any, context: BehaviorContex
         context=context,
     )
     assert run.status == NodeStatus.SUCCESS, run.toasts
-    np.testing.assert_allclose(_xyz(run.outputs["output_pose"]), [2.1, 0.0, 1.9], atol=1e-6)
+    np.testing.assert_allclose(_xyz(run.outputs["output_pose"]), [0.0, 2.1, 1.624], atol=1e-6)

@@ -20,8 +20,8 @@ from kinema.resources import bundled_dir
 from kinema.testing import publish_repeatedly, run_objective, tick_behavior
 
 WAYPOINTS = bundled_dir("configs") / "lab_sim" / "waypoints" / "lab_sim_waypoints.yaml"
-CUBE = (0.62, 0.3, 0.78)
-DOWN = "0.7071068;0.7071068;0;0"  # grasp_link's z axis pointing down, as at lab_sim's pick waypoint
+CUBE = (-0.3, 0.62, 0.504)
+DOWN = "0;1;0;0"  # grasp_link's z axis pointing down, as at lab_sim's pick waypoint
 
 # Issue 13: the pick and place objectives of lab_sim and what they reach.
 TASK_PLANNING = {

@@ -101,8 +101,8 @@ def test_unreachable_goal_times_out_with_a_reason(model, checker, waypoint_q):
     up at its timeout (and say so) instead of hanging."""
     home = waypoint_q("Home")
     wall = np.eye(4)
-    wall[:3, 3] = (0.3, 0.5, 1.1)
-    checker.scene.add_box("wall", (0.15, 0.01, 0.25), wall)
+    wall[:3, 3] = (-0.5, 0.3, 0.824)  # the rail runs along world -x as its joint grows
+    checker.scene.add_box("wall", (0.01, 0.15, 0.25), wall)
     goal = {"linear_rail_joint": 0.9}
     assert not checker.in_collision(home)
     assert not checker.in_collision(model.configuration(goal, home))

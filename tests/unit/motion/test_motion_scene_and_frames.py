@@ -79,14 +79,14 @@ def test_a_box_added_at_the_tool_puts_that_configuration_in_collision(
 
 def test_frame_tree_resolves_links_objects_and_world(model, waypoints: dict[str, dict[str, float]]) -> None:
     q = model.configuration(waypoints["Look at Table"])
-    tree = FrameTree(model, q, {"cube": _at(0.62, 0.3, 0.775)})
+    tree = FrameTree(model, q, {"cube": _at(-0.3, 0.62, 0.499)})
     assert np.allclose(tree.world_T("world"), np.eye(4)) and np.allclose(tree.world_T(""), np.eye(4))
     assert np.allclose(tree.world_T("grasp_link"), fk(model, q, "grasp_link"))
     for name in ("base_link", "tool0", "grasp_link", "cube"):
         assert name in tree.names() and name in tree
     # the cube's centre seen from the grasp link, and back
     in_grasp = tree.transform(np.eye(4), "cube", "grasp_link")
-    assert np.allclose(tree.transform(in_grasp, "grasp_link", "world"), _at(0.62, 0.3, 0.775))
+    assert np.allclose(tree.transform(in_grasp, "grasp_link", "world"), _at(-0.3, 0.62, 0.499))
 
 
 def test_an_unknown_frame_names_the_closest_ones(model) -> None:

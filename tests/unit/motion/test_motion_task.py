@@ -21,7 +21,7 @@ from kinema.motion.task_stages import (
     PlanToPose,
 )
 
-CUBE = np.array([0.62, 0.3, 0.78])  # lab_sim's cube, where the gripper grasps it
+CUBE = np.array([-0.3, 0.62, 0.504])  # lab_sim's cube, where the gripper grasps it
 
 
 @pytest.fixture
@@ -113,7 +113,7 @@ def test_batch_pose_ik_takes_the_reachable_pose_closest_to_the_state_before(
     unreachable = grasp.copy()
     unreachable[:3, 3] = [4.0, 3.0, 0.8]
     farther = grasp.copy()
-    farther[:3, 3] = CUBE + np.array([0.0, -0.25, 0.0])
+    farther[:3, 3] = CUBE + np.array([0.25, 0.0, 0.0])
     solution = plan_task(pick_task(start, [unreachable, farther, grasp]), checker)
     near = fk(model, solution.end, "grasp_link")[:3, 3]
     distances = {}
@@ -192,12 +192,12 @@ def test_plan_to_pose_and_to_joint_state_go_forwards_and_a_pose_inside_an_obstac
         assert solution.end[model.index(name)] == pytest.approx(value, abs=1e-6)
 
     # A box added to the planning scene around the target: no collision-free IK solution there.
-    checker.scene.add(CollisionObject("wall", "box", (0.3, 0.02, 0.3), _at(0.62, 0.3, 1.2)))
+    checker.scene.add(CollisionObject("wall", "box", (0.02, 0.3, 0.3), _at(-0.3, 0.62, 0.924)))
     with pytest.raises(TaskPlanningError) as failure:
         plan_task(
             Task(
                 "into the wall",
-                [CurrentState(start), PlanToPose(("world", _at(0.62, 0.3, 1.2, grasp)), "grasp_link")],
+                [CurrentState(start), PlanToPose(("world", _at(-0.3, 0.62, 0.924, grasp)), "grasp_link")],
             ),
             checker,
         )

@@ -115,10 +115,11 @@ def _save_ports(ros_type: str, what: str, overwrite: bool = True) -> list[PortIn
             input_port(
                 "overwrite",
                 bool,
-                False,
+                True,
                 "Replace an existing file. When false and the file exists, the message is saved beside it "
-                "with a time stamp in the name (MoveIt Pro's default is not public; keeping the old file "
-                "is Kinema's choice).",
+                "with a time stamp in the name. (MoveIt Pro's default is not public; the corpus implies "
+                "true: 'Record and Replay Scanning Motion' replays the joint_trajectory.yaml that 'Plan and "
+                "Save Trajectory' saves over the shipped one without setting overwrite.)",
             )
         )
     return ports
