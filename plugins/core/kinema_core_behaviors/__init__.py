@@ -28,7 +28,7 @@ from . import (
 
 FAMILIES = (controllers, files, io, messages, motion, planning_scene, poses, ui, vectors, waiting, waypoints)
 FAMILIES += (task_planning,)  # issue 13's family, kept on its own line
-FAMILIES += (perception,)  # issue 14's point-cloud family, kept on its own line
+FAMILIES += (perception,)  # issue 14's family, kept on its own line
 
 BEHAVIORS = tuple(behavior for family in FAMILIES for behavior in family.BEHAVIORS)
 

@@ -43,19 +43,28 @@ SCREEN_CHOICES = ("configs", "objectives", "blackboard", "behaviors", "logs", "w
     help="Replay a recorded run instead (no runtime needed): step through its transitions and see the "
     "blackboard at each. Without FILE, the newest recording (see `kinema logs --recordings`).",
 )
+@click.option(
+    "--camera",
+    "camera",
+    default=None,
+    metavar="TOPIC",
+    help="Also open the camera view on this image topic, e.g. /wrist_camera/color (key 7 opens it too).",
+)
 @selection_options
 def ui(
     endpoint: str | None,
     screen: str,
     demo: bool,
     replay: str | None,
+    camera: str | None,
     workspace: Path | None,
     config: str | None,
 ) -> None:
     """Open the terminal UI attached to a running runtime (`kinema run` in another terminal or machine).
 
     Closing the UI leaves the runtime running. The Configs screen browses the workspace selected with
-    -w/-c (or `kinema configure`). Keys: 1-6 switch screens, ctrl+p opens the command palette, q quits.
+    -w/-c (or `kinema configure`). Keys: 1-6 switch screens, 7 shows a camera image, ctrl+p opens the
+    command palette, q quits.
     """
     if replay is not None:
         _replay(replay)
@@ -75,7 +84,7 @@ def ui(
         from kinema.tui.sdk_connection import SdkConnection
 
         connection = SdkConnection(endpoint=endpoint, workspace=workspace, config=config)
-    run_app(connection, owns_runtime=False, initial_mode=screen)
+    run_app(connection, owns_runtime=False, initial_mode=screen, camera=camera)
 
 
 def _replay(which: str) -> None:

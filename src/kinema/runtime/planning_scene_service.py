@@ -61,6 +61,12 @@ def scene_of(context: Any, model: RobotModel) -> PlanningScene:
         return scene
 
 
+def existing_scene(context: Any) -> PlanningScene | None:
+    """The planning scene of ``context`` if one was made or set, else None (nothing is loaded)."""
+    with _SCENES_LOCK:
+        return _SCENES.get(context)
+
+
 def set_scene(context: Any, scene: PlanningScene) -> None:
     """Plan against (and serve) ``scene`` in ``context`` from now on."""
     with _SCENES_LOCK:

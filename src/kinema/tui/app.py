@@ -144,6 +144,14 @@ class KinemaApp(App[None]):
             )
             for mode, label, key in SCREENS
         ),
+        Binding(
+            "7",
+            "show_camera",
+            "Camera",
+            show=False,
+            id="app.camera",
+            tooltip="Show the latest image of a camera topic",
+        ),
         Binding("q", "quit", "Quit", id="app.quit", tooltip="Close the app"),
         Binding(
             "ctrl+x",
@@ -156,9 +164,15 @@ class KinemaApp(App[None]):
     ]
 
     def __init__(
-        self, connection: RuntimeConnection, *, owns_runtime: bool = False, initial_mode: str = "objectives"
+        self,
+        connection: RuntimeConnection,
+        *,
+        owns_runtime: bool = False,
+        initial_mode: str = "objectives",
+        camera: str | None = None,
     ) -> None:
         super().__init__()
+        self.camera_topic = camera
         self.connection = connection
         self.owns_runtime = owns_runtime
         self.initial_mode = initial_mode
@@ -180,6 +194,8 @@ class KinemaApp(App[None]):
     def on_mount(self) -> None:
         self.switch_mode(self.initial_mode)
         self.connection.open(self._receive)
+        if self.camera_topic:
+            self.action_show_camera(self.camera_topic)
         # Textual, the stylesheets and the screens make ~10^5 long-lived objects; every full garbage
         # collection walks them all (hundreds of ms while the blackboard streams). Freezing them after
         # the first frame keeps those collections to what was allocated since.
@@ -368,6 +384,17 @@ class KinemaApp(App[None]):
         except KinemaError as error:
             self.notify(str(error), title="Nothing to replay", severity="warning", timeout=8)
 
+    def action_show_camera(self, topic: str | None = None) -> None:
+        """Open the camera view (on ``topic``, else the last one shown)."""
+        from kinema.tui.screens.camera import CameraScreen
+
+        if isinstance(self.screen, CameraScreen):
+            return
+        try:
+            self.push_screen(CameraScreen(topic or self.camera_topic))
+        except ValueError as error:  # KINEMA_TUI_IMAGE names no drawing method
+            self.notify(str(error), title="Cannot show images", severity="error", timeout=8)
+
     def get_system_commands(self, screen: Screen[object]) -> Iterable[SystemCommand]:
         yield from super().get_system_commands(screen)
         for mode, label, key in SCREENS:
@@ -378,6 +405,11 @@ class KinemaApp(App[None]):
             )  # type: ignore[misc]
         yield SystemCommand(
             "Cancel objective", "Cancel the running objective (ctrl+x)", self.action_cancel_objective
+        )
+        yield SystemCommand(
+            "Show a camera image",
+            "The latest picture of an image topic, e.g. /wrist_camera/color (key 7)",
+            self.action_show_camera,
         )
         yield SystemCommand(
             "Replay the latest recording",
@@ -403,7 +435,10 @@ class KinemaApp(App[None]):
 
 
 def run_app(
-    connection: RuntimeConnection, owns_runtime: bool = False, initial_mode: str = "objectives"
+    connection: RuntimeConnection,
+    owns_runtime: bool = False,
+    initial_mode: str = "objectives",
+    camera: str | None = None,
 ) -> None:
     """Open the TUI on ``connection`` and return when the user closes it.
 
@@ -413,5 +448,10 @@ def run_app(
             says so in its title. An attached app (``kinema ui``) leaves the runtime running.
         initial_mode: the first screen (``configs``, ``objectives``, ``blackboard``, ``behaviors``,
             ``logs``, ``waypoints``).
+        camera: an image topic to show in the camera view on top of it.
     """
-    KinemaApp(connection, owns_runtime=owns_runtime, initial_mode=initial_mode).run()
+    # The camera view's image library asks the terminal what it can draw; that must happen before the
+    # app takes the terminal over.
+    import kinema.tui.screens.camera  # noqa: F401
+
+    KinemaApp(connection, owns_runtime=owns_runtime, initial_mode=initial_mode, camera=camera).run()

@@ -12,7 +12,7 @@ from __future__ import annotations
 import enum
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 if TYPE_CHECKING:
     from kinema.config import Workspace
@@ -294,6 +294,28 @@ class ApprovalRequested:
     duration: float = 0.0
 
 
+@dataclass(frozen=True)
+class CameraImage:
+    """One picture of an image topic, ready to show.
+
+    Attributes:
+        topic: the topic it came on.
+        pixels: HxWx3 uint8 RGB (depth images are shaded grey: near is light).
+        encoding: the message's encoding (``rgb8``, ``32FC1``, ...).
+        frame_id: the camera frame.
+        stamp: the message's time (s; sim time for the simulated cameras).
+    """
+
+    topic: str
+    pixels: Any
+    encoding: str = "rgb8"
+    frame_id: str = ""
+    stamp: float = 0.0
+
+
+ImageListener = Callable[[CameraImage], None]
+
+
 RuntimeEvent = (
     ConnectionChanged
     | Heartbeat
@@ -366,3 +388,12 @@ class RuntimeConnection(Protocol):
 
     def list_behaviors(self) -> list[BehaviorSummary]:
         """The behaviors the runtime's config can use."""
+
+    def image_topics(self) -> list[str]:
+        """The topics that carry ``sensor_msgs/Image`` now (camera colour and depth streams)."""
+
+    def watch_images(self, topic: str, listener: ImageListener) -> Callable[[], None]:
+        """Call ``listener`` with each image on ``topic`` (on background threads; it must not block).
+
+        Returns the function that stops watching. A simulated camera renders only while watched.
+        """

@@ -9,17 +9,19 @@ asked for from :attr:`FakeConnection.calls`. ``kinema ui --demo`` shows the app 
 from __future__ import annotations
 
 import threading
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 from kinema.errors import KinemaError, ObjectiveError
 from kinema.tui.connection import (
     BehaviorSummary,
+    CameraImage,
     ConnectionChanged,
     ConnectionState,
     EventListener,
     Heartbeat,
+    ImageListener,
     ObjectiveSummary,
     PortSummary,
     RuntimeEvent,
@@ -42,6 +44,8 @@ class FakeConnection:
         failures: method name -> the error that method raises (to test error display).
         calls: ``(method, args...)`` of every call the app made, in order.
         current_joints: what :meth:`save_waypoint` records.
+        cameras: image topic -> the picture a new watcher gets first (HxWx3 uint8), as a camera that
+            renders on demand sends one; :meth:`push_image` sends more.
     """
 
     objectives: list[ObjectiveSummary] = field(default_factory=list)
@@ -56,6 +60,8 @@ class FakeConnection:
     workspace_root: str | None = None
     connect_on_open: bool = True
     listener: EventListener | None = None
+    cameras: dict[str, object] = field(default_factory=dict)
+    image_watchers: dict[str, list[ImageListener]] = field(default_factory=dict)
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
     # -- the RuntimeConnection interface --------------------------------------------------------
@@ -130,6 +136,27 @@ class FakeConnection:
         self._record("list_behaviors")
         return list(self.behaviors)
 
+    def image_topics(self) -> list[str]:
+        self._record("image_topics")
+        return sorted(self.cameras)
+
+    def watch_images(self, topic: str, listener: ImageListener) -> Callable[[], None]:
+        self._record("watch_images", topic)
+        with self._lock:
+            self.image_watchers.setdefault(topic, []).append(listener)
+        first = self.cameras.get(topic)
+        if first is not None:
+            listener(CameraImage(topic, first, "rgb8", "camera_optical_frame", 0.0))
+
+        def stop() -> None:
+            self._record("stop_watching_images", topic)
+            with self._lock:
+                watchers = self.image_watchers.get(topic, [])
+                if listener in watchers:
+                    watchers.remove(listener)
+
+        return stop
+
     # -- driving it -----------------------------------------------------------------------------
 
     def emit(self, event: RuntimeEvent) -> None:
@@ -137,6 +164,14 @@ class FakeConnection:
         listener = self.listener
         if listener is not None:
             listener(event)
+
+    def push_image(self, topic: str, pixels: object, stamp: float = 0.0) -> int:
+        """Send a picture (HxWx3 uint8) to everyone watching ``topic``; returns how many watch it."""
+        with self._lock:
+            watchers = list(self.image_watchers.get(topic, []))
+        for listener in watchers:
+            listener(CameraImage(topic, pixels, "rgb8", "camera_optical_frame", stamp))
+        return len(watchers)
 
     def called(self, method: str) -> list[tuple[object, ...]]:
         """The argument tuples of every call of ``method``."""
@@ -228,8 +263,27 @@ class FakeConnection:
             ),
         ]
         return cls(
-            objectives=objectives, xml=xml, waypoints=waypoints, behaviors=behaviors, fake_config="lab_sim"
+            objectives=objectives,
+            xml=xml,
+            waypoints=waypoints,
+            behaviors=behaviors,
+            fake_config="lab_sim",
+            cameras={"/wrist_camera/color": demo_picture()},
         )
+
+
+def demo_picture(width: int = 64, height: int = 48) -> object:
+    """A small made-up camera picture: a grey-blue gradient (the table) with a red square (the cube)."""
+    import numpy as np
+
+    rows = np.linspace(90, 200, height, dtype=np.float32)[:, None]
+    pixels = np.empty((height, width, 3), dtype=np.uint8)
+    pixels[:, :, 0] = rows * 0.8
+    pixels[:, :, 1] = rows * 0.85
+    pixels[:, :, 2] = rows
+    y, x = height // 3, width // 2
+    pixels[y : y + height // 4, x : x + height // 4] = (200, 30, 30)
+    return pixels
 
 
 _PICK_XML = """<?xml version="1.0" encoding="UTF-8"?>

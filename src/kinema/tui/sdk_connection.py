@@ -14,7 +14,7 @@ import re
 import threading
 import time
 from collections import deque
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 from xml.sax.saxutils import quoteattr
@@ -30,6 +30,7 @@ from kinema.tui.connection import (
     ConnectionState,
     EventListener,
     Heartbeat,
+    ImageListener,
     LogEntry,
     LogLevel,
     NodeStatus,
@@ -55,6 +56,8 @@ log = logging.getLogger("kinema.tui")
 #: The runtime counts as gone when no heartbeat (10 Hz) arrived for this long. Generous: a runtime busy
 #: planning on a loaded machine delays heartbeats by a second or more without being gone.
 HEARTBEAT_TIMEOUT_S = 3.0
+#: How long image_topics() waits for the network's answer about its topics.
+GRAPH_QUERY_S = 1.0
 #: After this long without heartbeats the session is dropped and a new one is opened.
 RECONNECT_AFTER_S = 6.0
 RETRY_PERIOD_S = 1.0
@@ -475,6 +478,33 @@ class SdkConnection:
                     )
                 )
         return catalog
+
+    def image_topics(self) -> list[str]:
+        from kinema.tui.camera_image import IMAGE_TYPE
+
+        client = self._require_client()
+        # A fresh look at the whole network: a session's graph cache may not know every publisher yet.
+        topics = client.node.graph(timeout=GRAPH_QUERY_S).topics()
+        return sorted(name for name, types in topics.items() if IMAGE_TYPE in types)
+
+    def watch_images(self, topic: str, listener: ImageListener) -> Callable[[], None]:
+        from kinema.tui.camera_image import IMAGE_TYPE, camera_image
+
+        client = self._require_client()
+        problems: list[str] = []
+
+        def on_image(message: Any) -> None:
+            try:
+                image = camera_image(topic, message)
+            except KinemaError as error:
+                if not problems:  # say it once, not at every frame
+                    problems.append(str(error))
+                    self._emit(LogEntry(f"{topic}: {error}", LogLevel.WARN, time.time(), "camera view"))
+                return
+            listener(image)
+
+        subscription = client.node.create_subscription(IMAGE_TYPE, topic, on_image)
+        return subscription.close
 
     def _selection(self) -> tuple[Workspace, str | None]:
         if self._selection_cache is None:

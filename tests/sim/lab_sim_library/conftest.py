@@ -68,7 +68,7 @@ def library_cell(tmp_path_factory: pytest.TempPathFactory) -> Iterator[LibraryCe
         client = ObjectiveClient(session=client_session)
         cleanup.append(client.close)
         client.wait_for_runtime()
-        yield LibraryCell(client, Node(client_session, "lab_sim_library_probe"), objectives, driver)
+        yield LibraryCell(client, Node(client_session, "lab_sim_library_probe"), objectives, driver, endpoint)
     finally:
         for step in reversed(cleanup):
             step()

@@ -29,6 +29,7 @@ class LibraryCell:
     node: Any
     objectives: Path
     driver: Any = None  # the in-process MujocoDriver, for checks against the simulated geometry
+    endpoint: str = ""
     _topics: dict[str, list[Any]] = field(default_factory=dict)
     _lock: threading.Lock = field(default_factory=threading.Lock)
 

@@ -31,6 +31,13 @@ def test_committed_files_are_what_the_generator_writes(description):
     assert description.mjcf.read_text() == gen["render_scene"](), (
         "run configs/lab_sim/description/generate.py"
     )
+    folder = LAB_SIM / "description"
+    assert (folder / gen["APRILTAGS_FILE"]).read_text() == gen["render_apriltags"](), (
+        "run configs/lab_sim/description/generate.py"
+    )
+    for tag_id in {o.tag_id for o in gen["TAGGED_OBJECTS"]} | {gen["TRAY_TAG_ID"]}:
+        texture = folder / "textures" / f"{gen['tag_texture'](tag_id)}.png"
+        assert texture.read_bytes() == gen["tag_texture_png"](tag_id), f"{texture}: run generate.py"
 
 
 def _mujoco_qpos(cell, model, q):
@@ -116,7 +123,7 @@ def test_scene_is_ready_for_a_driver(cell):
     free = [
         m.body(m.jnt_bodyid[j]).name for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE
     ]
-    assert free == ["cube"]
+    assert free[0] == "cube" and "tag_block" in free  # the cube's qpos comes first; tagged objects after
     assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_BODY, "tray") >= 0
     assert mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_SITE, "grasp_site") >= 0
 
@@ -124,11 +131,20 @@ def test_scene_is_ready_for_a_driver(cell):
 def test_robot_holds_the_default_keyframe(cell):
     """With ctrl from the keyframe the servos hold the arm still and the cube rests on the table."""
     q0 = cell.arm_q()
-    cube0 = cell.body_pos("cube")
+    cube0, block0 = cell.body_pos("cube"), cell.body_pos("tag_block")
     cell.step(2.0)
     assert np.abs(cell.arm_q() - q0).max() < 1e-3
     assert np.linalg.norm(cell.body_pos("cube") - cube0) < 1e-3
-    assert cell.d.ncon <= 8  # only cube-table contacts: the robot touches nothing
+    assert np.linalg.norm(cell.body_pos("tag_block") - block0) < 1e-3
+    m, d = cell.m, cell.d
+    objects = {m.body(name).id for name in ("cube", "tag_block")}
+    touching = {
+        m.body(m.geom_bodyid[g]).name
+        for c in d.contact[: d.ncon]
+        for g in (c.geom1, c.geom2)
+        if m.geom_bodyid[g] != 0 and m.geom_bodyid[g] not in objects
+    }
+    assert not touching, f"only objects rest on the table; the robot touches nothing: {touching}"
 
 
 def test_waypoints_file_has_moveit_pro_format_and_names():

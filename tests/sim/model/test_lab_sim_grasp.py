@@ -101,6 +101,7 @@ def test_grasp_lift_carry_and_release(cell, waypoints):
 def test_three_waypoint_pick_and_place_cycle_with_the_planner(cell, waypoints, planning):
     """The sequence of "3 Waypoints Pick and Place", twice: pick -> tray -> back, positions within 2 cm."""
     cube_start = cell.body_pos("cube")
+    block_start = cell.body_pos("tag_block")
     tray = cell.body_pos("tray")
     _planned_move(cell, planning, waypoints["3 Waypoint Mid Point"])
     cell.grip(0.0)
@@ -129,3 +130,5 @@ def test_three_waypoint_pick_and_place_cycle_with_the_planner(cell, waypoints, p
         assert np.linalg.norm(back - cube_start) < 0.02
         # Upright: the cube's z axis still points up (it was not tipped over on the way).
         assert cell.d.body("cube").xmat.reshape(3, 3)[2, 2] > 0.99
+        # The AprilTag block standing between the pick spot and the tray is never touched.
+        assert np.linalg.norm(cell.body_pos("tag_block") - block_start) < 2e-3

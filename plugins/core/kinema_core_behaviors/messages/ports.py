@@ -40,6 +40,10 @@ PRODUCERS: dict[str, str] = {
     "moveit_studio_agent_msgs/msg/RobotJointState": "CreateRobotState, LoadRobotJointStateFromYaml",
     "trajectory_msgs/msg/JointTrajectory": "PlanToJointGoal, PlanCartesianPath, LoadJointTrajectoryFromYaml",
     "moveit_msgs/msg/CollisionObject": "UnpackGraspableObjectMessage",
+    "sensor_msgs/msg/Image": "GetImage, LoadImageFromFile",
+    "sensor_msgs/msg/CameraInfo": "GetCameraInfo",
+    "sensor_msgs/msg/PointCloud2": "GetPointCloud",
+    "vision_msgs/msg/Detection3DArray": "DetectAprilTags",
 }
 
 

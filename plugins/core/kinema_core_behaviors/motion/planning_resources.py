@@ -43,8 +43,9 @@ def set_planning_scene(context: Any, scene: PlanningScene) -> None:
 
 def existing_planning_scene(context: Any) -> PlanningScene | None:
     """The context's planning scene if a behavior has made or set one, else None (nothing is loaded)."""
-    with _SCENES_LOCK:
-        return _SCENES.get(context)
+    from kinema.runtime.planning_scene_service import existing_scene
+
+    return existing_scene(context)
 
 
 def planning_scene(context: Any, model: RobotModel) -> PlanningScene:

@@ -1,5 +1,6 @@
-"""Perception: camera messages onto the blackboard, point clouds transformed, cropped, merged, registered,
-loaded from files, cut out by image masks and turned into obstacles (planning scene, collision spheres).
+"""Perception: camera messages onto the blackboard, AprilTags found in images, point clouds transformed,
+cropped, merged, registered, loaded from files, cut out by image masks and turned into obstacles (planning
+scene, collision spheres).
 
 Ports hold ``sensor_msgs`` messages as MoveIt Pro's do; the work is done on numpy arrays by
 :mod:`kinema.perception`, with the conversions in :mod:`.clouds`.
@@ -7,6 +8,7 @@ Ports hold ``sensor_msgs`` messages as MoveIt Pro's do; the work is done on nump
 
 from __future__ import annotations
 
+from .apriltags import DetectAprilTags, GetDetectionPose
 from .box_filters import CropPointsInBox, RemovePointsInBox
 from .camera_topics import GetCameraInfo, GetImage, GetPointCloud
 from .centroid import GetCentroidFromPointCloud
@@ -36,4 +38,6 @@ BEHAVIORS = (
     GetPointCloudFromMask3D,
     FindMaskedObjects,
     CreateCollisionSpheresAtClosestPoints,
+    DetectAprilTags,
+    GetDetectionPose,
 )
