@@ -562,14 +562,15 @@ TAGGED_OBJECTS = (
         "tag_block",
         0,
         TAG_BLOCK_HALF,
-        (-0.12, 0.52, TABLE_TOP + TAG_BLOCK_HALF[2]),
+        (0.0, 0.52, TABLE_TOP + TAG_BLOCK_HALF[2]),
         CELL_YAW + math.radians(20.0),
     ),
 )
-# The block stands where the wrist camera sees it from "Look at Table" at about 0.5 m (its tag 40 px
-# wide). The tray's tag lies on the table off the tray's corner nearest the robot, outside that view, so
-# that a detection of "any tag" from there is the block's (Kinema's tray is smaller than MoveIt Pro's,
-# whose tag is 0.125 m from the tray's centre).
+# The block stands where the wrist camera sees it from "Look at Table" at about 0.53 m (its tag about 40 px
+# wide), 15 cm from where "Register CAD Part Subtree" guesses a bottle (-0.15, 0.5): nearer, ICP fitted the
+# bottle model onto the block. The tray's tag lies on the table off the tray's corner nearest the robot,
+# outside that view, so that a detection of "any tag" from there is the block's (Kinema's tray is smaller
+# than MoveIt Pro's, whose tag is 0.125 m from the tray's centre).
 TRAY_TAG_CENTER = (TRAY_CENTER[0] + 0.32, TRAY_CENTER[1] - 0.17, TABLE_TOP)
 
 

@@ -26,7 +26,10 @@ if TYPE_CHECKING:
         builtin_interfaces__msg__Time,
         geometry_msgs__msg__Pose,
         geometry_msgs__msg__PoseStamped,
+        geometry_msgs__msg__PoseWithCovariance,
         geometry_msgs__msg__TransformStamped,
+        geometry_msgs__msg__Vector3,
+        sensor_msgs__msg__Image,
         sensor_msgs__msg__JointState,
         sensor_msgs__msg__MultiDOFJointState,
         shape_msgs__msg__Mesh,
@@ -508,6 +511,41 @@ if TYPE_CHECKING:
         __msgtype__: ClassVar[str] = "kinema_msgs/msg/SimBody"
 
     @dataclass
+    class kinema_msgs__msg__SolutionStep:
+        """kinema_msgs/msg/SolutionStep."""
+
+        stage: str
+        duration: float
+        joint_names: list[str]
+        gripper: str
+        note: str
+        __msgtype__: ClassVar[str] = "kinema_msgs/msg/SolutionStep"
+
+    @dataclass
+    class kinema_msgs__msg__TaskPlanningStatus:
+        """kinema_msgs/msg/TaskPlanningStatus."""
+
+        task_id: str
+        node_path: str
+        state: str
+        seconds: float
+        message: str
+        stages: list[kinema_msgs__msg__TaskStageStatus]
+        __msgtype__: ClassVar[str] = "kinema_msgs/msg/TaskPlanningStatus"
+
+    @dataclass
+    class kinema_msgs__msg__TaskStageStatus:
+        """kinema_msgs/msg/TaskStageStatus."""
+
+        name: str
+        type: str
+        kind: str
+        state: str
+        seconds: float
+        comment: str
+        __msgtype__: ClassVar[str] = "kinema_msgs/msg/TaskStageStatus"
+
+    @dataclass
     class kinema_msgs__srv__GetObjectiveXml_Request:
         """kinema_msgs/srv/GetObjectiveXml_Request."""
 
@@ -574,6 +612,8 @@ if TYPE_CHECKING:
         behavior: str
         node_path: str
         prompt: str
+        steps: list[kinema_msgs__msg__SolutionStep]
+        duration: float
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/RequestApproval_Request"
 
     @dataclass
@@ -1002,6 +1042,23 @@ if TYPE_CHECKING:
         __msgtype__: ClassVar[str] = "moveit_studio_vision_msgs/msg/GraspableObject"
 
     @dataclass
+    class moveit_studio_vision_msgs__msg__Mask2D:
+        """moveit_studio_vision_msgs/msg/Mask2D."""
+
+        x: int
+        y: int
+        mask: sensor_msgs__msg__Image
+        __msgtype__: ClassVar[str] = "moveit_studio_vision_msgs/msg/Mask2D"
+
+    @dataclass
+    class moveit_studio_vision_msgs__msg__Mask3D:
+        """moveit_studio_vision_msgs/msg/Mask3D."""
+
+        header: std_msgs__msg__Header
+        point_indices: np.ndarray[tuple[int, ...], np.dtype[np.uint32]]
+        __msgtype__: ClassVar[str] = "moveit_studio_vision_msgs/msg/Mask3D"
+
+    @dataclass
     class object_recognition_msgs__msg__ObjectType:
         """object_recognition_msgs/msg/ObjectType."""
 
@@ -1043,6 +1100,48 @@ if TYPE_CHECKING:
         success: bool
         message: str
         __msgtype__: ClassVar[str] = "std_srvs/srv/Trigger_Response"
+
+    @dataclass
+    class vision_msgs__msg__BoundingBox3D:
+        """vision_msgs/msg/BoundingBox3D."""
+
+        center: geometry_msgs__msg__Pose
+        size: geometry_msgs__msg__Vector3
+        __msgtype__: ClassVar[str] = "vision_msgs/msg/BoundingBox3D"
+
+    @dataclass
+    class vision_msgs__msg__Detection3D:
+        """vision_msgs/msg/Detection3D."""
+
+        header: std_msgs__msg__Header
+        results: list[vision_msgs__msg__ObjectHypothesisWithPose]
+        bbox: vision_msgs__msg__BoundingBox3D
+        id: str
+        __msgtype__: ClassVar[str] = "vision_msgs/msg/Detection3D"
+
+    @dataclass
+    class vision_msgs__msg__Detection3DArray:
+        """vision_msgs/msg/Detection3DArray."""
+
+        header: std_msgs__msg__Header
+        detections: list[vision_msgs__msg__Detection3D]
+        __msgtype__: ClassVar[str] = "vision_msgs/msg/Detection3DArray"
+
+    @dataclass
+    class vision_msgs__msg__ObjectHypothesis:
+        """vision_msgs/msg/ObjectHypothesis."""
+
+        class_id: str
+        score: float
+        __msgtype__: ClassVar[str] = "vision_msgs/msg/ObjectHypothesis"
+
+    @dataclass
+    class vision_msgs__msg__ObjectHypothesisWithPose:
+        """vision_msgs/msg/ObjectHypothesisWithPose."""
+
+        hypothesis: vision_msgs__msg__ObjectHypothesis
+        pose: geometry_msgs__msg__PoseWithCovariance
+        __msgtype__: ClassVar[str] = "vision_msgs/msg/ObjectHypothesisWithPose"
 
     class CancelGoal(
         ServiceDefinition[
@@ -1388,6 +1487,9 @@ _MESSAGES = frozenset(
         "kinema_msgs__msg__ObjectiveServerHealth",
         "kinema_msgs__msg__SceneState",
         "kinema_msgs__msg__SimBody",
+        "kinema_msgs__msg__SolutionStep",
+        "kinema_msgs__msg__TaskPlanningStatus",
+        "kinema_msgs__msg__TaskStageStatus",
         "kinema_msgs__srv__GetObjectiveXml_Request",
         "kinema_msgs__srv__GetObjectiveXml_Response",
         "kinema_msgs__srv__GetSimBodies_Request",
@@ -1438,11 +1540,18 @@ _MESSAGES = frozenset(
         "moveit_studio_sdk_msgs__srv__ExecuteObjective_Request",
         "moveit_studio_sdk_msgs__srv__ExecuteObjective_Response",
         "moveit_studio_vision_msgs__msg__GraspableObject",
+        "moveit_studio_vision_msgs__msg__Mask2D",
+        "moveit_studio_vision_msgs__msg__Mask3D",
         "object_recognition_msgs__msg__ObjectType",
         "octomap_msgs__msg__Octomap",
         "octomap_msgs__msg__OctomapWithPose",
         "std_srvs__srv__Trigger_Request",
         "std_srvs__srv__Trigger_Response",
+        "vision_msgs__msg__BoundingBox3D",
+        "vision_msgs__msg__Detection3D",
+        "vision_msgs__msg__Detection3DArray",
+        "vision_msgs__msg__ObjectHypothesis",
+        "vision_msgs__msg__ObjectHypothesisWithPose",
     }
 )
 

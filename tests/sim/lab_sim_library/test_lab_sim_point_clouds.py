@@ -43,6 +43,22 @@ def cell(library_cell: LibraryCell) -> LibraryCell:
     assert cameras.ready.wait(60), "the camera thread did not get ready within 60 s"
     if cameras.unavailable is not None:
         pytest.skip(f"no OpenGL for MuJoCo ({cameras.unavailable}). {GL_HELP}")
+    # Each camera renders once before the objectives run, then stops again (nobody left subscribed): on a
+    # loaded machine a camera's very first frame took longer than the corpus's 10 s message timeout.
+    from kinema.transport import Node
+
+    # Subscribed now, long before an objective sends to the UI: a subscription made just before a run
+    # could still be on its way to the router when the snapshot went out.
+    library_cell.listen("sensor_msgs/msg/PointCloud2", CAPTURES)
+    probe = Node(library_cell.node.session, "lab_sim_camera_warmup")
+    try:
+        for topic in ("/scene_camera/points", "/wrist_camera/points"):
+            box: list[Any] = []
+            subscription = probe.create_subscription("sensor_msgs/msg/PointCloud2", topic, box.append)
+            wait_for(lambda: box, 120.0, f"a first cloud on {topic}")  # noqa: B023 - called now
+            subscription.close()
+    finally:
+        probe.close()
     return library_cell
 
 
