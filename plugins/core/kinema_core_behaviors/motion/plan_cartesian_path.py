@@ -21,7 +21,9 @@ class PlanCartesianPath(AsyncBehavior):
     """Plans the tool link through ``path`` (PoseStamped waypoints) in straight lines from the current state.
 
     Each pose is in ``world`` or in a robot link's frame (taken at the start state). IK is solved every
-    ``ik_cartesian_space_density`` metres along the lines, seeded by the previous solution. Fails naming
+    ``ik_cartesian_space_density`` metres along the lines, seeded by the previous solution and capped at
+    ``max_optimizer_iterations`` iterations; interior corners are rounded by ``blending_radius`` (a
+    circular arc tangent to both lines). Fails naming
     where and why the line could not be followed (no IK solution, a joint jump, a collision); the
     result is timed under the scaled joint limits.
     """
@@ -77,15 +79,19 @@ class PlanCartesianPath(AsyncBehavior):
                 "blending_radius",
                 float,
                 0.02,
-                "MoveIt Pro's corner blending (m); Kinema passes through every pose exactly, so it is "
-                "accepted and has no effect.",
+                "Corner rounding (m), >= 0: the tool leaves the straight lines this far before each "
+                "interior pose and joins the next line this far after it, along a circular arc tangent "
+                "to both (clamped to half the shorter neighbouring line), its orientation turning along "
+                "the arc; the first and last poses are reached exactly. 0 passes through every pose.",
             ),
             input_port(
                 "max_optimizer_iterations",
                 int,
                 1,
-                "MoveIt Pro's path optimizer iterations; Kinema does not optimise the IK path, so it is "
-                "accepted and has no effect (default from the corpus).",
+                "Iteration cap (>= 1) of the IK solved at each IK sample along the path, seeded by the "
+                "previous sample; a sample whose IK does not converge within it fails the planning. "
+                "Default 1 as in the MoveIt Pro objectives (one damped least-squares step per "
+                "sample).",
             ),
             output_port(
                 "joint_trajectory_msg",
@@ -124,6 +130,12 @@ class PlanCartesianPath(AsyncBehavior):
             jump = float(self.get_input("ik_joint_space_density"))
             if not jump > 0:
                 return self._fail(f"ik_joint_space_density must be > 0, got {jump}")
+            radius = float(self.get_input("blending_radius"))
+            if not radius >= 0:
+                return self._fail(f"blending_radius must be >= 0 (m), got {radius}")
+            iterations = int(self.get_input("max_optimizer_iterations"))
+            if iterations < 1:
+                return self._fail(f"max_optimizer_iterations must be >= 1, got {iterations}")
             poses = self._poses()
             start = joint_state_monitor(self.context, "PlanCartesianPath").positions(model.joint_names)
             targets = []
@@ -142,6 +154,8 @@ class PlanCartesianPath(AsyncBehavior):
                 max_step=float(self.get_input("ik_cartesian_space_density")),
                 jump_threshold=jump,
                 position_only=bool(self.get_input("position_only")),
+                blending_radius=radius,
+                max_iterations=iterations,
             )
             if result.fraction < 1.0 - 1e-6:
                 return self._fail(
