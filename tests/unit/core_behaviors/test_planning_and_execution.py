@@ -184,26 +184,6 @@ def test_plan_cartesian_path_refuses_a_negative_blending_radius(
     assert "blending_radius must be >= 0 (m), got -0.01" in run.toasts[-1], run.toasts
 
 
-def test_plan_cartesian_path_fails_when_the_ik_cannot_converge_in_max_optimizer_iterations(
-    behavior: Any, context: BehaviorContext, at_home: Any
-) -> None:
-    # one IK sample for a 15 cm move: one iteration cannot reach it, a hundred can
-    path = [_tool_pose(behavior, context, [0.0, 0.0, 0.15])]
-    hard = {"path": path, "ik_cartesian_space_density": 0.15, "ik_joint_space_density": 3.0}
-    capped = tick_behavior(
-        behavior("PlanCartesianPath"), {**hard, "max_optimizer_iterations": 1}, context=context, timeout=30.0
-    )
-    assert capped.status == NodeStatus.FAILURE
-    assert "the IK did not converge within 1 iteration(s)" in capped.toasts[-1], capped.toasts
-    roomy = tick_behavior(
-        behavior("PlanCartesianPath"),
-        {**hard, "max_optimizer_iterations": 100},
-        context=context,
-        timeout=30.0,
-    )
-    assert roomy.status == NodeStatus.SUCCESS, roomy.toasts
-
-
 class Controller:
     """A fake FollowJointTrajectory server."""
 

@@ -118,6 +118,6 @@ def test_an_ik_iteration_cap_too_small_for_the_steps_stops_the_path(model, check
     assert "the IK did not converge within 1 iteration(s)" in capped.reason, capped.reason
     roomy = plan_cartesian_path(checker, start, [corner, end], max_iterations=50, **hard)
     assert roomy.fraction == pytest.approx(1.0), roomy.reason
-    # MoveIt Pro's objectives use 1: enough for the default 5 mm samples
+    # on this easy corner one step per default 5 mm sample is enough
     fine = plan_cartesian_path(checker, start, [corner, end], blending_radius=0.02, max_iterations=1)
     assert fine.fraction == pytest.approx(1.0), fine.reason

@@ -21,9 +21,8 @@ class PlanCartesianPath(AsyncBehavior):
     """Plans the tool link through ``path`` (PoseStamped waypoints) in straight lines from the current state.
 
     Each pose is in ``world`` or in a robot link's frame (taken at the start state). IK is solved every
-    ``ik_cartesian_space_density`` metres along the lines, seeded by the previous solution and capped at
-    ``max_optimizer_iterations`` iterations; interior corners are rounded by ``blending_radius`` (a
-    circular arc tangent to both lines). Fails naming
+    ``ik_cartesian_space_density`` metres along the lines, seeded by the previous solution; interior
+    corners are rounded by ``blending_radius`` (a circular arc tangent to both lines). Fails naming
     where and why the line could not be followed (no IK solution, a joint jump, a collision); the
     result is timed under the scaled joint limits.
     """
@@ -88,10 +87,10 @@ class PlanCartesianPath(AsyncBehavior):
                 "max_optimizer_iterations",
                 int,
                 1,
-                "Iteration cap (>= 1) of the IK solved at each IK sample along the path, seeded by the "
-                "previous sample; a sample whose IK does not converge within it fails the planning. "
-                "Default 1 as in the MoveIt Pro objectives (one damped least-squares step per "
-                "sample).",
+                "MoveIt Pro's path optimizer iterations (its meaning is not public). Accepted and not "
+                "applied: as a cap on Kinema's per-sample IK, the corpus's 1 fails ordinary paths (one "
+                "damped least-squares step from the previous sample can miss the 0.1 mm tolerance), "
+                "so each sample's IK keeps its own cap of 50 iterations.",
             ),
             output_port(
                 "joint_trajectory_msg",
@@ -133,9 +132,6 @@ class PlanCartesianPath(AsyncBehavior):
             radius = float(self.get_input("blending_radius"))
             if not radius >= 0:
                 return self._fail(f"blending_radius must be >= 0 (m), got {radius}")
-            iterations = int(self.get_input("max_optimizer_iterations"))
-            if iterations < 1:
-                return self._fail(f"max_optimizer_iterations must be >= 1, got {iterations}")
             poses = self._poses()
             start = joint_state_monitor(self.context, "PlanCartesianPath").positions(model.joint_names)
             targets = []
@@ -155,7 +151,6 @@ class PlanCartesianPath(AsyncBehavior):
                 jump_threshold=jump,
                 position_only=bool(self.get_input("position_only")),
                 blending_radius=radius,
-                max_iterations=iterations,
             )
             if result.fraction < 1.0 - 1e-6:
                 return self._fail(
