@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-import itertools
 from collections.abc import Sequence
 from dataclasses import dataclass
 
 import numpy as np
 
 from kinema.errors import MotionError
+from kinema.motion.blending import blended_pieces
 from kinema.motion.collision import CollisionChecker
 from kinema.motion.inverse_kinematics import IkOptions, ik
 from kinema.motion.kinematics import fk
@@ -30,17 +30,6 @@ class CartesianResult:
     reason: str = ""
 
 
-def _slerp(qa: np.ndarray, qb: np.ndarray, t: float) -> np.ndarray:
-    dot = float(np.dot(qa, qb))
-    if dot < 0:
-        qb, dot = -qb, -dot
-    if dot > 0.9995:
-        q = qa + t * (qb - qa)
-        return q / np.linalg.norm(q)
-    theta = np.arccos(dot)
-    return (np.sin((1 - t) * theta) * qa + np.sin(t * theta) * qb) / np.sin(theta)
-
-
 def plan_cartesian_path(
     checker: CollisionChecker,
     start: np.ndarray,
@@ -52,8 +41,14 @@ def plan_cartesian_path(
     max_rotation_step: float = 0.05,
     jump_threshold: float = 0.3,
     position_only: bool = False,
+    blending_radius: float = 0.0,
+    max_iterations: int = 50,
 ) -> CartesianResult:
     """Move ``frame`` through ``world_T_waypoints`` in straight lines, solving IK every ``max_step`` metres.
+
+    With ``blending_radius`` > 0 each interior corner is rounded by a circular arc that leaves the lines
+    that far from the waypoint (see :func:`kinema.motion.blending.blended_pieces`); the last waypoint is
+    still reached exactly.
 
     Each step's IK is seeded with the previous step's answer, so the arm stays on one branch. The path
     stops early (``fraction`` < 1) at the first step with no IK solution, a joint jump larger than
@@ -69,11 +64,15 @@ def plan_cartesian_path(
         max_rotation_step: largest rotation between IK solutions (rad).
         jump_threshold: largest joint change allowed between consecutive solutions.
         position_only: only the position of ``frame`` follows the line.
+        blending_radius: distance (m) from each interior waypoint at which its corner blend starts and
+            ends; 0 passes through every waypoint.
+        max_iterations: iteration cap of each step's IK (seeded by the previous step); a step whose IK
+            does not converge within it stops the path.
 
     Raises:
-        MotionError: no waypoints, an unknown group/frame, or a start in collision.
+        MotionError: no waypoints, an unknown group/frame, a start in collision, a negative blending
+            radius or an iteration cap below 1.
     """
-    from scipy.spatial.transform import Rotation
 
     model = checker.model
     g = model.group(group)
@@ -88,32 +87,31 @@ def plan_cartesian_path(
     cols = list(g.indices)
     data = model.new_data()
     current = fk(model, q, tip, data)
+    if blending_radius < 0:
+        raise MotionError(f"blending_radius must be >= 0 (m), got {blending_radius}")
+    if max_iterations < 1:
+        raise MotionError(f"the IK iteration cap must be >= 1, got {max_iterations}")
     poses = [current, *(np.asarray(T, dtype=float) for T in world_T_waypoints)]
-    total = sum(float(np.linalg.norm(b[:3, 3] - a[:3, 3])) for a, b in itertools.pairwise(poses))
-    rotation_total = sum(
-        float((Rotation.from_matrix(a[:3, :3]).inv() * Rotation.from_matrix(b[:3, :3])).magnitude())
-        for a, b in itertools.pairwise(poses)
-    )
+    pieces = blended_pieces(poses, blending_radius)
+    total = sum(piece.length for piece in pieces)
+    rotation_total = sum(piece.rotation for piece in pieces)
     rows = [q[cols].copy()]
     done = 0.0
     done_rotation = 0.0
-    options = IkOptions(attempts=1, max_iterations=50)
+    options = IkOptions(attempts=1, max_iterations=max_iterations)
     reason = ""
-    for a, b in itertools.pairwise(poses):
-        qa = Rotation.from_matrix(a[:3, :3]).as_quat()
-        qb = Rotation.from_matrix(b[:3, :3]).as_quat()
-        seg = float(np.linalg.norm(b[:3, 3] - a[:3, 3]))
-        angle = float((Rotation.from_matrix(a[:3, :3]).inv() * Rotation.from_matrix(b[:3, :3])).magnitude())
+    for piece in pieces:
+        seg, angle = piece.length, piece.rotation
         steps = max(1, int(np.ceil(max(seg / max_step, 0 if position_only else angle / max_rotation_step))))
         for s in range(1, steps + 1):
-            t = s / steps
-            target = np.eye(4)
-            target[:3, 3] = a[:3, 3] + t * (b[:3, 3] - a[:3, 3])
-            target[:3, :3] = Rotation.from_quat(_slerp(qa, qb, t)).as_matrix()
+            target = piece.pose_at(s / steps)
             try:
                 q_next = ik(model, target, q, group, tip, position_only=position_only, options=options)
-            except MotionError:
-                reason = f"no IK solution at {np.round(target[:3, 3], 4).tolist()}"
+            except MotionError as error:
+                reason = (
+                    f"no IK solution at {np.round(target[:3, 3], 4).tolist()}: the IK did not converge "
+                    f"within {max_iterations} iteration(s) ({error})"
+                )
                 break
             jump = float(np.abs(q_next[cols] - q[cols]).max())
             if jump > jump_threshold:

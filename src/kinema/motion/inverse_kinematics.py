@@ -21,7 +21,7 @@ class IkOptions:
     Attributes:
         position_tolerance: accepted position error (m).
         orientation_tolerance: accepted orientation error (rad).
-        max_iterations: iterations per seed.
+        max_iterations: iterations (damped least-squares steps) per seed.
         attempts: seeds tried in all: the given seed first, then random ones inside the limits.
         restart_solutions: when the given seed fails, random restarts stop after this many solutions and
             the one closest to the seed is returned.
@@ -102,7 +102,8 @@ def ik(
         q = seed.copy()
         if attempt > 0:
             q[cols] = rng.uniform(lo, hi)
-        for _ in range(opts.max_iterations):
+        # max_iterations steps, each followed by a convergence check (the seed is checked first).
+        for iteration in range(opts.max_iterations + 1):
             pq = model.pin_configuration(q)
             pin.framesForwardKinematics(pm, data, pq)
             current_T_target = data.oMf[fid].actInv(target)
@@ -123,6 +124,8 @@ def ik(
                 break
             if (pos_err, rot_err) < best_error:
                 best_error = (pos_err, rot_err)
+            if iteration == opts.max_iterations:
+                break
             if position_only:
                 J = pin.computeFrameJacobian(pm, data, pq, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
                 J = (J @ model.mimic_map)[rows][:, cols]
@@ -145,6 +148,7 @@ def ik(
     )
     raise MotionError(
         f"no IK solution for {tip!r} in group {group!r} at position "
-        f"{np.round(target.translation, 4).tolist()} after {opts.attempts} seeds: best error "
+        f"{np.round(target.translation, 4).tolist()} after {opts.attempts} seed(s) of "
+        f"{opts.max_iterations} iteration(s) each: best error "
         f"{best_error[0]:.4f} m / {best_error[1]:.4f} rad; {reason}"
     )

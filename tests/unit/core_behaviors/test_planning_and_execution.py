@@ -134,6 +134,56 @@ def test_plan_cartesian_path_moves_the_tool_straight_down(
     np.testing.assert_allclose(moved, start[:3, 2] * 0.05, atol=2e-3)
 
 
+def _tool_pose(behavior: Any, context: BehaviorContext, xyz: list[float]) -> Any:
+    return tick_behavior(
+        behavior("CreatePoseStamped"),
+        {"reference_frame": "grasp_link", "position_xyz": xyz, "orientation_xyzw": [0.0, 0.0, 0.0, 1.0]},
+        context=context,
+    ).outputs["pose_stamped"]
+
+
+def test_plan_cartesian_path_rounds_corners_by_blending_radius(
+    behavior: Any, context: BehaviorContext, at_home: Any
+) -> None:
+    from kinema.motion import fk
+
+    model = context.robot_model
+    q = model.neutral().copy()
+    q[: len(HOME)] = HOME
+    start = fk(model, q, "grasp_link")
+    # 5 cm along the tool's z, then 5 cm along its x: a right angle 5 cm out
+    path = [_tool_pose(behavior, context, [0.0, 0.0, 0.05]), _tool_pose(behavior, context, [0.05, 0.0, 0.05])]
+    corner = (start @ np.array([0.0, 0.0, 0.05, 1.0]))[:3]
+    closest = {}
+    for radius in (0.0, 0.02):
+        run = tick_behavior(
+            behavior("PlanCartesianPath"),
+            {"path": path, "blending_radius": radius},
+            context=context,
+            timeout=30.0,
+        )
+        assert run.status == NodeStatus.SUCCESS, run.toasts
+        tool = []
+        for point in run.outputs["joint_trajectory_msg"].points:
+            q_point = q.copy()
+            q_point[: len(ARM)] = list(point.positions)
+            tool.append(fk(model, q_point, "grasp_link")[:3, 3])
+        closest[radius] = float(np.linalg.norm(np.array(tool) - corner, axis=1).min())
+    assert closest[0.0] < 2e-3, closest
+    assert closest[0.02] == pytest.approx(0.02 * (np.sqrt(2) - 1), abs=2e-3), closest
+
+
+def test_plan_cartesian_path_refuses_a_negative_blending_radius(
+    behavior: Any, context: BehaviorContext, at_home: Any
+) -> None:
+    path = [_tool_pose(behavior, context, [0.0, 0.0, 0.05])]
+    run = tick_behavior(
+        behavior("PlanCartesianPath"), {"path": path, "blending_radius": -0.01}, context=context, timeout=30.0
+    )
+    assert run.status == NodeStatus.FAILURE
+    assert "blending_radius must be >= 0 (m), got -0.01" in run.toasts[-1], run.toasts
+
+
 class Controller:
     """A fake FollowJointTrajectory server."""
 

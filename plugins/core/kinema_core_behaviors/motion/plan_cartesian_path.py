@@ -21,7 +21,8 @@ class PlanCartesianPath(AsyncBehavior):
     """Plans the tool link through ``path`` (PoseStamped waypoints) in straight lines from the current state.
 
     Each pose is in ``world`` or in a robot link's frame (taken at the start state). IK is solved every
-    ``ik_cartesian_space_density`` metres along the lines, seeded by the previous solution. Fails naming
+    ``ik_cartesian_space_density`` metres along the lines, seeded by the previous solution; interior
+    corners are rounded by ``blending_radius`` (a circular arc tangent to both lines). Fails naming
     where and why the line could not be followed (no IK solution, a joint jump, a collision); the
     result is timed under the scaled joint limits.
     """
@@ -77,15 +78,19 @@ class PlanCartesianPath(AsyncBehavior):
                 "blending_radius",
                 float,
                 0.02,
-                "MoveIt Pro's corner blending (m); Kinema passes through every pose exactly, so it is "
-                "accepted and has no effect.",
+                "Corner rounding (m), >= 0: the tool leaves the straight lines this far before each "
+                "interior pose and joins the next line this far after it, along a circular arc tangent "
+                "to both (clamped to half the shorter neighbouring line), its orientation turning along "
+                "the arc; the first and last poses are reached exactly. 0 passes through every pose.",
             ),
             input_port(
                 "max_optimizer_iterations",
                 int,
                 1,
-                "MoveIt Pro's path optimizer iterations; Kinema does not optimise the IK path, so it is "
-                "accepted and has no effect (default from the corpus).",
+                "MoveIt Pro's path optimizer iterations (its meaning is not public). Accepted and not "
+                "applied: as a cap on Kinema's per-sample IK, the corpus's 1 fails ordinary paths (one "
+                "damped least-squares step from the previous sample can miss the 0.1 mm tolerance), "
+                "so each sample's IK keeps its own cap of 50 iterations.",
             ),
             output_port(
                 "joint_trajectory_msg",
@@ -124,6 +129,9 @@ class PlanCartesianPath(AsyncBehavior):
             jump = float(self.get_input("ik_joint_space_density"))
             if not jump > 0:
                 return self._fail(f"ik_joint_space_density must be > 0, got {jump}")
+            radius = float(self.get_input("blending_radius"))
+            if not radius >= 0:
+                return self._fail(f"blending_radius must be >= 0 (m), got {radius}")
             poses = self._poses()
             start = joint_state_monitor(self.context, "PlanCartesianPath").positions(model.joint_names)
             targets = []
@@ -142,6 +150,7 @@ class PlanCartesianPath(AsyncBehavior):
                 max_step=float(self.get_input("ik_cartesian_space_density")),
                 jump_threshold=jump,
                 position_only=bool(self.get_input("position_only")),
+                blending_radius=radius,
             )
             if result.fraction < 1.0 - 1e-6:
                 return self._fail(
