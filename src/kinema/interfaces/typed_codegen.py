@@ -17,7 +17,7 @@ from typing import Any
 from rosbags.typesys.base import Nodetype, normalize_fieldname
 from rosbags.typesys.codegen import get_typehint
 
-from kinema.interfaces import load_interfaces
+from kinema.interfaces import interfaces_dir
 from kinema.interfaces.registry import TypeRegistry
 
 TARGET = Path(__file__).with_name("typed.py")
@@ -145,7 +145,11 @@ def _indent(lines: list[str]) -> list[str]:
 
 def generate(registry: TypeRegistry | None = None) -> str:
     """The source of ``typed.py`` for every interface package bundled in ``registry``."""
-    registry = registry if registry is not None else load_interfaces()
+    if registry is None:
+        # A registry of its own: the process-wide one lists fewer packages once some are loaded, so the
+        # output would depend on what ran before (a full test run generated another file than a fresh one).
+        registry = TypeRegistry()
+        registry.add_directory(interfaces_dir())
     packages = set(registry.packages())  # before loading: loaded packages of messages only are not listed
     registry.load_all()
     fielddefs = registry.typestore.fielddefs
@@ -164,7 +168,7 @@ def generate(registry: TypeRegistry | None = None) -> str:
     services: dict[str, str] = {}
     actions: dict[str, str] = {}
     for kind, table in (("srv", services), ("action", actions)):
-        for type_name in registry.names(kind):
+        for type_name in sorted(registry.names(kind)):
             short = type_name.rsplit("/", 1)[1]
             if short in services or short in actions:
                 raise ValueError(f"two interfaces named {short}: {services.get(short, actions.get(short))}")
