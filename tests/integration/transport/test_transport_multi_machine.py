@@ -154,8 +154,10 @@ def test_mutual_tls_and_access_rules(tmp_path: Path, endpoints: Callable[[], str
                 switch = operator.create_client(
                     "controller_manager_msgs/srv/SwitchController", "/controller_manager/switch_controller"
                 )
-                with pytest.raises(TransportError, match="no server"):
-                    switch.call({}, timeout=0.5)  # not in the operators' rules: dropped by the router
+                # Not in the operators' rules: the router drops the query. It comes back empty ("no server")
+                # or, on a loaded machine, runs out the whole 0.5 s ("did not answer"): never an answer.
+                with pytest.raises(TransportError, match=r"no server|did not answer"):
+                    switch.call({}, timeout=0.5)
             # The local process may do everything.
             local_switch = Node(robot, "local").create_client(
                 "controller_manager_msgs/srv/SwitchController", "/controller_manager/switch_controller"
