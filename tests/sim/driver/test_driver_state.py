@@ -149,8 +149,10 @@ def test_clock_runs_faster_than_wall_time_at_max_speed(sim: Sim) -> None:
     # Unpaced, the sim soon runs ahead of the wall clock even when the machine starves it for a moment; a
     # sim paced at real time never gets 1.5x ahead however long this waits.
     wait_for(
-        lambda: time.monotonic() - wall_start > 0.5
-        and clock[-1] - sim_start > 1.5 * (time.monotonic() - wall_start),
+        lambda: (
+            time.monotonic() - wall_start > 0.5
+            and clock[-1] - sim_start > 1.5 * (time.monotonic() - wall_start)
+        ),
         timeout=60.0,
         what="sim time 1.5x ahead of the wall clock",
     )
