@@ -61,9 +61,10 @@ def test_preempting_a_moving_arm_50_times_never_aborts(sim: Sim) -> None:
     offsets = []
     preempted = 0
     for i in range(50):
-        # Mid-motion, while the arm moves fast, with 50 to 250 ms of sim time spent "planning".
+        # Mid-motion, while the arm moves fast, with 50 to 410 ms of sim time spent "planning" (with at
+        # most 250 ms a quiet machine left only 3 of 40 starts beyond the path tolerance).
         wait_for(lambda r=running: _fast(sim, 0.3) or r.done(), 20.0, f"the arm to speed up ({i + 1})")
-        stale_for = 0.05 + 0.2 * ((i * 3) % 10) / 10
+        stale_for = 0.05 + 0.4 * ((i * 3) % 10) / 10
         new, off_by = _preempt_with_a_stale_start(sim, targets[(i + 1) % 2], stale_for)
         result = running.result(10.0)
         detail = f"preemption {i + 1}: {result.result.error_string}"
