@@ -120,3 +120,27 @@ def test_depth_and_grey_images_become_rgb() -> None:
     )
     with pytest.raises(PerceptionError, match="cannot show image encoding 'yuv422'; valid: rgb8"):
         camera_image("/cam/odd", bad)
+
+
+def test_a_camera_asked_for_at_start_is_shown_once_the_runtime_connects(
+    fake: FakeConnection, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """`kinema ui --camera TOPIC` opens the view before the connection is up: it waits, then watches."""
+    from kinema.tui.connection import ConnectionChanged, ConnectionState
+
+    monkeypatch.setenv("KINEMA_TUI_IMAGE", "halfcell")
+    fake.cameras = {"/wrist_camera/color": picture((200, 30, 30))}
+    fake.connect_on_open = False
+
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        screen = app.screen
+        assert isinstance(screen, CameraScreen)
+        assert not fake.called("watch_images")
+        fake.emit(ConnectionChanged(ConnectionState.CONNECTED, fake.fake_endpoint))
+        await pilot.pause(1.0)
+        await settle(pilot)
+        assert fake.called("watch_images")[-1] == ("/wrist_camera/color",)
+        await pilot.pause(0.5)  # the screen redraws every 0.2 s
+        assert (200, 30, 30) in drawn_colors(screen)
+
+    drive(fake, scenario, camera="/wrist_camera/color")

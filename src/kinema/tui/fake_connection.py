@@ -13,7 +13,7 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
-from kinema.errors import KinemaError, ObjectiveError
+from kinema.errors import KinemaError, ObjectiveError, TransportError
 from kinema.tui.connection import (
     BehaviorSummary,
     CameraImage,
@@ -59,6 +59,7 @@ class FakeConnection:
     fake_config: str | None = None
     workspace_root: str | None = None
     connect_on_open: bool = True
+    connected: bool = False
     listener: EventListener | None = None
     cameras: dict[str, object] = field(default_factory=dict)
     image_watchers: dict[str, list[ImageListener]] = field(default_factory=dict)
@@ -138,10 +139,12 @@ class FakeConnection:
 
     def image_topics(self) -> list[str]:
         self._record("image_topics")
+        self._require_connected()
         return sorted(self.cameras)
 
     def watch_images(self, topic: str, listener: ImageListener) -> Callable[[], None]:
         self._record("watch_images", topic)
+        self._require_connected()
         with self._lock:
             self.image_watchers.setdefault(topic, []).append(listener)
         first = self.cameras.get(topic)
@@ -159,8 +162,15 @@ class FakeConnection:
 
     # -- driving it -----------------------------------------------------------------------------
 
+    def _require_connected(self) -> None:
+        """Refuse as the real connection does before it has a runtime."""
+        if not self.connected:
+            raise TransportError(f"not connected to a runtime at {self.fake_endpoint} (fake)")
+
     def emit(self, event: RuntimeEvent) -> None:
         """Deliver ``event`` as the runtime would (on the calling thread)."""
+        if isinstance(event, ConnectionChanged):
+            self.connected = event.state is ConnectionState.CONNECTED
         listener = self.listener
         if listener is not None:
             listener(event)

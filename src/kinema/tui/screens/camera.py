@@ -21,7 +21,7 @@ from textual.message import Message
 from textual.screen import Screen
 from textual.widgets import Footer, Select, Static
 
-from kinema.tui.connection import CameraImage
+from kinema.tui.connection import CameraImage, ConnectionState
 
 try:  # Queries the terminal once; it must happen before the app starts (textual-image's rule).
     import textual_image.widget as image_widgets
@@ -116,7 +116,26 @@ class CameraScreen(Screen[None]):
 
     def on_mount(self) -> None:
         self.set_interval(REDRAW_PERIOD_S, self._redraw)
-        self.action_refresh_topics()
+        self._when_connected(self.action_refresh_topics)
+
+    def _when_connected(self, step: Any) -> None:
+        """Run ``step`` now if the runtime is connected, else as soon as it is: `kinema ui --camera` opens
+        this screen before the connection is up, and the connection refuses to list or watch until then."""
+        if self._connected():
+            step()
+            return
+        self._placeholder("Waiting for the runtime ...")
+
+        def check() -> None:
+            if self._connected():
+                timer.stop()
+                step()
+
+        timer = self.set_interval(0.25, check)
+
+    def _connected(self) -> bool:
+        status = getattr(self.app, "status", None)
+        return status is None or status.state is ConnectionState.CONNECTED
 
     @property
     def connection(self) -> Any:
@@ -195,7 +214,8 @@ class CameraScreen(Screen[None]):
 
     def on_screen_resume(self) -> None:
         if self.topic and not self._watching:
-            self.watch(self.topic)
+            topic = self.topic
+            self._when_connected(lambda: self._watching or self.watch(topic))
 
     def on_unmount(self) -> None:
         self._unwatch()
