@@ -4,9 +4,13 @@ from __future__ import annotations
 
 import functools
 import threading
+import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
+
+import pytest
 
 
 @functools.cache
@@ -19,6 +23,17 @@ def lab_sim_model() -> Any:
 
 # The arm's joints (rail first), as MoveIt Pro's files list them: lab_sim's "manipulator" group.
 ARM: tuple[str, ...] = tuple(lab_sim_model().group("manipulator").joint_names)
+
+
+def wait_for(predicate: Callable[[], Any], timeout: float, what: str) -> Any:
+    """The first true value of ``predicate`` within ``timeout`` s, else an AssertionError naming ``what``."""
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        value = predicate()
+        if value:
+            return value
+        time.sleep(0.02)
+    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
 
 
 @dataclass
@@ -41,3 +56,25 @@ class LibraryCell:
                 self._topics[topic] = box
                 self.node.create_subscription(msg_type, topic, box.append, latched=latched)
             return self._topics[topic]
+
+    def render_each_camera_once(self, topics: tuple[tuple[str, str], ...], timeout: float) -> None:
+        """Skip (naming what to install) without OpenGL; else take one message of each (type, topic).
+
+        The objectives give a camera 5-10 s; in this one process (driver, agent and test side by side on a
+        loaded machine) a camera's first frame after a subscription can take longer. Unwatched again
+        afterwards, the cameras stop rendering.
+        """
+        from kinema.drivers.mujoco.cameras import GL_HELP
+
+        cameras = self.driver.cameras
+        assert cameras is not None, "lab_sim has cameras, the driver serves none"
+        assert cameras.ready.wait(60), "the camera thread did not get ready within 60 s"
+        if cameras.unavailable is not None:
+            pytest.skip(f"no OpenGL for MuJoCo ({cameras.unavailable}). {GL_HELP}")
+        for msg_type, topic in topics:
+            box: list[Any] = []
+            subscription = self.node.create_subscription(msg_type, topic, box.append)
+            try:
+                wait_for(lambda: box, timeout, f"a first message on {topic}")  # noqa: B023 - called now
+            finally:
+                subscription.close()

@@ -9,13 +9,12 @@ from __future__ import annotations
 
 import runpy
 import time
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import pytest
 import yaml
-from lab_sim_library_cell import LibraryCell
+from lab_sim_library_cell import LibraryCell, wait_for
 from scipy.spatial.transform import Rotation
 
 from kinema.resources import bundled_dir
@@ -41,36 +40,10 @@ FIND_TAG = """<root BTCPP_format="4" main_tree_to_execute="Find Tag Test">
 </root>"""
 
 
-def wait_for(predicate: Callable[[], Any], timeout: float, what: str) -> Any:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.05)
-    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-
-
 @pytest.fixture(scope="module")
 def cell(library_cell: LibraryCell) -> LibraryCell:
     """The library cell, with its cameras rendering (else the tests skip, naming what to install)."""
-    from kinema.drivers.mujoco.cameras import GL_HELP
-
-    cameras = library_cell.driver.cameras
-    assert cameras is not None, "lab_sim has cameras, the driver serves none"
-    assert cameras.ready.wait(60), "the camera thread did not get ready within 60 s"
-    if cameras.unavailable is not None:
-        pytest.skip(f"no OpenGL for MuJoCo ({cameras.unavailable}). {GL_HELP}")
-    # One frame first: the objectives give the camera 5 s, and in this one process (driver, agent and
-    # test side by side on a loaded machine) the first frame after a subscription can take longer.
-    frames: list[Any] = []
-    subscription = library_cell.node.create_subscription(
-        "sensor_msgs/msg/Image", "/wrist_camera/color", frames.append
-    )
-    try:
-        wait_for(lambda: frames, 60.0, "a first wrist camera image")
-    finally:
-        subscription.close()  # unwatched, the camera stops rendering
+    library_cell.render_each_camera_once((("sensor_msgs/msg/Image", "/wrist_camera/color"),), 60.0)
     return library_cell
 
 

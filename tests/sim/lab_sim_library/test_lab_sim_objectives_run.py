@@ -9,27 +9,16 @@ from __future__ import annotations
 
 import itertools
 import time
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import pytest
 import yaml
-from lab_sim_library_cell import ARM, LibraryCell, lab_sim_model
+from lab_sim_library_cell import ARM, LibraryCell, lab_sim_model, wait_for
 
 pytestmark = pytest.mark.slow
 
 RUN_TIMEOUT = 240.0
-
-
-def wait_for(predicate: Callable[[], Any], timeout: float, what: str) -> Any:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.02)
-    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
 
 
 def run(cell: LibraryCell, name: str) -> Any:

@@ -9,14 +9,12 @@ from __future__ import annotations
 
 import threading
 import time
-from collections.abc import Callable
 from typing import Any
 
 import numpy as np
 import pytest
-from lab_sim_library_cell import LibraryCell
+from lab_sim_library_cell import LibraryCell, wait_for
 
-from kinema.drivers.mujoco.cameras import GL_HELP
 from kinema.perception.ros_messages import from_point_cloud2
 from kinema.transport import from_dict
 
@@ -26,39 +24,16 @@ RUN_TIMEOUT = 240.0
 CAPTURES = "/pcd_pointcloud_captures"
 
 
-def wait_for(predicate: Callable[[], Any], timeout: float, what: str) -> Any:
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        value = predicate()
-        if value:
-            return value
-        time.sleep(0.02)
-    raise AssertionError(f"timed out after {timeout} s waiting for {what}")
-
-
 @pytest.fixture(scope="module")
 def cell(library_cell: LibraryCell) -> LibraryCell:
-    cameras = library_cell.driver.cameras
-    assert cameras is not None, "lab_sim has cameras, the driver serves none"
-    assert cameras.ready.wait(60), "the camera thread did not get ready within 60 s"
-    if cameras.unavailable is not None:
-        pytest.skip(f"no OpenGL for MuJoCo ({cameras.unavailable}). {GL_HELP}")
-    # Each camera renders once before the objectives run, then stops again (nobody left subscribed): on a
-    # loaded machine a camera's very first frame took longer than the corpus's 10 s message timeout.
-    from kinema.transport import Node
-
     # Subscribed now, long before an objective sends to the UI: a subscription made just before a run
     # could still be on its way to the router when the snapshot went out.
     library_cell.listen("sensor_msgs/msg/PointCloud2", CAPTURES)
-    probe = Node(library_cell.node.session, "lab_sim_camera_warmup")
-    try:
-        for topic in ("/scene_camera/points", "/wrist_camera/points"):
-            box: list[Any] = []
-            subscription = probe.create_subscription("sensor_msgs/msg/PointCloud2", topic, box.append)
-            wait_for(lambda: box, 120.0, f"a first cloud on {topic}")  # noqa: B023 - called now
-            subscription.close()
-    finally:
-        probe.close()
+    # Each camera renders once before the objectives run (the corpus gives a message 10 s).
+    cloud = "sensor_msgs/msg/PointCloud2"
+    library_cell.render_each_camera_once(
+        ((cloud, "/scene_camera/points"), (cloud, "/wrist_camera/points")), 120.0
+    )
     return library_cell
 
 
