@@ -44,7 +44,7 @@ from kinema.tui.dialogs.confirm import ConfirmDialog
 from kinema.tui.messages import ModeSelected, RuntimeCallFailed, RuntimeCallSucceeded, RuntimeEventsArrived
 from kinema.tui.run_outcome import RunOutcome, parse_outcome
 from kinema.tui.runtime_status import RuntimeStatus
-from kinema.tui.screens.base import KinemaScreen
+from kinema.tui.screens.base import KinemaScreen, RuntimeView
 from kinema.tui.screens.behaviors import BehaviorsScreen
 from kinema.tui.screens.blackboard import BlackboardScreen
 from kinema.tui.screens.configs import ConfigsScreen
@@ -186,7 +186,7 @@ class KinemaApp(App[None]):
         # The task PlanMTCTask plans (or planned last) in the current run; None before one.
         self.task_planning: TaskPlanning | None = None
         self.inbox = EventInbox()
-        self.views: list[KinemaScreen] = []
+        self.views: list[RuntimeView] = []
         self.sub_title = connection.endpoint + ("  (closing stops the runtime)" if owns_runtime else "")
 
     # -- lifecycle ----------------------------------------------------------------------------------
@@ -207,12 +207,12 @@ class KinemaApp(App[None]):
         except Exception:
             log.exception("closing the runtime connection failed")
 
-    def register_view(self, screen: KinemaScreen) -> None:
+    def register_view(self, screen: RuntimeView) -> None:
         """A screen was mounted; it receives runtime updates from now on."""
         if screen not in self.views:
             self.views.append(screen)
 
-    def unregister_view(self, screen: KinemaScreen) -> None:
+    def unregister_view(self, screen: RuntimeView) -> None:
         """A screen was unmounted."""
         if screen in self.views:
             self.views.remove(screen)

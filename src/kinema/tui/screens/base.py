@@ -31,7 +31,42 @@ RETRY_PAUSE_S = 1.0
 LOAD_ATTEMPTS = 3
 
 
-class KinemaScreen(Screen[None]):
+class RuntimeView:
+    """What the app hands runtime updates to (``KinemaApp.register_view``): each hook does nothing here, and
+    a screen overrides those it cares about."""
+
+    def show_status(self, status: RuntimeStatus) -> None:
+        """The runtime status changed."""
+
+    def runtime_connected(self) -> None:
+        """The runtime (re)appeared: reload what this screen shows."""
+
+    def runtime_run_started(self, objective_name: str) -> None:
+        """A new objective run started."""
+
+    def runtime_node_statuses(self, batch: NodeStatusBatch) -> None:
+        """Nodes of the running tree changed status."""
+
+    def runtime_blackboard(self, diff: BlackboardDiff) -> None:
+        """The blackboard changed (``diff`` against what the app had)."""
+
+    def runtime_log(self, entry: LogEntry) -> None:
+        """A log message or toast arrived."""
+
+    def runtime_run_ended(self, outcome: RunOutcome) -> None:
+        """An objective run failed or was cancelled (its message stays shown until dismissed)."""
+
+    def runtime_task_planning(self, task: TaskPlanning) -> None:
+        """A task is being planned (PlanMTCTask): its stages' states changed."""
+
+    def runtime_reload(self, notice: ReloadNotice) -> None:
+        """A hot reload happened."""
+
+    def runtime_objectives_changed(self) -> None:
+        """The objective library changed."""
+
+
+class KinemaScreen(RuntimeView, Screen[None]):
     """A screen of the app. Subclasses set :attr:`MODE` and implement :meth:`compose_body`.
 
     The app calls the ``runtime_*`` hooks (attributes down); a screen overrides those it cares about.
@@ -117,32 +152,3 @@ class KinemaScreen(Screen[None]):
                 self.app.post_message(RuntimeCallSucceeded(what))
 
         self.run_worker(work, thread=True, group=what, name=what)
-
-    # -- hooks the app calls --------------------------------------------------------------------
-
-    def runtime_connected(self) -> None:
-        """The runtime (re)appeared: reload what this screen shows."""
-
-    def runtime_run_started(self, objective_name: str) -> None:
-        """A new objective run started."""
-
-    def runtime_node_statuses(self, batch: NodeStatusBatch) -> None:
-        """Nodes of the running tree changed status."""
-
-    def runtime_blackboard(self, diff: BlackboardDiff) -> None:
-        """The blackboard changed (``diff`` against what the app had)."""
-
-    def runtime_log(self, entry: LogEntry) -> None:
-        """A log message or toast arrived."""
-
-    def runtime_run_ended(self, outcome: RunOutcome) -> None:
-        """An objective run failed or was cancelled (its message stays shown until dismissed)."""
-
-    def runtime_task_planning(self, task: TaskPlanning) -> None:
-        """A task is being planned (PlanMTCTask): its stages' states changed."""
-
-    def runtime_reload(self, notice: ReloadNotice) -> None:
-        """A hot reload happened."""
-
-    def runtime_objectives_changed(self) -> None:
-        """The objective library changed."""

@@ -22,6 +22,7 @@ from textual.screen import Screen
 from textual.widgets import Footer, Select, Static
 
 from kinema.tui.connection import CameraImage, ConnectionState
+from kinema.tui.screens.base import RuntimeView
 
 try:  # Queries the terminal once; it must happen before the app starts (textual-image's rule).
     import textual_image.widget as image_widgets
@@ -72,7 +73,7 @@ class WatchStarted(Message):
         self.stop = stop
 
 
-class CameraScreen(Screen[None]):
+class CameraScreen(RuntimeView, Screen[None]):
     """The newest picture of one image topic, with its size, frame and time."""
 
     BINDINGS = [
@@ -116,26 +117,21 @@ class CameraScreen(Screen[None]):
 
     def on_mount(self) -> None:
         self.set_interval(REDRAW_PERIOD_S, self._redraw)
-        self._when_connected(self.action_refresh_topics)
-
-    def _when_connected(self, step: Any) -> None:
-        """Run ``step`` now if the runtime is connected, else as soon as it is: `kinema ui --camera` opens
-        this screen before the connection is up, and the connection refuses to list or watch until then."""
+        self.app.register_view(self)  # type: ignore[attr-defined]
         if self._connected():
-            step()
-            return
-        self._placeholder("Waiting for the runtime ...")
+            self.action_refresh_topics()
+        else:  # `kinema ui --camera` opens this before the connection is up: runtime_connected lists
+            self._placeholder("Waiting for the runtime ...")
 
-        def check() -> None:
-            if self._connected():
-                timer.stop()
-                step()
-
-        timer = self.set_interval(0.25, check)
+    def runtime_connected(self) -> None:
+        """The runtime (re)appeared: list its image topics again and watch the chosen one anew (a watch of
+        the previous connection ended with it)."""
+        self.action_refresh_topics()
+        if self.topic and self.is_current:
+            self.watch(self.topic)
 
     def _connected(self) -> bool:
-        status = getattr(self.app, "status", None)
-        return status is None or status.state is ConnectionState.CONNECTED
+        return self.app.status.state is ConnectionState.CONNECTED  # type: ignore[attr-defined, no-any-return]
 
     @property
     def connection(self) -> Any:
@@ -213,11 +209,11 @@ class CameraScreen(Screen[None]):
         self._unwatch()
 
     def on_screen_resume(self) -> None:
-        if self.topic and not self._watching:
-            topic = self.topic
-            self._when_connected(lambda: self._watching or self.watch(topic))
+        if self.topic and not self._watching and self._connected():
+            self.watch(self.topic)
 
     def on_unmount(self) -> None:
+        self.app.unregister_view(self)  # type: ignore[attr-defined]
         self._unwatch()
 
     def action_close(self) -> None:
