@@ -76,18 +76,17 @@ def _ok(run: Any) -> Any:
     return run.outputs
 
 
+def _camera_message(behavior: Any, context: BehaviorContext, behavior_id: str, topic: str) -> Any:
+    """The next message of ``topic``, taken by the camera behavior ``behavior_id`` (GetImage, ...)."""
+    inputs = {"topic_name": topic, **SLOW_FIRST_FRAME}
+    return _ok(tick_behavior(behavior(behavior_id), inputs, context=context, timeout=60))["message_out"]
+
+
 def test_the_microscope_cad_model_registers_onto_the_scene_camera_cloud(
     behavior: Any, context: BehaviorContext, driver: Any, cameras: Any
 ) -> None:
     truth = _body_pose(driver, "microscope")
-    cloud = _ok(
-        tick_behavior(
-            behavior("GetPointCloud"),
-            {"topic_name": "/scene_camera/points", **SLOW_FIRST_FRAME},
-            context=context,
-            timeout=60,
-        )
-    )["message_out"]
+    cloud = _camera_message(behavior, context, "GetPointCloud", "/scene_camera/points")
     world = _ok(
         tick_behavior(
             behavior("TransformPointCloudFrame"), {"input_cloud": cloud}, context=context, timeout=30
@@ -152,24 +151,9 @@ def test_a_mask_of_the_cubes_pixels_picks_the_cube_out_of_the_cloud(
     behavior: Any, context: BehaviorContext, driver: Any, cameras: Any
 ) -> None:
     cube = _body_pose(driver, "cube")[:3, 3]
-    topics = {"topic_name": "/scene_camera/camera_info"}
-    info = _ok(tick_behavior(behavior("GetCameraInfo"), topics, context=context, timeout=60))["message_out"]
-    image = _ok(
-        tick_behavior(
-            behavior("GetImage"),
-            {"topic_name": "/scene_camera/color", **SLOW_FIRST_FRAME},
-            context=context,
-            timeout=60,
-        )
-    )["message_out"]
-    cloud = _ok(
-        tick_behavior(
-            behavior("GetPointCloud"),
-            {"topic_name": "/scene_camera/points", **SLOW_FIRST_FRAME},
-            context=context,
-            timeout=60,
-        )
-    )["message_out"]
+    info = _camera_message(behavior, context, "GetCameraInfo", "/scene_camera/camera_info")
+    image = _camera_message(behavior, context, "GetImage", "/scene_camera/color")
+    cloud = _camera_message(behavior, context, "GetPointCloud", "/scene_camera/points")
     pixels = image_array(image).astype(int)
     red = (pixels[..., 0] > 120) & (pixels[..., 1] < 80) & (pixels[..., 2] < 80)
     rows, cols = np.nonzero(red)
