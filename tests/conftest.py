@@ -9,6 +9,7 @@ from typing import Any
 
 import pytest
 
+import kinema.mujoco_gl  # noqa: F401  (before any test module imports mujoco: see kinema.mujoco_gl)
 from failure_report import kinema_processes
 
 REPO_ROOT = Path(__file__).resolve().parent.parent

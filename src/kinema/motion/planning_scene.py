@@ -16,6 +16,7 @@ from pathlib import Path
 
 import numpy as np
 
+import kinema.mujoco_gl  # noqa: F401  (MuJoCo's OpenGL backend is chosen before the lazy mujoco imports below)
 from kinema.errors import MotionError, did_you_mean
 
 SHAPES = ("box", "cylinder", "sphere", "capsule")

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+import kinema.mujoco_gl  # noqa: F401  (MuJoCo's OpenGL backend is chosen before the lazy mujoco imports below)
 from kinema.errors import ConfigError
 from kinema.viz import scene_commands as sc
 from kinema.viz.geom_shapes import GeomVisual, geom_visuals, safe_name

@@ -17,6 +17,7 @@ from typing import Any
 
 import numpy as np
 
+import kinema.mujoco_gl  # noqa: F401  (MuJoCo's OpenGL backend is chosen before the lazy mujoco import below)
 from kinema.errors import KinemaError, ObjectiveError
 
 from ..motion.joint_states import joint_state_monitor

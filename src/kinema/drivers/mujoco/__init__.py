@@ -15,39 +15,9 @@ Names are imported lazily, so importing this package (or ``names``) does not loa
 from __future__ import annotations
 
 import importlib
-import os
-import sys
 from typing import Any
 
-
-def _choose_gl_backend() -> None:
-    """Pick MuJoCo's OpenGL backend before mujoco is first imported (it reads MUJOCO_GL then).
-
-    MuJoCo defaults to GLFW, which needs a display. Without one, render headless through EGL — but only
-    when its libraries load: ``import mujoco`` itself fails with MUJOCO_GL=egl and no libEGL. Without
-    them rendering is disabled, so the simulation still runs and the cameras say what to install. A
-    MUJOCO_GL the user set is left alone.
-    """
-    if "MUJOCO_GL" in os.environ or sys.platform != "linux":
-        return
-    if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
-        return
-    import ctypes
-
-    def loads(*names: str) -> bool:
-        for name in names:
-            try:
-                ctypes.CDLL(name)
-            except OSError:
-                continue
-            return True
-        return False
-
-    usable = loads("libEGL.so.1", "libEGL.so") and loads("libOpenGL.so.0", "libGL.so.1", "libGL.so")
-    os.environ["MUJOCO_GL"] = "egl" if usable else "disable"
-
-
-_choose_gl_backend()
+import kinema.mujoco_gl  # noqa: F401  (picks MuJoCo's OpenGL backend before mujoco loads)
 
 _EXPORTS = {
     "MujocoDriver": "driver",

@@ -32,6 +32,7 @@ from typing import Any
 
 import numpy as np
 
+import kinema.mujoco_gl
 from kinema.drivers.mujoco import names
 from kinema.perception.depth import depth_to_cloud
 from kinema.perception.intrinsics import CameraIntrinsics
@@ -286,6 +287,11 @@ class CameraServer:
         except Exception as error:  # any failure to get an OpenGL context means: no cameras
             backend = os.environ.get("MUJOCO_GL", "glfw")
             self.unavailable = f"cannot render with MUJOCO_GL={backend}: {error}"
+            if kinema.mujoco_gl.imported_too_early:
+                self.unavailable += (
+                    "; mujoco was imported before Kinema chose its OpenGL backend, so it kept GLFW: "
+                    "import kinema.mujoco_gl before mujoco, or set MUJOCO_GL=egl in the environment"
+                )
             log.warning("cameras unavailable (%s). %s", self.unavailable, GL_HELP)
             self._close_nodes()
             self.ready.set()
