@@ -26,7 +26,7 @@ if TYPE_CHECKING:
         ResultT,
         ServiceDefinition,
     )
-    from kinema.transport import ActionClient, ServiceClient
+    from kinema.transport import ActionClient, QoS, ServiceClient
 
 
 class BehaviorContext:
@@ -138,15 +138,18 @@ class BehaviorContext:
             ("action", id(node), type_name, name), lambda: node.create_action_client(type_name, name)
         )
 
-    def publisher(self, node: Any, message_type: str, topic: str, *, latched: bool = False) -> Any:
+    def publisher(
+        self, node: Any, message_type: str, topic: str, *, latched: bool = False, qos: QoS | None = None
+    ) -> Any:
         """A publisher shared by every behavior of this context (created on first use).
 
         Publishers stay declared for the context's lifetime, so a subscriber discovered once keeps
-        receiving (a publisher made per message could publish before anyone has matched it).
+        receiving (a publisher made per message could publish before anyone has matched it). ``qos``
+        defaults to ROS's default profile (``KEEP_ALL_QOS`` for messages that must not be dropped).
         """
         return self._endpoint(
-            ("publisher", id(node), message_type, topic, latched),
-            lambda: node.create_publisher(message_type, topic, latched=latched),
+            ("publisher", id(node), message_type, topic, latched, qos),
+            lambda: node.create_publisher(message_type, topic, qos, latched=latched),
         )
 
     def _endpoint(self, key: tuple[Any, ...], create: Callable[[], Any]) -> Any:

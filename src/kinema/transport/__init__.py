@@ -34,7 +34,7 @@ from kinema.transport.action import (
 )
 from kinema.transport.attachment import Attachment
 from kinema.transport.graph import Graph, GraphCache, query_graph
-from kinema.transport.keys import LATCHED_QOS, QoS
+from kinema.transport.keys import KEEP_ALL_QOS, LATCHED_QOS, QoS
 from kinema.transport.messages import from_dict, msg, parse_yaml_flow, to_dict, to_yaml, type_of
 from kinema.transport.node import Node
 from kinema.transport.pubsub import MessageInfo, Publisher, Subscription
@@ -52,6 +52,7 @@ from kinema.transport.session import (
 
 __all__ = [
     "DEFAULT_ENDPOINT",
+    "KEEP_ALL_QOS",
     "LATCHED_QOS",
     "STATUS_ABORTED",
     "STATUS_ACCEPTED",

@@ -65,6 +65,10 @@ class QoS:
 
 SERVICE_QOS = QoS()
 LATCHED_QOS = QoS(transient_local=True, depth=1)
+# Keep all: every message is delivered. Over zenoh (as rmw_zenoh maps KEEP_ALL) a full link queue makes
+# ``publish`` wait instead of dropping the message. For drawings a user asked for (snapshots, markers,
+# planned paths): a large one dropped under load simply never appears.
+KEEP_ALL_QOS = QoS(keep_all=True)
 
 
 def mangle(name: str) -> str:

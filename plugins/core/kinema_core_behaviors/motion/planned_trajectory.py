@@ -15,4 +15,9 @@ def publish_planned_trajectory(behavior: Any, message: Any) -> None:
     node = behavior.context.node
     if node is None:
         return
-    behavior.context.publisher(node, PLANNED_TRAJECTORY_TYPE, PLANNED_TRAJECTORY_TOPIC).publish(message)
+    from kinema.transport import KEEP_ALL_QOS
+
+    publisher = behavior.context.publisher(
+        node, PLANNED_TRAJECTORY_TYPE, PLANNED_TRAJECTORY_TOPIC, qos=KEEP_ALL_QOS
+    )
+    publisher.publish(message)

@@ -142,7 +142,7 @@ def publish_stage_paths(behavior: Any, solution: Any, model: Any) -> None:
     """
     from kinema.transport import from_dict
 
-    from ..ui.visualize_pose import MARKER_ARRAY_TYPE, MARKER_TOPIC
+    from ..ui.visualize_pose import MARKER_ARRAY_TYPE, marker_publisher
 
     node = behavior.context.node
     if node is None or not solution.sub_trajectories:
@@ -176,9 +176,7 @@ def publish_stage_paths(behavior: Any, solution: Any, model: Any) -> None:
         for i in range(1, MAX_STAGE_LINES + 1)
         if i not in drawn
     ]
-    behavior.context.publisher(node, MARKER_ARRAY_TYPE, MARKER_TOPIC).publish(
-        from_dict(MARKER_ARRAY_TYPE, {"markers": markers})
-    )
+    marker_publisher(behavior, node).publish(from_dict(MARKER_ARRAY_TYPE, {"markers": markers}))
 
 
 class ConvertMtcSolutionToJointTrajectory(SyncBehavior):

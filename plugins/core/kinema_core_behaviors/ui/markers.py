@@ -19,7 +19,7 @@ from ..messages.ports import (
     read_message,
     read_vector,
 )
-from .visualize_pose import MARKER_ARRAY_TYPE, MARKER_TOPIC
+from .visualize_pose import MARKER_ARRAY_TYPE, marker_publisher
 
 MARKER_TYPES = {"arrow": 0, "cube": 1, "sphere": 2, "cylinder": 3}
 _COLOR = {"r": 0.2, "g": 0.6, "b": 1.0, "a": 0.8}
@@ -29,9 +29,7 @@ def publish_markers(behavior: Any, markers: list[dict[str, Any]]) -> None:
     """Publish ``markers`` (Marker dicts) as one MarkerArray on the view's marker topic."""
     from kinema.transport import from_dict
 
-    node = behavior.context.require_node(behavior.registration_id)
-    publisher = behavior.context.publisher(node, MARKER_ARRAY_TYPE, MARKER_TOPIC)
-    publisher.publish(from_dict(MARKER_ARRAY_TYPE, {"markers": markers}))
+    marker_publisher(behavior).publish(from_dict(MARKER_ARRAY_TYPE, {"markers": markers}))
 
 
 def pose_dict(frame_and_matrix: tuple[str, np.ndarray]) -> tuple[str, dict[str, Any]]:

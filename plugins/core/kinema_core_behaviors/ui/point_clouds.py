@@ -67,8 +67,11 @@ def cloud_marker(
 
 
 def _publish_cloud(behavior: Any, cloud: Any, topic: str) -> None:
+    """Publish ``cloud`` keeping all: a snapshot of several MB dropped under load would never arrive."""
+    from kinema.transport import KEEP_ALL_QOS
+
     node = behavior.context.require_node(behavior.registration_id)
-    behavior.context.publisher(node, POINT_CLOUD, topic).publish(cloud)
+    behavior.context.publisher(node, POINT_CLOUD, topic, qos=KEEP_ALL_QOS).publish(cloud)
 
 
 def _draw(behavior: Any, cloud: Any, *, keep_previous: bool) -> None:

@@ -71,11 +71,22 @@ def publish_pose_marker(
     frame_id, matrix = pose_matrix(pose, "pose")
     if size <= 0:
         raise ObjectiveError(f"marker_size must be > 0, got {size}")
-    node = behavior.context.require_node(behavior.registration_id)
-    publisher = behavior.context.publisher(node, MARKER_ARRAY_TYPE, MARKER_TOPIC)
-    publisher.publish(
+    marker_publisher(behavior).publish(
         from_dict(MARKER_ARRAY_TYPE, triad_markers(frame_id, matrix, name, size, lifetime, text))
     )
+
+
+def marker_publisher(behavior: Any, node: Any = None) -> Any:
+    """The context's publisher of marker arrays on :data:`MARKER_TOPIC`, keeping all of them.
+
+    A drawing the objective asked for (or a DELETE of one) must not be dropped when the link is busy,
+    as a large snapshot cloud would be under load with ROS's default keep-last profile.
+    """
+    from kinema.transport import KEEP_ALL_QOS
+
+    if node is None:
+        node = behavior.context.require_node(behavior.registration_id)
+    return behavior.context.publisher(node, MARKER_ARRAY_TYPE, MARKER_TOPIC, qos=KEEP_ALL_QOS)
 
 
 class VisualizePose(SyncBehavior):
