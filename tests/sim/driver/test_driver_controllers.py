@@ -83,11 +83,12 @@ def test_a_best_effort_switch_skips_unknown_names(sim: Sim) -> None:
 
 def test_the_broadcaster_can_be_switched_off(sim: Sim) -> None:
     assert sim.switch(deactivate=[n.JOINT_STATE_BROADCASTER]).ok
-    received = len(sim.joint_states.stamps)
-    before = sim.driver.sim_time
-    wait_for(lambda: sim.driver.sim_time > before + 0.5, what="0.5 s of sim time")
-    time.sleep(0.05)  # messages already on their way may still arrive
-    assert len(sim.joint_states.stamps) - received <= 3
+    switched_off = sim.driver.sim_time
+    wait_for(lambda: sim.driver.sim_time > switched_off + 0.5, what="0.5 s of sim time")
+    time.sleep(0.5)  # let messages published before the switch drain (many, on a loaded machine)
+    # Judged by stamp, not by count: a backlog published before the switch may still be arriving.
+    later = [stamp for stamp in list(sim.joint_states.stamps) if stamp > switched_off + 0.02]
+    assert not later, f"/joint_states stamped {later[:5]} after the switch at sim time {switched_off:.3f}"
     assert sim.switch(activate=[n.JOINT_STATE_BROADCASTER]).ok
     sim.joint_states.wait_until(sim.driver.sim_time)
 
