@@ -51,6 +51,10 @@ CUBE_HALF = 0.025
 CUBE_START = (-0.30, 0.62, TABLE_TOP + CUBE_HALF)
 TRAY_CENTER = (0.30, 0.62)
 TRAY_FLOOR = 0.004  # thickness of the tray bottom: thin, so placing and re-picking stay level
+# Inside the tray's walls, half extents along world x and y (the tray turns with the cell: world x is
+# its local -y, world y its local x). Walls are 0.01 m thick and 0.04 m tall.
+TRAY_INNER_HALF = (0.14, 0.17)
+TRAY_WALL = 0.005  # half thickness
 
 # Cameras, named as MoveIt Pro's lab_sim names them (topics /<name>/color, depth, camera_info, points).
 # Each sits in a link of its own whose frame follows the ROS optical convention (z forward, x right,
@@ -568,10 +572,14 @@ TAGGED_OBJECTS = (
 )
 # The block stands where the wrist camera sees it from "Look at Table" at about 0.53 m (its tag about 40 px
 # wide), 15 cm from where "Register CAD Part Subtree" guesses a bottle (-0.15, 0.5): nearer, ICP fitted the
-# bottle model onto the block. The tray's tag lies on the table off the tray's corner nearest the robot,
-# outside that view, so that a detection of "any tag" from there is the block's (Kinema's tray is smaller
-# than MoveIt Pro's, whose tag is 0.125 m from the tray's centre).
-TRAY_TAG_CENTER = (TRAY_CENTER[0] + 0.32, TRAY_CENTER[1] - 0.17, TABLE_TOP)
+# bottle model onto the block. The tray's tag lies on the tray's floor, TRAY_TAG_TO_CENTER (MoveIt Pro's
+# tag_to_tray_center in pick_all_bottles_with_apriltags.xml) from the tray's centre toward the robot
+# (world -y), unturned: its +y axis points at the tray's centre, the direction
+# ComputeTrayPlacePositionsUsingAprilTags steps along. The bottle slots (3 rows 0.10 m apart along world x,
+# 2 columns 0.09 m apart along world y) take the middle of the tray; the tray is deep enough along y
+# (TRAY_INNER_HALF) for the tag beside them.
+TRAY_TAG_TO_CENTER = 0.125
+TRAY_TAG_CENTER = (TRAY_CENTER[0], TRAY_CENTER[1] - TRAY_TAG_TO_CENTER, TABLE_TOP + TRAY_FLOOR)
 
 
 def _yaw_quat(yaw: float) -> tuple[float, float, float, float]:
@@ -652,6 +660,8 @@ def _keyframe_qpos(arm: tuple[float, ...], knuckle: float) -> str:
 def render_scene() -> str:
     """Return the MuJoCo scene: robot and cameras from the link table, table, tray, cube, actuators."""
     tx, ty = TRAY_CENTER
+    ix, iy = TRAY_INNER_HALF
+    w = TRAY_WALL
     robot = []
     for link in LINKS:
         if link.parent == "world":
@@ -690,16 +700,16 @@ def render_scene() -> str:
         *robot,
         # The tray turns with the cell: its walls are given in the rail base's axes.
         f'    <body name="tray" pos="{_f(tx)} {_f(ty)} {_f(TABLE_TOP)}" quat="{_vec(CELL_QUAT)}">',
-        f'      <geom name="tray_floor" type="box" size="0.12 0.14 {_f(TRAY_FLOOR / 2)}" '
+        f'      <geom name="tray_floor" type="box" size="{_f(iy)} {_f(ix)} {_f(TRAY_FLOOR / 2)}" '
         f'pos="0 0 {_f(TRAY_FLOOR / 2)}" rgba="0.3 0.5 0.35 1"/>',
-        '      <geom name="tray_wall_front" type="box" size="0.125 0.005 0.02" pos="0 0.145 0.02" '
-        'rgba="0.3 0.5 0.35 1"/>',
-        '      <geom name="tray_wall_back" type="box" size="0.125 0.005 0.02" pos="0 -0.145 0.02" '
-        'rgba="0.3 0.5 0.35 1"/>',
-        '      <geom name="tray_wall_left" type="box" size="0.005 0.14 0.02" pos="0.125 0 0.02" '
-        'rgba="0.3 0.5 0.35 1"/>',
-        '      <geom name="tray_wall_right" type="box" size="0.005 0.14 0.02" pos="-0.125 0 0.02" '
-        'rgba="0.3 0.5 0.35 1"/>',
+        f'      <geom name="tray_wall_front" type="box" size="{_f(iy + w)} {_f(w)} 0.02" '
+        f'pos="0 {_f(ix + w)} 0.02" rgba="0.3 0.5 0.35 1"/>',
+        f'      <geom name="tray_wall_back" type="box" size="{_f(iy + w)} {_f(w)} 0.02" '
+        f'pos="0 {_f(-ix - w)} 0.02" rgba="0.3 0.5 0.35 1"/>',
+        f'      <geom name="tray_wall_left" type="box" size="{_f(w)} {_f(ix)} 0.02" '
+        f'pos="{_f(iy + w)} 0 0.02" rgba="0.3 0.5 0.35 1"/>',
+        f'      <geom name="tray_wall_right" type="box" size="{_f(w)} {_f(ix)} 0.02" '
+        f'pos="{_f(-iy - w)} 0 0.02" rgba="0.3 0.5 0.35 1"/>',
         "    </body>",
         f'    <body name="cube" pos="{_vec(CUBE_START)}">',
         '      <freejoint name="cube_joint"/>',

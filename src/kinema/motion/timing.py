@@ -79,17 +79,23 @@ def time_parameterize(
     spline = ta.SplineInterpolator(s, wp, bc_type="clamped")
     derate = _DERATE
     for _ in range(4):
-        instance = algo.TOPPRA(
-            [
-                constraint.JointVelocityConstraint(np.c_[-vmax * derate, vmax * derate]),
-                constraint.JointAccelerationConstraint(np.c_[-amax * derate, amax * derate]),
-            ],
-            spline,
-            parametrizer="ParametrizeConstAccel",
-        )
+        constraints = [
+            constraint.JointVelocityConstraint(np.c_[-vmax * derate, vmax * derate]),
+            constraint.JointAccelerationConstraint(np.c_[-amax * derate, amax * derate]),
+        ]
+        instance = algo.TOPPRA(constraints, spline, parametrizer="ParametrizeConstAccel")
         traj = instance.compute_trajectory(0, 0)
         if traj is None:
-            raise MotionError("toppra found no feasible time parameterization for the path")
+            # toppra's reachability solver can fail numerically on one grid (seen once in hundreds of
+            # preempted moves); the same problem on a uniform grid twice as fine is solved.
+            grid = np.linspace(s[0], s[-1], 2 * len(instance.gridpoints) + 1)
+            retry = algo.TOPPRA(constraints, spline, gridpoints=grid, parametrizer="ParametrizeConstAccel")
+            traj = retry.compute_trajectory(0, 0)
+        if traj is None:
+            raise MotionError(
+                f"toppra found no feasible time parameterization for the path ({len(points)} waypoints, "
+                f"{s[-1]:.4f} rad long; grids of {len(instance.gridpoints)} and {len(grid)} points)"
+            )
         ts = np.arange(0.0, traj.duration, _CHECK_DT)
         over = max(
             float(np.max(np.abs(traj(ts, 1)) / vmax)),

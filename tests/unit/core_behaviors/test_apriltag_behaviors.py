@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Iterator
 from typing import Any
 
@@ -169,3 +170,138 @@ def test_get_detection_pose_picks_by_id_and_label(behavior: Any, context: Behavi
     assert missing.status == NodeStatus.FAILURE
     assert "no detection with id 5 and label 'tag36h11'" in missing.toasts[-1]
     assert "id 3 (tag36h11)" in missing.toasts[-1] and "id 11 (tag36h11)" in missing.toasts[-1]
+
+
+def tray_detections(frame_id: str, tag_pose: np.ndarray, tag_id: int = 1) -> Any:
+    """A Detection3DArray with one tag at ``tag_pose`` (4x4) in ``frame_id``."""
+    from scipy.spatial.transform import Rotation
+
+    from kinema.transport import from_dict
+
+    x, y, z, w = Rotation.from_matrix(tag_pose[:3, :3]).as_quat()
+    pose = {
+        "position": dict(zip("xyz", (float(v) for v in tag_pose[:3, 3]), strict=True)),
+        "orientation": {"x": x, "y": y, "z": z, "w": w},
+    }
+    header = {"frame_id": frame_id}
+    return from_dict(
+        "vision_msgs/msg/Detection3DArray",
+        {
+            "header": header,
+            "detections": [
+                {
+                    "header": header,
+                    "id": str(tag_id),
+                    "results": [
+                        {"hypothesis": {"class_id": "tag36h11", "score": 0.9}, "pose": {"pose": pose}}
+                    ],
+                }
+            ],
+        },
+    )
+
+
+TRAY_INPUTS = {
+    "tray_apriltag_id": 1,
+    "num_rows": 3,
+    "columns_per_row": 2,
+    "row_spacing": 0.10,
+    "column_spacing": 0.09,
+    "tag_to_tray_center": 0.125,
+    "bottle_diameter": 0.04,
+    "visualization_topic": "",
+}
+
+
+def test_tray_place_positions_lay_the_slots_out_from_the_tag(behavior: Any, context: BehaviorContext) -> None:
+    from scipy.spatial.transform import Rotation
+
+    # The tag lies flat at (0.3, 0.5, 0.48), turned 90 degrees about z: its +y axis points along world -x.
+    tag = np.eye(4)
+    tag[:3, :3] = Rotation.from_euler("z", 90, degrees=True).as_matrix()
+    tag[:3, 3] = [0.3, 0.5, 0.48]
+    run = tick_behavior(
+        behavior("ComputeTrayPlacePositionsUsingAprilTags"),
+        {**TRAY_INPUTS, "detections": tray_detections("world", tag)},
+        context=context,
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    poses = run.outputs["place_positions"]
+    assert [p.header.frame_id for p in poses] == ["world"] * 6
+    found = np.array([[p.pose.position.x, p.pose.position.y, p.pose.position.z] for p in poses])
+    # Tray centre 0.125 m along the tag's +y (world -x); rows along the tag's x (world +y), the two slots
+    # of a row along the tag's y (world -x), nearest the tag first.
+    centre = np.array([0.3 - 0.125, 0.5, 0.48])
+    expected = np.array(
+        [centre + np.array([-dy, dx, 0.0]) for dx in (-0.10, 0.0, 0.10) for dy in (-0.045, 0.045)]
+    )
+    assert np.allclose(found, expected, atol=1e-9), found
+    for pose in poses:
+        q = pose.pose.orientation
+        z_axis = Rotation.from_quat([q.x, q.y, q.z, q.w]).as_matrix()[:, 2]
+        assert np.allclose(z_axis, [0, 0, -1], atol=1e-9), "the place frame's z points into the tray"
+
+
+def test_tray_place_positions_draw_the_slots_on_the_visualization_topic(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    # The tag 0.5 m in front of the camera, facing it (a half turn about x), its +y toward image top.
+    tag = np.eye(4)
+    tag[:3, :3] = np.diag([1.0, -1.0, -1.0])
+    tag[:3, 3] = [0.0, 0.0, 0.5]
+    images: list[Any] = []
+    subscription = context.node.create_subscription("sensor_msgs/msg/Image", "/tray_test_view", images.append)
+    try:
+        run = tick_behavior(
+            behavior("ComputeTrayPlacePositionsUsingAprilTags"),
+            {
+                **TRAY_INPUTS,
+                "detections": tray_detections("world", tag),
+                "input_image": tags_image({}),
+                "camera_info": camera_info(),
+                "visualization_topic": "/tray_test_view",
+            },
+            context=context,
+        )
+        assert run.status == NodeStatus.SUCCESS, run.toasts
+        deadline = time.monotonic() + 10
+        while not images and time.monotonic() < deadline:
+            time.sleep(0.02)
+    finally:
+        subscription.close()
+    assert images, "nothing was published on the visualization topic"
+    pixels = np.frombuffer(bytes(images[-1].data), dtype=np.uint8).reshape(HEIGHT, WIDTH, 3)
+    green = (pixels[:, :, 1] > 150) & (pixels[:, :, 0] < 100)
+    # The first slot: 0.125 - 0.045 m above the tag (image -v) and 0.10 m to its -x (image -u).
+    u = (WIDTH - 1) / 2 + FOCAL * -0.10 / 0.5
+    v = (HEIGHT - 1) / 2 - FOCAL * 0.08 / 0.5
+    r = FOCAL * 0.02 / 0.5
+    ring = green[int(v - r - 3) : int(v + r + 4), int(u - r - 3) : int(u + r + 4)]
+    assert ring.sum() > 20, f"no slot circle drawn around ({u:.0f}, {v:.0f})"
+    assert not green[int(v), int(u)], "a circle, not a disc"
+
+
+def test_tray_place_positions_name_bad_input(behavior: Any, context: BehaviorContext) -> None:
+    tag = np.eye(4)
+    detections = tray_detections("world", tag, tag_id=4)
+    run = tick_behavior(
+        behavior("ComputeTrayPlacePositionsUsingAprilTags"),
+        {**TRAY_INPUTS, "detections": detections},
+        context=context,
+    )
+    assert run.status == NodeStatus.FAILURE
+    assert "port [tray_apriltag_id] = 1: no detection" in run.toasts[-1], run.toasts
+    assert "ids detected: 4" in run.toasts[-1], run.toasts
+    for port, value, words in (
+        ("num_rows", 0, "1 or more"),
+        ("columns_per_row", -2, "1 or more"),
+        ("row_spacing", 0.03, "bottle_diameter (0.04)"),
+        ("bottle_diameter", 0.0, "> 0"),
+    ):
+        run = tick_behavior(
+            behavior("ComputeTrayPlacePositionsUsingAprilTags"),
+            {**TRAY_INPUTS, "detections": tray_detections("world", tag), port: value},
+            context=context,
+        )
+        assert run.status == NodeStatus.FAILURE, (port, value)
+        assert f"port [{port}] = {value}" in run.toasts[-1] and words in run.toasts[-1], run.toasts

@@ -101,3 +101,25 @@ def test_from_points_fills_in_velocities_so_motion_does_not_stop_at_points():
 def test_from_points_rejects_mismatched_lengths():
     with pytest.raises(MotionError, match="needs 2 rows of 2 values"):
         JointTrajectory.from_points(["a", "b"], [0.0, 1.0], [[0.0, 1.0], [1.0]])
+
+
+def test_a_grid_toppra_cannot_solve_is_retried_on_a_finer_uniform_one(model, pick_path, monkeypatch):
+    import toppra.algorithm as algo
+
+    solve = algo.TOPPRA.compute_trajectory
+    grids: list[int] = []
+
+    def fails_on_the_automatic_grid(self, *args, **kwargs):
+        grids.append(len(self.gridpoints))
+        # The automatic grid is not uniform; the retry's is.
+        uniform = np.allclose(np.diff(self.gridpoints), np.diff(self.gridpoints)[0])
+        return solve(self, *args, **kwargs) if uniform else None
+
+    monkeypatch.setattr(algo.TOPPRA, "compute_trajectory", fails_on_the_automatic_grid)
+    traj = time_parameterize(pick_path, model)
+    assert len(grids) >= 2 and grids[1] == 2 * grids[0] + 1, grids
+    np.testing.assert_allclose(traj.positions[-1], pick_path.positions[-1])
+
+    monkeypatch.setattr(algo.TOPPRA, "compute_trajectory", lambda self, *a, **k: None)
+    with pytest.raises(MotionError, match=r"no feasible time parameterization .* [0-9.]+ rad long"):
+        time_parameterize(pick_path, model)

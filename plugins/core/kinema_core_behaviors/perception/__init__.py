@@ -19,6 +19,7 @@ from .masks import GetMasks3DFromMasks2D, GetPointCloudFromMask3D
 from .merge_point_clouds import MergePointClouds
 from .register_point_clouds import RegisterPointClouds
 from .transform_point_cloud import TransformPointCloud, TransformPointCloudFrame
+from .tray_place_positions import ComputeTrayPlacePositionsUsingAprilTags
 from .update_planning_scene import UpdatePlanningSceneService
 
 BEHAVIORS = (
@@ -40,4 +41,5 @@ BEHAVIORS = (
     CreateCollisionSpheresAtClosestPoints,
     DetectAprilTags,
     GetDetectionPose,
+    ComputeTrayPlacePositionsUsingAprilTags,
 )
