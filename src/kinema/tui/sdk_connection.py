@@ -483,9 +483,12 @@ class SdkConnection:
         from kinema.tui.camera_image import IMAGE_TYPE
 
         client = self._require_client()
-        # A fresh look at the whole network: a session's graph cache may not know every publisher yet.
-        topics = client.node.graph(timeout=GRAPH_QUERY_S).topics()
-        return sorted(name for name, types in topics.items() if IMAGE_TYPE in types)
+        # A fresh look at the whole network (the session's graph cache may not know every publisher yet),
+        # joined with that cache (a query on a loaded machine may run out its time before every reply).
+        names: set[str] = set()
+        for graph in (client.node.graph(timeout=GRAPH_QUERY_S), client.node.graph()):
+            names.update(name for name, types in graph.topics().items() if IMAGE_TYPE in types)
+        return sorted(names)
 
     def watch_images(self, topic: str, listener: ImageListener) -> Callable[[], None]:
         from kinema.tui.camera_image import IMAGE_TYPE, camera_image

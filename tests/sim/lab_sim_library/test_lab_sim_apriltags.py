@@ -151,8 +151,17 @@ def test_the_tui_connection_lists_and_watches_the_wrist_camera(cell: LibraryCell
     connection.open(lambda event: isinstance(event, ConnectionChanged) and states.append(event.state))
     try:
         wait_for(lambda: ConnectionState.CONNECTED in states, 30.0, "the TUI connection to connect")
-        topics = connection.image_topics()
-        assert {"/wrist_camera/color", "/scene_camera/color", "/wrist_camera/depth"} <= set(topics), topics
+        expected = {"/wrist_camera/color", "/scene_camera/color", "/wrist_camera/depth"}
+        # Discovery takes its time on a loaded machine (the view has a refresh key for that): wait for it.
+        listed: list[list[str]] = []
+        try:
+            wait_for(
+                lambda: listed.append(connection.image_topics()) or expected <= set(listed[-1]),
+                30.0,
+                f"{sorted(expected)} among the listed image topics",
+            )
+        except AssertionError as error:
+            raise AssertionError(f"{error}; last listed: {listed[-1] if listed else None}") from None
         pictures: list[Any] = []
         stop = connection.watch_images("/wrist_camera/depth", pictures.append)
         try:

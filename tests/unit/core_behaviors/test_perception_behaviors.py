@@ -98,6 +98,34 @@ def test_get_point_cloud_takes_the_next_cloud_and_names_the_topics_there_are(
     assert relative.status == NodeStatus.FAILURE and "port [topic_name]" in relative.toasts[-1]
 
 
+def test_a_frame_stamped_before_the_behavior_subscribed_is_skipped(
+    behavior: Any, context: BehaviorContext, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """A frame rendered before the last motion but still arriving must not pass for the scene now."""
+    from types import SimpleNamespace
+
+    clock = context.clock
+    monkeypatch.setattr(context, "clock", SimpleNamespace(now=lambda: 100.0, call_later=clock.call_later))
+
+    def stamped(t: float) -> Any:
+        message = cloud_message(np.arange(12).reshape(4, 3), "scene_camera_optical_frame", shape=(2, 2))
+        message.header.stamp.sec, message.header.stamp.nanosec = int(t), round((t % 1) * 1e9)
+        return message
+
+    ports = {"topic_name": "/scene_camera/points", "message_timeout_sec": 1.0}
+    with publish_repeatedly(
+        context.node, "sensor_msgs/msg/PointCloud2", "/scene_camera/points", stamped(99.5)
+    ):
+        stale = tick_behavior(behavior("GetPointCloud"), ports, context=context, timeout=30.0)
+    assert stale.status == NodeStatus.FAILURE and "no message on /scene_camera/points" in stale.toasts[-1]
+    with publish_repeatedly(
+        context.node, "sensor_msgs/msg/PointCloud2", "/scene_camera/points", stamped(100.25)
+    ):
+        fresh = tick_behavior(behavior("GetPointCloud"), ports, context=context, timeout=30.0)
+    assert fresh.status == NodeStatus.SUCCESS, fresh.toasts
+    assert fresh.outputs["message_out"].header.stamp.nanosec == 250_000_000
+
+
 def test_get_camera_info_and_image_write_the_messages(behavior: Any, context: BehaviorContext) -> None:
     from kinema.perception import CameraIntrinsics
     from kinema.perception.ros_messages import camera_info_message, image_message

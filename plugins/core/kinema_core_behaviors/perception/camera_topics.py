@@ -2,7 +2,11 @@
 
 The MuJoCo driver renders a camera only while someone subscribes, so these behaviors subscribe, wait for
 a publisher (``publisher_timeout_sec``) and then for one message (``message_timeout_sec``). A message
-arrives after the subscription, so it shows the scene as it is now, not before the last motion.
+arrives after the subscription, so it shows the scene as it is now, not before the last motion — and
+for images and clouds, whose renderer may still be sending a frame taken earlier (another subscriber
+keeps the camera running; rendering takes its time on a loaded machine), the message must also be
+stamped at or after the moment of subscription. (A stamp of zero or more than ``_OTHER_TIME_BASE`` s
+before it is another time base, a camera clock not synchronised with the robot's: it is taken as it is.)
 """
 
 from __future__ import annotations
@@ -19,12 +23,22 @@ from .clouds import CAMERA_INFO, IMAGE, POINT_CLOUD
 
 # How often the graph is looked at while waiting for a publisher, s.
 _PUBLISHER_POLL = 0.05
+# A stamp this far (s) before the subscription is not a stale frame but another clock.
+_OTHER_TIME_BASE = 30.0
+
+
+def taken_since(message: Any, start: float) -> bool:
+    """Whether ``message`` (with a header) was stamped at or after ``start`` on the robot's clock."""
+    stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+    return stamp == 0 or stamp >= start - 1e-6 or stamp < start - _OTHER_TIME_BASE
 
 
 class _GetCameraMessage(AsyncBehavior):
     message_type: ClassVar[str] = ""
     default_topic: ClassVar[str] = ""
     default_output: ClassVar[str] = ""
+    # Only messages stamped since the subscription (a frame, not a camera's constant intrinsics).
+    taken_now: ClassVar[bool] = True
     subcategory = "Perception - Camera"
 
     @classmethod
@@ -59,10 +73,13 @@ class _GetCameraMessage(AsyncBehavior):
         received: list[Any] = []
         arrived = threading.Event()
 
+        start = self.context.clock.now()
+
         def on_message(message: Any) -> None:
-            if not arrived.is_set():
-                received.append(message)
-                arrived.set()
+            if arrived.is_set() or (self.taken_now and not taken_since(message, start)):
+                return
+            received.append(message)
+            arrived.set()
 
         subscription = node.create_subscription(self.message_type, topic, on_message)
         try:
@@ -111,7 +128,8 @@ class GetPointCloud(_GetCameraMessage):
     lab_sim's cameras publish ``/scene_camera/points`` and ``/wrist_camera/points`` (organised clouds in
     the camera's optical frame). Fails when nothing publishes on the topic within
     ``publisher_timeout_sec`` (naming the topics that carry clouds) or no cloud comes within
-    ``message_timeout_sec``.
+    ``message_timeout_sec``. The cloud must be stamped at or after the moment the behavior subscribed: a
+    frame rendered before the last motion, still on its way, is skipped.
     """
 
     message_type = POINT_CLOUD
@@ -121,7 +139,10 @@ class GetPointCloud(_GetCameraMessage):
 
 
 class GetImage(_GetCameraMessage):
-    """Waits for the next ``sensor_msgs/Image`` on ``topic_name`` (``/wrist_camera/color``, say)."""
+    """Waits for the next ``sensor_msgs/Image`` on ``topic_name`` (``/wrist_camera/color``, say).
+
+    The image must be stamped at or after the moment the behavior subscribed (see the module's notes).
+    """
 
     message_type = IMAGE
     default_topic = "/wrist_camera/color"
@@ -133,6 +154,7 @@ class GetCameraInfo(_GetCameraMessage):
     """Waits for the next ``sensor_msgs/CameraInfo`` on ``topic_name`` (a camera's intrinsics)."""
 
     message_type = CAMERA_INFO
+    taken_now = False
     default_topic = "/wrist_camera/camera_info"
     default_output = "{camera_info}"
     subcategory = "Perception - 2D Image"
