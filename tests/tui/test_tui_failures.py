@@ -89,6 +89,46 @@ def test_a_failed_run_keeps_statuses_highlights_the_path_and_explains_the_node(f
     drive(fake, scenario)
 
 
+def test_a_run_whose_statuses_come_before_its_heartbeat_keeps_them(fake: FakeConnection) -> None:
+    """Heartbeats and node statuses are two topics: a loaded machine may deliver a quick run's statuses first.
+
+    The run's start is then seen in its statuses (the root leaves IDLE); its late heartbeat must not wipe
+    them, and a run after it still starts clean.
+    """
+
+    def statuses_then_heartbeats(start: float) -> None:
+        run = NodeStatusBatch(
+            "Pick Object",
+            (
+                update(SEQUENCE, NodeStatus.RUNNING),
+                update(MOVE, NodeStatus.SUCCESS),
+                update(SCRIPT, NodeStatus.FAILURE),
+                update(SEQUENCE, NodeStatus.FAILURE, NodeStatus.RUNNING),
+            ),
+        )
+        fake.emit(run)
+        fake.emit(Heartbeat(start, "Pick Object", "Running"))
+        fake.emit(Heartbeat(start + 0.5, "Pick Object", "Failure"))
+
+    async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
+        fake.emit(Heartbeat(5.0, "Pick Object", "Success"))
+        for start in (10.0, 20.0):
+            statuses_then_heartbeats(start)
+            await settle(pilot)
+            view = app.screen.query_one(BehaviorTreeView)
+            assert view.shown_as("Script::9") == "FAILURE", f"the run at {start} s lost its failed node"
+            assert view.shown_as("MoveToWaypoint::2") == "SUCCESS"
+        # In the usual order (heartbeat first) a new run still starts clean.
+        fake.emit(Heartbeat(30.0, "Pick Object", "Running"))
+        await settle(pilot)
+        assert view.shown_as("Script::9") == "IDLE"
+        fake.emit(NodeStatusBatch("Pick Object", (update(SEQUENCE, NodeStatus.RUNNING),)))
+        await settle(pilot)
+        assert view.shown_as("TopLevelSequence") == "RUNNING" and view.shown_as("Script::9") == "IDLE"
+
+    drive(fake, scenario)
+
+
 def test_a_cancelled_run_shows_halted_nodes(fake: FakeConnection) -> None:
     async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
         fake.emit(Heartbeat(10.0, "Pick Object", "Running"))

@@ -32,6 +32,7 @@ from kinema.tui.connection import (
     Heartbeat,
     LogEntry,
     LogLevel,
+    NodeStatus,
     NodeStatusBatch,
     NodeStatusUpdate,
     ObjectivesChanged,
@@ -58,6 +59,8 @@ log = logging.getLogger("kinema.tui")
 MAX_LOGS = 2000
 MAX_RELOADS = 200
 TOAST_SEVERITY = {LogLevel.ERROR: "error", LogLevel.WARN: "warning"}
+# The uid of a tree's root node (BT.CPP numbers the nodes from 1, the root first).
+ROOT_UID = 1
 
 
 @dataclass
@@ -185,9 +188,20 @@ class KinemaApp(App[None]):
         self.outcomes: dict[str, RunOutcome] = {}
         # The task PlanMTCTask plans (or planned last) in the current run; None before one.
         self.task_planning: TaskPlanning | None = None
+        # A run's start comes twice, on two topics in either order: its heartbeat, and its root leaving
+        # IDLE in the node statuses. The first resets the per-run views; these say which one came first.
+        self._started_by_heartbeat: set[str] = set()
+        self._started_by_statuses: set[str] = set()
         self.inbox = EventInbox()
         self.views: list[RuntimeView] = []
         self.sub_title = connection.endpoint + ("  (closing stops the runtime)" if owns_runtime else "")
+
+    def _run_started(self, name: str) -> None:
+        """A new run of objective ``name``: forget the last one's statuses and outcome, reset the views."""
+        self.node_statuses.pop(name, None)
+        self.outcomes.pop(name, None)
+        self.task_planning = None
+        self._views_call(lambda view: view.runtime_run_started(name))
 
     # -- lifecycle ----------------------------------------------------------------------------------
 
@@ -248,11 +262,12 @@ class KinemaApp(App[None]):
             elif isinstance(event, Heartbeat):
                 was_connected = self.status.state is ConnectionState.CONNECTED
                 if self.status.apply_heartbeat(event):
-                    self.node_statuses.pop(event.objective_name, None)
-                    self.outcomes.pop(event.objective_name, None)
-                    self.task_planning = None
-                    name = event.objective_name
-                    self._views_call(lambda view: view.runtime_run_started(name))  # noqa: B023 - called now
+                    if event.objective_name in self._started_by_statuses:
+                        # Its statuses came first (a busy machine reorders topics): already reset.
+                        self._started_by_statuses.discard(event.objective_name)
+                    else:
+                        self._started_by_heartbeat.add(event.objective_name)
+                        self._run_started(event.objective_name)
                 if not was_connected:
                     self._views_call(lambda view: view.runtime_connected())
                 status_changed = True
@@ -260,6 +275,13 @@ class KinemaApp(App[None]):
                 self.status.apply_clock(event)
                 status_changed = True
             elif isinstance(event, NodeStatusBatch):
+                name = event.objective_name
+                if any(u.uid == ROOT_UID and u.previous is NodeStatus.IDLE for u in event.updates):
+                    if name in self._started_by_heartbeat:
+                        self._started_by_heartbeat.discard(name)
+                    else:
+                        self._started_by_statuses.add(name)
+                        self._run_started(name)
                 latest = self.node_statuses.setdefault(event.objective_name, {})
                 for update in event.updates:
                     latest[(update.uid, update.node_path)] = update
