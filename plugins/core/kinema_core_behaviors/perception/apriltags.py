@@ -29,9 +29,8 @@ from ..messages.ports import (
     read_message,
     read_text,
 )
+from .clouds import CAMERA_INFO, IMAGE
 
-IMAGE = "sensor_msgs/msg/Image"
-CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
 DETECTIONS = "vision_msgs/msg/Detection3DArray"
 POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 # A decision margin this high (or more) is scored 1.0; the library's margins run to a few hundred.

@@ -37,10 +37,9 @@ from ..messages.ports import (
     read_message,
     read_text,
 )
+from .apriltags import DETECTIONS
+from .clouds import CAMERA_INFO, IMAGE
 
-IMAGE = "sensor_msgs/msg/Image"
-CAMERA_INFO = "sensor_msgs/msg/CameraInfo"
-DETECTIONS = "vision_msgs/msg/Detection3DArray"
 # The place frame in the tag's frame: a half turn about x, z into the tray.
 _FLIP = np.diag([1.0, -1.0, -1.0])
 
