@@ -11,6 +11,7 @@ import pytest
 
 import kinema.mujoco_gl  # noqa: F401  (before any test module imports mujoco: see kinema.mujoco_gl)
 from failure_report import kinema_processes
+from kinema.transport import free_endpoint
 
 REPO_ROOT = Path(__file__).resolve().parent.parent
 SHARED_DIR = REPO_ROOT.parent / "shared"
@@ -31,6 +32,29 @@ def user_folders(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
         os.environ[name] = str(root / name.removeprefix("XDG_").removesuffix("_HOME").lower())
     try:
         yield root
+    finally:
+        for name, value in saved.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
+
+
+@pytest.fixture(scope="session", autouse=True)
+def own_network() -> Iterator[str]:
+    """The session's default router endpoint (``KINEMA_ZENOH_CONNECT``) is a free loopback port of its own.
+
+    A test, or a process it starts, that does not name an endpoint would otherwise take the default
+    ``tcp/127.0.0.1:7447``: join the runtime of the person running the suite, or meet a test of another
+    worker (``-n``) or of another test run beside it. The user's router config (``KINEMA_ZENOH_CONFIG``)
+    is left out for the same reason. Tests that need their own network still name an endpoint.
+    """
+    names = ("KINEMA_ZENOH_CONNECT", "KINEMA_ZENOH_CONFIG")
+    saved = {name: os.environ.get(name) for name in names}
+    os.environ.pop("KINEMA_ZENOH_CONFIG", None)
+    os.environ["KINEMA_ZENOH_CONNECT"] = free_endpoint()
+    try:
+        yield os.environ["KINEMA_ZENOH_CONNECT"]
     finally:
         for name, value in saved.items():
             if value is None:

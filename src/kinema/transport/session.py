@@ -76,13 +76,25 @@ def _install_exit_hook() -> None:
         _exit_hook_installed = True
 
 
+_handed_out: set[tuple[str, int]] = set()
+
+
 def free_endpoint(host: str = "127.0.0.1") -> str:
-    """``tcp/<host>:<port>`` on a port the OS reports free now (for tests and side-by-side runtimes)."""
+    """``tcp/<host>:<port>`` on a port the OS reports free now (for tests and side-by-side runtimes).
+
+    A port is never handed out twice by one process: the OS may offer a port again as soon as the probe
+    closes, before whoever took the first endpoint has started listening on it.
+    """
     import socket
 
-    with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
-        probe.bind((host, 0))
-        return f"tcp/{host}:{probe.getsockname()[1]}"
+    for _ in range(100):
+        with socket.socket(socket.AF_INET, socket.SOCK_STREAM) as probe:
+            probe.bind((host, 0))
+            port = int(probe.getsockname()[1])
+        if (host, port) not in _handed_out:
+            _handed_out.add((host, port))
+            return f"tcp/{host}:{port}"
+    raise TransportError(f"no free TCP port on {host} that this process has not handed out already")
 
 
 def resolve_endpoints(connect: str | Sequence[str] | None) -> list[str]:

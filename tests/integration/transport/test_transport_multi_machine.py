@@ -101,7 +101,10 @@ def _certificates(folder: Path) -> None:
 
 
 @pytest.mark.skipif(shutil.which("openssl") is None, reason="needs the openssl command to make certificates")
-def test_mutual_tls_and_access_rules(tmp_path: Path, endpoints: Callable[[], str]) -> None:
+def test_mutual_tls_and_access_rules(
+    tmp_path: Path, endpoints: Callable[[], str], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.delenv("KINEMA_ZENOH_CONNECT")  # the laptop's only setting is its client config file
     _certificates(tmp_path)
     local, lan = endpoints(), endpoints().replace("tcp/", "tls/")
     blocks = _json5_blocks()

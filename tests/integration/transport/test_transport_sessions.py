@@ -138,3 +138,33 @@ def test_process_exits_while_a_concurrent_handler_is_stuck() -> None:
     done = subprocess.run([sys.executable, "-c", _STUCK_HANDLER], capture_output=True, text=True, timeout=60)
     assert done.returncode == 0, done.stderr
     assert done.stdout.strip() == "in handler"
+
+
+def test_free_endpoint_never_hands_out_a_port_twice(monkeypatch: pytest.MonkeyPatch) -> None:
+    """The OS may offer a just-probed port again before its taker listens: the next caller must not get it."""
+    import socket
+
+    from kinema.transport import session
+
+    offered = iter([40001, 40001, 40002, 40001, 40003])
+
+    class Probe:
+        def __init__(self, *args: object) -> None:
+            self.port = 0
+
+        def __enter__(self) -> Probe:
+            return self
+
+        def __exit__(self, *exc: object) -> None:
+            return None
+
+        def bind(self, address: tuple[str, int]) -> None:
+            self.port = next(offered)
+
+        def getsockname(self) -> tuple[str, int]:
+            return ("127.0.0.1", self.port)
+
+    monkeypatch.setattr(session, "_handed_out", set())
+    monkeypatch.setattr(socket, "socket", Probe)
+    got = [session.free_endpoint() for _ in range(3)]
+    assert got == ["tcp/127.0.0.1:40001", "tcp/127.0.0.1:40002", "tcp/127.0.0.1:40003"]
