@@ -66,12 +66,13 @@ def test_latched_topic_reaches_a_late_subscriber(connect: Callable[[], Session])
 
 
 def test_plain_subscriber_does_not_get_history(connect: Callable[[], Session]) -> None:
-    publisher = Node(connect(), "snapshot").create_publisher(STRING, "/volatile")
+    talker = Node(connect(), "snapshot")
+    publisher = talker.create_publisher(STRING, "/volatile")
     publisher.publish({"data": "old"})
     received, callback = _collector()
     node = Node(connect(), "late")
     node.create_subscription(STRING, "/volatile", lambda m: callback(m.data))
-    _wait_matched(node, "/volatile")
+    _wait_matched(talker, "/volatile")  # the publisher's side must know the subscriber, not only the reverse
     publisher.publish({"data": "new"})
     assert _drain(received, 1) == ["new"]
     assert received.empty()

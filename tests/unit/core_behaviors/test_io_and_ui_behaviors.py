@@ -248,7 +248,9 @@ def test_point_cloud_snapshots_are_drawn_and_cleared(behavior: Any, context: Beh
     # A snapshot of several MB dropped on a busy link would never be drawn: these publishers keep all
     # (zenoh then waits instead of dropping), as a ROS graph tool shows.
     for topic in ("/pcd_pointcloud_captures", "/visualization_marker_array"):
-        publishers = wait_for(lambda: context.node.graph().publishers(topic), f"the publisher on {topic}")
+        publishers = wait_for(
+            lambda topic=topic: context.node.graph().publishers(topic), f"the publisher on {topic}"
+        )
         assert [p.qos.keep_all for p in publishers] == [True] * len(publishers), (topic, publishers)
 
 
