@@ -34,6 +34,7 @@ from typing import Any
 
 import numpy as np
 
+from kinema.drivers.mujoco.controller_manager import Broadcaster
 from kinema.drivers.mujoco.execution import Execution
 from kinema.drivers.mujoco.model_index import JointInfo
 from kinema.drivers.mujoco.trajectory_controller import JointTrajectoryController
@@ -85,33 +86,19 @@ class ForceTorqueSensor:
         return np.concatenate((data.sensordata[self._force], data.sensordata[self._torque]))
 
 
-class ForceTorqueSensorBroadcaster:
-    """Publishes the sensor's wrench while active (the driver asks :attr:`active` before publishing)."""
+class ForceTorqueSensorBroadcaster(Broadcaster):
+    """Publishes the sensor's wrench while active."""
 
     type_name = "force_torque_sensor_broadcaster/ForceTorqueSensorBroadcaster"
 
     def __init__(self, name: str, sensor: ForceTorqueSensor) -> None:
-        self.name = name
+        super().__init__(name)
         self.sensor = sensor
-        self.active = False
-
-    @property
-    def command_interfaces(self) -> list[str]:
-        """None: a broadcaster only reads."""
-        return []
 
     @property
     def state_interfaces(self) -> list[str]:
         """The sensor's six interfaces."""
         return self.sensor.interfaces
-
-    def activate(self, data: Any) -> None:
-        """Start publishing."""
-        self.active = True
-
-    def deactivate(self, data: Any) -> None:
-        """Stop publishing."""
-        self.active = False
 
     def message(self, data: Any) -> dict[str, Any]:
         """The ``geometry_msgs/WrenchStamped`` of the current reading."""
