@@ -97,8 +97,9 @@ def time_parameterize(
         max_step: largest joint change between spline knots (rad or m).
 
     Raises:
-        MotionError: a scale factor outside (0, 1], a joint without finite limits, or the limits still exceeded after derating
-            (when toppra finds no timing at all, the path is timed rest to rest at each waypoint).
+        MotionError: a scale factor outside (0, 1], a joint without finite limits, or the limits still
+            exceeded after derating (when toppra finds no timing at all, the path is timed rest to rest
+            at each waypoint).
     """
     import toppra as ta
     import toppra.algorithm as algo
