@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import contextlib
 import os
 from collections.abc import Callable, Iterator
 from pathlib import Path
@@ -27,17 +28,10 @@ def user_folders(tmp_path_factory: pytest.TempPathFactory) -> Iterator[Path]:
     """
     root = tmp_path_factory.mktemp("user")
     names = ("XDG_CONFIG_HOME", "XDG_DATA_HOME", "XDG_STATE_HOME", "XDG_CACHE_HOME")
-    saved = {name: os.environ.get(name) for name in names}
-    for name in names:
-        os.environ[name] = str(root / name.removeprefix("XDG_").removesuffix("_HOME").lower())
-    try:
+    with _environment(
+        {name: str(root / name.removeprefix("XDG_").removesuffix("_HOME").lower()) for name in names}
+    ):
         yield root
-    finally:
-        for name, value in saved.items():
-            if value is None:
-                os.environ.pop(name, None)
-            else:
-                os.environ[name] = value
 
 
 @pytest.fixture(scope="session", autouse=True)
@@ -49,12 +43,22 @@ def own_network() -> Iterator[str]:
     worker (``-n``) or of another test run beside it. The user's router config (``KINEMA_ZENOH_CONFIG``)
     is left out for the same reason. Tests that need their own network still name an endpoint.
     """
-    names = ("KINEMA_ZENOH_CONNECT", "KINEMA_ZENOH_CONFIG")
-    saved = {name: os.environ.get(name) for name in names}
-    os.environ.pop("KINEMA_ZENOH_CONFIG", None)
-    os.environ["KINEMA_ZENOH_CONNECT"] = free_endpoint()
+    endpoint = free_endpoint()
+    with _environment({"KINEMA_ZENOH_CONNECT": endpoint, "KINEMA_ZENOH_CONFIG": None}):
+        yield endpoint
+
+
+@contextlib.contextmanager
+def _environment(values: dict[str, str | None]) -> Iterator[None]:
+    """Set (a value) or unset (None) environment variables, and put the old values back afterwards."""
+    saved = {name: os.environ.get(name) for name in values}
     try:
-        yield os.environ["KINEMA_ZENOH_CONNECT"]
+        for name, value in values.items():
+            if value is None:
+                os.environ.pop(name, None)
+            else:
+                os.environ[name] = value
+        yield
     finally:
         for name, value in saved.items():
             if value is None:

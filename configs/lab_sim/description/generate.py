@@ -35,6 +35,11 @@ FINGER_TRAVEL = 0.0425
 FINGER_PER_KNUCKLE = FINGER_TRAVEL / KNUCKLE_CLOSED
 FINGER_HALF_THICKNESS = 0.01
 TCP_DEPTH = 0.13  # grasp_link along the gripper z axis, from tool0
+# The wrist force/torque sensor, between the flange and the gripper, as in MoveIt Pro's lab_sim: a site
+# named like the ros2_control sensor (tcp_fts_sensor) carrying MuJoCo force and torque sensors. It sits at
+# tool0, so its readings are in tool0's frame, the frame the force/torque broadcaster publishes them in.
+FTS_LINK = "tool0"
+FTS_SITE = "tcp_fts_sensor"
 
 # The cell in the world: MoveIt Pro's lab_sim runs its rail along world x (rail joint + toward -x) with the
 # work surface at +y, 0.474 m up. The cell (rail pedestal, table, tray, cube, scene camera) is built 0.75 m
@@ -509,6 +514,8 @@ def _mjcf_body(link: Link, depth: int) -> list[str]:
         out.append(_mjcf_geom(g, ind + "  "))
     if link.name == "grasp_link":
         out.append(f'{ind}  <site name="grasp_site" size="0.005" rgba="1 0 0 1"/>')
+    if link.name == FTS_LINK:
+        out.append(f'{ind}  <site name="{FTS_SITE}" size="0.01" rgba="0 1 0 0"/>')
     for camera in CAMERAS:
         if camera.link == link.name:
             out.append(
@@ -748,6 +755,10 @@ def render_scene() -> str:
         "  <actuator>",
         *actuators,
         "  </actuator>",
+        "  <sensor>",
+        f'    <force name="{FTS_SITE}_force" site="{FTS_SITE}"/>',
+        f'    <torque name="{FTS_SITE}_torque" site="{FTS_SITE}"/>',
+        "  </sensor>",
         "  <keyframe>",
         f'    <key name="default" qpos="{home_qpos}" ctrl="{ctrl}"/>',
         f'    <key name="home" qpos="{home_qpos}" ctrl="{ctrl}"/>',

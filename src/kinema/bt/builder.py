@@ -6,7 +6,7 @@ import enum
 from typing import TYPE_CHECKING, Any
 
 from kinema.bt.blackboard import Blackboard
-from kinema.bt.conversions import convert_from_string, parse_double_full, parse_int_full, type_name
+from kinema.bt.conversions import Unsigned, convert_from_string, parse_double_full, parse_int_full, type_name
 from kinema.bt.decorators import SubTreeNode
 from kinema.bt.errors import BTError, BTLogicError, BTRuntimeError, ScriptParseError
 from kinema.bt.names import (
@@ -57,6 +57,8 @@ class TreeBuilder:
         self._clock = factory.clock
         # (tag, attributes...) -> what that element compiles to (valid for this registry only)
         self.kinds: dict[tuple[Any, ...], NodeKind] = {}
+        # The entries SubTree number literals created (ids, while this tree is built): see _number_fits.
+        self._number_literals: set[int] = set()
 
     def build(self, tree_id: str, blackboard: Blackboard) -> Tree:
         """Instantiate ``tree_id`` with ``blackboard`` as the root scope."""
@@ -211,7 +213,10 @@ class TreeBuilder:
             else:
                 # A literal is stored locally and never auto-remapped.
                 new_bb.enable_auto_remapping(False)
-                new_bb.set(attr_name, literal_subtree_value(attr_value))
+                literal = literal_subtree_value(attr_value)
+                new_bb.set(attr_name, literal)
+                if not isinstance(literal, str):
+                    self._number_literals.add(id(new_bb.get_entry(attr_name)))
                 new_bb.enable_auto_remapping(autoremap)
         path = subtree.instance_name
         if path:
@@ -409,7 +414,12 @@ class TreeBuilder:
                     and isinstance(port_info.type, type)
                     and isinstance(existing.value, port_info.type)
                 )
-                if mismatch and existing.type is not str and not accepts:
+                if (
+                    mismatch
+                    and existing.type is not str
+                    and not accepts
+                    and not (id(existing) in self._number_literals and _number_fits(existing, port_info))
+                ):
                     raise BTRuntimeError(
                         f"The creation of the tree failed because the port [{key}] was initially "
                         f"created with type [{type_name(existing.type)}] and, later type "
@@ -422,6 +432,25 @@ class TreeBuilder:
                     blackboard.create_entry(key, port_info.type)
                 except BTError as error:
                     raise BTRuntimeError(error.message, location=location) from None
+
+
+def _number_fits(existing: Any, port_info: Any) -> bool:
+    """A number in the entry (from a SubTree literal) that the numeric port's type holds exactly.
+
+    BT.CPP 4.10 refuses ``<SubTree msec_key="500"/>`` reaching an ``unsigned`` port such as Timeout's
+    ``msec``: since 4.9.1 the literal is stored as ``int``. The BT.CPP that MoveIt Pro ships stored it as
+    text (the universal donor), and MoveIt Pro's own objectives rely on it (lab_sim's Force Relaxation), so
+    Kinema accepts a stored number that the port's numeric type represents exactly.
+    """
+    value, target = existing.value, port_info.type
+    if type(value) not in (int, float) or target not in (int, Unsigned, float):
+        return False
+    if target is float:
+        return True
+    if isinstance(value, float) and not value.is_integer():
+        return False
+    number = int(value)
+    return 0 <= number <= 2**32 - 1 if target is Unsigned else -(2**31) <= number < 2**31
 
 
 class NodeSpec:

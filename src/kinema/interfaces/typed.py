@@ -28,7 +28,9 @@ if TYPE_CHECKING:
         geometry_msgs__msg__PoseStamped,
         geometry_msgs__msg__PoseWithCovariance,
         geometry_msgs__msg__TransformStamped,
+        geometry_msgs__msg__Twist,
         geometry_msgs__msg__Vector3,
+        geometry_msgs__msg__Wrench,
         sensor_msgs__msg__Image,
         sensor_msgs__msg__JointState,
         sensor_msgs__msg__MultiDOFJointState,
@@ -821,6 +823,30 @@ if TYPE_CHECKING:
         __msgtype__: ClassVar[str] = "moveit_msgs/srv/GetPlanningScene_Response"
 
     @dataclass
+    class moveit_pro_controllers_msgs__msg__CartesianSelectionVector:
+        """moveit_pro_controllers_msgs/msg/CartesianSelectionVector."""
+
+        x: bool
+        y: bool
+        z: bool
+        rx: bool
+        ry: bool
+        rz: bool
+        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/msg/CartesianSelectionVector"
+
+    @dataclass
+    class moveit_pro_controllers_msgs__msg__VelocityForceCommand:
+        """moveit_pro_controllers_msgs/msg/VelocityForceCommand."""
+
+        header: std_msgs__msg__Header
+        twist: geometry_msgs__msg__Twist
+        wrench: geometry_msgs__msg__Wrench
+        velocity_controlled_axes: moveit_pro_controllers_msgs__msg__CartesianSelectionVector
+        force_controlled_axes: moveit_pro_controllers_msgs__msg__CartesianSelectionVector
+        wrench_gain: float
+        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/msg/VelocityForceCommand"
+
+    @dataclass
     class moveit_studio_agent_msgs__msg__Log:
         """moveit_studio_agent_msgs/msg/Log."""
 
@@ -1516,6 +1542,8 @@ _MESSAGES = frozenset(
         "moveit_msgs__msg__RobotState",
         "moveit_msgs__srv__GetPlanningScene_Request",
         "moveit_msgs__srv__GetPlanningScene_Response",
+        "moveit_pro_controllers_msgs__msg__CartesianSelectionVector",
+        "moveit_pro_controllers_msgs__msg__VelocityForceCommand",
         "moveit_studio_agent_msgs__msg__Log",
         "moveit_studio_agent_msgs__msg__ObjectiveServerStatus",
         "moveit_studio_agent_msgs__msg__RobotJointState",

@@ -34,6 +34,13 @@ class PlanningOptions:
         try_direct: first try the straight joint-space line from start to goal.
         limit_tolerance: how far (rad or m) the start may lie outside the limits and still be clamped in
             (joint encoders report values a hair outside).
+        fix_start_collision: a start state in collision (a gripper resting on the table after a press,
+            within the link padding of what it holds) is left for the nearest collision-free state found
+            by sampling around it, as MoveIt's FixStartStateCollision planning adapter does; the path
+            then begins with that short move. False: such a start is an error.
+        start_jiggle_fraction: the largest move tried, as a fraction of each joint's range (MoveIt's
+            ``jiggle_fraction``, whose 0.05 would let the tool jump ~15 cm; 0.01 is ~3 cm, enough to leave
+            a contact inside the link padding); smaller moves are tried first.
     """
 
     planner: str = "RRTConnect"
@@ -42,6 +49,8 @@ class PlanningOptions:
     max_step: float = 0.02
     try_direct: bool = True
     limit_tolerance: float = 1e-2
+    fix_start_collision: bool = True
+    start_jiggle_fraction: float = 0.01
 
 
 def _ompl():
@@ -135,14 +144,62 @@ def plan_joint_goal(
         q_goal = q_start.copy()
         full = np.asarray(goal, dtype=float)
         q_goal[list(g.indices)] = full[list(g.indices)]
+    cols = list(g.indices)
+    stuck = q_start
     if checker.in_collision(q_start):
-        raise MotionError(f"start state is in collision: {checker.describe(q_start)}")
+        colliding = checker.describe(q_start)
+        freed = _free_start(checker, q_start, cols, opts) if opts.fix_start_collision else None
+        if freed is None:
+            raise MotionError(
+                f"start state is in collision: {colliding}"
+                + (
+                    f"; no collision-free state within {opts.start_jiggle_fraction:g} of each joint's range "
+                    "around it"
+                    if opts.fix_start_collision
+                    else ""
+                )
+            )
+        q_start = freed
     if checker.in_collision(q_goal):
         raise MotionError(f"goal state is in collision: {checker.describe(q_goal)}")
-    cols = list(g.indices)
     if opts.try_direct and checker.first_invalid(np.array([q_start, q_goal]), opts.max_step) is None:
-        return JointPath(g.joint_names, np.array([q_start[cols], q_goal[cols]]))
-    return _plan_ompl(checker, q_start, q_goal, cols, g.joint_names, opts)
+        path = JointPath(g.joint_names, np.array([q_start[cols], q_goal[cols]]))
+    else:
+        path = _plan_ompl(checker, q_start, q_goal, cols, g.joint_names, opts)
+    if q_start is not stuck:
+        path = JointPath(path.joint_names, np.vstack((stuck[cols][None, :], path.positions)))
+    return path
+
+
+def _free_start(
+    checker: CollisionChecker, q_start: np.ndarray, cols: list[int], opts: PlanningOptions
+) -> np.ndarray | None:
+    """The collision-free state nearest ``q_start`` among samples around it (moving only ``cols``).
+
+    Samples are drawn in growing boxes (1/16, 1/8, ... up to ``start_jiggle_fraction`` of each joint's
+    range), 200 per box, from a fixed seed so the same start gives the same plan; the first box with a free
+    sample gives the nearest of its free samples.
+    """
+    model = checker.model
+    span = (model.upper - model.lower)[cols]
+    span = np.where(np.isfinite(span), span, 2 * np.pi)
+    rng = np.random.default_rng(0)
+    fraction = opts.start_jiggle_fraction / 16
+    while fraction <= opts.start_jiggle_fraction * (1 + 1e-9):
+        found: list[np.ndarray] = []
+        for _ in range(200):
+            q = q_start.copy()
+            q[cols] = np.clip(
+                q_start[cols] + rng.uniform(-1.0, 1.0, len(cols)) * fraction * span,
+                model.lower[cols],
+                model.upper[cols],
+            )
+            if not checker.in_collision(q):
+                found.append(q)
+        if found:
+            return min(found, key=lambda q: float(np.abs(q[cols] - q_start[cols]).max()))
+        fraction *= 2
+    return None
 
 
 def _plan_ompl(

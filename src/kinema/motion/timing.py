@@ -3,12 +3,15 @@
 from __future__ import annotations
 
 import itertools
+import logging
 
 import numpy as np
 
 from kinema.errors import MotionError
 from kinema.motion.robot_model import RobotModel
 from kinema.motion.trajectory import JointPath, JointTrajectory
+
+log = logging.getLogger(__name__)
 
 # toppra enforces the limits at its grid points only; between them the spline can exceed them (up to ~20 %
 # with chord-length parameterization). The limits are therefore derated and the result verified by sampling.
@@ -22,6 +25,52 @@ def _densify(points: np.ndarray, max_step: float) -> np.ndarray:
         n = max(1, int(np.ceil(np.abs(b - a).max() / max_step)))
         out.extend(a + (b - a) * (k / n) for k in range(1, n + 1))
     return np.array(out)
+
+
+def _rest_to_rest(
+    names: tuple[str, ...], points: np.ndarray, vmax: np.ndarray, amax: np.ndarray, sample_period: float
+) -> JointTrajectory:
+    """Time each straight segment of ``points`` with a joint-synchronised trapezoid, at rest at each point."""
+    pieces: list[tuple[np.ndarray, np.ndarray, float, float, float]] = []  # start, delta, T, t_acc, u_peak
+    for a, b in itertools.pairwise(points):
+        delta = b - a
+        moving = np.abs(delta) > 0
+        u_speed = float(np.min(vmax[moving] / np.abs(delta[moving])))  # path parameter u in [0, 1]
+        u_accel = float(np.min(amax[moving] / np.abs(delta[moving])))
+        if u_speed * u_speed / u_accel >= 1.0:  # triangular: never reaches full speed
+            t_acc = float(np.sqrt(1.0 / u_accel))
+            pieces.append((a, delta, 2 * t_acc, t_acc, u_accel * t_acc))
+        else:
+            t_acc = u_speed / u_accel
+            pieces.append((a, delta, 1.0 / u_speed + t_acc, t_acc, u_speed))
+    duration = sum(piece[2] for piece in pieces)
+    count = max(2, int(np.ceil(duration / sample_period)) + 1)
+    times = np.linspace(0.0, duration, count)
+    q = np.zeros((count, len(names)))
+    qd, qdd = np.zeros_like(q), np.zeros_like(q)
+    begin = 0.0
+    for index, (a, delta, total, t_acc, peak) in enumerate(pieces):
+        last = index == len(pieces) - 1
+        inside = (times >= begin) & ((times <= begin + total) if last else (times < begin + total))
+        t = times[inside] - begin
+        accel = peak / t_acc
+        t_dec = total - t_acc
+        u = np.where(
+            t < t_acc,
+            0.5 * accel * t * t,
+            np.where(
+                t <= t_dec, 0.5 * peak * t_acc + peak * (t - t_acc), 1.0 - 0.5 * accel * (total - t) ** 2
+            ),
+        )
+        ud = np.where(t < t_acc, accel * t, np.where(t <= t_dec, peak, accel * (total - t)))
+        udd = np.where(t < t_acc, accel, np.where(t <= t_dec, 0.0, -accel))
+        q[inside] = a + np.outer(np.clip(u, 0.0, 1.0), delta)
+        qd[inside] = np.outer(ud, delta)
+        qdd[inside] = np.outer(udd, delta)
+        begin += total
+    qd[0] = qd[-1] = 0.0
+    q[0], q[-1] = points[0], points[-1]
+    return JointTrajectory(names, times, q, qd, qdd)
 
 
 def time_parameterize(
@@ -48,7 +97,9 @@ def time_parameterize(
         max_step: largest joint change between spline knots (rad or m).
 
     Raises:
-        MotionError: a scale factor outside (0, 1], a joint without finite limits, or toppra failing.
+        MotionError: a scale factor outside (0, 1], a joint without finite limits, or the limits still
+            exceeded after derating (when toppra finds no timing at all, the path is timed rest to rest
+            at each waypoint).
     """
     import toppra as ta
     import toppra.algorithm as algo
@@ -92,10 +143,17 @@ def time_parameterize(
             retry = algo.TOPPRA(constraints, spline, gridpoints=grid, parametrizer="ParametrizeConstAccel")
             traj = retry.compute_trajectory(0, 0)
         if traj is None:
-            raise MotionError(
-                f"toppra found no feasible time parameterization for the path ({len(points)} waypoints, "
-                f"{s[-1]:.4f} rad long; grids of {len(instance.gridpoints)} and {len(grid)} points)"
+            # Still none (stressed run 114: a straight 0.055 rad path, twice): time the path's straight
+            # segments one by one instead, each from rest to rest, which is always feasible.
+            log.warning(
+                "toppra found no feasible time parameterization for the path (%d waypoints, %.4f rad long; "
+                "grids of %d and %d points): timing it segment by segment, stopping at each waypoint",
+                len(points),
+                s[-1],
+                len(instance.gridpoints),
+                len(grid),
             )
+            return _rest_to_rest(path.joint_names, points, vmax, amax, sample_period)
         ts = np.arange(0.0, traj.duration, _CHECK_DT)
         over = max(
             float(np.max(np.abs(traj(ts, 1)) / vmax)),

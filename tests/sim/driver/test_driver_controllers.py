@@ -16,12 +16,15 @@ STRICT, BEST_EFFORT = 2, 1
 
 def test_list_controllers_reports_the_config_controllers_active(sim: Sim) -> None:
     controllers = sim.controllers()
-    assert set(controllers) == {
+    active = {
         n.JOINT_STATE_BROADCASTER,
+        n.FORCE_TORQUE_SENSOR_BROADCASTER,
         n.JOINT_TRAJECTORY_CONTROLLER,
         n.GRIPPER_CONTROLLER,
     }
-    assert all(c.state == "active" for c in controllers.values())
+    inactive = {n.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER, n.VELOCITY_FORCE_CONTROLLER}
+    assert set(controllers) == active | inactive
+    assert {name for name, c in controllers.items() if c.state == "active"} == active
     trajectory_controller = controllers[n.JOINT_TRAJECTORY_CONTROLLER]
     assert trajectory_controller.type == "joint_trajectory_controller/JointTrajectoryController"
     assert list(trajectory_controller.claimed_interfaces) == [f"{j}/position" for j in ARM]
@@ -40,7 +43,8 @@ def test_switching_off_and_on_again(sim: Sim) -> None:
     # MoveIt Pro's objectives name controllers with a leading slash.
     response = sim.switch(activate=["/joint_trajectory_controller", n.GRIPPER_CONTROLLER])
     assert response.ok, response.message
-    assert all(c.state == "active" for c in sim.controllers().values())
+    states = {name: c.state for name, c in sim.controllers().items()}
+    assert states[n.JOINT_TRAJECTORY_CONTROLLER] == states[n.GRIPPER_CONTROLLER] == "active", states
 
 
 def test_a_goal_to_an_inactive_controller_is_rejected(sim: Sim) -> None:
@@ -64,20 +68,20 @@ def test_a_gripper_goal_to_an_inactive_controller_is_aborted(sim: Sim) -> None:
 
 def test_a_strict_switch_with_an_unknown_name_changes_nothing(sim: Sim) -> None:
     response = sim.switch(
-        deactivate=[n.JOINT_TRAJECTORY_CONTROLLER, "velocity_force_controller"], strictness=STRICT
+        deactivate=[n.JOINT_TRAJECTORY_CONTROLLER, "servo_controller"], strictness=STRICT
     )
     assert not response.ok
-    assert "velocity_force_controller" in response.message
+    assert "servo_controller" in response.message
     assert n.JOINT_TRAJECTORY_CONTROLLER in response.message  # the known controllers are listed
     assert sim.controllers()[n.JOINT_TRAJECTORY_CONTROLLER].state == "active"
 
 
 def test_a_best_effort_switch_skips_unknown_names(sim: Sim) -> None:
     response = sim.switch(
-        deactivate=[n.JOINT_TRAJECTORY_CONTROLLER, "velocity_force_controller"], strictness=BEST_EFFORT
+        deactivate=[n.JOINT_TRAJECTORY_CONTROLLER, "servo_controller"], strictness=BEST_EFFORT
     )
     assert response.ok
-    assert "velocity_force_controller" in response.message
+    assert "servo_controller" in response.message
     assert sim.controllers()[n.JOINT_TRAJECTORY_CONTROLLER].state == "inactive"
 
 

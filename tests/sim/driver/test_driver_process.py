@@ -60,8 +60,11 @@ def test_the_process_serves_and_stops_cleanly_on_sigterm(
         )
         assert {c.name for c in controllers.controller} == {
             n.JOINT_STATE_BROADCASTER,
+            n.FORCE_TORQUE_SENSOR_BROADCASTER,
             n.JOINT_TRAJECTORY_CONTROLLER,
             n.GRIPPER_CONTROLLER,
+            n.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER,
+            n.VELOCITY_FORCE_CONTROLLER,
         }
     driver_process.send_signal(signal.SIGTERM)
     _, stderr = driver_process.communicate(timeout=20.0)

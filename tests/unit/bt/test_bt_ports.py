@@ -223,6 +223,36 @@ def test_conflicting_port_types_fail_at_creation(bench) -> None:
         bench.tree('<Sequence><Doubler in="1" out="{v}"/><Text t="{v}"/></Sequence>')
 
 
+def _literal_into_timeout(msec: str) -> str:
+    return f"""
+<root BTCPP_format="4" main_tree_to_execute="Main">
+  <BehaviorTree ID="Main"><Sequence><SubTree ID="Relax" wait_ms="{msec}"/></Sequence></BehaviorTree>
+  <BehaviorTree ID="Relax">
+    <Timeout msec="{{wait_ms}}"><Sleep msec="2000"/></Timeout>
+  </BehaviorTree>
+</root>"""
+
+
+def test_a_subtree_number_literal_reaches_an_unsigned_port_as_moveit_pro_files_expect() -> None:
+    """MoveIt Pro's Force Relaxation passes relaxation_time_ms="500" on to Timeout's unsigned msec: BT.CPP
+    4.10 refuses it (the literal is an int since 4.9.1), MoveIt Pro's BT.CPP (text literals) runs it."""
+    import time
+
+    from kinema.bt import BehaviorTreeFactory
+
+    factory = BehaviorTreeFactory()
+    factory.register_behavior_tree_from_text(_literal_into_timeout("30"))
+    tree = factory.create_tree("Main")
+    started = time.monotonic()
+    assert tree.tick_while_running() is NodeStatus.FAILURE  # the 30 ms timeout fired, not the 2 s sleep
+    assert time.monotonic() - started < 1.5
+    for refused in ("-5", "1.5"):  # numbers an unsigned port cannot hold stay refused
+        factory = BehaviorTreeFactory()
+        factory.register_behavior_tree_from_text(_literal_into_timeout(refused))
+        with pytest.raises(BTError, match="was initially created with type"):
+            factory.create_tree("Main")
+
+
 def test_enum_ports(bench) -> None:
     class Color(IntEnum):
         RED = 1

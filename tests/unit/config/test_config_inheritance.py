@@ -281,6 +281,7 @@ def test_bundled_lab_sim_and_example_config_resolve():
     assert resolved.provenance["objectives.behavior_loader_plugins.core[0]"] == "lab_sim"
     assert resolved.get("ros2_control.controllers_active_at_startup") == [
         "joint_state_broadcaster",
+        "force_torque_sensor_broadcaster",
         "joint_trajectory_controller",
         "robotiq_gripper_controller",
     ]

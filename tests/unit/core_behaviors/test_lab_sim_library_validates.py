@@ -3,7 +3,7 @@
 The 83 public lab_sim objectives (and picknik_ur_base_config's, which their SubTrees reach) are copied
 into a config package based on Kinema's lab_sim, then every objective is validated with its SubTree
 closure against the config's behaviors. Issue 12 requires 27 of them, issue 14's point-cloud half 13
-more and its AprilTag half 5 more; ``kinema objective list`` must say in one line why each of the
+more, its AprilTag half 5 more and its force objectives 3 more; ``kinema objective list`` must say in one line why each of the
 others cannot load.
 """
 
@@ -79,6 +79,12 @@ APRILTAGS = {
     "take_picture_with_wrist_camera",
     "wrist_snap",
 }
+# Issue 14's force objectives: velocity-force control and the tray-place objective that uses it.
+FORCE = {
+    "force_relaxation",
+    "move_with_velocity_and_force",
+    "pick_all_bottles_with_apriltags",
+}
 
 
 @pytest.fixture(scope="module")
@@ -127,10 +133,10 @@ def test_the_required_lab_sim_objectives_validate_with_their_subtrees(corpus_wor
     problems = {path.stem: file_problem(library, path, factory) for path in files}
     valid = {stem for stem, problem in problems.items() if problem is None}
     failing = {stem: problem for stem, problem in problems.items() if problem is not None}
-    missing = sorted((BEFORE | ADDED | POINT_CLOUDS | APRILTAGS) - valid)
+    missing = sorted((BEFORE | ADDED | POINT_CLOUDS | APRILTAGS | FORCE) - valid)
     report = "\n".join(f"  {stem}: {failing.get(stem, '?')}" for stem in missing)
     assert not missing, f"{len(valid)} of 83 validate; these required ones do not:\n{report}"
-    assert len(valid) >= len(BEFORE | ADDED | POINT_CLOUDS | APRILTAGS)
+    assert len(valid) >= len(BEFORE | ADDED | POINT_CLOUDS | APRILTAGS | FORCE)
 
 
 def test_objective_list_says_why_each_objective_cannot_load(corpus_workspace: Path) -> None:

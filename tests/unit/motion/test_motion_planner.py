@@ -70,6 +70,35 @@ def test_start_in_collision(model, checker, waypoint_q, arm_goal):
         plan_joint_goal(checker, start, arm_goal("Home"))
 
 
+def test_a_start_touching_the_scene_is_left_for_a_nearby_free_state(model, checker, waypoint_q, arm_goal):
+    """A gripper resting on a surface (inside the link padding) plans away from it, as MoveIt's
+    FixStartStateCollision adapter lets it: the path starts where the arm is, then a short move frees it."""
+    start = waypoint_q("VFC Start")  # the gripper pointing straight down above the table
+    grasp = fk(model, start, "grasp_link")
+    slab = np.eye(4)
+    slab[:3, 3] = grasp[:3, 3] - np.array(
+        [0.0, 0.0, 0.045]
+    )  # its top 15 mm below grasp_link: 5 mm into the fingertips
+    checker.scene.add_box("slab", (0.06, 0.06, 0.03), slab)  # half extents
+    try:
+        assert checker.in_collision(start), "the fingertips should reach into the slab"
+        with pytest.raises(MotionError, match=r"start state is in collision: .*slab"):
+            plan_joint_goal(
+                checker, start, arm_goal("Home"), options=PlanningOptions(fix_start_collision=False)
+            )
+        path = plan_joint_goal(checker, start, arm_goal("Home"))
+        cols = list(model.group("manipulator").indices)
+        np.testing.assert_allclose(path.positions[0], start[cols])
+        freed = _full(model, start, path)[1]
+        assert not checker.in_collision(freed)
+        span = (model.upper - model.lower)[cols]
+        assert np.all(np.abs(freed[cols] - start[cols]) <= 0.01 * span + 1e-9)
+        assert checker.first_invalid(_full(model, start, path)[1:], max_step=0.005) is None
+        np.testing.assert_allclose(path.positions[-1], waypoint_q("Home")[cols], atol=1e-9)
+    finally:
+        checker.scene.remove("slab")
+
+
 def test_unknown_joint_names_list_the_valid_ones(checker, waypoint_q):
     with pytest.raises(
         MotionError, match=r"unknown joint 'elbow'.*valid joints: linear_rail_joint, shoulder_pan"

@@ -1,8 +1,9 @@
-"""Controllers: list and switch the driver's ros2_control-style controllers."""
+"""Controllers: list and switch the driver's ros2_control-style controllers; velocity-force control."""
 
 from __future__ import annotations
 
 from .list_controllers import ListControllers
 from .switch_controller import SwitchController
+from .velocity_force import ForceExceedsThreshold, PublishVelocityForceCommand
 
-BEHAVIORS = (ListControllers, SwitchController)
+BEHAVIORS = (ListControllers, SwitchController, PublishVelocityForceCommand, ForceExceedsThreshold)

@@ -18,6 +18,9 @@ def _names(values: list[str]) -> list[str]:
     return [name.strip().lstrip("/") for name in values if name.strip().lstrip("/")]
 
 
+_FOREVER = 1e9  # seconds: "no timeout" for a service call (halting the objective still ends the wait)
+
+
 class SwitchController(AsyncBehavior):
     """Activates ``activate_controllers`` and deactivates ``deactivate_controllers`` in one switch.
 
@@ -60,7 +63,13 @@ class SwitchController(AsyncBehavior):
             ),
             input_port("activate_asap", bool, True, "Start the activated controllers at once."),
             input_port("strictness", int, STRICT, "1: best effort, 2: strict (fail on any problem)."),
-            input_port("timeout", float, 10.0, "Seconds to wait for the controller manager."),
+            input_port(
+                "timeout",
+                float,
+                10.0,
+                "Seconds to wait for the controller manager; 0 or less waits as long as it takes (MoveIt "
+                "Pro's objectives pass -1), until the objective is halted.",
+            ),
         ]
 
     async def do_work(self) -> bool:
@@ -68,7 +77,8 @@ class SwitchController(AsyncBehavior):
         activate = _names(self.get_input_or("activate_controllers", []))
         deactivate = _names(self.get_input_or("deactivate_controllers", []))
         strictness = int(self.get_input("strictness"))
-        timeout = float(self.get_input("timeout"))
+        given = float(self.get_input("timeout"))
+        timeout = given if given > 0 else _FOREVER
         if strictness not in (BEST_EFFORT, STRICT):
             self.logger.publish_failure(
                 f"SwitchController: strictness must be 1 (best effort) or 2 (strict), got {strictness}"
@@ -127,7 +137,8 @@ class SwitchController(AsyncBehavior):
             "deactivate_controllers": deactivate,
             "strictness": strictness,
             "activate_asap": bool(self.get_input("activate_asap")),
-            "timeout": {"sec": int(timeout), "nanosec": int((timeout % 1.0) * 1e9)},
+            # ros2_control reads a zero timeout as none.
+            "timeout": {"sec": int(max(given, 0.0)), "nanosec": int((max(given, 0.0) % 1.0) * 1e9)},
         }
         try:
             response = await asyncio.wrap_future(client.call_async(request, timeout))

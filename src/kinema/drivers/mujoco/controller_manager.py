@@ -47,25 +47,19 @@ class Controller(Protocol):
         ...
 
 
-class JointStateBroadcaster:
-    """Publishes ``/joint_states`` while active (the driver asks :attr:`active` before publishing)."""
+class Broadcaster:
+    """A controller that only reads and publishes while active (the driver asks :attr:`active` first)."""
 
-    type_name = "joint_state_broadcaster/JointStateBroadcaster"
+    type_name = ""
 
-    def __init__(self, name: str, joint_names: Sequence[str]) -> None:
+    def __init__(self, name: str) -> None:
         self.name = name
-        self.joint_names = list(joint_names)
         self.active = False
 
     @property
     def command_interfaces(self) -> list[str]:
         """None: a broadcaster only reads."""
         return []
-
-    @property
-    def state_interfaces(self) -> list[str]:
-        """Position, velocity and effort of every joint."""
-        return [f"{name}/{kind}" for name in self.joint_names for kind in ("position", "velocity", "effort")]
 
     def activate(self, data: Any) -> None:
         """Start publishing."""
@@ -74,6 +68,21 @@ class JointStateBroadcaster:
     def deactivate(self, data: Any) -> None:
         """Stop publishing."""
         self.active = False
+
+
+class JointStateBroadcaster(Broadcaster):
+    """Publishes ``/joint_states`` while active."""
+
+    type_name = "joint_state_broadcaster/JointStateBroadcaster"
+
+    def __init__(self, name: str, joint_names: Sequence[str]) -> None:
+        super().__init__(name)
+        self.joint_names = list(joint_names)
+
+    @property
+    def state_interfaces(self) -> list[str]:
+        """Position, velocity and effort of every joint."""
+        return [f"{name}/{kind}" for name in self.joint_names for kind in ("position", "velocity", "effort")]
 
 
 def _normalize(name: str) -> str:

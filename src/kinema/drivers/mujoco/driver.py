@@ -18,11 +18,16 @@ publish rate of sim time; ``/joint_trajectory_controller/follow_joint_trajectory
 ``/controller_manager/switch_controller(s)``; ``/mujoco/set_state`` (keyframe and/or joint positions),
 ``/mujoco/bodies`` (free body poses), ``/mujoco/keyframes`` and the ``/mujoco/scene_state`` topic; per
 camera of the scene ``/<camera>/color``, ``/depth``, ``/camera_info`` and ``/points``, rendered only while
-subscribed (see :mod:`kinema.drivers.mujoco.cameras`).
+subscribed (see :mod:`kinema.drivers.mujoco.cameras`). With the wrist force/torque sensor
+(lab_sim's ``tcp_fts_sensor``): ``/force_torque_sensor_broadcaster/wrench``, the admittance trajectory
+controller's ``/joint_trajectory_admittance_controller/follow_joint_trajectory``, and the velocity-force
+controller's ``/velocity_force_controller/command`` and ``/zero_fts`` (see
+:mod:`kinema.drivers.mujoco.force_control`).
 """
 
 from __future__ import annotations
 
+import functools
 import logging
 import threading
 import time
@@ -36,6 +41,12 @@ from kinema.drivers.mujoco.cameras import CameraServer, SimState
 from kinema.drivers.mujoco.cdr_templates import ClockEncoder, JointStateEncoder, generic_serializers
 from kinema.drivers.mujoco.controller_manager import Controller, ControllerManager, JointStateBroadcaster
 from kinema.drivers.mujoco.execution import Execution
+from kinema.drivers.mujoco.force_control import (
+    ForceTorqueSensor,
+    ForceTorqueSensorBroadcaster,
+    JointTrajectoryAdmittanceController,
+    VelocityForceController,
+)
 from kinema.drivers.mujoco.gripper_controller import GripperController
 from kinema.drivers.mujoco.model_index import ModelIndex
 from kinema.drivers.mujoco.scene_state import (
@@ -106,10 +117,12 @@ class MujocoDriver:
         self._controllers = self._build_controllers()
         # The controllers that run goals: updated before every step, asked for feedback at every
         # publish (each returns at once when no goal runs), told about resets and shutdown.
-        self._goal_controllers: list[JointTrajectoryController | GripperController] = [
+        self._goal_controllers: list[
+            JointTrajectoryController | GripperController | VelocityForceController
+        ] = [
             c
             for c in self._controllers.values()
-            if isinstance(c, JointTrajectoryController | GripperController)
+            if isinstance(c, JointTrajectoryController | GripperController | VelocityForceController)
         ]
         self.controller_manager = ControllerManager(
             list(self._controllers.values()), update_rate=round(1.0 / self.index.timestep)
@@ -250,6 +263,35 @@ class MujocoDriver:
                     "track a timed joint trajectory",
                 )
             )
+        if names.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER in self._controllers:
+            served.append(
+                ServedInterface(
+                    "action",
+                    names.FOLLOW_JOINT_TRAJECTORY_ADMITTANCE_ACTION,
+                    names.FOLLOW_JOINT_TRAJECTORY_TYPE,
+                    "track a joint trajectory, aborting on a force/torque threshold",
+                )
+            )
+        if names.FORCE_TORQUE_SENSOR_BROADCASTER in self._controllers:
+            served.append(
+                ServedInterface(
+                    "topic", names.WRENCH_TOPIC, names.WRENCH_TYPE, "the wrist force/torque sensor"
+                )
+            )
+        if names.VELOCITY_FORCE_CONTROLLER in self._controllers:
+            served.append(
+                ServedInterface(
+                    "topic",
+                    names.VELOCITY_FORCE_COMMAND_TOPIC,
+                    names.VELOCITY_FORCE_COMMAND_TYPE,
+                    "Cartesian velocity/force commands (subscribed)",
+                )
+            )
+            served.append(
+                ServedInterface(
+                    "service", names.ZERO_FTS_SERVICE, names.TRIGGER_TYPE, "zero the force/torque sensor"
+                )
+            )
         if names.GRIPPER_CONTROLLER in self._controllers:
             served.append(
                 ServedInterface(
@@ -288,18 +330,58 @@ class MujocoDriver:
                 names.JOINT_STATE_BROADCASTER, self.index.joint_names
             ),
         }
+        sensor = None
+        if settings.force_torque_sensor and ForceTorqueSensor.present(
+            self.model, settings.force_torque_sensor
+        ):
+            site = self.model.site(settings.force_torque_sensor)
+            frame = self.model.body(int(site.bodyid[0])).name
+            sensor = ForceTorqueSensor(self.model, settings.force_torque_sensor, frame)
+            available[names.FORCE_TORQUE_SENSOR_BROADCASTER] = lambda: ForceTorqueSensorBroadcaster(
+                names.FORCE_TORQUE_SENSOR_BROADCASTER, sensor
+            )
         if arm:
             gains = np.array([self.model.actuator_gainprm[j.actuator, 0] for j in arm])
             damping = np.array([-self.model.actuator_biasprm[j.actuator, 2] for j in arm])
             feedforward = np.divide(damping, gains, out=np.zeros_like(gains), where=gains > 0)
-            available[names.JOINT_TRAJECTORY_CONTROLLER] = lambda: JointTrajectoryController(
-                names.JOINT_TRAJECTORY_CONTROLLER,
-                arm,
-                feedforward,
-                self.index.timestep,
-                gains=gains if np.all(gains > 0) else None,
-                inertia=self._effective_inertia([j.dof_address for j in arm]),
+
+            def trajectory_controller(name: str) -> JointTrajectoryController:
+                return JointTrajectoryController(
+                    name,
+                    arm,
+                    feedforward,
+                    self.index.timestep,
+                    gains=gains if np.all(gains > 0) else None,
+                    inertia=self._effective_inertia([j.dof_address for j in arm]),
+                )
+
+            available[names.JOINT_TRAJECTORY_CONTROLLER] = lambda: trajectory_controller(
+                names.JOINT_TRAJECTORY_CONTROLLER
             )
+            has_control_site = settings.control_site in {
+                self.model.site(i).name for i in range(self.model.nsite)
+            }
+            if sensor is not None:
+                available[names.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER] = lambda: (
+                    JointTrajectoryAdmittanceController(
+                        names.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER,
+                        arm,
+                        feedforward,
+                        self.index.timestep,
+                        gains=gains if np.all(gains > 0) else None,
+                        inertia=self._effective_inertia([j.dof_address for j in arm]),
+                        sensor=sensor,
+                    )
+                )
+            if sensor is not None and has_control_site:
+                available[names.VELOCITY_FORCE_CONTROLLER] = lambda: VelocityForceController(
+                    names.VELOCITY_FORCE_CONTROLLER,
+                    self.model,
+                    arm,
+                    feedforward,
+                    settings.control_site,
+                    sensor,
+                )
         if gripper_joint is not None:
             available[names.GRIPPER_CONTROLLER] = lambda: GripperController(
                 names.GRIPPER_CONTROLLER, gripper_joint, self.model, settings.gripper
@@ -353,12 +435,37 @@ class MujocoDriver:
             self._publishers["joint_states"] = self._node(names.JOINT_STATE_BROADCASTER).create_publisher(
                 names.JOINT_STATES_TYPE, names.JOINT_STATES_TOPIC
             )
-        if names.JOINT_TRAJECTORY_CONTROLLER in self._controllers:
-            self._node(names.JOINT_TRAJECTORY_CONTROLLER).create_action_server(
-                names.FOLLOW_JOINT_TRAJECTORY_TYPE,
-                names.FOLLOW_JOINT_TRAJECTORY_ACTION,
-                self._execute_trajectory,
-                cancel_callback=self._cancel_goal,
+        for name, action in (
+            (names.JOINT_TRAJECTORY_CONTROLLER, names.FOLLOW_JOINT_TRAJECTORY_ACTION),
+            (names.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER, names.FOLLOW_JOINT_TRAJECTORY_ADMITTANCE_ACTION),
+        ):
+            controller = self._controllers.get(name)
+            if controller is not None:
+                self._node(name).create_action_server(
+                    names.FOLLOW_JOINT_TRAJECTORY_TYPE,
+                    action,
+                    functools.partial(self._execute_trajectory, controller=controller),
+                    cancel_callback=self._cancel_goal,
+                )
+        if names.FORCE_TORQUE_SENSOR_BROADCASTER in self._controllers:
+            self._publishers["wrench"] = self._node(names.FORCE_TORQUE_SENSOR_BROADCASTER).create_publisher(
+                names.WRENCH_TYPE, names.WRENCH_TOPIC
+            )
+        velocity_force = self._controllers.get(names.VELOCITY_FORCE_CONTROLLER)
+        if isinstance(velocity_force, VelocityForceController):
+            node = self._node(names.VELOCITY_FORCE_CONTROLLER)
+            node.create_subscription(
+                names.VELOCITY_FORCE_COMMAND_TYPE,
+                names.VELOCITY_FORCE_COMMAND_TOPIC,
+                velocity_force.set_command,
+            )
+            node.create_service(
+                names.TRIGGER_TYPE,
+                names.ZERO_FTS_SERVICE,
+                lambda _request: {
+                    "success": True,
+                    "message": self.simulation.call(lambda: velocity_force.zero_sensor(self.data)),
+                },
             )
         if names.GRIPPER_CONTROLLER in self._controllers:
             self._node(names.GRIPPER_CONTROLLER).create_action_server(
@@ -400,6 +507,9 @@ class MujocoDriver:
                     data.qfrc_actuator[self._joint_dofs],
                 )
             )
+        sensor_broadcaster = self._controllers.get(names.FORCE_TORQUE_SENSOR_BROADCASTER)
+        if isinstance(sensor_broadcaster, ForceTorqueSensorBroadcaster) and sensor_broadcaster.active:
+            self._publishers["wrench"].publish(sensor_broadcaster.message(data))
         for controller in self._goal_controllers:
             controller.post_feedback(data)
         wall = time.perf_counter()
@@ -502,8 +612,7 @@ class MujocoDriver:
 
     # -- actions (goal threads) --------------------------------------------------------------------
 
-    def _execute_trajectory(self, handle: ServerGoalHandle) -> None:
-        controller = self._controllers[names.JOINT_TRAJECTORY_CONTROLLER]
+    def _execute_trajectory(self, handle: ServerGoalHandle, controller: Any) -> None:
         assert isinstance(controller, JointTrajectoryController)
         limits = {j.name: j.limits for j in controller.joints if j.limits is not None}
         try:

@@ -33,6 +33,17 @@ SCENE_STATE_TOPIC = "/mujoco/scene_state"
 SCENE_STATE_TYPE = "kinema_msgs/msg/SceneState"
 
 JOINT_TRAJECTORY_CONTROLLER = "joint_trajectory_controller"
+# The wrist force/torque sensor and the controllers using it (MoveIt Pro's lab_sim names).
+JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER = "joint_trajectory_admittance_controller"
+FOLLOW_JOINT_TRAJECTORY_ADMITTANCE_ACTION = "/joint_trajectory_admittance_controller/follow_joint_trajectory"
+VELOCITY_FORCE_CONTROLLER = "velocity_force_controller"
+VELOCITY_FORCE_COMMAND_TOPIC = "/velocity_force_controller/command"
+VELOCITY_FORCE_COMMAND_TYPE = "moveit_pro_controllers_msgs/msg/VelocityForceCommand"
+ZERO_FTS_SERVICE = "/velocity_force_controller/zero_fts"
+TRIGGER_TYPE = "std_srvs/srv/Trigger"
+FORCE_TORQUE_SENSOR_BROADCASTER = "force_torque_sensor_broadcaster"
+WRENCH_TOPIC = "/force_torque_sensor_broadcaster/wrench"
+WRENCH_TYPE = "geometry_msgs/msg/WrenchStamped"
 GRIPPER_CONTROLLER = "robotiq_gripper_controller"
 JOINT_STATE_BROADCASTER = "joint_state_broadcaster"
 

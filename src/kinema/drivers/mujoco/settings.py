@@ -42,6 +42,11 @@ class MujocoDriverSettings:
         active_controllers: controllers active at start.
         inactive_controllers: controllers loaded but inactive at start.
         gripper_joint: the joint the gripper controller commands (None: no gripper controller).
+        force_torque_sensor: the site carrying the wrist's MuJoCo force and torque sensors
+            (``<site>_force``, ``<site>_torque``), as ros2_control names the sensor; without it (None, or
+            absent from the scene) there is no force/torque broadcaster, velocity-force controller or
+            admittance controller.
+        control_site: the site of the end effector's control frame (the velocity-force controller's).
         tolerances: the trajectory controller's default tolerances.
         gripper: the gripper controller's thresholds.
         config: the config package the settings came from ("" when built by hand).
@@ -57,6 +62,8 @@ class MujocoDriverSettings:
     active_controllers: tuple[str, ...] = DEFAULT_CONTROLLERS
     inactive_controllers: tuple[str, ...] = ()
     gripper_joint: str | None = "robotiq_85_left_knuckle_joint"
+    force_torque_sensor: str | None = "tcp_fts_sensor"
+    control_site: str = "grasp_site"
     tolerances: ToleranceDefaults = field(default_factory=ToleranceDefaults)
     gripper: GripperSettings = field(default_factory=GripperSettings)
     config: str = ""

@@ -1,0 +1,152 @@
+"""PublishVelocityForceCommand and ForceExceedsThreshold on a private network (no driver)."""
+
+from __future__ import annotations
+
+import threading
+import time
+from typing import Any
+
+import pytest
+
+from kinema.behaviors import BehaviorContext
+from kinema.bt import NodeStatus
+from kinema.plugins import BehaviorRegistry
+from kinema.testing import build_tree, tick_behavior, tick_until_done
+from kinema.transport import from_dict
+
+COMMAND = "moveit_pro_controllers_msgs/msg/VelocityForceCommand"
+WRENCH = "geometry_msgs/msg/WrenchStamped"
+
+PUBLISH_FOR_300_MS = """
+<root BTCPP_format="4" main_tree_to_execute="Push">
+  <BehaviorTree ID="Push">
+    <Sequence>
+      <Action ID="CreateTwistStamped" reference_frame="grasp_link" twist_stamped="{stamped}"
+              linear_velocity_xyz="0;0;0.05" angular_velocity_xyz="0;0;0"/>
+      <Action ID="UnpackTwistStampedMessage" twist_stamped="{stamped}" twist="{twist}" header="{header}"/>
+      <Action ID="CreateWrenchStamped" reference_frame="grasp_link" wrench_stamped="{zero}"
+              force_xyz="0;0;0" torque_xyz="0;0;0"/>
+      <Action ID="UnpackWrenchStampedMessage" wrench_stamped="{zero}" wrench="{wrench}" header="{header}"/>
+      <Decorator ID="ForceSuccess">
+        <Decorator ID="Timeout" msec="300">
+          <Action ID="PublishVelocityForceCommand" twist="{twist}" wrench="{wrench}" publish_rate="50"
+                  velocity_controlled_axes="0;0;1;0;0;0" force_controlled_axes="1;1;0;0;0;0"
+                  wrench_gain="0.02"/>
+        </Decorator>
+      </Decorator>
+    </Sequence>
+  </BehaviorTree>
+</root>
+"""
+
+
+def _collect(node: Any, type_name: str, topic: str) -> list[Any]:
+    box: list[Any] = []
+    node.create_subscription(type_name, topic, box.append)
+    return box
+
+
+def test_the_command_streams_at_its_rate_until_the_timeout_halts_it(
+    registry: BehaviorRegistry, context: BehaviorContext
+) -> None:
+    received = _collect(context.node, COMMAND, "/velocity_force_controller/command")
+    tree = build_tree(PUBLISH_FOR_300_MS, registry=registry, context=context)
+    status, _ = tick_until_done(tree)
+    assert status is NodeStatus.SUCCESS
+    time.sleep(0.2)
+    count = len(received)
+    assert 10 <= count <= 20, count  # 50 Hz for 0.3 s: about 15 commands (the first one at once)
+    time.sleep(0.2)
+    assert len(received) == count  # halted: no more
+    command = received[-1]
+    assert command.twist.linear.z == pytest.approx(0.05)
+    assert command.velocity_controlled_axes.z and not command.velocity_controlled_axes.x
+    assert command.force_controlled_axes.x and command.force_controlled_axes.y
+    assert not command.force_controlled_axes.z
+    assert command.wrench_gain == pytest.approx(0.02)
+
+
+@pytest.mark.parametrize(
+    ("ports", "problem"),
+    [
+        ({"velocity_controlled_axes": "0;0;1;0;0"}, "has 5 values"),
+        ({"velocity_controlled_axes": "0;0;2;0;0;0"}, "each 0 or 1"),
+        (
+            {"velocity_controlled_axes": "0;0;1;0;0;0", "force_controlled_axes": "0;0;1;0;0;0"},
+            "names z, which velocity_controlled_axes names too",
+        ),
+        ({"publish_rate": 0.0}, "give a rate above 0 Hz"),
+    ],
+)
+def test_bad_command_ports_fail_with_the_port_and_the_fix(
+    behavior: Any, context: BehaviorContext, ports: dict[str, Any], problem: str
+) -> None:
+    twist = from_dict("geometry_msgs/msg/Twist", {})
+    wrench = from_dict("geometry_msgs/msg/Wrench", {})
+    run = tick_behavior(
+        behavior("PublishVelocityForceCommand"), {"twist": twist, "wrench": wrench, **ports}, context=context
+    )
+    assert run.status is NodeStatus.FAILURE
+    assert problem in run.toasts[-1], run.toasts
+
+
+def _publish_forces(node: Any, forces: list[float], topic: str = "/ft/wrench") -> threading.Thread:
+    publisher = node.create_publisher(WRENCH, topic)
+
+    def loop() -> None:
+        time.sleep(0.3)  # the behavior subscribes first
+        for force in forces:
+            publisher.publish(
+                {"header": {"frame_id": "tool0"}, "wrench": {"force": {"x": 0.6 * force, "z": -0.8 * force}}}
+            )
+            time.sleep(0.02)
+
+    thread = threading.Thread(target=loop, daemon=True)
+    thread.start()
+    return thread
+
+
+def test_force_exceeds_threshold_needs_the_force_above_it_that_many_times_in_a_row(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    # The magnitude counts (x and z together); a dip below the threshold starts the count again.
+    forces = [5.0, 31.0, 31.0, 31.0, 12.0, 31.0, 31.0, 31.0, 31.0] + [31.0] * 50
+    seen = _collect(context.node, WRENCH, "/ft/wrench")
+    thread = _publish_forces(context.node, forces)
+    run = tick_behavior(
+        behavior("ForceExceedsThreshold"),
+        {"wrench_topic_name": "/ft/wrench", "force_threshold": 30.0, "minimum_consecutive_wrench_values": 4},
+        context=context,
+    )
+    seen_when_done = len(seen)
+    thread.join()
+    assert run.status is NodeStatus.SUCCESS, run.toasts
+    # Not before the fourth 31 N after the dip (the ninth message); counting every 31 N would have
+    # succeeded at the sixth.
+    assert seen_when_done >= 9, seen_when_done
+
+
+def test_force_exceeds_threshold_keeps_running_below_it(behavior: Any, context: BehaviorContext) -> None:
+    thread = _publish_forces(context.node, [29.0] * 100)
+    with pytest.raises(TimeoutError):
+        tick_behavior(
+            behavior("ForceExceedsThreshold"),
+            {
+                "wrench_topic_name": "/ft/wrench",
+                "force_threshold": 30.0,
+                "minimum_consecutive_wrench_values": 1,
+            },
+            context=context,
+            timeout=1.0,
+        )
+    thread.join()
+
+
+def test_force_exceeds_threshold_fails_when_no_wrench_comes(
+    behavior: Any, context: BehaviorContext, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    cls = behavior("ForceExceedsThreshold")
+    monkeypatch.setattr(cls, "no_message_timeout", 0.5)
+    run = tick_behavior(cls, {"wrench_topic_name": "/nobody/wrench"}, context=context, timeout=10.0)
+    assert run.status is NodeStatus.FAILURE
+    assert "no wrench on /nobody/wrench within 0.5 s" in run.toasts[-1], run.toasts
