@@ -3,8 +3,8 @@
 The 83 public lab_sim objectives (and picknik_ur_base_config's, which their SubTrees reach) are copied
 into a config package based on Kinema's lab_sim, then every objective is validated with its SubTree
 closure against the config's behaviors. Issue 12 requires 27 of them, issue 14's point-cloud half 13
-more, its AprilTag half 5 more and its force objectives 3 more; ``kinema objective list`` must say in one line why each of the
-others cannot load.
+more, its AprilTag half 5 more and its force objectives 3 more; ``kinema objective list`` must say in
+one line why each of the others cannot load.
 """
 
 from __future__ import annotations
