@@ -67,9 +67,7 @@ def test_a_gripper_goal_to_an_inactive_controller_is_aborted(sim: Sim) -> None:
 
 
 def test_a_strict_switch_with_an_unknown_name_changes_nothing(sim: Sim) -> None:
-    response = sim.switch(
-        deactivate=[n.JOINT_TRAJECTORY_CONTROLLER, "servo_controller"], strictness=STRICT
-    )
+    response = sim.switch(deactivate=[n.JOINT_TRAJECTORY_CONTROLLER, "servo_controller"], strictness=STRICT)
     assert not response.ok
     assert "servo_controller" in response.message
     assert n.JOINT_TRAJECTORY_CONTROLLER in response.message  # the known controllers are listed
