@@ -345,14 +345,17 @@ class MujocoDriver:
             damping = np.array([-self.model.actuator_biasprm[j.actuator, 2] for j in arm])
             feedforward = np.divide(damping, gains, out=np.zeros_like(gains), where=gains > 0)
 
-            def trajectory_controller(name: str) -> JointTrajectoryController:
-                return JointTrajectoryController(
+            def trajectory_controller(
+                name: str, kind: type[JointTrajectoryController] = JointTrajectoryController, **extra: Any
+            ) -> JointTrajectoryController:
+                return kind(
                     name,
                     arm,
                     feedforward,
                     self.index.timestep,
                     gains=gains if np.all(gains > 0) else None,
                     inertia=self._effective_inertia([j.dof_address for j in arm]),
+                    **extra,
                 )
 
             available[names.JOINT_TRAJECTORY_CONTROLLER] = lambda: trajectory_controller(
@@ -362,16 +365,10 @@ class MujocoDriver:
                 self.model.site(i).name for i in range(self.model.nsite)
             }
             if sensor is not None:
-                available[names.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER] = lambda: (
-                    JointTrajectoryAdmittanceController(
-                        names.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER,
-                        arm,
-                        feedforward,
-                        self.index.timestep,
-                        gains=gains if np.all(gains > 0) else None,
-                        inertia=self._effective_inertia([j.dof_address for j in arm]),
-                        sensor=sensor,
-                    )
+                available[names.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER] = lambda: trajectory_controller(
+                    names.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER,
+                    JointTrajectoryAdmittanceController,
+                    sensor=sensor,
                 )
             if sensor is not None and has_control_site:
                 available[names.VELOCITY_FORCE_CONTROLLER] = lambda: VelocityForceController(

@@ -220,7 +220,6 @@ class VelocityForceController:
         self._pending: VelocityForceCommand | None = None
         self._command: VelocityForceCommand | None = None
         self._command_time = -np.inf
-        self.commands_received = 0
 
     @property
     def command_interfaces(self) -> list[str]:
@@ -267,7 +266,6 @@ class VelocityForceController:
         command = VelocityForceCommand.from_message(message)
         with self._lock:
             self._pending = command
-            self.commands_received += 1
 
     def zero_sensor(self, data: Any) -> str:
         """Take the sensor's current reading as its zero (the ``zero_fts`` service); returns a summary."""
