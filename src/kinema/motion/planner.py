@@ -41,6 +41,11 @@ class PlanningOptions:
         start_jiggle_fraction: the largest move tried, as a fraction of each joint's range (MoveIt's
             ``jiggle_fraction``, whose 0.05 would let the tool jump ~15 cm; 0.01 is ~3 cm, enough to leave
             a contact inside the link padding); smaller moves are tried first.
+        seed: None: search with OMPL, whose random generator is process-wide (the same request may take
+            another path later in the same process). A number: search with Kinema's seeded RRT-Connect
+            (:mod:`kinema.motion.rrt`), which gives the same path for the same request and seed in any
+            process; ``planner`` must then be ``"RRTConnect"``.
+        max_iterations: the seeded search's sample cap (OMPL's planners are bounded by ``timeout`` only).
     """
 
     planner: str = "RRTConnect"
@@ -51,6 +56,8 @@ class PlanningOptions:
     limit_tolerance: float = 1e-2
     fix_start_collision: bool = True
     start_jiggle_fraction: float = 0.01
+    seed: int | None = None
+    max_iterations: int = 5000
 
 
 def _ompl():
@@ -128,6 +135,11 @@ def plan_joint_goal(
     opts = options or PlanningOptions()
     if opts.planner not in PLANNERS:
         raise MotionError(f"unknown planner {opts.planner!r}; {did_you_mean(opts.planner, PLANNERS)}")
+    if opts.seed is not None and opts.planner != "RRTConnect":
+        raise MotionError(
+            f"a seeded plan searches with RRT-Connect; planner {opts.planner!r} cannot be seeded per plan "
+            "(OMPL's generator is process-wide): leave the seed out, or use RRTConnect"
+        )
     model = checker.model
     g = model.group(group)
     q_start = np.asarray(start, dtype=float)
@@ -164,6 +176,8 @@ def plan_joint_goal(
         raise MotionError(f"goal state is in collision: {checker.describe(q_goal)}")
     if opts.try_direct and checker.first_invalid(np.array([q_start, q_goal]), opts.max_step) is None:
         path = JointPath(g.joint_names, np.array([q_start[cols], q_goal[cols]]))
+    elif opts.seed is not None:
+        path = _plan_seeded(checker, q_start, q_goal, cols, g.joint_names, opts)
     else:
         path = _plan_ompl(checker, q_start, q_goal, cols, g.joint_names, opts)
     if q_start is not stuck:
@@ -200,6 +214,34 @@ def _free_start(
             return min(found, key=lambda q: float(np.abs(q[cols] - q_start[cols]).max()))
         fraction *= 2
     return None
+
+
+def _plan_seeded(
+    checker: CollisionChecker,
+    q_start: np.ndarray,
+    q_goal: np.ndarray,
+    cols: list[int],
+    names: tuple[str, ...],
+    opts: PlanningOptions,
+) -> JointPath:
+    from kinema.motion.rrt import RrtOptions, rrt_connect
+
+    scratch = q_start.copy()
+
+    def valid(q: np.ndarray) -> bool:
+        scratch[cols] = q
+        return not checker.in_collision(scratch)
+
+    # Checked at half the step from the start: the path goes to a controller, as OMPL's is re-checked.
+    rrt = RrtOptions(
+        seed=int(opts.seed or 0),
+        max_iterations=opts.max_iterations,
+        timeout=opts.timeout,
+        max_step=opts.max_step / 2,
+    )
+    model = checker.model
+    positions = rrt_connect(valid, q_start[cols], q_goal[cols], model.lower[cols], model.upper[cols], rrt)
+    return JointPath(names, positions)
 
 
 def _plan_ompl(

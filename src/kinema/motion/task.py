@@ -534,7 +534,15 @@ class _Planner:
         if left <= 0:
             raise _StageFailure(index, f"the task's planning timeout of {self.timeout:.2f} s ran out")
         path = plan_joint_goal(
-            checker, q_from, goal, motion.group, PlanningOptions(timeout=min(motion.planning_time, left))
+            checker,
+            q_from,
+            goal,
+            motion.group,
+            PlanningOptions(
+                timeout=min(motion.planning_time, left),
+                seed=motion.seed,
+                max_iterations=motion.max_iterations,
+            ),
         )
         rows = np.repeat(q_from[None, :], len(path.positions), axis=0)
         rows[:, list(g.indices)] = path.positions

@@ -44,8 +44,10 @@ class MotionSettings:
         acceleration_scale: fraction of the joints' acceleration limits, (0, 1].
         link_padding: clearance (m) kept between the robot and the planning scene.
         sample_period: spacing of the timed trajectory's points, seconds.
-        planning_time: seconds OMPL may search when a straight joint-space move collides.
-        seed: random seed of the IK restarts (the same seed gives the same solution).
+        planning_time: seconds the search may take when a straight joint-space move collides.
+        seed: random seed of the IK restarts and of the collision-free search (Kinema's seeded RRT-Connect):
+            the same task, scene and seed give the same solution in any process.
+        max_iterations: samples the collision-free search draws before the stage fails.
     """
 
     group: str = "manipulator"
@@ -55,6 +57,7 @@ class MotionSettings:
     sample_period: float = 0.01
     planning_time: float = 1.0
     seed: int = 0
+    max_iterations: int = 5000
 
     def __post_init__(self) -> None:
         for label, value in (("velocity", self.velocity_scale), ("acceleration", self.acceleration_scale)):
@@ -66,6 +69,8 @@ class MotionSettings:
             raise MotionError(f"the trajectory's sample period must be positive, got {self.sample_period} s")
         if not self.planning_time > 0:
             raise MotionError(f"planning time must be positive, got {self.planning_time} s")
+        if self.max_iterations < 1:
+            raise MotionError(f"max_iterations must be at least 1, got {self.max_iterations}")
 
 
 @dataclass(frozen=True, eq=False)

@@ -67,8 +67,8 @@ class MotionPorts:
                     "max_iterations",
                     int,
                     5000,
-                    "MoveIt Pro's RRT iteration cap; Kinema's OMPL planner is bounded by time instead (1 s), "
-                    "so it is accepted and has no effect.",
+                    "Samples the collision-free search (a seeded RRT-Connect, like MoveIt Pro's RRT) draws "
+                    "before the stage fails; the search is also bounded by 1 s.",
                 ),
             ]
         if self.seed:
@@ -77,9 +77,8 @@ class MotionPorts:
                     "seed",
                     int,
                     0,
-                    "Seed of the IK restarts (the same seed gives the same solutions); OMPL's RNG is seeded "
-                    "once per process, so a connect that needs OMPL may take another path in another "
-                    "process.",
+                    "Seed of the IK restarts and of the collision-free search: the same task, scene and "
+                    "seed give the same solution, in any process.",
                 )
             )
         return ports
@@ -107,6 +106,7 @@ class MotionPorts:
                     f"trajectory_sampling_rate must be positive (points per second), got {rate}"
                 )
             settings["sample_period"] = 1.0 / rate
+            settings["max_iterations"] = int(behavior.get_input("max_iterations"))
         if self.seed:
             settings["seed"] = int(behavior.get_input("seed"))
         return MotionSettings(**settings)
