@@ -7,6 +7,10 @@ the way an objective without MTC would (PlanToJointGoal / PlanCartesianPath): IK
 pre-grasp 10 cm back, ``plan_joint_goal`` to the pre-grasp, ``plan_cartesian_path`` down to the grasp,
 toppra on both.
 
+A second pair measures a search around an obstacle (a block where the straight move from "3 Waypoint Mid
+Point" to "3 Waypoint Pick Pose" takes the gripper): the seeded RRT-Connect the task stages use against
+OMPL's RRTConnect, which plans without a seed.
+
 Prints p50/p95 planning time of each and their ratio. Target (issue 13): a pick task under 300 ms p50 on
 2 cores. No assertions: numbers only. Run: ``python benchmarks/task_planning.py [--repeats N]``.
 """
@@ -24,6 +28,7 @@ import yaml
 from kinema.motion import (
     CollisionChecker,
     IkOptions,
+    PlanningOptions,
     RobotDescription,
     fk,
     ik,
@@ -31,6 +36,7 @@ from kinema.motion import (
     plan_joint_goal,
     time_parameterize,
 )
+from kinema.motion.planning_scene import PlanningScene
 from kinema.motion.task import Task, plan_task
 from kinema.motion.task_stages import BatchPoseIK, Connect, CurrentState, MotionSettings, MoveAlongFrameAxis
 from kinema.motion.trajectory import JointPath
@@ -113,6 +119,25 @@ def main() -> None:
         ("place, separate calls", lambda: separately(place)),
         ("pick task, 3 candidates", lambda: plan_task(task("pick", [far, far, grasp]), checker)),
     ]
+    blocked = CollisionChecker(model, PlanningScene(dict(checker.scene.objects)), padding=0.01)
+    mid = model.configuration(waypoints["3 Waypoint Mid Point"])
+    pick = model.configuration(waypoints["3 Waypoint Pick Pose"])
+    block = np.eye(4)
+    block[:3, 3] = (fk(model, mid, "grasp_link")[:3, 3] + fk(model, pick, "grasp_link")[:3, 3]) / 2
+    blocked.scene.add_box("block", (0.03, 0.03, 0.03), block)
+    seeds = iter(range(10**6))  # a new seed each time: the spread of searches, not one search repeated
+    rows += [
+        (
+            "around a block, seeded",
+            lambda: plan_joint_goal(
+                blocked, mid, pick, options=PlanningOptions(timeout=5.0, seed=next(seeds))
+            ),
+        ),
+        (
+            "around a block, OMPL",
+            lambda: plan_joint_goal(blocked, mid, pick, options=PlanningOptions(timeout=5.0)),
+        ),
+    ]
     results = {}
     print(f"task planning on lab_sim, {args.repeats} repeats each (seconds)")
     for label, fn in rows:
@@ -123,6 +148,8 @@ def main() -> None:
         task_p50 = results[f"{kind} task (plan_task)"]
         peer = results[f"{kind}, separate calls"]
         print(f"  {kind}: task / separate calls = {task_p50 / peer:.2f}")
+    ratio = results["around a block, seeded"] / results["around a block, OMPL"]
+    print(f"  around a block: seeded RRT-Connect / OMPL RRTConnect = {ratio:.2f}")
     met = "met" if results["pick task (plan_task)"] < 0.3 else "NOT met"
     print(f"  target: pick task p50 < 300 ms -> {met}")
 
