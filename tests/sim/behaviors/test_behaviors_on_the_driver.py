@@ -108,13 +108,17 @@ def test_the_gripper_closes_and_opens(behavior: Any, context: BehaviorContext) -
     assert opened.status == NodeStatus.SUCCESS, opened.toasts
 
 
-def test_without_the_trajectory_controller_execution_fails_until_it_is_back(
-    behavior: Any, context: BehaviorContext
-) -> None:
+def _active_command_controllers(behavior: Any, context: BehaviorContext) -> set[str]:
     listing = tick_behavior(
         behavior("ListControllers"), {"type": "command", "state": "active"}, context=context
     )
-    assert set(listing.outputs["controller_list"]) == {
+    return set(listing.outputs["controller_list"])
+
+
+def test_execution_activates_its_controller_when_it_is_inactive(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    assert _active_command_controllers(behavior, context) == {
         "joint_trajectory_controller",
         "robotiq_gripper_controller",
     }
@@ -124,19 +128,43 @@ def test_without_the_trajectory_controller_execution_fails_until_it_is_back(
         context=context,
     )
     assert off.status == NodeStatus.SUCCESS, off.toasts
+    assert _active_command_controllers(behavior, context) == {"robotiq_gripper_controller"}
     start = _arm(behavior, context).tolist()
     target = list(start)
     target[1] += 0.3
-    refused = _plan_and_execute(behavior, context, target)
-    assert refused.status == NodeStatus.FAILURE
-    assert "joint_trajectory_controller is inactive" in refused.toasts[-1]
-    on = tick_behavior(
-        behavior("SwitchController"),
-        {"activate_controllers": "/joint_trajectory_controller"},
+    run = _plan_and_execute(behavior, context, target)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    assert "ExecuteTrajectory: activated joint_trajectory_controller to execute" in run.toasts, run.toasts
+    np.testing.assert_allclose(_settled_arm(behavior, context), target, atol=0.01)
+
+    # The admittance controller's action takes the arm over from the trajectory controller, as lab_sim's
+    # "Pick All Bottles with AprilTags" expects right after "Pick from Pose".
+    plan = tick_behavior(
+        behavior("PlanToJointGoal"), {"joint_goal": _goal(start)}, context=context, timeout=30
+    )
+    assert plan.status == NodeStatus.SUCCESS, plan.toasts
+    back = tick_behavior(
+        behavior("ExecuteTrajectory"),
+        {
+            "joint_trajectory_msg": plan.outputs["joint_trajectory_msg"],
+            "controller_action_name": "/joint_trajectory_admittance_controller/follow_joint_trajectory",
+        },
         context=context,
     )
-    assert on.status == NodeStatus.SUCCESS, on.toasts
-    assert _plan_and_execute(behavior, context, target).status == NodeStatus.SUCCESS
+    assert back.status == NodeStatus.SUCCESS, back.toasts
+    assert (
+        "ExecuteTrajectory: activated joint_trajectory_admittance_controller instead of "
+        "joint_trajectory_controller to execute"
+    ) in back.toasts, back.toasts
+    assert _active_command_controllers(behavior, context) == {
+        "joint_trajectory_admittance_controller",
+        "robotiq_gripper_controller",
+    }
+    np.testing.assert_allclose(_settled_arm(behavior, context), start, atol=0.01)
+    restored = tick_behavior(
+        behavior("SwitchController"), {"activate_controllers": "joint_trajectory_controller"}, context=context
+    )
+    assert restored.status == NodeStatus.SUCCESS, restored.toasts
 
 
 def test_set_mujoco_state_jumps_the_arm(behavior: Any, context: BehaviorContext) -> None:

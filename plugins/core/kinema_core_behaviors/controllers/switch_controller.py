@@ -3,19 +3,35 @@
 from __future__ import annotations
 
 import asyncio
+from typing import Any
 
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port
 from kinema.errors import TransportError
 
 BEST_EFFORT = 1
 STRICT = 2
-_LIST_TYPE = "controller_manager_msgs/srv/ListControllers"
-_SWITCH_TYPE = "controller_manager_msgs/srv/SwitchController"
+LIST_TYPE = "controller_manager_msgs/srv/ListControllers"
+SWITCH_TYPE = "controller_manager_msgs/srv/SwitchController"
 
 
 def _names(values: list[str]) -> list[str]:
     """Controller names without blanks or the leading '/' MoveIt Pro objectives sometimes give."""
     return [name.strip().lstrip("/") for name in values if name.strip().lstrip("/")]
+
+
+def conflicting_active(controllers: dict[str, Any], activate: list[str]) -> list[str]:
+    """The active controllers, besides ``activate``, that command an interface one of ``activate`` needs.
+
+    ``controllers`` maps names to ListControllers entries (``state``, ``required_command_interfaces``).
+    """
+    wanted = {i for n in activate if n in controllers for i in controllers[n].required_command_interfaces}
+    return [
+        name
+        for name, controller in controllers.items()
+        if controller.state == "active"
+        and name not in activate
+        and wanted.intersection(controller.required_command_interfaces)
+    ]
 
 
 _FOREVER = 1e9  # seconds: "no timeout" for a service call (halting the objective still ends the wait)
@@ -91,7 +107,7 @@ class SwitchController(AsyncBehavior):
         automatic_activation = bool(self.get_input("automatic_activation"))
         if (automatic_deactivation and activate) or (automatic_activation and deactivate):
             list_name = str(self.get_input("controller_list_action_name"))
-            client = self.context.service_client(node, _LIST_TYPE, list_name)
+            client = self.context.service_client(node, LIST_TYPE, list_name)
             try:
                 listing = await asyncio.wrap_future(client.call_async({}, timeout))
             except TransportError as error:
@@ -101,16 +117,7 @@ class SwitchController(AsyncBehavior):
                 return False
             controllers = {str(c.name): c for c in listing.controller}
             if automatic_deactivation:
-                wanted = {
-                    i
-                    for n in activate
-                    if n in controllers
-                    for i in controllers[n].required_command_interfaces
-                }
-                for name, controller in controllers.items():
-                    conflicts = wanted.intersection(controller.required_command_interfaces)
-                    if controller.state == "active" and name not in activate and conflicts:
-                        deactivate.append(name)
+                deactivate += [n for n in conflicting_active(controllers, activate) if n not in deactivate]
             if automatic_activation:
                 freed = {
                     i
@@ -131,7 +138,7 @@ class SwitchController(AsyncBehavior):
             ):
                 return True  # already as asked: skip the switch (a round trip per motion)
         switch_name = str(self.get_input("controller_switch_action_name"))
-        client = self.context.service_client(node, _SWITCH_TYPE, switch_name)
+        client = self.context.service_client(node, SWITCH_TYPE, switch_name)
         request = {
             "activate_controllers": activate,
             "deactivate_controllers": deactivate,

@@ -10,10 +10,15 @@ from kinema.behaviors import AsyncBehavior, PortInfo, input_port
 from kinema.behaviors.work_runner import RUNNER
 from kinema.errors import KinemaError, ObjectiveError, TransportError
 
+from ..controllers.switch_controller import LIST_TYPE, STRICT, SWITCH_TYPE, conflicting_active
 from ..messages.conversions import duration, trajectory_from_message
 from .planned_trajectory import publish_planned_trajectory
 
 FOLLOW_JOINT_TRAJECTORY = "control_msgs/action/FollowJointTrajectory"
+CONTROLLER_MANAGER = "/controller_manager"
+# Execution goes on without a switch when no controller manager is on the graph (another robot's
+# driver) or it does not answer in time.
+LIST_TIMEOUT = 2.0
 # How long the controller's action server may be missing from the graph before the run fails: long
 # enough to ride out a liveliness hiccup, short enough that a crashed driver fails the run within 1 s.
 SERVER_LOST_AFTER = 0.3
@@ -22,6 +27,12 @@ _POLL = 0.01
 
 class ExecuteTrajectory(AsyncBehavior):
     """Sends ``joint_trajectory_msg`` to a FollowJointTrajectory controller and waits until it is done.
+
+    When the controller manager lists the controller (``/<controller>/follow_joint_trajectory``) as
+    inactive, it is activated first, and the active controllers commanding the same joints are
+    deactivated, as MoveIt's trajectory execution manager does with managed controllers. MoveIt Pro's
+    objectives rely on it: lab_sim's "Pick All Bottles with AprilTags" retracts on the admittance
+    controller right after "Pick from Pose" executed on the default one, with no SwitchController between.
 
     Halting the behavior (cancelling the objective) cancels the controller's goal, which stops the
     arm where it is. Fails with the controller's error when it rejects the trajectory (unknown joints,
@@ -69,22 +80,23 @@ class ExecuteTrajectory(AsyncBehavior):
                 "execution_pipeline",
                 str,
                 "",
-                "MoveIt Pro's execution pipeline; Kinema sends trajectories to the controller directly.",
+                "MoveIt Pro's execution pipeline (jtc, jtac); Kinema sends the trajectory to the "
+                "controller of controller_action_name, activating it first when it is inactive.",
             ),
             input_port(
                 "absolute_force_torque_threshold",
                 list[float],
                 "",
-                "Stop when the wrist force/torque exceeds fx;fy;fz;tx;ty;tz (N, Nm). Needs a force-torque "
-                "sensor and the admittance controller, which Kinema's drivers do not have yet: a non-empty "
-                "value fails the behavior when it runs.",
+                "Stop when the wrist force/torque exceeds fx;fy;fz;tx;ty;tz (N, Nm). Kinema's admittance "
+                "controller stops at fixed limits (45 N, 10 N m, MoveIt Pro's defaults) and takes none per "
+                "trajectory: a non-empty value fails the behavior when it runs.",
             ),
             input_port(
                 "admittance_parameters_msg",
                 None,
                 "",
-                "Admittance parameters (from SetAdmittanceParameters) for the admittance controller, which "
-                "Kinema's drivers do not have yet: a value fails the behavior when it runs.",
+                "Admittance parameters (from SetAdmittanceParameters): Kinema's admittance controller does "
+                "not simulate compliance, so a value fails the behavior when it runs.",
             ),
         ]
 
@@ -125,6 +137,9 @@ class ExecuteTrajectory(AsyncBehavior):
         except KinemaError as error:
             return self._fail(str(error))
         publish_planned_trajectory(self, goal["trajectory"])
+        refused = await self._activate(node, name)
+        if refused:
+            return self._fail(refused)
         client = self.context.action_client(node, FOLLOW_JOINT_TRAJECTORY, name)
         sending = RUNNER.run_function(lambda: client.send_goal(goal, timeout=5.0))
         try:
@@ -166,6 +181,44 @@ class ExecuteTrajectory(AsyncBehavior):
         detail = str(result.error_string) or f"error code {int(result.error_code)}"
         return self._fail(f"the controller {name} ended the trajectory {outcome.status_name}: {detail}")
 
+    async def _activate(self, node: Any, action: str) -> str:
+        """Activate the controller behind ``action`` when the controller manager has it inactive.
+
+        Returns why that failed, or '' (also when there is no controller manager to ask).
+        """
+        parts = action.strip("/").split("/")
+        if len(parts) != 2 or parts[1] != "follow_joint_trajectory":
+            return ""
+        controller = parts[0]
+        lister = self.context.service_client(node, LIST_TYPE, f"{CONTROLLER_MANAGER}/list_controllers")
+        if not lister.service_is_ready():
+            return ""
+        try:
+            listing = await asyncio.wrap_future(lister.call_async({}, LIST_TIMEOUT))
+        except TransportError:
+            return ""
+        controllers = {str(c.name): c for c in listing.controller}
+        if controller not in controllers or controllers[controller].state == "active":
+            return ""
+        deactivate = conflicting_active(controllers, [controller])
+        switcher = self.context.service_client(node, SWITCH_TYPE, f"{CONTROLLER_MANAGER}/switch_controller")
+        request = {
+            "activate_controllers": [controller],
+            "deactivate_controllers": deactivate,
+            "strictness": STRICT,
+            "activate_asap": True,
+            "timeout": {"sec": 5, "nanosec": 0},
+        }
+        try:
+            response = await asyncio.wrap_future(switcher.call_async(request, 10.0))
+        except TransportError as error:
+            return f"{controller} is inactive and the controller manager cannot be reached: {error}"
+        if not response.ok:
+            return f"{controller} is inactive and activating it was refused: {response.message}"
+        replaced = f" instead of {', '.join(deactivate)}" if deactivate else ""
+        self.logger.publish_info(f"ExecuteTrajectory: activated {controller}{replaced} to execute")
+        return ""
+
     def do_halt(self) -> None:
         handle, self._handle = self._handle, None
         if handle is not None and not handle.done():
@@ -180,15 +233,15 @@ class ExecuteTrajectory(AsyncBehavior):
         threshold = self.get_input_or("absolute_force_torque_threshold", [])
         if isinstance(threshold, list) and threshold:
             return (
-                f"port [absolute_force_torque_threshold] = {threshold}: force-torque limits need a "
-                "force-torque sensor and the admittance controller, which Kinema's drivers do not provide "
-                "yet; leave it empty"
+                f"port [absolute_force_torque_threshold] = {threshold}: Kinema's admittance controller "
+                "stops at fixed force-torque limits (45 N, 10 N m) and takes none per trajectory; leave "
+                "it empty"
             )
         parameters = self.get_input_or("admittance_parameters_msg", "")
         if parameters not in ("", None):
             return (
-                "port [admittance_parameters_msg] is set: admittance control is not supported by Kinema's "
-                "drivers yet; remove the port to run the trajectory without it"
+                "port [admittance_parameters_msg] is set: Kinema's admittance controller does not simulate "
+                "compliance; remove the port to run the trajectory without it"
             )
         return ""
 
