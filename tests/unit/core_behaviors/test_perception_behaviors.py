@@ -3,6 +3,7 @@ cloud turned into obstacles the next plan avoids (against a private in-process n
 
 from __future__ import annotations
 
+import time
 from pathlib import Path
 from typing import Any
 
@@ -170,6 +171,47 @@ def test_transform_point_cloud_frame_puts_grasp_link_points_in_the_world(
         timeout=30.0,
     )
     assert unknown.status == NodeStatus.FAILURE and "gras_link" in unknown.toasts[-1], unknown.toasts
+
+
+def test_a_cloud_is_placed_with_the_robot_as_it_was_when_the_cloud_was_taken(
+    behavior: Any, context: BehaviorContext, lab_sim_model: Any
+) -> None:
+    """As TF looks up a transform at a message's stamp: a wrist camera's cloud taken while the arm was at
+    HOME lands where HOME puts the camera, even when the newest joint state says the arm is at MID (the
+    arm moved on, or a loaded machine delivered the newer state first). A stamp of 0 means now."""
+    from kinema.motion import fk
+
+    def joint_state(arm: list[float], stamp: float) -> dict[str, Any]:
+        sec = int(stamp)
+        return {
+            "header": {"stamp": {"sec": sec, "nanosec": round((stamp - sec) * 1e9)}},
+            "name": [*ARM, GRIPPER],
+            "position": [*arm, 0.0],
+        }
+
+    local = np.array([[0.0, 0.0, 0.1]], dtype=np.float32)
+
+    def placed(stamp: float) -> np.ndarray:
+        cloud = to_point_cloud2(PointCloud(local, None, "grasp_link", stamp), _types())
+        run = tick_behavior(
+            behavior("TransformPointCloudFrame"), {"input_cloud": cloud}, context=context, timeout=30.0
+        )
+        assert run.status == NodeStatus.SUCCESS, run.toasts
+        return points_of(run.outputs["output_cloud"])[0]
+
+    def expected(arm: list[float]) -> np.ndarray:
+        world_T_grasp = fk(lab_sim_model, _q(lab_sim_model, arm), "grasp_link")
+        return world_T_grasp[:3, :3] @ local[0] + world_T_grasp[:3, 3]
+
+    topic, kind = "/joint_states", "sensor_msgs/msg/JointState"
+    with publish_repeatedly(context.node, kind, topic, joint_state(HOME, 5.0)):
+        assert np.allclose(placed(0.0), expected(HOME), atol=1e-4)
+    with publish_repeatedly(context.node, kind, topic, joint_state(MID, 6.0)):
+        deadline = time.monotonic() + 30.0
+        while not np.allclose(placed(0.0), expected(MID), atol=1e-4):
+            assert time.monotonic() < deadline, "the MID joint state never arrived"
+        assert np.allclose(placed(5.0), expected(HOME), atol=1e-4)
+        assert np.allclose(placed(6.0), expected(MID), atol=1e-4)
 
 
 def test_transform_point_cloud_moves_points_by_the_pose(behavior: Any, context: BehaviorContext) -> None:

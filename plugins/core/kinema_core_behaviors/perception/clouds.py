@@ -62,8 +62,9 @@ def frame_of(cloud: Any) -> str:
     return cloud.frame_id or "world"
 
 
-def target_T_source(node: Any, source: str, target: str, port: str) -> np.ndarray:
-    """The 4x4 transform taking points in ``source`` to ``target``, from the cell's frames now.
+def target_T_source(node: Any, source: str, target: str, port: str, at: float = 0.0) -> np.ndarray:
+    """The 4x4 transform taking points in ``source`` to ``target``, from the cell's frames now (or at
+    stamp ``at``, a cloud's: a wrist camera's frame goes where the camera was when it was taken).
 
     Raises:
         PortValueError: either frame is unknown (the frame tree's message lists the known ones).
@@ -73,7 +74,7 @@ def target_T_source(node: Any, source: str, target: str, port: str) -> np.ndarra
     from ..poses.frame_tree import current_frame_tree
 
     try:
-        return current_frame_tree(node).transform(np.eye(4), source, target)
+        return current_frame_tree(node, at=at).transform(np.eye(4), source, target)
     except KinemaError as error:
         raise port_error(node, port, f"cannot relate frame {source!r} to {target!r}: {error}", "") from None
 

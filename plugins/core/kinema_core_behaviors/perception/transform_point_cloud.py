@@ -19,9 +19,10 @@ from .clouds import POINT_CLOUD, frame_of, read_cloud, target_T_source, write_cl
 class TransformPointCloudFrame(SyncBehavior):
     """Writes ``input_cloud`` expressed in ``target_frame`` (the same points in the world, other frame).
 
-    Frames are those TransformPoseFrame knows (robot links at the current joint state, camera optical
-    frames, simulated objects, planning-scene objects). An organised cloud stays organised. Fails naming
-    the frame when either frame is unknown.
+    Frames are those TransformPoseFrame knows (robot links, camera optical frames, simulated objects,
+    planning-scene objects), with the robot's joints as they were at the cloud's stamp, as TF looks up a
+    transform at a message's stamp: a wrist camera's cloud lands where the camera was when it was taken.
+    An organised cloud stays organised. Fails naming the frame when either frame is unknown.
     """
 
     subcategory = "Perception - 3D Point Cloud"
@@ -40,7 +41,7 @@ class TransformPointCloudFrame(SyncBehavior):
         target = str(read_input(self, "target_frame")).strip()
         if not target:
             raise port_error(self, "target_frame", "is empty", "give a frame, e.g. world")
-        transform = target_T_source(self, frame_of(cloud), target, "target_frame")
+        transform = target_T_source(self, frame_of(cloud), target, "target_frame", at=cloud.stamp)
         write_cloud(self, "output_cloud", cloud.transformed(transform, target))
         return NodeStatus.SUCCESS
 
@@ -73,6 +74,6 @@ class TransformPointCloud(SyncBehavior):
         cloud = read_cloud(self, "input_cloud")
         pose_frame, transform = pose_matrix(read_message(self, "transform_pose"), "transform_pose")
         frame = pose_frame or frame_of(cloud)
-        in_frame = target_T_source(self, frame_of(cloud), frame, "transform_pose")
+        in_frame = target_T_source(self, frame_of(cloud), frame, "transform_pose", at=cloud.stamp)
         write_cloud(self, "output_cloud", cloud.transformed(transform @ in_frame, frame))
         return NodeStatus.SUCCESS

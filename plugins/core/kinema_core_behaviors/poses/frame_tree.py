@@ -89,13 +89,16 @@ def _sim_bodies(behavior: Any) -> dict[str, np.ndarray]:
     return {str(body.name): pose_of(body.pose.position, body.pose.orientation) for body in response.bodies}
 
 
-def current_frame_tree(behavior: Any, joint_state: Any = None) -> Any:
-    """The frame tree of ``behavior``'s cell now (or with the robot at ``joint_state``).
+def current_frame_tree(behavior: Any, joint_state: Any = None, at: float = 0.0) -> Any:
+    """The frame tree of ``behavior``'s cell now (or with the robot at ``joint_state``, or as it was at
+    stamp ``at``).
 
     Args:
         behavior: the calling behavior (its context gives the model, transport and scene).
         joint_state: a ``sensor_msgs/JointState`` to place the robot at instead of the current state;
             joints it does not name keep their current value (or 0 without a robot driver).
+        at: a stamp (s, the robot's clock) to place the robot at, e.g. a camera frame's: the robot's
+            joints as they were then (:meth:`JointStateMonitor.positions_at`); 0: now.
 
     Raises:
         ObjectiveError: no robot model, or no joint state to place the robot.
@@ -105,7 +108,7 @@ def current_frame_tree(behavior: Any, joint_state: Any = None) -> Any:
     name = getattr(behavior, "registration_id", type(behavior).__name__)
     model = robot_model(behavior.context, name)
     if joint_state is None:
-        q = joint_state_monitor(behavior.context, name).positions(model.joint_names)
+        q = joint_state_monitor(behavior.context, name).positions_at(model.joint_names, at)
     else:
         q = _positions_from(behavior, model, joint_state)
     fixed: dict[str, np.ndarray] = dict(_camera_frames(behavior.context))
