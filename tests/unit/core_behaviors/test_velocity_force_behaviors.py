@@ -106,24 +106,48 @@ def _publish_forces(node: Any, forces: list[float], topic: str = "/ft/wrench") -
     return thread
 
 
+FORCE_FOUR_TIMES = """
+<root BTCPP_format="4" main_tree_to_execute="Wait">
+  <BehaviorTree ID="Wait">
+    <Action ID="ForceExceedsThreshold" wrench_topic_name="/ft/wrench" force_threshold="30.0"
+            minimum_consecutive_wrench_values="4"/>
+  </BehaviorTree>
+</root>
+"""
+
+
+def _tick_while(tree: Any, condition: Any, timeout: float = 30.0) -> NodeStatus:
+    """Tick ``tree`` while it runs and ``condition()`` is false; its last status."""
+    deadline = time.monotonic() + timeout
+    while True:
+        status = tree.tick_once()
+        if status is not NodeStatus.RUNNING or condition():
+            return status
+        assert time.monotonic() < deadline, "timed out"
+        tree.sleep(0.005)
+
+
 def test_force_exceeds_threshold_needs_the_force_above_it_that_many_times_in_a_row(
-    behavior: Any, context: BehaviorContext
+    registry: BehaviorRegistry, context: BehaviorContext
 ) -> None:
-    # The magnitude counts (x and z together); a dip below the threshold starts the count again.
-    forces = [5.0, 31.0, 31.0, 31.0, 12.0, 31.0, 31.0, 31.0, 31.0] + [31.0] * 50
+    # The magnitude counts (x and z together); a dip below the threshold starts the count again. The
+    # wrenches go out in two parts, so the test does not race the behavior's subscription against its own:
+    # after the first eight (three above the threshold since the dip) it must still run; the ninth ends it.
+    # Counting every 31 N would have ended it at the sixth.
     seen = _collect(context.node, WRENCH, "/ft/wrench")
-    thread = _publish_forces(context.node, forces)
-    run = tick_behavior(
-        behavior("ForceExceedsThreshold"),
-        {"wrench_topic_name": "/ft/wrench", "force_threshold": 30.0, "minimum_consecutive_wrench_values": 4},
-        context=context,
-    )
-    seen_when_done = len(seen)
-    thread.join()
-    assert run.status is NodeStatus.SUCCESS, run.toasts
-    # Not before the fourth 31 N after the dip (the ninth message); counting every 31 N would have
-    # succeeded at the sixth.
-    assert seen_when_done >= 9, seen_when_done
+    tree = build_tree(FORCE_FOUR_TIMES, registry=registry, context=context)
+    first = _publish_forces(context.node, [5.0, 31.0, 31.0, 31.0, 12.0, 31.0, 31.0, 31.0])
+    status = _tick_while(tree, lambda: not first.is_alive() and len(seen) >= 8)
+    # Give the behavior's own subscription the same time again to receive what the test's has received.
+    until = time.monotonic() + 0.5
+    while status is NodeStatus.RUNNING and time.monotonic() < until:
+        status = tree.tick_once()
+        tree.sleep(0.005)
+    assert status is NodeStatus.RUNNING, "it ended before the fourth 31 N after the dip"
+    second = _publish_forces(context.node, [31.0] * 50)
+    status = _tick_while(tree, lambda: False)
+    second.join()
+    assert status is NodeStatus.SUCCESS
 
 
 def test_force_exceeds_threshold_keeps_running_below_it(behavior: Any, context: BehaviorContext) -> None:
