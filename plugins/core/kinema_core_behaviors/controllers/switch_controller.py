@@ -34,6 +34,20 @@ def conflicting_active(controllers: dict[str, Any], activate: list[str]) -> list
     ]
 
 
+def switch_request(
+    activate: list[str], deactivate: list[str], strictness: int, activate_asap: bool, timeout: float
+) -> dict[str, Any]:
+    """The controller manager's SwitchController request; a ``timeout`` of 0 or less means none."""
+    wait = max(timeout, 0.0)  # ros2_control reads a zero timeout as none
+    return {
+        "activate_controllers": activate,
+        "deactivate_controllers": deactivate,
+        "strictness": strictness,
+        "activate_asap": activate_asap,
+        "timeout": {"sec": int(wait), "nanosec": int((wait % 1.0) * 1e9)},
+    }
+
+
 _FOREVER = 1e9  # seconds: "no timeout" for a service call (halting the objective still ends the wait)
 
 
@@ -139,14 +153,9 @@ class SwitchController(AsyncBehavior):
                 return True  # already as asked: skip the switch (a round trip per motion)
         switch_name = str(self.get_input("controller_switch_action_name"))
         client = self.context.service_client(node, SWITCH_TYPE, switch_name)
-        request = {
-            "activate_controllers": activate,
-            "deactivate_controllers": deactivate,
-            "strictness": strictness,
-            "activate_asap": bool(self.get_input("activate_asap")),
-            # ros2_control reads a zero timeout as none.
-            "timeout": {"sec": int(max(given, 0.0)), "nanosec": int((max(given, 0.0) % 1.0) * 1e9)},
-        }
+        request = switch_request(
+            activate, deactivate, strictness, bool(self.get_input("activate_asap")), given
+        )
         try:
             response = await asyncio.wrap_future(client.call_async(request, timeout))
         except TransportError as error:

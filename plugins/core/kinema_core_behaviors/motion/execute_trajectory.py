@@ -10,7 +10,13 @@ from kinema.behaviors import AsyncBehavior, PortInfo, input_port
 from kinema.behaviors.work_runner import RUNNER
 from kinema.errors import KinemaError, ObjectiveError, TransportError
 
-from ..controllers.switch_controller import LIST_TYPE, STRICT, SWITCH_TYPE, conflicting_active
+from ..controllers.switch_controller import (
+    LIST_TYPE,
+    STRICT,
+    SWITCH_TYPE,
+    conflicting_active,
+    switch_request,
+)
 from ..messages.conversions import duration, trajectory_from_message
 from .planned_trajectory import publish_planned_trajectory
 
@@ -202,13 +208,7 @@ class ExecuteTrajectory(AsyncBehavior):
             return ""
         deactivate = conflicting_active(controllers, [controller])
         switcher = self.context.service_client(node, SWITCH_TYPE, f"{CONTROLLER_MANAGER}/switch_controller")
-        request = {
-            "activate_controllers": [controller],
-            "deactivate_controllers": deactivate,
-            "strictness": STRICT,
-            "activate_asap": True,
-            "timeout": {"sec": 5, "nanosec": 0},
-        }
+        request = switch_request([controller], deactivate, STRICT, True, 5.0)
         try:
             response = await asyncio.wrap_future(switcher.call_async(request, 10.0))
         except TransportError as error:

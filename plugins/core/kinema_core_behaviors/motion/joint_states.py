@@ -53,14 +53,12 @@ class JointStateMonitor:
         with self._changed:
             self._latest = message
             self._received_at = time.monotonic()
-            if not self._stamps or stamp >= self._stamps[-1]:
-                self._stamps.append(stamp)
-                self._history.append(message)
-            else:  # the clock went back (a reset simulation): the old history is another timeline
+            if self._stamps and stamp < self._stamps[-1]:
+                # The clock went back (a reset simulation): the old history is another timeline.
                 self._stamps.clear()
                 self._history.clear()
-                self._stamps.append(stamp)
-                self._history.append(message)
+            self._stamps.append(stamp)
+            self._history.append(message)
             self._changed.notify_all()
 
     def latest(self, timeout: float = 2.0) -> Any:
