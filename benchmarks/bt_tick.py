@@ -15,10 +15,10 @@ them. Structures:
 * building each of them from XML, with a new factory each time and again with the same factory
   (which Kinema serves from its cache of parsed, verified and compiled documents).
 
-Kinema is also measured "as objectives run": with the objective server's status observer (its
-``NodeStatusRecorder`` reading the tree's transition log: one NodeStatusChange per transition,
-taken after every tick) and a blackboard
-snapshot at 10 Hz attached. Rates are ticks per CPU second (``time.process_time``), median of
+Kinema is also measured "as objectives run": with what the runtime attaches on the tick thread
+(:class:`ObjectiveObservers`: the status recorder reading the tree's transition log after every
+tick, the agent's node status messages built and serialised, the blackboard snapshot at 10 Hz and
+the run's ``.btlog`` recording). Rates are ticks per CPU second (``time.process_time``), median of
 ``--rounds`` rounds; ratios are Kinema's time over BT.CPP's (lower is better; 1.0 = parity).
 Targets (issue 17): sequence <= 1.0x, mixed <= 1.5x, XML build <= 2x, observers <= +20 %.
 Run: ``python benchmarks/bt_tick.py [--seconds S] [--rounds N] [--profile STRUCTURE]``.
@@ -171,17 +171,45 @@ def btcpp_tree(xml: str, factory: Any = None) -> Any:
     return tree
 
 
+class _SerializingPublisher:
+    """A publisher that does the agent's work up to the network: the message to CDR bytes."""
+
+    def __init__(self, type_name: str) -> None:
+        from kinema.transport.messages import _registry
+
+        self.type_name = type_name
+        self.registry = _registry(None)
+        self.sent = 0
+
+    def publish(self, message: Any) -> None:
+        self.sent += len(self.registry.serialize(message, self.type_name))
+
+
 class ObjectiveObservers:
-    """What the objective server attaches to a running tree: its NodeStatusRecorder (a
-    NodeStatusChange per transition, taken after every tick) and a blackboard snapshot at 10 Hz."""
+    """What the runtime attaches to a running tree, all of it on the tick thread: the objective
+    server's NodeStatusRecorder (the transition log, read after every tick), the agent's streams
+    (node status and node table messages built and serialised to CDR; the blackboard snapshot at
+    10 Hz, rendered and serialised) and the run recording (``.btlog`` and blackboard file, written
+    to a temporary folder). Only the network and Groot2's sockets are left out."""
 
     def __init__(self, tree: Any) -> None:
-        from kinema.runtime.objective_server import NodeStatusRecorder, blackboard_entries
+        import tempfile
+        from types import SimpleNamespace
+
+        from kinema.runtime.agent import _Streams
+        from kinema.runtime.node_status import NodeStatusRecorder
+        from kinema.runtime.objective_server import blackboard_entries
+        from kinema.runtime.recordings import RunRecorder
 
         self.tree = tree
         self.recorder = NodeStatusRecorder()
-        self.published = 0
-        self.snapshots = 0
+        self._folder = tempfile.TemporaryDirectory(prefix="kinema-bench-")
+        node = SimpleNamespace(
+            create_publisher=lambda type_name, _topic, **_: _SerializingPublisher(type_name)
+        )
+        self.streams = _Streams(node, None, SimpleNamespace())  # type: ignore[arg-type]
+        self.recording = RunRecorder(self._folder.name)
+        self.recording.on_tree_loaded("bench", tree)
         self._last = 0.0
         self._entries = blackboard_entries
         self.recorder.attach(tree)
@@ -189,12 +217,15 @@ class ObjectiveObservers:
     def tick(self) -> None:
         self.tree.tick_once()
         changes = self.recorder.take()
-        self.published += len(changes)
+        if changes is not None:
+            self.streams.on_node_status("bench", changes)
+            self.recording.on_node_status("bench", changes)
         now = time.monotonic()
         if now - self._last >= 0.1:
             self._last = now
-            self._entries(self.tree)
-            self.snapshots += 1
+            entries = self._entries(self.tree)
+            self.streams.on_blackboard("bench", entries)
+            self.recording.on_blackboard("bench", entries)
 
 
 # -- py_trees equivalents ---------------------------------------------------------------------------

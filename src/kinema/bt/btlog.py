@@ -23,7 +23,7 @@ import time
 from collections.abc import Iterable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import IO, TYPE_CHECKING
+from typing import IO, TYPE_CHECKING, Any
 
 from kinema.bt.errors import BTRuntimeError
 from kinema.bt.status import NodeStatus
@@ -57,6 +57,40 @@ def pack_transition(offset_us: int, uid: int, status: int) -> bytes:
     """The 9 bytes of one transition (offsets are clamped to the 48 bits the format keeps)."""
     offset = min(max(int(offset_us), 0), _MAX_OFFSET_US)
     return offset.to_bytes(6, "little") + struct.pack("<HB", uid & 0xFFFF, int(status))
+
+
+_RECORD = None  # the numpy dtype of one 9-byte record, made on first use
+
+
+def pack_transition_columns(offsets_us: Any, uids: Any, statuses: Any) -> bytes:
+    """The 9-byte records of many transitions at once: ``uids`` and ``statuses`` are equally long
+    arrays, ``offsets_us`` one more or a single offset for all (microseconds, clamped to 48 bits)."""
+    import numpy as np
+
+    global _RECORD
+    if _RECORD is None:
+        _RECORD = np.dtype([("low", "<u4"), ("high", "<u2"), ("uid", "<u2"), ("status", "u1")])
+    records = np.empty(len(uids), dtype=_RECORD)
+    offsets = np.clip(np.asarray(offsets_us, dtype=np.int64), 0, _MAX_OFFSET_US)
+    records["low"] = offsets & 0xFFFFFFFF
+    records["high"] = offsets >> 32
+    records["uid"] = np.asarray(uids) & 0xFFFF
+    records["status"] = statuses
+    return records.tobytes()
+
+
+def last_per_key(keys: Any, values: Any) -> tuple[Any, Any]:
+    """For each distinct key (a small non-negative integer, a uid), the value that came last:
+    ``(keys, values)``, keys ascending. Linear (``np.maximum.at`` keeps the latest position of each key),
+    where sorting (``np.unique``) cost ten times more per tick."""
+    import numpy as np
+
+    if not len(keys):
+        return keys, values
+    latest = np.full(int(keys.max()) + 1, -1, dtype=np.int64)
+    np.maximum.at(latest, keys, np.arange(len(keys)))
+    present = np.flatnonzero(latest >= 0)
+    return present.astype(keys.dtype, copy=False), values[latest[present]]
 
 
 def header_bytes(tree_xml: str, start_epoch_us: int) -> bytes:
@@ -121,6 +155,38 @@ class BtlogWriter:
             file.flush()
             self.size += len(chunk)
             self.count += len(chunk) // TRANSITION_SIZE
+
+    def write_packed(self, records: bytes) -> None:
+        """Append transitions already packed (:func:`pack_transition_columns`) and flush them."""
+        file = self._file
+        if file is None or self.truncated or not records:
+            return
+        if self.max_bytes is not None and self.size + len(records) > self.max_bytes:
+            room = max(0, self.max_bytes - self.size) // TRANSITION_SIZE * TRANSITION_SIZE
+            records = records[:room]
+            self.truncated = True
+        if records:
+            file.write(records)
+            file.flush()
+            self.size += len(records)
+            self.count += len(records) // TRANSITION_SIZE
+
+    def last_statuses(self) -> dict[int, int]:
+        """uid -> the status its last transition in the file gives it (what a replay ends on)."""
+        import numpy as np
+
+        if self._file is None or not self.count:
+            return {}
+        self._file.flush()
+        header = self.size - self.count * TRANSITION_SIZE
+        with open(self.path, "rb") as file:
+            file.seek(header)
+            data = file.read(self.count * TRANSITION_SIZE)
+        records = np.frombuffer(data, dtype=np.uint8)[: len(data) // TRANSITION_SIZE * TRANSITION_SIZE]
+        records = records.reshape(-1, TRANSITION_SIZE)
+        uids = records[:, 6].astype(np.int64) | (records[:, 7].astype(np.int64) << 8)
+        keys, values = last_per_key(uids, records[:, 8])
+        return dict(zip(keys.tolist(), values.tolist(), strict=True))
 
     def close(self) -> None:
         """Flush and close the file (idempotent)."""

@@ -86,6 +86,33 @@ class TransitionLog:
         marks.clear()
         return batches
 
+    def take_columns(self) -> tuple[list[float], list[int], list[int]]:
+        """The changes since the last call column-wise, without a Python step per change:
+        ``(stamps, starts, codes)``, where the codes from ``starts[i]`` up to the next start
+        happened at ``stamps[i]``. All three are empty when nothing changed."""
+        codes = self.codes
+        marks = self._marks
+        if not codes:
+            marks.clear()
+            return [], [], []
+        if not marks or marks[0][0] != 0:
+            marks.insert(0, (0, self._clock()))
+        stamps: list[float] = []
+        starts: list[int] = []
+        count = len(codes)
+        for start, stamp in marks:
+            if start >= count:
+                break
+            if starts and starts[-1] == start:  # an empty batch: the later mark wins
+                stamps[-1] = stamp
+            else:
+                starts.append(start)
+                stamps.append(stamp)
+        taken = codes[:]
+        codes.clear()
+        marks.clear()
+        return stamps, starts, taken
+
     def take(self) -> list[Transition]:
         """The changes since the last call as ``(node, previous, new, time)``, oldest first."""
         nodes = self.nodes

@@ -458,6 +458,29 @@ if TYPE_CHECKING:
         __msgtype__: ClassVar[str] = "kinema_msgs/msg/NodeStatusChanges"
 
     @dataclass
+    class kinema_msgs__msg__NodeStatusCodes:
+        """kinema_msgs/msg/NodeStatusCodes."""
+
+        objective_name: str
+        table_id: int
+        stamps: list[builtin_interfaces__msg__Time]
+        starts: np.ndarray[tuple[int, ...], np.dtype[np.uint32]]
+        codes: np.ndarray[tuple[int, ...], np.dtype[np.uint32]]
+        __msgtype__: ClassVar[str] = "kinema_msgs/msg/NodeStatusCodes"
+
+    @dataclass
+    class kinema_msgs__msg__NodeTable:
+        """kinema_msgs/msg/NodeTable."""
+
+        objective_name: str
+        table_id: int
+        uids: np.ndarray[tuple[int, ...], np.dtype[np.uint32]]
+        node_paths: list[str]
+        node_ids: list[str]
+        node_names: list[str]
+        __msgtype__: ClassVar[str] = "kinema_msgs/msg/NodeTable"
+
+    @dataclass
     class kinema_msgs__msg__ObjectiveInfo:
         """kinema_msgs/msg/ObjectiveInfo."""
 
@@ -1508,6 +1531,8 @@ _MESSAGES = frozenset(
         "kinema_msgs__msg__BlackboardSnapshot",
         "kinema_msgs__msg__NodeStatusChange",
         "kinema_msgs__msg__NodeStatusChanges",
+        "kinema_msgs__msg__NodeStatusCodes",
+        "kinema_msgs__msg__NodeTable",
         "kinema_msgs__msg__ObjectiveInfo",
         "kinema_msgs__msg__ObjectivePort",
         "kinema_msgs__msg__ObjectiveServerHealth",

@@ -20,12 +20,13 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
 from kinema.errors import KinemaError, ObjectiveError
 from kinema.runtime import names
 from kinema.runtime.error_codes import MoveItErrorCode
 from kinema.runtime.log_files import PLUGIN_LOGGER
 from kinema.runtime.objective_server import (
-    NodeStatusChange,
     ObjectiveRequest,
     ObjectiveRun,
     ObjectiveServer,
@@ -39,6 +40,7 @@ if TYPE_CHECKING:
     from kinema.bt import Clock
     from kinema.config import ObjectiveInfo, WaypointStore
     from kinema.plugins import BehaviorHost, ReloadEvent
+    from kinema.runtime.node_status import NodeStatusBatch
     from kinema.runtime.objective_source import LibraryTreeSource
     from kinema.transport import Node, Session
 
@@ -53,8 +55,8 @@ LOG_ERROR, LOG_WARN, LOG_INFO = 1, 2, 3
 DO_OBJECTIVE_RESULT_KEEP_S = 60.0
 
 
-# Most node status changes in one ``/objective_server/node_status`` message (about 100 kB).
-NODE_STATUS_CHUNK = 1000
+# Most node status changes in one ``/objective_server/node_status`` message (4 bytes each: 200 kB).
+NODE_STATUS_CHUNK = 50_000
 
 
 def _stamp(seconds: float) -> dict[str, int]:
@@ -153,6 +155,9 @@ class _Streams:
         self._health = node.create_publisher(names.HEALTH_TYPE, names.HEALTH, latched=True)
         self._last_warnings: tuple[str, ...] = ()
         self._node_status = node.create_publisher(names.NODE_STATUS_TYPE, names.NODE_STATUS)
+        self._node_table = node.create_publisher(names.NODE_TABLE_TYPE, names.NODE_TABLE, latched=True)
+        self._table_id = 0
+        self._classes: tuple[type, type] | None = None
         self._blackboard = node.create_publisher(names.BLACKBOARD_TYPE, names.BLACKBOARD, latched=True)
         self._log = node.create_publisher(names.LOG_TYPE, names.LOG)
         self._status: tuple[ObjectiveStatus, str] = (ObjectiveStatus.IDLE, "")
@@ -208,29 +213,51 @@ class _Streams:
         log.info("objective %r: %s", objective_name, status)
         self.publish_heartbeat()
 
-    def on_node_status(self, objective_name: str, changes: list[NodeStatusChange]) -> None:
+    def on_node_status(self, objective_name: str, changes: NodeStatusBatch) -> None:
         from kinema.transport.messages import msg
 
-        items = [
-            {
-                "stamp": _stamp(change.timestamp),
-                "objective_name": objective_name,
-                "uid": change.uid,
-                "node_path": change.node_path,
-                "node_id": change.node_id,
-                "node_name": change.node_name,
-                "previous_status": change.previous,
-                "status": change.status,
-            }
-            for change in changes
-        ]
-        # In messages of at most NODE_STATUS_CHUNK changes: the stream is best effort (rmw_zenoh's
-        # KEEP_LAST: dropped when the link is congested), and a 60,000-node tick sent as one 10 MB message
-        # was lost whole on a loaded machine; in chunks, what gets through is applied.
-        for start in range(0, len(items), NODE_STATUS_CHUNK):
-            self._node_status.publish(
-                msg(names.NODE_STATUS_TYPE, changes=items[start : start + NODE_STATUS_CHUNK])
+        table = changes.table
+        if table.id != self._table_id:
+            # Once per run, latched, before its first changes: subscribers name nodes with it.
+            self._node_table.publish(
+                msg(
+                    names.NODE_TABLE_TYPE,
+                    objective_name=objective_name,
+                    table_id=table.id,
+                    uids=table.uid_array,
+                    node_paths=table.paths,
+                    node_ids=table.node_ids,
+                    node_names=table.names,
+                )
             )
+            self._table_id = table.id
+        # In messages of at most NODE_STATUS_CHUNK changes: the stream is best effort (rmw_zenoh's
+        # KEEP_LAST: dropped when the link is congested), and a very large message can be lost whole on a
+        # loaded machine; in chunks, what gets through is applied. Built from the message classes: the
+        # fields are already of their types (msg() would check every one, on every tick).
+        codes_class, time_class = self._node_status_classes()
+        for part in changes.split(NODE_STATUS_CHUNK):
+            self._node_status.publish(
+                codes_class(
+                    objective_name=objective_name,
+                    table_id=table.id,
+                    stamps=[time_class(**_stamp(stamp)) for stamp in part.stamps],
+                    starts=np.array(part.starts, dtype=np.uint32),
+                    codes=part.code_array(),
+                )
+            )
+
+    def _node_status_classes(self) -> tuple[type, type]:
+        classes = self._classes
+        if classes is None:
+            from kinema.transport.messages import load_interfaces
+
+            registry = load_interfaces()
+            classes = self._classes = (
+                registry.message_class(names.NODE_STATUS_TYPE),
+                registry.message_class("builtin_interfaces/msg/Time"),
+            )
+        return classes
 
     def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
         from kinema.transport.messages import msg

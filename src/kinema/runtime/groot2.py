@@ -33,13 +33,17 @@ from collections import deque
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
 
+import numpy as np
+
+from kinema.bt.btlog import last_per_key, pack_transition_columns
 from kinema.errors import KinemaError
 
 if TYPE_CHECKING:
     from kinema.bt.node import TreeNode
     from kinema.bt.status import NodeStatus
     from kinema.bt.tree import Tree
-    from kinema.runtime.objective_server import NodeStatusChange, ObjectiveRun
+    from kinema.runtime.node_status import NodeStatusBatch
+    from kinema.runtime.objective_server import ObjectiveRun
     from kinema.runtime.objective_status import ObjectiveStatus
     from kinema.runtime.result import ObjectiveResult
 
@@ -77,7 +81,17 @@ def blackboard_value(value: Any) -> Any:
 class _TreeState:
     """What is served about one tree; replaced as a whole when a new objective starts."""
 
-    __slots__ = ("recording_epoch", "scopes", "status", "status_index", "tree", "uuid", "xml", "zero")
+    __slots__ = (
+        "offset_array",
+        "recording_epoch",
+        "scopes",
+        "status",
+        "status_index",
+        "tree",
+        "uuid",
+        "xml",
+        "zero",
+    )
 
     def __init__(self, tree: Tree) -> None:
         from kinema.bt.model_xml import write_tree_to_xml
@@ -92,6 +106,10 @@ class _TreeState:
             self.status += struct.pack("<H", node.uid & 0xFFFF)
             self.status_index[node.uid] = len(self.status)
             self.status.append(int(node.status))
+        # uid -> offset of its status byte (-1: no such node), for batches of changes
+        self.offset_array = np.full(max(self.status_index, default=0) + 1, -1, dtype=np.int64)
+        for uid, offset in self.status_index.items():
+            self.offset_array[uid] = offset
         # Tree-clock time and wall time at one instant, to turn tree-clock stamps into epoch time.
         self.zero = (tree.clock.now(), time.time())
         self.recording_epoch = 0.0
@@ -173,9 +191,24 @@ class Groot2Server:
     def on_tree_loaded(self, objective_name: str, tree: Tree) -> None:
         self.set_tree(tree)
 
-    def on_node_status(self, objective_name: str, changes: list[NodeStatusChange]) -> None:
-        for change in changes:
-            self.transition(change.timestamp, change.uid, change.previous, change.status)
+    def on_node_status(self, objective_name: str, changes: NodeStatusBatch) -> None:
+        # Column-wise: a tick of a large tree brings thousands of changes, one Python step each was
+        # most of the tick thread's time.
+        with self._lock:
+            state = self._state
+            if state is None:
+                return
+            times, uids, previous, statuses = changes.columns()
+            shown = np.where(statuses == 0, previous + 10, statuses).astype(np.uint8)
+            last_uids, last_shown = last_per_key(uids, shown)
+            offsets = state.offset_array[last_uids]
+            known = offsets >= 0
+            np.frombuffer(state.status, dtype=np.uint8)[offsets[known]] = last_shown[known]
+            if self._recording:
+                epoch = state.zero[1] - state.zero[0] - state.recording_epoch
+                micros = np.rint((times + epoch) * 1e6)
+                packed = pack_transition_columns(micros, uids, statuses)
+                self._transitions.extend(packed[at : at + 9] for at in range(0, len(packed), 9))
 
     def on_status(self, status: ObjectiveStatus, objective_name: str) -> None:
         pass

@@ -21,8 +21,12 @@ HEARTBEAT_PERIOD_S = 0.1
 HEALTH = "/objective_server/health"
 HEALTH_TYPE = "kinema_msgs/msg/ObjectiveServerHealth"
 
+# Node status changes travel column-wise (an integer per change) and name nodes by their index in the
+# run's node table, which is published once per run, latched (see kinema.sdk.node_status).
 NODE_STATUS = "/objective_server/node_status"
-NODE_STATUS_TYPE = "kinema_msgs/msg/NodeStatusChanges"
+NODE_STATUS_TYPE = "kinema_msgs/msg/NodeStatusCodes"
+NODE_TABLE = "/objective_server/node_table"
+NODE_TABLE_TYPE = "kinema_msgs/msg/NodeTable"
 BLACKBOARD = "/objective_server/blackboard"
 BLACKBOARD_TYPE = "kinema_msgs/msg/BlackboardSnapshot"
 LOG = "/objective_server/log"

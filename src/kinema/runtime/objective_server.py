@@ -39,11 +39,11 @@ from collections import deque
 from collections.abc import Callable, Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
-from typing import TYPE_CHECKING, Any, NamedTuple, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
-from kinema.bt.node import node_children
 from kinema.bt.status import NodeStatus
 from kinema.errors import KinemaError, ObjectiveError, did_you_mean
+from kinema.runtime.node_status import NodeStatusBatch, NodeStatusRecorder
 from kinema.runtime.objective_status import ObjectiveStatus
 from kinema.runtime.overrides import ParameterOverride, apply_overrides
 from kinema.runtime.result import ObjectiveResult
@@ -58,7 +58,6 @@ from kinema.runtime.watchdog import StuckCode, stuck_code
 
 if TYPE_CHECKING:
     from kinema.bt import BehaviorTreeFactory, Tree
-    from kinema.bt.transitions import TransitionLog
 
 log = logging.getLogger("kinema.objective_server")
 
@@ -105,149 +104,14 @@ class ObjectiveRequest:
         return "<objective XML>" if self.objective_xml else "<empty request>"
 
 
-class NodeStatusChange(NamedTuple):
-    """One node of the running tree changed status (published as kinema_msgs/NodeStatusChange).
-
-    A named tuple: one is made per status transition on the tick thread (thousands per tick in a
-    large tree), and a tuple is built several times faster than a frozen dataclass.
-    """
-
-    timestamp: float
-    uid: int
-    node_path: str
-    node_id: str
-    node_name: str
-    previous: int
-    status: int
-
-
-_new_tuple = tuple.__new__
-
-
-class NodeStatusRecorder:
-    """The server's status observer: one :class:`NodeStatusChange` per transition, kept until the
-    tick is flushed, and the leaves that failed (the failure message names the last one).
-
-    Attached to a tree (:meth:`attach`) it reads the tree's transition log once per tick instead
-    of being called for every transition; it can also be registered as a plain status observer.
-    Everything but the timestamp is prepared once per node and transition (a table indexed by
-    previous and new status) and each change is built with ``tuple.__new__`` (a NamedTuple's own
-    constructor is a Python function).
-    """
-
-    __slots__ = ("_failures", "_leaf_failures", "_log", "_nodes", "_pending", "_rows")
-
-    def __init__(self) -> None:
-        self._pending: list[NodeStatusChange] = []
-        self._failures: list[tuple[str, str]] = []
-        self._nodes: dict[Any, _NodeRows] = {}
-        self._log: TransitionLog | None = None
-        # transition log code -> the fields of its NodeStatusChange after the timestamp
-        self._rows: dict[int, tuple[Any, ...]] = {}
-        # codes of a leaf turning FAILURE -> (path, registration ID)
-        self._leaf_failures: dict[int, tuple[str, str]] = {}
-
-    def attach(self, tree: Tree) -> None:
-        """Record the transitions of ``tree`` through its transition log (one per tree)."""
-        self.detach()
-        self._rows.clear()
-        self._leaf_failures.clear()
-        self._log = tree.record_transitions()
-
-    def detach(self) -> None:
-        """Stop recording the attached tree (what was recorded stays readable)."""
-        log = self._log
-        if log is not None:
-            self._drain()
-            log.close()
-            self._log = None
-
-    def __call__(self, timestamp: float, node: Any, previous: Any, status: Any) -> None:
-        self._record(node, previous, status, timestamp)
-
-    def _record(self, node: Any, previous: Any, status: Any, timestamp: float) -> None:
-        rows = self._nodes.get(node)
-        if rows is None:
-            rows = self._nodes[node] = _NodeRows(node)
-        row = rows.by_previous[previous]
-        rest = row[status]
-        if rest is None:
-            rest = row[status] = (*rows.fields, int(previous), int(status))
-        self._pending.append(_new_tuple(NodeStatusChange, (timestamp,) + rest))  # noqa: RUF005 - faster
-        if status is _FAILURE and rows.leaf is not None:
-            self._failures.append(rows.leaf)
-
-    def _drain(self) -> None:
-        log = self._log
-        if log is None or not log.codes:
-            return
-        rows = self._rows
-        pending = self._pending
-        for stamp, codes in log.take_codes():
-            try:
-                # One dict lookup per change: a code names the node and both statuses.
-                pending.extend([_new_tuple(NodeStatusChange, (stamp,) + rows[code]) for code in codes])
-            except KeyError:  # a change not seen yet: fill its row
-                for code in codes:
-                    rest = rows.get(code)
-                    if rest is None:
-                        rest = rows[code] = self._row(log, code)
-                    pending.append(_new_tuple(NodeStatusChange, (stamp,) + rest))  # noqa: RUF005
-            failed = self._leaf_failures
-            if failed:
-                self._failures.extend([failed[code] for code in codes if code in failed])
-
-    def _row(self, log: TransitionLog, code: int) -> tuple[Any, ...]:
-        node = log.nodes[code // 25]
-        previous, status = code // 5 % 5, code % 5
-        path = node.full_path
-        if status == _FAILURE and not node_children(node):
-            self._leaf_failures[code] = (path, node.registration_id)
-        return (int(node.uid), path, node.registration_id, node.name, previous, status)
-
-    @property
-    def pending(self) -> list[NodeStatusChange]:
-        """The changes not taken yet."""
-        self._drain()
-        return self._pending
-
-    @property
-    def failures(self) -> list[tuple[str, str]]:
-        """``(path, registration ID)`` of every leaf that failed, oldest first."""
-        self._drain()
-        return self._failures
-
-    def take(self) -> list[NodeStatusChange]:
-        """The changes since the last call (the list is handed over, not copied)."""
-        self._drain()
-        changes, self._pending = self._pending, []
-        return changes
-
-
-class _NodeRows:
-    """What :class:`NodeStatusRecorder` knows of one node."""
-
-    __slots__ = ("by_previous", "fields", "leaf")
-
-    def __init__(self, node: Any) -> None:
-        path = node.full_path
-        self.fields = (int(node.uid), path, node.registration_id, node.name)
-        self.leaf = None if node_children(node) else (path, node.registration_id)
-        n = len(NodeStatus)
-        self.by_previous: list[list[tuple[Any, ...] | None]] = [[None] * n for _ in range(n)]
-
-
-_FAILURE = NodeStatus.FAILURE
-
-
 class ServerListener(Protocol):
     """Receives what happens in the server. Every method runs on the tick thread and must not block."""
 
     def on_status(self, status: ObjectiveStatus, objective_name: str) -> None:
         """The server's status changed (Idle, Loading, Running, Success, Failure, Cancelled)."""
 
-    def on_node_status(self, objective_name: str, changes: list[NodeStatusChange]) -> None:
-        """Nodes changed status during one tick."""
+    def on_node_status(self, objective_name: str, changes: NodeStatusBatch) -> None:
+        """Nodes changed status during one tick (iterate the batch for NodeStatusChange objects)."""
 
     def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
         """A blackboard snapshot: ``(scope, key, type_name, value)`` for every entry (throttled)."""
@@ -1027,9 +891,9 @@ class ObjectiveServer:
     # -- observation (tick thread) --------------------------------------------------------------
 
     def _flush_node_changes(self, run: ObjectiveRun) -> None:
-        if not self._recorder.pending:
-            return
         changes = self._recorder.take()
+        if changes is None:
+            return
         for listener in self._listeners:
             try:
                 listener.on_node_status(run.objective_name, changes)
@@ -1051,10 +915,10 @@ class ObjectiveServer:
                 log.exception("a blackboard listener raised")
 
     def _failure_message(self, run: ObjectiveRun) -> str:
-        failures = self._recorder.failures
-        if not failures:
+        failure = self._recorder.last_failure
+        if failure is None:
             return f"objective {run.objective_name!r} returned FAILURE"
-        path, registration_id = failures[-1]
+        path, registration_id = failure
         with self._notes_lock:
             message = self._failure_notes.get(path, "")
         detail = f": {message}" if message else " returned FAILURE"

@@ -23,12 +23,15 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from kinema.bt.btlog import SUFFIX, BtlogWriter, Recording, read_btlog
+import numpy as np
+
+from kinema.bt.btlog import SUFFIX, BtlogWriter, Recording, pack_transition_columns, read_btlog
 from kinema.errors import KinemaError
 
 if TYPE_CHECKING:
     from kinema.bt.tree import Tree
-    from kinema.runtime.objective_server import NodeStatusChange, ObjectiveRun
+    from kinema.runtime.node_status import NodeStatusBatch
+    from kinema.runtime.objective_server import ObjectiveRun
     from kinema.runtime.objective_status import ObjectiveStatus
     from kinema.runtime.result import ObjectiveResult
 
@@ -95,7 +98,6 @@ class RunRecorder:
         self._last_entries: list[list[str]] | None = None
         self._clock: Any = None
         self._tree: Tree | None = None
-        self._recorded: dict[int, int] = {}
         self._t0 = 0.0
         self._objective = ""
 
@@ -119,7 +121,6 @@ class RunRecorder:
             return
         self._clock = tree.clock
         self._tree = tree
-        self._recorded = {}
         self._t0 = tree.clock.now()
         self._objective = objective_name
         self._last_entries = None
@@ -130,16 +131,22 @@ class RunRecorder:
             log.warning("not recording the blackboard of %r: %s", objective_name, error)
             self._blackboard = None
 
-    def on_node_status(self, objective_name: str, changes: list[NodeStatusChange]) -> None:
+    def on_node_status(self, objective_name: str, changes: NodeStatusBatch) -> None:
         writer = self._writer
         if writer is None:
             return
-        t0 = self._t0
         was_truncated = writer.truncated
-        for change in changes:
-            self._recorded[change.uid] = change.status
+        codes = changes.code_array()
+        uids = changes.table.uid_array[codes // 25]
+        statuses = codes % 5
+        stamps = changes.stamps
+        if len(stamps) == 1:
+            offsets: Any = round((stamps[0] - self._t0) * 1e6)
+        else:
+            times = np.repeat(np.asarray(stamps), np.diff([*changes.starts, len(codes)]))
+            offsets = np.rint((times - self._t0) * 1e6)
         try:
-            writer.write((round((c.timestamp - t0) * 1e6), c.uid, c.status) for c in changes)
+            writer.write_packed(pack_transition_columns(offsets, uids, statuses))
         except OSError as error:
             log.warning("recording %s stopped: %s", writer.path, error)
             self._close_writer()
@@ -158,10 +165,14 @@ class RunRecorder:
         writer, tree = self._writer, self._tree
         if writer is not None and tree is not None and self._clock is not None:
             offset = round((self._clock.now() - self._t0) * 1e6)
+            try:
+                recorded = writer.last_statuses()
+            except OSError:
+                recorded = {}
             missing = [
                 (offset, node.uid, int(node.status))
                 for node in tree.nodes()
-                if int(node.status) != self._recorded.get(node.uid, 0)
+                if int(node.status) != recorded.get(node.uid & 0xFFFF, 0)
             ]
             try:
                 writer.write(missing)

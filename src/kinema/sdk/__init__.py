@@ -18,6 +18,9 @@ _EXPORTS = {
     "BlackboardValue": "kinema.sdk.streams",
     "LogEntry": "kinema.sdk.streams",
     "MessageStream": "kinema.sdk.streams",
+    "NodeStatusChange": "kinema.sdk.streams",
+    "NodeStatusChanges": "kinema.sdk.streams",
+    "NodeStatusDecoder": "kinema.sdk.streams",
     "ServerStatus": "kinema.sdk.streams",
     "MoveItErrorCode": "kinema.runtime.error_codes",
     "ObjectiveStatus": "kinema.runtime.objective_status",
@@ -36,6 +39,9 @@ __all__ = [
     "LogEntry",
     "MessageStream",
     "MoveItErrorCode",
+    "NodeStatusChange",
+    "NodeStatusChanges",
+    "NodeStatusDecoder",
     "ObjectiveClient",
     "ObjectiveHandle",
     "ObjectiveResult",
@@ -54,7 +60,16 @@ if TYPE_CHECKING:
     from kinema.runtime.result import ObjectiveResult
     from kinema.sdk.client import ObjectiveClient, ObjectiveHandle, parameter_messages
     from kinema.sdk.quick import QuickClient, QuickRun
-    from kinema.sdk.streams import BlackboardSnapshot, BlackboardValue, LogEntry, MessageStream, ServerStatus
+    from kinema.sdk.streams import (
+        BlackboardSnapshot,
+        BlackboardValue,
+        LogEntry,
+        MessageStream,
+        NodeStatusChange,
+        NodeStatusChanges,
+        NodeStatusDecoder,
+        ServerStatus,
+    )
 
 
 def __getattr__(name: str) -> Any:

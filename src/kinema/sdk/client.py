@@ -27,7 +27,14 @@ from kinema.errors import TransportError
 from kinema.runtime import names
 from kinema.runtime.overrides import ParameterOverride
 from kinema.runtime.result import ObjectiveResult
-from kinema.sdk.streams import BlackboardSnapshot, LogEntry, MessageStream, ServerStatus
+from kinema.sdk.streams import (
+    BlackboardSnapshot,
+    LogEntry,
+    MessageStream,
+    NodeStatusChanges,
+    NodeStatusDecoder,
+    ServerStatus,
+)
 
 if TYPE_CHECKING:
     from kinema.config.objective_file import ObjectivePort
@@ -377,13 +384,36 @@ class ObjectiveClient:
             timeout=timeout,
         )
 
-    def node_statuses(self, *, timeout: float | None = None) -> MessageStream[Any]:
-        """Iterate over batches of node status changes (``kinema_msgs/msg/NodeStatusChanges``)."""
-        return MessageStream(
-            lambda cb: self.node.create_subscription(names.NODE_STATUS_TYPE, names.NODE_STATUS, cb),
-            lambda message: message,
-            timeout=timeout,
-        )
+    def node_statuses(self, *, timeout: float | None = None) -> MessageStream[NodeStatusChanges]:
+        """Iterate over the node status changes of running objectives, a batch per message (usually
+        one tick): :class:`~kinema.sdk.streams.NodeStatusChanges` of
+        :class:`~kinema.sdk.streams.NodeStatusChange` (stamp, uid, path, registration ID, name,
+        previous and new status). Decoded from ``/objective_server/node_status`` with the run's
+        node table (``/objective_server/node_table``), see :class:`~kinema.sdk.streams.NodeStatusDecoder`.
+        """
+        decoder = NodeStatusDecoder()
+
+        def subscribe(push: Any) -> _Subscriptions:
+            def on_table(message: Any) -> None:
+                for ready in decoder.on_table(message):
+                    push(ready)
+
+            def on_codes(message: Any) -> None:
+                decoded = decoder.on_codes(message)
+                if decoded is not None:
+                    push(decoded)
+
+            tables = self.node.create_subscription(
+                names.NODE_TABLE_TYPE, names.NODE_TABLE, on_table, latched=True
+            )
+            try:
+                codes = self.node.create_subscription(names.NODE_STATUS_TYPE, names.NODE_STATUS, on_codes)
+            except BaseException:
+                tables.close()
+                raise
+            return _Subscriptions(tables, codes)
+
+        return MessageStream(subscribe, lambda batch: batch, timeout=timeout)
 
     # -- lifecycle -----------------------------------------------------------------------------------
 
@@ -407,3 +437,14 @@ def _xml_name(xml: str) -> str:
     from kinema.sdk.quick import xml_objective_name
 
     return xml_objective_name(xml)
+
+
+class _Subscriptions:
+    """Several subscriptions closed as one."""
+
+    def __init__(self, *subscriptions: Any) -> None:
+        self._subscriptions = subscriptions
+
+    def close(self) -> None:
+        for subscription in self._subscriptions:
+            subscription.close()

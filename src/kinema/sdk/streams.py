@@ -200,6 +200,110 @@ class LogEntry:
         return f"{self.level.upper():5} {self.text}"
 
 
+@dataclass(frozen=True, slots=True)
+class NodeStatusChange:
+    """One node of a running objective's tree changed status.
+
+    Attributes:
+        stamp: the server's clock at the start of the root tick the change happened in (seconds).
+        objective_name: the objective whose tree it is.
+        uid: the node's uid (depth-first order, 1-based as in BT.CPP).
+        node_path: its path from the root, e.g. ``"Pick/TopLevelSequence/MoveToWaypoint"``.
+        node_id, node_name: its registration ID (Sequence, MoveToWaypoint, ...) and instance name.
+        previous_status, status: IDLE=0, RUNNING=1, SUCCESS=2, FAILURE=3, SKIPPED=4.
+    """
+
+    stamp: float
+    objective_name: str
+    uid: int
+    node_path: str
+    node_id: str
+    node_name: str
+    previous_status: int
+    status: int
+
+
+@dataclass(frozen=True, slots=True)
+class NodeStatusChanges:
+    """Node status changes of one objective, oldest first (usually those of one tick)."""
+
+    objective_name: str
+    changes: tuple[NodeStatusChange, ...]
+
+
+class NodeStatusDecoder:
+    """Names the changes of ``/objective_server/node_status`` with their run's node table.
+
+    The server sends a change as one integer (``node index * 25 + previous * 5 + status``) and each
+    run's node table once, latched, on ``/objective_server/node_table``. Feed both topics' messages
+    here (any thread); changes that arrive before their table wait for it (the newest 256 messages).
+    """
+
+    KEEP_TABLES = 8
+    KEEP_WAITING = 256
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._tables: dict[int, tuple[str, list[int], list[str], list[str], list[str]]] = {}
+        self._waiting: list[Any] = []
+
+    def on_table(self, message: Any) -> list[NodeStatusChanges]:
+        """Take a node table; returns the waiting changes it names."""
+        table = (
+            str(message.objective_name),
+            [int(uid) for uid in message.uids],
+            [str(path) for path in message.node_paths],
+            [str(node_id) for node_id in message.node_ids],
+            [str(name) for name in message.node_names],
+        )
+        with self._lock:
+            self._tables[int(message.table_id)] = table
+            while len(self._tables) > self.KEEP_TABLES:
+                del self._tables[next(iter(self._tables))]
+            ready = [waiting for waiting in self._waiting if int(waiting.table_id) == int(message.table_id)]
+            self._waiting = [waiting for waiting in self._waiting if waiting not in ready]
+        return [self._decode(waiting, table) for waiting in ready]
+
+    def on_codes(self, message: Any) -> NodeStatusChanges | None:
+        """Take a node status message; None while its table has not arrived (it waits)."""
+        with self._lock:
+            table = self._tables.get(int(message.table_id))
+            if table is None:
+                self._waiting.append(message)
+                del self._waiting[: -self.KEEP_WAITING]
+                return None
+        return self._decode(message, table)
+
+    @staticmethod
+    def _decode(
+        message: Any, table: tuple[str, list[int], list[str], list[str], list[str]]
+    ) -> NodeStatusChanges:
+        objective, uids, paths, node_ids, names = table
+        codes = [int(code) for code in message.codes]
+        starts = [int(start) for start in message.starts]
+        stamps = [_seconds(stamp) for stamp in message.stamps]
+        bounds = [*starts[1:], len(codes)]
+        changes = []
+        for stamp, first, end in zip(stamps, starts, bounds, strict=True):
+            for code in codes[first:end]:
+                index = code // 25
+                if index >= len(uids):
+                    continue  # not of this table: a damaged message
+                changes.append(
+                    NodeStatusChange(
+                        stamp,
+                        objective,
+                        uids[index],
+                        paths[index],
+                        node_ids[index],
+                        names[index],
+                        code // 5 % 5,
+                        code % 5,
+                    )
+                )
+        return NodeStatusChanges(str(message.objective_name) or objective, tuple(changes))
+
+
 class MessageStream(Generic[T]):
     """An iterator over messages of one subscription; closing it (or leaving a ``for`` loop) unsubscribes.
 

@@ -109,6 +109,17 @@ def _convert(registry: TypeRegistry, desc: Any, value: Any, where: str) -> Any:
     if kind == Nodetype.NAME:
         return _build(registry, rest, value, where)
     (sub_kind, sub_rest), size = rest
+    if (
+        isinstance(value, np.ndarray)
+        and value.ndim == 1
+        and sub_kind == Nodetype.BASE
+        and sub_rest[0] in _NUMPY_DTYPES
+        and np.can_cast(value.dtype, _NUMPY_DTYPES[sub_rest[0]], "safe")
+        and (kind != Nodetype.ARRAY or len(value) == size)
+        and not (kind == Nodetype.SEQUENCE and size and len(value) > size)
+    ):
+        # A numpy array whose every value the field's type holds: no per-element conversion.
+        return np.asarray(value, dtype=_NUMPY_DTYPES[sub_rest[0]])
     if isinstance(value, str | bytes | Mapping) or not hasattr(value, "__iter__"):
         if not (
             isinstance(value, bytes)

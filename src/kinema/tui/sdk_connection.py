@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 from xml.sax.saxutils import quoteattr
 
 from kinema.errors import KinemaError, ObjectiveError, TransportError
+from kinema.sdk.streams import NodeStatusChanges, NodeStatusDecoder
 from kinema.tui.connection import (
     ApprovalRequested,
     BehaviorSummary,
@@ -117,6 +118,7 @@ class SdkConnection:
         self._config = config
         self._heartbeat_timeout = heartbeat_timeout
         self._listener: EventListener | None = None
+        self._node_decoder = NodeStatusDecoder()
         self._client: ObjectiveClient | None = None
         self._service_clients: dict[str, Any] = {}
         self._lock = threading.Lock()
@@ -210,6 +212,7 @@ class SdkConnection:
         from kinema.sdk import ObjectiveClient
 
         client = ObjectiveClient(self._endpoint, timeout=CALL_TIMEOUT_S)
+        self._node_decoder = NodeStatusDecoder()  # a restarted runtime numbers its tables anew
         # Published before subscribing: the latched heartbeat can arrive while subscribing, and a
         # screen that sees "connected" must find a client to call.
         with self._lock:
@@ -219,6 +222,9 @@ class SdkConnection:
         try:
             node.create_subscription(names.HEARTBEAT_TYPE, names.HEARTBEAT, self._on_heartbeat, latched=True)
             node.create_subscription(names.HEALTH_TYPE, names.HEALTH, self._on_health, latched=True)
+            node.create_subscription(
+                names.NODE_TABLE_TYPE, names.NODE_TABLE, self._on_node_table, latched=True
+            )
             node.create_subscription(names.NODE_STATUS_TYPE, names.NODE_STATUS, self._on_node_status)
             node.create_subscription(
                 names.BLACKBOARD_TYPE, names.BLACKBOARD, self._on_blackboard, latched=True
@@ -308,21 +314,29 @@ class SdkConnection:
     def _on_health(self, message: Any) -> None:
         self._warnings = tuple(str(warning) for warning in message.warnings)
 
+    def _on_node_table(self, message: Any) -> None:
+        for batch in self._node_decoder.on_table(message):
+            self._emit_node_changes(batch)
+
     def _on_node_status(self, message: Any) -> None:
-        by_objective: dict[str, list[NodeStatusUpdate]] = {}
-        for change in message.changes:
-            by_objective.setdefault(str(change.objective_name), []).append(
-                NodeStatusUpdate(
-                    int(change.uid),
-                    str(change.node_path),
-                    str(change.node_id),
-                    str(change.node_name),
-                    _status(change.status),
-                    _status(change.previous_status),
-                )
+        batch = self._node_decoder.on_codes(message)
+        if batch is not None:
+            self._emit_node_changes(batch)
+
+    def _emit_node_changes(self, batch: NodeStatusChanges) -> None:
+        updates = tuple(
+            NodeStatusUpdate(
+                change.uid,
+                change.node_path,
+                change.node_id,
+                change.node_name,
+                _status(change.status),
+                _status(change.previous_status),
             )
-        for objective, updates in by_objective.items():
-            self._emit(NodeStatusBatch(objective, tuple(updates)))
+            for change in batch.changes
+        )
+        if updates:
+            self._emit(NodeStatusBatch(batch.objective_name, updates))
 
     def _on_blackboard(self, message: Any) -> None:
         stamp = message.stamp

@@ -113,32 +113,47 @@ def test_a_heartbeat_never_reports_a_status_older_than_the_one_published_before_
 
 
 def test_a_large_tick_is_published_as_several_node_status_messages_in_order() -> None:
+    from kinema.bt import BehaviorTreeFactory
     from kinema.runtime.agent import NODE_STATUS_CHUNK, _Streams
+    from kinema.runtime.node_status import NodeStatusRecorder
 
-    sent: list[list[int]] = []
+    sent: list[tuple[str, Any]] = []
 
     class Publisher:
         def __init__(self, topic: str) -> None:
             self.topic = topic
 
         def publish(self, message: Any) -> None:
-            if self.topic.endswith("node_status"):
-                sent.append([change.uid for change in message.changes])
+            sent.append((self.topic, message))
 
+    leaves = NODE_STATUS_CHUNK + NODE_STATUS_CHUNK // 4  # two changes each: three messages
+    xml = (
+        '<root BTCPP_format="4"><BehaviorTree ID="Big"><Sequence>'
+        + "<AlwaysSuccess/>" * leaves
+        + "</Sequence></BehaviorTree></root>"
+    )
+    tree = BehaviorTreeFactory().create_tree_from_text(xml)
+    recorder = NodeStatusRecorder()
+    recorder.attach(tree)
+    tree.tick_once()
+    batch = recorder.take()
+    assert batch is not None and len(batch) > 2 * NODE_STATUS_CHUNK
     node = SimpleNamespace(create_publisher=lambda _type, topic, **_: Publisher(topic))
     streams = _Streams(node, None, SimpleNamespace())  # type: ignore[arg-type]
-    changes = [
-        SimpleNamespace(
-            timestamp=1.0,
-            uid=uid,
-            node_path=f"Big/n{uid}",
-            node_id="AlwaysSuccess",
-            node_name="",
-            previous=0,
-            status=2,
-        )
-        for uid in range(1, 2 * NODE_STATUS_CHUNK + 501)
+    streams.on_node_status("Big", batch)
+    topics = [topic for topic, _ in sent]
+    assert topics == ["/objective_server/node_table"] + ["/objective_server/node_status"] * 3, topics
+    table = sent[0][1]
+    assert len(table.uids) == leaves + 1 and table.table_id == batch.table.id
+    parts = [message for _, message in sent[1:]]
+    assert [len(part.codes) for part in parts] == [
+        NODE_STATUS_CHUNK,
+        NODE_STATUS_CHUNK,
+        len(batch) - 2 * NODE_STATUS_CHUNK,
     ]
-    streams.on_node_status("Big", changes)  # type: ignore[arg-type]
-    assert [len(batch) for batch in sent] == [NODE_STATUS_CHUNK, NODE_STATUS_CHUNK, 500]
-    assert [uid for batch in sent for uid in batch] == list(range(1, 2 * NODE_STATUS_CHUNK + 501))
+    assert [int(code) for part in parts for code in part.codes] == batch.codes
+    # the table goes out once per run
+    sent.clear()
+    tree.tick_once()
+    streams.on_node_status("Big", recorder.take())  # type: ignore[arg-type]
+    assert [topic for topic, _ in sent] == ["/objective_server/node_status"] * 3

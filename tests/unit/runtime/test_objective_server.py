@@ -10,9 +10,9 @@ import pytest
 
 from kinema.bt import BehaviorTreeFactory
 from kinema.runtime.error_codes import MoveItErrorCode
+from kinema.runtime.node_status import NodeStatusBatch, NodeStatusChange
 from kinema.runtime.objective_server import (
     FactoryTreeSource,
-    NodeStatusChange,
     ObjectiveRequest,
     ObjectiveRun,
     ObjectiveServer,
@@ -60,7 +60,7 @@ class Recorder:
     def on_status(self, status: ObjectiveStatus, objective_name: str) -> None:
         self.statuses.append((status, objective_name))
 
-    def on_node_status(self, objective_name: str, changes: list[NodeStatusChange]) -> None:
+    def on_node_status(self, objective_name: str, changes: NodeStatusBatch) -> None:
         self.changes.extend(changes)
 
     def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, object]]) -> None:
