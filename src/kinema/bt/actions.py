@@ -141,9 +141,14 @@ class ScriptNode(_ScriptCode, SyncActionNode):
             return TreeNode.execute_tick(self)
         config = self.config
         try:
-            script.run(config.blackboard, config.enums)
+            single = script.single
+            if single is not None:
+                single(config.blackboard, config.enums)  # Script.run without its frame
+            else:
+                script.run(config.blackboard, config.enums)
         except Exception as error:
-            raise self._wrap_exception(error) from error
+            failure = script.error(error)
+            raise self._wrap_exception(failure) from failure
         prev = self._status
         if prev is not SUCCESS:
             self._status = SUCCESS
@@ -196,7 +201,16 @@ class ScriptConditionNode(_ScriptCode, ConditionNode):
             return TreeNode.execute_tick(self)
         config = self.config
         try:
-            value = script.run(config.blackboard, config.enums)
+            single = script.single
+            try:
+                # Script.run without its frame
+                value = (
+                    single(config.blackboard, config.enums)
+                    if single is not None
+                    else script.run(config.blackboard, config.enums)
+                )
+            except Exception as error:
+                raise script.error(error) from None
             if value.__class__ is float:
                 status = SUCCESS if value != 0.0 else FAILURE
             else:

@@ -168,7 +168,10 @@ class SequenceWithMemoryNode(ControlNode):
 
 
 class FallbackNode(_ResumingControl):
-    """Ticks children in order until one succeeds (the mirror of Sequence)."""
+    """Ticks children in order until one succeeds (the mirror of Sequence).
+
+    The async variant yields (wake-up + RUNNING) after each child that fails from IDLE.
+    """
 
     _asynch = False
 
@@ -183,9 +186,10 @@ class FallbackNode(_ResumingControl):
             else:
                 self._status = RUNNING
         idx = self._idx
-        while idx < n:
-            child = children[idx]
-            prev = child._status
+        if self._asynch:
+            return self._tick_async(children, n, idx)
+        # The plain Fallback's hot loop (the async one is the same plus a yield after each failure).
+        for child in children if idx == 0 else children[idx:]:
             try:
                 status = child.execute_tick()
             except BaseException:
@@ -195,7 +199,33 @@ class FallbackNode(_ResumingControl):
                 raise
             if status is FAILURE:
                 idx += 1
-                if self._asynch and prev is IDLE and idx < n:
+            elif status is RUNNING:
+                self._idx = idx
+                return RUNNING
+            elif status is SUCCESS:
+                self.reset_children()
+                self._idx = 0
+                return SUCCESS
+            elif status is SKIPPED:
+                idx += 1
+                self._skipped += 1
+            else:
+                self._idx = idx
+                raise _idle_child(self)
+        return self._finish(n)
+
+    def _tick_async(self, children: list, n: int, idx: int) -> NodeStatus:
+        while idx < n:
+            child = children[idx]
+            prev = child._status
+            try:
+                status = child.execute_tick()
+            except BaseException:
+                self._idx = idx  # as in the plain loop
+                raise
+            if status is FAILURE:
+                idx += 1
+                if prev is IDLE and idx < n:
                     self._idx = idx
                     self.emit_wake_up_signal()
                     return RUNNING
@@ -212,6 +242,9 @@ class FallbackNode(_ResumingControl):
             else:
                 self._idx = idx
                 raise _idle_child(self)
+        return self._finish(n)
+
+    def _finish(self, n: int) -> NodeStatus:
         all_skipped = self._skipped == n
         self.reset_children()
         self._idx = 0

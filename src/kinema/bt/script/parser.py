@@ -180,12 +180,15 @@ class Script:
         statements: the parsed statements; the value of the script is that of the last one.
     """
 
-    __slots__ = ("_fns", "code", "statements")
+    __slots__ = ("_fns", "code", "single", "statements")
 
     def __init__(self, code: str, statements: list[Expr]) -> None:
         self.code = code
         self.statements = statements
         self._fns = [compile_expr(statement) for statement in statements]
+        # The compiled statement of a one-statement script (nearly all): callers on a hot path call it
+        # directly, turning an exception into the ScriptError run() raises with error().
+        self.single = self._fns[0] if len(self._fns) == 1 else None
 
     def run(self, blackboard: Blackboard, enums: dict[str, int] | None = None) -> Any:
         """Execute every statement and return the value of the last one.
@@ -201,11 +204,15 @@ class Script:
             for fn in fns:
                 value = fn(blackboard, enums)
             return value
-        except ScriptError:
-            raise
         except Exception as error:
-            message = getattr(error, "message", None) or str(error)
-            raise ScriptError(f"Error in script [{self.code}]\n{message}") from None
+            raise self.error(error) from None
+
+    def error(self, error: Exception) -> ScriptError:
+        """What :meth:`run` raises for ``error`` raised while running (a ScriptError as it is)."""
+        if isinstance(error, ScriptError):
+            return error
+        message = getattr(error, "message", None) or str(error)
+        return ScriptError(f"Error in script [{self.code}]\n{message}")
 
     def __repr__(self) -> str:
         return f"Script({self.code!r})"
