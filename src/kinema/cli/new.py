@@ -73,7 +73,18 @@ def new_config(
     click.echo(f"created config package {name} in {path}")
     if overlaid is not None and overlaid.origin == "bundled":
         click.echo(f"note: it overlays Kinema's bundled {name} ({overlaid.path}) in this workspace")
-    click.echo(f"try: kinema config show -c {name} --provenance")
+    # Where the package went may be outside what commands find from here (``-o`` elsewhere): the
+    # hint must be a command that works.
+    refound, _ = resolve_selection(workspace, None, need_config=False)
+    if refound.has_package(name):
+        click.echo(f"try: kinema config show -c {name} --provenance")
+    elif path.parent.name == "src":
+        click.echo(f"try: kinema config show -c {name} -w {path.parent.parent} --provenance")
+    else:
+        click.echo(
+            f"note: {path.parent} is not a workspace's src/ folder, so kinema commands do not find {name} "
+            "from here; create it inside a workspace (kinema init WS, then kinema new config ... -w WS)"
+        )
 
 
 @new.command("behavior")

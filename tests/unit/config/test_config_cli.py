@@ -231,3 +231,23 @@ def test_run_with_an_unknown_config_is_refused_before_a_run_folder_or_router_exi
     assert code == 1 and err.startswith("error: ") and "no config package named 'nope'" in err, err
     after = sorted(runs_dir().iterdir())
     assert after == before, f"new run folders: {set(after) - set(before)}"
+
+
+def test_the_hint_after_new_config_is_a_command_that_finds_the_package(capsys, tmp_path: Path):
+    # Inside a workspace's src/ that is not the selected one: the hint names the workspace.
+    workspace = tmp_path / "other_ws"
+    assert run(capsys, "init", str(workspace))[0] == 0
+    code, out, _ = run(
+        capsys, "new", "config", "cell_a", "-b", "lab_sim", "--no-input", "-o", str(workspace / "src")
+    )
+    assert code == 0, out
+    hint = next(line for line in out.splitlines() if line.startswith("try: kinema "))
+    code, shown, err = run(capsys, *hint.removeprefix("try: kinema ").split())
+    assert code == 0 and "chain: lab_sim → cell_a" in shown, (hint, shown, err)
+    # Outside any workspace: no command finds it, and the note says so instead of a hint that fails.
+    code, out, _ = run(
+        capsys, "new", "config", "cell_b", "-b", "lab_sim", "--no-input", "-o", str(tmp_path / "loose")
+    )
+    assert code == 0, out
+    assert "try: kinema" not in out
+    assert "not a workspace's src/ folder" in out and "kinema init" in out, out
