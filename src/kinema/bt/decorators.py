@@ -33,27 +33,14 @@ class _ResultMappingDecorator(DecoratorNode):
     _on_failure = FAILURE
 
     def tick(self) -> NodeStatus:
-        if self._status is not RUNNING:
-            if self._watched:
-                _set_status_unchecked(self, RUNNING)
-            else:
-                self._status = RUNNING
+        # What the execute_tick below does inline; this plain form serves nodes with conditions or
+        # callbacks (DecoratorNode.execute_tick's hooked path).
+        _set_status_unchecked(self, RUNNING)
         child = self.child
         assert child is not None
         status = child.execute_tick()
         if status is SUCCESS or status is FAILURE:
-            # reset_child() inlined for the common case: a completed child
-            done = child._status
-            if done is RUNNING:
-                self.reset_child()
-            else:
-                child._status = IDLE
-                if child._watched and done is not IDLE:
-                    log = child._log
-                    if log is not None:
-                        log(child._log_base + done * 5)  # IDLE is 0
-                    if child._observers:
-                        child._notify_observers(done, IDLE)
+            self.reset_child()
             return self._on_success if status is SUCCESS else self._on_failure
         if status is RUNNING or status is SKIPPED:
             return status
@@ -587,26 +574,14 @@ class SubTreeNode(DecoratorNode):
         ]
 
     def tick(self) -> NodeStatus:
+        # What the execute_tick below does inline, for nodes with conditions or callbacks.
         if self._status is IDLE:
-            if self._watched:
-                _set_status_unchecked(self, RUNNING)
-            else:
-                self._status = RUNNING
+            _set_status_unchecked(self, RUNNING)
         child = self.child
         assert child is not None
         status = child.execute_tick()
         if status is SUCCESS or status is FAILURE:
-            done = child._status
-            if done is RUNNING:
-                self.reset_child()
-            else:
-                child._status = IDLE
-                if child._watched and done is not IDLE:
-                    log = child._log
-                    if log is not None:
-                        log(child._log_base + done * 5)  # IDLE is 0
-                    if child._observers:
-                        child._notify_observers(done, IDLE)
+            self.reset_child()
         return status
 
     def execute_tick(self) -> NodeStatus:
