@@ -201,6 +201,8 @@ class Groot2Server:
             times, uids, previous, statuses = changes.columns()
             shown = np.where(statuses == 0, previous + 10, statuses).astype(np.uint8)
             last_uids, last_shown = last_per_key(uids, shown)
+            inside = last_uids < len(state.offset_array)  # a uid of another tree is not served
+            last_uids, last_shown = last_uids[inside], last_shown[inside]
             offsets = state.offset_array[last_uids]
             known = offsets >= 0
             np.frombuffer(state.status, dtype=np.uint8)[offsets[known]] = last_shown[known]
