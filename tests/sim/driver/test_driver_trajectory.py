@@ -107,30 +107,53 @@ def test_an_unreachable_goal_tolerance_aborts_after_the_goal_time_tolerance(sim:
 
 
 def test_cancel_stops_the_arm_within_50_ms_of_sim_time(start_sim: Callable[..., Sim]) -> None:
-    # At real time the wall-time latency of watching and cancelling (up to a second on a loaded machine)
-    # is the same sim time, well inside the 2 s the arm moves fast; the 50 ms are measured from the
-    # driver's cancel time.
+    # At real time the wall-time latency of watching and cancelling is the same sim time; the 50 ms are
+    # measured from the driver's cancel time. On a loaded machine that latency can outlast the 2.4 s the
+    # arm moves fast (minimum jerk: above 0.5 rad/s from 0.8 s to 3.2 s of the 4 s): a cancel that went in
+    # while the arm was slow tests nothing, so the move is tried again, back the other way, up to 3 times.
     sim = start_sim(sim_speed=1.0)
-    start = sim.joint_states.latest()
-    goal = start + np.array([0.5, 2.5, 0.3, -0.3, 1.0, 1.0, 2.5])
-    handle = sim.follow(trajectory(start, goal, 4.0))
-    # Cancel once the arm is well on its way (fast), far from both ends of the move.
-    wait_for(lambda: sim.joint_states.latest()[1] > start[1] + 0.5, what="the arm to get going")
-    assert handle.cancel()
-    result = handle.result(10.0)
-    assert result.status == STATUS_CANCELED
-    match = re.search(r"canceled at sim time ([0-9.]+) s", result.result.error_string)
-    assert match, result.result.error_string
-    canceled_at = float(match.group(1))
-    sim.joint_states.wait_until(canceled_at + 0.6)
-    stamps, positions = sim.joint_states.history()
-    with sim.joint_states.lock:
-        speeds = np.abs(np.array(sim.joint_states.velocities))  # every joint, the gripper's too
-    at_cancel = int(np.searchsorted(stamps, canceled_at))
-    assert speeds[at_cancel].max() > 0.5, "the arm was not moving fast when cancelled"
+    delta = np.array([0.5, 2.5, 0.3, -0.3, 1.0, 1.0, 2.5])
+    seen = []
+    for attempt in range(3):
+        start = sim.joint_states.latest()
+        goal = start + delta * (1 if attempt % 2 == 0 else -1)
+        handle = sim.follow(trajectory(start, goal, 4.0))
+        # Cancel once the arm is well on its way (fast), far from both ends of the move.
+        wait_for(
+            lambda start=start, goal=goal: abs(sim.joint_states.latest()[1] - start[1]) > 0.5,
+            what="the arm to get going",
+        )
+        triggered_at = sim.joint_states.latest_stamp()
+        assert handle.cancel()
+        result = handle.result(10.0)
+        assert result.status == STATUS_CANCELED
+        match = re.search(r"canceled at sim time ([0-9.]+) s", result.result.error_string)
+        assert match, result.result.error_string
+        canceled_at = float(match.group(1))
+        sim.joint_states.wait_until(canceled_at + 0.6)
+        stamps, positions = sim.joint_states.history()
+        with sim.joint_states.lock:
+            speeds = np.abs(np.array(sim.joint_states.velocities[: len(stamps)]))  # the gripper's too
+        # The last state the driver reported before it took the cancel (the first one after may show
+        # the stop already).
+        at_cancel = int(np.searchsorted(stamps, canceled_at, side="left")) - 1
+        around = range(max(0, at_cancel - 3), min(len(stamps), at_cancel + 5))
+        seen.append(
+            f"attempt {attempt + 1}: seen under way at sim time {triggered_at:.4f} s, cancel taken at "
+            f"{canceled_at:.4f} s\n"
+            + "\n".join(
+                f"  {stamps[i]:.4f} s  fastest joint {speeds[i].max():.3f} rad/s"
+                + ("  <- last before the cancel" if i == at_cancel else "")
+                for i in around
+            )
+        )
+        if at_cancel >= 0 and speeds[at_cancel].max() > 0.5:
+            break
+    else:
+        raise AssertionError("no cancel went in while the arm moved fast:\n" + "\n".join(seen))
     after_50ms = int(np.searchsorted(stamps, canceled_at + 0.05))
     # From 50 ms after the cancel on, the robot is still: no joint faster than 0.01 rad/s (m/s) ...
-    assert speeds[after_50ms:].max() < 0.01
+    assert speeds[after_50ms:].max() < 0.01, seen[-1]
     assert np.abs(positions[after_50ms:] - positions[after_50ms]).max() < 1e-3
     # ... and the arm stopped close to where it was, far from where it was heading.
     assert np.abs(positions[after_50ms] - positions[at_cancel]).max() < 0.1
