@@ -61,6 +61,8 @@ class ObjectiveLibrary:
     errors: list[ObjectiveError] = field(default_factory=list)
     notices: list[str] = field(default_factory=list)
     resolved: ResolvedConfig | None = None
+    # file -> when it was first read: files() registers them in this order
+    _load_order: dict[Path, int] = field(default_factory=dict, repr=False)
 
     @classmethod
     def load(cls, resolved: ResolvedConfig) -> ObjectiveLibrary:
@@ -128,8 +130,15 @@ class ObjectiveLibrary:
         return sorted(self.objectives.values(), key=lambda info: info.id.lower())
 
     def files(self) -> list[Path]:
-        """The files that define at least one winning objective, in load order."""
-        return list(dict.fromkeys(info.file for info in self.objectives.values()))
+        """The files that define at least one winning objective, in load order (least-derived first).
+
+        Registering them in this order lets each file's trees replace those of the files before it, so a
+        BehaviorTree factory ends up with every winning definition even when a parent's file that still
+        wins for another objective also defines one its child overrides.
+        """
+        winning = dict.fromkeys(info.file for info in self.objectives.values())
+        order = self._load_order
+        return sorted(winning, key=lambda path: order.get(path, len(order)))
 
     def own_library(self) -> LibraryPath:
         """The first library folder owned by the most-derived config package (where saves go).
@@ -249,6 +258,7 @@ class ObjectiveLibrary:
             self.errors.append(error)
             return []
         self.notices.extend(parsed.warnings)
+        self._load_order.setdefault(path, len(self._load_order))
         for info in parsed.objectives:
             info.package = package
             previous = self.objectives.get(info.id)

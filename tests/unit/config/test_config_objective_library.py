@@ -319,3 +319,22 @@ def test_favorite_rules_are_noted(ws):
     library = ObjectiveLibrary.load(resolve_config("robot", Workspace.discover(ws.root)))
     assert any("'Hidden Helper' is a favorite but not runnable" in n for n in library.notices)
     assert any("package robot has 10 favorite objectives" in n for n in library.notices)
+
+
+def test_a_factory_loaded_from_the_library_runs_the_child_s_version_of_an_overridden_objective(ws):
+    # The parent's file still wins for "Helper", so it is loaded too; it also defines "Pick", which the
+    # child overrides: the child's file must be registered after it (a factory keeps the last definition).
+    from kinema.bt import BehaviorTreeFactory
+
+    ws.config("base")
+    ws.child("cell", "base")
+    helper = '  <BehaviorTree ID="Helper"><AlwaysSuccess/></BehaviorTree>\n'
+    base_file = ws.objective("base", "Pick", body=helper, _description="base pick")
+    cell_file = ws.objective("cell", "Pick", _description="cell pick")
+    library = ObjectiveLibrary.load(resolve_config("cell", Workspace.discover(ws.root)))
+    assert library.get("Pick").file == cell_file and library.get("Helper").file == base_file
+    factory = BehaviorTreeFactory()
+    for path in library.files():
+        factory.register_behavior_tree_from_file(path)
+    for objective_id, info in library.objectives.items():
+        assert factory.tree_definition(objective_id).filename == str(info.file), objective_id
