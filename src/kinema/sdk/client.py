@@ -20,6 +20,7 @@ no runtime answers within the client's ``timeout``.
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any, Literal, overload
 
@@ -391,29 +392,9 @@ class ObjectiveClient:
         previous and new status). Decoded from ``/objective_server/node_status`` with the run's
         node table (``/objective_server/node_table``), see :class:`~kinema.sdk.streams.NodeStatusDecoder`.
         """
-        decoder = NodeStatusDecoder()
-
-        def subscribe(push: Any) -> _Subscriptions:
-            def on_table(message: Any) -> None:
-                for ready in decoder.on_table(message):
-                    push(ready)
-
-            def on_codes(message: Any) -> None:
-                decoded = decoder.on_codes(message)
-                if decoded is not None:
-                    push(decoded)
-
-            tables = self.node.create_subscription(
-                names.NODE_TABLE_TYPE, names.NODE_TABLE, on_table, latched=True
-            )
-            try:
-                codes = self.node.create_subscription(names.NODE_STATUS_TYPE, names.NODE_STATUS, on_codes)
-            except BaseException:
-                tables.close()
-                raise
-            return _Subscriptions(tables, codes)
-
-        return MessageStream(subscribe, lambda batch: batch, timeout=timeout)
+        return MessageStream(
+            lambda push: NodeStatusSubscription(self.node, push), lambda batch: batch, timeout=timeout
+        )
 
     # -- lifecycle -----------------------------------------------------------------------------------
 
@@ -439,12 +420,71 @@ def _xml_name(xml: str) -> str:
     return xml_objective_name(xml)
 
 
-class _Subscriptions:
-    """Several subscriptions closed as one."""
+class NodeStatusSubscription:
+    """Both node status topics of a runtime, decoded: ``on_changes(NodeStatusChanges)`` per message.
 
-    def __init__(self, *subscriptions: Any) -> None:
-        self._subscriptions = subscriptions
+    The node table of a run is one latched message. When changes name a table that has not arrived (a
+    large table can be dropped on a congested link, as any message can), the table topic is subscribed
+    again, which reads the runtime's latched copy; at most once a second, from a thread of its own.
+    """
+
+    REFETCH_AFTER_S = 1.0
+
+    def __init__(self, node: Any, on_changes: Any) -> None:
+        self._node = node
+        self._on_changes = on_changes
+        self.decoder = NodeStatusDecoder()
+        self._lock = threading.Lock()
+        self._closed = False
+        self._refetching = False
+        self._last_refetch = 0.0
+        self._tables = node.create_subscription(
+            names.NODE_TABLE_TYPE, names.NODE_TABLE, self._on_table, latched=True
+        )
+        try:
+            self._codes = node.create_subscription(names.NODE_STATUS_TYPE, names.NODE_STATUS, self._on_codes)
+        except BaseException:
+            self._tables.close()
+            raise
+
+    def _on_table(self, message: Any) -> None:
+        for ready in self.decoder.on_table(message):
+            self._on_changes(ready)
+
+    def _on_codes(self, message: Any) -> None:
+        decoded = self.decoder.on_codes(message)
+        if decoded is not None:
+            self._on_changes(decoded)
+            return
+        now = time.monotonic()
+        with self._lock:
+            if self._closed or self._refetching or now - self._last_refetch < self.REFETCH_AFTER_S:
+                return
+            self._refetching = True
+            self._last_refetch = now
+        threading.Thread(target=self._refetch, name="kinema-node-table", daemon=True).start()
+
+    def _refetch(self) -> None:
+        try:
+            fresh = self._node.create_subscription(
+                names.NODE_TABLE_TYPE, names.NODE_TABLE, self._on_table, latched=True
+            )
+        except Exception:
+            fresh = None  # the node is closing; the next changes try again
+        with self._lock:
+            self._refetching = False
+            if fresh is None:
+                return
+            if self._closed:
+                old = fresh
+            else:
+                old, self._tables = self._tables, fresh
+        old.close()
 
     def close(self) -> None:
-        for subscription in self._subscriptions:
-            subscription.close()
+        """Unsubscribe both topics."""
+        with self._lock:
+            self._closed = True
+            tables = self._tables
+        self._codes.close()
+        tables.close()

@@ -260,8 +260,12 @@ class NodeStatusDecoder:
             self._tables[int(message.table_id)] = table
             while len(self._tables) > self.KEEP_TABLES:
                 del self._tables[next(iter(self._tables))]
-            ready = [waiting for waiting in self._waiting if int(waiting.table_id) == int(message.table_id)]
-            self._waiting = [waiting for waiting in self._waiting if waiting not in ready]
+            # Split by table id (messages hold arrays: they cannot be compared with ==).
+            ready: list[Any] = []
+            still: list[Any] = []
+            for waiting in self._waiting:
+                (ready if int(waiting.table_id) == int(message.table_id) else still).append(waiting)
+            self._waiting = still
         return [self._decode(waiting, table) for waiting in ready]
 
     def on_codes(self, message: Any) -> NodeStatusChanges | None:

@@ -79,7 +79,13 @@ def _convert_base(base: str, value: Any, where: str) -> Any:
             return bool(value)
     elif base in _INTEGERS:
         if isinstance(value, int | np.integer) and not isinstance(value, bool):
-            return int(value)
+            number = int(value)
+            info = np.iinfo(_NUMPY_DTYPES[base])
+            if not int(info.min) <= number <= int(info.max):
+                raise TransportError(
+                    f"{_at(where)}{number} does not fit in {base} ({int(info.min)}..{int(info.max)})"
+                )
+            return number
     elif base in _FLOATS:
         if isinstance(value, int | float | np.integer | np.floating) and not isinstance(value, bool):
             return float(value)

@@ -20,7 +20,6 @@ from typing import TYPE_CHECKING, Any
 from xml.sax.saxutils import quoteattr
 
 from kinema.errors import KinemaError, ObjectiveError, TransportError
-from kinema.sdk.streams import NodeStatusChanges, NodeStatusDecoder
 from kinema.tui.connection import (
     ApprovalRequested,
     BehaviorSummary,
@@ -51,6 +50,7 @@ from kinema.tui.connection import (
 if TYPE_CHECKING:
     from kinema.config import ResolvedConfig, Workspace
     from kinema.sdk import ObjectiveClient
+    from kinema.sdk.streams import NodeStatusChanges
 
 log = logging.getLogger("kinema.tui")
 
@@ -118,7 +118,6 @@ class SdkConnection:
         self._config = config
         self._heartbeat_timeout = heartbeat_timeout
         self._listener: EventListener | None = None
-        self._node_decoder = NodeStatusDecoder()
         self._client: ObjectiveClient | None = None
         self._service_clients: dict[str, Any] = {}
         self._lock = threading.Lock()
@@ -210,9 +209,9 @@ class SdkConnection:
     def _connect(self) -> None:
         from kinema.runtime import names
         from kinema.sdk import ObjectiveClient
+        from kinema.sdk.client import NodeStatusSubscription
 
         client = ObjectiveClient(self._endpoint, timeout=CALL_TIMEOUT_S)
-        self._node_decoder = NodeStatusDecoder()  # a restarted runtime numbers its tables anew
         # Published before subscribing: the latched heartbeat can arrive while subscribing, and a
         # screen that sees "connected" must find a client to call.
         with self._lock:
@@ -222,10 +221,7 @@ class SdkConnection:
         try:
             node.create_subscription(names.HEARTBEAT_TYPE, names.HEARTBEAT, self._on_heartbeat, latched=True)
             node.create_subscription(names.HEALTH_TYPE, names.HEALTH, self._on_health, latched=True)
-            node.create_subscription(
-                names.NODE_TABLE_TYPE, names.NODE_TABLE, self._on_node_table, latched=True
-            )
-            node.create_subscription(names.NODE_STATUS_TYPE, names.NODE_STATUS, self._on_node_status)
+            NodeStatusSubscription(node, self._emit_node_changes)  # closed with the client's node
             node.create_subscription(
                 names.BLACKBOARD_TYPE, names.BLACKBOARD, self._on_blackboard, latched=True
             )
@@ -313,15 +309,6 @@ class SdkConnection:
 
     def _on_health(self, message: Any) -> None:
         self._warnings = tuple(str(warning) for warning in message.warnings)
-
-    def _on_node_table(self, message: Any) -> None:
-        for batch in self._node_decoder.on_table(message):
-            self._emit_node_changes(batch)
-
-    def _on_node_status(self, message: Any) -> None:
-        batch = self._node_decoder.on_codes(message)
-        if batch is not None:
-            self._emit_node_changes(batch)
 
     def _emit_node_changes(self, batch: NodeStatusChanges) -> None:
         updates = tuple(

@@ -135,10 +135,12 @@ def test_a_subscriber_decodes_the_wire_messages_to_the_same_changes() -> None:
         return registry.deserialize(registry.serialize(message, type_name), type_name)
 
     decoder = NodeStatusDecoder()
-    # The first part arrives before the (latched) table: it waits for it, in order.
+    # The first two parts arrive before the (latched) table: they wait for it, in order.
     assert decoder.on_codes(wire(codes_messages[0], names.NODE_STATUS_TYPE)) is None
+    assert decoder.on_codes(wire(codes_messages[1], names.NODE_STATUS_TYPE)) is None
     decoded = decoder.on_table(wire(table_message, names.NODE_TABLE_TYPE))
-    for message in codes_messages[1:]:
+    assert len(decoded) == 2
+    for message in codes_messages[2:]:
         part = decoder.on_codes(wire(message, names.NODE_STATUS_TYPE))
         assert part is not None
         decoded.append(part)
@@ -149,3 +151,57 @@ def test_a_subscriber_decodes_the_wire_messages_to_the_same_changes() -> None:
         (c.uid, c.node_path, c.node_id, c.node_name, c.previous, c.status) for c in want
     ]
     assert all(abs(g.stamp - w.timestamp) < 1e-6 for g, w in zip(got, want, strict=True))
+
+
+def test_a_subscriber_whose_table_was_dropped_reads_the_latched_copy_again() -> None:
+    import threading
+    import time
+    from types import SimpleNamespace
+
+    from kinema.runtime import names
+    from kinema.sdk.client import NodeStatusSubscription
+
+    tree = BehaviorTreeFactory().create_tree_from_text(XML)
+    recorder = NodeStatusRecorder()
+    recorder.attach(tree)
+    tree.tick_once()
+    batch = recorder.take()
+    assert batch is not None
+    table = batch.table
+    table_message = SimpleNamespace(
+        objective_name="Demo",
+        table_id=table.id,
+        uids=table.uids,
+        node_paths=table.paths,
+        node_ids=table.node_ids,
+        node_names=table.names,
+    )
+    codes_message = SimpleNamespace(
+        objective_name="Demo",
+        table_id=table.id,
+        stamps=[SimpleNamespace(sec=1, nanosec=0)],
+        starts=[0],
+        codes=batch.codes,
+    )
+    subscribed: list[tuple[str, Any]] = []
+    closed: list[str] = []
+
+    class Node:
+        # The live table message is lost; a new latched subscription reads the publisher's cached copy.
+        def create_subscription(self, _type: str, topic: str, callback: Any, latched: bool = False) -> Any:
+            subscribed.append((topic, callback))
+            if topic == names.NODE_TABLE and sum(t == names.NODE_TABLE for t, _ in subscribed) > 1:
+                threading.Thread(target=callback, args=(table_message,)).start()
+            return SimpleNamespace(close=lambda: closed.append(topic))
+
+    got: list[Any] = []
+    subscription = NodeStatusSubscription(Node(), got.append)
+    on_codes = next(callback for topic, callback in subscribed if topic == names.NODE_STATUS)
+    on_codes(codes_message)  # no table yet: it waits, and the table is read again
+    deadline = time.monotonic() + 10
+    while not got and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert got and [c.node_path for c in got[0].changes] == [c.node_path for c in batch]
+    assert [t for t, _ in subscribed].count(names.NODE_TABLE) == 2
+    assert closed == [names.NODE_TABLE]  # the first table subscription was replaced
+    subscription.close()

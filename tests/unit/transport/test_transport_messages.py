@@ -87,3 +87,17 @@ def test_cdr_has_the_encapsulation_header() -> None:
     cancel = "moveit_studio_sdk_msgs/srv/CancelObjective_Request"
     empty = registry.serialize(from_dict(cancel), cancel)
     assert empty == bytes.fromhex("0001000000")  # an empty struct carries one dummy byte
+
+
+def test_a_numpy_array_that_fits_the_field_is_taken_whole_and_one_that_does_not_is_checked() -> None:
+    codes = np.arange(5, dtype=np.uint32)
+    message = msg("kinema_msgs/msg/NodeStatusCodes", codes=codes)
+    assert message.codes.dtype == np.uint32 and message.codes.tolist() == [0, 1, 2, 3, 4]
+    widened = msg("kinema_msgs/msg/NodeStatusCodes", starts=np.array([1, 2], dtype=np.uint16))
+    assert widened.starts.dtype == np.uint32 and widened.starts.tolist() == [1, 2]
+    # int64 into uint32 is not a safe cast: each value is checked as a list's would be
+    assert msg("kinema_msgs/msg/NodeStatusCodes", codes=np.array([7, 8])).codes.tolist() == [7, 8]
+    with pytest.raises(TransportError):
+        msg("kinema_msgs/msg/NodeStatusCodes", codes=np.array([-1]))
+    with pytest.raises(TransportError):
+        msg("kinema_msgs/msg/NodeStatusCodes", codes=np.zeros((2, 2), dtype=np.uint32))
