@@ -199,7 +199,8 @@ def test_a_subscriber_whose_table_was_dropped_reads_the_latched_copy_again() -> 
     on_codes = next(callback for topic, callback in subscribed if topic == names.NODE_STATUS)
     on_codes(codes_message)  # no table yet: it waits, and the table is read again
     deadline = time.monotonic() + 10
-    while not got and time.monotonic() < deadline:
+    # the table can arrive before the old subscription is closed: wait for both
+    while not (got and closed) and time.monotonic() < deadline:
         time.sleep(0.01)
     assert got and [c.node_path for c in got[0].changes] == [c.node_path for c in batch]
     assert [t for t, _ in subscribed].count(names.NODE_TABLE) == 2
