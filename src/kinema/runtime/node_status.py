@@ -140,7 +140,7 @@ class NodeStatusBatch(Sequence[NodeStatusChange]):
     Indexing or iterating it gives :class:`NodeStatusChange` objects (decoded on first use).
     """
 
-    __slots__ = ("_array", "_decoded", "codes", "stamps", "starts", "table")
+    __slots__ = ("_array", "_columns", "_decoded", "codes", "stamps", "starts", "table")
 
     def __init__(self, table: NodeTable, stamps: list[float], starts: list[int], codes: list[int]) -> None:
         self.table = table
@@ -149,6 +149,7 @@ class NodeStatusBatch(Sequence[NodeStatusChange]):
         self.codes = codes
         self._array: array.array | None = None
         self._decoded: list[NodeStatusChange] | None = None
+        self._columns: tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray] | None = None
 
     def __len__(self) -> int:
         return len(self.codes)
@@ -186,7 +187,13 @@ class NodeStatusBatch(Sequence[NodeStatusChange]):
         return np.frombuffer(self._array, dtype=np.uint32)
 
     def columns(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-        """``(timestamps, uids, previous, status)``, one element per change, as numpy arrays."""
+        """``(timestamps, uids, previous, status)``, one element per change, as numpy arrays (computed once:
+        Groot2 and the recording both read them; shared, do not modify)."""
+        if self._columns is None:
+            self._columns = self._compute_columns()
+        return self._columns
+
+    def _compute_columns(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         codes = self.code_array()
         counts = np.diff(np.append(np.asarray(self.starts, dtype=np.int64), len(codes)))
         times = np.repeat(np.asarray(self.stamps, dtype=np.float64), counts)

@@ -136,17 +136,9 @@ class RunRecorder:
         if writer is None:
             return
         was_truncated = writer.truncated
-        codes = changes.code_array()
-        uids = changes.table.uid_array[codes // 25]
-        statuses = codes % 5
-        stamps = changes.stamps
-        if len(stamps) == 1:
-            offsets: Any = round((stamps[0] - self._t0) * 1e6)
-        else:
-            times = np.repeat(np.asarray(stamps), np.diff([*changes.starts, len(codes)]))
-            offsets = np.rint((times - self._t0) * 1e6)
+        times, uids, _previous, statuses = changes.columns()
         try:
-            writer.write_packed(pack_transition_columns(offsets, uids, statuses))
+            writer.write_packed(pack_transition_columns(np.rint((times - self._t0) * 1e6), uids, statuses))
         except OSError as error:
             log.warning("recording %s stopped: %s", writer.path, error)
             self._close_writer()
