@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import asyncio
 import concurrent.futures
+import threading
 from typing import TYPE_CHECKING, Any, ClassVar, Generic
 
 from kinema.behaviors.asynchronous import AsyncBehavior
@@ -52,7 +53,9 @@ class ActionClientBehavior(AsyncBehavior, Generic[GoalT, ResultT, FeedbackT]):
     def process_feedback(self, feedback: FeedbackT) -> None:
         """Follow progress (e.g. ``set_output`` or a toast); default: ignore it.
 
-        Called on a transport thread for each feedback message while the goal runs. Must not block.
+        Called on a transport thread for each feedback message while the goal runs. Must not block. Feedback
+        that reaches the client after the result is dropped, and a call in progress ends before
+        :meth:`process_result` starts, so progress is never reported after the outcome.
         """
 
     def process_result(self, result: GoalResult[ResultT]) -> bool:
@@ -84,13 +87,29 @@ class ActionClientBehavior(AsyncBehavior, Generic[GoalT, ResultT, FeedbackT]):
         name = self.get_action_name()
         goal = self.create_goal()
         client = self.context.action_client(node, self.action_type, name)
+        loop = asyncio.get_running_loop()
+        finished: asyncio.Future[None] = loop.create_future()
         feedback_errors: list[BaseException] = []
+        # Feedback travels apart from the result and can be dispatched after it: once the result is in,
+        # late feedback is dropped, so process_feedback never reports progress after the outcome. The lock
+        # also lets a feedback call in progress finish before the result is processed.
+        feedback_lock = threading.Lock()
+        result_in = False
 
         def on_feedback(feedback: Any) -> None:
-            try:
-                self.process_feedback(feedback)
-            except Exception as error:
-                feedback_errors.append(error)
+            with feedback_lock:
+                if result_in:
+                    return
+                try:
+                    self.process_feedback(feedback)
+                except Exception as error:
+                    feedback_errors.append(error)
+
+        def on_done(_handle: Any) -> None:
+            nonlocal result_in
+            with feedback_lock:
+                result_in = True
+            loop.call_soon_threadsafe(_resolve, finished)
 
         sending = RUNNER.run_function(lambda: client.send_goal(goal, on_feedback, timeout=10.0))
         try:
@@ -106,9 +125,7 @@ class ActionClientBehavior(AsyncBehavior, Generic[GoalT, ResultT, FeedbackT]):
             self.logger.publish_failure(f"The goal was rejected by {name}")
             return False
         self._goal_handle = handle
-        loop = asyncio.get_running_loop()
-        finished: asyncio.Future[None] = loop.create_future()
-        handle.add_done_callback(lambda _h: loop.call_soon_threadsafe(_resolve, finished))
+        handle.add_done_callback(on_done)
         try:
             await asyncio.wait_for(finished, self.get_result_timeout())
         except TimeoutError:

@@ -124,6 +124,49 @@ def test_an_action_client_typed_by_its_interface_classes_gets_typed_feedback_and
     assert (run.status, run.outputs["sequence"]) == (NodeStatus.SUCCESS, [0, 1, 1, 2])
 
 
+def test_feedback_that_arrives_after_the_result_is_not_processed(node: Any, monkeypatch) -> None:
+    # Feedback travels apart from the result and can be dispatched after it (a loaded machine showed it: the
+    # generated action client's last toast was its progress, not its result). Hold the last feedback until
+    # the result is being processed, then deliver it: the behavior must not report progress after that.
+    from kinema.transport.action import ClientGoalHandle
+
+    first_delivered, result_started, late_delivered = threading.Event(), threading.Event(), threading.Event()
+    deliver = ClientGoalHandle._on_feedback
+
+    def held(handle: Any, feedback: Any) -> None:
+        if list(feedback.sequence) == [99]:
+            result_started.wait(10.0)
+            deliver(handle, feedback)
+            late_delivered.set()
+        else:
+            deliver(handle, feedback)
+            first_delivered.set()
+
+    monkeypatch.setattr(ClientGoalHandle, "_on_feedback", held)
+    seen: list[str] = []
+
+    class Following(Fibonacci):
+        def process_feedback(self, feedback: Any) -> None:
+            seen.append(f"feedback {list(map(int, feedback.sequence))}")
+
+        def process_result(self, result: Any) -> bool:
+            seen.append("result")
+            result_started.set()
+            assert late_delivered.wait(10.0), "the held feedback never reached the client"
+            return super().process_result(result)
+
+    def execute(handle: Any) -> None:
+        handle.publish_feedback({"sequence": [0]})
+        first_delivered.wait(10.0)  # feedback that comes before the result is processed
+        handle.publish_feedback({"sequence": [99]})
+        handle.succeed({"sequence": [0, 1]})
+
+    node.create_action_server("example_interfaces/action/Fibonacci", "/fibonacci", execute)
+    run = tick_behavior(Following, {"order": 2}, node=node)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    assert seen == ["feedback [0]", "result"]
+
+
 def test_a_rejected_goal_fails_with_a_toast(node: Any) -> None:
     _Server(node, accept=False)
     run = tick_behavior(Fibonacci, node=node)
