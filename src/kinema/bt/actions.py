@@ -15,6 +15,7 @@ from kinema.bt.node import (
     StatefulActionNode,
     SyncActionNode,
     TreeNode,
+    inlines_tick,
     script_bool,
 )
 from kinema.bt.ports import PortInfo, bidirectional_port, blackboard_pointer, input_port
@@ -30,6 +31,7 @@ class _ConstantNode(SyncActionNode):
     def tick(self) -> NodeStatus:
         return self._result
 
+    @inlines_tick
     def execute_tick(self) -> NodeStatus:
         # Same semantics as TreeNode.execute_tick without the call to tick(): these leaves are
         # the bulk of large trees, so one call less per node is measurable.
@@ -133,6 +135,7 @@ class ScriptNode(_ScriptCode, SyncActionNode):
             script.run(config.blackboard, config.enums)
         return SUCCESS
 
+    @inlines_tick
     def execute_tick(self) -> NodeStatus:
         # TreeNode.execute_tick fused with tick() for literal code on a node without conditions
         # or callbacks (nearly every Script): one call less per tick, same status and errors.
@@ -193,6 +196,7 @@ class ScriptConditionNode(_ScriptCode, ConditionNode):
             return SUCCESS if value != 0.0 else FAILURE
         return SUCCESS if script_bool(value) else FAILURE
 
+    @inlines_tick
     def execute_tick(self) -> NodeStatus:
         # TreeNode.execute_tick fused with tick() for literal code on a node without conditions
         # or callbacks: one call less per tick, same status and errors.

@@ -3,8 +3,15 @@
 from __future__ import annotations
 
 from kinema.bt.conversions import FLT_EPSILON, parse_double_full, parse_int_full
-from kinema.bt.errors import BTLogicError, BTRuntimeError
-from kinema.bt.node import ControlNode, NodeConfig, PortError, _set_status_unchecked
+from kinema.bt.errors import BTLogicError, BTRuntimeError, NodeExecutionError
+from kinema.bt.node import (
+    ControlNode,
+    NodeConfig,
+    PortError,
+    _set_status_unchecked,
+    _store_status,
+    inlines_tick,
+)
 from kinema.bt.ports import PortInfo, input_port
 from kinema.bt.status import FAILURE, IDLE, RUNNING, SKIPPED, SUCCESS, NodeStatus
 
@@ -39,43 +46,68 @@ class SequenceNode(_ResumingControl):
     _asynch = False
 
     def tick(self) -> NodeStatus:
-        children = self.children
-        n = len(children)
-        if self._status is not RUNNING:
-            if self._status is IDLE:
-                self._skipped = 0
-            if self._watched:
-                _set_status_unchecked(self, RUNNING)
+        return SequenceNode.execute_tick(self, False)  # plain=False: the caller stores the status
+
+    @inlines_tick
+    def execute_tick(self, plain: bool = True) -> NodeStatus:
+        # Fused with TreeNode.execute_tick (one Python frame per Sequence instead of two); tick(), the
+        # hooked path's entry, runs the same body with plain=False, which leaves the status to it.
+        if plain and self._hooked:
+            return self._execute_tick_hooked()
+        try:
+            children = self.children
+            n = len(children)
+            if self._status is not RUNNING:
+                if self._status is IDLE:
+                    self._skipped = 0
+                if self._watched:
+                    _set_status_unchecked(self, RUNNING)
+                else:
+                    self._status = RUNNING
+            idx = self._idx
+            if self._asynch:
+                status = self._tick_async(children, n, idx)
             else:
-                self._status = RUNNING
-        idx = self._idx
-        if self._asynch:
-            return self._tick_async(children, n, idx)
-        # The plain Sequence's hot loop (the async one is the same plus a yield after each success).
-        for child in children if idx == 0 else children[idx:]:
-            try:
-                status = child.execute_tick()
-            except BaseException:
-                # BT.CPP advances its member index in place: an exception that escapes a child
-                # leaves it on that child, and the next tick resumes there.
-                self._idx = idx
-                raise
-            if status is SUCCESS:
-                idx += 1
-            elif status is RUNNING:
-                self._idx = idx
-                return RUNNING
-            elif status is FAILURE:
-                self.reset_children()
-                self._idx = 0
-                return FAILURE
-            elif status is SKIPPED:
-                idx += 1
-                self._skipped += 1
-            else:
-                self._idx = idx
-                raise _idle_child(self)
-        return self._finish(n)
+                # The plain Sequence's hot loop (the async one is the same plus a yield after each success).
+                for child in children if idx == 0 else children[idx:]:
+                    try:
+                        status = child.execute_tick()
+                    except BaseException:
+                        # BT.CPP advances its member index in place: an exception that escapes a child
+                        # leaves it on that child, and the next tick resumes there.
+                        self._idx = idx
+                        raise
+                    if status is SUCCESS:
+                        idx += 1
+                    elif status is RUNNING:
+                        self._idx = idx
+                        break
+                    elif status is FAILURE:
+                        self.reset_children()
+                        self._idx = 0
+                        break
+                    elif status is SKIPPED:
+                        idx += 1
+                        self._skipped += 1
+                    else:
+                        self._idx = idx
+                        raise _idle_child(self)
+                else:
+                    status = self._finish(n)
+        except NodeExecutionError:
+            raise
+        except Exception as error:
+            raise self._wrap_exception(error) from error
+        if plain:
+            prev = self._status
+            if status is not prev:
+                if (status is SUCCESS or status is FAILURE) and not self._watched:
+                    self._status = status
+                else:
+                    _store_status(self, prev, status)
+            elif status is IDLE:
+                self._set_status(status)
+        return status
 
     def _tick_async(self, children: list, n: int, idx: int) -> NodeStatus:
         while idx < n:
@@ -176,43 +208,67 @@ class FallbackNode(_ResumingControl):
     _asynch = False
 
     def tick(self) -> NodeStatus:
-        children = self.children
-        n = len(children)
-        if self._status is not RUNNING:
-            if self._status is IDLE:
-                self._skipped = 0
-            if self._watched:
-                _set_status_unchecked(self, RUNNING)
+        return FallbackNode.execute_tick(self, False)  # plain=False: the caller stores the status
+
+    @inlines_tick
+    def execute_tick(self, plain: bool = True) -> NodeStatus:
+        # Fused with TreeNode.execute_tick, as SequenceNode's.
+        if plain and self._hooked:
+            return self._execute_tick_hooked()
+        try:
+            children = self.children
+            n = len(children)
+            if self._status is not RUNNING:
+                if self._status is IDLE:
+                    self._skipped = 0
+                if self._watched:
+                    _set_status_unchecked(self, RUNNING)
+                else:
+                    self._status = RUNNING
+            idx = self._idx
+            if self._asynch:
+                status = self._tick_async(children, n, idx)
             else:
-                self._status = RUNNING
-        idx = self._idx
-        if self._asynch:
-            return self._tick_async(children, n, idx)
-        # The plain Fallback's hot loop (the async one is the same plus a yield after each failure).
-        for child in children if idx == 0 else children[idx:]:
-            try:
-                status = child.execute_tick()
-            except BaseException:
-                # BT.CPP advances its member index in place: an exception that escapes a child
-                # leaves it on that child, and the next tick resumes there.
-                self._idx = idx
-                raise
-            if status is FAILURE:
-                idx += 1
-            elif status is RUNNING:
-                self._idx = idx
-                return RUNNING
-            elif status is SUCCESS:
-                self.reset_children()
-                self._idx = 0
-                return SUCCESS
-            elif status is SKIPPED:
-                idx += 1
-                self._skipped += 1
-            else:
-                self._idx = idx
-                raise _idle_child(self)
-        return self._finish(n)
+                # The plain Fallback's hot loop (the async one is the same plus a yield after each failure).
+                for child in children if idx == 0 else children[idx:]:
+                    try:
+                        status = child.execute_tick()
+                    except BaseException:
+                        # BT.CPP advances its member index in place: an exception that escapes a child
+                        # leaves it on that child, and the next tick resumes there.
+                        self._idx = idx
+                        raise
+                    if status is FAILURE:
+                        idx += 1
+                    elif status is RUNNING:
+                        self._idx = idx
+                        break
+                    elif status is SUCCESS:
+                        self.reset_children()
+                        self._idx = 0
+                        break
+                    elif status is SKIPPED:
+                        idx += 1
+                        self._skipped += 1
+                    else:
+                        self._idx = idx
+                        raise _idle_child(self)
+                else:
+                    status = self._finish(n)
+        except NodeExecutionError:
+            raise
+        except Exception as error:
+            raise self._wrap_exception(error) from error
+        if plain:
+            prev = self._status
+            if status is not prev:
+                if (status is SUCCESS or status is FAILURE) and not self._watched:
+                    self._status = status
+                else:
+                    _store_status(self, prev, status)
+            elif status is IDLE:
+                self._set_status(status)
+        return status
 
     def _tick_async(self, children: list, n: int, idx: int) -> NodeStatus:
         while idx < n:
@@ -275,46 +331,69 @@ class ReactiveSequenceNode(_RunningChildControl):
     """Re-ticks every child from the first on every tick; a RUNNING child halts all the others."""
 
     def tick(self) -> NodeStatus:
-        all_skipped = True
-        prev = self._status
-        if prev is not RUNNING:
-            if prev is IDLE:
-                self._running_child = -1
-            if self._watched:
-                _set_status_unchecked(self, RUNNING)
-            else:
-                self._status = RUNNING
-        children = self.children
-        index = -1
-        for child in children:
-            index += 1
-            status = child.execute_tick()
-            if status is SUCCESS:
+        return ReactiveSequenceNode.execute_tick(self, False)  # plain=False: the caller stores the status
+
+    @inlines_tick
+    def execute_tick(self, plain: bool = True) -> NodeStatus:
+        # Fused with TreeNode.execute_tick, as SequenceNode's.
+        if plain and self._hooked:
+            return self._execute_tick_hooked()
+        try:
+            all_skipped = True
+            prev = self._status
+            if prev is not RUNNING:
+                if prev is IDLE:
+                    self._running_child = -1
+                if self._watched:
+                    _set_status_unchecked(self, RUNNING)
+                else:
+                    self._status = RUNNING
+            children = self.children
+            index = -1
+            for child in children:
+                index += 1
+                status = child.execute_tick()
+                if status is SUCCESS:
+                    all_skipped = False
+                    continue
+                if status is SKIPPED:
+                    self.halt_child(index)
+                    continue
                 all_skipped = False
-                continue
-            if status is SKIPPED:
-                self.halt_child(index)
-                continue
-            all_skipped = False
-            if status is RUNNING:
-                for i in range(len(children)):
-                    if i != index:
-                        self.halt_child(i)
-                if self._running_child == -1:
-                    self._running_child = index
-                return RUNNING
-            if status is FAILURE:
-                self.reset_children()
-                return FAILURE
-            raise _idle_child(self)
-        # reset_children() inlined: after a pass that succeeded no child is RUNNING
-        for child in children:
-            if child._status is not IDLE:
-                if child._status is RUNNING or child._watched:
+                if status is RUNNING:
+                    for i in range(len(children)):
+                        if i != index:
+                            self.halt_child(i)
+                    if self._running_child == -1:
+                        self._running_child = index
+                    break
+                if status is FAILURE:
                     self.reset_children()
                     break
-                child._status = IDLE
-        return SKIPPED if all_skipped else SUCCESS
+                raise _idle_child(self)
+            else:
+                # reset_children() inlined: after a pass that succeeded no child is RUNNING
+                for child in children:
+                    if child._status is not IDLE:
+                        if child._status is RUNNING or child._watched:
+                            self.reset_children()
+                            break
+                        child._status = IDLE
+                status = SKIPPED if all_skipped else SUCCESS
+        except NodeExecutionError:
+            raise
+        except Exception as error:
+            raise self._wrap_exception(error) from error
+        if plain:
+            prev = self._status
+            if status is not prev:
+                if (status is SUCCESS or status is FAILURE) and not self._watched:
+                    self._status = status
+                else:
+                    _store_status(self, prev, status)
+            elif status is IDLE:
+                self._set_status(status)
+        return status
 
 
 class ReactiveFallbackNode(_RunningChildControl):

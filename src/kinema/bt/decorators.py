@@ -8,7 +8,14 @@ from typing import Any
 from kinema.bt.clock import WakeUpTimer
 from kinema.bt.conversions import Unsigned, convert_from_string, list_item_type
 from kinema.bt.errors import BTLogicError, BTRuntimeError, NodeExecutionError, ScriptParseError
-from kinema.bt.node import DecoratorNode, NodeConfig, PortError, _set_status_unchecked, script_bool
+from kinema.bt.node import (
+    DecoratorNode,
+    NodeConfig,
+    PortError,
+    _set_status_unchecked,
+    inlines_tick,
+    script_bool,
+)
 from kinema.bt.ports import PortInfo, bidirectional_port, blackboard_pointer, input_port, output_port
 from kinema.bt.script import Script, parse_script
 from kinema.bt.status import FAILURE, IDLE, RUNNING, SKIPPED, SUCCESS, NodeStatus
@@ -46,6 +53,7 @@ class _ResultMappingDecorator(DecoratorNode):
             return status
         raise _idle_child(self)
 
+    @inlines_tick
     def execute_tick(self) -> NodeStatus:
         # DecoratorNode.execute_tick fused with tick() (one call less per decorator; these and SubTree
         # are the decorators of nearly every tree), same statuses, transitions and errors.
@@ -584,6 +592,7 @@ class SubTreeNode(DecoratorNode):
             self.reset_child()
         return status
 
+    @inlines_tick
     def execute_tick(self) -> NodeStatus:
         # DecoratorNode.execute_tick fused with tick(), as in the result-mapping decorators.
         if self._hooked:

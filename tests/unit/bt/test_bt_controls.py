@@ -319,3 +319,44 @@ def test_navigation_with_recovery(bench) -> None:
     assert tree.tick_once() is S
     assert ticks == Counter({"stuck_1": 3, "compute": 1, "follow": 1, "stuck_2": 1, "backup": 1})
     assert halted == ["follow"]
+
+
+@pytest.mark.parametrize(
+    ("base", "tag"),
+    [
+        ("SequenceNode", "Sequence"),
+        ("FallbackNode", "Fallback"),
+        ("ReactiveSequenceNode", "ReactiveSequence"),
+        ("InverterNode", "Inverter"),
+        ("AlwaysSuccessNode", "AlwaysSuccess"),
+        ("ScriptNode", "Script"),
+    ],
+)
+def test_a_subclass_of_a_built_in_node_that_overrides_tick_runs_its_override(
+    bench, base: str, tag: str
+) -> None:
+    # The built-ins run their own tick() inline on the plain path; a subclass's tick() must still run,
+    # conditions or not.
+    from kinema.bt import actions, controls, decorators
+
+    calls: list[str] = []
+
+    def tick(self) -> NodeStatus:
+        calls.append(self.name)
+        return super(type(self), self).tick()
+
+    counting = type(
+        f"Counting{tag}",
+        (next(getattr(m, base) for m in (actions, controls, decorators) if hasattr(m, base)),),
+        {"tick": tick},
+    )
+    bench.factory.register_node_type(counting, "Counting")
+    bench.action("A", F if tag == "Inverter" else S)
+    body = "" if tag in ("AlwaysSuccess", "Script") else "<A/>"
+    script = ' code="x := 1"' if tag == "Script" else ""
+    tree = bench.tree(
+        f'<Sequence><Counting name="plain"{script}>{body}</Counting>'
+        f'<Counting name="hooked" _post="y := 2"{script}>{body}</Counting></Sequence>'
+    )
+    tree.tick_while_running()
+    assert calls == ["plain", "hooked"]

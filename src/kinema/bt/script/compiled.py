@@ -118,10 +118,12 @@ def _comparison(expr: Comparison) -> Evaluator:
     # range compares with the same result as its double; anything else takes the general path.
     name = lhs_expr.name  # type: ignore[attr-defined]
     floats = _FLOAT_COMPARE[expr.ops[0]]
+    local = name[:1] != "@"
 
     def name_vs_number(bb: Blackboard, enums: dict[str, int] | None) -> Any:
         if not enums or name not in enums:
-            entry = bb.get_entry(name)
+            # get_entry's first step inline: an entry of this scope is the one it would return.
+            entry = (bb._storage.get(name) if local else None) or bb.get_entry(name)
             if entry is not None:
                 value = entry.value
                 kind = value.__class__
@@ -170,16 +172,26 @@ def _int_step(key: str, op: str, step: int, slow: Evaluator) -> Evaluator:
     """``counter += 1`` on an int entry in integer arithmetic: while operands and result stay
     within 2**53 - 1 the double arithmetic BT.CPP does is exact, so the result is the same."""
     apply = operator.add if op == "+=" else operator.sub if op == "-=" else operator.mul
+    local = key[:1] != "@"
 
     def int_step(bb: Blackboard, enums: dict[str, int] | None) -> Any:
-        entry = bb.get_entry(key)
+        # get_entry's first step inline: an entry of this scope is the one it would return.
+        entry = (bb._storage.get(key) if local else None) or bb.get_entry(key)
         if entry is not None:
             dst = entry.value
             if dst.__class__ is int and -_MAX_EXACT_INT <= dst <= _MAX_EXACT_INT:
                 new = apply(dst, step)
                 if -_MAX_EXACT_INT <= new <= _MAX_EXACT_INT:
                     entry.value = new
-                    bb._written(key, entry)  # notify_written without the extra call
+                    # Blackboard._written inline: the write's sequence id, stamp and observers.
+                    entry.sequence_id += 1
+                    source = bb.time_source
+                    if source is not None:
+                        entry.stamp = source()
+                    observers = entry.owner._observers
+                    if observers:
+                        for callback in tuple(observers):
+                            callback(key, entry)
                     return new
         return slow(bb, enums)
 
