@@ -9,6 +9,7 @@ from kinema.bt.blackboard import Blackboard
 from kinema.bt.conversions import Unsigned, convert_from_string, parse_double_full, parse_int_full, type_name
 from kinema.bt.decorators import SubTreeNode
 from kinema.bt.errors import BTError, BTLogicError, BTRuntimeError, ScriptParseError
+from kinema.bt.limits import MAX_TREE_NODES
 from kinema.bt.names import (
     POST_CONDITIONS,
     PRE_CONDITIONS,
@@ -364,20 +365,24 @@ class TreeBuilder:
         spec = spec.kind  # type: ignore[assignment]
         config = _new_config(NodeConfig)
         config.blackboard = blackboard
-        uid = config.uid = tree.next_uid()
+        uid = tree._uid + 1
+        if uid > MAX_TREE_NODES:
+            tree.next_uid()  # raises, with the explanation
+        tree._uid = config.uid = uid
         instance_name = spec.instance_name
         config.path = prefix + instance_name + f"::{uid}" if spec.unnamed else prefix + instance_name
         config.manifest = spec.manifest
         config.enums = self._enums
-        config.other_attributes = spec.other.copy()
         config.wake_up = tree.wake_up
         config.clock = self._clock
         config.source_file = filename
         config.source_line = line
-        config.input_ports = spec.input_ports.copy()
-        config.output_ports = spec.output_ports.copy()
-        config.pre_conditions = spec.pre_conditions.copy()
-        config.post_conditions = spec.post_conditions.copy()
+        # Each node owns its dicts (a node may change them); most are empty, and {} is the cheap copy.
+        config.other_attributes = spec.other.copy() if spec.other else {}
+        config.input_ports = spec.input_ports.copy() if spec.input_ports else {}
+        config.output_ports = spec.output_ports.copy() if spec.output_ports else {}
+        config.pre_conditions = spec.pre_conditions.copy() if spec.pre_conditions else {}
+        config.post_conditions = spec.post_conditions.copy() if spec.post_conditions else {}
         if spec.is_subtree:
             node = self.factory.instantiate_node("SubTree", instance_name, config)
             assert isinstance(node, SubTreeNode)

@@ -171,7 +171,10 @@ class TreeNode:
         self.registration_id: str = manifest.id if manifest is not None else type(self).__name__
         self._pre_tick: Callable[[TreeNode], NodeStatus] | None = None
         self._post_tick: Callable[[TreeNode, NodeStatus], NodeStatus] | None = None
-        self._refresh_hooked()
+        config = self.config
+        self._hooked = bool(
+            config.pre_conditions or config.post_conditions
+        )  # _refresh_hooked, no callbacks yet
 
     def _refresh_hooked(self) -> None:
         # The plain tick path is taken unless the node has conditions or injected callbacks.

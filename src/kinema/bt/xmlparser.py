@@ -41,7 +41,9 @@ _PORT_TAGS = {
 
 def element_children(element: etree._Element) -> list[etree._Element]:
     """Child elements only (comments and processing instructions skipped)."""
-    return list(element.iterchildren(etree.Element))
+    # A comment's or processing instruction's tag is a function, an element's a str; this is about
+    # twice as fast as iterchildren(etree.Element), and every build walks every element.
+    return [child for child in element if child.tag.__class__ is str] if len(element) else []
 
 
 def line_of(element: etree._Element) -> int:
