@@ -149,9 +149,24 @@ def _drawn(path: list[str]) -> str:
     )
 
 
-def _settled_screenshot(page: HeadlessChromium) -> bytes:
-    page.evaluate("viewer.set_dirty()")
-    time.sleep(0.4)
+def _hidden(paths: list[str]) -> str:
+    """JavaScript: is every meshcat object at ``paths`` (scene paths) there and invisible?"""
+    return (
+        "(function(ps){for(const p of ps){let n=viewer.scene_tree;"
+        "for(const k of p.split('/').filter(Boolean)){n=n.children[k];if(!n)return false;}"
+        f"if(!n.object||n.object.visible!==false)return false;}}return true;}})({json.dumps(paths)})"
+    )
+
+
+def _settled_screenshot(page: HeadlessChromium, ready: str | None = None) -> bytes:
+    """A screenshot once ``ready`` (JavaScript) holds and a frame has been drawn since."""
+    if ready is not None:
+        page.wait_for(ready, timeout=30.0)
+    page.evaluate(
+        "window.__kinema_drawn=false;viewer.set_dirty();"
+        "requestAnimationFrame(()=>requestAnimationFrame(()=>{window.__kinema_drawn=true;}))"
+    )
+    page.wait_for("window.__kinema_drawn", timeout=30.0)
     return page.screenshot()
 
 
@@ -174,7 +189,7 @@ def test_the_robot_is_drawn(viewer: Any, page: HeadlessChromium) -> None:
     with_robot = _settled_screenshot(page)
     viewer.server.send([sc.set_property(node.path, "visible", False) for node in robot])
     try:
-        without_robot = _settled_screenshot(page)
+        without_robot = _settled_screenshot(page, _hidden([node.path for node in robot]))
     finally:
         viewer.server.send([sc.set_property(node.path, "visible", True) for node in robot])
     _keep("with_robot", with_robot)
@@ -264,14 +279,16 @@ def test_a_visualize_pose_triad_appears_and_expires_after_its_lifetime(
         publisher = node.create_publisher(MARKER_ARRAY_TYPE, MARKER_ARRAY_TOPIC)
         message = from_dict(MARKER_ARRAY_TYPE, {"markers": triad})
         deadline = time.monotonic() + 20
+        sent = time.monotonic()
         while time.monotonic() < deadline and not page.evaluate(shown):
+            sent = time.monotonic()  # the lifetime runs from a publish at or before this one
             publisher.publish(message)
             time.sleep(0.3)
         assert page.evaluate(shown), "the triad did not appear in the page"
-        appeared = time.monotonic()  # before the screenshot, which takes seconds on a busy machine
         _keep("marker", _settled_screenshot(page))
-        page.wait_for(gone, timeout=10)
-        assert time.monotonic() - appeared > 1.5, "the triad went away long before its 3 s lifetime"
+        page.wait_for(gone, timeout=20)
+        lasted = time.monotonic() - sent
+        assert lasted > 1.5, f"the triad went away {lasted:.1f} s after the last publish, not after its 3 s"
     finally:
         node.close()
 

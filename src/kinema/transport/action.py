@@ -64,6 +64,9 @@ _RESULT_QUERY_TIMEOUT = 7 * 24 * 3600.0
 # Closing a server waits this long for its running goals to end as cancelled, so that clients get that
 # result rather than "the server went away".
 CLOSE_GRACE_S = 1.0
+# ...and then this long for the results of goals that ended on close to leave before the server's
+# entities close.
+CLOSE_FLUSH_S = 0.25
 # Feedback travels on a topic, the result on a service: feedback sent before the result may be
 # dispatched after it. A finished goal's feedback callback still gets such feedback for this long.
 LATE_FEEDBACK_S = 5.0
@@ -432,6 +435,11 @@ class ActionServer:
         deadline = time.monotonic() + CLOSE_GRACE_S
         while any(handle.is_active for handle in active) and time.monotonic() < deadline:
             time.sleep(0.005)
+        if active:
+            # The results just answered are queued, not delivered (zenoh confirms no reply), and closing
+            # the queryable and then the session drops them: the client would hear "went away"
+            # instead of CANCELED (4 runs of 6 did). Give them a moment to leave.
+            time.sleep(CLOSE_FLUSH_S)
         for entity in (self._send_goal, self._cancel, self._get_result, self._feedback, self._status):
             entity.close()
         self.node._forget(self)

@@ -11,7 +11,7 @@ import pytest
 from kinema.behaviors import BehaviorContext
 from kinema.bt import NodeStatus
 from kinema.plugins import BehaviorRegistry
-from kinema.testing import build_tree, tick_behavior, tick_until_done
+from kinema.testing import build_tree, tick_behavior
 from kinema.transport import from_dict
 
 COMMAND = "moveit_pro_controllers_msgs/msg/VelocityForceCommand"
@@ -47,17 +47,43 @@ def _collect(node: Any, type_name: str, topic: str) -> list[Any]:
 
 
 def test_the_command_streams_at_its_rate_until_the_timeout_halts_it(
-    registry: BehaviorRegistry, context: BehaviorContext
+    registry: BehaviorRegistry, node: Any, lab_sim_model: Any
 ) -> None:
-    received = _collect(context.node, COMMAND, "/velocity_force_controller/command")
-    tree = build_tree(PUBLISH_FOR_300_MS, registry=registry, context=context)
-    status, _ = tick_until_done(tree)
-    assert status is NodeStatus.SUCCESS
-    time.sleep(0.2)
-    count = len(received)
-    assert 10 <= count <= 20, count  # 50 Hz for 0.3 s: about 15 commands (the first one at once)
-    time.sleep(0.2)
-    assert len(received) == count  # halted: no more
+    # On a manual clock the count is exact whatever the machine's load: 50 Hz inside a 300 ms Timeout.
+    from kinema.bt import ManualClock
+    from kinema.config import resolve_config
+
+    clock = ManualClock()
+    context = BehaviorContext(node, clock=clock, robot_model=lab_sim_model, config=resolve_config("lab_sim"))
+    received = _collect(node, COMMAND, "/velocity_force_controller/command")
+    published: list[Any] = []
+    make_publisher = context.publisher
+
+    def counting_publisher(*args: Any, **kwargs: Any) -> Any:
+        publisher = make_publisher(*args, **kwargs)
+        send = publisher.publish
+        publisher.publish = lambda message: (published.append(message), send(message))[1]
+        return publisher
+
+    context.publisher = counting_publisher  # type: ignore[method-assign]
+    try:
+        tree = build_tree(PUBLISH_FOR_300_MS, registry=registry, context=context)
+        status = tree.tick_once()
+        while status is NodeStatus.RUNNING:
+            clock.advance(0.005)
+            status = tree.tick_once()
+        assert status is NodeStatus.SUCCESS
+        # a command at 0, 20, ... 280 ms: the one due at 300 ms meets the Timeout's halt
+        assert len(published) == 15, len(published)
+        for _ in range(50):
+            clock.advance(0.02)  # no timer of the halted behavior publishes again
+        assert len(published) == 15
+        deadline = time.monotonic() + 30.0
+        while len(received) < 15 and time.monotonic() < deadline:
+            time.sleep(0.01)
+        assert len(received) == 15, len(received)
+    finally:
+        context.close()
     command = received[-1]
     assert command.twist.linear.z == pytest.approx(0.05)
     assert command.velocity_controlled_axes.z and not command.velocity_controlled_axes.x
