@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import itertools
 import os
 import signal
 import subprocess
@@ -118,9 +119,12 @@ def test_heartbeat_comes_at_10_hz(client: ObjectiveClient) -> None:
     with client.statuses(timeout=5) as stream:
         for heartbeat in stream:
             stamps.append(heartbeat.process_time)
-            if len(stamps) == 11:
+            if len(stamps) == 21:
                 break
-    assert 0.5 < stamps[-1] - stamps[1] < 2.0  # nine periods of 0.1 s, loosely
+    # The median period, stamped by the runtime: a stall on a busy machine stretches a few periods only.
+    periods = sorted(b - a for a, b in itertools.pairwise(stamps))
+    median = periods[len(periods) // 2]
+    assert 0.05 < median < 0.3, periods
 
 
 def test_failure_names_the_node_and_reaches_the_log_stream(client: ObjectiveClient) -> None:

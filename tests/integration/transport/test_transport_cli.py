@@ -121,11 +121,15 @@ def test_topic_echo_and_pub(demo: Node, router_endpoint: str, capsys: pytest.Cap
         "std_msgs/msg/String",
         "{data: typed}",
         "--once",
+        "-w",
+        "1",  # wait for the subscription to match: one message published before would be lost
+        "--timeout",
+        "30",
         "-e",
         router_endpoint,
     )
     assert code == 0
-    deadline = time.monotonic() + 5
+    deadline = time.monotonic() + 30
     while not received and time.monotonic() < deadline:
         time.sleep(0.01)
     assert received == ["typed"]

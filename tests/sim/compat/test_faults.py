@@ -7,7 +7,9 @@ import signal
 import subprocess
 import sys
 import time
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import pytest
@@ -51,14 +53,26 @@ def cell(start_cell, fault_objectives: Path) -> Cell:
     return start_cell(extra_objectives=fault_objectives)
 
 
+def _logged(logs: Any, wanted: Callable[[str], bool], timeout: float = 30.0) -> list[str]:
+    """The log texts up to the first that ``wanted`` accepts, waiting up to ``timeout`` for it: a log line
+    travels apart from the result and may arrive after it."""
+    texts: list[str] = []
+    deadline = time.monotonic() + timeout
+    for entry in logs:
+        texts.append(entry.text)
+        if wanted(entry.text) or time.monotonic() > deadline:
+            break
+    return texts
+
+
 def test_an_unreachable_waypoint_fails_with_the_planning_error(cell: Cell) -> None:
-    logs = cell.client.logs(timeout=1.0)
+    logs = cell.client.logs(timeout=30.0)
     result = cell.client.execute("Go Through the Table")
     assert result.failed
     assert "PlanToJointGoal" in result.error_message, result.error_message
     assert "collision" in result.error_message and "table" in result.error_message, result.error_message
-    texts = [entry.text for entry in logs]
-    assert any("PlanToJointGoal: planning failed" in text and "table" in text for text in texts), texts
+    texts = _logged(logs, lambda text: "PlanToJointGoal: planning failed" in text and "table" in text)
+    assert "PlanToJointGoal: planning failed" in texts[-1] and "table" in texts[-1], texts
 
 
 def test_a_misspelled_waypoint_names_the_right_one(cell: Cell) -> None:
@@ -140,7 +154,7 @@ def test_a_driver_killed_mid_trajectory_fails_the_behavior_within_1_s(
     )
     try:
         wait_for(lambda: len(cell.joint_history()[0]) > 0, 30.0, "the driver process to publish")
-        logs = cell.client.logs(timeout=1.0)
+        logs = cell.client.logs(timeout=30.0)
         handle = cell.client.start("Swing Slowly")
         wait_for(lambda: _moving(cell, 0.1), 30.0, "the arm to move")
         time.sleep(0.3)
@@ -158,6 +172,7 @@ def test_a_driver_killed_mid_trajectory_fails_the_behavior_within_1_s(
     # (waiting for a goal result that never comes): wall-clock speed is not for asserting tests.
     assert failed_after < 15.0, f"the objective failed {failed_after:.2f} s after the driver died"
     assert "ExecuteTrajectory" in result.error_message and "went away" in result.error_message, result
-    assert any("lost the controller" in entry.text for entry in logs)
+    texts = _logged(logs, lambda text: "lost the controller" in text)
+    assert texts and "lost the controller" in texts[-1], texts
     # The agent keeps serving: another objective runs.
     assert cell.client.execute("Say Hello").succeeded

@@ -199,8 +199,12 @@ def test_sleep_on_a_manual_clock_waits_for_simulated_time() -> None:
     )
     done = threading.Event()
     threading.Thread(target=lambda: (tree.sleep(2.0), done.set()), daemon=True).start()
+    # Advance only once the sleeper's timer is set (a starved thread may take a while to get there).
+    deadline = time.monotonic() + 30.0
+    while not clock._heap and time.monotonic() < deadline:
+        time.sleep(0.005)
     time.sleep(0.05)
-    assert not done.is_set()
+    assert not done.is_set()  # 0.05 s of wall time and none of the clock's: still asleep
     clock.advance(2.0)
     assert done.wait(5.0)
 
