@@ -183,7 +183,7 @@ def test_halting_the_action_client_cancels_the_goal_on_the_server(node: Any) -> 
     )
     for _ in range(500):
         tree.tick_once()
-        if server.server.goals:
+        if server.server.goals():
             break
         tree.sleep(0.01)
     tree.halt_tree()
