@@ -157,7 +157,7 @@ def test_nothing_is_rendered_while_nobody_subscribes(camera_sim: Sim) -> None:
     rendered = cameras.frames_rendered
     assert rendered >= 1
     # The subscription is gone: rendering stops (a frame may have been in flight).
-    wait_for(lambda: _stable(cameras), 20, "rendering to stop")
+    wait_for(lambda: _stable(cameras), 60, "rendering to stop")
     settled = cameras.frames_rendered
     later = camera_sim.driver.sim_time
     wait_for(lambda: camera_sim.driver.sim_time > later + 2.0, 30, "2 s more of sim time")
@@ -167,8 +167,9 @@ def test_nothing_is_rendered_while_nobody_subscribes(camera_sim: Sim) -> None:
 def _stable(cameras: Any) -> bool:
     import time
 
+    # 2 s: a software-rendered frame that was in flight can take over a second on a busy machine.
     before = cameras.frames_rendered
-    time.sleep(0.5)
+    time.sleep(2.0)
     return cameras.frames_rendered == before
 
 
