@@ -429,6 +429,7 @@ class NodeStatusSubscription:
     """
 
     REFETCH_AFTER_S = 1.0
+    REFETCH_FOR_S = 30.0
 
     def __init__(self, node: Any, on_changes: Any) -> None:
         self._node = node
@@ -437,6 +438,7 @@ class NodeStatusSubscription:
         self._lock = threading.Lock()
         self._closed = False
         self._refetching = False
+        self._closing = threading.Event()
         self._last_refetch = 0.0
         self._tables = node.create_subscription(
             names.NODE_TABLE_TYPE, names.NODE_TABLE, self._on_table, latched=True
@@ -456,35 +458,48 @@ class NodeStatusSubscription:
         if decoded is not None:
             self._on_changes(decoded)
             return
-        now = time.monotonic()
         with self._lock:
-            if self._closed or self._refetching or now - self._last_refetch < self.REFETCH_AFTER_S:
+            if self._closed or self._refetching:
                 return
             self._refetching = True
-            self._last_refetch = now
-        threading.Thread(target=self._refetch, name="kinema-node-table", daemon=True).start()
+        threading.Thread(target=self._refetch_while_waiting, name="kinema-node-table", daemon=True).start()
 
-    def _refetch(self) -> None:
+    def _refetch_while_waiting(self) -> None:
+        # Read the latched table again, at most once a second, for as long as changes wait for a table
+        # (up to REFETCH_FOR_S): the last changes of a run may be the only ones that name it, so waiting
+        # for more changes to try again could wait forever.
+        deadline = time.monotonic() + self.REFETCH_FOR_S
         try:
-            fresh = self._node.create_subscription(
-                names.NODE_TABLE_TYPE, names.NODE_TABLE, self._on_table, latched=True
-            )
-        except Exception:
-            fresh = None  # the node is closing; the next changes try again
-        with self._lock:
-            self._refetching = False
-            if fresh is None:
-                return
-            if self._closed:
-                old = fresh
-            else:
-                old, self._tables = self._tables, fresh
-        old.close()
+            while True:
+                pause = self._last_refetch + self.REFETCH_AFTER_S - time.monotonic()
+                if pause > 0 and self._closing.wait(pause):
+                    return
+                if not self.decoder.waiting or time.monotonic() > deadline:
+                    return
+                self._last_refetch = time.monotonic()
+                try:
+                    fresh = self._node.create_subscription(
+                        names.NODE_TABLE_TYPE, names.NODE_TABLE, self._on_table, latched=True
+                    )
+                except Exception:
+                    return  # the node is closing
+                with self._lock:
+                    if self._closed:
+                        old = fresh
+                    else:
+                        old, self._tables = self._tables, fresh
+                old.close()
+                if self._closing.is_set():
+                    return
+        finally:
+            with self._lock:
+                self._refetching = False
 
     def close(self) -> None:
         """Unsubscribe both topics."""
         with self._lock:
             self._closed = True
             tables = self._tables
+        self._closing.set()
         self._codes.close()
         tables.close()

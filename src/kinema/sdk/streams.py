@@ -268,6 +268,12 @@ class NodeStatusDecoder:
             self._waiting = still
         return [self._decode(waiting, table) for waiting in ready]
 
+    @property
+    def waiting(self) -> int:
+        """How many messages wait for their table."""
+        with self._lock:
+            return len(self._waiting)
+
     def on_codes(self, message: Any) -> NodeStatusChanges | None:
         """Take a node status message; None while its table has not arrived (it waits)."""
         with self._lock:

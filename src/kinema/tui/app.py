@@ -44,7 +44,7 @@ from kinema.tui.connection import (
 from kinema.tui.dialogs.confirm import ConfirmDialog
 from kinema.tui.messages import ModeSelected, RuntimeCallFailed, RuntimeCallSucceeded, RuntimeEventsArrived
 from kinema.tui.run_outcome import RunOutcome, parse_outcome
-from kinema.tui.runtime_status import RuntimeStatus
+from kinema.tui.runtime_status import ACTIVE_STATUSES, RuntimeStatus
 from kinema.tui.screens.base import KinemaScreen, RuntimeView
 from kinema.tui.screens.behaviors import BehaviorsScreen
 from kinema.tui.screens.blackboard import BlackboardScreen
@@ -192,6 +192,11 @@ class KinemaApp(App[None]):
         # IDLE in the node statuses. The first resets the per-run views; these say which one came first.
         self._started_by_heartbeat: set[str] = set()
         self._started_by_statuses: set[str] = set()
+        # Objectives whose outcome (a log message, a third topic) came before the heartbeat reported the
+        # run's end, with the heartbeat's (objective, status) then: a start signal that arrives before the
+        # heartbeat moves on to another resting status is that ended run's, late, and must not wipe the
+        # explanation the outcome put on the tree.
+        self._ended_ahead: dict[str, tuple[str, str]] = {}
         self.inbox = EventInbox()
         self.views: list[RuntimeView] = []
         self.sub_title = connection.endpoint + ("  (closing stops the runtime)" if owns_runtime else "")
@@ -261,7 +266,17 @@ class KinemaApp(App[None]):
                     self.notify(f"Connected to {event.endpoint}", title="Reconnected")
             elif isinstance(event, Heartbeat):
                 was_connected = self.status.state is ConnectionState.CONNECTED
-                if self.status.apply_heartbeat(event):
+                started = self.status.apply_heartbeat(event)
+                ahead = self._ended_ahead.get(event.objective_name)
+                if (
+                    ahead is not None
+                    and event.status not in ACTIVE_STATUSES
+                    and ahead != (event.objective_name, event.status)
+                ):
+                    del self._ended_ahead[event.objective_name]  # the heartbeat caught up with the end
+                if started and event.objective_name in self._ended_ahead:
+                    pass  # the ended run's own start, late (see _ended_ahead)
+                elif started:
                     if event.objective_name in self._started_by_statuses:
                         # Its statuses came first (a busy machine reorders topics): already reset.
                         self._started_by_statuses.discard(event.objective_name)
@@ -277,7 +292,16 @@ class KinemaApp(App[None]):
             elif isinstance(event, NodeStatusBatch):
                 name = event.objective_name
                 if any(u.uid == ROOT_UID and u.previous is NodeStatus.IDLE for u in event.updates):
-                    if name in self._started_by_heartbeat:
+                    if name in self._ended_ahead or (
+                        name in self.outcomes
+                        and self.outcomes[name].outcome == "Failure"
+                        and any(u.uid == ROOT_UID and u.status is NodeStatus.FAILURE for u in event.updates)
+                    ):
+                        # The failed run whose outcome is shown, arriving late (before the heartbeat said
+                        # it ended, or whole in one batch): apply it, keep the explanation. A new run that
+                        # fails within one batch sends its own outcome next, which explains it again.
+                        pass
+                    elif name in self._started_by_heartbeat:
                         self._started_by_heartbeat.discard(name)
                     else:
                         self._started_by_statuses.add(name)
@@ -332,6 +356,9 @@ class KinemaApp(App[None]):
         outcome = parse_outcome(entry.message) if entry.level <= LogLevel.WARN else None
         if outcome is not None:
             self.outcomes[outcome.objective_name] = outcome
+            beat = (self.status.objective, self.status.status)
+            if beat != (outcome.objective_name, outcome.outcome):
+                self._ended_ahead[outcome.objective_name] = beat
         self._views_call(lambda view: view.runtime_log(entry))
         if outcome is not None:
             self._views_call(lambda view: view.runtime_run_ended(outcome))

@@ -206,3 +206,58 @@ def test_a_subscriber_whose_table_was_dropped_reads_the_latched_copy_again() -> 
     assert [t for t, _ in subscribed].count(names.NODE_TABLE) == 2
     assert closed == [names.NODE_TABLE]  # the first table subscription was replaced
     subscription.close()
+
+
+def test_a_subscriber_keeps_reading_the_latched_table_while_changes_wait_for_it() -> None:
+    # A run's last changes may be the only ones naming its table: when the first re-read is lost too, the
+    # subscriber must try again on its own (waiting for more changes would wait forever).
+    import threading
+    import time
+    from types import SimpleNamespace
+
+    from kinema.runtime import names
+    from kinema.sdk.client import NodeStatusSubscription
+
+    tree = BehaviorTreeFactory().create_tree_from_text(XML)
+    recorder = NodeStatusRecorder()
+    recorder.attach(tree)
+    tree.tick_once()
+    batch = recorder.take()
+    assert batch is not None
+    table = batch.table
+    table_message = SimpleNamespace(
+        objective_name="Demo",
+        table_id=table.id,
+        uids=table.uids,
+        node_paths=table.paths,
+        node_ids=table.node_ids,
+        node_names=table.names,
+    )
+    codes_message = SimpleNamespace(
+        objective_name="Demo",
+        table_id=table.id,
+        stamps=[SimpleNamespace(sec=1, nanosec=0)],
+        starts=[0],
+        codes=batch.codes,
+    )
+    subscribed: list[tuple[str, Any]] = []
+
+    class Node:
+        # The live table and the first re-read are lost; the second re-read gets the latched copy.
+        def create_subscription(self, _type: str, topic: str, callback: Any, latched: bool = False) -> Any:
+            subscribed.append((topic, callback))
+            if topic == names.NODE_TABLE and sum(t == names.NODE_TABLE for t, _ in subscribed) == 3:
+                threading.Thread(target=callback, args=(table_message,)).start()
+            return SimpleNamespace(close=lambda: None)
+
+    got: list[Any] = []
+    subscription = NodeStatusSubscription(Node(), got.append)
+    subscription.REFETCH_AFTER_S = 0.05
+    on_codes = next(callback for topic, callback in subscribed if topic == names.NODE_STATUS)
+    on_codes(codes_message)  # the only changes of the run
+    deadline = time.monotonic() + 30
+    while not got and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert got and [c.node_path for c in got[0].changes] == [c.node_path for c in batch]
+    assert [t for t, _ in subscribed].count(names.NODE_TABLE) == 3
+    subscription.close()
