@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from types import SimpleNamespace
 from typing import Any
 
 from kinema.bt import BehaviorTreeFactory, NodeStatus
@@ -153,14 +154,8 @@ def test_a_subscriber_decodes_the_wire_messages_to_the_same_changes() -> None:
     assert all(abs(g.stamp - w.timestamp) < 1e-6 for g, w in zip(got, want, strict=True))
 
 
-def test_a_subscriber_whose_table_was_dropped_reads_the_latched_copy_again() -> None:
-    import threading
-    import time
-    from types import SimpleNamespace
-
-    from kinema.runtime import names
-    from kinema.sdk.client import NodeStatusSubscription
-
+def _one_tick_as_messages() -> tuple[NodeStatusBatch, Any, Any]:
+    """One tick of XML's tree: its batch, and the node table and status codes messages a runtime sends."""
     tree = BehaviorTreeFactory().create_tree_from_text(XML)
     recorder = NodeStatusRecorder()
     recorder.attach(tree)
@@ -183,6 +178,17 @@ def test_a_subscriber_whose_table_was_dropped_reads_the_latched_copy_again() -> 
         starts=[0],
         codes=batch.codes,
     )
+    return batch, table_message, codes_message
+
+
+def test_a_subscriber_whose_table_was_dropped_reads_the_latched_copy_again() -> None:
+    import threading
+    import time
+
+    from kinema.runtime import names
+    from kinema.sdk.client import NodeStatusSubscription
+
+    batch, table_message, codes_message = _one_tick_as_messages()
     subscribed: list[tuple[str, Any]] = []
     closed: list[str] = []
 
@@ -213,33 +219,11 @@ def test_a_subscriber_keeps_reading_the_latched_table_while_changes_wait_for_it(
     # subscriber must try again on its own (waiting for more changes would wait forever).
     import threading
     import time
-    from types import SimpleNamespace
 
     from kinema.runtime import names
     from kinema.sdk.client import NodeStatusSubscription
 
-    tree = BehaviorTreeFactory().create_tree_from_text(XML)
-    recorder = NodeStatusRecorder()
-    recorder.attach(tree)
-    tree.tick_once()
-    batch = recorder.take()
-    assert batch is not None
-    table = batch.table
-    table_message = SimpleNamespace(
-        objective_name="Demo",
-        table_id=table.id,
-        uids=table.uids,
-        node_paths=table.paths,
-        node_ids=table.node_ids,
-        node_names=table.names,
-    )
-    codes_message = SimpleNamespace(
-        objective_name="Demo",
-        table_id=table.id,
-        stamps=[SimpleNamespace(sec=1, nanosec=0)],
-        starts=[0],
-        codes=batch.codes,
-    )
+    batch, table_message, codes_message = _one_tick_as_messages()
     subscribed: list[tuple[str, Any]] = []
 
     class Node:
