@@ -436,9 +436,8 @@ class NodeStatusSubscription:
         self._on_changes = on_changes
         self.decoder = NodeStatusDecoder()
         self._lock = threading.Lock()
-        self._closed = False
+        self._closed = threading.Event()
         self._refetching = False
-        self._closing = threading.Event()
         self._last_refetch = 0.0
         self._tables = node.create_subscription(
             names.NODE_TABLE_TYPE, names.NODE_TABLE, self._on_table, latched=True
@@ -459,7 +458,7 @@ class NodeStatusSubscription:
             self._on_changes(decoded)
             return
         with self._lock:
-            if self._closed or self._refetching:
+            if self._closed.is_set() or self._refetching:
                 return
             self._refetching = True
         threading.Thread(target=self._refetch_while_waiting, name="kinema-node-table", daemon=True).start()
@@ -472,7 +471,7 @@ class NodeStatusSubscription:
         try:
             while True:
                 pause = self._last_refetch + self.REFETCH_AFTER_S - time.monotonic()
-                if pause > 0 and self._closing.wait(pause):
+                if pause > 0 and self._closed.wait(pause):
                     return
                 if not self.decoder.waiting or time.monotonic() > deadline:
                     return
@@ -484,12 +483,12 @@ class NodeStatusSubscription:
                 except Exception:
                     return  # the node is closing
                 with self._lock:
-                    if self._closed:
+                    if self._closed.is_set():
                         old = fresh
                     else:
                         old, self._tables = self._tables, fresh
                 old.close()
-                if self._closing.is_set():
+                if self._closed.is_set():
                     return
         finally:
             with self._lock:
@@ -498,8 +497,7 @@ class NodeStatusSubscription:
     def close(self) -> None:
         """Unsubscribe both topics."""
         with self._lock:
-            self._closed = True
+            self._closed.set()
             tables = self._tables
-        self._closing.set()
         self._codes.close()
         tables.close()
