@@ -18,8 +18,11 @@ them. Structures:
 Kinema is also measured "as objectives run": with what the runtime attaches on the tick thread
 (:class:`ObjectiveObservers`: the status recorder reading the tree's transition log after every
 tick, the agent's node status messages built and serialised, the blackboard snapshot at 10 Hz and
-the run's ``.btlog`` recording). Rates are ticks per CPU second (``time.process_time``), median of
-``--rounds`` rounds; ratios are Kinema's time over BT.CPP's (lower is better; 1.0 = parity).
+the run's ``.btlog`` recording). BT.CPP is measured the same way with what a BT.CPP application
+attaches to record a run: its ``FileLogger2`` (the ``.btlog`` writer, which takes every transition
+through a status callback and writes from its own thread). Rates are ticks per CPU second
+(``time.process_time``, every thread of the process), median of ``--rounds`` rounds; ratios are
+Kinema's time over BT.CPP's (lower is better; 1.0 = parity).
 Targets (issue 17): sequence <= 1.0x, mixed <= 1.5x, XML build <= 2x, observers <= +20 %.
 Run: ``python benchmarks/bt_tick.py [--seconds S] [--rounds N] [--profile STRUCTURE]``.
 """
@@ -171,6 +174,21 @@ def btcpp_tree(xml: str, factory: Any = None) -> Any:
     return tree
 
 
+class BtcppRecorded:
+    """A BT.CPP tree with its ``FileLogger2`` attached, writing to a temporary folder."""
+
+    def __init__(self, xml: str) -> None:
+        import os
+        import tempfile
+
+        import behaviortreepy as bt
+
+        self._folder = tempfile.TemporaryDirectory(prefix="kinema-bench-btcpp-")
+        self.tree = btcpp_tree(xml)
+        self.logger = bt.FileLogger(self.tree, os.path.join(self._folder.name, "run.btlog"))
+        self.tick = self.tree.tick_once
+
+
 class _SerializingPublisher:
     """A publisher that does the agent's work up to the network: the message to CDR bytes."""
 
@@ -208,7 +226,9 @@ class ObjectiveObservers:
             create_publisher=lambda type_name, _topic, **_: _SerializingPublisher(type_name)
         )
         self.streams = _Streams(node, None, SimpleNamespace())  # type: ignore[arg-type]
-        self.recording = RunRecorder(self._folder.name)
+        # Every transition is written, as FileLogger2 writes them (no size cap).
+        unlimited = 1 << 40
+        self.recording = RunRecorder(self._folder.name, max_file_bytes=unlimited, max_total_bytes=unlimited)
         self.recording.on_tree_loaded("bench", tree)
         self._last = 0.0
         self._entries = blackboard_entries
@@ -349,24 +369,33 @@ def main() -> None:
     have_btcpp = _btcpp_available()
     py_trees_builders = {"sequence": py_trees_sequence, "mixed": py_trees_mixed}
     print(f"ticks per CPU second, median of {args.rounds} rounds; ratio = BT.CPP rate / Kinema rate")
+    print(
+        "plain: nothing attached; recorded: Kinema with the runtime's observers, BT.CPP with its FileLogger2;"
+        " cost: recorded against plain"
+    )
     header = f"{'structure':<12} {'nodes':>6} {'BT.CPP':>9} {'Kinema':>9} {'ratio':>6} "
-    print(header + f"{'+observers':>11} {'cost':>6} {'py_trees':>9}")
-    observed_cost = {}
+    header += f"{'BT.CPP rec':>11} {'cost':>6} {'Kinema rec':>11} {'cost':>6} {'ratio':>6} {'py_trees':>9}"
+    print(header)
+    nan = float("nan")
     for name, make_xml in STRUCTURES.items():
         xml = make_xml()
         tree = kinema_tree(xml)
         kinema = rate(tree.tick_once, args.seconds, args.rounds)
-        observed_tree = kinema_tree(xml)
-        observers = ObjectiveObservers(observed_tree)
+        observers = ObjectiveObservers(kinema_tree(xml))
         observed = rate(observers.tick, args.seconds, args.rounds)
-        observed_cost[name] = kinema / observed - 1.0
-        btcpp = rate(btcpp_tree(xml).tick_once, args.seconds, args.rounds) if have_btcpp else float("nan")
-        pt = float("nan")
+        btcpp = btcpp_recorded = nan
+        if have_btcpp:
+            btcpp = rate(btcpp_tree(xml).tick_once, args.seconds, args.rounds)
+            recorded = BtcppRecorded(xml)  # the logger lives as long as this object
+            btcpp_recorded = rate(recorded.tick, args.seconds, args.rounds)
+        pt = nan
         if name in py_trees_builders:
             pt = rate(py_trees_builders[name]().tick_once, args.seconds, args.rounds)
         print(
             f"{name:<12} {len(tree):>6} {btcpp:>9.0f} {kinema:>9.0f} {btcpp / kinema:>5.2f}x "
-            f"{observed:>11.0f} {observed_cost[name]:>+5.0%} {pt:>9.0f}"
+            f"{btcpp_recorded:>11.0f} {btcpp / btcpp_recorded - 1.0:>+6.0%} "
+            f"{observed:>11.0f} {kinema / observed - 1.0:>+6.0%} {btcpp_recorded / observed:>5.2f}x "
+            f"{pt:>9.0f}"
         )
     print("\nbuild from XML, CPU ms (median); ratio = Kinema / BT.CPP")
     print("  new factory each time (built-ins registered, the text parsed, verified and compiled):")
