@@ -25,10 +25,14 @@ MAX_DEPTH = 256
 # The pre-pass works on runs, not characters: most of a file is text, comments and tags whose quoted
 # values need no escaping, and one regex match copies such a run unchanged. Possessive quantifiers keep
 # every pattern linear (no backtracking on unterminated tags or quotes).
+# A quoted value that needs no escaping: no raw '<', '>', tab or newline, and '&' only as an entity.
+_CLEAN_VALUE = r"""(?:"(?:[^"<>&\n\t]++|&(?=ENTITY))*+"|'(?:[^'<>&\n\t]++|&(?=ENTITY))*+')""".replace(
+    "ENTITY", _ENTITY
+)
 _UNCHANGED = re.compile(
     r"(?:[^<&]++|&(?=" + _ENTITY + r")"
     r"|<!--.*?(?:-->|\Z)|<!\[CDATA\[.*?(?:\]\]>|\Z)|<\?.*?(?:\?>|\Z)|<!.*?(?:>|\Z)"
-    r"""|<(?:[^"'>]++|"[^"<>&\n\t]*+"|'[^'<>&\n\t]*+')*+>)++""",
+    r"""|<(?:[^"'>]++|""" + _CLEAN_VALUE + r""")*+>)++""",
     re.S,
 )
 # A start or end tag up to its first '>' outside quotes; an unterminated quote runs to the end of the text.
