@@ -25,6 +25,7 @@ from kinema.bt import (
     output_port,
     write_tree_nodes_model_xml,
 )
+from kinema.bt.builtins import BUILTIN_NODE_TYPES
 
 S, F, R, IDLE = NodeStatus.SUCCESS, NodeStatus.FAILURE, NodeStatus.RUNNING, NodeStatus.IDLE
 
@@ -142,6 +143,21 @@ def test_registration_rules() -> None:
     factory.register_simple_condition("Ok", lambda n: S)
     assert factory.manifests()["Ok"].category is NodeType.CONDITION
     assert factory.unregister("Ok") and not factory.is_registered("Ok")
+
+
+def test_every_factory_gets_the_same_builtin_models_and_owns_them() -> None:
+    # Later factories copy what the first one read from the classes; each owns its manifests.
+    first, second = BehaviorTreeFactory(), BehaviorTreeFactory()
+    assert second._builders == first._builders == BUILTIN_NODE_TYPES
+    assert write_tree_nodes_model_xml(second, include_builtin=True) == write_tree_nodes_model_xml(
+        first, include_builtin=True
+    )
+    second.manifests()["Sequence"].description = "changed"
+    second.manifests()["Timeout"].ports.pop("msec")
+    third = BehaviorTreeFactory()
+    assert third.manifests()["Sequence"].description == first.manifests()["Sequence"].description
+    assert "msec" in third.manifests()["Timeout"].ports
+    assert third.manifests()["SubTree"].category is NodeType.SUBTREE
 
 
 def test_builtin_ids_match_btcpp_4_10() -> None:
