@@ -58,6 +58,15 @@ class TreeBuilder:
         self._clock = factory.clock
         # (tag, attributes...) -> what that element compiles to (valid for this registry only)
         self.kinds: dict[tuple[Any, ...], NodeKind] = {}
+        # The instance path of every Subtree made so far (two SubTree nodes may not make the same one).
+        self._subtree_paths: set[str] = set()
+        # Registered node classes, which the builder constructs itself (other builders go through
+        # factory.instantiate_node, which checks what they return).
+        self._classes = {
+            node_id: builder
+            for node_id, builder in factory._builders.items()
+            if isinstance(builder, type) and issubclass(builder, TreeNode)
+        }
         # The entries SubTree number literals created (ids, while this tree is built): see _number_fits.
         self._number_literals: set[int] = set()
 
@@ -98,6 +107,7 @@ class TreeBuilder:
         blackboard.name = tree_path or tree_id
         subtree = Subtree(tree_id, tree_path, blackboard)
         self.tree.subtrees.append(subtree)
+        self._subtree_paths.add(tree_path)
         ancestors.append(tree_id)
         filename = definition.filename
         plan = definition.plan if definition.plan_key == self.plan_key else None
@@ -224,14 +234,13 @@ class TreeBuilder:
             path += "/"
         name = kind.explicit_name
         path += name if name is not None else f"{subtree_id}::{node.uid}"
-        for existing in self.tree.subtrees:
-            if existing.instance_name == path:
-                raise BTRuntimeError(
-                    f"Duplicate SubTree path detected: '{path}'. Multiple SubTree nodes with the same 'name' "
-                    "attribute under the same parent are not allowed. Please use unique names or omit the "
-                    "'name' attribute to auto-generate unique paths.",
-                    location=SourceLocation(filename, spec.line),
-                )
+        if path in self._subtree_paths:
+            raise BTRuntimeError(
+                f"Duplicate SubTree path detected: '{path}'. Multiple SubTree nodes with the same 'name' "
+                "attribute under the same parent are not allowed. Please use unique names or omit the "
+                "'name' attribute to auto-generate unique paths.",
+                location=SourceLocation(filename, spec.line),
+            )
         self._create_subtree(subtree_id, path, path + "/", new_bb, node, ancestors)
 
     def _compile_node(self, element: etree._Element, filename: str, prefix: str) -> NodeSpec:
@@ -390,8 +399,19 @@ class TreeBuilder:
         else:
             if spec.entries:
                 self._precreate_entries(spec.entries, blackboard, _LazyLocation(filename, line))
+            type_id = spec.type_id
+            cls = self._classes.get(type_id)
             try:
-                node = self.factory.instantiate_node(spec.type_id, instance_name, config)
+                if cls is None:
+                    node = self.factory.instantiate_node(type_id, instance_name, config)
+                else:
+                    # What instantiate_node does for a class (its manifest is already in the config).
+                    node = cls(instance_name, config)
+                    if node.config is not config:
+                        raise BTLogicError(
+                            f"node type [{type_id}] must pass its config to TreeNode.__init__(name, config)"
+                        )
+                    node.registration_id = type_id
             except BTError as error:
                 if error.location is None:
                     error.location = _LazyLocation(filename, line)

@@ -145,6 +145,28 @@ def test_registration_rules() -> None:
     assert factory.unregister("Ok") and not factory.is_registered("Ok")
 
 
+def test_a_node_that_drops_its_config_or_a_builder_that_returns_no_node_fails_the_build_at_its_line() -> None:
+    factory = BehaviorTreeFactory()
+
+    class Forgetful(SyncActionNode):
+        def __init__(self, name: str, config: object) -> None:
+            super().__init__(name)  # its own config, not the builder's
+
+        def tick(self) -> NodeStatus:
+            return S
+
+    factory.register_node_type(Forgetful, "Forgetful")
+    from kinema.bt.manifest import NodeManifest
+
+    factory.register_builder(NodeManifest("NotANode", NodeType.ACTION), lambda name, config: "a string")
+    for node_id, message in (("Forgetful", "must pass its config"), ("NotANode", "not a TreeNode")):
+        tree = f'<BehaviorTree ID="T">\n<Sequence>\n<{node_id}/></Sequence></BehaviorTree>'
+        xml = f'<root BTCPP_format="4">{tree}</root>'
+        with pytest.raises(BTLogicError, match=message) as caught:
+            factory.create_tree_from_text(xml)
+        assert caught.value.location is not None and caught.value.location.line == 3
+
+
 def test_every_factory_gets_the_same_builtin_models_and_owns_them() -> None:
     # Later factories copy what the first one read from the classes; each owns its manifests.
     first, second = BehaviorTreeFactory(), BehaviorTreeFactory()
