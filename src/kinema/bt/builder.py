@@ -21,7 +21,7 @@ from kinema.bt.node import ControlNode, DecoratorNode, NodeConfig, TreeNode
 from kinema.bt.ports import PortDirection, blackboard_pointer, strict_blackboard_pointer
 from kinema.bt.script import parse_script
 from kinema.bt.tree import Subtree, Tree
-from kinema.bt.xmlparser import EXPLICIT_TAGS, element_children, line_of
+from kinema.bt.xmlparser import EXPLICIT_TAGS, element_children
 from kinema.errors import SourceLocation
 
 if TYPE_CHECKING:
@@ -135,19 +135,26 @@ class TreeBuilder:
     ) -> NodeSpec:
         stack: list[tuple[etree._Element, TreeNode | None, NodeSpec | None]] = [(root_element, parent, None)]
         nodes = subtree.nodes
+        kinds = self.kinds
         root_spec: NodeSpec | None = None
         while stack:
             element, parent_node, parent_spec = stack.pop()
-            spec = self._compile_node(element, filename, prefix)
+            # What the element compiles to depends only on its tag and attributes (and the registry).
+            line = element.sourceline or 0
+            signature = (element.tag, *element.items())
+            kind = kinds.get(signature)
+            if kind is None:
+                kind = kinds[signature] = self._compile_kind(element, filename, prefix, line)
+            spec = NodeSpec(kind, line)
             if parent_spec is None:
                 root_spec = spec
             else:
                 parent_spec.children.append(spec)
             node = self._create_node(spec, blackboard, parent_node, prefix, filename)
             nodes.append(node)
-            if spec.kind.is_subtree:
+            if kind.is_subtree:
                 self._enter_subtree(node, spec, subtree, blackboard, filename, ancestors)  # type: ignore[arg-type]
-            else:
+            elif len(element):
                 for child in reversed(element_children(element)):
                     stack.append((child, node, spec))
         assert root_spec is not None
@@ -242,15 +249,6 @@ class TreeBuilder:
                 location=SourceLocation(filename, spec.line),
             )
         self._create_subtree(subtree_id, path, path + "/", new_bb, node, ancestors)
-
-    def _compile_node(self, element: etree._Element, filename: str, prefix: str) -> NodeSpec:
-        """What building ``element`` needs that depends only on the XML and the registry."""
-        line = line_of(element)
-        signature = (element.tag, *element.attrib.items())
-        kind = self.kinds.get(signature)
-        if kind is None:
-            kind = self.kinds[signature] = self._compile_kind(element, filename, prefix, line)
-        return NodeSpec(kind, line)
 
     def _compile_kind(self, element: etree._Element, filename: str, prefix: str, line: int) -> NodeKind:
         tag = str(element.tag)
