@@ -367,6 +367,18 @@ def find_structure_problems(
             line, f"The tag <BehaviorTree> with ID '{tree_id}' must have exactly 1 child"
         ):
             return problems
+        if _plain_and_shallow(element):
+            # Every node is an element and none is too deep: walk them in document order (the order
+            # of the walk below) without listing each node's children.
+            for node in element.iterdescendants():
+                kind = (node.tag, node.get("ID"), len(node))
+                if kind not in fine:
+                    found = len(problems)
+                    if _verify_node(node, 1, manifests, report, known_trees, list(node)):
+                        return problems
+                    if len(problems) == found and kind[0] != "ReactiveSequence":
+                        fine.add(kind)
+            continue
         stack = [(child, 1) for child in reversed(element_children(element))]
         while stack:
             node, depth = stack.pop()
@@ -384,6 +396,19 @@ def find_structure_problems(
                 children.reverse()
                 stack.extend([(child, depth + 1) for child in children])
     return problems
+
+
+def _plain_and_shallow(tree: etree._Element) -> bool:
+    """True if a ``<BehaviorTree>`` holds no comment or processing instruction (its nodes' children
+    are all elements) and no node deeper than ``MAX_DEPTH`` (libxml2 answers both)."""
+    return not _NOT_PLAIN_OR_TOO_DEEP(tree)
+
+
+# Anything below the tree that is not an element, or a node at depth MAX_DEPTH + 1 (the tree's child
+# is at depth 1).
+_NOT_PLAIN_OR_TOO_DEEP = etree.XPath(
+    "boolean(.//comment() | .//processing-instruction() | ./*" + "/*" * MAX_DEPTH + ")"
+)
 
 
 def _verify_node(

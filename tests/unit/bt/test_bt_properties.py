@@ -254,3 +254,36 @@ def test_completed_or_halted_trees_leave_every_node_idle(body: str, actions: lis
         assert error.message
     finally:
         tree.halt_tree()
+
+
+def structure_soup(depth: int) -> st.SearchStrategy[str]:
+    """Trees with structural mistakes (empty controls, decorators with two children, leaves with
+    children, unknown and explicit tags), one element per line."""
+    leaves = st.sampled_from(
+        [*LEAVES, "<Nope/>", "<Action/>", '<Action ID="AlwaysSuccess"/>', '<SubTree ID="X"/>']
+    )
+    if depth == 0:
+        return leaves
+    child = structure_soup(depth - 1)
+    tags = st.sampled_from([*CONTROLS, *DECORATORS, "AlwaysSuccess", "SubTree", "Nope"])
+    return st.one_of(
+        leaves,
+        st.tuples(tags, st.lists(child, max_size=3)).map(
+            lambda t: f"<{t[0]}>\n{chr(10).join(t[1])}\n</{t[0].split()[0]}>"
+        ),
+    )
+
+
+@PROPERTY_SETTINGS
+@given(structure_soup(3), st.sampled_from(["<!-- note -->", "<?pi data?>"]))
+def test_comments_in_a_tree_do_not_change_its_structure_problems(body: str, remark: str) -> None:
+    # A tree without comments is checked on a quicker path; it must find the same problems, in the
+    # same order, at the same lines, as the walk that skips comments.
+    from kinema.bt.xmlparser import find_structure_problems
+    from kinema.bt.xmlsource import parse_xml
+
+    manifests = BehaviorTreeFactory().manifests()
+    plain = f'<root BTCPP_format="4"><BehaviorTree ID="M">\n{body}\n</BehaviorTree></root>'
+    remarked = plain.replace("\n", remark + "\n")
+    problems = find_structure_problems(parse_xml(plain), "f.xml", manifests)
+    assert find_structure_problems(parse_xml(remarked), "f.xml", manifests) == problems
