@@ -98,8 +98,9 @@ class TreeBuilder:
             raise BTRuntimeError(
                 f"Can't find a tree with name: {tree_id}; {did_you_mean(tree_id, self.library.trees)}"
             )
-        root_element = definition.root_element
-        if root_element is None:
+        plan = definition.plan if definition.plan_key == self.plan_key else None
+        root_element = definition.root_element if plan is None else None  # a plan was compiled from one
+        if plan is None and root_element is None:
             raise BTRuntimeError(
                 f"The tag <BehaviorTree> with ID '{tree_id}' must have exactly 1 child",
                 location=definition.location,
@@ -110,10 +111,10 @@ class TreeBuilder:
         self._subtree_paths.add(tree_path)
         ancestors.append(tree_id)
         filename = definition.filename
-        plan = definition.plan if definition.plan_key == self.plan_key else None
         if plan is None:
             # First instance with this registry: compile each element as it is reached (so the
             # first error is the one a plain walk meets first) and keep the plan for the next ones.
+            assert root_element is not None
             plan = self._compile_and_instantiate(
                 root_element, blackboard, parent, prefix, subtree, ancestors, filename
             )

@@ -569,6 +569,8 @@ class SubTreeNode(DecoratorNode):
         subtree_id: the ID of the tree it instantiates.
     """
 
+    __slots__ = ("subtree_id",)
+
     def __init__(self, name: str, config: NodeConfig | None = None) -> None:
         super().__init__(name, config)
         self.subtree_id = ""
