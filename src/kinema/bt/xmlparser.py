@@ -345,6 +345,8 @@ def find_structure_problems(
     if len(models) > 1 and report(line_of(models[1]), "Only a single node <TreeNodesModel> is supported"):
         return problems
     top_level = element_children(root)
+    # No node of any tree deeper than MAX_DEPTH (libxml2 answers for the whole document at once).
+    shallow = not _TOO_DEEP(root)
     tree_elements = root.findall("BehaviorTree")
     for element in tree_elements:
         tree_id = element.get("ID") or ""
@@ -367,7 +369,7 @@ def find_structure_problems(
             line, f"The tag <BehaviorTree> with ID '{tree_id}' must have exactly 1 child"
         ):
             return problems
-        if _plain_and_shallow(element):
+        if shallow and _plain(element):
             # Every node is an element and none is too deep: walk them in document order (the order
             # of the walk below) without listing each node's children.
             for node in element.iterdescendants():
@@ -398,17 +400,15 @@ def find_structure_problems(
     return problems
 
 
-def _plain_and_shallow(tree: etree._Element) -> bool:
-    """True if a ``<BehaviorTree>`` holds no comment or processing instruction (its nodes' children
-    are all elements) and no node deeper than ``MAX_DEPTH`` (libxml2 answers both)."""
-    return not _NOT_PLAIN_OR_TOO_DEEP(tree)
+def _plain(tree: etree._Element) -> bool:
+    """True if a ``<BehaviorTree>`` holds no comment or processing instruction (so its nodes' children
+    are all elements)."""
+    return not _NOT_PLAIN(tree)
 
 
-# Anything below the tree that is not an element, or a node at depth MAX_DEPTH + 1 (the tree's child
-# is at depth 1).
-_NOT_PLAIN_OR_TOO_DEEP = etree.XPath(
-    "boolean(.//comment() | .//processing-instruction() | ./*" + "/*" * MAX_DEPTH + ")"
-)
+_NOT_PLAIN = etree.XPath("boolean(.//comment() | .//processing-instruction())")
+# A node at depth MAX_DEPTH + 1 in any tree of the document (a tree's root node is at depth 1).
+_TOO_DEEP = etree.XPath("boolean(./*/*" + "/*" * MAX_DEPTH + ")")
 
 
 def _verify_node(

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import re
 
+import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
@@ -287,3 +288,20 @@ def test_comments_in_a_tree_do_not_change_its_structure_problems(body: str, rema
     remarked = plain.replace("\n", remark + "\n")
     problems = find_structure_problems(parse_xml(plain), "f.xml", manifests)
     assert find_structure_problems(parse_xml(remarked), "f.xml", manifests) == problems
+
+
+@pytest.mark.parametrize("depth", [255, 256, 257, 300])
+def test_nesting_at_the_depth_limit_is_reported_the_same_with_and_without_comments(depth: int) -> None:
+    # parse_xml refuses such documents itself; the check also serves trees built with lxml.
+    from lxml import etree
+
+    from kinema.bt.xmlparser import find_structure_problems
+
+    manifests = BehaviorTreeFactory().manifests()
+    body = "<Inverter>" * (depth - 1) + "<AlwaysSuccess/>" + "</Inverter>" * (depth - 1)
+    plain = f'<root BTCPP_format="4"><BehaviorTree ID="M">{body}</BehaviorTree></root>'
+    remarked = plain.replace("<AlwaysSuccess/>", "<AlwaysSuccess/><!-- leaf -->")
+    parser = etree.XMLParser(huge_tree=True)
+    problems = find_structure_problems(etree.fromstring(plain, parser), "f.xml", manifests)
+    assert find_structure_problems(etree.fromstring(remarked, parser), "f.xml", manifests) == problems
+    assert bool(problems) == (depth > 256)
