@@ -145,7 +145,7 @@ class TreeBuilder:
             signature = (element.tag, *element.items())
             kind = kinds.get(signature)
             if kind is None:
-                kind = kinds[signature] = self._compile_kind(element, filename, prefix, line)
+                kind = kinds[signature] = self._compile_kind(signature, filename, prefix, line)
             spec = NodeSpec(kind, line)
             if parent_spec is None:
                 root_spec = spec
@@ -251,31 +251,40 @@ class TreeBuilder:
             )
         self._create_subtree(subtree_id, path, path + "/", new_bb, node, ancestors)
 
-    def _compile_kind(self, element: etree._Element, filename: str, prefix: str, line: int) -> NodeKind:
-        tag = str(element.tag)
-        location = _LazyLocation(filename, line)
-        element_id = element.get("ID")
+    def _compile_kind(self, signature: tuple[Any, ...], filename: str, prefix: str, line: int) -> NodeKind:
+        """What an element compiles to, from its signature: its tag, then its attributes' (name, value)."""
+        tag = str(signature[0])
+        attributes: list[tuple[str, str]] = list(signature[1:])
+        values = dict(attributes)
+        element_id = values.get("ID")
         if tag in EXPLICIT_TAGS:
             if element_id is None:
-                raise BTRuntimeError(f"Attribute [ID] is mandatory in <{tag}>", location=location)
+                raise BTRuntimeError(
+                    f"Attribute [ID] is mandatory in <{tag}>", location=_LazyLocation(filename, line)
+                )
             type_id = element_id
         else:
             if not self.factory.is_registered(tag):
-                raise BTRuntimeError(f"{tag} is not a registered node", location=location)
+                raise BTRuntimeError(
+                    f"{tag} is not a registered node", location=_LazyLocation(filename, line)
+                )
             type_id = tag
             if element_id is not None:
-                raise BTRuntimeError(f"Attribute [ID] is not allowed in <{type_id}>", location=location)
-        explicit_name = element.get("name")
+                raise BTRuntimeError(
+                    f"Attribute [ID] is not allowed in <{type_id}>", location=_LazyLocation(filename, line)
+                )
+        explicit_name = values.get("name")
         instance_name = explicit_name if explicit_name is not None else type_id
         if explicit_name is not None:
             problem = instance_name_problem(explicit_name)
             if problem:
-                raise BTRuntimeError(f"Error at line {line}: {problem}", location=location)
+                raise BTRuntimeError(
+                    f"Error at line {line}: {problem}", location=_LazyLocation(filename, line)
+                )
         is_subtree = tag == "SubTree"
         manifest = None if is_subtree else self.manifests.get(type_id)
         port_remap: dict[str, str] = {}
         other: dict[str, str] = {}
-        attributes = [(str(name), value) for name, value in element.attrib.items()]
         for attr_name, attr_value in attributes:
             if is_allowed_port_name(attr_name):
                 if manifest is not None:
@@ -292,7 +301,7 @@ class TreeBuilder:
                                 if manifest.ports
                                 else f"{type_id} has no ports."
                             ),
-                            location=location,
+                            location=_LazyLocation(filename, line),
                         )
                     if (
                         not strict_blackboard_pointer(attr_value)
@@ -305,7 +314,7 @@ class TreeBuilder:
                             raise BTLogicError(
                                 f'The port with name "{attr_name}" and value "{attr_value}" can not be '
                                 f"converted to {type_name(port_info.type)}",
-                                location=location,
+                                location=_LazyLocation(filename, line),
                             ) from None
                 port_remap[attr_name] = attr_value
             elif attr_name not in RESERVED_ATTRIBUTES:
@@ -319,19 +328,18 @@ class TreeBuilder:
         spec.attributes = attributes
         # The path gets "::uid" when the node has no name of its own.
         spec.unnamed = instance_name == type_id
-        if other or len(attributes) > len(port_remap):
+        if not _CONDITION_ATTRIBUTES.isdisjoint(values):
             # The path the node is about to get (for messages only).
             path = prefix + instance_name + (f"::{self.tree._uid + 1}" if spec.unnamed else "")
-            # Only elements with reserved attributes can carry pre/post-conditions; the parsed
-            # scripts are stateless and shared by every instance.
+            # The parsed scripts are stateless and shared by every instance.
             for key in PRE_CONDITIONS:
-                code = element.get(key)
+                code = values.get(key)
                 if code is not None:
-                    spec.pre_conditions[key] = _parse_condition(code, key, path, location)
+                    spec.pre_conditions[key] = _parse_condition(code, key, path, filename, line)
             for key in POST_CONDITIONS:
-                code = element.get(key)
+                code = values.get(key)
                 if code is not None:
-                    spec.post_conditions[key] = _parse_condition(code, key, path, location)
+                    spec.post_conditions[key] = _parse_condition(code, key, path, filename, line)
         if is_subtree:
             spec.input_ports = dict(port_remap)
             spec.manifest = self.manifests.get("SubTree")
@@ -341,7 +349,7 @@ class TreeBuilder:
 
             raise BTRuntimeError(
                 f"Node not recognized: {type_id}; {did_you_mean(type_id, self.manifests)}",
-                location=location,
+                location=_LazyLocation(filename, line),
             )
         spec.manifest = manifest
         for port_name, port_info in manifest.ports.items():
@@ -530,6 +538,7 @@ class NodeKind:
 
 
 _new_config = object.__new__
+_CONDITION_ATTRIBUTES = frozenset((*PRE_CONDITIONS, *POST_CONDITIONS))
 
 
 class _LazyLocation(SourceLocation):
@@ -559,11 +568,11 @@ def _apply_defaults(manifest: Any, config: NodeSpec) -> None:
             config.output_ports[port_name] = text
 
 
-def _parse_condition(code: str, attribute: str, path: str, location: SourceLocation) -> Any:
+def _parse_condition(code: str, attribute: str, path: str, filename: str, line: int) -> Any:
     try:
         return parse_script(code)
     except ScriptParseError as error:
         raise BTLogicError(
             f"Error in the script \"{code}\" of attribute {attribute} in node '{path}': {error.message}",
-            location=location,
+            location=_LazyLocation(filename, line),
         ) from None

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import functools
+import re
 
 from kinema.bt.ports import RESERVED_PORT_NAMES
 
@@ -75,8 +76,11 @@ def is_allowed_port_name(name: str) -> bool:
 
 def instance_name_problem(name: str) -> str | None:
     """Why ``name`` is not a valid instance name (only control characters are refused), or None."""
-    for c in name:
-        code = ord(c)
-        if (code < 32 and c not in "\t\n\r") or code == 127:
-            return f"Instance name '{name}' contains invalid control character (ASCII {code})"
-    return None
+    found = _CONTROL_CHARACTER.search(name)
+    if found is None:
+        return None
+    return f"Instance name '{name}' contains invalid control character (ASCII {ord(found.group())})"
+
+
+# ASCII control characters other than tab, newline and carriage return, and DEL.
+_CONTROL_CHARACTER = re.compile("[\x00-\x08\x0b\x0c\x0e-\x1f\x7f]")

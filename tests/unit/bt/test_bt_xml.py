@@ -215,3 +215,12 @@ def test_objectives_are_written_back_with_their_metadata() -> None:
     assert model.metadata == [("subcategory", "Motion")] and model.ports["speed"].description == "how fast"
     tree = again.create_tree_from_text(written)
     assert tree.tick_once() is S
+
+
+def test_an_instance_name_with_a_control_character_is_refused_at_its_line() -> None:
+    # XML itself refuses most control characters; DEL reaches the name check, tab is a valid name.
+    document = '<root><BehaviorTree ID="T">\n<AlwaysSuccess name="{}"/></BehaviorTree></root>'
+    with pytest.raises(BTError, match=r"invalid control character \(ASCII 127\)") as caught:
+        BehaviorTreeFactory().create_tree_from_text(document.format("arm\x7f1"))
+    assert caught.value.location is not None and caught.value.location.line == 2
+    BehaviorTreeFactory().create_tree_from_text(document.format("arm&#9;1"))
