@@ -23,9 +23,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
-from kinema.bt.btlog import SUFFIX, BtlogWriter, Recording, pack_transition_columns, read_btlog
+from kinema.bt.btlog import SUFFIX, BtlogWriter, Recording, coded_records, pack_coded_transitions, read_btlog
 from kinema.errors import KinemaError
 
 if TYPE_CHECKING:
@@ -100,6 +98,9 @@ class RunRecorder:
         self._tree: Tree | None = None
         self._t0 = 0.0
         self._objective = ""
+        # the 9-byte record of every code of the run's node table (made at its first batch)
+        self._records: Any = None
+        self._records_table = 0
 
     @property
     def current(self) -> Path | None:
@@ -136,9 +137,17 @@ class RunRecorder:
         if writer is None:
             return
         was_truncated = writer.truncated
-        times, uids, _previous, statuses = changes.columns()
+        table = changes.table
+        if self._records_table != table.id:
+            self._records = coded_records(table.uids)
+            self._records_table = table.id
+        t0 = self._t0
+        # rounded half to even, as numpy's rint
+        offsets = [round((stamp - t0) * 1e6) for stamp in changes.stamps]
         try:
-            writer.write_packed(pack_transition_columns(np.rint((times - self._t0) * 1e6), uids, statuses))
+            writer.write_packed(
+                pack_coded_transitions(self._records, changes.code_array(), offsets, changes.starts)
+            )
         except OSError as error:
             log.warning("recording %s stopped: %s", writer.path, error)
             self._close_writer()
