@@ -190,7 +190,8 @@ class BtcppRecorded:
 
 
 class _SerializingPublisher:
-    """A publisher that does the agent's work up to the network: the message to CDR bytes."""
+    """A publisher that does the agent's work up to the network: the message to CDR bytes (the node
+    status codes come already serialised)."""
 
     def __init__(self, type_name: str) -> None:
         from kinema.transport.messages import _registry
@@ -201,6 +202,9 @@ class _SerializingPublisher:
 
     def publish(self, message: Any) -> None:
         self.sent += len(self.registry.serialize(message, self.type_name))
+
+    def publish_raw(self, payload: bytes) -> None:
+        self.sent += len(payload)
 
 
 class ObjectiveObservers:

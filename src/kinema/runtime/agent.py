@@ -20,12 +20,11 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from kinema.errors import KinemaError, ObjectiveError
 from kinema.runtime import names
 from kinema.runtime.error_codes import MoveItErrorCode
 from kinema.runtime.log_files import PLUGIN_LOGGER
+from kinema.runtime.node_status_cdr import NodeStatusCodesEncoder, generic_serializer
 from kinema.runtime.objective_server import (
     ObjectiveRequest,
     ObjectiveRun,
@@ -157,7 +156,7 @@ class _Streams:
         self._node_status = node.create_publisher(names.NODE_STATUS_TYPE, names.NODE_STATUS)
         self._node_table = node.create_publisher(names.NODE_TABLE_TYPE, names.NODE_TABLE, latched=True)
         self._table_id = 0
-        self._classes: tuple[type, type] | None = None
+        self._encoder: NodeStatusCodesEncoder | None = None
         self._blackboard = node.create_publisher(names.BLACKBOARD_TYPE, names.BLACKBOARD, latched=True)
         self._log = node.create_publisher(names.LOG_TYPE, names.LOG)
         self._status: tuple[ObjectiveStatus, str] = (ObjectiveStatus.IDLE, "")
@@ -233,31 +232,21 @@ class _Streams:
             self._table_id = table.id
         # In messages of at most NODE_STATUS_CHUNK changes: the stream is best effort (rmw_zenoh's
         # KEEP_LAST: dropped when the link is congested), and a very large message can be lost whole on a
-        # loaded machine; in chunks, what gets through is applied. Built from the message classes: the
-        # fields are already of their types (msg() would check every one, on every tick).
-        codes_class, time_class = self._node_status_classes()
+        # loaded machine; in chunks, what gets through is applied. Laid out directly as CDR: the generic
+        # serializer's fixed cost was most of this on every tick of a small tree.
+        encode = self._node_status_encoder().encode
         for part in changes.split(NODE_STATUS_CHUNK):
-            self._node_status.publish(
-                codes_class(
-                    objective_name=objective_name,
-                    table_id=table.id,
-                    stamps=[time_class(**_stamp(stamp)) for stamp in part.stamps],
-                    starts=np.array(part.starts, dtype=np.uint32),
-                    codes=part.code_array(),
-                )
+            self._node_status.publish_raw(
+                encode(objective_name, table.id, part.stamps, part.starts, part.code_array())
             )
 
-    def _node_status_classes(self) -> tuple[type, type]:
-        classes = self._classes
-        if classes is None:
+    def _node_status_encoder(self) -> NodeStatusCodesEncoder:
+        encoder = self._encoder
+        if encoder is None:
             from kinema.transport.messages import load_interfaces
 
-            registry = load_interfaces()
-            classes = self._classes = (
-                registry.message_class(names.NODE_STATUS_TYPE),
-                registry.message_class("builtin_interfaces/msg/Time"),
-            )
-        return classes
+            encoder = self._encoder = NodeStatusCodesEncoder(generic_serializer(load_interfaces()))
+        return encoder
 
     def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
         from kinema.transport.messages import msg

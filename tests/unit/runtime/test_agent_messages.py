@@ -116,15 +116,21 @@ def test_a_large_tick_is_published_as_several_node_status_messages_in_order() ->
     from kinema.bt import BehaviorTreeFactory
     from kinema.runtime.agent import NODE_STATUS_CHUNK, _Streams
     from kinema.runtime.node_status import NodeStatusRecorder
+    from kinema.transport.messages import _registry
 
+    registry = _registry(None)
     sent: list[tuple[str, Any]] = []
 
     class Publisher:
-        def __init__(self, topic: str) -> None:
+        def __init__(self, type_name: str, topic: str) -> None:
+            self.type_name = type_name
             self.topic = topic
 
         def publish(self, message: Any) -> None:
             sent.append((self.topic, message))
+
+        def publish_raw(self, payload: bytes) -> None:
+            sent.append((self.topic, registry.deserialize(payload, self.type_name)))
 
     leaves = NODE_STATUS_CHUNK + NODE_STATUS_CHUNK // 4  # two changes each: three messages
     xml = (
@@ -138,7 +144,7 @@ def test_a_large_tick_is_published_as_several_node_status_messages_in_order() ->
     tree.tick_once()
     batch = recorder.take()
     assert batch is not None and len(batch) > 2 * NODE_STATUS_CHUNK
-    node = SimpleNamespace(create_publisher=lambda _type, topic, **_: Publisher(topic))
+    node = SimpleNamespace(create_publisher=lambda type_name, topic, **_: Publisher(type_name, topic))
     streams = _Streams(node, None, SimpleNamespace())  # type: ignore[arg-type]
     streams.on_node_status("Big", batch)
     topics = [topic for topic, _ in sent]
