@@ -96,8 +96,30 @@ def overrides_from_messages(parameters: Sequence[Any]) -> tuple[ParameterOverrid
     return tuple(result)
 
 
+# Texts of plain values already rendered (short str, int, bool, None: equal values of one type render
+# alike). Every blackboard snapshot renders every entry twice (stream and recording), YAML takes about
+# 100 µs for a short string, and a tree's scopes hold the same few strings and numbers snapshot after
+# snapshot.
+_RENDERED: dict[tuple[type, Any], str] = {}
+_RENDERED_MOST = 4096
+_PLAIN = frozenset({str, int, bool, type(None)})
+
+
 def render_value(value: Any) -> str:
     """A blackboard value as one line of YAML flow text (messages as their fields), cut when long."""
+    kind = type(value)
+    if kind in _PLAIN and (kind is not str or len(value) <= MAX_VALUE_CHARS):
+        key = (kind, value)
+        text = _RENDERED.get(key)
+        if text is None:
+            if len(_RENDERED) >= _RENDERED_MOST:
+                _RENDERED.clear()
+            text = _RENDERED[key] = _render(value)
+        return text
+    return _render(value)
+
+
+def _render(value: Any) -> str:
     import yaml
 
     try:

@@ -58,6 +58,16 @@ def test_blackboard_values_render_as_yaml_flow(value: Any, text: str) -> None:
     assert render_value(value) == text
 
 
+def test_remembered_renderings_keep_equal_values_of_other_types_apart() -> None:
+    """1 == True == 1.0 and 0.0 == -0.0, but they render differently; so do a string and its quoted twin."""
+    from kinema.runtime.agent import _render
+
+    values = [1, True, 1.0, 0, False, 0.0, -0.0, None, "yes", "1", "1", 1, True, "x" * 3000, "x" * 3000]
+    for _ in range(2):
+        assert [render_value(value) for value in values] == [_render(value) for value in values]
+    assert [render_value(value) for value in (1, True, "yes")] == ["1", "true", "'yes'"]
+
+
 def test_long_values_are_cut() -> None:
     rendered = render_value(list(range(5000)))
     assert len(rendered) <= 2000 and "more" in rendered
