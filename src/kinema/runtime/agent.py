@@ -24,7 +24,7 @@ from kinema.errors import KinemaError, ObjectiveError
 from kinema.runtime import names
 from kinema.runtime.error_codes import MoveItErrorCode
 from kinema.runtime.log_files import PLUGIN_LOGGER
-from kinema.runtime.node_status_cdr import NodeStatusCodesEncoder, generic_serializer
+from kinema.runtime.node_status_cdr import NodeStatusCodesEncoder, generic_serializer, time_parts
 from kinema.runtime.objective_server import (
     ObjectiveRequest,
     ObjectiveRun,
@@ -59,8 +59,8 @@ NODE_STATUS_CHUNK = 50_000
 
 
 def _stamp(seconds: float) -> dict[str, int]:
-    sec = int(seconds)
-    return {"sec": sec, "nanosec": int((seconds - sec) * 1e9)}
+    sec, nanosec = time_parts(seconds)
+    return {"sec": sec, "nanosec": nanosec}
 
 
 def overrides_from_messages(parameters: Sequence[Any]) -> tuple[ParameterOverride, ...]:

@@ -22,8 +22,8 @@ _ENCAPSULATION = b"\x00\x01\x00\x00"
 _LITTLE = sys.byteorder == "little"
 
 
-def _stamp(seconds: float) -> tuple[int, int]:
-    """``builtin_interfaces/Time`` of ``seconds``, as the agent makes every stamp it sends."""
+def time_parts(seconds: float) -> tuple[int, int]:
+    """``(sec, nanosec)`` of a ``builtin_interfaces/Time`` for ``seconds``: every stamp the agent sends."""
     sec = int(seconds)
     return sec, int((seconds - sec) * 1e9)
 
@@ -64,7 +64,7 @@ class NodeStatusCodesEncoder:
         count = len(stamps)
         values: list[int] = [count]
         for seconds in stamps:
-            values.extend(_stamp(seconds))
+            values.extend(time_parts(seconds))
         values.append(len(starts))
         values.extend(starts)
         values.append(len(codes))
@@ -91,7 +91,7 @@ def generic_serializer(registry: Any) -> Callable[[str, int, Sequence[float], Se
         message = codes_class(
             objective_name=objective_name,
             table_id=table_id,
-            stamps=[time_class(*_stamp(seconds)) for seconds in stamps],
+            stamps=[time_class(*time_parts(seconds)) for seconds in stamps],
             starts=np.array(starts, dtype=np.uint32),
             codes=codes,
         )
