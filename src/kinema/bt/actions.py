@@ -42,11 +42,7 @@ class _ConstantNode(SyncActionNode):
         if prev is not result:
             self._status = result
             if self._watched:
-                log = self._log
-                if log is not None:
-                    log(self._log_base + prev * 5 + result)
-                if self._observers:
-                    self._notify_observers(prev, result)
+                self._log(self._log_base + prev * 5 + result)
         return result
 
 
@@ -156,11 +152,7 @@ class ScriptNode(_ScriptCode, SyncActionNode):
         if prev is not SUCCESS:
             self._status = SUCCESS
             if self._watched:
-                log = self._log
-                if log is not None:
-                    log(self._log_base + prev * 5 + SUCCESS)
-                if self._observers:
-                    self._notify_observers(prev, SUCCESS)
+                self._log(self._log_base + prev * 5 + SUCCESS)
         return SUCCESS
 
 
@@ -225,11 +217,7 @@ class ScriptConditionNode(_ScriptCode, ConditionNode):
         if prev is not status:
             self._status = status
             if self._watched:
-                log = self._log
-                if log is not None:
-                    log(self._log_base + prev * 5 + status)
-                if self._observers:
-                    self._notify_observers(prev, status)
+                self._log(self._log_base + prev * 5 + status)
         return status
 
 

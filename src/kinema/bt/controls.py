@@ -60,10 +60,10 @@ class SequenceNode(_ResumingControl):
             if self._status is not RUNNING:
                 if self._status is IDLE:
                     self._skipped = 0
+                was = self._status
+                self._status = RUNNING
                 if self._watched:
-                    _set_status_unchecked(self, RUNNING)
-                else:
-                    self._status = RUNNING
+                    self._log(self._log_base + was * 5 + RUNNING)
             idx = self._idx
             if self._asynch:
                 status = self._tick_async(children, n, idx)
@@ -101,8 +101,10 @@ class SequenceNode(_ResumingControl):
         if plain:
             prev = self._status
             if status is not prev:
-                if (status is SUCCESS or status is FAILURE) and not self._watched:
+                if status is SUCCESS or status is FAILURE:
                     self._status = status
+                    if self._watched:
+                        self._log(self._log_base + prev * 5 + status)
                 else:
                     _store_status(self, prev, status)
             elif status is IDLE:
@@ -168,10 +170,10 @@ class SequenceWithMemoryNode(ControlNode):
         if self._status is not RUNNING:
             if self._status is IDLE:
                 self._skipped = 0
+            was = self._status
+            self._status = RUNNING
             if self._watched:
-                _set_status_unchecked(self, RUNNING)
-            else:
-                self._status = RUNNING
+                self._log(self._log_base + was * 5 + RUNNING)
         while self._idx < n:
             child = children[self._idx]
             prev = child._status
@@ -221,10 +223,10 @@ class FallbackNode(_ResumingControl):
             if self._status is not RUNNING:
                 if self._status is IDLE:
                     self._skipped = 0
+                was = self._status
+                self._status = RUNNING
                 if self._watched:
-                    _set_status_unchecked(self, RUNNING)
-                else:
-                    self._status = RUNNING
+                    self._log(self._log_base + was * 5 + RUNNING)
             idx = self._idx
             if self._asynch:
                 status = self._tick_async(children, n, idx)
@@ -262,8 +264,10 @@ class FallbackNode(_ResumingControl):
         if plain:
             prev = self._status
             if status is not prev:
-                if (status is SUCCESS or status is FAILURE) and not self._watched:
+                if status is SUCCESS or status is FAILURE:
                     self._status = status
+                    if self._watched:
+                        self._log(self._log_base + prev * 5 + status)
                 else:
                     _store_status(self, prev, status)
             elif status is IDLE:
@@ -344,10 +348,10 @@ class ReactiveSequenceNode(_RunningChildControl):
             if prev is not RUNNING:
                 if prev is IDLE:
                     self._running_child = -1
+                was = self._status
+                self._status = RUNNING
                 if self._watched:
-                    _set_status_unchecked(self, RUNNING)
-                else:
-                    self._status = RUNNING
+                    self._log(self._log_base + was * 5 + RUNNING)
             children = self.children
             index = -1
             for child in children:
@@ -387,8 +391,10 @@ class ReactiveSequenceNode(_RunningChildControl):
         if plain:
             prev = self._status
             if status is not prev:
-                if (status is SUCCESS or status is FAILURE) and not self._watched:
+                if status is SUCCESS or status is FAILURE:
                     self._status = status
+                    if self._watched:
+                        self._log(self._log_base + prev * 5 + status)
                 else:
                     _store_status(self, prev, status)
             elif status is IDLE:

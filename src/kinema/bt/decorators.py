@@ -61,10 +61,10 @@ class _ResultMappingDecorator(DecoratorNode):
             return DecoratorNode.execute_tick(self)
         try:
             if self._status is not RUNNING:
+                was = self._status
+                self._status = RUNNING
                 if self._watched:
-                    _set_status_unchecked(self, RUNNING)
-                else:
-                    self._status = RUNNING
+                    self._log(self._log_base + was * 5 + RUNNING)
             child = self.child
             assert child is not None
             status = child.execute_tick()
@@ -75,11 +75,7 @@ class _ResultMappingDecorator(DecoratorNode):
                 else:
                     child._status = IDLE
                     if child._watched and done is not IDLE:
-                        log = child._log
-                        if log is not None:
-                            log(child._log_base + done * 5)  # IDLE is 0
-                        if child._observers:
-                            child._notify_observers(done, IDLE)
+                        child._log(child._log_base + done * 5)  # IDLE is 0
                 result = self._on_success if status is SUCCESS else self._on_failure
             elif status is RUNNING or status is SKIPPED:
                 return status  # stored already (RUNNING), or never stored (SKIPPED)
@@ -93,11 +89,7 @@ class _ResultMappingDecorator(DecoratorNode):
         if result is not prev:
             self._status = result
             if self._watched:
-                log = self._log
-                if log is not None:
-                    log(self._log_base + prev * 5 + result)
-                if self._observers:
-                    self._notify_observers(prev, result)
+                self._log(self._log_base + prev * 5 + result)
         return result
 
 
@@ -601,10 +593,10 @@ class SubTreeNode(DecoratorNode):
             return DecoratorNode.execute_tick(self)
         try:
             if self._status is IDLE:
+                was = self._status
+                self._status = RUNNING
                 if self._watched:
-                    _set_status_unchecked(self, RUNNING)
-                else:
-                    self._status = RUNNING
+                    self._log(self._log_base + was * 5 + RUNNING)
             child = self.child
             assert child is not None
             status = child.execute_tick()
@@ -615,11 +607,7 @@ class SubTreeNode(DecoratorNode):
                 else:
                     child._status = IDLE
                     if child._watched and done is not IDLE:
-                        log = child._log
-                        if log is not None:
-                            log(child._log_base + done * 5)  # IDLE is 0
-                        if child._observers:
-                            child._notify_observers(done, IDLE)
+                        child._log(child._log_base + done * 5)  # IDLE is 0
         except NodeExecutionError:
             raise
         except Exception as error:
@@ -629,11 +617,7 @@ class SubTreeNode(DecoratorNode):
             if status is SUCCESS or status is FAILURE:
                 self._status = status
                 if self._watched:
-                    log = self._log
-                    if log is not None:
-                        log(self._log_base + prev * 5 + status)
-                    if self._observers:
-                        self._notify_observers(prev, status)
+                    self._log(self._log_base + prev * 5 + status)
             elif status is not SKIPPED:
                 self._set_status(status)
         return status

@@ -19,6 +19,9 @@ from kinema.bt.errors import BTError, BTLogicError, BTRuntimeError, NodeExecutio
 from kinema.bt.ports import PortInfo, blackboard_pointer
 from kinema.bt.status import FAILURE, IDLE, RUNNING, SKIPPED, SUCCESS, NodeStatus
 
+# A change code's statuses: code % 25 is previous * 5 + new, each an index into this.
+_STATUSES = tuple(NodeStatus)
+
 if TYPE_CHECKING:
     from kinema.bt.blackboard import Blackboard
     from kinema.bt.clock import Clock
@@ -139,6 +142,7 @@ class TreeNode:
         "_hooked",
         "_literal_cache",
         "_log",
+        "_log_append",
         "_log_base",
         "_observers",
         "_post_tick",
@@ -161,8 +165,11 @@ class TreeNode:
         self._observers: tuple[StatusObserver, ...] = ()
         # The tree's transition log (``TransitionLog.codes.append``) while one is attached, and
         # this node's base code in it.
-        self._log: Callable[[int], None] | None = None
+        self._log_append: Callable[[int], None] | None = None
         self._log_base = 0
+        # Where a change goes while anything observes the node (see _rewire): called with the change's
+        # code, ``_log_base + previous * 5 + new``. None while nothing does.
+        self._log: Callable[[int], None] | None = None
         # True while anything observes the node (a callback or a log): the one test on the hot path.
         self._watched = False
         self._bindings: dict[str, tuple[str | None, Any, Any]] = {}
@@ -261,11 +268,7 @@ class TreeNode:
                 # Inlined _set_status for the common case: this is the hot path of every tick.
                 self._status = status
                 if self._watched:
-                    log = self._log
-                    if log is not None:
-                        log(self._log_base + prev * 5 + status)
-                    if self._observers:
-                        self._notify_observers(prev, status)
+                    self._log(self._log_base + prev * 5 + status)
             elif status is not SKIPPED:
                 self._set_status(status)
         elif status is IDLE or (status is RUNNING and self._forbid_running):
@@ -273,16 +276,32 @@ class TreeNode:
         return status
 
     def _notify(self, prev: NodeStatus, new: NodeStatus) -> None:
-        """Report a change already stored: one code in the tree's log, then each callback.
+        """Report a change already stored (only while ``_watched``; the hot paths inline this call)."""
+        self._log(self._log_base + prev * 5 + new)  # type: ignore[misc]
 
-        The hot paths inline the log's half and call :meth:`_notify_observers` only when there are
-        callbacks.
+    def _rewire(self) -> None:
+        """Point ``_log`` at what observes the node now: the tree's log, the callbacks, both, or nothing.
+
+        One call per change then serves them all, and the hot paths test one flag.
         """
-        log = self._log
-        if log is not None:
-            log(self._log_base + prev * 5 + new)
-        if self._observers:
-            self._notify_observers(prev, new)
+        append = self._log_append
+        if not self._observers:
+            self._log = append
+        elif append is None:
+            self._log = self._notify_code
+        else:
+            notify = self._notify_code
+
+            def log_and_notify(code: int) -> None:
+                append(code)
+                notify(code)
+
+            self._log = log_and_notify
+        self._watched = self._log is not None
+
+    def _notify_code(self, code: int) -> None:
+        rest = code % 25
+        self._notify_observers(_STATUSES[rest // 5], _STATUSES[rest % 5])
 
     def _notify_observers(self, prev: NodeStatus, new: NodeStatus) -> None:
         clock = self.config.clock
@@ -381,11 +400,7 @@ class TreeNode:
             return
         self._status = IDLE
         if self._watched:
-            log = self._log
-            if log is not None:
-                log(self._log_base + prev * 5)  # IDLE is 0
-            if self._observers:
-                self._notify_observers(prev, IDLE)
+            self._log(self._log_base + prev * 5)  # IDLE is 0
 
     def halt_node(self) -> None:
         """``halt()`` followed by the ``_onHalted`` script."""
@@ -406,14 +421,14 @@ class TreeNode:
     def subscribe_to_status_change(self, callback: StatusObserver) -> Callable[[], None]:
         """Call ``callback(timestamp, node, prev, new)`` on every status change; returns an unsubscriber."""
         self._observers = (*self._observers, callback)
-        self._watched = True
+        self._rewire()
 
         def unsubscribe() -> None:
             if callback in self._observers:
                 observers = list(self._observers)
                 observers.remove(callback)
                 self._observers = tuple(observers)
-                self._watched = bool(observers) or self._log is not None
+                self._rewire()
 
         return unsubscribe
 
@@ -680,11 +695,7 @@ def _store_status(node: TreeNode, prev: NodeStatus, status: NodeStatus) -> None:
     if status is SUCCESS or status is FAILURE:
         node._status = status
         if node._watched:
-            log = node._log
-            if log is not None:
-                log(node._log_base + prev * 5 + status)
-            if node._observers:
-                node._notify_observers(prev, status)
+            node._log(node._log_base + prev * 5 + status)
     elif status is not SKIPPED:
         node._set_status(status)
 
@@ -695,11 +706,7 @@ def _set_status_unchecked(node: TreeNode, new: NodeStatus) -> None:
         return
     node._status = new
     if node._watched:
-        log = node._log
-        if log is not None:
-            log(node._log_base + prev * 5 + new)
-        if node._observers:
-            node._notify_observers(prev, new)
+        node._log(node._log_base + prev * 5 + new)
 
 
 # -- composites -------------------------------------------------------------------------------------
@@ -733,11 +740,7 @@ class ControlNode(TreeNode):
                 elif child._watched:
                     # reset_status() inlined: an observed tree resets every completed child
                     child._status = IDLE
-                    log = child._log
-                    if log is not None:
-                        log(child._log_base + status * 5)  # IDLE is 0
-                    if child._observers:
-                        child._notify_observers(status, IDLE)
+                    child._log(child._log_base + status * 5)  # IDLE is 0
                 else:
                     child._status = IDLE
 
@@ -790,11 +793,7 @@ class DecoratorNode(TreeNode):
                 if status is SUCCESS or status is FAILURE:
                     self._status = status
                     if self._watched:
-                        log = self._log
-                        if log is not None:
-                            log(self._log_base + prev * 5 + status)
-                        if self._observers:
-                            self._notify_observers(prev, status)
+                        self._log(self._log_base + prev * 5 + status)
                 elif status is not SKIPPED:
                     self._set_status(status)
             elif status is IDLE or (status is RUNNING and self._forbid_running):

@@ -54,9 +54,9 @@ class TransitionLog:
             )
         append = self.codes.append
         for index, node in enumerate(self.nodes):
-            node._log = append
+            node._log_append = append
             node._log_base = index * 25
-            node._watched = True
+            node._rewire()
         tree.transition_log = self
 
     def mark(self) -> None:
@@ -125,7 +125,7 @@ class TransitionLog:
     def close(self) -> None:
         """Stop recording (what was recorded stays readable)."""
         for node in self.nodes:
-            node._log = None
-            node._watched = bool(node._observers)
+            node._log_append = None
+            node._rewire()
         if self._tree.transition_log is self:
             self._tree.transition_log = None

@@ -78,3 +78,29 @@ def test_one_log_per_tree_and_close_stops_it() -> None:
     again = tree.record_transitions()
     tree.tick_once()
     assert len(again.take()) > 0
+
+
+def test_callbacks_and_the_log_come_and_go_independently() -> None:
+    # One call per change serves the log, the callbacks or both: each reader sees exactly its own span.
+    tree = _tree(XML)
+    reference = _tree(XML)
+    every: list[tuple[str, NodeStatus, NodeStatus]] = []
+    reference.add_status_observer(lambda _t, node, prev, new: every.append((node.full_path, prev, new)))
+    per_tick = []
+    for _ in range(4):
+        before = len(every)
+        reference.tick_once()
+        per_tick.append(every[before:])
+
+    seen: list[tuple[str, NodeStatus, NodeStatus]] = []
+    handle = tree.add_status_observer(lambda _t, node, prev, new: seen.append((node.full_path, prev, new)))
+    tree.tick_once()  # callback only
+    log = tree.record_transitions()
+    tree.tick_once()  # both
+    tree.remove_status_observer(handle)
+    tree.tick_once()  # log only
+    log.close()
+    tree.tick_once()  # neither
+    assert seen == per_tick[0] + per_tick[1]
+    assert [(node.full_path, prev, new) for node, prev, new, _ in log.take()] == per_tick[1] + per_tick[2]
+    assert all(not node._watched and node._log is None for node in tree.nodes())
