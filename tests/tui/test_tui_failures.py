@@ -210,6 +210,41 @@ def test_a_cancelled_run_shows_halted_nodes(fake: FakeConnection) -> None:
     drive(fake, scenario)
 
 
+def test_halts_reported_after_the_cancellation_keep_the_nodes_shown_halted(fake: FakeConnection) -> None:
+    """On a loaded machine the halt's changes (RUNNING -> IDLE) can reach the UI after the run's end."""
+
+    async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
+        fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
+        fake.emit(
+            NodeStatusBatch(
+                "Pick Object",
+                (
+                    update(SEQUENCE, NodeStatus.RUNNING),
+                    update(MOVE, NodeStatus.SUCCESS),
+                    update(WAIT, NodeStatus.RUNNING),
+                    update(SLEEP, NodeStatus.RUNNING),
+                ),
+            )
+        )
+        fake.emit(Heartbeat(11.0, "Pick Object", "Cancelled"))
+        fake.emit(LogEntry("objective 'Pick Object' was cancelled: cancelled", LogLevel.WARN, 1.0))
+        await settle(pilot)
+        fake.emit(
+            NodeStatusBatch(
+                "Pick Object",
+                tuple(update(node, NodeStatus.IDLE, NodeStatus.RUNNING) for node in (SLEEP, WAIT, SEQUENCE)),
+            )
+        )
+        await settle(pilot)
+        view = app.screen.query_one(BehaviorTreeView)
+        assert view.shown_as("Wait and Log::3/Sleep::5") == "HALTED"
+        assert view.shown_as("TopLevelSequence") == "HALTED"
+        assert view.shown_as("MoveToWaypoint::2") == "SUCCESS"
+        assert app.screen.query_one("#failure-panel", Static).has_class("cancelled")
+
+    drive(fake, scenario)
+
+
 def test_a_failure_whose_node_never_reported_it_is_still_shown(fake: FakeConnection) -> None:
     """An exception in a behavior ends the run before the node's FAILURE reaches the UI."""
 

@@ -109,6 +109,8 @@ class BehaviorTreeView(Tree["OutlineNode"]):
             previous = self.statuses.get(node.uid, NodeStatus.IDLE)
             if update.status is NodeStatus.IDLE and previous in _RESULTS:
                 continue  # parents reset finished children to IDLE; keep showing how they ended
+            if update.status is NodeStatus.IDLE and node.uid in self.halted:
+                continue  # its halt, reported after the run's end had already shown it halted
             if update.status is NodeStatus.IDLE and previous is NodeStatus.RUNNING:
                 self.halted.add(node.uid)  # a running node reset to IDLE was halted
             else:
