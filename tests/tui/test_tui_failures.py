@@ -180,6 +180,44 @@ def test_a_failure_whose_outcome_comes_before_the_run_itself_stays_explained(fak
     drive(fake, scenario)
 
 
+def test_the_run_after_one_whose_start_came_last_starts_clean(
+    fake: FakeConnection,
+) -> None:
+    """Statuses, then the outcome, then the ended run's late start on the heartbeat: the next run's
+    start must still reset the tree (the late start belonged to the run its statuses had started)."""
+    batch = NodeStatusBatch(
+        "Pick Object",
+        (
+            update(SEQUENCE, NodeStatus.RUNNING),
+            update(SCRIPT, NodeStatus.FAILURE),
+            update(SEQUENCE, NodeStatus.FAILURE, NodeStatus.RUNNING),
+            update(SCRIPT, NodeStatus.IDLE, NodeStatus.FAILURE),
+            update(SEQUENCE, NodeStatus.IDLE, NodeStatus.FAILURE),
+        ),
+    )
+
+    async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
+        view = app.screen.query_one(BehaviorTreeView)
+        fake.emit(Heartbeat(5.0, "Pick Object", "Idle"))
+        await settle(pilot)
+        for event in (
+            batch,
+            LogEntry(FAILED, LogLevel.ERROR, 1.0, "objective_server"),
+            Heartbeat(10.0, "Pick Object", "Running"),
+            Heartbeat(10.5, "Pick Object", "Failure"),
+        ):
+            fake.emit(event)
+            await settle(pilot)
+        assert view.failed_path == [1, 7, 9]
+        fake.emit(Heartbeat(20.0, "Pick Object", "Idle"))
+        await settle(pilot)
+        fake.emit(Heartbeat(30.0, "Pick Object", "Running"))  # the next run, before any of its statuses
+        await settle(pilot)
+        assert view.failed_path == [] and view.shown_as("Script::9") == "IDLE"
+
+    drive(fake, scenario)
+
+
 def test_a_cancelled_run_shows_halted_nodes(fake: FakeConnection) -> None:
     async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
         fake.emit(Heartbeat(10.0, "Pick Object", "Running"))

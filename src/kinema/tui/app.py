@@ -275,7 +275,9 @@ class KinemaApp(App[None]):
                 ):
                     del self._ended_ahead[event.objective_name]  # the heartbeat caught up with the end
                 if started and event.objective_name in self._ended_ahead:
-                    pass  # the ended run's own start, late (see _ended_ahead)
+                    # The ended run's own start, late (see _ended_ahead). If its statuses started it,
+                    # that note is used up: the next start on the heartbeat is a new run's.
+                    self._started_by_statuses.discard(event.objective_name)
                 elif started:
                     if event.objective_name in self._started_by_statuses:
                         # Its statuses came first (a busy machine reorders topics): already reset.
