@@ -28,6 +28,19 @@ def update(node: tuple[int, str, str, str], status: NodeStatus, previous: NodeSt
     return NodeStatusUpdate(*node, status, previous)
 
 
+# A whole run in one batch: the script fails, the sequence with it, and both are reset.
+FAILED_RUN = NodeStatusBatch(
+    "Pick Object",
+    (
+        update(SEQUENCE, NodeStatus.RUNNING),
+        update(SCRIPT, NodeStatus.FAILURE),
+        update(SEQUENCE, NodeStatus.FAILURE, NodeStatus.RUNNING),
+        update(SCRIPT, NodeStatus.IDLE, NodeStatus.FAILURE),
+        update(SEQUENCE, NodeStatus.IDLE, NodeStatus.FAILURE),
+    ),
+)
+
+
 def failed_run(fake: FakeConnection) -> None:
     """A run of Pick Object whose Script fails; parents reset their children to IDLE as the run ends."""
     fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
@@ -133,16 +146,6 @@ def test_a_failure_whose_outcome_comes_before_the_run_itself_stays_explained(fak
     """The outcome travels on the log topic: a loaded machine may deliver it before the run's heartbeat and
     statuses (seen in CI: the failed node was marked, then wiped by the run's own late start). Late start
     signals of the run whose outcome is shown must not reset the tree; a later run still starts clean."""
-    batch = NodeStatusBatch(
-        "Pick Object",
-        (
-            update(SEQUENCE, NodeStatus.RUNNING),
-            update(SCRIPT, NodeStatus.FAILURE),
-            update(SEQUENCE, NodeStatus.FAILURE, NodeStatus.RUNNING),
-            update(SCRIPT, NodeStatus.IDLE, NodeStatus.FAILURE),
-            update(SEQUENCE, NodeStatus.IDLE, NodeStatus.FAILURE),
-        ),
-    )
 
     async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
         view = app.screen.query_one(BehaviorTreeView)
@@ -153,7 +156,7 @@ def test_a_failure_whose_outcome_comes_before_the_run_itself_stays_explained(fak
         await settle(pilot)
         fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
         await settle(pilot)
-        fake.emit(batch)
+        fake.emit(FAILED_RUN)
         await settle(pilot)
         fake.emit(Heartbeat(10.5, "Pick Object", "Failure"))
         await settle(pilot)
@@ -168,7 +171,7 @@ def test_a_failure_whose_outcome_comes_before_the_run_itself_stays_explained(fak
         await settle(pilot)
         fake.emit(Heartbeat(21.0, "Pick Object", "Failure"))
         await settle(pilot)
-        fake.emit(batch)
+        fake.emit(FAILED_RUN)
         await settle(pilot)
         assert view.shown_as("Script::9") == "FAILURE"
         assert view.failed_path == [1, 7, 9]
@@ -185,23 +188,13 @@ def test_the_run_after_one_whose_start_came_last_starts_clean(
 ) -> None:
     """Statuses, then the outcome, then the ended run's late start on the heartbeat: the next run's
     start must still reset the tree (the late start belonged to the run its statuses had started)."""
-    batch = NodeStatusBatch(
-        "Pick Object",
-        (
-            update(SEQUENCE, NodeStatus.RUNNING),
-            update(SCRIPT, NodeStatus.FAILURE),
-            update(SEQUENCE, NodeStatus.FAILURE, NodeStatus.RUNNING),
-            update(SCRIPT, NodeStatus.IDLE, NodeStatus.FAILURE),
-            update(SEQUENCE, NodeStatus.IDLE, NodeStatus.FAILURE),
-        ),
-    )
 
     async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
         view = app.screen.query_one(BehaviorTreeView)
         fake.emit(Heartbeat(5.0, "Pick Object", "Idle"))
         await settle(pilot)
         for event in (
-            batch,
+            FAILED_RUN,
             LogEntry(FAILED, LogLevel.ERROR, 1.0, "objective_server"),
             Heartbeat(10.0, "Pick Object", "Running"),
             Heartbeat(10.5, "Pick Object", "Failure"),

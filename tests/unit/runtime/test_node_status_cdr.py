@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 import pytest
+from observed_tree import SMALL_TREE_XML
 
 from kinema.bt import BehaviorTreeFactory, ManualClock
 from kinema.errors import TransportError
@@ -76,12 +77,7 @@ def test_the_agent_publishes_the_bytes_of_the_generic_serializer(monkeypatch: py
     streams = agent._Streams(node, None, SimpleNamespace())  # type: ignore[arg-type]
     clock = ManualClock(1_700_000_000.123456789)
     factory = BehaviorTreeFactory(clock=clock)
-    xml = (
-        '<root BTCPP_format="4"><BehaviorTree ID="Main"><Sequence>'
-        "<Fallback><AlwaysFailure/><AlwaysSuccess/></Fallback>"
-        '<Inverter><AlwaysFailure/></Inverter><Delay delay_msec="1"><AlwaysSuccess/></Delay>'
-        "</Sequence></BehaviorTree></root>"
-    )
+    xml = SMALL_TREE_XML
     for objective_name in ("Run one", "Deux"):
         tree = factory.create_tree_from_text(xml)
         recorder = NodeStatusRecorder()

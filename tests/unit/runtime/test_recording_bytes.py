@@ -6,6 +6,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from observed_tree import SMALL_TREE_XML
 
 from kinema.bt import BehaviorTreeFactory, ManualClock
 from kinema.bt.btlog import (
@@ -58,12 +59,7 @@ def _half_microsecond_steps(count: int) -> list[float]:
 def test_the_recorder_writes_the_bytes_the_columns_gave(tmp_path: Path) -> None:
     clock = ManualClock(1000.0)
     factory = BehaviorTreeFactory(clock=clock)
-    xml = (
-        '<root BTCPP_format="4"><BehaviorTree ID="Main"><Sequence>'
-        "<Fallback><AlwaysFailure/><AlwaysSuccess/></Fallback>"
-        '<Inverter><AlwaysFailure/></Inverter><Delay delay_msec="1"><AlwaysSuccess/></Delay>'
-        "</Sequence></BehaviorTree></root>"
-    )
+    xml = SMALL_TREE_XML
     recording = RunRecorder(tmp_path)
     expected = b""
     half_steps = iter(_half_microsecond_steps(40))
