@@ -28,6 +28,17 @@ def update(node: tuple[int, str, str, str], status: NodeStatus, previous: NodeSt
     return NodeStatusUpdate(*node, status, previous)
 
 
+# A run's first tick: the move done, the subtree's Sleep running.
+RUNNING_RUN = NodeStatusBatch(
+    "Pick Object",
+    (
+        update(SEQUENCE, NodeStatus.RUNNING),
+        update(MOVE, NodeStatus.SUCCESS),
+        update(WAIT, NodeStatus.RUNNING),
+        update(SLEEP, NodeStatus.RUNNING),
+    ),
+)
+
 # A whole run in one batch: the script fails, the sequence with it, and both are reset.
 FAILED_RUN = NodeStatusBatch(
     "Pick Object",
@@ -214,17 +225,7 @@ def test_the_run_after_one_whose_start_came_last_starts_clean(
 def test_a_cancelled_run_shows_halted_nodes(fake: FakeConnection) -> None:
     async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
         fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
-        fake.emit(
-            NodeStatusBatch(
-                "Pick Object",
-                (
-                    update(SEQUENCE, NodeStatus.RUNNING),
-                    update(MOVE, NodeStatus.SUCCESS),
-                    update(WAIT, NodeStatus.RUNNING),
-                    update(SLEEP, NodeStatus.RUNNING),
-                ),
-            )
-        )
+        fake.emit(RUNNING_RUN)
         fake.emit(NodeStatusBatch("Pick Object", (update(SLEEP, NodeStatus.IDLE, NodeStatus.RUNNING),)))
         fake.emit(Heartbeat(11.0, "Pick Object", "Cancelled"))
         fake.emit(LogEntry("objective 'Pick Object' was cancelled: cancelled", LogLevel.WARN, 1.0))
@@ -246,17 +247,7 @@ def test_halts_reported_after_the_cancellation_keep_the_nodes_shown_halted(fake:
 
     async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
         fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
-        fake.emit(
-            NodeStatusBatch(
-                "Pick Object",
-                (
-                    update(SEQUENCE, NodeStatus.RUNNING),
-                    update(MOVE, NodeStatus.SUCCESS),
-                    update(WAIT, NodeStatus.RUNNING),
-                    update(SLEEP, NodeStatus.RUNNING),
-                ),
-            )
-        )
+        fake.emit(RUNNING_RUN)
         fake.emit(Heartbeat(11.0, "Pick Object", "Cancelled"))
         fake.emit(LogEntry("objective 'Pick Object' was cancelled: cancelled", LogLevel.WARN, 1.0))
         await settle(pilot)
