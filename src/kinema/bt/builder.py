@@ -273,7 +273,7 @@ class TreeBuilder:
                 raise BTRuntimeError(
                     f"Attribute [ID] is not allowed in <{type_id}>", location=_LazyLocation(filename, line)
                 )
-        explicit_name = values.get("name")
+        explicit_name: str | None = values.get("name")
         instance_name = explicit_name if explicit_name is not None else type_id
         if explicit_name is not None:
             problem = instance_name_problem(explicit_name)
@@ -356,9 +356,9 @@ class TreeBuilder:
             value = port_remap.get(port_name)
             if value is None:
                 continue
-            key = blackboard_pointer(value, port_name)
-            if key is not None:
-                spec.entries.append((key, port_info))
+            entry_key = blackboard_pointer(value, port_name)
+            if entry_key is not None:
+                spec.entries.append((entry_key, port_info))
         for port_name, value in port_remap.items():
             direction = manifest.ports[port_name].direction
             if direction is not PortDirection.OUTPUT:
@@ -378,35 +378,35 @@ class TreeBuilder:
     ) -> TreeNode:
         tree = self.tree
         line = spec.line
-        spec = spec.kind  # type: ignore[assignment]
+        kind = spec.kind
         config = _new_config(NodeConfig)
         config.blackboard = blackboard
         uid = tree._uid + 1
         if uid > MAX_TREE_NODES:
             tree.next_uid()  # raises, with the explanation
         tree._uid = config.uid = uid
-        instance_name = spec.instance_name
-        config.path = prefix + instance_name + f"::{uid}" if spec.unnamed else prefix + instance_name
-        config.manifest = spec.manifest
+        instance_name = kind.instance_name
+        config.path = prefix + instance_name + f"::{uid}" if kind.unnamed else prefix + instance_name
+        config.manifest = kind.manifest
         config.enums = self._enums
         config.wake_up = tree.wake_up
         config.clock = self._clock
         config.source_file = filename
         config.source_line = line
         # Each node owns its dicts (a node may change them); most are empty, and {} is the cheap copy.
-        config.other_attributes = spec.other.copy() if spec.other else {}
-        config.input_ports = spec.input_ports.copy() if spec.input_ports else {}
-        config.output_ports = spec.output_ports.copy() if spec.output_ports else {}
-        config.pre_conditions = spec.pre_conditions.copy() if spec.pre_conditions else {}
-        config.post_conditions = spec.post_conditions.copy() if spec.post_conditions else {}
-        if spec.is_subtree:
+        config.other_attributes = kind.other.copy() if kind.other else {}
+        config.input_ports = kind.input_ports.copy() if kind.input_ports else {}
+        config.output_ports = kind.output_ports.copy() if kind.output_ports else {}
+        config.pre_conditions = kind.pre_conditions.copy() if kind.pre_conditions else {}
+        config.post_conditions = kind.post_conditions.copy() if kind.post_conditions else {}
+        if kind.is_subtree:
             node = self.factory.instantiate_node("SubTree", instance_name, config)
             assert isinstance(node, SubTreeNode)
-            node.subtree_id = spec.type_id
+            node.subtree_id = kind.type_id
         else:
-            if spec.entries:
-                self._precreate_entries(spec.entries, blackboard, _LazyLocation(filename, line))
-            type_id = spec.type_id
+            if kind.entries:
+                self._precreate_entries(kind.entries, blackboard, _LazyLocation(filename, line))
+            type_id = kind.type_id
             cls = self._classes.get(type_id)
             try:
                 if cls is None:
@@ -549,7 +549,7 @@ class _LazyLocation(SourceLocation):
         object.__setattr__(self, "line", line)
 
 
-def _apply_defaults(manifest: Any, config: NodeSpec) -> None:
+def _apply_defaults(manifest: Any, config: NodeKind) -> None:
     """Declared defaults for ports the XML omits (an empty default is not applied, as in BT.CPP)."""
     for port_name, port_info in manifest.ports.items():
         if not port_info.has_default or not port_info.default_str:

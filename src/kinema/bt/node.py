@@ -169,7 +169,7 @@ class TreeNode:
         self._log_base = 0
         # Where a change goes while anything observes the node (see _rewire): called with the change's
         # code, ``_log_base + previous * 5 + new``. None while nothing does.
-        self._log: Callable[[int], None] | None = None
+        self._log: Any = None  # Callable[[int], None] | None, called only while _watched
         # True while anything observes the node (a callback or a log): the one test on the hot path.
         self._watched = False
         self._bindings: dict[str, tuple[str | None, Any, Any]] = {}
@@ -277,7 +277,7 @@ class TreeNode:
 
     def _notify(self, prev: NodeStatus, new: NodeStatus) -> None:
         """Report a change already stored (only while ``_watched``; the hot paths inline this call)."""
-        self._log(self._log_base + prev * 5 + new)  # type: ignore[misc]
+        self._log(self._log_base + prev * 5 + new)
 
     def _rewire(self) -> None:
         """Point ``_log`` at what observes the node now: the tree's log, the callbacks, both, or nothing.
