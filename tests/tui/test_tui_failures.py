@@ -6,7 +6,15 @@ from textual.pilot import Pilot
 from textual.widgets import RichLog, Static
 from tui_pilot_harness import drive, settle
 
-from kinema.tui.connection import Heartbeat, LogEntry, LogLevel, NodeStatus, NodeStatusBatch, NodeStatusUpdate
+from kinema.tui.connection import (
+    Heartbeat,
+    LogEntry,
+    LogLevel,
+    NodeStatus,
+    NodeStatusBatch,
+    NodeStatusUpdate,
+    RuntimeEvent,
+)
 from kinema.tui.fake_connection import FakeConnection
 from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
 
@@ -26,6 +34,13 @@ FAILED = (
 
 def update(node: tuple[int, str, str, str], status: NodeStatus, previous: NodeStatus = NodeStatus.IDLE):
     return NodeStatusUpdate(*node, status, previous)
+
+
+async def deliver(fake: FakeConnection, pilot: Pilot[None], *events: RuntimeEvent) -> None:
+    """Emit ``events`` one at a time, letting the app take each before the next (their order is the test)."""
+    for event in events:
+        fake.emit(event)
+        await settle(pilot)
 
 
 # A run's first tick: the move done, the subtree's Sleep running.
@@ -160,17 +175,16 @@ def test_a_failure_whose_outcome_comes_before_the_run_itself_stays_explained(fak
 
     async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
         view = app.screen.query_one(BehaviorTreeView)
-        fake.emit(Heartbeat(5.0, "Pick Object", "Success"))  # the run before, held
-        await settle(pilot)
+        await deliver(fake, pilot, Heartbeat(5.0, "Pick Object", "Success"))  # the run before, held
         # Outcome first, then the run's heartbeat and statuses, then its end on the heartbeat.
-        fake.emit(LogEntry(FAILED, LogLevel.ERROR, 1.0, "objective_server"))
-        await settle(pilot)
-        fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
-        await settle(pilot)
-        fake.emit(FAILED_RUN)
-        await settle(pilot)
-        fake.emit(Heartbeat(10.5, "Pick Object", "Failure"))
-        await settle(pilot)
+        await deliver(
+            fake,
+            pilot,
+            LogEntry(FAILED, LogLevel.ERROR, 1.0, "objective_server"),
+            Heartbeat(10.0, "Pick Object", "Running"),
+            FAILED_RUN,
+            Heartbeat(10.5, "Pick Object", "Failure"),
+        )
         assert view.shown_as("Script::9") == "FAILURE"
         assert view.failed_path == [1, 7, 9]
         assert any(line.startswith("why: ") for line in detail_lines(view))
@@ -178,12 +192,13 @@ def test_a_failure_whose_outcome_comes_before_the_run_itself_stays_explained(fak
         fake.emit(Heartbeat(20.0, "Pick Object", "Idle"))
         await pilot.press("r")
         await settle(pilot)
-        fake.emit(LogEntry(FAILED, LogLevel.ERROR, 1.0, "objective_server"))
-        await settle(pilot)
-        fake.emit(Heartbeat(21.0, "Pick Object", "Failure"))
-        await settle(pilot)
-        fake.emit(FAILED_RUN)
-        await settle(pilot)
+        await deliver(
+            fake,
+            pilot,
+            LogEntry(FAILED, LogLevel.ERROR, 1.0, "objective_server"),
+            Heartbeat(21.0, "Pick Object", "Failure"),
+            FAILED_RUN,
+        )
         assert view.shown_as("Script::9") == "FAILURE"
         assert view.failed_path == [1, 7, 9]
         # A new run, in the usual order, starts clean.
@@ -202,16 +217,15 @@ def test_the_run_after_one_whose_start_came_last_starts_clean(
 
     async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
         view = app.screen.query_one(BehaviorTreeView)
-        fake.emit(Heartbeat(5.0, "Pick Object", "Idle"))
-        await settle(pilot)
-        for event in (
+        await deliver(
+            fake,
+            pilot,
+            Heartbeat(5.0, "Pick Object", "Idle"),
             FAILED_RUN,
             LogEntry(FAILED, LogLevel.ERROR, 1.0, "objective_server"),
             Heartbeat(10.0, "Pick Object", "Running"),
             Heartbeat(10.5, "Pick Object", "Failure"),
-        ):
-            fake.emit(event)
-            await settle(pilot)
+        )
         assert view.failed_path == [1, 7, 9]
         fake.emit(Heartbeat(20.0, "Pick Object", "Idle"))
         await settle(pilot)
