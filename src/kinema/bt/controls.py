@@ -9,7 +9,6 @@ from kinema.bt.node import (
     NodeConfig,
     PortError,
     _set_status_unchecked,
-    _store_status,
     inlines_tick,
 )
 from kinema.bt.ports import PortInfo, input_port
@@ -105,8 +104,8 @@ class SequenceNode(_ResumingControl):
                     self._status = status
                     if self._watched:
                         self._log(self._log_base + prev * 5 + status)
-                else:
-                    _store_status(self, prev, status)
+                elif status is not SKIPPED:
+                    self._set_status(status)
             elif status is IDLE:
                 self._set_status(status)
         return status
@@ -268,8 +267,8 @@ class FallbackNode(_ResumingControl):
                     self._status = status
                     if self._watched:
                         self._log(self._log_base + prev * 5 + status)
-                else:
-                    _store_status(self, prev, status)
+                elif status is not SKIPPED:
+                    self._set_status(status)
             elif status is IDLE:
                 self._set_status(status)
         return status
@@ -395,8 +394,8 @@ class ReactiveSequenceNode(_RunningChildControl):
                     self._status = status
                     if self._watched:
                         self._log(self._log_base + prev * 5 + status)
-                else:
-                    _store_status(self, prev, status)
+                elif status is not SKIPPED:
+                    self._set_status(status)
             elif status is IDLE:
                 self._set_status(status)
         return status

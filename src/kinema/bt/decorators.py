@@ -593,10 +593,9 @@ class SubTreeNode(DecoratorNode):
             return DecoratorNode.execute_tick(self)
         try:
             if self._status is IDLE:
-                was = self._status
                 self._status = RUNNING
                 if self._watched:
-                    self._log(self._log_base + was * 5 + RUNNING)
+                    self._log(self._log_base + RUNNING)  # from IDLE, which is 0
             child = self.child
             assert child is not None
             status = child.execute_tick()

@@ -689,17 +689,6 @@ def inlines_tick(method: Callable[..., NodeStatus]) -> Callable[..., NodeStatus]
     return method
 
 
-def _store_status(node: TreeNode, prev: NodeStatus, status: NodeStatus) -> None:
-    """Store what a plain tick returned when it differs from ``prev``: the end of
-    :meth:`TreeNode.execute_tick`, for nodes whose fused ``execute_tick`` inlines only its common case."""
-    if status is SUCCESS or status is FAILURE:
-        node._status = status
-        if node._watched:
-            node._log(node._log_base + prev * 5 + status)
-    elif status is not SKIPPED:
-        node._set_status(status)
-
-
 def _set_status_unchecked(node: TreeNode, new: NodeStatus) -> None:
     prev = node._status
     if prev is new:
