@@ -25,10 +25,7 @@ from kinema.errors import SourceLocation
 if TYPE_CHECKING:
     from kinema.bt.manifest import NodeManifest
 
-# Documents loaded from text, by (text, filename, verify, registry): a factory that loads the same
-# objective again (a hot reload of an unchanged file, /do_objective with the same XML) skips parsing,
-# verifying and compiling it. Oldest first; the trees are read-only once loaded.
-_DOCUMENTS: dict[tuple[object, ...], tuple[etree._Element, list[TreeDefinition]]] = {}
+# How many documents loaded from text a library keeps for loading them again (see TreeLibrary.load_text).
 _MAX_CACHED_DOCUMENTS = 32
 
 EXPLICIT_TAGS = frozenset({"Action", "Condition", "Control", "Decorator", "SubTree"})
@@ -126,6 +123,12 @@ class TreeLibrary:
         self.first_main_tree: str | None = None
         self.documents_loaded = 0
         self._suffix = 0
+        # Documents loaded from text, by (text, filename, verify, registry), oldest first: loading the
+        # same objective again (a hot reload of an unchanged file, /do_objective with the same XML)
+        # skips parsing, verifying and compiling it. The cache is the library's own and goes with its
+        # factory: a registry key names one factory, so no other library could use an entry, and
+        # entries kept past their factory only grew the collector's oldest generation.
+        self._documents: dict[tuple[object, ...], tuple[etree._Element, list[TreeDefinition]]] = {}
 
     def clear(self) -> None:
         """Forget every tree (the factory's ``clear_registered_behavior_trees``)."""
@@ -156,7 +159,8 @@ class TreeLibrary:
         document and its trees' compiled plans (a document with ``<include>`` is always re-read).
         """
         key = (text, filename, verify, registry) if registry is not None else None
-        cached = _DOCUMENTS.get(key) if key is not None else None
+        documents = self._documents
+        cached = documents.get(key) if key is not None else None
         if cached is not None:
             root, definitions = cached
             self._read_models(root, filename)
@@ -171,9 +175,9 @@ class TreeLibrary:
         if key is not None and root.find("include") is None:
             ids = [element.get("ID") for element in root.findall("BehaviorTree")]
             if all(ids):
-                if len(_DOCUMENTS) >= _MAX_CACHED_DOCUMENTS:
-                    del _DOCUMENTS[next(iter(_DOCUMENTS))]
-                _DOCUMENTS[key] = (root, [self.trees[tree_id] for tree_id in ids if tree_id is not None])
+                if len(documents) >= _MAX_CACHED_DOCUMENTS:
+                    del documents[next(iter(documents))]
+                documents[key] = (root, [self.trees[tree_id] for tree_id in ids if tree_id is not None])
         return root
 
     def load_file(

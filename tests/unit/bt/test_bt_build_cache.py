@@ -2,10 +2,13 @@
 
 from __future__ import annotations
 
+import gc
+
 import pytest
 
 from kinema.bt import BehaviorTreeFactory, NodeStatus
 from kinema.bt.errors import BTError
+from kinema.bt.xmlparser import TreeDefinition
 
 XML = """
 <root BTCPP_format="4" main_tree_to_execute="Main">
@@ -66,3 +69,21 @@ def test_a_registry_change_is_seen_by_the_next_build() -> None:
     tree = factory.create_tree_from_text(XML)
     tree.root_blackboard.set("count", 0)
     assert tree.tick_once() is NodeStatus.SUCCESS
+
+
+def test_a_dropped_factory_takes_its_loaded_documents_with_it() -> None:
+    # The cache of loaded documents belongs to the factory: a runtime that makes a factory per
+    # reload does not keep every version of every objective it ever loaded.
+    def alive() -> int:
+        gc.collect()
+        return sum(1 for obj in gc.get_objects() if isinstance(obj, TreeDefinition))
+
+    before = alive()
+    factory = _factory()
+    factory.create_tree_from_text(XML)
+    assert alive() == before + 2  # Main and Leaf
+    for _ in range(3):
+        _factory().create_tree_from_text(XML)
+    assert alive() == before + 2
+    del factory
+    assert alive() == before
