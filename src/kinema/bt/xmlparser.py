@@ -377,12 +377,15 @@ def find_structure_problems(
             # Every node is an element and none is too deep: walk them in document order (the order
             # of the walk below) without listing each node's children.
             for node in element.iterdescendants():
-                kind = (node.tag, node.get("ID"), len(node))
+                tag = node.tag
+                kind = (tag, node.get("ID"), len(node))
+                if tag == "ReactiveSequence":
+                    kind += tuple([child.tag for child in node])
                 if kind not in fine:
                     found = len(problems)
                     if _verify_node(node, 1, manifests, report, known_trees, list(node)):
                         return problems
-                    if len(problems) == found and kind[0] != "ReactiveSequence":
+                    if len(problems) == found:
                         fine.add(kind)
             continue
         stack = [(child, 1) for child in reversed(element_children(element))]
@@ -391,12 +394,15 @@ def find_structure_problems(
             children = element_children(node)
             # Whether a node is fine depends only on its tag, ID and number of children (and its
             # depth, and for a ReactiveSequence its children's tags): check each such kind once.
-            kind = (node.tag, node.get("ID"), len(children))
+            tag = node.tag
+            kind = (tag, node.get("ID"), len(children))
+            if tag == "ReactiveSequence":
+                kind += tuple([child.tag for child in children])
             if depth > MAX_DEPTH or kind not in fine:
                 found = len(problems)
                 if _verify_node(node, depth, manifests, report, known_trees, children):
                     return problems
-                if len(problems) == found and kind[0] != "ReactiveSequence":
+                if len(problems) == found:
                     fine.add(kind)
             if children:
                 children.reverse()

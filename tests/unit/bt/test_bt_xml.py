@@ -66,6 +66,22 @@ def test_document_errors(xml: str, message: str) -> None:
     assert message in str(info.value)
 
 
+@pytest.mark.parametrize("comment", ["", "<!-- a comment makes the walk list each node's children -->"])
+def test_a_reactive_sequence_is_checked_by_its_own_children(comment: str) -> None:
+    # Two ReactiveSequences alike in all but their children's tags: only the second one is wrong.
+    async_child = "<AsyncSequence><AlwaysSuccess/></AsyncSequence>"
+    xml = (
+        '<root BTCPP_format="4">\n<BehaviorTree ID="M">\n<Sequence>\n'
+        f"<ReactiveSequence>{async_child}<Sequence><AlwaysSuccess/></Sequence></ReactiveSequence>\n"
+        f"<ReactiveSequence>{async_child}{comment}{async_child}</ReactiveSequence>\n"
+        "</Sequence>\n</BehaviorTree>\n</root>"
+    )
+    with pytest.raises(ObjectiveError) as info:
+        BehaviorTreeFactory().create_tree_from_text(xml)
+    assert "Error at line 5" in str(info.value)
+    assert "more than one async child" in str(info.value)
+
+
 def test_errors_carry_file_and_line(tmp_path: Path) -> None:
     path = tmp_path / "bad.xml"
     path.write_text(
