@@ -73,6 +73,8 @@ class _ScriptCode:
     unchanged script costs no extra call).
     """
 
+    __slots__ = ()  # a mixin: Script and ScriptCondition hold its state in their own slots
+
     config: NodeConfig
     full_path: str
     registration_id: str
@@ -110,6 +112,8 @@ class _ScriptCode:
 
 class ScriptNode(_ScriptCode, SyncActionNode):
     """Runs the ``code`` script and returns SUCCESS (an empty script does nothing)."""
+
+    __slots__ = ("_code", "_literal", "_script")
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
@@ -158,6 +162,8 @@ class ScriptNode(_ScriptCode, SyncActionNode):
 
 class ScriptConditionNode(_ScriptCode, ConditionNode):
     """SUCCESS if the ``code`` script evaluates to true, else FAILURE."""
+
+    __slots__ = ("_code", "_literal", "_script")
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

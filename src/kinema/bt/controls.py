@@ -25,6 +25,10 @@ class _ResumingControl(ControlNode):
     Halting starts over from the first child (SequenceWithMemory keeps its index and is not one).
     """
 
+    # Slots, as for the node state of every built-in: no instance dict to allocate per node, and the
+    # tick reads them as slots.
+    __slots__ = ("_idx", "_skipped")
+
     def __init__(self, name: str, config: NodeConfig | None = None) -> None:
         super().__init__(name, config)
         self._idx = 0
@@ -320,6 +324,8 @@ class AsyncFallbackNode(FallbackNode):
 class _RunningChildControl(ControlNode):
     """State of ReactiveSequence, ReactiveFallback and Switch: the index of a child that went
     RUNNING (-1: none); halting forgets it."""
+
+    __slots__ = ("_running_child",)
 
     def __init__(self, name: str, config: NodeConfig | None = None) -> None:
         super().__init__(name, config)

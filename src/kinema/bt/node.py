@@ -31,6 +31,8 @@ if TYPE_CHECKING:
 StatusObserver = Callable[[float, "TreeNode", NodeStatus, NodeStatus], None]
 
 _MISSING: Any = object()
+# The port-read caches of a node that has read no port yet (never written: see TreeNode.__init__).
+_NOTHING_READ: Any = {}
 
 
 class NodeConfig:
@@ -172,8 +174,11 @@ class TreeNode:
         self._log: Any = None  # Callable[[int], None] | None, called only while _watched
         # True while anything observes the node (a callback or a log): the one test on the hot path.
         self._watched = False
-        self._bindings: dict[str, tuple[str | None, Any, Any]] = {}
-        self._literal_cache: dict[tuple[str, Any], Any] = {}
+        # Filled by the first port reads; until then both are the one shared empty dict (most nodes
+        # read no port, and a tree of them skips two allocations a node). Written only after
+        # replacing it: see _binding and get_input.
+        self._bindings: dict[str, tuple[str | None, Any, Any]] = _NOTHING_READ
+        self._literal_cache: dict[tuple[str, Any], Any] = _NOTHING_READ
         manifest = self.config.manifest
         self.registration_id: str = manifest.id if manifest is not None else type(self).__name__
         self._pre_tick: Callable[[TreeNode], NodeStatus] | None = None
@@ -449,6 +454,8 @@ class TreeNode:
         manifest = self.config.manifest
         port_info = manifest.ports.get(name) if manifest is not None else None
         binding = (key, raw, port_info.type if port_info is not None else None)
+        if self._bindings is _NOTHING_READ:
+            self._bindings = {}
         self._bindings[name] = binding
         return binding
 
@@ -479,6 +486,8 @@ class TreeNode:
                     f"node '{self.full_path}': port [{name}] value \"{raw}\" can not be converted: "
                     f"{error.message}"
                 ) from None
+            if self._literal_cache is _NOTHING_READ:
+                self._literal_cache = {}
             self._literal_cache[cache_key] = value
             return list(value) if value.__class__ is list else value
         entry = self.config.blackboard.get_entry(key)
