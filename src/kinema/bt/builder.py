@@ -5,6 +5,8 @@ from __future__ import annotations
 import enum
 from typing import TYPE_CHECKING, Any
 
+from lxml import etree
+
 from kinema.bt.blackboard import Blackboard
 from kinema.bt.conversions import Unsigned, convert_from_string, parse_double_full, parse_int_full, type_name
 from kinema.bt.decorators import SubTreeNode
@@ -21,12 +23,10 @@ from kinema.bt.node import ControlNode, DecoratorNode, NodeConfig, TreeNode
 from kinema.bt.ports import PortDirection, blackboard_pointer, strict_blackboard_pointer
 from kinema.bt.script import parse_script
 from kinema.bt.tree import Subtree, Tree
-from kinema.bt.xmlparser import EXPLICIT_TAGS, element_children
+from kinema.bt.xmlparser import EXPLICIT_TAGS
 from kinema.errors import SourceLocation
 
 if TYPE_CHECKING:
-    from lxml import etree
-
     from kinema.bt.factory import BehaviorTreeFactory
 
 MAX_SUBTREE_DEPTH = 256
@@ -133,37 +133,43 @@ class TreeBuilder:
         subtree: Subtree,
         ancestors: list[str],
         filename: str,
-    ) -> NodeSpec:
-        stack: list[tuple[etree._Element, TreeNode | None, NodeSpec | None]] = [(root_element, parent, None)]
+    ) -> list[PlanStep]:
+        # The elements in document order (pre-order: the order nodes are created and numbered in),
+        # each compiled as it is reached, so the first error is the one a plain walk meets first.
+        plan: list[PlanStep] = []
         nodes = subtree.nodes
         kinds = self.kinds
-        root_spec: NodeSpec | None = None
-        while stack:
-            element, parent_node, parent_spec = stack.pop()
+        # element -> its index in the plan, for elements that take children (a SubTree's are ignored)
+        index_of: dict[etree._Element, int] = {}
+        elements = root_element.iter(etree.Element)
+        for element in elements:
+            if plan:
+                parent_index = index_of.get(element.getparent(), -1)
+                if parent_index < 0:
+                    continue  # below a <SubTree>
+                parent_node: TreeNode | None = nodes[parent_index]
+            else:
+                parent_index = -1
+                parent_node = parent
             # What the element compiles to depends only on its tag and attributes (and the registry).
             line = element.sourceline or 0
             signature = (element.tag, *element.items())
             kind = kinds.get(signature)
             if kind is None:
                 kind = kinds[signature] = self._compile_kind(signature, filename, prefix, line)
-            spec = NodeSpec(kind, line)
-            if parent_spec is None:
-                root_spec = spec
-            else:
-                parent_spec.children.append(spec)
-            node = self._create_node(spec, blackboard, parent_node, prefix, filename)
-            nodes.append(node)
+            plan.append((kind, line, parent_index))
+            node = self._create_node(kind, line, blackboard, parent_node, prefix, filename)
             if kind.is_subtree:
-                self._enter_subtree(node, spec, subtree, blackboard, filename, ancestors)  # type: ignore[arg-type]
-            elif len(element):
-                for child in reversed(element_children(element)):
-                    stack.append((child, node, spec))
-        assert root_spec is not None
-        return root_spec
+                nodes.append(node)
+                self._enter_subtree(node, kind, line, subtree, blackboard, filename, ancestors)  # type: ignore[arg-type]
+            else:
+                index_of[element] = len(nodes)
+                nodes.append(node)
+        return plan
 
     def _instantiate_plan(
         self,
-        plan: NodeSpec,
+        plan: list[PlanStep],
         blackboard: Blackboard,
         parent: TreeNode | None,
         prefix: str,
@@ -171,30 +177,28 @@ class TreeBuilder:
         ancestors: list[str],
         filename: str,
     ) -> None:
-        # Iterative depth-first walk (pre-order, uids in creation order) so deep trees cannot
-        # exhaust the Python stack.
-        stack: list[tuple[NodeSpec, TreeNode | None]] = [(plan, parent)]
+        # A flat walk: each step's parent was made before it (pre-order), and the subtree's nodes
+        # are the plan's steps in order.
         nodes = subtree.nodes
-        while stack:
-            spec, parent_node = stack.pop()
-            node = self._create_node(spec, blackboard, parent_node, prefix, filename)
+        create = self._create_node
+        for kind, line, parent_index in plan:
+            node = create(
+                kind, line, blackboard, nodes[parent_index] if parent_index >= 0 else parent, prefix, filename
+            )
             nodes.append(node)
-            if spec.kind.is_subtree:
-                self._enter_subtree(node, spec, subtree, blackboard, filename, ancestors)  # type: ignore[arg-type]
-            else:
-                for child in reversed(spec.children):
-                    stack.append((child, node))
+            if kind.is_subtree:
+                self._enter_subtree(node, kind, line, subtree, blackboard, filename, ancestors)  # type: ignore[arg-type]
 
     def _enter_subtree(
         self,
         node: SubTreeNode,
-        spec: NodeSpec,
+        kind: NodeKind,
+        line: int,
         subtree: Subtree,
         blackboard: Blackboard,
         filename: str,
         ancestors: list[str],
     ) -> None:
-        kind = spec.kind
         subtree_id = kind.type_id
         new_bb = Blackboard.create(blackboard)
         remapping: dict[str, str] = {}
@@ -206,7 +210,7 @@ class TreeBuilder:
                 try:
                     autoremap = convert_from_string(bool, attr_value)
                 except BTError as error:
-                    location = SourceLocation(filename, spec.line)
+                    location = SourceLocation(filename, line)
                     raise BTRuntimeError(error.message, location=location) from None
                 new_bb.enable_auto_remapping(autoremap)
                 continue
@@ -222,7 +226,7 @@ class TreeBuilder:
                             f'In the <TreeNodesModel> the <Subtree ID="{subtree_id}"> is defining '
                             "a mandatory "
                             f"port called [{port_name}], but you are not remapping it",
-                            location=SourceLocation(filename, spec.line),
+                            location=SourceLocation(filename, line),
                         )
                     remapping[port_name] = port_info.default_str
         for attr_name, attr_value in remapping.items():
@@ -247,7 +251,7 @@ class TreeBuilder:
                 f"Duplicate SubTree path detected: '{path}'. Multiple SubTree nodes with the same 'name' "
                 "attribute under the same parent are not allowed. Please use unique names or omit the "
                 "'name' attribute to auto-generate unique paths.",
-                location=SourceLocation(filename, spec.line),
+                location=SourceLocation(filename, line),
             )
         self._create_subtree(subtree_id, path, path + "/", new_bb, node, ancestors)
 
@@ -370,15 +374,14 @@ class TreeBuilder:
 
     def _create_node(
         self,
-        spec: NodeSpec,
+        kind: NodeKind,
+        line: int,
         blackboard: Blackboard,
         parent: TreeNode | None,
         prefix: str,
         filename: str,
     ) -> TreeNode:
         tree = self.tree
-        line = spec.line
-        kind = spec.kind
         config = _new_config(NodeConfig)
         config.blackboard = blackboard
         uid = tree._uid + 1
@@ -485,21 +488,6 @@ def _number_fits(existing: Any, port_info: Any) -> bool:
     return 0 <= number <= 2**32 - 1 if target is Unsigned else -(2**31) <= number < 2**31
 
 
-class NodeSpec:
-    """One element of a tree definition as the builder needs it: its kind, line and children.
-
-    Plans (a spec per element, children in order) are kept on the :class:`TreeDefinition` with the
-    registry generation they were made for, so SubTree instances and later builds skip the XML.
-    """
-
-    __slots__ = ("children", "kind", "line")
-
-    def __init__(self, kind: NodeKind, line: int) -> None:
-        self.kind = kind
-        self.line = line
-        self.children: list[NodeSpec] = []
-
-
 class NodeKind:
     """What an element compiles to against a registry, shared by every element written the same
     way (same tag and attributes) and by every instance of it."""
@@ -536,6 +524,12 @@ class NodeKind:
         # (blackboard key, port info) of every port given as a {pointer}, in the manifest's order
         self.entries: list[tuple[str, Any]] = []
 
+
+# One element of a tree definition as the builder needs it: (what it compiles to, its line, the index
+# of its parent's step, -1 for the tree's root). A plan is a definition's steps in document order
+# (pre-order); it is kept on the TreeDefinition with the registry generation it was made for, so
+# SubTree instances and later builds skip the XML.
+PlanStep = tuple["NodeKind", int, int]
 
 _new_config = object.__new__
 _CONDITION_ATTRIBUTES = frozenset((*PRE_CONDITIONS, *POST_CONDITIONS))
