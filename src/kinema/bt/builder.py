@@ -52,6 +52,7 @@ class TreeBuilder:
         self.library = factory.library
         self.manifests = factory.manifests()
         self.tree = Tree(factory.clock, self.manifests)
+        self._wake_up = self.tree.wake_up  # one bound method for every node's config
         # Plans compiled for another factory or registry generation are not reused.
         self.plan_key = factory.plan_key()
         self._enums = factory.enums
@@ -392,16 +393,17 @@ class TreeBuilder:
         config.path = prefix + instance_name + f"::{uid}" if kind.unnamed else prefix + instance_name
         config.manifest = kind.manifest
         config.enums = self._enums
-        config.wake_up = tree.wake_up
+        config.wake_up = self._wake_up
         config.clock = self._clock
         config.source_file = filename
         config.source_line = line
         # Each node owns its dicts (a node may change them); most are empty, and {} is the cheap copy.
-        config.other_attributes = kind.other.copy() if kind.other else {}
+        # (the three made on demand stay None when empty)
+        config._other_attributes = kind.other.copy() if kind.other else None
         config.input_ports = kind.input_ports.copy() if kind.input_ports else {}
         config.output_ports = kind.output_ports.copy() if kind.output_ports else {}
-        config.pre_conditions = kind.pre_conditions.copy() if kind.pre_conditions else {}
-        config.post_conditions = kind.post_conditions.copy() if kind.post_conditions else {}
+        config._pre_conditions = kind.pre_conditions.copy() if kind.pre_conditions else None
+        config._post_conditions = kind.post_conditions.copy() if kind.post_conditions else None
         if kind.is_subtree:
             node = self.factory.instantiate_node("SubTree", instance_name, config)
             assert isinstance(node, SubTreeNode)

@@ -35,6 +35,26 @@ _MISSING: Any = object()
 _NOTHING_READ: Any = {}
 
 
+class _DictOnDemand:
+    """A dict attribute of :class:`NodeConfig` kept as None in its slot (``_<name>``) until it is first
+    read or set: most nodes have none, and a tree builds faster without allocating them."""
+
+    def __set_name__(self, owner: type, name: str) -> None:
+        self.slot = getattr(owner, "_" + name)  # the slot's member descriptor
+
+    def __get__(self, config: Any, owner: type | None = None) -> Any:
+        if config is None:
+            return self
+        value = self.slot.__get__(config, owner)
+        if value is None:
+            value = {}
+            self.slot.__set__(config, value)
+        return value
+
+    def __set__(self, config: Any, value: dict[str, Any]) -> None:
+        self.slot.__set__(config, value)
+
+
 class NodeConfig:
     """Everything a node instance gets from the tree that contains it.
 
@@ -53,21 +73,25 @@ class NodeConfig:
     """
 
     __slots__ = (
+        "_other_attributes",
+        "_post_conditions",
+        "_pre_conditions",
         "blackboard",
         "clock",
         "enums",
         "input_ports",
         "manifest",
-        "other_attributes",
         "output_ports",
         "path",
-        "post_conditions",
-        "pre_conditions",
         "source_file",
         "source_line",
         "uid",
         "wake_up",
     )
+
+    pre_conditions: dict[str, Script] = _DictOnDemand()  # type: ignore[assignment]
+    post_conditions: dict[str, Script] = _DictOnDemand()  # type: ignore[assignment]
+    other_attributes: dict[str, str] = _DictOnDemand()  # type: ignore[assignment]
 
     def __init__(self, blackboard: Blackboard | None = None) -> None:
         if blackboard is None:
@@ -81,9 +105,10 @@ class NodeConfig:
         self.uid = 0
         self.path = ""
         self.enums: dict[str, int] = {}
-        self.pre_conditions: dict[str, Script] = {}
-        self.post_conditions: dict[str, Script] = {}
-        self.other_attributes: dict[str, str] = {}
+        # None stands for empty (see _DictOnDemand): most nodes have no conditions or other attributes.
+        self._pre_conditions: dict[str, Script] | None = None
+        self._post_conditions: dict[str, Script] | None = None
+        self._other_attributes: dict[str, str] | None = None
         self.wake_up: Any = None
         self.clock: Clock | None = None
         self.source_file: str | None = None
@@ -185,14 +210,14 @@ class TreeNode:
         self._post_tick: Callable[[TreeNode, NodeStatus], NodeStatus] | None = None
         config = self.config
         self._hooked = bool(
-            config.pre_conditions or config.post_conditions
+            config._pre_conditions or config._post_conditions
         )  # _refresh_hooked, no callbacks yet
 
     def _refresh_hooked(self) -> None:
         # The plain tick path is taken unless the node has conditions or injected callbacks.
         config = self.config
         self._hooked = bool(
-            config.pre_conditions or config.post_conditions or self._pre_tick or self._post_tick
+            config._pre_conditions or config._post_conditions or self._pre_tick or self._post_tick
         )
 
     def set_pre_tick_callback(self, callback: Callable[[TreeNode], NodeStatus] | None) -> None:
@@ -327,7 +352,7 @@ class TreeNode:
 
     def _execute_tick_hooked(self) -> NodeStatus:
         config = self.config
-        status = self._check_pre_conditions() if config.pre_conditions else None
+        status = self._check_pre_conditions() if config._pre_conditions else None
         if status is None:
             pre_tick = self._pre_tick
             if pre_tick is not None and self._status is not SUCCESS and self._status is not FAILURE:
@@ -341,8 +366,8 @@ class TreeNode:
                     raise
                 except Exception as error:
                     raise self._wrap_exception(error) from error
-        if (status is SUCCESS or status is FAILURE) and config.post_conditions:
-            post = config.post_conditions
+        if (status is SUCCESS or status is FAILURE) and config._post_conditions:
+            post = config._post_conditions
             script = post.get("_onSuccess" if status is SUCCESS else "_onFailure")
             if script is not None:
                 script.run(config.blackboard, config.enums)

@@ -14,6 +14,7 @@ from kinema.bt import (
     BTLogicError,
     ConditionNode,
     ManualClock,
+    NodeConfig,
     NodeExecutionError,
     NodeStatus,
     NodeType,
@@ -165,6 +166,32 @@ def test_a_node_that_drops_its_config_or_a_builder_that_returns_no_node_fails_th
         with pytest.raises(BTLogicError, match=message) as caught:
             factory.create_tree_from_text(xml)
         assert caught.value.location is not None and caught.value.location.line == 3
+
+
+def test_each_node_owns_its_config_dicts(bench) -> None:
+    # Empty ones are made on first use, each node its own; what the XML gave is each node's copy.
+    tree = bench.tree(
+        '<Sequence><AlwaysSuccess name="a"/><AlwaysSuccess name="b"/>'
+        '<AlwaysSuccess name="c" _note="x" _onSuccess="done := 1"/>'
+        '<AlwaysSuccess name="d" _note="x" _onSuccess="done := 1"/>'
+        "</Sequence>"
+    )
+    a, b, c, d = (tree.node_by_path(name).config for name in "abcd")
+    for name in ("other_attributes", "pre_conditions", "post_conditions", "input_ports", "output_ports"):
+        assert getattr(a, name) == {} and getattr(a, name) is not getattr(b, name), name
+        assert getattr(a, name) is getattr(a, name), name
+    a.other_attributes["_note"] = "mine"
+    a.post_conditions["_onSuccess"] = c.post_conditions["_onSuccess"]
+    assert b.other_attributes == {} and b.post_conditions == {}
+    assert c.other_attributes == d.other_attributes == {"_note": "x"}
+    c.other_attributes["_note"] = "changed"
+    assert d.other_attributes == {"_note": "x"}
+    assert tree.tick_once() is S
+    assert tree.root_blackboard.get("done") == 1
+    fresh = NodeConfig()
+    assert fresh.pre_conditions == fresh.post_conditions == fresh.other_attributes == {}
+    fresh.other_attributes = {"k": "v"}
+    assert fresh.other_attributes == {"k": "v"}
 
 
 def test_every_factory_gets_the_same_builtin_models_and_owns_them() -> None:
