@@ -201,7 +201,7 @@ class TreeBuilder:
         ancestors: list[str],
     ) -> None:
         subtree_id = kind.type_id
-        new_bb = Blackboard.create(blackboard)
+        new_bb = Blackboard(blackboard)
         remapping: dict[str, str] = {}
         autoremap = False
         for attr_name, attr_value in kind.attributes:
@@ -326,6 +326,7 @@ class TreeBuilder:
                 other[attr_name] = attr_value
         spec = NodeKind()
         spec.type_id = type_id
+        spec.node_type = "SubTree" if is_subtree else type_id
         spec.instance_name = instance_name
         spec.explicit_name = explicit_name
         spec.is_subtree = is_subtree
@@ -404,30 +405,28 @@ class TreeBuilder:
         config.output_ports = kind.output_ports.copy() if kind.output_ports else {}
         config._pre_conditions = kind.pre_conditions.copy() if kind.pre_conditions else None
         config._post_conditions = kind.post_conditions.copy() if kind.post_conditions else None
+        if kind.entries:
+            self._precreate_entries(kind.entries, blackboard, _LazyLocation(filename, line))
+        node_type = kind.node_type
+        cls = self._classes.get(node_type)
+        try:
+            if cls is None:
+                node = self.factory.instantiate_node(node_type, instance_name, config)
+            else:
+                # What instantiate_node does for a class (its manifest is already in the config).
+                node = cls(instance_name, config)
+                if node.config is not config:
+                    raise BTLogicError(
+                        f"node type [{node_type}] must pass its config to TreeNode.__init__(name, config)"
+                    )
+                node.registration_id = node_type
+        except BTError as error:
+            if error.location is None:
+                error.location = _LazyLocation(filename, line)
+            raise
         if kind.is_subtree:
-            node = self.factory.instantiate_node("SubTree", instance_name, config)
             assert isinstance(node, SubTreeNode)
             node.subtree_id = kind.type_id
-        else:
-            if kind.entries:
-                self._precreate_entries(kind.entries, blackboard, _LazyLocation(filename, line))
-            type_id = kind.type_id
-            cls = self._classes.get(type_id)
-            try:
-                if cls is None:
-                    node = self.factory.instantiate_node(type_id, instance_name, config)
-                else:
-                    # What instantiate_node does for a class (its manifest is already in the config).
-                    node = cls(instance_name, config)
-                    if node.config is not config:
-                        raise BTLogicError(
-                            f"node type [{type_id}] must pass its config to TreeNode.__init__(name, config)"
-                        )
-                    node.registration_id = type_id
-            except BTError as error:
-                if error.location is None:
-                    error.location = _LazyLocation(filename, line)
-                raise
         if parent is not None:
             if isinstance(parent, ControlNode):
                 parent.add_child(node)
@@ -502,6 +501,7 @@ class NodeKind:
         "instance_name",
         "is_subtree",
         "manifest",
+        "node_type",
         "other",
         "output_ports",
         "post_conditions",
@@ -511,7 +511,9 @@ class NodeKind:
     )
 
     def __init__(self) -> None:
+        # The tree (SubTree) or node type it instantiates, and the registered type that makes its node.
         self.type_id = ""
+        self.node_type = ""
         self.instance_name = ""
         self.explicit_name: str | None = None
         self.is_subtree = False
