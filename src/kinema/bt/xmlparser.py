@@ -29,6 +29,9 @@ if TYPE_CHECKING:
 _MAX_CACHED_DOCUMENTS = 32
 
 EXPLICIT_TAGS = frozenset({"Action", "Condition", "Control", "Decorator", "SubTree"})
+# Tags whose structural check reads more than the tag and the number of children: the ID, or (for a
+# ReactiveSequence) the children's tags.
+_CHECKED_BY_MORE = EXPLICIT_TAGS | {"ReactiveSequence"}
 _PORT_TAGS = {
     "input_port": PortDirection.INPUT,
     "output_port": PortDirection.OUTPUT,
@@ -345,6 +348,8 @@ def find_structure_problems(
         return first_only
 
     fine: set[tuple[object, ...]] = set()
+    # tag -> numbers of children found fine, for the tags whose check needs nothing else
+    fine_counts: dict[str, set[int]] = {}
     models = root.findall("TreeNodesModel")
     if len(models) > 1 and report(line_of(models[1]), "Only a single node <TreeNodesModel> is supported"):
         return problems
@@ -378,6 +383,18 @@ def find_structure_problems(
             # of the walk below) without listing each node's children.
             for node in element.iterdescendants():
                 tag = node.tag
+                if tag not in _CHECKED_BY_MORE:
+                    # Most nodes: only the tag and the number of children matter (not the ID).
+                    count = len(node)
+                    counts = fine_counts.get(tag)
+                    if counts is not None and count in counts:
+                        continue
+                    found = len(problems)
+                    if _verify_node(node, 1, manifests, report, known_trees, list(node)):
+                        return problems
+                    if len(problems) == found:
+                        fine_counts.setdefault(tag, set()).add(count)
+                    continue
                 kind = (tag, node.get("ID"), len(node))
                 if tag == "ReactiveSequence":
                     kind += tuple([child.tag for child in node])

@@ -82,6 +82,32 @@ def test_a_reactive_sequence_is_checked_by_its_own_children(comment: str) -> Non
     assert "more than one async child" in str(info.value)
 
 
+@pytest.mark.parametrize("comment", ["", "<!-- a comment makes the walk list each node's children -->"])
+@pytest.mark.parametrize(
+    ("good", "bad", "message"),
+    [
+        (
+            "<Inverter><AlwaysSuccess/></Inverter>",
+            "<Inverter><AlwaysSuccess/>{comment}<AlwaysSuccess/></Inverter>",
+            "'Inverter' must have exactly 1 child",
+        ),
+        ("<AlwaysSuccess/>", "<AlwaysSuccess>{comment}<AlwaysSuccess/></AlwaysSuccess>", "must not have"),
+        ('<Action ID="AlwaysSuccess"/>', '<Action ID="Nowhere"/>{comment}', "Node not recognized: Nowhere"),
+    ],
+)
+def test_a_node_like_one_already_checked_is_checked_again_where_it_differs(
+    good: str, bad: str, message: str, comment: str
+) -> None:
+    xml = (
+        '<root BTCPP_format="4">\n<BehaviorTree ID="M">\n<Sequence>\n'
+        f"{good}\n{bad.format(comment=comment)}\n</Sequence>\n</BehaviorTree>\n</root>"
+    )
+    with pytest.raises(ObjectiveError) as info:
+        BehaviorTreeFactory().create_tree_from_text(xml)
+    assert "Error at line 5" in str(info.value)
+    assert message in str(info.value)
+
+
 def test_errors_carry_file_and_line(tmp_path: Path) -> None:
     path = tmp_path / "bad.xml"
     path.write_text(
