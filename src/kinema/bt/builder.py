@@ -134,17 +134,18 @@ class TreeBuilder:
         subtree: Subtree,
         ancestors: list[str],
         filename: str,
-    ) -> list[PlanStep]:
+    ) -> Plan:
         # The elements in document order (pre-order: the order nodes are created and numbered in),
         # each compiled as it is reached, so the first error is the one a plain walk meets first.
-        plan: list[PlanStep] = []
+        plan_kinds: list[NodeKind] = []
+        plan_lines: list[int] = []
+        plan_parents: list[int] = []
         nodes = subtree.nodes
         kinds = self.kinds
         # element -> its index in the plan, for elements that take children (a SubTree's are ignored)
         index_of: dict[etree._Element, int] = {}
-        elements = root_element.iter(etree.Element)
-        for element in elements:
-            if plan:
+        for element in root_element.iter(etree.Element):
+            if plan_kinds:
                 parent_index = index_of.get(element.getparent(), -1)
                 if parent_index < 0:
                     continue  # below a <SubTree>
@@ -158,7 +159,9 @@ class TreeBuilder:
             kind = kinds.get(signature)
             if kind is None:
                 kind = kinds[signature] = self._compile_kind(signature, filename, prefix, line)
-            plan.append((kind, line, parent_index))
+            plan_kinds.append(kind)
+            plan_lines.append(line)
+            plan_parents.append(parent_index)
             node = self._create_node(kind, line, blackboard, parent_node, prefix, filename)
             if kind.is_subtree:
                 nodes.append(node)
@@ -166,11 +169,11 @@ class TreeBuilder:
             else:
                 index_of[element] = len(nodes)
                 nodes.append(node)
-        return plan
+        return plan_kinds, plan_lines, plan_parents
 
     def _instantiate_plan(
         self,
-        plan: list[PlanStep],
+        plan: Plan,
         blackboard: Blackboard,
         parent: TreeNode | None,
         prefix: str,
@@ -182,7 +185,7 @@ class TreeBuilder:
         # are the plan's steps in order.
         nodes = subtree.nodes
         create = self._create_node
-        for kind, line, parent_index in plan:
+        for kind, line, parent_index in zip(*plan, strict=True):
             node = create(
                 kind, line, blackboard, nodes[parent_index] if parent_index >= 0 else parent, prefix, filename
             )
@@ -398,11 +401,11 @@ class TreeBuilder:
         config.clock = self._clock
         config.source_file = filename
         config.source_line = line
-        # Each node owns its dicts (a node may change them); most are empty, and {} is the cheap copy.
-        # (the three made on demand stay None when empty)
+        # Each node owns its dicts (a node may change them): a copy of the kind's, or None for an empty
+        # one (NodeConfig makes it on first use).
         config._other_attributes = kind.other.copy() if kind.other else None
-        config.input_ports = kind.input_ports.copy() if kind.input_ports else {}
-        config.output_ports = kind.output_ports.copy() if kind.output_ports else {}
+        config._input_ports = kind.input_ports.copy() if kind.input_ports else None
+        config._output_ports = kind.output_ports.copy() if kind.output_ports else None
         config._pre_conditions = kind.pre_conditions.copy() if kind.pre_conditions else None
         config._post_conditions = kind.post_conditions.copy() if kind.post_conditions else None
         if kind.entries:
@@ -529,11 +532,11 @@ class NodeKind:
         self.entries: list[tuple[str, Any]] = []
 
 
-# One element of a tree definition as the builder needs it: (what it compiles to, its line, the index
-# of its parent's step, -1 for the tree's root). A plan is a definition's steps in document order
-# (pre-order); it is kept on the TreeDefinition with the registry generation it was made for, so
-# SubTree instances and later builds skip the XML.
-PlanStep = tuple["NodeKind", int, int]
+# A tree definition as the builder needs it, one step per element in document order (pre-order), as
+# three columns (a step costs no object of its own): what each element compiles to, its line, and
+# the index of its parent's step (-1 for the tree's root). A plan is kept on the TreeDefinition with
+# the registry generation it was made for, so SubTree instances and later builds skip the XML.
+Plan = tuple[list["NodeKind"], list[int], list[int]]
 
 _new_config = object.__new__
 _CONDITION_ATTRIBUTES = frozenset((*PRE_CONDITIONS, *POST_CONDITIONS))

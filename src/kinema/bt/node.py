@@ -37,7 +37,9 @@ _NOTHING_READ: Any = {}
 
 class _DictOnDemand:
     """A dict attribute of :class:`NodeConfig` kept as None in its slot (``_<name>``) until it is first
-    read or set: most nodes have none, and a tree builds faster without allocating them."""
+    read or set: many nodes have none, and a tree builds faster without allocating them (each
+    allocation also brings the next collection nearer). Reading one costs a Python call: the hot
+    paths read them once per node (a port's binding is cached) or test the slot itself."""
 
     def __set_name__(self, owner: type, name: str) -> None:
         self.slot = getattr(owner, "_" + name)  # the slot's member descriptor
@@ -73,15 +75,15 @@ class NodeConfig:
     """
 
     __slots__ = (
+        "_input_ports",
         "_other_attributes",
+        "_output_ports",
         "_post_conditions",
         "_pre_conditions",
         "blackboard",
         "clock",
         "enums",
-        "input_ports",
         "manifest",
-        "output_ports",
         "path",
         "source_file",
         "source_line",
@@ -89,6 +91,8 @@ class NodeConfig:
         "wake_up",
     )
 
+    input_ports: dict[str, Any] = _DictOnDemand()  # type: ignore[assignment]
+    output_ports: dict[str, Any] = _DictOnDemand()  # type: ignore[assignment]
     pre_conditions: dict[str, Script] = _DictOnDemand()  # type: ignore[assignment]
     post_conditions: dict[str, Script] = _DictOnDemand()  # type: ignore[assignment]
     other_attributes: dict[str, str] = _DictOnDemand()  # type: ignore[assignment]
@@ -99,13 +103,14 @@ class NodeConfig:
 
             blackboard = Blackboard.create()
         self.blackboard: Blackboard = blackboard
-        self.input_ports: dict[str, Any] = {}
-        self.output_ports: dict[str, Any] = {}
         self.manifest: Any = None
         self.uid = 0
         self.path = ""
         self.enums: dict[str, int] = {}
-        # None stands for empty (see _DictOnDemand): most nodes have no conditions or other attributes.
+        # None stands for empty (see _DictOnDemand): many nodes have no ports, and most no conditions
+        # or other attributes.
+        self._input_ports: dict[str, Any] | None = None
+        self._output_ports: dict[str, Any] | None = None
         self._pre_conditions: dict[str, Script] | None = None
         self._post_conditions: dict[str, Script] | None = None
         self._other_attributes: dict[str, str] | None = None

@@ -64,7 +64,7 @@ class TreeDefinition:
         self.id = tree_id
         self.element = element
         self.filename = filename
-        # The builder's compiled plan (a list of kinema.bt.builder.PlanStep) and the registry it is valid for.
+        # The builder's compiled plan (kinema.bt.builder.Plan) and the registry it is valid for.
         self.plan: Any = None
         self.plan_key: Any = None
 
