@@ -58,13 +58,6 @@ class AlwaysFailureNode(_ConstantNode):
     _result = FAILURE
 
 
-def _literal_code(config: NodeConfig) -> str | None:
-    raw = config.input_ports.get("code")
-    if isinstance(raw, str) and blackboard_pointer(raw, "code") is None:
-        return raw
-    return None
-
-
 class _ScriptCode:
     """The parsed ``code`` port shared by Script and ScriptCondition.
 
@@ -85,13 +78,14 @@ class _ScriptCode:
     def _init_script(self) -> None:
         self._code = ""
         self._script = None
-        if self.config.input_ports.get("code") is None:
+        raw = self.config.input_ports.get("code")
+        if raw is None:
             # BT.CPP reads the port in the constructor: a Script without code fails createTree
             raise BTRuntimeError(f"Missing port [code] in {self.registration_id} '{self.full_path}'")
-        code = _literal_code(self.config)
-        self._literal = code is not None
-        if code:
-            self._load(code)
+        # A literal script (not a {pointer}) is parsed now, once.
+        self._literal = isinstance(raw, str) and blackboard_pointer(raw, "code") is None
+        if self._literal and raw:
+            self._load(raw)
 
     def _set_code(self, code: str) -> None:
         if code == "":

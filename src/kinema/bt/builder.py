@@ -205,24 +205,15 @@ class TreeBuilder:
     ) -> None:
         subtree_id = kind.type_id
         new_bb = Blackboard(blackboard)
-        remapping: dict[str, str] = {}
-        autoremap = False
-        for attr_name, attr_value in kind.attributes:
-            if attr_value == "{=}":
-                attr_value = "{" + attr_name + "}"
-            if attr_name == "_autoremap":
-                try:
-                    autoremap = convert_from_string(bool, attr_value)
-                except BTError as error:
-                    location = SourceLocation(filename, line)
-                    raise BTRuntimeError(error.message, location=location) from None
-                new_bb.enable_auto_remapping(autoremap)
-                continue
-            if not is_allowed_port_name(attr_name):
-                continue
-            remapping[attr_name] = attr_value
+        ports = kind.subtree_ports
+        if ports is None:
+            ports = kind.subtree_ports = _subtree_ports(kind, filename, line)
+        remapping, autoremap = ports
+        if autoremap:
+            new_bb.enable_auto_remapping(True)
         model = self.library.subtree_models.get(subtree_id)
         if model is not None:
+            remapping = dict(remapping)
             for port_name, port_info in model.ports.items():
                 if port_name not in remapping and not autoremap:
                     if not port_info.default_str:
@@ -473,6 +464,25 @@ class TreeBuilder:
                     raise BTRuntimeError(error.message, location=location) from None
 
 
+def _subtree_ports(kind: NodeKind, filename: str, line: int) -> tuple[dict[str, str], bool]:
+    """What a ``<SubTree>`` element's own attributes give its instances: the port remapping (port ->
+    ``{key}`` or literal text, ``{=}`` spelled out) and ``_autoremap``."""
+    remapping: dict[str, str] = {}
+    autoremap = False
+    for attr_name, attr_value in kind.attributes:
+        if attr_value == "{=}":
+            attr_value = "{" + attr_name + "}"
+        if attr_name == "_autoremap":
+            try:
+                autoremap = convert_from_string(bool, attr_value)
+            except BTError as error:
+                raise BTRuntimeError(error.message, location=SourceLocation(filename, line)) from None
+            continue
+        if is_allowed_port_name(attr_name):
+            remapping[attr_name] = attr_value
+    return remapping, autoremap
+
+
 def _number_fits(existing: Any, port_info: Any) -> bool:
     """A number in the entry (from a SubTree literal) that the numeric port's type holds exactly.
 
@@ -509,6 +519,7 @@ class NodeKind:
         "output_ports",
         "post_conditions",
         "pre_conditions",
+        "subtree_ports",
         "type_id",
         "unnamed",
     )
@@ -530,6 +541,8 @@ class NodeKind:
         self.post_conditions: dict[str, Any] = {}
         # (blackboard key, port info) of every port given as a {pointer}, in the manifest's order
         self.entries: list[tuple[str, Any]] = []
+        # A SubTree's remapping and _autoremap from its attributes (see _subtree_ports; on first use)
+        self.subtree_ports: tuple[dict[str, str], bool] | None = None
 
 
 # A tree definition as the builder needs it, one step per element in document order (pre-order), as

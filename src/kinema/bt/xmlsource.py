@@ -104,7 +104,8 @@ def parse_xml(text: str | bytes, filename: str = "<string>") -> etree._Element:
     parser = etree.XMLParser(remove_blank_text=False, resolve_entities=False, huge_tree=False)
     root = None
     strict = text
-    if "\r" not in text and _VALUE_WITH_BREAK.search(text) is None:
+    breaks = "\n" in text or "\t" in text  # (no value can hold one if the text holds none)
+    if "\r" not in text and (not breaks or _VALUE_WITH_BREAK.search(text) is None):
         # Most files are strict XML already, and where no attribute value holds a newline or tab,
         # lxml reads them exactly as it reads the pre-pass's output: skip the pre-pass (a third
         # of the parse) unless lxml refuses the text.
