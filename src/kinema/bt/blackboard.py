@@ -61,6 +61,10 @@ class Entry:
         return f"Entry({self.type_name}, {self.value!r}, seq={self.sequence_id})"
 
 
+# The remappings of a scope that has none (never written: see Blackboard.add_subtree_remapping).
+_NO_REMAPPING: dict[str, str] = {}
+
+
 class Blackboard:
     """A scope of typed entries, optionally with a parent scope (SubTree instances).
 
@@ -73,9 +77,12 @@ class Blackboard:
     def __init__(self, parent: Blackboard | None = None) -> None:
         self._storage: dict[str, Entry] = {}
         self._parent = parent
-        self._remapping: dict[str, str] = {}
+        # The shared empty dict until the first remapping (most scopes have none; see
+        # add_subtree_remapping)
+        self._remapping: dict[str, str] = _NO_REMAPPING
         self._autoremap = False
-        self._observers: list[BlackboardObserver] = []
+        # A tuple, replaced on (un)subscribe: a write iterates it without copying it.
+        self._observers: tuple[BlackboardObserver, ...] = ()
         self.name = ""
         self.time_source: Callable[[], float] | None = parent.time_source if parent is not None else None
 
@@ -109,6 +116,8 @@ class Blackboard:
 
     def add_subtree_remapping(self, internal: str, external: str) -> None:
         """Make ``internal`` in this scope an alias of ``external`` in the parent scope."""
+        if self._remapping is _NO_REMAPPING:
+            self._remapping = {}
         self._remapping[internal] = external
 
     @property
@@ -131,11 +140,13 @@ class Blackboard:
 
         Returns a function that removes the observer.
         """
-        self._observers.append(callback)
+        self._observers = (*self._observers, callback)
 
         def remove() -> None:
-            if callback in self._observers:
-                self._observers.remove(callback)
+            observers = list(self._observers)
+            if callback in observers:
+                observers.remove(callback)
+                self._observers = tuple(observers)
 
         return remove
 
@@ -145,9 +156,8 @@ class Blackboard:
         if source is not None:
             entry.stamp = source()
         owner = entry.owner
-        if owner._observers:
-            for callback in tuple(owner._observers):
-                callback(key, entry)
+        for callback in owner._observers:
+            callback(key, entry)
 
     def notify_written(self, key: str, entry: Entry) -> None:
         """Record a write made directly to ``entry.value`` (sequence id, stamp, observers)."""

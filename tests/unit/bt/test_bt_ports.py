@@ -150,6 +150,27 @@ def test_blackboard_observer_sees_every_write() -> None:
     assert seen == [("a", 1, 1), ("a", 2, 2)]
 
 
+def test_blackboard_observers_come_and_go_independently_even_from_a_callback() -> None:
+    bb = Blackboard.create()
+    other = Blackboard.create()
+    calls: list[str] = []
+
+    def once(key: str, entry: object) -> None:
+        calls.append("once")
+        remove_once()  # leaving during a write: the write still reaches the others
+
+    remove_once = bb.add_observer(once)
+    remove_all = bb.add_observer(lambda key, entry: calls.append("all"))
+    bb.set("a", 1)
+    bb.set("a", 2)
+    other.set("a", 1)  # another scope's observers are its own
+    assert calls == ["once", "all", "all"]
+    remove_once()  # twice is harmless
+    remove_all()
+    bb.set("a", 3)
+    assert calls == ["once", "all", "all"]
+
+
 class Doubler(SyncActionNode):
     @classmethod
     def provided_ports(cls) -> list:
