@@ -23,7 +23,7 @@ from kinema.bt.node import ControlNode, DecoratorNode, NodeConfig, TreeNode
 from kinema.bt.ports import PortDirection, blackboard_pointer, strict_blackboard_pointer
 from kinema.bt.script import parse_script
 from kinema.bt.tree import Subtree, Tree
-from kinema.bt.xmlparser import EXPLICIT_TAGS
+from kinema.bt.xmlparser import EXPLICIT_TAGS, Skeleton
 from kinema.errors import SourceLocation
 
 if TYPE_CHECKING:
@@ -115,10 +115,16 @@ class TreeBuilder:
         if plan is None:
             # First instance with this registry: compile each element as it is reached (so the
             # first error is the one a plain walk meets first) and keep the plan for the next ones.
-            assert root_element is not None
-            plan = self._compile_and_instantiate(
-                root_element, blackboard, parent, prefix, subtree, ancestors, filename
-            )
+            skeleton = definition.skeleton
+            if skeleton is not None:
+                plan = self._compile_skeleton(
+                    skeleton, blackboard, parent, prefix, subtree, ancestors, filename
+                )
+            else:
+                assert root_element is not None
+                plan = self._compile_and_instantiate(
+                    root_element, blackboard, parent, prefix, subtree, ancestors, filename
+                )
             definition.plan = plan
             definition.plan_key = self.plan_key
         else:
@@ -170,6 +176,35 @@ class TreeBuilder:
                 index_of[element] = len(nodes)
                 nodes.append(node)
         return plan_kinds, plan_lines, plan_parents
+
+    def _compile_skeleton(
+        self,
+        skeleton: Skeleton,
+        blackboard: Blackboard,
+        parent: TreeNode | None,
+        prefix: str,
+        subtree: Subtree,
+        ancestors: list[str],
+        filename: str,
+    ) -> Plan:
+        # What _compile_and_instantiate does, from what verification read off the elements.
+        signatures, lines, parents = skeleton
+        plan_kinds: list[NodeKind] = []
+        nodes = subtree.nodes
+        kinds = self.kinds
+        create = self._create_node
+        for signature, line, parent_index in zip(signatures, lines, parents, strict=True):
+            kind = kinds.get(signature)
+            if kind is None:
+                kind = kinds[signature] = self._compile_kind(signature, filename, prefix, line)
+            plan_kinds.append(kind)
+            node = create(
+                kind, line, blackboard, nodes[parent_index] if parent_index >= 0 else parent, prefix, filename
+            )
+            nodes.append(node)
+            if kind.is_subtree:
+                self._enter_subtree(node, kind, line, subtree, blackboard, filename, ancestors)  # type: ignore[arg-type]
+        return plan_kinds, lines, parents
 
     def _instantiate_plan(
         self,

@@ -25,6 +25,10 @@ from kinema.errors import SourceLocation
 if TYPE_CHECKING:
     from kinema.bt.manifest import NodeManifest
 
+# A tree's nodes in document order as three columns: signature (tag, then the (name, value) pairs of
+# its attributes), line, and the index of its parent node (-1 for the root node). See TreeDefinition.
+Skeleton = tuple[list[tuple[Any, ...]], list[int], list[int]]
+
 # How many documents loaded from text a library keeps for loading them again (see TreeLibrary.load_text).
 _MAX_CACHED_DOCUMENTS = 32
 
@@ -58,7 +62,7 @@ class TreeDefinition:
     an objective can be written back unchanged in meaning.
     """
 
-    __slots__ = ("element", "filename", "id", "plan", "plan_key")
+    __slots__ = ("element", "filename", "id", "plan", "plan_key", "skeleton")
 
     def __init__(self, tree_id: str, element: etree._Element, filename: str) -> None:
         self.id = tree_id
@@ -67,6 +71,10 @@ class TreeDefinition:
         # The builder's compiled plan (kinema.bt.builder.Plan) and the registry it is valid for.
         self.plan: Any = None
         self.plan_key: Any = None
+        # What verification read off the tree's nodes for the builder, when it walked them in
+        # document order (see find_structure_problems): None, or the columns (signature, line,
+        # parent index), a signature being the tag followed by the (name, value) attribute pairs.
+        self.skeleton: Skeleton | None = None
 
     @property
     def attributes(self) -> dict[str, str]:
@@ -205,8 +213,9 @@ class TreeLibrary:
             raise located_error("The XML must have a root node called <root>", filename, line_of(root))
         for include in root.findall("include"):
             self._load_include(include, filename, manifests, include_stack, verify)
+        skeletons: dict[etree._Element, Skeleton] | None = {} if verify else None
         if verify:
-            verify_document(root, filename, manifests)
+            verify_document(root, filename, manifests, skeletons)
         self._read_models(root, filename)
         if self.documents_loaded == 0 and self.first_main_tree is None:
             self.first_main_tree = root.get("main_tree_to_execute")
@@ -216,7 +225,9 @@ class TreeLibrary:
             if tree_id is None:
                 tree_id = f"BehaviorTree_{self._suffix}"
                 self._suffix += 1
-            self.trees[tree_id] = TreeDefinition(tree_id, element, filename)
+            definition = self.trees[tree_id] = TreeDefinition(tree_id, element, filename)
+            if skeletons:
+                definition.skeleton = skeletons.get(element)
 
     def _load_include(
         self,
@@ -321,9 +332,19 @@ class TreeLibrary:
         raise BTRuntimeError("[main_tree_to_execute] was not specified correctly")
 
 
-def verify_document(root: etree._Element, filename: str, manifests: dict[str, NodeManifest]) -> None:
-    """BT.CPP's ``VerifyXML``: raise the first structural problem of a document."""
-    problems = find_structure_problems(root, filename, manifests, first_only=True)
+def verify_document(
+    root: etree._Element,
+    filename: str,
+    manifests: dict[str, NodeManifest],
+    skeletons: dict[etree._Element, Skeleton] | None = None,
+) -> None:
+    """BT.CPP's ``VerifyXML``: raise the first structural problem of a document.
+
+    ``skeletons`` (optional) gets the skeleton of each ``<BehaviorTree>`` element verified in one
+    walk of its nodes (see :class:`TreeDefinition`): the builder then compiles it without reading
+    the XML again.
+    """
+    problems = find_structure_problems(root, filename, manifests, first_only=True, skeletons=skeletons)
     if problems:
         line, message = problems[0]
         raise located_error(f"Error at line {line}: -> {message}", filename, line)
@@ -336,10 +357,13 @@ def find_structure_problems(
     *,
     first_only: bool = False,
     known_trees: set[str] | None = None,
+    skeletons: dict[etree._Element, Skeleton] | None = None,
 ) -> list[tuple[int, str]]:
     """Structural problems of a document as ``(line, message)`` (VerifyXML's checks).
 
-    With ``known_trees``, ``<SubTree ID>`` values that name no known tree are reported too.
+    With ``known_trees``, ``<SubTree ID>`` values that name no known tree are reported too. With
+    ``skeletons``, the trees walked in document order get their skeleton there (meaningful only
+    where no problem was found).
     """
     problems: list[tuple[int, str]] = []
 
@@ -381,8 +405,22 @@ def find_structure_problems(
         if shallow and _plain(element):
             # Every node is an element and none is too deep: walk them in document order (the order
             # of the walk below) without listing each node's children.
+            if skeletons is not None:
+                signatures: list[tuple[Any, ...]] = []
+                lines: list[int] = []
+                parents: list[int] = []
+                # node element -> its index, for the nodes that have children
+                index_of: dict[etree._Element, int] = {}
+                skeletons[element] = (signatures, lines, parents)
             for node in element.iterdescendants():
                 tag = node.tag
+                if skeletons is not None:
+                    # The builder's reading of the node, taken on the way (one walk instead of two).
+                    if len(node):
+                        index_of[node] = len(signatures)
+                    parents.append(index_of.get(node.getparent(), -1))  # -1: the tree's root node
+                    signatures.append((tag, *node.items()))
+                    lines.append(node.sourceline or 0)
                 if tag not in _CHECKED_BY_MORE:
                     # Most nodes: only the tag and the number of children matter (not the ID).
                     count = len(node)

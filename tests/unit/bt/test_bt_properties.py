@@ -305,3 +305,35 @@ def test_nesting_at_the_depth_limit_is_reported_the_same_with_and_without_commen
     problems = find_structure_problems(etree.fromstring(plain, parser), "f.xml", manifests)
     assert find_structure_problems(etree.fromstring(remarked, parser), "f.xml", manifests) == problems
     assert bool(problems) == (depth > 256)
+
+
+def _built(xml: str) -> object:
+    """What a new factory builds from ``xml``: each node's uid, path, type, line and ports, or the
+    error's message and location."""
+    try:
+        tree = BehaviorTreeFactory().create_tree_from_text(xml)
+    except KinemaError as error:
+        return ("error", error.message, error.location)
+    return [
+        (node.uid, node.full_path, node.registration_id, node.config.source_line, node.config.input_ports)
+        for node in tree.nodes()
+    ]
+
+
+@PROPERTY_SETTINGS
+@given(random_tree(4), st.sampled_from(["<!-- note -->", "<?pi data?>"]))
+def test_a_tree_builds_the_same_from_verification_s_reading_as_from_the_xml(body: str, remark: str) -> None:
+    # A tree without comments is compiled from what verification read off its elements; with a
+    # comment, from the elements themselves. Both must make the same nodes, at the same lines.
+    lines = body.replace("><", ">\n<")
+    plain = (
+        '<root BTCPP_format="4" main_tree_to_execute="M"><BehaviorTree ID="M">\n<Sequence>\n'
+        f'{lines}\n<SubTree ID="S" v="{{n}}" name="sub"/>\n<SubTree ID="S" v="3"/>\n</Sequence>\n'
+        '</BehaviorTree>\n<BehaviorTree ID="S">\n<Fallback>\n<ScriptCondition code="v == 3"/>\n'
+        '<Script code="n := v"/>\n</Fallback>\n</BehaviorTree>\n</root>'
+    )
+    remarked = plain.replace("\n", remark + "\n")
+    built = _built(plain)
+    assert _built(remarked) == built
+    if "TryCatch" not in body and "Switch2" not in body:  # (those may lack children)
+        assert built[0] != "error"
