@@ -353,32 +353,40 @@ class TreeBuilder:
                 port_remap[attr_name] = attr_value
             elif attr_name not in RESERVED_ATTRIBUTES:
                 other[attr_name] = attr_value
-        spec = NodeKind()
-        spec.type_id = type_id
-        spec.node_type = "SubTree" if is_subtree else type_id
-        spec.instance_name = instance_name
-        spec.explicit_name = explicit_name
-        spec.is_subtree = is_subtree
-        spec.other = other
-        spec.attributes = attributes
         # The path gets "::uid" when the node has no name of its own.
-        spec.unnamed = instance_name == type_id
+        unnamed = instance_name == type_id
+        pre_conditions: dict[str, Any] = _NOTHING
+        post_conditions: dict[str, Any] = _NOTHING
         if not _CONDITION_ATTRIBUTES.isdisjoint(values):
             # The path the node is about to get (for messages only).
-            path = prefix + instance_name + (f"::{self.tree._uid + 1}" if spec.unnamed else "")
+            path = prefix + instance_name + (f"::{self.tree._uid + 1}" if unnamed else "")
             # The parsed scripts are stateless and shared by every instance.
-            for key in PRE_CONDITIONS:
-                code = values.get(key)
-                if code is not None:
-                    spec.pre_conditions[key] = _parse_condition(code, key, path, filename, line)
-            for key in POST_CONDITIONS:
-                code = values.get(key)
-                if code is not None:
-                    spec.post_conditions[key] = _parse_condition(code, key, path, filename, line)
+            pre_conditions = {
+                key: _parse_condition(values[key], key, path, filename, line)
+                for key in PRE_CONDITIONS
+                if key in values
+            }
+            post_conditions = {
+                key: _parse_condition(values[key], key, path, filename, line)
+                for key in POST_CONDITIONS
+                if key in values
+            }
         if is_subtree:
-            spec.input_ports = dict(port_remap)
-            spec.manifest = self.manifests.get("SubTree")
-            return spec
+            return NodeKind(
+                type_id,
+                True,
+                instance_name,
+                explicit_name,
+                unnamed,
+                self.manifests.get("SubTree"),
+                attributes,
+                other,
+                port_remap,
+                _NOTHING,
+                pre_conditions,
+                post_conditions,
+                (),
+            )
         if manifest is None:
             from kinema.errors import did_you_mean
 
@@ -386,22 +394,41 @@ class TreeBuilder:
                 f"Node not recognized: {type_id}; {did_you_mean(type_id, self.manifests)}",
                 location=_LazyLocation(filename, line),
             )
-        spec.manifest = manifest
-        for port_name, port_info in manifest.ports.items():
-            value = port_remap.get(port_name)
-            if value is None:
-                continue
-            entry_key = blackboard_pointer(value, port_name)
-            if entry_key is not None:
-                spec.entries.append((entry_key, port_info))
-        for port_name, value in port_remap.items():
-            direction = manifest.ports[port_name].direction
-            if direction is not PortDirection.OUTPUT:
-                spec.input_ports[port_name] = value
-            if direction is not PortDirection.INPUT:
-                spec.output_ports[port_name] = value
-        _apply_defaults(manifest, spec)
-        return spec
+        entries: list[tuple[str, Any]] = []
+        input_ports: dict[str, Any] = {}
+        output_ports: dict[str, Any] = {}
+        if port_remap:
+            ports = manifest.ports
+            for port_name, port_info in ports.items():
+                value = port_remap.get(port_name)
+                if value is None:
+                    continue
+                entry_key = blackboard_pointer(value, port_name)
+                if entry_key is not None:
+                    entries.append((entry_key, port_info))
+            for port_name, value in port_remap.items():
+                direction = ports[port_name].direction
+                if direction is not PortDirection.OUTPUT:
+                    input_ports[port_name] = value
+                if direction is not PortDirection.INPUT:
+                    output_ports[port_name] = value
+        if manifest.ports:
+            _apply_defaults(manifest, input_ports, output_ports)
+        return NodeKind(
+            type_id,
+            False,
+            instance_name,
+            explicit_name,
+            unnamed,
+            manifest,
+            attributes,
+            other,
+            input_ports,
+            output_ports,
+            pre_conditions,
+            post_conditions,
+            entries,
+        )
 
     def _create_node(
         self,
@@ -559,23 +586,40 @@ class NodeKind:
         "unnamed",
     )
 
-    def __init__(self) -> None:
+    def __init__(
+        self,
+        type_id: str,
+        is_subtree: bool,
+        instance_name: str,
+        explicit_name: str | None,
+        unnamed: bool,
+        manifest: Any,
+        attributes: list[tuple[str, str]],
+        other: dict[str, str],
+        input_ports: dict[str, Any],
+        output_ports: dict[str, Any],
+        pre_conditions: dict[str, Any],
+        post_conditions: dict[str, Any],
+        entries: list[tuple[str, Any]] | tuple[()],
+    ) -> None:
         # The tree (SubTree) or node type it instantiates, and the registered type that makes its node.
-        self.type_id = ""
-        self.node_type = ""
-        self.instance_name = ""
-        self.explicit_name: str | None = None
-        self.is_subtree = False
-        self.unnamed = False
-        self.manifest: Any = None
-        self.attributes: list[tuple[str, str]] = []
-        self.other: dict[str, str] = {}
-        self.input_ports: dict[str, Any] = {}
-        self.output_ports: dict[str, Any] = {}
-        self.pre_conditions: dict[str, Any] = {}
-        self.post_conditions: dict[str, Any] = {}
+        self.type_id = type_id
+        self.is_subtree = is_subtree
+        self.node_type = "SubTree" if is_subtree else type_id
+        self.instance_name = instance_name
+        self.explicit_name = explicit_name
+        # True when the instance path gets "::uid" (no name of its own)
+        self.unnamed = unnamed
+        self.manifest = manifest
+        self.attributes = attributes
+        # Read-only once made: each node gets copies (empty ones may be shared).
+        self.other = other
+        self.input_ports = input_ports
+        self.output_ports = output_ports
+        self.pre_conditions = pre_conditions
+        self.post_conditions = post_conditions
         # (blackboard key, port info) of every port given as a {pointer}, in the manifest's order
-        self.entries: list[tuple[str, Any]] = []
+        self.entries = entries
         # A SubTree's remapping and _autoremap from its attributes (see _subtree_ports; on first use)
         self.subtree_ports: tuple[dict[str, str], bool] | None = None
 
@@ -587,6 +631,8 @@ class NodeKind:
 Plan = tuple[list["NodeKind"], list[int], list[int]]
 
 _new_config = object.__new__
+# The empty mapping NodeKinds share (never written: kinds are read-only once made).
+_NOTHING: dict[str, Any] = {}
 _CONDITION_ATTRIBUTES = frozenset((*PRE_CONDITIONS, *POST_CONDITIONS))
 
 
@@ -598,23 +644,23 @@ class _LazyLocation(SourceLocation):
         object.__setattr__(self, "line", line)
 
 
-def _apply_defaults(manifest: Any, config: NodeKind) -> None:
+def _apply_defaults(manifest: Any, input_ports: dict[str, Any], output_ports: dict[str, Any]) -> None:
     """Declared defaults for ports the XML omits (an empty default is not applied, as in BT.CPP)."""
     for port_name, port_info in manifest.ports.items():
         if not port_info.has_default or not port_info.default_str:
             continue
         text = port_info.default_str
-        if port_info.direction is not PortDirection.OUTPUT and port_name not in config.input_ports:
+        if port_info.direction is not PortDirection.OUTPUT and port_name not in input_ports:
             # Plain values travel as text, like BT.CPP's default strings; other objects (no text
             # form) are handed over as they are.
             plain = isinstance(port_info.default, str | int | float | list | tuple | enum.Enum)
-            config.input_ports[port_name] = text if plain else port_info.default
+            input_ports[port_name] = text if plain else port_info.default
         if (
             port_info.direction is not PortDirection.INPUT
-            and port_name not in config.output_ports
+            and port_name not in output_ports
             and blackboard_pointer(text, port_name) is not None
         ):
-            config.output_ports[port_name] = text
+            output_ports[port_name] = text
 
 
 def _parse_condition(code: str, attribute: str, path: str, filename: str, line: int) -> Any:

@@ -65,6 +65,7 @@ def port_name_problem(name: str) -> str | None:
 
 
 @functools.lru_cache(maxsize=4096)
+@functools.lru_cache(maxsize=4096)  # attribute names repeat: every element's are checked when compiled
 def is_allowed_port_name(name: str) -> bool:
     """``IsAllowedPortName``: an attribute that is treated as a port."""
     if not name or not (name[0].isalpha() and ord(name[0]) < 0x80):
