@@ -5,8 +5,6 @@ from __future__ import annotations
 import enum
 from typing import TYPE_CHECKING, Any
 
-from lxml import etree
-
 from kinema.bt.blackboard import Blackboard
 from kinema.bt.conversions import Unsigned, convert_from_string, parse_double_full, parse_int_full, type_name
 from kinema.bt.decorators import SubTreeNode
@@ -23,7 +21,7 @@ from kinema.bt.node import ControlNode, DecoratorNode, NodeConfig, TreeNode
 from kinema.bt.ports import PortDirection, blackboard_pointer, strict_blackboard_pointer
 from kinema.bt.script import parse_script
 from kinema.bt.tree import Subtree, Tree
-from kinema.bt.xmlparser import EXPLICIT_TAGS, Skeleton
+from kinema.bt.xmlparser import EXPLICIT_TAGS, Skeleton, read_skeleton
 from kinema.errors import SourceLocation
 
 if TYPE_CHECKING:
@@ -116,66 +114,15 @@ class TreeBuilder:
             # First instance with this registry: compile each element as it is reached (so the
             # first error is the one a plain walk meets first) and keep the plan for the next ones.
             skeleton = definition.skeleton
-            if skeleton is not None:
-                plan = self._compile_skeleton(
-                    skeleton, blackboard, parent, prefix, subtree, ancestors, filename
-                )
-            else:
+            if skeleton is None:  # (verification did not walk it: it holds comments, say)
                 assert root_element is not None
-                plan = self._compile_and_instantiate(
-                    root_element, blackboard, parent, prefix, subtree, ancestors, filename
-                )
+                skeleton = read_skeleton(root_element)
+            plan = self._compile_skeleton(skeleton, blackboard, parent, prefix, subtree, ancestors, filename)
             definition.plan = plan
             definition.plan_key = self.plan_key
         else:
             self._instantiate_plan(plan, blackboard, parent, prefix, subtree, ancestors, filename)
         ancestors.pop()
-
-    def _compile_and_instantiate(
-        self,
-        root_element: etree._Element,
-        blackboard: Blackboard,
-        parent: TreeNode | None,
-        prefix: str,
-        subtree: Subtree,
-        ancestors: list[str],
-        filename: str,
-    ) -> Plan:
-        # The elements in document order (pre-order: the order nodes are created and numbered in),
-        # each compiled as it is reached, so the first error is the one a plain walk meets first.
-        plan_kinds: list[NodeKind] = []
-        plan_lines: list[int] = []
-        plan_parents: list[int] = []
-        nodes = subtree.nodes
-        kinds = self.kinds
-        # element -> its index in the plan, for elements that take children (a SubTree's are ignored)
-        index_of: dict[etree._Element, int] = {}
-        for element in root_element.iter(etree.Element):
-            if plan_kinds:
-                parent_index = index_of.get(element.getparent(), -1)
-                if parent_index < 0:
-                    continue  # below a <SubTree>
-                parent_node: TreeNode | None = nodes[parent_index]
-            else:
-                parent_index = -1
-                parent_node = parent
-            # What the element compiles to depends only on its tag and attributes (and the registry).
-            line = element.sourceline or 0
-            signature = (element.tag, *element.items())
-            kind = kinds.get(signature)
-            if kind is None:
-                kind = kinds[signature] = self._compile_kind(signature, filename, prefix, line)
-            plan_kinds.append(kind)
-            plan_lines.append(line)
-            plan_parents.append(parent_index)
-            node = self._create_node(kind, line, blackboard, parent_node, prefix, filename)
-            if kind.is_subtree:
-                nodes.append(node)
-                self._enter_subtree(node, kind, line, subtree, blackboard, filename, ancestors)  # type: ignore[arg-type]
-            else:
-                index_of[element] = len(nodes)
-                nodes.append(node)
-        return plan_kinds, plan_lines, plan_parents
 
     def _compile_skeleton(
         self,
@@ -187,7 +134,8 @@ class TreeBuilder:
         ancestors: list[str],
         filename: str,
     ) -> Plan:
-        # What _compile_and_instantiate does, from what verification read off the elements.
+        # Each element is compiled as it is reached, in document order (the order nodes are created
+        # and numbered in), so the first error is the one a plain walk meets first.
         signatures, lines, parents = skeleton
         plan_kinds: list[NodeKind] = []
         nodes = subtree.nodes

@@ -50,6 +50,33 @@ def element_children(element: etree._Element) -> list[etree._Element]:
     return [child for child in element if child.tag.__class__ is str] if len(element) else []
 
 
+def read_skeleton(tree_root: etree._Element) -> Skeleton:
+    """The skeleton of a tree (see :data:`Skeleton`) read from its root node's element: elements only,
+    and nothing below a ``<SubTree>`` (its children, which verification refuses, are ignored).
+
+    Verification reads the same off the trees it walks in document order (find_structure_problems).
+    """
+    signatures: list[tuple[Any, ...]] = []
+    lines: list[int] = []
+    parents: list[int] = []
+    # element -> its index, for the elements whose children are nodes
+    index_of: dict[etree._Element, int] = {}
+    for element in tree_root.iter(etree.Element):
+        if signatures:
+            parent_index = index_of.get(element.getparent(), -1)
+            if parent_index < 0:
+                continue  # below a <SubTree>
+        else:
+            parent_index = -1
+        tag = element.tag
+        if tag != "SubTree":
+            index_of[element] = len(signatures)
+        parents.append(parent_index)
+        signatures.append((tag, *element.items()))
+        lines.append(element.sourceline or 0)
+    return signatures, lines, parents
+
+
 def line_of(element: etree._Element) -> int:
     """The 1-based source line of an element (0 if unknown)."""
     return element.sourceline or 0
