@@ -66,7 +66,7 @@ class _ScriptCode:
     unchanged script costs no extra call).
     """
 
-    __slots__ = ()  # a mixin: Script and ScriptCondition hold its state in their own slots
+    # A mixin: Script and ScriptCondition hold its state in slots of their own (__slots__ below).
 
     config: NodeConfig
     full_path: str

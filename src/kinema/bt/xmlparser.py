@@ -460,7 +460,7 @@ def find_structure_problems(
                     if len(problems) == found:
                         fine_counts.setdefault(tag, set()).add(count)
                     continue
-                kind = (tag, node.get("ID"), len(node))
+                kind: tuple[Any, ...] = (tag, node.get("ID"), len(node))
                 if tag == "ReactiveSequence":
                     kind += tuple([child.tag for child in node])
                 if kind not in fine:
