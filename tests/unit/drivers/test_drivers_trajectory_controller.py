@@ -110,6 +110,33 @@ def test_a_blocked_joint_violates_the_path_tolerance_and_the_arm_holds(
     np.testing.assert_allclose(plant.ctrl, plant.qpos)
 
 
+def test_an_abort_names_what_the_robot_touches() -> None:
+    # A joint held back by something in the way: the message says what the robot touches then.
+    joints = [JointInfo(name, i, i, None, i) for i, name in enumerate(NAMES)]
+    touching = {"now": []}
+    controller = JointTrajectoryController("arm", joints, np.zeros(2), DT, touching=lambda data: touching["now"])
+
+    def blocked(ctrl: np.ndarray, qpos: np.ndarray) -> np.ndarray:
+        if ctrl[0] > 0.2:
+            touching["now"] = ["cube (left_finger, right_finger)", "tray (wrist)"]
+        return np.array([min(ctrl[0], 0.2), ctrl[1]])
+
+    plant = Plant(blocked)
+    controller.activate(plant)
+    execution = start(controller, plant, make_goal([1.0, 0.5]))
+    plant.run(controller, execution)
+    assert execution.outcome is not None
+    message = execution.outcome.result["error_string"]
+    assert message.endswith("; the robot touches cube (left_finger, right_finger), tray (wrist)"), message
+    # Touching nothing, the message says nothing of it.
+    plant, touching["now"] = Plant(lambda ctrl, qpos: ctrl + np.array([0.0, 0.05])), []
+    controller.activate(plant)
+    execution = start(controller, plant, make_goal([0.3, 0.3], goal_time_tolerance=0.25))
+    plant.run(controller, execution)
+    assert execution.outcome is not None
+    assert "touches" not in execution.outcome.result["error_string"]
+
+
 def test_an_offset_at_the_end_violates_the_goal_tolerance_after_the_goal_time(
     controller: JointTrajectoryController,
 ) -> None:

@@ -58,6 +58,7 @@ from kinema.drivers.mujoco.scene_state import (
 from kinema.drivers.mujoco.settings import MujocoDriverSettings
 from kinema.drivers.mujoco.sim_speed import format_sim_speed
 from kinema.drivers.mujoco.simulation import Simulation
+from kinema.drivers.mujoco.contacts import contact_reporter
 from kinema.drivers.mujoco.trajectory_controller import JointTrajectoryController
 from kinema.drivers.mujoco.trajectory_goal import INVALID_GOAL, GoalRejected, parse_trajectory_goal
 from kinema.drivers.protocol import ServedInterface
@@ -344,6 +345,7 @@ class MujocoDriver:
             gains = np.array([self.model.actuator_gainprm[j.actuator, 0] for j in arm])
             damping = np.array([-self.model.actuator_biasprm[j.actuator, 2] for j in arm])
             feedforward = np.divide(damping, gains, out=np.zeros_like(gains), where=gains > 0)
+            touching = contact_reporter(self.model, [j.name for j in arm])
 
             def trajectory_controller(
                 name: str, kind: type[JointTrajectoryController] = JointTrajectoryController, **extra: Any
@@ -355,6 +357,7 @@ class MujocoDriver:
                     self.index.timestep,
                     gains=gains if np.all(gains > 0) else None,
                     inertia=self._effective_inertia([j.dof_address for j in arm]),
+                    touching=touching,
                     **extra,
                 )
 

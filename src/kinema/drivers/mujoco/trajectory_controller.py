@@ -140,6 +140,8 @@ class JointTrajectoryController:
         gains: ``kp`` of each joint's position actuator (N/m or N·m/rad); with ``inertia``, stops brake.
         inertia: returns each joint's effective inertia (kg or kg·m², the mass matrix diagonal) in the
             current state; without it a stop holds the position the joints had.
+        touching: names what the robot touches in the current state (see ``contacts.py``); a goal that
+            aborts on a tolerance says it.
     """
 
     type_name = "joint_trajectory_controller/JointTrajectoryController"
@@ -152,6 +154,7 @@ class JointTrajectoryController:
         dt: float,
         gains: np.ndarray | None = None,
         inertia: Callable[[Any], np.ndarray] | None = None,
+        touching: Callable[[Any], list[str]] | None = None,
     ) -> None:
         self.name = name
         self.dt = dt
@@ -168,6 +171,7 @@ class JointTrajectoryController:
         self._running: _Running | None = None
         self._gains = None if gains is None else np.asarray(gains, dtype=float)
         self._inertia = inertia
+        self._touching = touching
         self._brake: _Brake | None = None
 
     @property
@@ -400,6 +404,10 @@ class JointTrajectoryController:
 
     def _fail(self, data: Any, code: int, what: str, violations: list[str]) -> None:
         message = f"{what} (sim time {float(data.time):.3f} s): {'; '.join(violations)}"
+        touched = self._touching(data) if self._touching is not None else []
+        if touched:
+            # Most often why the arm is off: something is in its way.
+            message += f"; the robot touches {', '.join(touched)}"
         log.warning("%s: %s", self.name, message)
         self._end(data, "aborted", _result(code, message), hold=True)
 
