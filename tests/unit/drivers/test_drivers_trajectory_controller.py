@@ -113,8 +113,10 @@ def test_a_blocked_joint_violates_the_path_tolerance_and_the_arm_holds(
 def test_an_abort_names_what_the_robot_touches() -> None:
     # A joint held back by something in the way: the message says what the robot touches then.
     joints = [JointInfo(name, i, i, None, i) for i, name in enumerate(NAMES)]
-    touching = {"now": []}
-    controller = JointTrajectoryController("arm", joints, np.zeros(2), DT, touching=lambda data: touching["now"])
+    touching: dict[str, list[str]] = {"now": []}
+    controller = JointTrajectoryController(
+        "arm", joints, np.zeros(2), DT, touching=lambda data: touching["now"]
+    )
 
     def blocked(ctrl: np.ndarray, qpos: np.ndarray) -> np.ndarray:
         if ctrl[0] > 0.2:

@@ -39,6 +39,7 @@ import numpy as np
 from kinema.drivers.mujoco import names
 from kinema.drivers.mujoco.cameras import CameraServer, SimState
 from kinema.drivers.mujoco.cdr_templates import ClockEncoder, JointStateEncoder, generic_serializers
+from kinema.drivers.mujoco.contacts import contact_reporter
 from kinema.drivers.mujoco.controller_manager import Controller, ControllerManager, JointStateBroadcaster
 from kinema.drivers.mujoco.execution import Execution
 from kinema.drivers.mujoco.force_control import (
@@ -58,7 +59,6 @@ from kinema.drivers.mujoco.scene_state import (
 from kinema.drivers.mujoco.settings import MujocoDriverSettings
 from kinema.drivers.mujoco.sim_speed import format_sim_speed
 from kinema.drivers.mujoco.simulation import Simulation
-from kinema.drivers.mujoco.contacts import contact_reporter
 from kinema.drivers.mujoco.trajectory_controller import JointTrajectoryController
 from kinema.drivers.mujoco.trajectory_goal import INVALID_GOAL, GoalRejected, parse_trajectory_goal
 from kinema.drivers.protocol import ServedInterface
