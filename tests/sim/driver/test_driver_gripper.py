@@ -4,10 +4,10 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from driver_harness import GRIPPER, Sim
+from driver_harness import ARM, GRIPPER, Sim, trajectory
 
 from kinema.drivers.mujoco import names as n
-from kinema.transport import STATUS_SUCCEEDED
+from kinema.transport import STATUS_ABORTED, STATUS_SUCCEEDED
 
 CLOSED = 0.7929
 
@@ -60,3 +60,16 @@ def test_max_effort_caps_the_grip_force(sim: Sim, pick_pose: dict[str, float]) -
     firm = sim.gripper(CLOSED)
     assert firm.result.stalled
     assert firm.result.effort > 1.0
+
+
+def test_an_arm_stopped_by_the_cube_says_it_touches_the_cube(sim: Sim, pick_pose: dict[str, float]) -> None:
+    # Closed fingers driven down to the pick pose land on the cube's top: the trajectory aborts on a
+    # tolerance, and the message names what is in the way.
+    assert sim.gripper(CLOSED).status == STATUS_SUCCEEDED
+    start = sim.joint_states.latest()
+    goal = np.array([pick_pose[name] for name in ARM])
+    result = sim.follow(trajectory(start, goal, 3.0)).result(60.0)
+    assert result.status == STATUS_ABORTED, result.result.error_string
+    assert "the robot touches cube (robotiq_85_left_finger_link" in result.result.error_string, (
+        result.result.error_string
+    )
