@@ -32,8 +32,10 @@ def _preempt_with_a_stale_start(
         sim.joint_states.wait_until(until)
     else:
         wait_for(
-            lambda: sim.joint_states.latest_stamp() >= until
-            or float(np.abs(sim.joint_states.latest() - stale).max()) > beyond,
+            lambda: (
+                sim.joint_states.latest_stamp() >= until
+                or float(np.abs(sim.joint_states.latest() - stale).max()) > beyond
+            ),
             20.0,
             f"the arm to move {beyond} from the stale state",
         )
