@@ -55,12 +55,12 @@ def rendered(app: Any) -> str:
     from rich.console import Console
 
     panel = app.screen.query_one(TaskPanel)
-    if not panel.has_class("shown") or panel.task is None:
+    if not panel.has_class("shown") or panel.planning is None:
         return ""
     from kinema.tui.widgets.task_panel import task_table
 
     console = Console(width=120, record=True)
-    console.print(task_table(panel.task))
+    console.print(task_table(panel.planning))
     return console.export_text()
 
 

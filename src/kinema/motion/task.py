@@ -390,6 +390,7 @@ class _Planner:
             after = self.rules[index + 1] if index + 1 < len(self.rules) else self.rules[index]
             change = SceneChange(stage.name, 0, stage.describe(), after)
             return _Piece(index, rows, MotionSettings(), change=change)
+        assert not isinstance(stage, GENERATORS), "a generator's rows come with its solutions"
         return _Piece(index, rows, stage.motion)
 
     def world_T(self, target: Target, q: np.ndarray) -> np.ndarray:
@@ -603,8 +604,9 @@ class _Planner:
             )
         if not generators:
             if before is None:
-                first = members[0] if members else 0
-                raise _StageFailure(first, "a task starts with a state: a current state or a solution")
+                raise _StageFailure(
+                    members[0] if members else 0, "a task starts with a state: a current state or a solution"
+                )
             return self.propagate(members, [], before)
         g = generators[0]
         failures: list[_StageFailure] = []

@@ -24,6 +24,7 @@ from textual.widgets import Footer, Select, Static
 from kinema.tui.connection import CameraImage, ConnectionState
 from kinema.tui.screens.base import RuntimeView
 
+image_widgets: Any
 try:  # Queries the terminal once; it must happen before the app starts (textual-image's rule).
     import textual_image.widget as image_widgets
 except Exception as error:  # a closed stdout and the like: the screen says why instead
@@ -65,12 +66,13 @@ class TopicsListed(Message):
 
 
 class WatchStarted(Message):
-    """Watching a topic began; ``stop`` ends it."""
+    """Watching a topic began; ``end`` ends it (not ``stop``: Message.stop() stops the message's
+    bubbling)."""
 
-    def __init__(self, topic: str, stop: Any) -> None:
+    def __init__(self, topic: str, end: Any) -> None:
         super().__init__()
         self.topic = topic
-        self.stop = stop
+        self.end = end
 
 
 class CameraScreen(RuntimeView, Screen[None]):
@@ -128,7 +130,7 @@ class CameraScreen(RuntimeView, Screen[None]):
         the previous connection ended with it)."""
         self.action_refresh_topics()
         if self.topic and self.is_current:
-            self.watch(self.topic)
+            self.watch_topic(self.topic)
 
     def _connected(self) -> bool:
         return self.app.status.state is ConnectionState.CONNECTED  # type: ignore[attr-defined, no-any-return]
@@ -167,12 +169,12 @@ class CameraScreen(RuntimeView, Screen[None]):
 
     def on_select_changed(self, event: Select.Changed) -> None:
         if isinstance(event.value, str) and event.value != self._watching:
-            self.watch(event.value)
+            self.watch_topic(event.value)
 
     # -- watching ----------------------------------------------------------------------------------
 
-    def watch(self, topic: str) -> None:
-        """Show ``topic`` from now on."""
+    def watch_topic(self, topic: str) -> None:
+        """Show ``topic`` from now on (not ``watch``: that is Textual's DOMNode.watch)."""
         self._unwatch()
         self.topic = topic
         self._watching = topic
@@ -185,9 +187,9 @@ class CameraScreen(RuntimeView, Screen[None]):
 
     def on_watch_started(self, message: WatchStarted) -> None:
         if message.topic != self._watching:  # switched again meanwhile
-            message.stop()
+            message.end()
             return
-        self._stop_watching = message.stop
+        self._stop_watching = message.end
 
     def _receive(self, image: CameraImage) -> None:
         """A transport thread's picture: keep only the newest."""
@@ -210,7 +212,7 @@ class CameraScreen(RuntimeView, Screen[None]):
 
     def on_screen_resume(self) -> None:
         if self.topic and not self._watching and self._connected():
-            self.watch(self.topic)
+            self.watch_topic(self.topic)
 
     def on_unmount(self) -> None:
         self.app.unregister_view(self)  # type: ignore[attr-defined]

@@ -57,11 +57,12 @@ def task_table(task: TaskPlanning) -> Group:
 class TaskPanel(Static):
     """Shows a :class:`TaskPlanning`; hidden until a task is planned in the current run."""
 
-    task: TaskPlanning | None = None
+    # (not ``task``: Textual's MessagePump.task is the widget's asyncio task)
+    planning: TaskPlanning | None = None
 
     def show_task(self, task: TaskPlanning | None) -> None:
         """Show ``task`` (None hides the panel)."""
-        self.task = task
+        self.planning = task
         self.set_class(task is not None, "shown")
         self.set_class(task is not None and task.state == "failed", "failed")
         self.update(task_table(task) if task is not None else "")
