@@ -92,21 +92,34 @@ def test_a_goal_is_tracked_and_succeeds(controller: JointTrajectoryController) -
     assert not controller.busy
 
 
-def test_a_blocked_joint_violates_the_path_tolerance_and_the_arm_holds(
-    controller: JointTrajectoryController,
-) -> None:
-    def blocked(ctrl: np.ndarray, qpos: np.ndarray) -> np.ndarray:
+def run_blocked(
+    controller: JointTrajectoryController, blocked: Callable[[], None] = lambda: None
+) -> tuple[Plant, Execution]:
+    """Run a goal during which joint ``a`` cannot pass 0.2 (``blocked()`` is called while it is held)."""
+
+    def response(ctrl: np.ndarray, qpos: np.ndarray) -> np.ndarray:
+        if ctrl[0] > 0.2:
+            blocked()
         return np.array([min(ctrl[0], 0.2), ctrl[1]])
 
-    plant = Plant(blocked)
+    plant = Plant(response)
     controller.activate(plant)
     execution = start(controller, plant, make_goal([1.0, 0.5]))
     plant.run(controller, execution)
-    assert execution.outcome is not None
-    assert execution.outcome.status == "aborted"
-    assert execution.outcome.result["error_code"] == PATH_TOLERANCE_VIOLATED
-    assert "a off by" in execution.outcome.result["error_string"]
-    assert "b off by" not in execution.outcome.result["error_string"]
+    return plant, execution
+
+
+def test_a_blocked_joint_violates_the_path_tolerance_and_the_arm_holds(
+    controller: JointTrajectoryController,
+) -> None:
+    plant, execution = run_blocked(controller)
+    outcome = execution.outcome
+    assert outcome is not None
+    assert outcome.status == "aborted"
+    assert outcome.result["error_code"] == PATH_TOLERANCE_VIOLATED
+    assert "a off by" in outcome.result["error_string"]
+    assert "b off by" not in outcome.result["error_string"]
+    assert "touches" not in outcome.result["error_string"]  # (this controller cannot tell)
     np.testing.assert_allclose(plant.ctrl, plant.qpos)
 
 
@@ -117,18 +130,12 @@ def test_an_abort_names_what_the_robot_touches() -> None:
     controller = JointTrajectoryController(
         "arm", joints, np.zeros(2), DT, touching=lambda data: touching["now"]
     )
-
-    def blocked(ctrl: np.ndarray, qpos: np.ndarray) -> np.ndarray:
-        if ctrl[0] > 0.2:
-            touching["now"] = ["cube (left_finger, right_finger)", "tray (wrist)"]
-        return np.array([min(ctrl[0], 0.2), ctrl[1]])
-
-    plant = Plant(blocked)
-    controller.activate(plant)
-    execution = start(controller, plant, make_goal([1.0, 0.5]))
-    plant.run(controller, execution)
-    assert execution.outcome is not None
-    message = execution.outcome.result["error_string"]
+    _, execution = run_blocked(
+        controller, lambda: touching.update(now=["cube (left_finger, right_finger)", "tray (wrist)"])
+    )
+    outcome = execution.outcome
+    assert outcome is not None
+    message = outcome.result["error_string"]
     assert message.endswith("; the robot touches cube (left_finger, right_finger), tray (wrist)"), message
     # Touching nothing, the message says nothing of it.
     plant, touching["now"] = Plant(lambda ctrl, qpos: ctrl + np.array([0.0, 0.05])), []
