@@ -61,7 +61,7 @@ class TreeBuilder:
         self._subtree_paths: set[str] = set()
         # Registered node classes, which the builder constructs itself (other builders go through
         # factory.instantiate_node, which checks what they return).
-        self._classes = {
+        self._classes: dict[str, type[TreeNode]] = {
             node_id: builder
             for node_id, builder in factory._builders.items()
             if isinstance(builder, type) and issubclass(builder, TreeNode)
@@ -334,6 +334,7 @@ class TreeBuilder:
                 pre_conditions,
                 post_conditions,
                 (),
+                self._classes.get("SubTree"),
             )
         if manifest is None:
             from kinema.errors import did_you_mean
@@ -376,6 +377,7 @@ class TreeBuilder:
             pre_conditions,
             post_conditions,
             entries,
+            self._classes.get(type_id),
         )
 
     def _create_node(
@@ -412,7 +414,7 @@ class TreeBuilder:
         if kind.entries:
             self._precreate_entries(kind.entries, blackboard, _LazyLocation(filename, line))
         node_type = kind.node_type
-        cls = self._classes.get(node_type)
+        cls = kind.node_class
         try:
             if cls is None:
                 node = self.factory.instantiate_node(node_type, instance_name, config)
@@ -524,6 +526,7 @@ class NodeKind:
         "instance_name",
         "is_subtree",
         "manifest",
+        "node_class",
         "node_type",
         "other",
         "output_ports",
@@ -549,11 +552,15 @@ class NodeKind:
         pre_conditions: dict[str, Any],
         post_conditions: dict[str, Any],
         entries: list[tuple[str, Any]] | tuple[()],
+        node_class: type[TreeNode] | None,
     ) -> None:
         # The tree (SubTree) or node type it instantiates, and the registered type that makes its node.
         self.type_id = type_id
         self.is_subtree = is_subtree
         self.node_type = "SubTree" if is_subtree else type_id
+        # The registered class the builder constructs itself, or None (a builder function: see
+        # TreeBuilder._classes); kinds are only reused with the registry they were made for.
+        self.node_class = node_class
         self.instance_name = instance_name
         self.explicit_name = explicit_name
         # True when the instance path gets "::uid" (no name of its own)

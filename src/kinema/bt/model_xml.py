@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 from lxml import etree
 
@@ -103,15 +103,22 @@ def _node_element(node: TreeNode, subtree_paths: dict[int, str], add_metadata: b
         element = etree.Element(node.registration_id, name=node.name)
     if add_metadata:
         element.set("_uid", str(node.uid))
-    for port, value in config.input_ports.items():
+    # Read from the slots: NodeConfig makes an empty map on first use, and a tree written for every
+    # run need not make four per node (None stands for empty).
+    inputs = config._input_ports or _NOTHING
+    for port, value in inputs.items():
         if isinstance(value, str):
             element.set(port, value)
-    for port, value in config.output_ports.items():
-        if isinstance(value, str) and port not in config.input_ports:
+    for port, value in (config._output_ports or _NOTHING).items():
+        if isinstance(value, str) and port not in inputs:
             element.set(port, value)
-    for key, script in (*config.pre_conditions.items(), *config.post_conditions.items()):
-        element.set(key, script.code)
+    for conditions in (config._pre_conditions, config._post_conditions):
+        for key, script in (conditions or _NOTHING).items():
+            element.set(key, script.code)
     return element
+
+
+_NOTHING: dict[str, Any] = {}
 
 
 def write_tree_to_xml(tree: Tree, add_metadata: bool = True, add_builtin_models: bool = True) -> str:
