@@ -310,6 +310,36 @@ def test_a_failure_whose_node_never_reported_it_is_still_shown(fake: FakeConnect
     drive(fake, scenario)
 
 
+def test_a_failed_run_whose_start_comes_after_its_outcome_keeps_the_failure(fake: FakeConnection) -> None:
+    """An exception ends the run before its failing node reports FAILURE, and a loaded machine may
+    deliver the run's first statuses (the nodes going RUNNING) after its outcome, which travels on the
+    log topic (seen in CI with the tutorial's MyBehavior): they must not undo the explanation."""
+
+    async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
+        view = app.screen.query_one(BehaviorTreeView)
+        message = (
+            "objective 'Pick Object' failed (FAILURE): "
+            "Exception in node 'Wait and Log::3/Sleep::5' [Sleep]: ValueError: no clock"
+        )
+        await deliver(
+            fake,
+            pilot,
+            Heartbeat(10.0, "Pick Object", "Running"),
+            Heartbeat(10.1, "Pick Object", "Failure"),
+            LogEntry(message, LogLevel.ERROR, 1.0),
+            RUNNING_RUN,
+        )
+        assert view.shown_as("Wait and Log::3/Sleep::5") == "FAILURE"
+        assert view.failed_path == [1, 3, 4, 5]
+        assert view.shown_as("MoveToWaypoint::2") == "SUCCESS"  # what the late statuses add is kept
+        assert view.shown_as("TopLevelSequence") != "RUNNING"
+        # The next run starts clean and shows its nodes running again.
+        await deliver(fake, pilot, Heartbeat(20.0, "Pick Object", "Running"), RUNNING_RUN)
+        assert view.failed_path == [] and view.shown_as("Wait and Log::3/Sleep::5") == "RUNNING"
+
+    drive(fake, scenario)
+
+
 def test_long_log_lines_wrap(fake: FakeConnection) -> None:
     async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
         fake.emit(LogEntry(FAILED, LogLevel.ERROR, 1.0, "objective_server"))

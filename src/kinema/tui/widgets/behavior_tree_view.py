@@ -55,6 +55,10 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         self.halted: set[int] = set()
         self.failed_path: list[int] = []
         self.failure_message = ""
+        # True from a run's end (finish_run) to the next run's start: nothing runs any more, so a
+        # RUNNING reported then is the ended run's, late (its statuses and its outcome travel on two
+        # topics), and must not undo how the run ended.
+        self.run_over = False
         self._by_uid: dict[int, TreeNode[OutlineNode]] = {}
         self._parents: dict[int, int | None] = {}
         self._details: list[TreeNode[OutlineNode]] = []
@@ -66,6 +70,7 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         self.halted = set()
         self.failed_path = []
         self.failure_message = ""
+        self.run_over = False
         self._by_uid = {}
         self._parents = {}
         self._details = []
@@ -106,6 +111,8 @@ class BehaviorTreeView(Tree["OutlineNode"]):
             if node is None:
                 continue
             found += 1
+            if update.status is NodeStatus.RUNNING and self.run_over:
+                continue  # the ended run's start, reported after its end: it keeps showing how it ended
             previous = self.statuses.get(node.uid, NodeStatus.IDLE)
             if update.status is NodeStatus.IDLE and previous in _RESULTS:
                 continue  # parents reset finished children to IDLE; keep showing how they ended
@@ -122,6 +129,7 @@ class BehaviorTreeView(Tree["OutlineNode"]):
     def reset_statuses(self) -> None:
         """Show every node as idle (a new run started)."""
         self._clear_failure()
+        self.run_over = False
         uids = set(self.statuses) | self.halted
         self.statuses = {}
         self.halted = set()
@@ -135,6 +143,7 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         deepest node reported FAILURE) is marked failed, the path to it highlighted and expanded, and it
         opens onto its ports and ``message``. Returns the failed node, if one was found.
         """
+        self.run_over = True
         for running, status in list(self.statuses.items()):
             if status is NodeStatus.RUNNING:
                 self.statuses[running] = NodeStatus.IDLE
