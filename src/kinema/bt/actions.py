@@ -42,7 +42,7 @@ class _ConstantNode(SyncActionNode):
         if prev is not result:
             self._status = result
             if self._watched:
-                self._log(self._log_base + prev * 5 + result)
+                self._log.append(self._log_base + prev * 5 + result)
         return result
 
 
@@ -150,7 +150,7 @@ class ScriptNode(_ScriptCode, SyncActionNode):
         if prev is not SUCCESS:
             self._status = SUCCESS
             if self._watched:
-                self._log(self._log_base + prev * 5 + SUCCESS)
+                self._log.append(self._log_base + prev * 5 + SUCCESS)
         return SUCCESS
 
 
@@ -217,7 +217,7 @@ class ScriptConditionNode(_ScriptCode, ConditionNode):
         if prev is not status:
             self._status = status
             if self._watched:
-                self._log(self._log_base + prev * 5 + status)
+                self._log.append(self._log_base + prev * 5 + status)
         return status
 
 

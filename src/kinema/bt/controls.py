@@ -66,7 +66,7 @@ class SequenceNode(_ResumingControl):
                 was = self._status
                 self._status = RUNNING
                 if self._watched:
-                    self._log(self._log_base + was * 5 + RUNNING)
+                    self._log.append(self._log_base + was * 5 + RUNNING)
             idx = self._idx
             if self._asynch:
                 status = self._tick_async(children, n, idx)
@@ -107,7 +107,7 @@ class SequenceNode(_ResumingControl):
                 if status is SUCCESS or status is FAILURE:
                     self._status = status
                     if self._watched:
-                        self._log(self._log_base + prev * 5 + status)
+                        self._log.append(self._log_base + prev * 5 + status)
                 elif status is not SKIPPED:
                     self._set_status(status)
             elif status is IDLE:
@@ -176,7 +176,7 @@ class SequenceWithMemoryNode(ControlNode):
             was = self._status
             self._status = RUNNING
             if self._watched:
-                self._log(self._log_base + was * 5 + RUNNING)
+                self._log.append(self._log_base + was * 5 + RUNNING)
         while self._idx < n:
             child = children[self._idx]
             prev = child._status
@@ -229,7 +229,7 @@ class FallbackNode(_ResumingControl):
                 was = self._status
                 self._status = RUNNING
                 if self._watched:
-                    self._log(self._log_base + was * 5 + RUNNING)
+                    self._log.append(self._log_base + was * 5 + RUNNING)
             idx = self._idx
             if self._asynch:
                 status = self._tick_async(children, n, idx)
@@ -270,7 +270,7 @@ class FallbackNode(_ResumingControl):
                 if status is SUCCESS or status is FAILURE:
                     self._status = status
                     if self._watched:
-                        self._log(self._log_base + prev * 5 + status)
+                        self._log.append(self._log_base + prev * 5 + status)
                 elif status is not SKIPPED:
                     self._set_status(status)
             elif status is IDLE:
@@ -356,7 +356,7 @@ class ReactiveSequenceNode(_RunningChildControl):
                 was = self._status
                 self._status = RUNNING
                 if self._watched:
-                    self._log(self._log_base + was * 5 + RUNNING)
+                    self._log.append(self._log_base + was * 5 + RUNNING)
             children = self.children
             index = -1
             for child in children:
@@ -399,7 +399,7 @@ class ReactiveSequenceNode(_RunningChildControl):
                 if status is SUCCESS or status is FAILURE:
                     self._status = status
                     if self._watched:
-                        self._log(self._log_base + prev * 5 + status)
+                        self._log.append(self._log_base + prev * 5 + status)
                 elif status is not SKIPPED:
                     self._set_status(status)
             elif status is IDLE:

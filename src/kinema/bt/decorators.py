@@ -64,7 +64,7 @@ class _ResultMappingDecorator(DecoratorNode):
                 was = self._status
                 self._status = RUNNING
                 if self._watched:
-                    self._log(self._log_base + was * 5 + RUNNING)
+                    self._log.append(self._log_base + was * 5 + RUNNING)
             child = self.child
             assert child is not None
             status = child.execute_tick()
@@ -75,7 +75,7 @@ class _ResultMappingDecorator(DecoratorNode):
                 else:
                     child._status = IDLE
                     if child._watched and done is not IDLE:
-                        child._log(child._log_base + done * 5)  # IDLE is 0
+                        child._log.append(child._log_base + done * 5)  # IDLE is 0
                 result = self._on_success if status is SUCCESS else self._on_failure
             elif status is RUNNING or status is SKIPPED:
                 return status  # stored already (RUNNING), or never stored (SKIPPED)
@@ -89,7 +89,7 @@ class _ResultMappingDecorator(DecoratorNode):
         if result is not prev:
             self._status = result
             if self._watched:
-                self._log(self._log_base + prev * 5 + result)
+                self._log.append(self._log_base + prev * 5 + result)
         return result
 
 
@@ -595,7 +595,7 @@ class SubTreeNode(DecoratorNode):
             if self._status is IDLE:
                 self._status = RUNNING
                 if self._watched:
-                    self._log(self._log_base + RUNNING)  # from IDLE, which is 0
+                    self._log.append(self._log_base + RUNNING)  # from IDLE, which is 0
             child = self.child
             assert child is not None
             status = child.execute_tick()
@@ -606,7 +606,7 @@ class SubTreeNode(DecoratorNode):
                 else:
                     child._status = IDLE
                     if child._watched and done is not IDLE:
-                        child._log(child._log_base + done * 5)  # IDLE is 0
+                        child._log.append(child._log_base + done * 5)  # IDLE is 0
         except NodeExecutionError:
             raise
         except Exception as error:
@@ -616,7 +616,7 @@ class SubTreeNode(DecoratorNode):
             if status is SUCCESS or status is FAILURE:
                 self._status = status
                 if self._watched:
-                    self._log(self._log_base + prev * 5 + status)
+                    self._log.append(self._log_base + prev * 5 + status)
             elif status is not SKIPPED:
                 self._set_status(status)
         return status

@@ -134,6 +134,32 @@ class NodeConfig:
         self.source_line = value.line if value is not None else 0
 
 
+class _Notifier:
+    """A node's change sink while status callbacks observe it and no transition log does."""
+
+    __slots__ = ("node",)
+
+    def __init__(self, node: TreeNode) -> None:
+        self.node = node
+
+    def append(self, code: int) -> None:
+        self.node._notify_code(code)
+
+
+class _LoggingNotifier(_Notifier):
+    """A node's change sink while both the tree's transition log and status callbacks observe it."""
+
+    __slots__ = ("codes",)
+
+    def __init__(self, codes: list[int], node: TreeNode) -> None:
+        super().__init__(node)
+        self.codes = codes
+
+    def append(self, code: int) -> None:
+        self.codes.append(code)
+        self.node._notify_code(code)
+
+
 class PortError(BTRuntimeError):
     """A port could not be read or written."""
 
@@ -174,8 +200,8 @@ class TreeNode:
         "_hooked",
         "_literal_cache",
         "_log",
-        "_log_append",
         "_log_base",
+        "_log_codes",
         "_observers",
         "_post_tick",
         "_pre_tick",
@@ -195,13 +221,13 @@ class TreeNode:
         self._status = IDLE
         # A tuple, replaced on (un)subscribe: notifying iterates it without copying it.
         self._observers: tuple[StatusObserver, ...] = ()
-        # The tree's transition log (``TransitionLog.codes.append``) while one is attached, and
-        # this node's base code in it.
-        self._log_append: Callable[[int], None] | None = None
+        # The tree's transition log (``TransitionLog.codes``) while one is attached, and this node's
+        # base code in it.
+        self._log_codes: list[int] | None = None
         self._log_base = 0
-        # Where a change goes while anything observes the node (see _rewire): called with the change's
-        # code, ``_log_base + previous * 5 + new``. None while nothing does.
-        self._log: Any = None  # Callable[[int], None] | None, called only while _watched
+        # Where a change goes while anything observes the node (see _rewire): something with an
+        # ``append(code)``, the code being ``_log_base + previous * 5 + new``. None while nothing does.
+        self._log: Any = None  # list[int] | _Notifier | None, used only while _watched
         # True while anything observes the node (a callback or a log): the one test on the hot path.
         self._watched = False
         # Filled by the first port reads; until then both are the one shared empty dict (most nodes
@@ -303,7 +329,7 @@ class TreeNode:
                 # Inlined _set_status for the common case: this is the hot path of every tick.
                 self._status = status
                 if self._watched:
-                    self._log(self._log_base + prev * 5 + status)
+                    self._log.append(self._log_base + prev * 5 + status)
             elif status is not SKIPPED:
                 self._set_status(status)
         elif status is IDLE or (status is RUNNING and self._forbid_running):
@@ -312,26 +338,20 @@ class TreeNode:
 
     def _notify(self, prev: NodeStatus, new: NodeStatus) -> None:
         """Report a change already stored (only while ``_watched``; the hot paths inline this call)."""
-        self._log(self._log_base + prev * 5 + new)
+        self._log.append(self._log_base + prev * 5 + new)
 
     def _rewire(self) -> None:
         """Point ``_log`` at what observes the node now: the tree's log, the callbacks, both, or nothing.
 
         One call per change then serves them all, and the hot paths test one flag.
         """
-        append = self._log_append
+        codes = self._log_codes
         if not self._observers:
-            self._log = append
-        elif append is None:
-            self._log = self._notify_code
+            self._log = codes  # the hot paths' ``self._log.append(code)`` is then CPython's list append
+        elif codes is None:
+            self._log = _Notifier(self)
         else:
-            notify = self._notify_code
-
-            def log_and_notify(code: int) -> None:
-                append(code)
-                notify(code)
-
-            self._log = log_and_notify
+            self._log = _LoggingNotifier(codes, self)
         self._watched = self._log is not None
 
     def _notify_code(self, code: int) -> None:
@@ -435,7 +455,7 @@ class TreeNode:
             return
         self._status = IDLE
         if self._watched:
-            self._log(self._log_base + prev * 5)  # IDLE is 0
+            self._log.append(self._log_base + prev * 5)  # IDLE is 0
 
     def halt_node(self) -> None:
         """``halt()`` followed by the ``_onHalted`` script."""
@@ -734,7 +754,7 @@ def _set_status_unchecked(node: TreeNode, new: NodeStatus) -> None:
         return
     node._status = new
     if node._watched:
-        node._log(node._log_base + prev * 5 + new)
+        node._log.append(node._log_base + prev * 5 + new)
 
 
 # -- composites -------------------------------------------------------------------------------------
@@ -768,7 +788,7 @@ class ControlNode(TreeNode):
                 elif child._watched:
                     # reset_status() inlined: an observed tree resets every completed child
                     child._status = IDLE
-                    child._log(child._log_base + status * 5)  # IDLE is 0
+                    child._log.append(child._log_base + status * 5)  # IDLE is 0
                 else:
                     child._status = IDLE
 
@@ -821,7 +841,7 @@ class DecoratorNode(TreeNode):
                 if status is SUCCESS or status is FAILURE:
                     self._status = status
                     if self._watched:
-                        self._log(self._log_base + prev * 5 + status)
+                        self._log.append(self._log_base + prev * 5 + status)
                 elif status is not SKIPPED:
                     self._set_status(status)
             elif status is IDLE or (status is RUNNING and self._forbid_running):

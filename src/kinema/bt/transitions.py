@@ -52,9 +52,9 @@ class TransitionLog:
                 "the tree already has a transition log: a tree has one at a time "
                 "(close it first, or use Tree.add_status_observer for another reader)"
             )
-        append = self.codes.append
+        codes = self.codes
         for index, node in enumerate(self.nodes):
-            node._log_append = append
+            node._log_codes = codes
             node._log_base = index * 25
             node._rewire()
         tree.transition_log = self
@@ -125,7 +125,7 @@ class TransitionLog:
     def close(self) -> None:
         """Stop recording (what was recorded stays readable)."""
         for node in self.nodes:
-            node._log_append = None
+            node._log_codes = None
             node._rewire()
         if self._tree.transition_log is self:
             self._tree.transition_log = None
