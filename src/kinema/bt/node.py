@@ -343,7 +343,8 @@ class TreeNode:
     def _rewire(self) -> None:
         """Point ``_log`` at what observes the node now: the tree's log, the callbacks, both, or nothing.
 
-        One call per change then serves them all, and the hot paths test one flag.
+        One ``append`` per change then serves them all (the log's own list append when only the log
+        observes), and the hot paths test one flag.
         """
         codes = self._log_codes
         if not self._observers:
