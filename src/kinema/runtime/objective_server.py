@@ -784,6 +784,13 @@ class ObjectiveServer:
         factory = self._source.factory()
         if request.objective_name:
             names = self._source.objective_names()
+            reread = getattr(self._source, "invalidate_objectives", None)
+            if request.objective_name not in names and reread is not None:
+                # A file saved a moment ago: hot reload reports a burst of changes only once the folder
+                # has been quiet for a while. Read the objective files again before calling it unknown.
+                reread()
+                factory = self._source.factory()
+                names = self._source.objective_names()
             if request.objective_name not in names:
                 explain = getattr(self._source, "load_error", None)
                 problem = explain(request.objective_name) if explain is not None else None

@@ -40,3 +40,18 @@ def test_changed_objective_files_are_picked_up_after_invalidation(tmp_path: Path
     source.invalidate_objectives()
     assert source.factory() is not first
     assert source.objective_names() == ["Good", "Later"]
+
+
+def test_an_objective_saved_before_hot_reload_reports_it_runs_by_name(tmp_path: Path) -> None:
+    # The tutorial's step: save a new objective file, run it by name at once. Hot reload waits for the
+    # folder to be quiet before it reports the file; asking for a name the library does not know reads
+    # the files again first. A name that is in no file is still unknown.
+    (tmp_path / "good.xml").write_text(GOOD)
+    source = _source(tmp_path)
+    assert source.objective_names() == ["Good"]
+    (tmp_path / "later.xml").write_text(GOOD.replace("Good", "Later"))
+    with ObjectiveServer(source) as server:
+        assert server.submit(ObjectiveRequest("Later")).wait(5).succeeded  # type: ignore[union-attr]
+        result = server.submit(ObjectiveRequest("Nowhere")).wait(5)
+    assert result is not None and result.failed
+    assert "unknown objective 'Nowhere'" in result.error_message
