@@ -204,6 +204,12 @@ def check_cell_is_free(
 ) -> None:
     """Refuse when the network already has the agent or drivers this ``kinema run`` would start.
 
+    Look through a **client** session of the router. A peer that has just joined sees another peer's
+    tokens only once its own direct link to that peer is up (zenoh's peers form a full mesh, and the
+    router does not relay between them); a driver busy stepping its simulation can take seconds to
+    answer the handshake, and a peer's look would miss it. A client is answered from the router's
+    tables, which hold every process linked to it.
+
     Raises:
         CellError: naming what runs (config, pid, host, endpoint) and how to stop it, join it, or run a
             second cell beside it.

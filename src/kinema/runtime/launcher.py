@@ -418,10 +418,13 @@ class Launcher:
         if self.hosting or self.session is None:
             return  # a router of our own: nobody else is there yet
         from kinema.runtime.cell import check_cell_is_free
+        from kinema.transport import open_session
 
-        check_cell_is_free(
-            self.session, agent=self.options.agent, drivers=self.options.drivers, endpoint=self.endpoint
-        )
+        # Looked at as a client: see check_cell_is_free on why this session (a peer) would miss some.
+        with open_session(self.endpoint, self.session.domain_id, mode="client") as looking:
+            check_cell_is_free(
+                looking, agent=self.options.agent, drivers=self.options.drivers, endpoint=self.endpoint
+            )
 
     def _watch_cell(self) -> None:
         """Report two agents or two drivers on the network, should they appear anyway."""

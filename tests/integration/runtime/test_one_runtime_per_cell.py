@@ -4,6 +4,7 @@ agents that meet anyway are reported."""
 from __future__ import annotations
 
 import os
+import signal
 import subprocess
 import sys
 import time
@@ -47,6 +48,14 @@ def _run(env: dict[str, str], *args: str) -> subprocess.CompletedProcess[str]:
     )
 
 
+def _child(pid: int, module: str) -> int:
+    """The child process of ``pid`` that runs ``module``."""
+    for child in Path(f"/proc/{pid}/task/{pid}/children").read_text().split():
+        if module in Path(f"/proc/{child}/cmdline").read_bytes().decode(errors="replace"):
+            return int(child)
+    raise AssertionError(f"no child of pid {pid} runs {module}")
+
+
 def _agents(endpoint: str) -> list[str]:
     """The zenoh ids of the processes with an /objective_server node, once the graph has come in."""
 
@@ -83,7 +92,14 @@ def test_agent_and_drivers_started_apart_form_one_cell_and_a_full_run_is_refused
     drivers = Terminal(["-o", "--headless", "--sim-speed", "1"], env)
     try:
         drivers.wait_for(DRIVERS_READY, timeout=120)
-        full = _run(env)
+        # A driver busy with its simulation can take seconds to answer a newly joined peer's handshake
+        # (seen in CI); stopped, it answers none while the full run looks at the cell.
+        driver = _child(drivers.process.pid, "kinema.drivers.mujoco")
+        os.kill(driver, signal.SIGSTOP)
+        try:
+            full = _run(env)
+        finally:
+            os.kill(driver, signal.SIGCONT)
         assert full.returncode == 1, full.stdout + full.stderr
         assert "agent of config lab_sim" in full.stderr and "driver 'mujoco' of config lab_sim" in full.stderr
         again = _run(env, "-o")
