@@ -45,7 +45,7 @@ from kinema.bt.status import NodeStatus
 from kinema.errors import KinemaError, ObjectiveError, did_you_mean
 from kinema.runtime.node_status import NodeStatusBatch, NodeStatusRecorder
 from kinema.runtime.objective_status import ObjectiveStatus
-from kinema.runtime.overrides import ParameterOverride, apply_overrides
+from kinema.runtime.overrides import ParameterOverride, apply_overrides, model_defaults
 from kinema.runtime.result import ObjectiveResult
 from kinema.runtime.tick_watchdog import (
     WATCHDOG_PERIOD_S,
@@ -58,6 +58,7 @@ from kinema.runtime.watchdog import StuckCode, stuck_code
 
 if TYPE_CHECKING:
     from kinema.bt import BehaviorTreeFactory, Tree
+    from kinema.bt.xmlparser import SubtreeModel
 
 log = logging.getLogger("kinema.objective_server")
 
@@ -746,9 +747,10 @@ class ObjectiveServer:
         self._set_status(ObjectiveStatus.LOADING, run.objective_name)
         try:
             with self._behavior_code(worker, "building the tree"):
-                tree, name = self._build(run.request)
+                tree, name, model = self._build(run.request)
                 run.objective_name = name
-                apply_overrides(tree, run.request.overrides, objective_name=name)
+                defaults = model_defaults(model)
+                apply_overrides(tree, run.request.overrides, objective_name=name, defaults=defaults)
         except Abandoned:
             raise
         except KinemaError as error:
@@ -780,7 +782,8 @@ class ObjectiveServer:
                     log.exception("a tree listener raised")
         self._set_status(ObjectiveStatus.RUNNING, name)
 
-    def _build(self, request: ObjectiveRequest) -> tuple[Tree, str]:
+    def _build(self, request: ObjectiveRequest) -> tuple[Tree, str, SubtreeModel | None]:
+        """The tree of ``request``, its objective's name, and the model of its ports (None if undeclared)."""
         factory = self._source.factory()
         if request.objective_name:
             names = self._source.objective_names()
@@ -798,7 +801,8 @@ class ObjectiveServer:
                     raise ObjectiveError(f"objective {request.objective_name!r} cannot run: {problem}")
                 alternatives = did_you_mean(request.objective_name, names)
                 raise ObjectiveError(f"unknown objective {request.objective_name!r}; {alternatives}")
-            return factory.create_tree(request.objective_name), request.objective_name
+            tree = factory.create_tree(request.objective_name)
+            return tree, request.objective_name, factory.library.subtree_models.get(request.objective_name)
         xml = request.objective_xml
         if not xml.strip():
             raise ObjectiveError("the request names no objective and carries no objective XML")
@@ -808,7 +812,8 @@ class ObjectiveServer:
             limit = MAX_OBJECTIVE_XML_BYTES / 1e6
             raise ObjectiveError(f"the objective XML is {size / 1e6:.1f} MB; the limit is {limit:.1f} MB")
         name = main_tree_id(xml)
-        return _create_from_scratch_text(factory, xml), name
+        tree, model = _create_from_scratch_text(factory, xml, name)
+        return tree, name, model
 
     def _tick(self, worker: TickWorker) -> None:
         tree, run = self._tree, self._run
@@ -964,8 +969,11 @@ def blackboard_entries(tree: Tree) -> list[tuple[str, str, str, Any]]:
     return entries
 
 
-def _create_from_scratch_text(factory: BehaviorTreeFactory, xml: str) -> Tree:
-    """Build the main tree of an ad-hoc XML document without adding its trees to ``factory``.
+def _create_from_scratch_text(
+    factory: BehaviorTreeFactory, xml: str, name: str
+) -> tuple[Tree, SubtreeModel | None]:
+    """Build the main tree (``name``) of an ad-hoc XML document without adding its trees to ``factory``;
+    with the model of that tree's ports, as the document and the library declare it.
 
     An XML string sent to ``/do_objective`` may define trees named like library objectives; they must
     shadow the library for this run only, never replace it for later runs.
@@ -980,7 +988,8 @@ def _create_from_scratch_text(factory: BehaviorTreeFactory, xml: str) -> Tree:
     )
     factory.library = scratch
     try:
-        return factory.create_tree_from_text(xml, filename="<objective XML>")
+        tree = factory.create_tree_from_text(xml, filename="<objective XML>")
+        return tree, scratch.subtree_models.get(name)
     finally:
         factory.library = saved
 

@@ -5,11 +5,21 @@ its name, its text is parsed as YAML into that type, and it is written into the 
 the blackboards of the subtrees named by ``behavior_namespaces``. Any failure (no port reads that name,
 a value of the wrong type, an unknown namespace) rejects the whole request before the tree ticks:
 overrides never apply partially.
+
+An objective's own ports (``<TreeNodesModel><SubTree ID>``) carry defaults, which MoveIt Pro's request
+says overrides replace ("Default values of named parameters in the predefined objective will be
+overridden"). BT.CPP applies them only where the objective is a ``<SubTree>`` of another; an objective
+run on its own gets them here, as if it were that SubTree with no attributes: each literal default
+(neither empty nor a ``{key}``) is parsed into the type of the port that reads it and written into the
+root blackboard, unless an override sets the name. A default no port reads, or one that does not parse
+into the port's type, is left out, and the tree reads the key as it would without it (whether MoveIt Pro
+itself seeds them is not public; its UI and ``kinema objective show`` present them as the values used).
 """
 
 from __future__ import annotations
 
 import enum
+import logging
 from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
@@ -18,6 +28,9 @@ from kinema.errors import ObjectiveError, did_you_mean
 
 if TYPE_CHECKING:
     from kinema.bt import Blackboard, Tree
+    from kinema.bt.xmlparser import SubtreeModel
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -51,15 +64,48 @@ class ParameterOverride:
         return cls(name.strip(), value)
 
 
-def apply_overrides(tree: Tree, overrides: Sequence[ParameterOverride], *, objective_name: str = "") -> None:
+def model_defaults(model: SubtreeModel | None) -> list[ParameterOverride]:
+    """The literal defaults of an objective's own ports (see the module's docstring), as overrides."""
+    if model is None:
+        return []
+    defaults = []
+    for name, port in model.ports.items():
+        text = port.default_str
+        if not text or not text.strip():
+            continue
+        stripped = text.strip()
+        if stripped.startswith("{") and stripped.endswith("}"):
+            continue  # wires the port to the key of its own name: nothing to seed at the root
+        defaults.append(ParameterOverride(name, text))
+    return defaults
+
+
+def apply_overrides(
+    tree: Tree,
+    overrides: Sequence[ParameterOverride],
+    *,
+    objective_name: str = "",
+    defaults: Sequence[ParameterOverride] = (),
+) -> None:
     """Convert every override and write them all into ``tree``'s blackboards, or none of them.
+
+    ``defaults`` (from :func:`model_defaults`) are written first into the root blackboard, each where a
+    port reads its name and no override (for the root) sets it; one that does not convert is skipped.
 
     Raises:
         ObjectiveError: naming the override, the objective and what would have been accepted.
     """
-    if not overrides:
-        return
     writes: list[tuple[Blackboard, str, Any]] = []
+    overridden = {o.name for o in overrides if not o.behavior_namespaces}
+    root = tree.root_blackboard
+    for default in defaults:
+        entry = root.get_entry(default.name)
+        if default.name in overridden or entry is None or entry.value is not None:
+            continue
+        try:
+            writes.append((root, default.name, _convert(root, "", default, objective_name)))
+        except ObjectiveError as error:
+            log.debug("default left out: %s", error)
     for override in overrides:
         for blackboard, scope in _target_blackboards(tree, override, objective_name):
             writes.append((blackboard, override.name, _convert(blackboard, scope, override, objective_name)))

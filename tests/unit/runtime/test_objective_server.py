@@ -44,6 +44,20 @@ LIBRARY = """
   <BehaviorTree ID="Inner">
     <Sleep msec="{msec}"/>
   </BehaviorTree>
+  <BehaviorTree ID="Defaulted">
+    <Sequence>
+      <Sleep msec="{delay}"/>
+      <SetBlackboard value="{greeting}" output_key="echo"/>
+    </Sequence>
+  </BehaviorTree>
+  <TreeNodesModel>
+    <SubTree ID="Defaulted">
+      <input_port name="delay" default="5"/>
+      <input_port name="greeting" default="hi there"/>
+      <inout_port name="echo" default="{echo}"/>
+      <input_port name="unread" default="7"/>
+    </SubTree>
+  </TreeNodesModel>
 </root>
 """
 
@@ -212,6 +226,40 @@ def test_bad_overrides_reject_the_request_before_the_first_tick(
     assert reason in result.error_message
     assert ObjectiveStatus.RUNNING not in [s for s, _ in recorder.statuses]
     assert recorder.changes == []
+
+
+def _echo(recorder: Recorder) -> object:
+    return next(value for scope, key, _, value in recorder.snapshots[-1] if key == "echo")
+
+
+def test_an_objective_run_on_its_own_reads_the_defaults_of_its_ports_and_overrides_replace_them(
+    server: ObjectiveServer, recorder: Recorder
+) -> None:
+    # As if it were a <SubTree ID="Defaulted"/> with no attributes: "delay" and "greeting" come from
+    # the model; "unread" is read by no port, "{echo}" wires the key of its name (nothing to seed).
+    assert server.submit(ObjectiveRequest("Defaulted")).wait(5) == ObjectiveResult.success("Defaulted")
+    assert _echo(recorder) == "hi there"
+    overrides = (ParameterOverride("greeting", "hello"),)
+    result = server.submit(ObjectiveRequest("Defaulted", overrides=overrides)).wait(5)
+    assert result == ObjectiveResult.success("Defaulted")
+    assert _echo(recorder) == "hello"
+    # A bad override is still refused, default or not.
+    bad = server.submit(ObjectiveRequest("Defaulted", overrides=(ParameterOverride("delay", "soon"),))).wait(5)
+    assert bad is not None and bad.failed and "'soon' is not a valid" in bad.error_message
+
+
+def test_an_adhoc_document_s_main_tree_reads_the_defaults_its_model_declares(
+    server: ObjectiveServer, recorder: Recorder
+) -> None:
+    xml = """<root BTCPP_format="4" main_tree_to_execute="Greets">
+      <BehaviorTree ID="Greets"><SetBlackboard value="{greeting}" output_key="echo"/></BehaviorTree>
+      <TreeNodesModel><SubTree ID="Greets"><input_port name="greeting" default="ahoy"/></SubTree></TreeNodesModel>
+    </root>"""
+    assert server.submit(ObjectiveRequest(objective_xml=xml)).wait(5) == ObjectiveResult.success("Greets")
+    assert _echo(recorder) == "ahoy"
+    # Without a model, a key nobody wrote is still missing (BT.CPP's own semantics).
+    result = server.submit(ObjectiveRequest("Typed")).wait(5)
+    assert result is not None and result.failed and "Missing parameter [msec]" in result.error_message
 
 
 def test_namespaced_overrides_reach_only_that_subtree(server: ObjectiveServer) -> None:
