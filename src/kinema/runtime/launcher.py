@@ -29,9 +29,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from kinema.errors import KinemaError
+from kinema.runtime.cell import CellError
 from kinema.runtime.instance import InstanceRecord
 from kinema.runtime.lifeline import Lifeline
-from kinema.runtime.run_folder import RunFolder
+from kinema.runtime.run_folder import RunFolder, prune_runs
 
 if TYPE_CHECKING:
     from kinema.transport import Session
@@ -139,7 +140,7 @@ class Launcher:
         options = self.options
         # A config that does not resolve is refused before anything exists: no run folder, no router.
         self._resolved()
-        self.run_folder = RunFolder.create(options.config)
+        self.run_folder = RunFolder.create(options.config, keep=None)  # pruned once the cell is ours
         supervisor_log = self.run_folder.log_file("supervisor")
         configure_process_logging(supervisor_log, verbose=options.verbose, echo=options.verbose)
         self.lifeline = Lifeline()
@@ -151,7 +152,7 @@ class Launcher:
                 os.getpid(), self.endpoint, str(self.run_folder.path), options.config
             )
             self.record.save()
-            self._check_cell_is_free()
+            prune_runs()
             clock = "auto"
             starting = self._start_drivers() if options.drivers else []
             if options.drivers and not starting:
@@ -166,6 +167,10 @@ class Launcher:
                     self.options.echo(f"Groot2: connect to 127.0.0.1 port {options.groot2_port}")
             if options.viewer:
                 self._start_viewer()
+        except CellError:
+            self.stop()
+            self.run_folder.discard()  # nothing was started: its logs are not a run's
+            raise
         except BaseException:
             self.stop()
             raise
@@ -400,7 +405,7 @@ class Launcher:
 
         bound_heap_growth()  # the router reassembles large messages too; see kinema.transport.heap
         plan = plan_router(self.options.endpoint, self.options.security_dir)
-        session = open_router(plan, insecure=self.options.insecure)
+        session = open_router(plan, insecure=self.options.insecure, before_join=self._check_cell_is_free)
         self.endpoint = plan.local
         if session.exposed:
             log.warning("%s", insecure_warning(session.exposed))
@@ -413,17 +418,17 @@ class Launcher:
             )
         return session
 
-    def _check_cell_is_free(self) -> None:
-        """Refuse to start a second agent or second drivers on a router that has them (one per cell)."""
-        if self.hosting or self.session is None:
-            return  # a router of our own: nobody else is there yet
+    def _check_cell_is_free(self, endpoint: str) -> None:
+        """Refuse to start a second agent or second drivers on the router at ``endpoint`` that has them
+        (one per cell); called before joining it, so that a refused run joins nothing.
+        """
         from kinema.runtime.cell import check_cell_is_free
         from kinema.transport import open_session
 
-        # Looked at as a client: see check_cell_is_free on why this session (a peer) would miss some.
-        with open_session(self.endpoint, self.session.domain_id, mode="client") as looking:
+        # Looked at as a client: see check_cell_is_free on why a peer that just joined would miss some.
+        with open_session(endpoint, mode="client") as looking:
             check_cell_is_free(
-                looking, agent=self.options.agent, drivers=self.options.drivers, endpoint=self.endpoint
+                looking, agent=self.options.agent, drivers=self.options.drivers, endpoint=endpoint
             )
 
     def _watch_cell(self) -> None:

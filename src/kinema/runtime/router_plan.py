@@ -13,6 +13,7 @@ client's (another machine of the cell, with its certificate) makes ``kinema run 
 from __future__ import annotations
 
 import os
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -119,8 +120,13 @@ def _loopback_twin(endpoints: list[str]) -> str | None:
     return None
 
 
-def open_router(plan: RouterPlan, *, insecure: bool = False) -> Session:
+def open_router(
+    plan: RouterPlan, *, insecure: bool = False, before_join: Callable[[str], None] | None = None
+) -> Session:
     """Host the planned router, or join the one already running at ``plan.local``.
+
+    ``before_join`` is called with the endpoint before joining a running router (what it raises is
+    raised, and nothing is joined).
 
     Raises:
         ExposureError: a listener beyond loopback without mutual TLS and access rules, not ``insecure``.
@@ -130,12 +136,14 @@ def open_router(plan: RouterPlan, *, insecure: bool = False) -> Session:
     from kinema.transport.exposure import ExposureError
 
     if plan.config_file is None:
-        return host_or_join(",".join(plan.listen), insecure=insecure)
+        return host_or_join(",".join(plan.listen), insecure=insecure, before_join=before_join)
     try:
         return host_router(list(plan.listen), config_file=str(plan.config_file), insecure=insecure)
     except ExposureError:
         raise
     except TransportError as hosting_error:
+        if before_join is not None:
+            before_join(plan.local)
         try:
             return open_session(plan.local)  # a runtime hosts it already (one per cell decides next)
         except TransportError:

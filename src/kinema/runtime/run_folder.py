@@ -78,8 +78,10 @@ class RunFolder:
         return sorted(found)
 
     @classmethod
-    def create(cls, config_name: str, *, keep: int = KEEP_RUNS) -> RunFolder:
-        """Create a fresh folder for a run of ``config_name`` and prune the oldest beyond ``keep``."""
+    def create(cls, config_name: str, *, keep: int | None = KEEP_RUNS) -> RunFolder:
+        """Create a fresh folder for a run of ``config_name`` and prune the oldest beyond ``keep``
+        (None: prune later, with :func:`prune_runs`, once the run has started).
+        """
         safe = re.sub(r"[^A-Za-z0-9_.-]+", "_", config_name) or "run"
         now = time.time()
         # The stamp leads the name, so names sort in creation order (mtimes can tie).
@@ -91,8 +93,23 @@ class RunFolder:
             suffix += 1
             path = base / f"{stamp}-{safe}-{suffix}"
         path.mkdir(parents=True)
-        _prune(base, keep)
+        if keep is not None:
+            _prune(base, keep)
         return cls(path)
+
+    def discard(self) -> None:
+        """Remove the folder of a run that started nothing (a refused ``kinema run``), so that it is
+        neither the latest run for ``kinema logs`` nor counted against the runs kept.
+        """
+        import logging
+        import shutil
+
+        root = logging.getLogger()
+        for handler in list(root.handlers):
+            if isinstance(handler, logging.FileHandler) and Path(handler.baseFilename).parent == self.path:
+                root.removeHandler(handler)
+                handler.close()
+        shutil.rmtree(self.path, ignore_errors=True)
 
     @classmethod
     def latest(cls) -> RunFolder:
@@ -114,6 +131,11 @@ def _regular_file(path: Path) -> bool:
         return stat.S_ISREG(path.lstat().st_mode)
     except OSError:
         return False
+
+
+def prune_runs(keep: int = KEEP_RUNS) -> None:
+    """Remove the oldest run folders beyond ``keep``."""
+    _prune(runs_dir(), keep)
 
 
 def _prune(base: Path, keep: int) -> None:

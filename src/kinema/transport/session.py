@@ -22,7 +22,7 @@ import os
 import threading
 import time
 import weakref
-from collections.abc import Iterable, Mapping, Sequence
+from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, Literal
 
 from kinema.errors import TransportError
@@ -473,6 +473,7 @@ def host_or_join(
     config_file: str | None = None,
     config_overrides: Mapping[str, Any] | None = None,
     insecure: bool = False,
+    before_join: Callable[[str], None] | None = None,
 ) -> Session:
     """Host the router at ``endpoint``, or join the one already listening there (what ``kinema run`` does).
 
@@ -480,7 +481,8 @@ def host_or_join(
     comma-separated endpoints are all listened on (and joined through). A router this process may not
     host (a listener beyond loopback without mutual TLS, see :mod:`kinema.transport.exposure`) is still
     joined when one runs there (that is connecting, not listening); when none does, the refusal is
-    raised.
+    raised. ``before_join`` is called with the endpoint before joining (what it raises is raised, and
+    nothing is joined).
     """
     target = endpoint or resolve_endpoints(None)[0]
     try:
@@ -489,12 +491,16 @@ def host_or_join(
         )
     except ExposureError as refusal:
         log.info("not hosting a router at %s (%s); joining one there", target, refusal)
+        if before_join is not None:
+            before_join(target)
         try:
             return open_session(target, domain_id, config_file=config_file, config_overrides=config_overrides)
         except TransportError:
             raise refusal from None
     except TransportError as hosting_error:
         log.info("cannot host the router at %s (%s); joining it", target, hosting_error)
+        if before_join is not None:
+            before_join(target)
         try:
             return open_session(target, domain_id, config_file=config_file, config_overrides=config_overrides)
         except TransportError as joining_error:

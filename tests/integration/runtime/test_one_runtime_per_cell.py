@@ -74,6 +74,8 @@ def test_a_second_run_refuses_naming_the_running_instance_and_the_ways_out(
 ) -> None:
     endpoint = env["KINEMA_ZENOH_CONNECT"]
     agents_before = _agents(endpoint)
+    runs = Path(env["XDG_STATE_HOME"], "kinema", "runs")
+    runs_before = sorted(runs.iterdir())
     second = _run(env, "-n")
     assert second.returncode == 1, second.stdout + second.stderr
     message = second.stderr
@@ -84,6 +86,8 @@ def test_a_second_run_refuses_naming_the_running_instance_and_the_ways_out(
     assert "Kinema is running" not in second.stdout
     assert _agents(endpoint) == agents_before and len(agents_before) == 1
     assert agent_run.process.poll() is None  # the running instance is untouched
+    # The refused run leaves no log folder: `kinema logs` still shows the running instance's run.
+    assert sorted(runs.iterdir()) == runs_before
 
 
 def test_agent_and_drivers_started_apart_form_one_cell_and_a_full_run_is_refused(
