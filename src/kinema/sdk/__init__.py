@@ -28,6 +28,7 @@ _EXPORTS = {
     "ObjectiveResult": "kinema.runtime.result",
     "ObjectiveClient": "kinema.sdk.client",
     "ObjectiveHandle": "kinema.sdk.client",
+    "ObjectiveTimeoutError": "kinema.sdk.client",
     "parameter_messages": "kinema.sdk.client",
     "QuickClient": "kinema.sdk.quick",
     "QuickRun": "kinema.sdk.quick",
@@ -46,6 +47,7 @@ __all__ = [
     "ObjectiveHandle",
     "ObjectiveResult",
     "ObjectiveStatus",
+    "ObjectiveTimeoutError",
     "ParameterOverride",
     "QuickClient",
     "QuickRun",
@@ -58,7 +60,7 @@ if TYPE_CHECKING:
     from kinema.runtime.objective_status import ObjectiveStatus
     from kinema.runtime.overrides import ParameterOverride
     from kinema.runtime.result import ObjectiveResult
-    from kinema.sdk.client import ObjectiveClient, ObjectiveHandle, parameter_messages
+    from kinema.sdk.client import ObjectiveClient, ObjectiveHandle, ObjectiveTimeoutError, parameter_messages
     from kinema.sdk.quick import QuickClient, QuickRun
     from kinema.sdk.streams import (
         BlackboardSnapshot,

@@ -19,6 +19,7 @@ no runtime answers within the client's ``timeout``.
 
 from __future__ import annotations
 
+import logging
 import threading
 import time
 from collections.abc import Iterable, Mapping
@@ -44,6 +45,8 @@ if TYPE_CHECKING:
 Overrides = Mapping[str, Any] | Iterable[ParameterOverride] | None
 
 DEFAULT_TIMEOUT = 5.0
+
+log = logging.getLogger(__name__)
 
 
 def parameter_messages(overrides: Overrides) -> list[dict[str, Any]]:
@@ -83,6 +86,10 @@ def _result_from(error_code: Any, error_message: str, objective_name: str) -> Ob
     return ObjectiveResult(int(error_code.val), message, objective_name)
 
 
+class ObjectiveTimeoutError(TransportError):
+    """An objective waited for with a ``timeout`` did not end in time; it was cancelled."""
+
+
 class ObjectiveHandle:
     """An objective started with :meth:`ObjectiveClient.start`: cancel it, wait for its result."""
 
@@ -118,6 +125,33 @@ class ObjectiveHandle:
 
     def __repr__(self) -> str:
         return f"<ObjectiveHandle {self.objective_name!r} {self.status}>"
+
+
+def _wait_or_cancel(handle: ObjectiveHandle, timeout: float | None) -> ObjectiveResult:
+    """The result of ``handle``; cancels the objective when ``timeout`` passes or the wait is interrupted."""
+    try:
+        return handle.result(timeout)
+    except KeyboardInterrupt:
+        _cancel_quietly(handle)
+        raise
+    except TransportError:
+        if handle.done:
+            raise  # the agent answered with an error, or went away
+        cancelled = _cancel_quietly(handle)
+        what = "it was cancelled" if cancelled else "cancelling it failed: it may still run"
+        raise ObjectiveTimeoutError(
+            f"objective {handle.objective_name!r} did not end within {timeout:g} s; {what}"
+        ) from None
+
+
+def _cancel_quietly(handle: ObjectiveHandle) -> bool:
+    """Cancel ``handle``'s objective; False when the agent could not be asked."""
+    try:
+        handle.cancel()
+    except TransportError as error:
+        log.warning("cancelling objective %r failed: %s", handle.objective_name, error)
+        return False
+    return True
 
 
 class ObjectiveClient:
@@ -222,15 +256,17 @@ class ObjectiveClient:
             overrides: parameter overrides (see :func:`parameter_messages`).
             wait: True blocks until it ends and returns its :class:`ObjectiveResult`; False returns an
                 :class:`ObjectiveHandle` at once (as :meth:`start`).
-            timeout: with ``wait``, how long the objective may take (None: as long as it runs).
+            timeout: with ``wait``, how long the objective may take (None: as long as it runs). When it
+                passes, the objective is cancelled and :class:`ObjectiveTimeoutError` raised. An
+                interrupt (Ctrl-C, ``KeyboardInterrupt``) while waiting cancels it too: the robot never
+                keeps moving for a program that stopped waiting.
+
+        Raises:
+            ObjectiveTimeoutError: ``timeout`` passed (the objective was cancelled).
+            TransportError: the agent is not there, or went away before answering.
         """
-        if not wait:
-            return self.start(name, overrides)
-        self.wait_for_runtime()
-        client = self._client(names.EXECUTE_OBJECTIVE_TYPE, names.EXECUTE_OBJECTIVE)
-        request = {"objective_name": name, "parameter_overrides": parameter_messages(overrides)}
-        response = client.call(request, timeout=1e9 if timeout is None else timeout)
-        return _result_from(response.error_code, "", name)
+        handle = self.start(name, overrides)
+        return _wait_or_cancel(handle, timeout) if wait else handle
 
     def start(self, name: str = "", overrides: Overrides = None, *, xml: str = "") -> ObjectiveHandle:
         """Start an objective through ``/do_objective`` and return its handle (name wins over ``xml``)."""
@@ -277,7 +313,7 @@ class ObjectiveClient:
     ) -> ObjectiveResult | ObjectiveHandle:
         """Run an objective given as a BT.CPP v4 XML string (its main tree); see :meth:`execute`."""
         handle = self.start(overrides=overrides, xml=xml)
-        return handle.result(timeout) if wait else handle
+        return _wait_or_cancel(handle, timeout) if wait else handle
 
     def cancel(self) -> bool:
         """Cancel whatever objective runs; False when none was running."""

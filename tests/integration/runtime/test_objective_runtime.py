@@ -8,13 +8,21 @@ import signal
 import subprocess
 import sys
 import textwrap
+import threading
 import time
 from typing import Any
 
 import pytest
 
 from kinema.errors import TransportError
-from kinema.sdk import MoveItErrorCode, ObjectiveClient, ObjectiveResult, ObjectiveStatus, ParameterOverride
+from kinema.sdk import (
+    MoveItErrorCode,
+    ObjectiveClient,
+    ObjectiveResult,
+    ObjectiveStatus,
+    ObjectiveTimeoutError,
+    ParameterOverride,
+)
 
 TEST_SIMPLE = """<root BTCPP_format="4" main_tree_to_execute="test simple">
   <BehaviorTree ID="test simple">
@@ -52,6 +60,37 @@ def test_cancel_stops_a_looping_objective(client: ObjectiveClient) -> None:
     assert result.cancelled and result.error_code == MoveItErrorCode.PREEMPTED
     assert handle.status == "CANCELED"
     assert client.status().status in (ObjectiveStatus.CANCELLED, ObjectiveStatus.IDLE)
+
+
+def _stops_running(client: ObjectiveClient, timeout: float = 5) -> None:
+    deadline = time.monotonic() + timeout
+    while client.status().status in (ObjectiveStatus.RUNNING, ObjectiveStatus.LOADING):
+        assert time.monotonic() < deadline, f"still {client.status()}"
+        time.sleep(0.05)
+
+
+def test_waiting_with_a_timeout_cancels_the_objective_when_it_passes(client: ObjectiveClient) -> None:
+    with pytest.raises(ObjectiveTimeoutError, match=r"'Forever' did not end within 0\.5 s; it was cancelled"):
+        client.execute("Forever", timeout=0.5)
+    _stops_running(client)
+    with pytest.raises(ObjectiveTimeoutError, match=r"did not end within 0\.5 s"):
+        client.do_xml(
+            TEST_SIMPLE.replace('<Action ID="AlwaysSuccess"/>', '<SubTree ID="Forever"/>'), timeout=0.5
+        )
+    _stops_running(client)
+    assert client.execute("Quick", timeout=10).succeeded  # in time: its result, as without a timeout
+
+
+def test_interrupting_a_wait_cancels_the_objective(client: ObjectiveClient) -> None:
+    # Ctrl-C in a script blocked in execute(): the objective must not keep the robot moving.
+    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT))
+    timer.start()
+    try:
+        with pytest.raises(KeyboardInterrupt):
+            client.execute("Forever")
+    finally:
+        timer.cancel()
+    _stops_running(client)
 
 
 def test_cancel_objective_service_halts_what_runs(client: ObjectiveClient) -> None:
