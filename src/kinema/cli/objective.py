@@ -8,7 +8,13 @@ from typing import TYPE_CHECKING
 
 import click
 
-from kinema.cli.options import print_notices, resolve_selection, selection_options, verbose_option
+from kinema.cli.options import (
+    print_notices,
+    resolve_selection,
+    running_selection,
+    selection_options,
+    verbose_option,
+)
 
 if TYPE_CHECKING:
     from kinema.config import ObjectiveLibrary
@@ -16,12 +22,21 @@ if TYPE_CHECKING:
 
 @click.group()
 def objective() -> None:
-    """List, inspect and run the objectives of a config package."""
+    """List, inspect and run the objectives of a config package.
+
+    `list` and `show` read the objective files of the config that `-c` names, else of the config the
+    runtime on this machine runs (`kinema run -c NAME`, at the router these verbs join), else of the
+    selected one ($KINEMA_CONFIG, `kinema configure`).
+    """
 
 
 def _load_library(workspace: Path | None, config: str | None, verbose: bool) -> ObjectiveLibrary:
     from kinema.config import ObjectiveLibrary, resolve_config
 
+    running = running_selection(workspace, config)
+    if running is not None:
+        workspace, config, note = running
+        click.secho(f"note: {note}", err=True, fg="yellow")
     found, name = resolve_selection(workspace, config)
     resolved = resolve_config(name, found)
     library = ObjectiveLibrary.load(resolved)
@@ -107,7 +122,8 @@ def show(
 
     The ports listed are what `-p NAME=VALUE` can set (the subtree ports the objective declares, then
     the blackboard keys its behaviors read), with their types, followed by its declared outputs: the
-    same list the SDK's `objectives()` and the terminal UI's override form give.
+    same list the SDK's `objectives()` and the terminal UI's override form give. A run without `-p`
+    for a port starts from the default shown.
     """
     from dataclasses import replace
 

@@ -56,6 +56,39 @@ def resolve_selection(
     return found, name
 
 
+def running_selection(workspace: Path | None, config: str | None) -> tuple[Path | None, str, str] | None:
+    """The workspace and config of the runtime running on this machine at the router the verbs join, with
+    a note saying so, when nothing chooses another (no ``-w``/``-c``, no ``KINEMA_WORKSPACE``/
+    ``KINEMA_CONFIG``) and it runs another config than the stored one (``kinema run -c NAME``).
+
+    None when no such runtime runs, or when it runs the selected config.
+    """
+    from kinema.config import active_selection
+
+    selection = active_selection(workspace, config)
+    if selection.config_source in ("flag", "environment") or selection.workspace_source in (
+        "flag",
+        "environment",
+    ):
+        return None
+    from kinema.runtime.instance import running_instances
+    from kinema.transport.session import resolve_endpoints
+
+    endpoint = resolve_endpoints(None)[0]
+    runs = [r for r in running_instances() if r.router == endpoint and r.config]
+    if len(runs) != 1:
+        return None
+    run = runs[0]
+    run_workspace = Path(run.workspace) if run.workspace else None
+    if run.config == selection.config and run_workspace in (None, selection.workspace):
+        return None
+    note = (
+        f"config {run.config}: what the runtime at {endpoint} runs (kinema run pid {run.pid}); "
+        f"the selected config is {selection.config} (-c chooses)"
+    )
+    return run_workspace, run.config, note
+
+
 def print_notices(notices: list[str]) -> None:
     """Print verbose-mode notices on stderr."""
     for notice in notices:

@@ -36,6 +36,7 @@ class InstanceRecord:
         router: the zenoh endpoint every client connects to.
         run_folder: the run's log folder.
         config: the config package that runs.
+        workspace: the workspace it was started with ("" when none was given).
         started: wall time the instance started (seconds since the epoch).
         children: process ids of the agent and the drivers.
     """
@@ -44,6 +45,7 @@ class InstanceRecord:
     router: str
     run_folder: str
     config: str = ""
+    workspace: str = ""
     started: float = field(default_factory=time.time)
     children: list[int] = field(default_factory=list)
 

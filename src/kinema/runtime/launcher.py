@@ -149,7 +149,11 @@ class Launcher:
             self.hosting = self.session.is_router
             log.info("%s the router at %s", "hosting" if self.hosting else "joined", self.endpoint)
             self.record = InstanceRecord(
-                os.getpid(), self.endpoint, str(self.run_folder.path), options.config
+                os.getpid(),
+                self.endpoint,
+                str(self.run_folder.path),
+                options.config,
+                str(options.workspace or ""),
             )
             self.record.save()
             prune_runs()

@@ -244,7 +244,8 @@ def test_an_objective_run_on_its_own_reads_the_defaults_of_its_ports_and_overrid
     assert result == ObjectiveResult.success("Defaulted")
     assert _echo(recorder) == "hello"
     # A bad override is still refused, default or not.
-    bad = server.submit(ObjectiveRequest("Defaulted", overrides=(ParameterOverride("delay", "soon"),))).wait(5)
+    soon = (ParameterOverride("delay", "soon"),)
+    bad = server.submit(ObjectiveRequest("Defaulted", overrides=soon)).wait(5)
     assert bad is not None and bad.failed and "'soon' is not a valid" in bad.error_message
 
 
@@ -253,7 +254,9 @@ def test_an_adhoc_document_s_main_tree_reads_the_defaults_its_model_declares(
 ) -> None:
     xml = """<root BTCPP_format="4" main_tree_to_execute="Greets">
       <BehaviorTree ID="Greets"><SetBlackboard value="{greeting}" output_key="echo"/></BehaviorTree>
-      <TreeNodesModel><SubTree ID="Greets"><input_port name="greeting" default="ahoy"/></SubTree></TreeNodesModel>
+      <TreeNodesModel>
+        <SubTree ID="Greets"><input_port name="greeting" default="ahoy"/></SubTree>
+      </TreeNodesModel>
     </root>"""
     assert server.submit(ObjectiveRequest(objective_xml=xml)).wait(5) == ObjectiveResult.success("Greets")
     assert _echo(recorder) == "ahoy"
