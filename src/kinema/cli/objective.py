@@ -24,9 +24,9 @@ if TYPE_CHECKING:
 def objective() -> None:
     """List, inspect and run the objectives of a config package.
 
-    `list` and `show` read the objective files of the config that `-c` names, else of the config the
-    runtime on this machine runs (`kinema run -c NAME`, at the router these verbs join), else of the
-    selected one ($KINEMA_CONFIG, `kinema configure`).
+    `list` and `show` read the objective files of the config that `-c` or $KINEMA_CONFIG names, else of
+    the config the runtime on this machine runs (`kinema run -c NAME`, at the router these verbs join),
+    else of the one `kinema configure` stored.
     """
 
 
