@@ -220,8 +220,12 @@ def _show_toast(level: str, text: str) -> None:
         click.echo(text)
 
 
-def _finish(run, wait: bool) -> None:  # type: ignore[no-untyped-def]
-    """Wait for a started objective (Ctrl-C cancels it) and exit 0 only when it succeeded."""
+def _finish(run, wait: bool, source: str = "") -> None:  # type: ignore[no-untyped-def]
+    """Wait for a started objective (Ctrl-C cancels it) and exit 0 only when it succeeded.
+
+    ``source``: the file the objective's XML came from, named in its messages instead of the runtime's
+    ``<objective XML>`` (which only ever saw the text).
+    """
     if not wait:
         click.echo(f"started {run.objective_name!r}")
         return
@@ -231,10 +235,11 @@ def _finish(run, wait: bool) -> None:  # type: ignore[no-untyped-def]
         click.echo(f"cancelling {run.objective_name!r} ...", err=True)
         run.cancel()
         result = run.result(on_toast=_show_toast)
+    text = str(result).replace("<objective XML>", source) if source else str(result)
     if result.succeeded:
-        click.echo(str(result))
+        click.echo(text)
         return
-    click.secho(str(result), err=True, fg="yellow" if result.cancelled else "red")
+    click.secho(text, err=True, fg="yellow" if result.cancelled else "red")
     raise click.exceptions.Exit(1)
 
 
@@ -272,15 +277,16 @@ def run_(name: str, params: tuple[str, ...], no_wait: bool, connect: str | None,
 def do_(file, no_wait: bool, connect: str | None, timeout: float) -> None:  # type: ignore[no-untyped-def]
     """Run the BT.CPP v4 XML in FILE (`-` reads stdin) as an ad-hoc objective (its main tree)."""
     xml = file.read()
+    source = "" if file.name == "<stdin>" else file.name
     with _client(connect, timeout) as client:
-        _finish(client.start(xml=xml), not no_wait)
+        _finish(client.start(xml=xml), not no_wait, source)
 
 
 @objective.command("cancel")
 @connect_option
 @timeout_option
 def cancel_(connect: str | None, timeout: float) -> None:
-    """Cancel the objective that is running (its result is PREEMPTED)."""
+    """Cancel the objective that is running: it ends as cancelled (MoveIt's error code PREEMPTED)."""
     with _client(connect, timeout) as client:
         cancelled, name = client.cancel()
     click.echo(f"cancelled {name!r}" if cancelled else "no objective was running")

@@ -10,6 +10,7 @@ import sys
 import textwrap
 import threading
 import time
+from pathlib import Path
 from typing import Any
 
 import pytest
@@ -315,6 +316,10 @@ def test_the_cli_runs_and_reports_objectives(agent: Any, tmp_path: object) -> No
     assert failed.returncode == 1 and "node 'broken'" in failed.stderr
     adhoc = kinema("do", "-", stdin=TEST_SIMPLE)
     assert adhoc.returncode == 0 and "'test simple' succeeded" in adhoc.stdout
+    broken = Path(str(tmp_path), "broken.xml")
+    broken.write_text('<root BTCPP_format="4"><BehaviorTree ID="x"><Sequence></BehaviorTree></root>')
+    malformed = kinema("do", str(broken))
+    assert malformed.returncode == 1 and f"{broken}:1: XML syntax error" in malformed.stderr, malformed.stderr
     started = kinema("run", "Forever", "--no-wait")
     assert started.returncode == 0
     status = kinema("status")
