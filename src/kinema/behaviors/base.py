@@ -8,6 +8,7 @@ it with the matching engine node type.
 from __future__ import annotations
 
 import inspect
+import re
 from typing import Any, ClassVar
 
 from kinema.behaviors.context import BehaviorContext
@@ -51,7 +52,10 @@ class Behavior:
         description = cls.description
         if not description:
             doc = inspect.getdoc(cls) or ""
-            description = doc.split("\n\n", 1)[0].replace("\n", " ").strip()
+            # A docstring's reST literals (``name``) read as `name` where descriptions are shown: the
+            # terminal UI, `kinema behaviors`, Groot2's palette.
+            summary = doc.split("\n\n", 1)[0].replace("\n", " ").strip()
+            description = re.sub(r"``(.+?)``", r"`\1`", summary)
         return {"subcategory": cls.subcategory, "description": description}
 
     @property

@@ -102,7 +102,7 @@ def reset(keyframe: str | None, connect: str | None, timeout: float) -> None:
 def set_joints(assignments: tuple[str, ...], connect: str | None, timeout: float) -> None:
     """Teleport joints to positions given as JOINT=VALUE (m or rad).
 
-    Example: ``kinema sim set-joints elbow_joint=1.2 wrist_1_joint=-1.5``. The controllers hold the
+    Example: `kinema sim set-joints elbow_joint=1.2 wrist_1_joint=-1.5`. The controllers hold the
     joints where they are set; a trajectory in progress is aborted.
     """
     positions: dict[str, float] = {}

@@ -67,6 +67,17 @@ def test_tick_behavior_reports_toasts_and_the_metadata_comes_from_the_class() ->
     assert NeedsThree.metadata() == {"subcategory": "Tests", "description": "Needs x, y and z."}
 
 
+def test_a_description_from_the_docstring_shows_its_literals_as_the_cli_writes_them() -> None:
+    class Adds(SyncBehavior):
+        """Adds ``int_1`` and
+        ``int_2``.
+
+        The rest of the docstring is not the description.
+        """
+
+    assert Adds.metadata()["description"] == "Adds `int_1` and `int_2`."
+
+
 def test_the_robot_model_is_built_once_on_first_use() -> None:
     calls = []
 
