@@ -37,4 +37,4 @@ def test_the_reference_gives_each_behavior_its_ports_with_direction_type_and_def
     assert "## Vector Handling" in text and "### PushBackVector" in text and "### ForEach" in text
     assert "| `element` | input | `BT::AnyTypeAllowed` | `{element}` |" in text
     assert "| `index` | output | `int` | `{index}` |" in text
-    assert "Appends ``element`` to the end of ``input_vector``" in text
+    assert "Appends `element` to the end of `input_vector`" in text
