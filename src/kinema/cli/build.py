@@ -70,6 +70,8 @@ def build(
             pip_install(missing, lambda line: click.echo(f"    {line}"))
 
     resolved = resolve_config(name, found)
+    for warning in resolved.warnings:
+        click.secho(f"warning: {warning}", err=True, fg="yellow")
     host = BehaviorHost.for_config(resolved)
     report = host.load()
     for warning in report.warnings:
@@ -80,7 +82,9 @@ def build(
     registry = host.registry
     click.echo(f"{len(registry)} behaviors from {len(host.plugins)} plugins for config {resolved.name}")
 
-    file_count, problems = validate_objectives(resolved, registry)
+    file_count, problems, warnings = validate_objectives(resolved, registry)
+    for warning in warnings:
+        click.secho(f"warning: {warning}", err=True, fg="yellow")
     for problem in problems:
         click.secho(str(problem), err=True, fg="red")
     errors += len(problems)

@@ -96,6 +96,8 @@ def show(
 
     found, name = resolve_selection(workspace, config)
     resolved = resolve_config(name, found, check_files=not no_check)
+    for warning in resolved.warnings:
+        click.secho(f"warning: {warning}", err=True, fg="yellow")
     if verbose:
         print_notices(resolved.notices)
     if as_json:

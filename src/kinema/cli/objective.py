@@ -40,6 +40,8 @@ def _load_library(workspace: Path | None, config: str | None, verbose: bool) -> 
     found, name = resolve_selection(workspace, config)
     resolved = resolve_config(name, found)
     library = ObjectiveLibrary.load(resolved)
+    for warning in [*resolved.warnings, *library.warnings]:
+        click.secho(f"warning: {warning}", err=True, fg="yellow")
     if verbose:
         print_notices([*resolved.notices, *library.notices])
     return library

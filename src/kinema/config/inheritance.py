@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import Any
 
 from kinema.config.refs import PackageRef, as_ref, is_ref
-from kinema.config.schema import REQUIRED, SCHEMA, Field, dotted, validate_document
+from kinema.config.schema import REQUIRED, SCHEMA, Field, dotted, is_unknown_key_notice, validate_document
 from kinema.config.workspace import Package, Workspace
 from kinema.config.yamlsource import YamlDocument, load_yaml_file
 from kinema.errors import ConfigError, SourceLocation, did_you_mean
@@ -106,7 +106,8 @@ class ResolvedConfig:
         sources: each chain package's own config.yaml.
         data: the merged config, shaped like config.yaml.
         provenance: dotted key path of each merged leaf -> package that set it.
-        notices: things worth saying in verbose mode (unknown keys, overlays, unused keys).
+        notices: things worth saying in verbose mode (overlays, unused keys).
+        warnings: things worth saying always: keys no schema knows (typos, most of the time).
     """
 
     name: str
@@ -116,6 +117,7 @@ class ResolvedConfig:
     data: dict[str, Any]
     provenance: dict[str, str]
     notices: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
     _origins: dict[KeyPath, str] = field(default_factory=dict, repr=False)
 
     @property
@@ -413,6 +415,7 @@ def resolve_config(
     workspace = workspace if workspace is not None else Workspace.discover()
     sources = resolve_chain(name, workspace)
     chain = [source.package.name for source in sources]
+    said = [*workspace.notices, *(n for source in sources for n in source.notices)]
     data, origins = merge_layers([(source.package.name, source.data) for source in sources])
     resolved = ResolvedConfig(
         name=chain[-1],
@@ -421,7 +424,8 @@ def resolve_config(
         sources={source.package.name: source for source in sources},
         data=data,
         provenance={dotted(key): package for key, package in origins.items()},
-        notices=[*workspace.notices, *(n for source in sources for n in source.notices)],
+        notices=[n for n in said if not is_unknown_key_notice(n)],
+        warnings=[n for n in said if is_unknown_key_notice(n)],
         _origins=origins,
     )
     _check_required(resolved)
@@ -435,12 +439,7 @@ def _check_required(resolved: ResolvedConfig) -> None:
     for key_path in REQUIRED:
         if resolved.get(key_path) is None:
             own = resolved.sources[resolved.name]
-            hints = [
-                notice
-                for source in resolved.sources.values()
-                for notice in source.notices
-                if "unknown key" in notice
-            ]
+            hints = resolved.warnings
             hint = f" (note: {hints[0]})" if hints else ""
             raise ConfigError(
                 f"config {resolved.name!r} does not set {dotted(key_path)}, which is required, "

@@ -53,6 +53,7 @@ class ObjectiveLibrary:
         objectives: objective ID -> the winning :class:`ObjectiveInfo`.
         errors: files that could not be read, as ObjectiveErrors (``str()`` gives ``file:line: message``).
         notices: shadowed objectives and soft problems (verbose output).
+        warnings: problems worth saying always: one package defining an objective ID in two files.
         resolved: the config the library was built for (None for a library built from folders).
     """
 
@@ -60,6 +61,7 @@ class ObjectiveLibrary:
     objectives: dict[str, ObjectiveInfo] = field(default_factory=dict)
     errors: list[ObjectiveError] = field(default_factory=list)
     notices: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
     resolved: ResolvedConfig | None = None
     # file -> when it was first read: files() registers them in this order
     _load_order: dict[Path, int] = field(default_factory=dict, repr=False)
@@ -87,7 +89,7 @@ class ObjectiveLibrary:
         library = cls(libraries=list(by_folder.values()))
         for library_path in library.libraries:
             for xml_file in _xml_files(library_path.path):
-                library._add_file(xml_file, library_path.package)
+                library._add_file(xml_file, library_path.package, folder=library_path.path)
         library._note_favorites()
         return library
 
@@ -251,7 +253,10 @@ class ObjectiveLibrary:
         except ObjectiveError:
             return False
 
-    def _add_file(self, path: Path, package: str, *, replace: bool = False) -> list[ObjectiveInfo]:
+    def _add_file(
+        self, path: Path, package: str, *, replace: bool = False, folder: Path | None = None
+    ) -> list[ObjectiveInfo]:
+        """Read ``path`` (of library ``folder``, in ``package``) into the library; its objectives."""
         try:
             parsed = parse_objective_file(path)
         except ObjectiveError as error:
@@ -264,7 +269,15 @@ class ObjectiveLibrary:
             previous = self.objectives.get(info.id)
             if previous is not None and previous.file != path:
                 info.shadows = [*previous.shadows, previous.file]
-                if not replace:
+                if folder is not None and previous.file.resolve().is_relative_to(folder.resolve()):
+                    # Two files of one library folder, not a library overriding another's: a copy that
+                    # kept its ID, most of the time. Files load in name order; the last one wins.
+                    self.warnings.append(
+                        f"{info.location}: objective {info.id!r} is defined again in the library "
+                        f"{folder} (first at {previous.location}); this one is used. Give each objective "
+                        "its own ID"
+                    )
+                elif not replace:
                     self.notices.append(
                         f"{info.location}: objective {info.id!r} from {package} shadows the one in "
                         f"{previous.package} ({previous.location})"

@@ -180,6 +180,15 @@ def field_at(path: tuple[Hashable, ...]) -> Field | None:
     return current
 
 
+# Notices that start so (after ``file:line: ``) name a key no schema knows: a typo, most of the time.
+UNKNOWN_KEY = "unknown key"
+
+
+def is_unknown_key_notice(notice: str) -> bool:
+    """Whether a notice of :func:`validate_document` names an unknown key (shown without ``-v``)."""
+    return f": {UNKNOWN_KEY} " in notice
+
+
 def validate_document(document: YamlDocument, package: str) -> list[str]:
     """Check one config.yaml against the schema.
 
@@ -217,8 +226,8 @@ def _check(
                 hint = did_you_mean(str(key), spec.keys)
                 where = dotted(path) if path else "the top level"
                 notices.append(
-                    f"{document.location((*path, key))}: unknown key {key!r} in {where} is kept but not used "
-                    f"by Kinema ({hint})"
+                    f"{document.location((*path, key))}: {UNKNOWN_KEY} {key!r} in {where} is kept but not "
+                    f"used by Kinema ({hint})"
                 )
                 continue
             if spec.used and not child_spec.used:  # inside an unused section, its own notice suffices

@@ -19,10 +19,13 @@ if TYPE_CHECKING:
     from kinema.plugins.registry import BehaviorRegistry
 
 
-def validate_objectives(resolved: ResolvedConfig, registry: BehaviorRegistry) -> tuple[int, list[Problem]]:
-    """Validate every objective file of ``resolved``; return (number of files, problems).
+def validate_objectives(
+    resolved: ResolvedConfig, registry: BehaviorRegistry
+) -> tuple[int, list[Problem], list[str]]:
+    """Validate every objective file of ``resolved``; return (number of files, problems, warnings).
 
-    Files that do not parse and duplicate definitions are problems too, with their ``file:line``.
+    Files that do not parse and duplicate definitions are problems too, with their ``file:line``. The
+    warnings (``file:line: ...``) are the library's: an objective ID defined twice in one package.
     """
     from kinema.bt.validation import Problem, validate_files
     from kinema.config import ObjectiveLibrary
@@ -33,7 +36,7 @@ def validate_objectives(resolved: ResolvedConfig, registry: BehaviorRegistry) ->
     ]
     files = library.files()
     problems += validate_files(list(files), registry.create_factory())
-    return len(files), problems
+    return len(files), problems, list(library.warnings)
 
 
 def write_tree_nodes_model(registry: BehaviorRegistry, path: Path) -> Path:

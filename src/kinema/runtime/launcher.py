@@ -143,6 +143,9 @@ class Launcher:
         self.run_folder = RunFolder.create(options.config, keep=None)  # pruned once the cell is ours
         supervisor_log = self.run_folder.log_file("supervisor")
         configure_process_logging(supervisor_log, verbose=options.verbose, echo=options.verbose)
+        for warning in self._resolved().warnings:  # a key no schema knows: a typo, most of the time
+            log.warning("%s", warning)
+            options.echo(f"warning: {warning}")
         self.lifeline = Lifeline()
         try:
             self.session = self._open_router()

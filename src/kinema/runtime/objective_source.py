@@ -107,6 +107,8 @@ class LibraryTreeSource:
             self._objectives_stale = False
         for error in self._library.errors:
             log.warning("objective library: %s", error)
+        for warning in self._library.warnings:
+            log.warning("objective library: %s", warning)
         if registry is not None:
             factory = registry.create_factory(self._context, clock=self._clock)
         else:

@@ -251,3 +251,23 @@ def test_the_hint_after_new_config_is_a_command_that_finds_the_package(capsys, t
     assert code == 0, out
     assert "try: kinema" not in out
     assert "not a workspace's src/ folder" in out and "kinema init" in out, out
+
+
+def test_a_misspelt_config_key_is_a_warning_without_verbose(capsys, tmp_path: Path):
+    workspace = tmp_path / "ws"
+    assert run(capsys, "init", str(workspace))[0] == 0
+    assert (
+        run(capsys, "new", "config", "my_cell", "-w", str(workspace), "--based-on", "lab_sim", "--no-input")[
+            0
+        ]
+        == 0
+    )
+    config_file = workspace / "src" / "my_cell" / "config" / "config.yaml"
+    text = config_file.read_text()
+    assert "\nobjectives:\n" in text
+    config_file.write_text(text.replace("\nobjectives:\n", "\nobjectives:\n  waypoint_file: foo\n", 1))
+    line = config_file.read_text().splitlines().index("  waypoint_file: foo") + 1
+    expected = f"warning: {config_file}:{line}: unknown key 'waypoint_file' in objectives"
+    for verb in (("config", "show"), ("objective", "list", "--no-check")):
+        code, _, err = run(capsys, *verb, "-w", str(workspace), "-c", "my_cell")
+        assert code == 0 and expected in err and "did you mean 'waypoints_file'" in err, err

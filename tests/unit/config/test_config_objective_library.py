@@ -139,6 +139,22 @@ def test_most_derived_package_wins_and_the_shadowed_file_is_reported(ws):
     assert library.get("Only Base").package == "base"
 
 
+def test_two_files_of_one_library_with_one_id_are_a_warning_without_verbose(ws, capsys):
+    from kinema.cli.main import main
+
+    ws.config("robot")
+    first = ws.objective("robot", "Wave", file="wave.xml", _description="first")
+    copy = ws.objective("robot", "Wave", file="wave2.xml", _description="the copy")
+    library = ObjectiveLibrary.load(resolve_config("robot", Workspace.discover(ws.root)))
+    assert library.get("Wave").description == "the copy"  # files load in name order; the last wins
+    assert len(library.warnings) == 1
+    warning = library.warnings[0]
+    assert warning.startswith(f"{copy}:3: objective 'Wave' is defined again")
+    assert f"first at {first}:3" in warning
+    assert main(["objective", "list", "-w", str(ws.root), "-c", "robot", "--no-check"]) == 0
+    assert f"warning: {copy}:3: objective 'Wave' is defined again" in capsys.readouterr().err
+
+
 def test_a_child_library_declared_first_still_wins_by_chain_position(ws):
     base = ws.root_data("base")
     # the root config lists a library of the child package before its own
