@@ -252,6 +252,11 @@ def test_a_cancelled_run_shows_halted_nodes(fake: FakeConnection) -> None:
         assert view.failed_path == []
         panel = app.screen.query_one("#failure-panel", Static)
         assert panel.has_class("shown") and panel.has_class("cancelled")
+        # The next run starts: how the last one ended no longer describes what the screen shows.
+        fake.emit(Heartbeat(13.0, "", "Idle"))
+        fake.emit(Heartbeat(14.0, "Open Gripper", "Running"))
+        await settle(pilot)
+        assert not panel.has_class("shown")
 
     drive(fake, scenario)
 

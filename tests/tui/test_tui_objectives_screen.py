@@ -77,6 +77,23 @@ def test_run_sends_the_filled_in_parameters_and_cancel_cancels(fake: FakeConnect
     drive(fake, scenario)
 
 
+def test_the_parameters_key_puts_the_cursor_in_the_form_and_enter_runs(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        await pilot.press("p")
+        await settle(pilot)
+        form = app.screen.query_one(OverrideForm)
+        first = form.query(Input).first()
+        assert app.focused is first and first.name == "waypoint_name"
+        await pilot.press(*"box")  # x is the screen's cancel key, but here it is a letter of the value
+        await settle(pilot)
+        assert first.value == "box" and fake.called("cancel_objective") == []
+        await pilot.press("enter")
+        await settle(pilot)
+        assert fake.called("start_objective") == [("Pick Object", {"waypoint_name": "box"})]
+
+    drive(fake, scenario)
+
+
 def test_a_subtree_only_objective_is_not_run(fake: FakeConnection) -> None:
     async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
         await pilot.press("down", "down")

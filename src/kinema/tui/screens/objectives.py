@@ -205,6 +205,8 @@ class ObjectivesScreen(KinemaScreen):
     def on_input_submitted(self, event: Input.Submitted) -> None:
         if event.input.id == "objective-search":
             self.query_one("#objective-list", OptionList).focus()
+        elif event.input in self.query_one(OverrideForm).query(Input):
+            self.action_run()  # Enter in a parameter runs the objective with the form's values
 
     def on_select_changed(self, event: Select.Changed) -> None:
         self._refilter()
@@ -300,11 +302,17 @@ class ObjectivesScreen(KinemaScreen):
 
     def action_tab(self, tab: str) -> None:
         self.query_one(TabbedContent).active = tab
+        if tab == "parameters":
+            # Typing goes into the form at once: a value's letters are not the screen's keys (x cancels).
+            fields = self.query_one(OverrideForm).query(Input)
+            if fields:
+                fields.first().focus()
 
     # -- live status -------------------------------------------------------------------------------
 
     def runtime_run_started(self, objective_name: str) -> None:
         self.query_one(TaskPanel).show_task(None)
+        self.action_dismiss_failure()  # how the last run ended no longer describes what runs
         if self.selected is not None and self.selected.name == objective_name:
             self.query_one(BehaviorTreeView).reset_statuses()
 
