@@ -174,10 +174,11 @@ def _list_configs(workspace: Path | None) -> None:
     "--timeout", type=float, default=15.0, show_default=True, help="Seconds to wait for a clean stop."
 )
 def down(timeout: float) -> None:
-    """Stop every `kinema run` of this user on this machine (agents, drivers, routers), cleanly.
+    """Stop every Kinema this user runs here.
 
-    The runs are those recorded in the user's state folder ($XDG_STATE_HOME): a cell split with
-    `kinema run -n` and `kinema run -o` stops whole. SIGTERM first, SIGKILL after --timeout seconds.
+    Every `kinema run` recorded in the user's state folder ($XDG_STATE_HOME) stops cleanly, with its
+    agent, drivers and router: a cell split with `kinema run -n` and `kinema run -o` stops whole.
+    SIGTERM first, SIGKILL after --timeout seconds.
     """
     from kinema.runtime.instance import stop_all
 

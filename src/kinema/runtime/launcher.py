@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from kinema.errors import KinemaError
+from kinema.errors import KinemaError, TransportError
 from kinema.runtime.cell import CellError
 from kinema.runtime.instance import InstanceRecord
 from kinema.runtime.lifeline import Lifeline
@@ -433,7 +433,11 @@ class Launcher:
         from kinema.transport import open_session
 
         # Looked at as a client: see check_cell_is_free on why a peer that just joined would miss some.
-        with open_session(endpoint, mode="client") as looking:
+        try:
+            looking = open_session(endpoint, mode="client")
+        except TransportError:
+            return  # nothing answers there: joining fails too, and says why
+        with looking:
             check_cell_is_free(
                 looking, agent=self.options.agent, drivers=self.options.drivers, endpoint=endpoint
             )

@@ -65,8 +65,8 @@ def test_cancel_stops_a_looping_objective(client: ObjectiveClient) -> None:
 
 def _stops_running(client: ObjectiveClient, timeout: float = 5) -> None:
     deadline = time.monotonic() + timeout
-    while client.status().status in (ObjectiveStatus.RUNNING, ObjectiveStatus.LOADING):
-        assert time.monotonic() < deadline, f"still {client.status()}"
+    while client.status(timeout=timeout).status in (ObjectiveStatus.RUNNING, ObjectiveStatus.LOADING):
+        assert time.monotonic() < deadline, f"still {client.status(timeout=timeout)}"
         time.sleep(0.05)
 
 
@@ -82,15 +82,24 @@ def test_waiting_with_a_timeout_cancels_the_objective_when_it_passes(client: Obj
     assert client.execute("Quick", timeout=10).succeeded  # in time: its result, as without a timeout
 
 
-def test_interrupting_a_wait_cancels_the_objective(client: ObjectiveClient) -> None:
+def test_interrupting_a_wait_cancels_the_objective(agent: Any, client: ObjectiveClient) -> None:
     # Ctrl-C in a script blocked in execute(): the objective must not keep the robot moving.
-    timer = threading.Timer(1.0, os.kill, (os.getpid(), signal.SIGINT))
-    timer.start()
-    try:
-        with pytest.raises(KeyboardInterrupt):
-            client.execute("Forever")
-    finally:
-        timer.cancel()
+    from kinema.sdk import QuickClient
+
+    def interrupt_once_it_runs() -> None:
+        # The signal comes once execute() waits for the result (the run has started), as a user's would.
+        with QuickClient(agent.endpoint, timeout=10) as quick:
+            deadline = time.monotonic() + 30
+            while quick.status() != (ObjectiveStatus.RUNNING, "Forever") and time.monotonic() < deadline:
+                time.sleep(0.02)
+        time.sleep(0.3)
+        os.kill(os.getpid(), signal.SIGINT)
+
+    interrupter = threading.Thread(target=interrupt_once_it_runs, daemon=True)
+    interrupter.start()
+    with pytest.raises(KeyboardInterrupt):
+        client.execute("Forever", timeout=60)
+    interrupter.join(5)
     _stops_running(client)
 
 
