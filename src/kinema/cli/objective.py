@@ -288,7 +288,10 @@ def do_(file, no_wait: bool, connect: str | None, timeout: float) -> None:  # ty
 @connect_option
 @timeout_option
 def cancel_(connect: str | None, timeout: float) -> None:
-    """Cancel the objective that is running: it ends as cancelled (MoveIt's error code PREEMPTED)."""
+    """Cancel the objective that is running.
+
+    It ends as cancelled (MoveIt's error code PREEMPTED): its running behaviors are halted.
+    """
     with _client(connect, timeout) as client:
         cancelled, name = client.cancel()
     click.echo(f"cancelled {name!r}" if cancelled else "no objective was running")
