@@ -16,7 +16,18 @@ def test_the_shell_has_a_connected_client(agent: Any) -> None:
         timeout=60,
     )
     assert done.returncode == 0, done.stderr
-    assert "RESULT True" in done.stdout
+    # Piped-in code runs as a script: its output only, no banner or prompts.
+    assert done.stdout == "RESULT True\n"
+    failing = subprocess.run(
+        [sys.executable, "-m", "kinema", "shell", "--connect", agent.endpoint],
+        input="x = 1\nraise ValueError('boom')\n",
+        capture_output=True,
+        text=True,
+        timeout=60,
+    )
+    assert failing.returncode == 1 and failing.stdout == ""
+    assert 'File "<stdin>", line 2' in failing.stderr and failing.stderr.endswith("ValueError: boom\n")
+    assert "shell.py" not in failing.stderr  # the user's frames, not Kinema's
 
 
 def test_the_add_two_ints_example_serves_and_prints_requests(agent: Any) -> None:
