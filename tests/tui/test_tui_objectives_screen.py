@@ -90,6 +90,11 @@ def test_the_parameters_key_puts_the_cursor_in_the_form_and_enter_runs(fake: Fak
         await pilot.press("enter")
         await settle(pilot)
         assert fake.called("start_objective") == [("Pick Object", {"waypoint_name": "box"})]
+        # The run shows its tree, and the keys are the screen's again: x cancels, not a letter typed.
+        assert app.screen.query_one(TabbedContent).active == "tree"
+        await pilot.press("x")
+        await settle(pilot)
+        assert fake.called("cancel_objective") == [()] and first.value == "box"
 
     drive(fake, scenario)
 

@@ -206,7 +206,10 @@ class ObjectivesScreen(KinemaScreen):
         if event.input.id == "objective-search":
             self.query_one("#objective-list", OptionList).focus()
         elif event.input in self.query_one(OverrideForm).query(Input):
-            self.action_run()  # Enter in a parameter runs the objective with the form's values
+            # Enter in a parameter runs the objective with the form's values. The keys are the screen's
+            # again (x cancels, r runs again): the field the run hides must not keep the focus.
+            self.query_one("#objective-list", OptionList).focus()
+            self.action_run()
 
     def on_select_changed(self, event: Select.Changed) -> None:
         self._refilter()
