@@ -187,7 +187,7 @@ def parse_yaml_value(text: str, port_type: Any) -> Any:
     """
     import yaml
 
-    from kinema.bt.conversions import AnyValue, ConversionError, convert_from_string, has_converter
+    from kinema.bt.conversions import AnyValue, ConversionError, Unsigned, convert_from_string, has_converter
 
     try:
         parsed = yaml.safe_load(text) if text.strip() else text
@@ -199,6 +199,15 @@ def parse_yaml_value(text: str, port_type: Any) -> Any:
         return parsed
     if port_type is str:
         return parsed if isinstance(parsed, str) else text
+    if isinstance(parsed, str) and port_type in (int, Unsigned, float):
+        # YAML left it a string (1e3, 0x10, or 0.5x): the whole of it must be the number. BT.CPP's own
+        # conversion reads a leading number and ignores the rest, which suits XML attributes written by
+        # hand, not a value a program or a form sends.
+        try:
+            number: float | int = float(parsed) if port_type is float else int(parsed.strip(), 0)
+        except ValueError:
+            raise ValueError(f"{text!r} is not a valid {_type_label(port_type)}") from None
+        return coerce_value(number, port_type, text=text)
     if isinstance(parsed, str) and has_converter(port_type) and not _is_class_type(port_type):
         try:
             return convert_from_string(port_type, parsed)

@@ -23,6 +23,8 @@ class Mode(enum.Enum):
         ("2.0", int, 2),
         ("1.5", float, 1.5),
         ("3", float, 3.0),
+        ("1e3", float, 1000.0),  # YAML 1.1 leaves it a string; it is all number
+        ("0x10", int, 16),
         ("true", bool, True),
         ("false", bool, False),
         ("Look at Table", str, "Look at Table"),
@@ -46,6 +48,8 @@ def test_values_parse_into_the_port_type(text: str, port_type: object, expected:
     ("text", "port_type", "reason"),
     [
         ("abc", int, "int"),
+        ("0.5x", float, "'0.5x' is not a valid double"),  # BT.CPP would read 0.5 and drop the rest
+        ("5000 apples", int, "'5000 apples' is not a valid int"),
         ("1.5", int, "int"),
         ("true", int, "int"),
         ("maybe", bool, "bool"),
