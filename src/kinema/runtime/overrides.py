@@ -204,7 +204,7 @@ def parse_yaml_value(text: str, port_type: Any) -> Any:
         # conversion reads a leading number and ignores the rest, which suits XML attributes written by
         # hand, not a value a program or a form sends.
         try:
-            number: float | int = float(parsed) if port_type is float else int(parsed.strip(), 0)
+            number: float | int = float(parsed) if port_type is float else _whole_int(parsed)
         except ValueError:
             raise ValueError(f"{text!r} is not a valid {_type_label(port_type)}") from None
         return coerce_value(number, port_type, text=text)
@@ -214,6 +214,14 @@ def parse_yaml_value(text: str, port_type: Any) -> Any:
         except ConversionError as error:
             raise ValueError(f"{text!r} is not a valid {_type_label(port_type)} ({error})") from None
     return coerce_value(parsed, port_type, text=text)
+
+
+def _whole_int(text: str) -> int:
+    """``text`` as an int, decimal (``08`` too) or with a base prefix (``0x10``); ValueError otherwise."""
+    try:
+        return int(text.strip(), 10)
+    except ValueError:
+        return int(text.strip(), 0)
 
 
 def _is_class_type(port_type: Any) -> bool:

@@ -25,6 +25,7 @@ class Mode(enum.Enum):
         ("3", float, 3.0),
         ("1e3", float, 1000.0),  # YAML 1.1 leaves it a string; it is all number
         ("0x10", int, 16),
+        ("08", int, 8),  # not YAML 1.1 octal: a string, and all decimal digits
         ("true", bool, True),
         ("false", bool, False),
         ("Look at Table", str, "Look at Table"),
