@@ -139,6 +139,9 @@ class ObjectiveRun:
         self.id = run_id
         self.request = request
         self.objective_name = request.label
+        # The objective's declared ports that nothing set (no default, no override): a failure that
+        # names one of them gets a hint saying which parameter to give.
+        self.unset_parameters: tuple[str, ...] = ()
         self._server = server
         self._done = threading.Event()
         self._result: ObjectiveResult | None = None
@@ -751,6 +754,8 @@ class ObjectiveServer:
                 run.objective_name = name
                 defaults = model_defaults(model)
                 apply_overrides(tree, run.request.overrides, objective_name=name, defaults=defaults)
+                given = {o.name for o in (*defaults, *run.request.overrides)}
+                run.unset_parameters = tuple(p for p in (model.ports if model else ()) if p not in given)
         except Abandoned:
             raise
         except KinemaError as error:
@@ -832,7 +837,8 @@ class ObjectiveServer:
             raise
         except KinemaError as error:
             self._halt_quietly(worker, tree)
-            self._end(run, ObjectiveResult.failure(str(error), run.objective_name), ObjectiveStatus.FAILURE)
+            message = str(error) + _missing_parameter_hint(str(error), run)
+            self._end(run, ObjectiveResult.failure(message, run.objective_name), ObjectiveStatus.FAILURE)
             return
         except BaseException as error:  # SystemExit, KeyboardInterrupt...: fail the run, keep serving
             log.error("ticking objective %r raised", run.objective_name, exc_info=error)
@@ -934,7 +940,22 @@ class ObjectiveServer:
         with self._notes_lock:
             message = self._failure_notes.get(path, "")
         detail = f": {message}" if message else " returned FAILURE"
-        return f"objective {run.objective_name!r} failed: node '{path}' [{registration_id}]{detail}"
+        text = f"objective {run.objective_name!r} failed: node '{path}' [{registration_id}]{detail}"
+        return text + _missing_parameter_hint(text, run)
+
+
+def _missing_parameter_hint(message: str, run: ObjectiveRun) -> str:
+    """``; give parameter 'NAME' ...`` when ``message`` is a missing blackboard key that is one of the
+    objective's own ports with no default and no override ("" otherwise)."""
+    if "unable to find the key" not in message:
+        return ""
+    for name in run.unset_parameters:
+        if f"[{name}]" in message:  # "... the key [port] remapped to [name]"
+            return (
+                f"; {name!r} is a parameter of objective {run.objective_name!r} without a default: give it "
+                f"(kinema objective run {run.objective_name!r} -p {name}=VALUE, or the SDK's overrides)"
+            )
+    return ""
 
 
 def main_tree_id(xml: str) -> str:

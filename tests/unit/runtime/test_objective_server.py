@@ -325,3 +325,40 @@ def test_the_final_status_is_held_then_the_server_reports_idle(recorder: Recorde
         ObjectiveStatus.IDLE,
     ]
     assert recorder.statuses[-1] == (ObjectiveStatus.IDLE, "Quick")
+
+
+def test_a_missing_parameter_without_a_default_is_named_in_the_failure() -> None:
+    from kinema.behaviors import NodeStatus as Status
+    from kinema.behaviors import SyncBehavior, input_port
+    from kinema.testing import registry_of
+
+    class LooksUp(SyncBehavior):
+        """Reads a waypoint name."""
+
+        @classmethod
+        def provided_ports(cls):  # type: ignore[no-untyped-def]
+            return [input_port("waypoint", str)]
+
+        def tick(self) -> Status:
+            self.get_required_inputs("waypoint")
+            return Status.SUCCESS
+
+    factory = registry_of([LooksUp]).create_factory()
+    factory.register_behavior_tree_from_text(
+        """<root BTCPP_format="4">
+          <BehaviorTree ID="Go"><Action ID="LooksUp" waypoint="{waypoint_name}"/></BehaviorTree>
+          <TreeNodesModel>
+            <SubTree ID="Go"><input_port name="waypoint_name" default=""/></SubTree>
+          </TreeNodesModel>
+        </root>"""
+    )
+    with ObjectiveServer(FactoryTreeSource(factory)) as running:
+        result = running.submit(ObjectiveRequest("Go")).wait(5)
+        assert result is not None and result.failed
+        assert "unable to find the key [waypoint] remapped to [waypoint_name]" in result.error_message
+        assert "'waypoint_name' is a parameter of objective 'Go' without a default" in result.error_message
+        assert "-p waypoint_name=VALUE" in result.error_message
+        given = (ParameterOverride("waypoint_name", "Home"),)
+        assert running.submit(ObjectiveRequest("Go", overrides=given)).wait(5) == ObjectiveResult.success(
+            "Go"
+        )
