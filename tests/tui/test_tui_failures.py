@@ -111,6 +111,7 @@ def test_a_failed_run_keeps_statuses_highlights_the_path_and_explains_the_node(f
         assert any(line.startswith("why: objective 'Pick Object' failed") for line in lines)
         panel = app.screen.query_one("#failure-panel", Static)
         assert panel.has_class("shown") and "node 'Script::9'" in str(panel.render())
+        assert "the tree below shows the failed path" in str(panel.render())
         # The failure stays: a later heartbeat (Idle) changes nothing; d dismisses the panel only.
         fake.emit(Heartbeat(13.0, "Pick Object", "Idle"))
         await settle(pilot)
@@ -355,5 +356,22 @@ def test_long_log_lines_wrap(fake: FakeConnection) -> None:
         assert len(panel.lines) >= 2, "the message is wrapped onto several lines, not cut at the edge"
         shown = "".join(line.text for line in panel.lines)
         assert "not std::string" in shown.split("std::string", 1)[1], "the end of the message is shown"
+
+    drive(fake, scenario)
+
+
+def test_the_failure_of_another_objective_than_the_selected_one_says_where_its_path_is(
+    fake: FakeConnection,
+) -> None:
+    async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
+        assert app.screen.selected.name == "Pick Object"
+        fake.emit(Heartbeat(10.0, "Open Gripper", "Running"))
+        fake.emit(Heartbeat(11.0, "Open Gripper", "Failure"))
+        fake.emit(LogEntry("objective 'Open Gripper' failed: node 'X' [Y]: stuck", LogLevel.ERROR, 1.0))
+        await settle(pilot)
+        panel = app.screen.query_one("#failure-panel", Static)
+        assert panel.has_class("shown") and "'Open Gripper' failed" in str(panel.render())
+        # The tree below is Pick Object's: the box does not claim it shows the failed path.
+        assert "select it to see the failed path" in str(panel.render())
 
     drive(fake, scenario)

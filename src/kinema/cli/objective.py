@@ -145,7 +145,8 @@ def show(
     click.echo(f"  package:     {info.package}")
     click.echo(f"  description: {info.description or '-'}")
     click.echo(f"  subcategory: {info.subcategory or '-'}")
-    click.echo(f"  runnable:    {'yes' if info.runnable else 'no (subtree only)'}")
+    subtree_only = "no (a subtree: the UI does not offer it; `objective run` runs it from its defaults)"
+    click.echo(f"  runnable:    {'yes' if info.runnable else subtree_only}")
     click.echo(f"  favorite:    {'yes' if info.favorite else 'no'}")
     for path in info.shadows:
         click.echo(f"  shadows:     {path}")

@@ -329,7 +329,11 @@ class ObjectivesScreen(KinemaScreen):
         failed = outcome.outcome == "Failure"
         text = Text()
         text.append("✘ failed" if failed else "◼ cancelled", style="bold red" if failed else "bold yellow")
-        hint = "  (d dismisses; the tree below shows the failed path)" if failed else "  (d dismisses)"
+        hint = "  (d dismisses)"
+        if failed:
+            shown = self.selected is not None and self.selected.name == outcome.objective_name
+            where = "the tree below shows the failed path" if shown else "select it to see the failed path"
+            hint = f"  (d dismisses; {where})"
         text.append(hint + "\n", style="dim")
         text.append(outcome.message)
         panel.update(text)
