@@ -48,7 +48,7 @@ def build(
     TARGET is accepted for MoveIt Pro habits: `all` and `user_workspace` do the same here (there is no
     image to build; behavior packages are loaded from their folders). Exits 1 on any error.
     """
-    from kinema.cli.options import resolve_selection
+    from kinema.cli.options import print_warnings, resolve_selection
     from kinema.config import resolve_config
     from kinema.plugins import BehaviorHost
     from kinema.plugins.dependencies import pip_install, unsatisfied, workspace_behavior_packages
@@ -70,12 +70,10 @@ def build(
             pip_install(missing, lambda line: click.echo(f"    {line}"))
 
     resolved = resolve_config(name, found)
-    for warning in resolved.warnings:
-        click.secho(f"warning: {warning}", err=True, fg="yellow")
+    print_warnings(resolved.warnings)
     host = BehaviorHost.for_config(resolved)
     report = host.load()
-    for warning in report.warnings:
-        click.secho(f"warning: {warning}", err=True, fg="yellow")
+    print_warnings(report.warnings)
     for error in report.errors:
         click.secho(str(error), err=True, fg="red")
         errors += 1
@@ -83,8 +81,7 @@ def build(
     click.echo(f"{len(registry)} behaviors from {len(host.plugins)} plugins for config {resolved.name}")
 
     file_count, problems, warnings = validate_objectives(resolved, registry)
-    for warning in warnings:
-        click.secho(f"warning: {warning}", err=True, fg="yellow")
+    print_warnings(warnings)
     for problem in problems:
         click.secho(str(problem), err=True, fg="red")
     errors += len(problems)

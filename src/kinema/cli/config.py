@@ -10,6 +10,7 @@ import click
 
 from kinema.cli.options import (
     print_notices,
+    print_warnings,
     resolve_selection,
     selection_options,
     verbose_option,
@@ -96,8 +97,7 @@ def show(
 
     found, name = resolve_selection(workspace, config)
     resolved = resolve_config(name, found, check_files=not no_check)
-    for warning in resolved.warnings:
-        click.secho(f"warning: {warning}", err=True, fg="yellow")
+    print_warnings(resolved.warnings)
     if verbose:
         print_notices(resolved.notices)
     if as_json:

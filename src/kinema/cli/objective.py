@@ -10,6 +10,7 @@ import click
 
 from kinema.cli.options import (
     print_notices,
+    print_warnings,
     resolve_selection,
     running_selection,
     selection_options,
@@ -40,8 +41,7 @@ def _load_library(workspace: Path | None, config: str | None, verbose: bool) -> 
     found, name = resolve_selection(workspace, config)
     resolved = resolve_config(name, found)
     library = ObjectiveLibrary.load(resolved)
-    for warning in [*resolved.warnings, *library.warnings]:
-        click.secho(f"warning: {warning}", err=True, fg="yellow")
+    print_warnings([*resolved.warnings, *library.warnings])
     if verbose:
         print_notices([*resolved.notices, *library.notices])
     return library

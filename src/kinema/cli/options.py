@@ -8,7 +8,7 @@ turns them into a :class:`~kinema.config.Workspace` and a config name.
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from pathlib import Path
 from typing import Any, TypeVar
 
@@ -87,6 +87,12 @@ def running_selection(workspace: Path | None, config: str | None) -> tuple[Path 
         f"the selected config is {selection.config} (-c chooses)"
     )
     return run_workspace, run.config, note
+
+
+def print_warnings(warnings: Iterable[str]) -> None:
+    """Print warnings (shown without ``-v``) on stderr."""
+    for warning in warnings:
+        click.secho(f"warning: {warning}", err=True, fg="yellow")
 
 
 def print_notices(notices: list[str]) -> None:

@@ -24,8 +24,9 @@ def _load(workspace: Path | None, config: str | None) -> tuple[Any, Any, str]:
 
 
 def _print_problems(report: Any) -> None:
-    for warning in report.warnings:
-        click.secho(f"warning: {warning}", err=True, fg="yellow")
+    from kinema.cli.options import print_warnings
+
+    print_warnings(report.warnings)
     for error in report.errors:
         click.secho(f"error: {error}", err=True, fg="red")
 

@@ -53,7 +53,7 @@ class ObjectiveLibrary:
         objectives: objective ID -> the winning :class:`ObjectiveInfo`.
         errors: files that could not be read, as ObjectiveErrors (``str()`` gives ``file:line: message``).
         notices: shadowed objectives and soft problems (verbose output).
-        warnings: problems worth saying always: one package defining an objective ID in two files.
+        warnings: problems worth saying always: an objective ID defined in two files of one library folder.
         resolved: the config the library was built for (None for a library built from folders).
     """
 

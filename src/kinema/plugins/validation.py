@@ -25,7 +25,7 @@ def validate_objectives(
     """Validate every objective file of ``resolved``; return (number of files, problems, warnings).
 
     Files that do not parse and duplicate definitions are problems too, with their ``file:line``. The
-    warnings (``file:line: ...``) are the library's: an objective ID defined twice in one package.
+    warnings (``file:line: ...``) are the library's: an objective ID defined twice in one folder.
     """
     from kinema.bt.validation import Problem, validate_files
     from kinema.config import ObjectiveLibrary

@@ -66,18 +66,16 @@ class ParameterOverride:
 
 def model_defaults(model: SubtreeModel | None) -> list[ParameterOverride]:
     """The literal defaults of an objective's own ports (see the module's docstring), as overrides."""
+    from kinema.bt.ports import blackboard_pointer
+
     if model is None:
         return []
-    defaults = []
-    for name, port in model.ports.items():
-        text = port.default_str
-        if not text or not text.strip():
-            continue
-        stripped = text.strip()
-        if stripped.startswith("{") and stripped.endswith("}"):
-            continue  # wires the port to the key of its own name: nothing to seed at the root
-        defaults.append(ParameterOverride(name, text))
-    return defaults
+    # A {key} default wires the port to a key of the caller's: at the root there is nothing to seed.
+    return [
+        ParameterOverride(name, text)
+        for name, port in model.ports.items()
+        if (text := port.default_str) and text.strip() and blackboard_pointer(text, name) is None
+    ]
 
 
 def apply_overrides(
