@@ -13,16 +13,16 @@ In-process::
 As a process: ``python -m kinema.drivers.mujoco --config lab_sim --sim-speed max`` (see ``--help``).
 
 What it serves (names in :mod:`kinema.drivers.mujoco.names`): ``/clock`` and ``/joint_states`` at the
-publish rate of sim time; per controller of the config, by its ros2_control type:
-``/<trajectory controller>/follow_joint_trajectory`` and ``/<gripper controller>/gripper_cmd``
-(lab_sim: ``/joint_trajectory_controller/...`` and ``/robotiq_gripper_controller/gripper_cmd``);
-``/controller_manager/list_controllers`` and ``/controller_manager/switch_controller(s)``; ``/mujoco/set_state`` (keyframe and/or joint positions),
-``/mujoco/bodies`` (free body poses), ``/mujoco/keyframes`` and the ``/mujoco/scene_state`` topic; per
-camera of the scene ``/<camera>/color``, ``/depth``, ``/camera_info`` and ``/points``, rendered only while
-subscribed (see :mod:`kinema.drivers.mujoco.cameras`). With the config's force/torque sensor
-(lab_sim's ``tcp_fts_sensor``): ``/<broadcaster>/wrench``, the admittance trajectory
-controller's ``/<controller>/follow_joint_trajectory``, and the velocity-force
-controller's ``/<controller>/command`` and ``/<controller>/zero_fts`` (see
+publish rate of sim time; per controller of the config, by its ros2_control type: ``/<trajectory
+controller>/follow_joint_trajectory`` and ``/<gripper controller>/gripper_cmd`` (lab_sim:
+``/joint_trajectory_controller/...`` and ``/robotiq_gripper_controller/gripper_cmd``);
+``/controller_manager/list_controllers`` and ``/controller_manager/switch_controller(s)``;
+``/mujoco/set_state`` (keyframe and/or joint positions), ``/mujoco/bodies`` (free body poses),
+``/mujoco/keyframes`` and the ``/mujoco/scene_state`` topic; per camera of the scene ``/<camera>/color``,
+``/depth``, ``/camera_info`` and ``/points``, rendered only while subscribed (see
+:mod:`kinema.drivers.mujoco.cameras`). With the config's force/torque sensor (lab_sim's ``tcp_fts_sensor``):
+``/<broadcaster>/wrench``, the admittance trajectory controller's ``/<controller>/follow_joint_trajectory``,
+and the velocity-force controller's ``/<controller>/command`` and ``/<controller>/zero_fts`` (see
 :mod:`kinema.drivers.mujoco.force_control`).
 """
 
