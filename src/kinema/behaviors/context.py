@@ -17,6 +17,7 @@ from kinema.errors import ObjectiveError
 
 if TYPE_CHECKING:
     from kinema.bt import Clock
+    from kinema.config.cell import CellSettings
     from kinema.interfaces.definition import (
         ActionDefinition,
         FeedbackT,
@@ -27,6 +28,9 @@ if TYPE_CHECKING:
         ServiceDefinition,
     )
     from kinema.transport import ActionClient, QoS, ServiceClient
+
+
+_UNSET = object()
 
 
 class BehaviorContext:
@@ -61,9 +65,24 @@ class BehaviorContext:
         self.clock = clock
         self.log_sink = log_sink if log_sink is not None else LogSink()
         self._robot_model = robot_model
+        self._cell: Any = _UNSET
         self._robot_model_lock = threading.Lock()
         self._endpoints: dict[tuple[Any, ...], Any] = {}
         self._endpoints_lock = threading.Lock()
+
+    @property
+    def cell(self) -> CellSettings | None:
+        """The cell's robot settings (planning group, tool frame, gripper, ...) from the config; None
+        without a config. Read once, on first use.
+
+        Raises:
+            ConfigError: the config's robot settings are wrong (the message names config.yaml's line).
+        """
+        if self._cell is _UNSET:
+            from kinema.config.cell import CellSettings
+
+            self._cell = CellSettings.from_config(self.config) if self.config is not None else None
+        return self._cell  # type: ignore[return-value]
 
     @classmethod
     def offline(cls) -> BehaviorContext:

@@ -34,6 +34,7 @@ The default planning group is ``moveit_params.joint_group_name``. Which controll
 
 from __future__ import annotations
 
+import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
@@ -364,3 +365,31 @@ def _force_torque_sensor(
         frame=str(entry.get("frame") or params.get("frame_id") or ""),
         control_site=str(entry.get("control_site") or ""),
     )
+
+
+# A subtree port default that is the running config's value, written in a <TreeNodesModel> as
+# ``default="$(config moveit_params.joint_group_name)"``. Kinema's core subtrees use it, so they name no robot's group or link.
+_CONFIG_DEFAULT = re.compile(r"^\$\(config\s+([A-Za-z0-9_.]+)\)$")
+
+
+def config_default_key(text: str | None) -> str | None:
+    """The config key a ``$(config KEY)`` port default names, or None for any other default."""
+    found = _CONFIG_DEFAULT.match(text.strip()) if text else None
+    return found.group(1) if found else None
+
+
+def substitute_config_defaults(subtree_models: Mapping[str, Any], resolved: ResolvedConfig | None) -> None:
+    """Replace each ``$(config KEY)`` default of the subtree models with the config's value at KEY.
+
+    A key the config does not set leaves the port without a default, so a caller that does not give the
+    port fails with the engine's "mandatory port" message; without a config (``resolved`` None) the same.
+    """
+    for model in subtree_models.values():
+        for port in model.ports.values():
+            key = config_default_key(port.default_str)
+            if key is None:
+                continue
+            value = resolved.get(key) if resolved is not None else None
+            text = "" if value is None else str(value)
+            port.default = text
+            port.default_str = text

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
+from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError, ObjectiveError, did_you_mean
 
 from ..messages.conversions import pose_matrix, trajectory_message
@@ -35,7 +36,7 @@ class PlanCartesianPath(AsyncBehavior):
             input_port(
                 "path", None, "{path}", "Poses to pass through (a list of geometry_msgs/PoseStamped)."
             ),
-            input_port("planning_group_name", str, "manipulator", "The planning group that moves."),
+            cell_input_port("planning_group_name", str, "planning_group", "The planning group that moves."),
             input_port(
                 "tip_links", list[str], "", "The tool frame that follows the path ('': the group's tip)."
             ),
