@@ -6,6 +6,7 @@ from __future__ import annotations
 import textwrap
 
 import pytest
+from tests.unit.config.conftest import WorkspaceBuilder
 
 from kinema.behaviors.cell_ports import cell_input_port, resolve_cell_ports
 from kinema.config import Workspace, resolve_config
@@ -16,7 +17,6 @@ from kinema.config.cell import (
     substitute_config_defaults,
 )
 from kinema.errors import ConfigError
-from tests.unit.config.conftest import WorkspaceBuilder
 
 
 def _cell(ws: WorkspaceBuilder, name: str, extra: dict) -> CellSettings:
@@ -50,7 +50,11 @@ def test_controllers_and_gripper_come_from_the_config(ws: WorkspaceBuilder) -> N
         {
             "moveit_params": {"joint_group_name": "arm"},
             "ros2_control": {
-                "controllers_active_at_startup": ["joint_state_broadcaster", "arm_controller", "hand_controller"]
+                "controllers_active_at_startup": [
+                    "joint_state_broadcaster",
+                    "arm_controller",
+                    "hand_controller",
+                ]
             },
             "robot": {
                 "tool_frame": "panda_hand_tcp",
@@ -73,12 +77,16 @@ def test_controllers_and_gripper_come_from_the_config(ws: WorkspaceBuilder) -> N
 
 
 def test_a_controller_of_unknown_type_is_an_error_naming_the_types(ws: WorkspaceBuilder) -> None:
-    with pytest.raises(ConfigError, match=r"controller 'arm_controller' has no type.*JointTrajectoryController"):
+    with pytest.raises(
+        ConfigError, match=r"controller 'arm_controller' has no type.*JointTrajectoryController"
+    ):
         _cell(ws, "typeless", {"ros2_control": {"controllers_active_at_startup": ["arm_controller"]}})
 
 
 def test_a_gripper_without_its_positions_names_what_is_missing(ws: WorkspaceBuilder) -> None:
-    with pytest.raises(ConfigError, match=r"config.yaml:\d+: robot.gripper lacks open_position, closed_position"):
+    with pytest.raises(
+        ConfigError, match=r"config.yaml:\d+: robot.gripper lacks open_position, closed_position"
+    ):
         _cell(ws, "half", {"robot": {"gripper": {"controller": "hand", "joint": "f"}}})
 
 
