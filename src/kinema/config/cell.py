@@ -368,7 +368,8 @@ def _force_torque_sensor(
 
 
 # A subtree port default that is the running config's value, written in a <TreeNodesModel> as
-# ``default="$(config moveit_params.joint_group_name)"``. Kinema's core subtrees use it, so they name no robot's group or link.
+# ``default="$(config moveit_params.joint_group_name)"``. Kinema's core subtrees use it, so they name no
+# robot's group or link.
 _CONFIG_DEFAULT = re.compile(r"^\$\(config\s+([A-Za-z0-9_.]+)\)$")
 
 
