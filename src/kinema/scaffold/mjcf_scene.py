@@ -459,6 +459,15 @@ def _add_world(spec: Any, *, mounted: list[str], reach: float, table: bool) -> N
     spec.visual.global_.offheight = 480
     floor_z = -TABLE_HEIGHT if table else 0.0
     spec.add_texture(
+        name="sky",
+        type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
+        builtin=mujoco.mjtBuiltin.mjBUILTIN_GRADIENT,
+        rgb1=[0.75, 0.8, 0.85],
+        rgb2=[0.35, 0.4, 0.45],
+        width=128,
+        height=128,
+    )
+    spec.add_texture(
         name="grid",
         type=mujoco.mjtTexture.mjTEXTURE_2D,
         builtin=mujoco.mjtBuiltin.mjBUILTIN_CHECKER,
@@ -492,8 +501,9 @@ def _add_world(spec: Any, *, mounted: list[str], reach: float, table: bool) -> N
         # The base is bolted to the table: every link fixed to the root may touch it.
         for link in mounted:
             spec.add_exclude(bodyname1="table", bodyname2=link)
-    target = np.array([0.25 * reach, 0.0, 0.35 * reach])
-    position = np.array([2.2 * reach + 0.6, 0.0, 1.1 * reach + 0.3])
+    # In front, a little to the side (depth reads better than straight on), looking at the workspace.
+    target = np.array([0.3 * reach, 0.0, 0.2 * reach])
+    position = np.array([1.6 * reach + 0.4, 0.35 * reach, 0.9 * reach + 0.3])
     # As in lab_sim: the camera sits in an optical-frame body, which the driver stamps its images with.
     frame = world.add_body(
         name="scene_camera_optical_frame", pos=list(position), quat=_optical_frame_quat(position, target)
