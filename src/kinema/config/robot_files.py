@@ -103,7 +103,7 @@ class PackageIndex:
     ``ROS_PACKAGE_PATH`` (scanned; a folder named like the package also counts), each
     ``AMENT_PREFIX_PATH`` entry's ``share/<pkg>``, and every ``cmeel.prefix/share`` under the
     environment's site-packages (pip-installed description packages: example-robot-data's URIs are
-    ``package://example-robot-data/robots/...``, so that package is ``cmeel.prefix/share/example-robot-data``).
+    ``package://example-robot-data/robots/...``: that package is ``cmeel.prefix/share/example-robot-data``).
 
     Args:
         packages: package name → folder, consulted first.
@@ -123,8 +123,10 @@ class PackageIndex:
         env = os.environ if self.environ is None else self.environ
         self._ros_package_path = [Path(p) for p in env.get("ROS_PACKAGE_PATH", "").split(os.pathsep) if p]
         self._ament_prefixes = [Path(p) for p in env.get("AMENT_PREFIX_PATH", "").split(os.pathsep) if p]
-        sites = _site_package_folders() if self.site_packages is None else [Path(p) for p in self.site_packages]
-        self._cmeel_shares = []
+        sites = (
+            _site_package_folders() if self.site_packages is None else [Path(p) for p in self.site_packages]
+        )
+        self._cmeel_shares: list[Path] = []
         for folder in sites:
             share = folder / "cmeel.prefix" / "share"
             if share.is_dir() and share not in self._cmeel_shares:
@@ -278,7 +280,9 @@ def _xacro_find_through(index: PackageIndex, source: Path) -> Iterator[None]:
     def find(name: str) -> str:
         folder = index.find(name)
         if folder is None:
-            raise ConfigError(f"$(find {name}): {index.not_found_message(name)}", location=SourceLocation(str(source)))
+            raise ConfigError(
+                f"$(find {name}): {index.not_found_message(name)}", location=SourceLocation(str(source))
+            )
         return str(folder)
 
     saved_function = substitution_args._eval_find
@@ -292,7 +296,9 @@ def _xacro_find_through(index: PackageIndex, source: Path) -> Iterator[None]:
         substitution_args._eval_dict["find"] = saved_symbol
 
 
-def process_xacro(path: str | Path, args: Mapping[str, str] | None = None, *, index: PackageIndex | None = None) -> str:
+def process_xacro(
+    path: str | Path, args: Mapping[str, str] | None = None, *, index: PackageIndex | None = None
+) -> str:
     """The URDF text of ``path``: xacro-expanded with ``args`` when it is a xacro file, else as it is.
 
     A file is xacro when its name ends in ``.xacro`` or its root element declares the xacro namespace.
@@ -305,8 +311,10 @@ def process_xacro(path: str | Path, args: Mapping[str, str] | None = None, *, in
     try:
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
-        raise ConfigError(f"cannot read robot description: {exc.strerror or exc}", location=SourceLocation(str(path))) from None
-    if not (path.name.endswith(".xacro") or "xmlns:xacro" in text[:4000] and "<xacro:" in text):
+        raise ConfigError(
+            f"cannot read robot description: {exc.strerror or exc}", location=SourceLocation(str(path))
+        ) from None
+    if not (path.name.endswith(".xacro") or ("xmlns:xacro" in text[:4000] and "<xacro:" in text)):
         return text
     import xml.parsers.expat
 
@@ -321,7 +329,9 @@ def process_xacro(path: str | Path, args: Mapping[str, str] | None = None, *, in
             raise
         except xml.parsers.expat.ExpatError as exc:
             where = (xacro.filestack or [str(path)])[-1] or str(path)
-            raise ConfigError(f"xacro: not valid XML: {exc}", location=SourceLocation(str(where), exc.lineno)) from None
+            raise ConfigError(
+                f"xacro: not valid XML: {exc}", location=SourceLocation(str(where), exc.lineno)
+            ) from None
         except Exception as exc:  # xacro raises XacroException, NameError, KeyError, ... for bad input
             cause = exc.exc if isinstance(exc, xacro.XacroException) and exc.exc is not None else exc
             if isinstance(cause, ConfigError):
@@ -388,7 +398,7 @@ def convert_mesh(path: str | Path, cache_dir: str | Path) -> Path:
     import trimesh
 
     try:
-        loaded = trimesh.load(str(path), force="scene")
+        loaded = trimesh.load_scene(str(path))
     except Exception as exc:  # trimesh/pycollada raise anything from ValueError to KeyError on bad files
         raise ConfigError(f"cannot read mesh {path}: {exc}") from None
     meshes: list[trimesh.Trimesh] = []
@@ -403,16 +413,18 @@ def convert_mesh(path: str | Path, cache_dir: str | Path) -> Path:
         rgba = _mesh_rgba(mesh)
         if rgba is not None:
             colours.append((float(mesh.area), rgba))
+        mesh.visual = trimesh.visual.ColorVisuals(mesh)  # geometry only: MuJoCo ignores .mtl colours
         meshes.append(mesh)
     if not meshes:
         raise ConfigError(f"mesh {path} holds no triangles")
     combined = trimesh.util.concatenate(meshes)
-    combined.visual = trimesh.visual.ColorVisuals(combined)  # geometry only: MuJoCo ignores .mtl colours
     cache_dir.mkdir(parents=True, exist_ok=True)
     from kinema.config.atomic_write import atomic_write_bytes, atomic_write_text
 
-    data = combined.export(file_type="obj", include_normals=True, include_color=False, include_texture=False)
-    atomic_write_bytes(target, data.encode("utf-8") if isinstance(data, str) else data)
+    text = trimesh.exchange.obj.export_obj(
+        combined, include_normals=True, include_color=False, include_texture=False
+    )
+    atomic_write_bytes(target, text.encode("utf-8"))
     total = sum(area for area, _ in colours)
     if colours and total > 0:
         average = [sum(area * c[i] for area, c in colours) / total for i in range(4)]
@@ -521,7 +533,9 @@ class ResolvedRobot:
         references = iter(self.meshes)
         for element in _mesh_elements(root):
             reference = next(references)
-            replacement = paths.get(str(reference.path), reference.path) if paths is not None else reference.path
+            replacement = (
+                paths.get(str(reference.path), reference.path) if paths is not None else reference.path
+            )
             element.set("filename", str(replacement))
         return etree.tostring(root, encoding="unicode")
 
@@ -566,6 +580,11 @@ def _float(value: str | None) -> float | None:
         return None
 
 
+def _float_or(value: str | None, default: float) -> float:
+    number = _float(value)
+    return default if number is None else number
+
+
 def _parse(urdf_text: str) -> etree._Element:
     return etree.fromstring(urdf_text.encode("utf-8"))
 
@@ -588,12 +607,12 @@ def parse_joints(urdf_text: str) -> list[UrdfJoint]:
                 upper=_float(limit.get("upper")) if limit is not None else None,
                 effort=_float(limit.get("effort")) if limit is not None else None,
                 velocity=_float(limit.get("velocity")) if limit is not None else None,
-                damping=(_float(dynamics.get("damping")) or 0.0) if dynamics is not None else 0.0,
+                damping=_float_or(dynamics.get("damping"), 0.0) if dynamics is not None else 0.0,
                 mimic=(
                     (
                         mimic.get("joint", ""),
-                        _float(mimic.get("multiplier")) if mimic.get("multiplier") is not None else 1.0,
-                        _float(mimic.get("offset")) or 0.0,
+                        _float_or(mimic.get("multiplier"), 1.0),
+                        _float_or(mimic.get("offset"), 0.0),
                     )
                     if mimic is not None
                     else None
@@ -610,7 +629,9 @@ def root_link(urdf_text: str) -> str:
     children = {c.get("link") for c in root.iterfind("joint/child")}
     roots = [link.get("name", "") for link in root.findall("link") if link.get("name") not in children]
     if len(roots) != 1:
-        raise ConfigError(f"a URDF has one root link; this one has {len(roots)}: {', '.join(roots) or 'none'}")
+        raise ConfigError(
+            f"a URDF has one root link; this one has {len(roots)}: {', '.join(roots) or 'none'}"
+        )
     return roots[0]
 
 
@@ -633,9 +654,13 @@ def resolve_robot(
     try:
         root = _parse(text)
     except etree.XMLSyntaxError as exc:
-        raise ConfigError(f"not valid XML: {exc.msg}", location=SourceLocation(str(path), exc.lineno or 0)) from None
+        raise ConfigError(
+            f"not valid XML: {exc.msg}", location=SourceLocation(str(path), exc.lineno or 0)
+        ) from None
     if root.tag != "robot":
-        raise ConfigError(f"not a URDF: the root element is <{root.tag}>, not <robot>", location=SourceLocation(str(path)))
+        raise ConfigError(
+            f"not a URDF: the root element is <{root.tag}>, not <robot>", location=SourceLocation(str(path))
+        )
     expanded = path.name.endswith(".xacro")
     meshes = []
     for link in root.iter("link"):
@@ -646,11 +671,15 @@ def resolve_robot(
                     where = SourceLocation(str(path), line)
                     uri = mesh.get("filename", "")
                     if not uri:
-                        raise ConfigError(f"link {link.get('name')!r}: <mesh> without a filename", location=where)
+                        raise ConfigError(
+                            f"link {link.get('name')!r}: <mesh> without a filename", location=where
+                        )
                     try:
                         resolved = resolve_uri(uri, base_dir=path.parent, index=index, location=where)
                         check_mesh(resolved, location=where)
                     except ConfigError as exc:
-                        raise ConfigError(f"link {link.get('name')!r} ({role}): {exc.message}", location=where) from None
+                        raise ConfigError(
+                            f"link {link.get('name')!r} ({role}): {exc.message}", location=where
+                        ) from None
                     meshes.append(MeshReference(uri, resolved, link.get("name", ""), role, where))
     return ResolvedRobot(source=path, urdf_text=text, name=root.get("name", path.stem), meshes=tuple(meshes))

@@ -190,7 +190,9 @@ def test_xacro_find_of_an_unknown_package_is_a_config_error(tmp_path: Path) -> N
 
 def test_a_xacro_syntax_error_names_file_and_line(tmp_path: Path) -> None:
     path = tmp_path / "broken.urdf.xacro"
-    path.write_text('<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">\n  <link name="a">\n</robot>\n')
+    path.write_text(
+        '<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">\n  <link name="a">\n</robot>\n'
+    )
     with pytest.raises(ConfigError) as caught:
         process_xacro(path, {}, index=bare_index())
     assert caught.value.location is not None
@@ -200,9 +202,10 @@ def test_a_xacro_syntax_error_names_file_and_line(tmp_path: Path) -> None:
 def test_a_xacro_error_names_the_file(tmp_path: Path) -> None:
     path = tmp_path / "bad.urdf.xacro"
     path.write_text(
-        '<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro"><link name="${undefined_property}"/></robot>'
+        '<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">'
+        '<link name="${undefined_property}"/></robot>'
     )
-    with pytest.raises(ConfigError, match="xacro failed: .*undefined_property") as caught:
+    with pytest.raises(ConfigError, match=r"xacro failed: .*undefined_property") as caught:
         process_xacro(path, {}, index=bare_index())
     assert caught.value.location is not None and caught.value.location.file == str(path)
 
@@ -243,7 +246,9 @@ COLLADA_TETRAHEDRON = """<?xml version="1.0" encoding="utf-8"?>
       <diffuse><color>{red} 0.1 0.1 1</color></diffuse>
     </phong></technique></profile_COMMON></effect>
   </library_effects>
-  <library_materials><material id="red" name="red"><instance_effect url="#red-fx"/></material></library_materials>
+  <library_materials>
+    <material id="red" name="red"><instance_effect url="#red-fx"/></material>
+  </library_materials>
   <library_geometries>
     <geometry id="tetra" name="tetra"><mesh>
       <source id="tetra-pos">
@@ -324,7 +329,9 @@ ROBOT = """<?xml version="1.0"?>
 """
 
 
-def two_link(tmp_path: Path, arm_mesh: str = "package://two_link_description/meshes/arm.stl") -> tuple[Path, PackageIndex]:
+def two_link(
+    tmp_path: Path, arm_mesh: str = "package://two_link_description/meshes/arm.stl"
+) -> tuple[Path, PackageIndex]:
     package = make_package(tmp_path / "src" / "two_link_description", "two_link_description")
     write_cube_stl(package / "meshes" / "base.stl")
     write_cube_stl(package / "meshes" / "arm.stl")
@@ -365,7 +372,10 @@ def test_the_written_urdf_has_absolute_mesh_paths_and_loads_in_pinocchio(tmp_pat
 @pytest.mark.parametrize(
     ("arm_mesh", "message"),
     [
-        ("package://nope/arm.stl", "link 'arm' (collision): package://nope/arm.stl: ROS package 'nope' not found"),
+        (
+            "package://nope/arm.stl",
+            "link 'arm' (collision): package://nope/arm.stl: ROS package 'nope' not found",
+        ),
         ("package://two_link_description/meshes/gone.stl", "link 'arm' (collision): mesh not found"),
         ("package://two_link_description/meshes/lfs.stl", "is a Git LFS pointer file (run `git lfs pull`)"),
     ],
