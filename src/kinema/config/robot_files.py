@@ -296,6 +296,11 @@ def _xacro_find_through(index: PackageIndex, source: Path) -> Iterator[None]:
         substitution_args._eval_dict["find"] = saved_symbol
 
 
+def _is_xacro(path: Path, text: str) -> bool:
+    """A ``.xacro`` file, or one that declares the xacro namespace and uses it."""
+    return path.name.endswith(".xacro") or ("xmlns:xacro" in text[:4000] and "<xacro:" in text)
+
+
 def process_xacro(
     path: str | Path, args: Mapping[str, str] | None = None, *, index: PackageIndex | None = None
 ) -> str:
@@ -314,7 +319,7 @@ def process_xacro(
         raise ConfigError(
             f"cannot read robot description: {exc.strerror or exc}", location=SourceLocation(str(path))
         ) from None
-    if not (path.name.endswith(".xacro") or ("xmlns:xacro" in text[:4000] and "<xacro:" in text)):
+    if not _is_xacro(path, text):
         return text
     import xml.parsers.expat
 
@@ -322,6 +327,7 @@ def process_xacro(
 
     index = index if index is not None else PackageIndex()
     mappings = {str(k): str(v) for k, v in (args or {}).items()}
+    given = ", ".join(sorted(mappings)) or "none"  # xacro adds the <xacro:arg> defaults to mappings
     with _XACRO_LOCK, _xacro_find_through(index, path):
         try:
             document = xacro.process_file(str(path), mappings=mappings)
@@ -339,7 +345,7 @@ def process_xacro(
             where = (xacro.filestack or [str(path)])[-1] or str(path)
             message = str(exc) or type(exc).__name__
             if isinstance(exc, KeyError) or "Undefined substitution argument" in message:
-                message += f" (xacro arguments given: {', '.join(sorted(mappings)) or 'none'})"
+                message += f" (xacro arguments given: {given})"
             raise ConfigError(f"xacro failed: {message}", location=SourceLocation(str(where))) from None
         return str(document.toprettyxml(indent="  "))
 
@@ -661,25 +667,62 @@ def resolve_robot(
         raise ConfigError(
             f"not a URDF: the root element is <{root.tag}>, not <robot>", location=SourceLocation(str(path))
         )
-    expanded = path.name.endswith(".xacro")
+    expanded = _is_xacro(path, text)
     meshes = []
+    problems: list[tuple[SourceLocation, str]] = []
+    missing_packages: dict[str, list[tuple[SourceLocation, str, str]]] = {}
     for link in root.iter("link"):
         for role in ("visual", "collision"):
             for element in link.findall(role):
                 for mesh in element.findall("geometry/mesh"):
-                    line = 0 if expanded else (mesh.sourceline or 0)
-                    where = SourceLocation(str(path), line)
+                    # Lines of xacro output are not lines of any file the user wrote.
+                    where = SourceLocation(str(path), 0 if expanded else (mesh.sourceline or 0))
+                    what = f"link {link.get('name')!r} ({role})"
                     uri = mesh.get("filename", "")
                     if not uri:
-                        raise ConfigError(
-                            f"link {link.get('name')!r}: <mesh> without a filename", location=where
-                        )
+                        problems.append((where, f"{what}: <mesh> without a filename"))
+                        continue
+                    if uri.startswith("package://"):
+                        package = uri[len("package://") :].partition("/")[0]
+                        if index.find(package) is None:
+                            missing_packages.setdefault(package, []).append((where, what, uri))
+                            continue
                     try:
                         resolved = resolve_uri(uri, base_dir=path.parent, index=index, location=where)
                         check_mesh(resolved, location=where)
                     except ConfigError as exc:
-                        raise ConfigError(
-                            f"link {link.get('name')!r} ({role}): {exc.message}", location=where
-                        ) from None
+                        problems.append((where, f"{what}: {exc.message}"))
+                        continue
                     meshes.append(MeshReference(uri, resolved, link.get("name", ""), role, where))
+    if problems or missing_packages:
+        raise _mesh_problems(problems, missing_packages, index)
     return ResolvedRobot(source=path, urdf_text=text, name=root.get("name", path.stem), meshes=tuple(meshes))
+
+
+def _mesh_problems(
+    problems: list[tuple[SourceLocation, str]],
+    missing_packages: dict[str, list[tuple[SourceLocation, str, str]]],
+    index: PackageIndex,
+) -> ConfigError:
+    """One error for every mesh that cannot be used: a user fixes them all in one go."""
+    uses = sum(len(u) for u in missing_packages.values())
+    if len(problems) + uses == 1:
+        if problems:
+            where, message = problems[0]
+            return ConfigError(message, location=where)
+        ((package, [(where, what, uri)]),) = missing_packages.items()
+        return ConfigError(f"{what}: {uri}: {index.not_found_message(package)}", location=where)
+    lines = [f"{where}: {message}" for where, message in problems]
+    for package, places in missing_packages.items():
+        first_where, _, first_uri = places[0]
+        lines.append(
+            f"ROS package {package!r} not found, needed by {len(places)} mesh(es), first {first_uri} "
+            f"at {first_where}; {did_you_mean(package, index.known_packages())}"
+        )
+    if missing_packages:
+        lines.append(f"packages were looked for in: {'; '.join(index.searched())}")
+    first = problems[0][0] if problems else next(iter(missing_packages.values()))[0][0]
+    count = len(problems) + uses
+    return ConfigError(
+        f"{count} meshes of the robot cannot be used:\n  " + "\n  ".join(lines), location=first
+    )

@@ -424,3 +424,60 @@ def test_pinocchio_resolves_example_robot_data_uris_through_package_dirs(tmp_pat
     assert meshes and all(m.is_file() for m in meshes)
     robot = resolve_robot(urdf, index=index)
     assert {m.path for m in robot.meshes if m.role == "collision"} == set(meshes)
+
+
+def test_every_unusable_mesh_is_reported_at_once(tmp_path: Path) -> None:
+    urdf, _ = two_link(tmp_path, "package://two_link_description/meshes/gone.stl")
+    text = urdf.read_text()
+    text = text.replace(
+        "package://two_link_description/meshes/base.stl", "package://ur_descripton/meshes/base.stl"
+    )
+    text = text.replace("../meshes/base.stl", "package://ur_descripton/meshes/base_collision.stl")
+    urdf.write_text(text)
+    make_package(tmp_path / "src" / "ur_description", "ur_description")
+    with pytest.raises(ConfigError) as caught:
+        resolve_robot(urdf, index=bare_index(package_roots=[tmp_path / "src"]))
+    lines = str(caught.value).splitlines()
+    assert lines[0] == f"{urdf}:8: 3 meshes of the robot cannot be used:"
+    assert lines[1].startswith(f"  {urdf}:8: link 'arm' (collision): mesh not found")
+    assert lines[2].startswith("  ROS package 'ur_descripton' not found, needed by 2 mesh(es), first ")
+    assert f"at {urdf}:4; did you mean 'ur_description'" in lines[2]
+    assert lines[3].startswith("  packages were looked for in: ")
+
+
+# -- a real MoveIt Pro description ------------------------------------------------------------------------
+
+MOVEIT_PRO_PACKAGES = (
+    Path(__file__).resolve().parents[4] / "shared" / "compat" / "moveit_pro" / "packages" / "src"
+)
+
+
+def test_a_moveit_pro_xacro_expands_with_its_config_arguments_and_names_what_is_missing() -> None:
+    """lab_sim's picknik_ur.xacro: $(find) through the index, urdf_params as arguments, no ROS install."""
+    xacro_file = MOVEIT_PRO_PACKAGES / "lab_sim" / "description" / "picknik_ur.xacro"
+    if not xacro_file.is_file():
+        pytest.skip(f"the MoveIt Pro reference packages are not at {MOVEIT_PRO_PACKAGES}")
+    index = bare_index(package_roots=[MOVEIT_PRO_PACKAGES])
+    with pytest.raises(ConfigError, match=r"Undefined substitution argument mujoco_viewer"):
+        process_xacro(xacro_file, {}, index=index)
+    urdf = process_xacro(
+        xacro_file,
+        {"mujoco_keyframe": "default", "mujoco_model": "description/scene.xml", "mujoco_viewer": "false"},
+        index=index,
+    )
+    assert 'name="shoulder_pan_joint"' in urdf and "package://robotiq_description/" in urdf
+    with pytest.raises(ConfigError) as caught:
+        resolve_robot(
+            xacro_file,
+            xacro_args={
+                "mujoco_keyframe": "default",
+                "mujoco_model": "description/scene.xml",
+                "mujoco_viewer": "false",
+            },
+            index=index,
+        )
+    message = str(caught.value)
+    # The UR and Robotiq description packages are not in the reference tree: one line each, not 40.
+    assert "ROS package 'ur_description' not found" in message
+    assert "ROS package 'robotiq_description' not found" in message
+    assert message.count("ROS package 'ur_description' not found") == 1
