@@ -130,7 +130,7 @@ def _check_srdf_names(semantic: SemanticDescription, robot: ResolvedRobot, srdf:
 
 def _generated_srdf(robot: ResolvedRobot, group: str, base: str, tip: str, semantic: SemanticDescription) -> str:
     root = etree.Element("robot", name=robot.name)
-    root.append(etree.Comment(" Made by kinema new config --from-urdf: the URDF's longest chain of movable joints. "))
+    root.append(etree.Comment(" Made by kinema new config from the URDF: the URDF's longest chain of movable joints. "))
     element = etree.SubElement(root, "group", name=group)
     etree.SubElement(element, "chain", base_link=base, tip_link=tip)
     pairs = {tuple(sorted(p)) for p in semantic.disabled_collisions}
@@ -314,7 +314,7 @@ def _waypoints_yaml(plan: RobotPlan) -> str:
 def _gripper_objective(plan: RobotPlan, objective: str, position: float) -> str:
     return f"""<?xml version="1.0" encoding="UTF-8"?>
 <root BTCPP_format="4" main_tree_to_execute="{objective}">
-  <!-- Made by kinema new config --from-urdf: the gripper's joint {plan.gripper_joint} to {position:g}. -->
+  <!-- Made by kinema new config (from the URDF): the gripper's joint {plan.gripper_joint} to {position:g}. -->
   <BehaviorTree ID="{objective}" _description="{objective.split()[0]} the gripper" _favorite="true">
     <Action ID="MoveGripperAction" position="{position:g}"/>
   </BehaviorTree>
