@@ -82,14 +82,19 @@ def _chain_joints(joints: Mapping[str, UrdfJoint], base: str, tip: str) -> list[
     while link != base:
         joint = by_child.get(link)
         if joint is None:
-            raise ScaffoldError(f"the SRDF names a chain from {base!r} to {tip!r}, which the URDF does not have")
+            raise ScaffoldError(
+                f"the SRDF names a chain from {base!r} to {tip!r}, which the URDF does not have"
+            )
         chain.append(joint.name)
         link = joint.parent
     return [name for name in reversed(chain) if joints[name].movable]
 
 
 def _group_joints(
-    name: str, groups: Mapping[str, GroupDefinition], joints: Mapping[str, UrdfJoint], seen: frozenset[str] = frozenset()
+    name: str,
+    groups: Mapping[str, GroupDefinition],
+    joints: Mapping[str, UrdfJoint],
+    seen: frozenset[str] = frozenset(),
 ) -> list[str]:
     group = groups[name]
     out: list[str] = []
@@ -113,7 +118,9 @@ def _check_srdf_names(semantic: SemanticDescription, robot: ResolvedRobot, srdf:
         problems += [f"group {group.name!r} names joint {j!r}" for j in group.joints if j not in joints]
         problems += [f"group {group.name!r} names link {lk!r}" for lk in group.links if lk not in links]
         for base, tip in group.chains:
-            problems += [f"group {group.name!r} chain names link {lk!r}" for lk in (base, tip) if lk not in links]
+            problems += [
+                f"group {group.name!r} chain names link {lk!r}" for lk in (base, tip) if lk not in links
+            ]
     for (group, state), values in semantic.group_states.items():
         problems += [f"group state {state!r} ({group}) names joint {j!r}" for j in values if j not in joints]
     for effector in semantic.end_effectors:
@@ -128,9 +135,15 @@ def _check_srdf_names(semantic: SemanticDescription, robot: ResolvedRobot, srdf:
         )
 
 
-def _generated_srdf(robot: ResolvedRobot, group: str, base: str, tip: str, semantic: SemanticDescription) -> str:
+def _generated_srdf(
+    robot: ResolvedRobot, group: str, base: str, tip: str, semantic: SemanticDescription
+) -> str:
     root = etree.Element("robot", name=robot.name)
-    root.append(etree.Comment(" Made by kinema new config from the URDF: the URDF's longest chain of movable joints. "))
+    root.append(
+        etree.Comment(
+            " Made by kinema new config from the URDF: the URDF's longest chain of movable joints. "
+        )
+    )
     element = etree.SubElement(root, "group", name=group)
     etree.SubElement(element, "chain", base_link=base, tip_link=tip)
     pairs = {tuple(sorted(p)) for p in semantic.disabled_collisions}
@@ -178,9 +191,7 @@ def plan_robot(
         _check_srdf_names(semantic, robot, srdf)
         srdf_text = Path(srdf).read_text()
     groups = {
-        n: _group_joints(n, semantic.groups, joints)
-        for n, g in semantic.groups.items()
-        if not g.subgroups
+        n: _group_joints(n, semantic.groups, joints) for n, g in semantic.groups.items() if not g.subgroups
     }
     groups = {n: js for n, js in groups.items() if js}
     if groups:
@@ -210,7 +221,11 @@ def plan_robot(
     home: dict[str, float] = {n: _clip(joints[n], 0.0) for n in active}
     for state in ("home", "ready", "default"):
         found = next(
-            (v for (g, s), v in semantic.group_states.items() if s.lower() == state and set(group_joints) <= set(v)),
+            (
+                v
+                for (g, s), v in semantic.group_states.items()
+                if s.lower() == state and set(group_joints) <= set(v)
+            ),
             None,
         )
         if found is not None:
@@ -333,7 +348,8 @@ def _gripper_objective(plan: RobotPlan, objective: str, position: float) -> str:
 def _config_yaml(plan: RobotPlan, scene: str, source: str) -> str:
     name = plan.name
     controllers = [ARM_CONTROLLER] + ([GRIPPER_CONTROLLER] if plan.gripper_joint else [])
-    text = f"""#
+    text = (
+        f"""#
 # {name}: made by `kinema new config {name} --from-urdf {source}`.
 # The schema is MoveIt Pro's config.yaml, with Kinema's hardware.simulation and robot sections.
 #
@@ -358,7 +374,7 @@ ros_global_params:
   use_sim_time: True
 
 moveit_params:
-  # The default planning group of behaviors and core subtrees ({', '.join(plan.group_joints)}).
+  # The default planning group of behaviors and core subtrees ({", ".join(plan.group_joints)}).
   joint_group_name: "{plan.planning_group}"
   joint_limits:
     package: "{name}"
@@ -367,15 +383,18 @@ moveit_params:
 ros2_control:
   controllers_active_at_startup:
     - "joint_state_broadcaster"
-""" + "".join(f'    - "{c}"\n' for c in controllers) + f"""
+"""
+        + "".join(f'    - "{c}"\n' for c in controllers)
+        + f"""
 robot:
   # The frame Cartesian moves and IK place when an objective names none.
   tool_frame: "{plan.tool_frame}"
   controllers:
     {ARM_CONTROLLER}:
       type: "joint_trajectory_controller/JointTrajectoryController"
-      joints: [{', '.join(plan.group_joints)}]
+      joints: [{", ".join(plan.group_joints)}]
 """
+    )
     if plan.gripper_joint:
         text += f"""    {GRIPPER_CONTROLLER}:
       type: "position_controllers/GripperActionController"
@@ -453,15 +472,15 @@ def new_robot_package(
             raise ScaffoldError(f"{label} file not found: {given}")
     index = _package_index(workspace)
     say(f"reading {Path(urdf).name}")
-    plan = plan_robot(
-        name, Path(urdf), srdf=Path(srdf) if srdf else None, xacro_args=xacro_args, index=index
-    )
+    plan = plan_robot(name, Path(urdf), srdf=Path(srdf) if srdf else None, xacro_args=xacro_args, index=index)
     target_dir.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{name}-", dir=target_dir))
     try:
         description = staging / "description"
         description.mkdir()
-        (description / f"{name}.urdf").write_text('<?xml version="1.0"?>\n' + _strip_declaration(plan.robot.urdf_text))
+        (description / f"{name}.urdf").write_text(
+            '<?xml version="1.0"?>\n' + _strip_declaration(plan.robot.urdf_text)
+        )
         (description / f"{name}.srdf").write_text(plan.srdf_text)
         (description / "joint_limits.yaml").write_text(_joint_limits_yaml(plan))
         if mjcf is not None:
@@ -515,5 +534,3 @@ def _copy_scene(mjcf: Path, description: Path) -> str:
     destination = description / "mjcf"
     shutil.copytree(mjcf.parent, destination)
     return f"mjcf/{mjcf.name}"
-
-

@@ -38,7 +38,10 @@ class PlanCartesianPath(AsyncBehavior):
             ),
             cell_input_port("planning_group_name", str, "planning_group", "The planning group that moves."),
             input_port(
-                "tip_links", list[str], "", "The tool frame that follows the path ('': the group's tip)."
+                "tip_links",
+                list[str],
+                "",
+                "The tool frame that follows the path ('': the config's robot.tool_frame, else the group's tip).",
             ),
             input_port(
                 "position_only", bool, False, "Follow the positions only, leave the orientation free."
@@ -120,7 +123,9 @@ class PlanCartesianPath(AsyncBehavior):
             tips = [t.strip() for t in self.get_input_or("tip_links", []) if t.strip()]
             if len(tips) > 1:
                 return self._fail(f"one tip link at a time is supported, got {', '.join(tips)}")
-            tip = tips[0] if tips else model.group(group).tip_link
+            cell = self.context.cell
+            tip = tips[0] if tips else (cell.tool_frame if cell and cell.tool_frame else None)
+            tip = tip or model.group(group).tip_link
             timing = self._timing()
             if timing is not None:
                 return self._fail(timing)
