@@ -343,7 +343,7 @@ def process_xacro(
             if isinstance(cause, ConfigError):
                 raise cause from None
             where = (xacro.filestack or [str(path)])[-1] or str(path)
-            message = str(exc) or type(exc).__name__
+            message = " ".join(str(exc).split()) or type(exc).__name__  # xacro breaks lines oddly
             if isinstance(exc, KeyError) or "Undefined substitution argument" in message:
                 message += f" (xacro arguments given: {given})"
             raise ConfigError(f"xacro failed: {message}", location=SourceLocation(str(where))) from None
