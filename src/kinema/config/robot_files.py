@@ -452,6 +452,13 @@ def _mesh_rgba(mesh: object) -> list[float] | None:
     return [v / 255.0 for v in values]
 
 
+def default_mesh_cache() -> Path:
+    """Where converted meshes are kept between runs: ``<user cache dir>/kinema/meshes``."""
+    import platformdirs
+
+    return platformdirs.user_cache_path("kinema") / "meshes"
+
+
 def converted_mesh_rgba(converted: str | Path) -> tuple[float, float, float, float] | None:
     """The colour :func:`convert_mesh` recorded for a converted mesh, or None."""
     sidecar = Path(converted).with_suffix(".json")

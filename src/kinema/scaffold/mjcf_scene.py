@@ -48,6 +48,7 @@ from kinema.config.robot_files import (
     UrdfJoint,
     convert_mesh,
     converted_mesh_rgba,
+    default_mesh_cache,
     parse_joints,
     root_link,
 )
@@ -261,7 +262,8 @@ def generate_scene(
         table: whether to put the robot on a table (without one it stands on the floor at the origin).
         disabled_collisions: link pairs whose contacts to exclude besides the adjacent ones (an SRDF's
             ``disable_collisions``).
-        mesh_cache: where converted meshes are cached between runs (default: ``<out_dir>/meshes``).
+        mesh_cache: where converted meshes are cached between runs (default: the user's cache folder,
+            :func:`~kinema.config.robot_files.default_mesh_cache`).
 
     Raises:
         ScaffoldError: a keyframe names an unknown joint, or MuJoCo cannot compile the robot.
@@ -273,7 +275,7 @@ def generate_scene(
     name = name or robot.name
     mesh_dir = out_dir / "meshes"
     mesh_dir.mkdir(parents=True, exist_ok=True)
-    cache = Path(mesh_cache) if mesh_cache is not None else mesh_dir
+    cache = Path(mesh_cache) if mesh_cache is not None else default_mesh_cache()
 
     # Meshes into meshes/, under names unique by content.
     file_names: dict[str, str] = {}

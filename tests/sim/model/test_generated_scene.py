@@ -145,8 +145,12 @@ def test_visual_meshes_show_and_collision_meshes_collide(generated: Generated, m
 
 
 def test_the_scene_folder_is_portable_and_holds_no_collada(generated: Generated, tmp_path: Path) -> None:
+    from lxml import etree
+
     folder = generated.scene.parent
-    assert not list((folder / "meshes").glob("*.dae"))
+    referenced = {m.get("file") for m in etree.parse(str(generated.scene)).getroot().iter("mesh")}
+    assert {p.name for p in (folder / "meshes").iterdir()} == referenced, "meshes/ holds what the scene uses"
+    assert not [name for name in referenced if not name.endswith((".obj", ".stl"))]
     moved = tmp_path / "elsewhere"
     shutil.copytree(folder, moved)
     shutil.rmtree(folder / "meshes")
