@@ -343,7 +343,7 @@ def process_xacro(
             if isinstance(cause, ConfigError):
                 raise cause from None
             where = (xacro.filestack or [str(path)])[-1] or str(path)
-            message = str(exc) or type(exc).__name__
+            message = " ".join(str(exc).split()) or type(exc).__name__  # xacro breaks lines oddly
             if isinstance(exc, KeyError) or "Undefined substitution argument" in message:
                 message += f" (xacro arguments given: {given})"
             raise ConfigError(f"xacro failed: {message}", location=SourceLocation(str(where))) from None
@@ -450,6 +450,13 @@ def _mesh_rgba(mesh: object) -> list[float] | None:
     if len(values) == 3:
         values.append(255.0)
     return [v / 255.0 for v in values]
+
+
+def default_mesh_cache() -> Path:
+    """Where converted meshes are kept between runs: ``<user cache dir>/kinema/meshes``."""
+    import platformdirs
+
+    return platformdirs.user_cache_path("kinema") / "meshes"
 
 
 def converted_mesh_rgba(converted: str | Path) -> tuple[float, float, float, float] | None:

@@ -48,6 +48,7 @@ from kinema.config.robot_files import (
     UrdfJoint,
     convert_mesh,
     converted_mesh_rgba,
+    default_mesh_cache,
     parse_joints,
     root_link,
 )
@@ -261,7 +262,8 @@ def generate_scene(
         table: whether to put the robot on a table (without one it stands on the floor at the origin).
         disabled_collisions: link pairs whose contacts to exclude besides the adjacent ones (an SRDF's
             ``disable_collisions``).
-        mesh_cache: where converted meshes are cached between runs (default: ``<out_dir>/meshes``).
+        mesh_cache: where converted meshes are cached between runs (default: the user's cache folder,
+            :func:`~kinema.config.robot_files.default_mesh_cache`).
 
     Raises:
         ScaffoldError: a keyframe names an unknown joint, or MuJoCo cannot compile the robot.
@@ -273,7 +275,7 @@ def generate_scene(
     name = name or robot.name
     mesh_dir = out_dir / "meshes"
     mesh_dir.mkdir(parents=True, exist_ok=True)
-    cache = Path(mesh_cache) if mesh_cache is not None else mesh_dir
+    cache = Path(mesh_cache) if mesh_cache is not None else default_mesh_cache()
 
     # Meshes into meshes/, under names unique by content.
     file_names: dict[str, str] = {}
@@ -390,7 +392,12 @@ def generate_scene(
     mujoco.mj_forward(model, data_)
     inertia_matrix = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data_, inertia_matrix)  # MuJoCo 4: (m, d, dst); MjData.qM is gone
-    reach = _reach(model, data_)
+    groups = rigid_groups(robot.urdf_text)
+    mounted = [link for link, head in groups.items() if head == groups[base] and link in body_names]
+    # Where the robot stands: the root link, or the first body fixed to it when the root is a URDF
+    # "world" link (MuJoCo merges that into its world body, with the mount's offset kept).
+    stand = np.array(data_.xpos[min(model.body(link).id for link in mounted)]) if mounted else np.zeros(3)
+    reach = _reach(model, data_, stand)
 
     for info in actuated:
         joint_id = model.joint(info.name).id
@@ -407,9 +414,7 @@ def generate_scene(
             actuator.forcerange = [-info.effort, info.effort]
             actuator.forcelimited = mujoco.mjtLimited.mjLIMITED_TRUE
 
-    groups = rigid_groups(robot.urdf_text)
-    mounted = [link for link, head in groups.items() if head == groups[base] and link in body_names]
-    _add_world(spec, mounted=mounted, reach=reach, table=table)
+    _add_world(spec, mounted=mounted, stand=stand, reach=reach, table=table)
 
     named = {"home": home or {}, **(keyframes or {})}
     for key_name, values in named.items():
@@ -514,18 +519,20 @@ def _give_moving_links_mass(urdf: etree._Element) -> None:
         )
 
 
-def _reach(model: Any, data: Any) -> float:
-    """How far the robot's bodies are from the world origin (its base) at the pose in ``data``, m (≥ 0.3)."""
-    distances = [float(np.linalg.norm(data.xpos[b])) for b in range(1, model.nbody)]
+def _reach(model: Any, data: Any, stand: np.ndarray) -> float:
+    """How far the robot's bodies are from where it stands at the pose in ``data``, m (≥ 0.3)."""
+    distances = [float(np.linalg.norm(data.xpos[b] - stand)) for b in range(1, model.nbody)]
     return max([0.3, *distances])
 
 
-def _add_world(spec: Any, *, mounted: list[str], reach: float, table: bool) -> None:
+def _add_world(spec: Any, *, mounted: list[str], stand: np.ndarray, reach: float, table: bool) -> None:
+    """Floor, light, table and camera around a robot standing at ``stand`` (the world origin, usually)."""
     import mujoco
 
     spec.visual.global_.offwidth = 640
     spec.visual.global_.offheight = 480
-    floor_z = -TABLE_HEIGHT if table else 0.0
+    x, y, z = (float(v) for v in stand)
+    floor_z = z - TABLE_HEIGHT if table else z
     spec.add_texture(
         name="sky",
         type=mujoco.mjtTexture.mjTEXTURE_SKYBOX,
@@ -550,7 +557,7 @@ def _add_world(spec: Any, *, mounted: list[str], reach: float, table: bool) -> N
     world = spec.worldbody
     world.add_light(
         name="top",
-        pos=[0.0, 0.0, floor_z + 3.0],
+        pos=[x, y, floor_z + 3.0],
         dir=[0.0, 0.0, -1.0],
         type=mujoco.mjtLightType.mjLIGHT_DIRECTIONAL,
     )
@@ -558,13 +565,13 @@ def _add_world(spec: Any, *, mounted: list[str], reach: float, table: bool) -> N
         name="floor",
         type=mujoco.mjtGeom.mjGEOM_PLANE,
         size=[4.0, 4.0, 0.05],
-        pos=[0.0, 0.0, floor_z],
+        pos=[x, y, floor_z],
         material="floor",
     )
     if table:
         # From a little behind the base to most of the reach in front, as wide as the reach both sides.
         back, front, half_width = 0.25, max(0.6, 0.9 * reach), max(0.5, 0.8 * reach)
-        top = spec.worldbody.add_body(name="table", pos=[(front - back) / 2.0, 0.0, -TABLE_HEIGHT / 2.0])
+        top = spec.worldbody.add_body(name="table", pos=[x + (front - back) / 2.0, y, z - TABLE_HEIGHT / 2.0])
         top.add_geom(
             name="table",
             type=mujoco.mjtGeom.mjGEOM_BOX,
@@ -575,8 +582,8 @@ def _add_world(spec: Any, *, mounted: list[str], reach: float, table: bool) -> N
         for link in mounted:
             spec.add_exclude(bodyname1="table", bodyname2=link)
     # In front, a little to the side (depth reads better than straight on), looking at the workspace.
-    target = np.array([0.3 * reach, 0.0, 0.2 * reach])
-    position = np.array([1.6 * reach + 0.4, 0.35 * reach, 0.9 * reach + 0.3])
+    target = stand + np.array([0.3 * reach, 0.0, 0.2 * reach])
+    position = stand + np.array([1.6 * reach + 0.4, 0.35 * reach, 0.9 * reach + 0.3])
     # As in lab_sim: the camera sits in an optical-frame body, which the driver stamps its images with.
     frame = world.add_body(
         name="scene_camera_optical_frame", pos=list(position), quat=_optical_frame_quat(position, target)

@@ -145,8 +145,12 @@ def test_visual_meshes_show_and_collision_meshes_collide(generated: Generated, m
 
 
 def test_the_scene_folder_is_portable_and_holds_no_collada(generated: Generated, tmp_path: Path) -> None:
+    from lxml import etree
+
     folder = generated.scene.parent
-    assert not list((folder / "meshes").glob("*.dae"))
+    referenced = {m.get("file") for m in etree.parse(str(generated.scene)).getroot().iter("mesh")}
+    assert {p.name for p in (folder / "meshes").iterdir()} == referenced, "meshes/ holds what the scene uses"
+    assert not [name for name in referenced if not name.endswith((".obj", ".stl"))]
     moved = tmp_path / "elsewhere"
     shutil.copytree(folder, moved)
     shutil.rmtree(folder / "meshes")
@@ -259,6 +263,32 @@ def test_the_robot_holds_home_for_two_seconds(generated: Generated) -> None:
         mujoco.mj_step(model, data)
     worst = np.abs(data.qpos - start).max()
     assert worst < 0.01, f"drifted {worst:.4f} rad/m from home"
+
+
+def test_each_joint_follows_a_ramp_and_settles(generated: Generated) -> None:
+    """The servo rule gives tracking a planner can rely on: lag ≈ 2·v/ω on a ramp, settled soon after."""
+    model = generated.model
+    for actuator in range(model.nu):
+        data = at_keyframe(model, "home")
+        joint = int(model.actuator_trnid[actuator, 0])
+        address = model.jnt_qposadr[joint]
+        high = model.actuator_ctrlrange[actuator][1] if model.actuator_ctrllimited[actuator] else np.inf
+        revolute = model.jnt_type[joint] == mujoco.mjtJoint.mjJNT_HINGE
+        speed = 0.3 if revolute else 0.01  # rad/s or m/s, for one second
+        start = float(data.ctrl[actuator])
+        if start + speed > high:
+            speed = -speed
+        worst_lag = 0.0
+        while data.time < 1.5:
+            data.ctrl[actuator] = start + speed * min(data.time, 1.0)
+            mujoco.mj_step(model, data)
+            worst_lag = max(worst_lag, abs(data.qpos[address] - data.ctrl[actuator]))
+        name = model.actuator(actuator).name
+        assert worst_lag < 3.0 * abs(speed) / NATURAL_FREQUENCY, f"{name} lags {worst_lag:.4f}"
+        assert abs(data.qpos[address] - (start + speed)) < 0.002, f"{name} did not settle"
+        assert data.ncon == 0 or all(
+            model.geom_bodyid[c.geom1] != model.body("table").id for c in data.contact[: data.ncon]
+        ), f"{name}'s ramp ran into the table: pick another"
 
 
 def test_home_is_collision_free(generated: Generated) -> None:
@@ -400,3 +430,23 @@ def test_a_robot_without_meshes_inertia_or_limits(tmp_path: Path) -> None:
         mujoco.mj_step(model, data)
     assert np.abs(data.qpos - start).max() < 0.01
     assert longest_chain(robot.urdf_text) == ("mount", "no_inertia", ["swing", "twist"])
+
+
+def test_a_robot_mounted_on_a_world_link_stands_on_the_table_where_its_mount_is(tmp_path: Path) -> None:
+    mounted = SMALL_ROBOT.replace(
+        '<link name="mount">',
+        '<link name="world"/><joint name="world_joint" type="fixed"><parent link="world"/>'
+        '<child link="mount"/><origin xyz="0.5 0.2 0.1"/></joint>\n  <link name="mount">',
+    )
+    urdf = tmp_path / "mounted.urdf"
+    urdf.write_text(mounted)
+    robot = resolve_robot(urdf, index=PackageIndex(environ={}, site_packages=[]))
+    model = mujoco.MjModel.from_xml_path(str(generate_scene(robot, tmp_path / "out")))
+    data = at_keyframe(model, "home")
+    assert data.xpos[model.body("mount").id].tolist() == pytest.approx([0.5, 0.2, 0.1])
+    table = model.geom("table").id
+    top = data.geom_xpos[table] + model.geom_size[table]
+    low = data.geom_xpos[table] - model.geom_size[table]
+    assert top[2] == pytest.approx(0.1)
+    assert low[0] < 0.5 < top[0] and low[1] < 0.2 < top[1]
+    assert data.ncon == 0

@@ -199,13 +199,29 @@ def test_a_xacro_syntax_error_names_file_and_line(tmp_path: Path) -> None:
     assert caught.value.location.file == str(path) and caught.value.location.line == 3
 
 
+def test_a_syntax_error_in_an_included_xacro_names_the_included_file(tmp_path: Path) -> None:
+    top = tmp_path / "top.urdf.xacro"
+    top.write_text(
+        '<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">\n'
+        '  <xacro:include filename="parts.xacro"/>\n</robot>\n'
+    )
+    (tmp_path / "parts.xacro").write_text(
+        '<robot xmlns:xacro="http://www.ros.org/wiki/xacro">\n\n  <link name="a">\n</robot>\n'
+    )
+    with pytest.raises(ConfigError) as caught:
+        process_xacro(top, {}, index=bare_index())
+    assert str(caught.value).startswith(f"{tmp_path / 'parts.xacro'}:4: xacro: not valid XML: mismatched tag")
+
+
 def test_a_xacro_error_names_the_file(tmp_path: Path) -> None:
     path = tmp_path / "bad.urdf.xacro"
     path.write_text(
         '<robot name="x" xmlns:xacro="http://www.ros.org/wiki/xacro">'
         '<link name="${undefined_property}"/></robot>'
     )
-    with pytest.raises(ConfigError, match=r"xacro failed: .*undefined_property") as caught:
+    with pytest.raises(
+        ConfigError, match=r"xacro failed: name 'undefined_property' is not defined when"
+    ) as caught:
         process_xacro(path, {}, index=bare_index())
     assert caught.value.location is not None and caught.value.location.file == str(path)
 
