@@ -329,7 +329,7 @@ def _waypoints_yaml(plan: RobotPlan) -> str:
 def _gripper_objective(plan: RobotPlan, objective: str, position: float) -> str:
     return f"""<?xml version="1.0" encoding="UTF-8"?>
 <root BTCPP_format="4" main_tree_to_execute="{objective}">
-  <!-- Made by kinema new config (from the URDF): the gripper's joint {plan.gripper_joint} to {position:g}. -->
+  <!-- Made by kinema new config (from the URDF): {plan.gripper_joint} to {position:g}. -->
   <BehaviorTree ID="{objective}" _description="{objective.split()[0]} the gripper" _favorite="true">
     <Action ID="MoveGripperAction" position="{position:g}"/>
   </BehaviorTree>

@@ -41,7 +41,8 @@ class PlanCartesianPath(AsyncBehavior):
                 "tip_links",
                 list[str],
                 "",
-                "The tool frame that follows the path ('': the config's robot.tool_frame, else the group's tip).",
+                "The tool frame that follows the path ('': the config's robot.tool_frame, else the "
+                "group's tip).",
             ),
             input_port(
                 "position_only", bool, False, "Follow the positions only, leave the orientation free."
