@@ -30,19 +30,19 @@ def new() -> None:
 @click.option(
     "--from-urdf",
     "urdf",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=str,
     default=None,
-    help="Make the package for your own robot from its URDF or .xacro (based on kinema_base).",
+    help="Make the package for your own robot from its URDF or .xacro, a path or package://PKG/PATH.",
 )
 @click.option(
     "--srdf",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=str,
     default=None,
     help="With --from-urdf: the robot's SRDF (planning groups, group states, end effector).",
 )
 @click.option(
     "--mjcf",
-    type=click.Path(dir_okay=False, path_type=Path),
+    type=str,
     default=None,
     help="With --from-urdf: a MuJoCo scene to simulate it in (default: one is generated).",
 )
@@ -60,9 +60,9 @@ def new_config(
     output_dir: Path | None,
     workspace: Path | None,
     no_input: bool,
-    urdf: Path | None,
-    srdf: Path | None,
-    mjcf: Path | None,
+    urdf: str | None,
+    srdf: str | None,
+    mjcf: str | None,
     xacro_args: tuple[str, ...],
 ) -> None:
     """Create config package NAME based on PARENT, or for your own robot with --from-urdf.
@@ -139,9 +139,9 @@ def new_config(
 
 def _new_robot_config(
     name: str,
-    urdf: Path,
-    srdf: Path | None,
-    mjcf: Path | None,
+    urdf: str,
+    srdf: str | None,
+    mjcf: str | None,
     xacro_args: tuple[str, ...],
     output_dir: Path | None,
     found: object,

@@ -9,6 +9,7 @@ loading path reads — there is no second path for generated robots::
     NAME/description/NAME.srdf         the given SRDF, or one made from the URDF's longest chain
     NAME/description/joint_limits.yaml velocity limits from the URDF, accelerations (see below)
     NAME/description/NAME_scene.xml    the MuJoCo scene (generated, or the one given) + meshes/
+    NAME/description/objects.xml       your objects in that world (a generated scene includes it)
     NAME/waypoints/waypoints.yaml      Home and the SRDF's group states, under their own names
     NAME/objectives/                   Open Gripper / Close Gripper when the robot has a gripper
 
@@ -467,10 +468,12 @@ def new_robot_package(
     target = target_dir / name
     if target.exists():
         raise ScaffoldError(f"{target} already exists; choose another name or remove it")
+    index = _package_index(workspace)
+    urdf, srdf, mjcf = (_locate(given, index) for given in (urdf, srdf, mjcf))
     for label, given in (("URDF", urdf), ("SRDF", srdf), ("MuJoCo scene", mjcf)):
         if given is not None and not Path(given).is_file():
             raise ScaffoldError(f"{label} file not found: {given}")
-    index = _package_index(workspace)
+    assert urdf is not None
     say(f"reading {Path(urdf).name}")
     plan = plan_robot(name, Path(urdf), srdf=Path(srdf) if srdf else None, xacro_args=xacro_args, index=index)
     target_dir.mkdir(parents=True, exist_ok=True)
@@ -497,6 +500,7 @@ def new_robot_package(
                 disabled_collisions=[tuple(sorted(p)) for p in plan.semantic.disabled_collisions],  # type: ignore[misc]
             )
             scene = path.name
+            _add_objects_include(path)
         (staging / "waypoints").mkdir()
         (staging / "waypoints" / "waypoints.yaml").write_text(_waypoints_yaml(plan))
         (staging / "objectives").mkdir()
@@ -520,6 +524,47 @@ def new_robot_package(
         shutil.rmtree(staging, ignore_errors=True)
         raise
     return target, plan
+
+
+OBJECTS_FILE = "objects.xml"
+_OBJECTS_TEXT = """<mujoco>
+  <!--
+    Your objects in the simulated world: put bodies inside <worldbody> (a <freejoint/> makes one movable,
+    e.g. a cube to pick). The robot stands on the table top at z = 0, the table reaching in front of it
+    along +x. The scene includes this file; it is yours to edit (kinema new config never rewrites it).
+  -->
+  <worldbody>
+  </worldbody>
+</mujoco>
+"""
+
+
+def _add_objects_include(scene: Path) -> None:
+    """Make the generated scene include ``objects.xml`` (the user's objects), after the robot's bodies so
+    the keyframes' joint values keep their places."""
+    tree = etree.parse(str(scene))
+    root = tree.getroot()
+    worldbody = root.find("worldbody")
+    include = etree.Element("include", file=OBJECTS_FILE)
+    if worldbody is not None:
+        worldbody.addnext(include)
+    else:
+        root.append(include)
+    scene.write_text(etree.tostring(root, encoding="unicode") + "\n")
+    (scene.parent / OBJECTS_FILE).write_text(_OBJECTS_TEXT)
+
+
+def _locate(given: str | Path | None, index: PackageIndex) -> Path | None:
+    """A path, or a ``package://PKG/PATH`` URI found through ``index`` (installed description packages,
+    the workspace, ROS_PACKAGE_PATH, AMENT_PREFIX_PATH)."""
+    if given is None:
+        return None
+    text = str(given)
+    if text.startswith("package://"):
+        from kinema.config.robot_files import resolve_uri
+
+        return resolve_uri(text, base_dir=Path.cwd(), index=index)
+    return Path(given)
 
 
 def _strip_declaration(text: str) -> str:

@@ -140,7 +140,9 @@ class PlanCartesianPath(AsyncBehavior):
             if not radius >= 0:
                 return self._fail(f"blending_radius must be >= 0 (m), got {radius}")
             poses = self._poses()
-            start = joint_state_monitor(self.context, "PlanCartesianPath").positions(model.joint_names)
+            start = joint_state_monitor(self.context, "PlanCartesianPath").current_positions(
+                model.joint_names, self.context.clock
+            )
             targets = []
             for frame, matrix in poses:
                 world_T_point = matrix if frame in WORLD_FRAMES else fk(model, start, frame) @ matrix

@@ -92,7 +92,9 @@ class PlanToJointGoal(AsyncBehavior):
                 )
             if not goal:
                 return self._fail("joint_goal names no joint")
-            start = joint_state_monitor(self.context, "PlanToJointGoal").positions(model.joint_names)
+            start = joint_state_monitor(self.context, "PlanToJointGoal").current_positions(
+                model.joint_names, self.context.clock
+            )
             checker = collision_checker(self.context, "PlanToJointGoal", padding)
             options = PlanningOptions(planner=planner, timeout=float(self.get_input("planning_time")))
             path = plan_joint_goal(checker, start, goal, group, options)
