@@ -663,7 +663,16 @@ def resolve_robot(
     """
     path = Path(path).resolve()
     index = index if index is not None else PackageIndex()
-    text = process_xacro(path, xacro_args, index=index)
+    return resolve_robot_text(path, process_xacro(path, xacro_args, index=index), index=index)
+
+
+def resolve_robot_text(path: str | Path, text: str, *, index: PackageIndex) -> ResolvedRobot:
+    """:func:`resolve_robot` for a description already read (xacro expanded) from ``path``.
+
+    Raises:
+        ConfigError: as :func:`resolve_robot`, xacro failures aside.
+    """
+    path = Path(path).resolve()
     try:
         root = _parse(text)
     except etree.XMLSyntaxError as exc:
