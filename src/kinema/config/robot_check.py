@@ -91,6 +91,11 @@ class _Urdf:
     links: list[str]
 
     @property
+    def movable_joints(self) -> list[str]:
+        """The joints a waypoint, a limit or a controller can name: revolute, continuous, prismatic."""
+        return [j.name for j in self.joints.values() if j.movable]
+
+    @property
     def active_joints(self) -> list[str]:
         return [j.name for j in self.joints.values() if j.movable and j.mimic is None]
 
@@ -287,7 +292,7 @@ def _check_joint_limits(resolved: ResolvedConfig, urdf: _Urdf, report: RobotRepo
         if str(joint) not in urdf.joints:
             report.problem(
                 f"joint_limits names joint {joint!r}, which is not a {urdf.describe('joint')}; "
-                f"{did_you_mean(str(joint), urdf.joints)}",
+                f"{did_you_mean(str(joint), urdf.movable_joints)}",
                 document.location(("joint_limits", joint)),
             )
 
@@ -313,7 +318,7 @@ def _check_waypoints(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport)
         if unknown:
             report.problem(
                 f"waypoint {waypoint.name!r} names {_joints(unknown)} not in {urdf.source.name}; "
-                f"{did_you_mean(unknown[0], urdf.joints)}",
+                f"{did_you_mean(unknown[0], urdf.movable_joints)}",
                 document.location((number, "joint_state", "name")),
             )
 
@@ -534,7 +539,7 @@ def _check_cell(resolved: ResolvedConfig, urdf: _Urdf, scene: _Scene | None, rep
         if joint not in urdf.joints:
             report.problem(
                 f"{what} names joint {joint!r}, which is not a {urdf.describe('joint')}; "
-                f"{did_you_mean(joint, urdf.joints)}",
+                f"{did_you_mean(joint, urdf.movable_joints)}",
                 location,
             )
         elif scene is not None and joint not in scene.actuators:
