@@ -95,8 +95,8 @@ def build(
 
     robot = robot_report(resolved)
     print_warnings(robot.warnings)
-    for problem in robot.problems:
-        click.secho(str(problem), err=True, fg="red")
+    for robot_problem in robot.problems:
+        click.secho(str(robot_problem), err=True, fg="red")
     errors += len(robot.problems)
     click.echo(f"checked the robot: {len(robot.problems)} problems")
     if errors:

@@ -14,8 +14,9 @@ file (and line where known) and the names that would have been valid:
   groups and links;
 - joint_limits.yaml names URDF joints;
 - the MuJoCo scene: every file it and its includes name (include, mesh, texture, hfield, skin) exists and
-  is not an LFS pointer — checked before MuJoCo parses it, so the message is Kinema's — then it loads,
-  simulates every active URDF joint (movable, not a mimic) and has the configured keyframe;
+  is not an LFS pointer, and no mesh is a text STL (MuJoCo reads binary STL only) — checked before MuJoCo
+  parses it, so the message is Kinema's — then it loads, simulates every active URDF joint (movable, not
+  a mimic) and has the configured keyframe;
 - the waypoints name URDF joints;
 - the controllers' and the gripper's joints are URDF joints actuated in the scene (by an actuator named
   like the joint, as the MuJoCo driver finds them), the tool frame is a URDF link, the F/T sensor's sites
@@ -41,6 +42,7 @@ from typing import TYPE_CHECKING, Any
 
 from lxml import etree
 
+from kinema.config.robot_files import is_ascii_stl
 from kinema.errors import ConfigError, KinemaError, SourceLocation, did_you_mean
 
 if TYPE_CHECKING:
@@ -483,6 +485,11 @@ class _SceneFiles:
             return
         if self._pointer(found):
             self.pointers.append((str(element.tag), found, where))
+            return
+        if element.tag == "mesh" and is_ascii_stl(found):
+            self._problem(
+                f"mesh {found} is a text STL, which MuJoCo cannot read: save it as binary STL or OBJ", where
+            )
         elif not _under(found, (self.main.parent,)):
             self.virtual[relative] = found
 

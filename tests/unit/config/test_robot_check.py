@@ -265,13 +265,21 @@ def test_a_scene_file_missing_or_an_lfs_pointer_is_told_by_kinema_not_mujoco(lab
     description = lab_sim / "src" / "lab_sim" / "description"
     scene = description / "lab_sim_scene.xml"
     (description / "assets" / "bottle.stl").write_text(LFS_POINTER)
-    edit(scene, "<asset>", '<include file="parts/gone.xml"/>\n  <asset><mesh file="assets/bottle.stl"/>')
+    (description / "assets" / "text.stl").write_text("solid t\nendsolid t\n")
+    edit(
+        scene,
+        "<asset>",
+        '<include file="parts/gone.xml"/>\n  <asset><mesh file="assets/bottle.stl"/>\n'
+        '    <mesh file="assets/text.stl"/>',
+    )
     messages = [str(p) for p in check_robot(resolve_config("lab_sim", Workspace.discover(lab_sim)))]
     include_line = line_of(scene, "parts/gone.xml")
     bottle_line = line_of(scene, "bottle.stl")
     assert messages == [
         f"{scene}:{include_line}: include file 'parts/gone.xml' not found (looked for "
         f"{description / 'parts' / 'gone.xml'})",
+        f"{scene}:{line_of(scene, 'text.stl')}: mesh {description / 'assets' / 'text.stl'} is a text STL, "
+        "which MuJoCo cannot read: save it as binary STL or OBJ",
         f"{scene}:{bottle_line}: mesh {description / 'assets' / 'bottle.stl'} is a Git LFS pointer file "
         "(run `git lfs pull`)",
     ]
