@@ -258,6 +258,24 @@ def test_a_scene_missing_a_joint_is_told_before_the_controllers(lab_sim: Path) -
     )
 
 
+def test_a_urdf_the_planner_cannot_load_is_a_problem(lab_sim: Path) -> None:
+    urdf = lab_sim / "src" / "lab_sim" / "description" / "lab_sim.urdf"
+    edit(
+        urdf,
+        '<joint name="linear_rail_joint" type="prismatic">',
+        '<joint name="linear_rail_joint" type="planar">',
+    )
+    assert_problems(
+        check_robot(resolve_config("lab_sim", Workspace.discover(lab_sim))),
+        (
+            urdf,
+            None,
+            f"joint 'linear_rail_joint' in {urdf} has 4 coordinates; only revolute (with limits) and "
+            "prismatic joints are supported",
+        ),
+    )
+
+
 # -- the scene's files, before MuJoCo reads them ----------------------------------------------------------
 
 
