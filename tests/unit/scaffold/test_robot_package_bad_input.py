@@ -104,6 +104,19 @@ def _srdf_names_other_joints(robot: Path) -> tuple[Path, tuple[str, ...], str]:
     )
 
 
+def _srdf_chain_upside_down(robot: Path) -> tuple[Path, tuple[str, ...], str]:
+    srdf = robot / "bot.srdf"
+    srdf.write_text(
+        '<robot name="bot"><group name="arm"><chain base_link="arm" tip_link="base"/></group></robot>'
+    )
+    return (
+        robot / "bot.urdf",
+        ("--srdf", str(srdf)),
+        f"{srdf}: the SRDF does not fit the URDF bot.urdf: group 'arm' chain's tip 'base' is not below its "
+        "base 'arm'.",
+    )
+
+
 def _xacro_error(robot: Path) -> tuple[Path, tuple[str, ...], str]:
     xacro = robot / "bot.urdf.xacro"
     text = urdf_text().replace(
@@ -125,8 +138,15 @@ def _no_movable_joints(robot: Path) -> tuple[Path, tuple[str, ...], str]:
 
 @pytest.mark.parametrize(
     "make",
-    [_missing_mesh, _lfs_pointer, _srdf_names_other_joints, _xacro_error, _no_movable_joints],
-    ids=["missing mesh", "LFS pointer mesh", "SRDF joints", "xacro error", "no movable joints"],
+    [
+        _missing_mesh,
+        _lfs_pointer,
+        _srdf_names_other_joints,
+        _srdf_chain_upside_down,
+        _xacro_error,
+        _no_movable_joints,
+    ],
+    ids=["missing mesh", "LFS pointer mesh", "SRDF joints", "SRDF chain", "xacro error", "no movable joints"],
 )
 def test_bad_input_is_one_clear_error_and_writes_nothing(
     workspace_root: Path, robot: Path, make: object, capsys: pytest.CaptureFixture[str]
