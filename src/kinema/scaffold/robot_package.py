@@ -123,8 +123,10 @@ def _check_srdf_names(semantic: SemanticDescription, robot: ResolvedRobot, srdf:
             problems += [f"group {group.name!r} chain names link {lk!r}" for lk in unknown]
             if not unknown and not _below(tip, base, parents):
                 problems.append(f"group {group.name!r} chain's tip {tip!r} is not below its base {base!r}")
-    for (group, state), values in semantic.group_states.items():
-        problems += [f"group state {state!r} ({group}) names joint {j!r}" for j in values if j not in joints]
+    for (group_name, state), values in semantic.group_states.items():
+        problems += [
+            f"group state {state!r} ({group_name}) names joint {j!r}" for j in values if j not in joints
+        ]
     for effector in semantic.end_effectors:
         if effector.parent_link not in links:
             problems.append(f"end effector {effector.name!r} names link {effector.parent_link!r}")
