@@ -374,6 +374,26 @@ def check_mesh(path: str | Path, *, location: SourceLocation | None = None) -> P
     return path
 
 
+def is_ascii_stl(path: str | Path) -> bool:
+    """An STL file in the text format, which MuJoCo's decoder refuses (it reads binary STL only).
+
+    A binary STL is 84 bytes of header and count plus 50 bytes a triangle; its 80-byte header may itself
+    begin with ``solid``, so the size decides, and the ``solid`` keyword only when the size does not fit.
+    """
+    path = Path(path)
+    if path.suffix.lower() != ".stl":
+        return False
+    try:
+        size = path.stat().st_size
+        with path.open("rb") as handle:
+            head = handle.read(84)
+    except OSError:
+        return False
+    if len(head) == 84 and size == 84 + 50 * int.from_bytes(head[80:84], "little"):
+        return False
+    return head.lstrip().startswith(b"solid")
+
+
 def _file_digest(path: Path) -> str:
     digest = hashlib.sha256()
     with path.open("rb") as handle:
@@ -385,17 +405,18 @@ def _file_digest(path: Path) -> str:
 def convert_mesh(path: str | Path, cache_dir: str | Path) -> Path:
     """A mesh file MuJoCo can read with the same geometry as ``path``.
 
-    STL and OBJ come back as they are. Other formats (COLLADA ``.dae`` above all, which MuJoCo refuses)
-    are loaded with trimesh, their scene graph flattened into one mesh in the file's own frame and units,
-    and written as ``<cache_dir>/<stem>-<content hash>.obj``, so a file is converted once however often
-    it is asked for. The sub-meshes' colours, averaged by area, are kept beside it (see
-    :func:`converted_mesh_rgba`) for the MJCF's ``rgba``: MuJoCo reads no materials from an OBJ.
+    Binary STL and OBJ come back as they are. Other formats (COLLADA ``.dae`` above all, which MuJoCo
+    refuses, and text STL, which it refuses too) are loaded with trimesh, their scene graph flattened into
+    one mesh in the file's own frame and units, and written as ``<cache_dir>/<stem>-<content hash>.obj``,
+    so a file is converted once however often it is asked for. The sub-meshes' colours, averaged by area,
+    are kept beside it (see :func:`converted_mesh_rgba`) for the MJCF's ``rgba``: MuJoCo reads no
+    materials from an OBJ.
 
     Raises:
         ConfigError: the file is missing, an LFS pointer, or trimesh cannot read it.
     """
     path = check_mesh(path)
-    if path.suffix.lower() in MUJOCO_MESH_SUFFIXES:
+    if path.suffix.lower() in MUJOCO_MESH_SUFFIXES and not is_ascii_stl(path):
         return path
     cache_dir = Path(cache_dir)
     target = cache_dir / f"{path.stem}-{_file_digest(path)}.obj"
@@ -663,7 +684,16 @@ def resolve_robot(
     """
     path = Path(path).resolve()
     index = index if index is not None else PackageIndex()
-    text = process_xacro(path, xacro_args, index=index)
+    return resolve_robot_text(path, process_xacro(path, xacro_args, index=index), index=index)
+
+
+def resolve_robot_text(path: str | Path, text: str, *, index: PackageIndex) -> ResolvedRobot:
+    """:func:`resolve_robot` for a description already read (xacro expanded) from ``path``.
+
+    Raises:
+        ConfigError: as :func:`resolve_robot`, xacro failures aside.
+    """
+    path = Path(path).resolve()
     try:
         root = _parse(text)
     except etree.XMLSyntaxError as exc:

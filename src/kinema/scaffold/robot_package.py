@@ -114,16 +114,20 @@ def _check_srdf_names(semantic: SemanticDescription, robot: ResolvedRobot, srdf:
     """Every joint and link the SRDF names must be the URDF's; one error lists them all."""
     joints = {j.name for j in robot.joints()}
     links = {j.child for j in robot.joints()} | {robot.root_link()}
+    parents = {j.child: j.parent for j in robot.joints()}
     problems = []
     for group in semantic.groups.values():
         problems += [f"group {group.name!r} names joint {j!r}" for j in group.joints if j not in joints]
         problems += [f"group {group.name!r} names link {lk!r}" for lk in group.links if lk not in links]
         for base, tip in group.chains:
-            problems += [
-                f"group {group.name!r} chain names link {lk!r}" for lk in (base, tip) if lk not in links
-            ]
-    for (group, state), values in semantic.group_states.items():
-        problems += [f"group state {state!r} ({group}) names joint {j!r}" for j in values if j not in joints]
+            unknown = [lk for lk in (base, tip) if lk not in links]
+            problems += [f"group {group.name!r} chain names link {lk!r}" for lk in unknown]
+            if not unknown and not _below(tip, base, parents):
+                problems.append(f"group {group.name!r} chain's tip {tip!r} is not below its base {base!r}")
+    for (group_name, state), values in semantic.group_states.items():
+        problems += [
+            f"group state {state!r} ({group_name}) names joint {j!r}" for j in values if j not in joints
+        ]
     for effector in semantic.end_effectors:
         if effector.parent_link not in links:
             problems.append(f"end effector {effector.name!r} names link {effector.parent_link!r}")
@@ -134,6 +138,18 @@ def _check_srdf_names(semantic: SemanticDescription, robot: ResolvedRobot, srdf:
             + (f" (and {len(problems) - 8} more)" if len(problems) > 8 else "")
             + f". The URDF's joints: {', '.join(sorted(joints))}"
         )
+
+
+def _below(tip: str, base: str, parents: Mapping[str, str]) -> bool:
+    """``tip`` is ``base`` or one of its descendants (following each link's parent)."""
+    link = tip
+    for _ in range(len(parents) + 1):
+        if link == base:
+            return True
+        if link not in parents:
+            return False
+        link = parents[link]
+    return False
 
 
 def _generated_srdf(

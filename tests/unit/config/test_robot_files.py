@@ -12,6 +12,7 @@ from kinema.config.robot_files import (
     check_mesh,
     convert_mesh,
     converted_mesh_rgba,
+    is_ascii_stl,
     process_xacro,
     resolve_robot,
     resolve_uri,
@@ -252,6 +253,26 @@ def test_stl_and_obj_pass_through_unconverted(tmp_path: Path) -> None:
     stl = write_cube_stl(tmp_path / "a.stl")
     assert convert_mesh(stl, tmp_path / "cache") == stl
     assert not (tmp_path / "cache").exists()
+
+
+def test_a_text_stl_is_converted_because_mujoco_reads_only_binary_stl(tmp_path: Path) -> None:
+    import mujoco
+    import trimesh
+
+    text = tmp_path / "cube.stl"
+    text.write_bytes(trimesh.creation.box(extents=(0.1, 0.2, 0.3)).export(file_type="stl_ascii").encode())
+    binary = write_cube_stl(tmp_path / "binary.stl")
+    labelled = tmp_path / "solid_header.stl"  # a binary STL whose 80-byte header starts with "solid"
+    labelled.write_bytes(b"solid exported by a CAD tool".ljust(80, b" ") + binary.read_bytes()[80:])
+    assert [is_ascii_stl(p) for p in (text, binary, labelled)] == [True, False, False]
+    assert convert_mesh(labelled, tmp_path / "cache") == labelled
+    converted = convert_mesh(text, tmp_path / "cache")
+    assert converted.suffix == ".obj" and converted.parent == tmp_path / "cache"
+    model = mujoco.MjModel.from_xml_string(
+        f'<mujoco><asset><mesh name="m" file="{converted}"/></asset>'
+        '<worldbody><geom type="mesh" mesh="m"/></worldbody></mujoco>'
+    )
+    assert model.mesh_vertnum[0] >= 8
 
 
 COLLADA_TETRAHEDRON = """<?xml version="1.0" encoding="utf-8"?>
