@@ -485,13 +485,14 @@ def new_robot_package(
     if target.exists():
         raise ScaffoldError(f"{target} already exists; choose another name or remove it")
     index = _package_index(workspace)
-    urdf, srdf, mjcf = (_locate(given, index) for given in (urdf, srdf, mjcf))
-    for label, given in (("URDF", urdf), ("SRDF", srdf), ("MuJoCo scene", mjcf)):
-        if given is not None and not Path(given).is_file():
+    urdf_path = _locate(urdf, index)
+    srdf_path, mjcf_path = _locate(srdf, index), _locate(mjcf, index)
+    for label, given in (("URDF", urdf_path), ("SRDF", srdf_path), ("MuJoCo scene", mjcf_path)):
+        if given is not None and not given.is_file():
             raise ScaffoldError(f"{label} file not found: {given}")
-    assert urdf is not None
-    say(f"reading {Path(urdf).name}")
-    plan = plan_robot(name, Path(urdf), srdf=Path(srdf) if srdf else None, xacro_args=xacro_args, index=index)
+    assert urdf_path is not None
+    say(f"reading {urdf_path.name}")
+    plan = plan_robot(name, urdf_path, srdf=srdf_path, xacro_args=xacro_args, index=index)
     target_dir.mkdir(parents=True, exist_ok=True)
     staging = Path(tempfile.mkdtemp(prefix=f".{name}-", dir=target_dir))
     try:
@@ -502,8 +503,8 @@ def new_robot_package(
         )
         (description / f"{name}.srdf").write_text(plan.srdf_text)
         (description / "joint_limits.yaml").write_text(_joint_limits_yaml(plan))
-        if mjcf is not None:
-            scene = _copy_scene(Path(mjcf), description)
+        if mjcf_path is not None:
+            scene = _copy_scene(mjcf_path, description)
         else:
             say("generating the MuJoCo scene (meshes are converted once)")
             keyframes = {n.lower().replace(" ", "_"): v for n, v in plan.waypoints.items() if n != HOME}
@@ -517,6 +518,8 @@ def new_robot_package(
             )
             scene = path.name
             _add_objects_include(path)
+            if plan.gripper_joint:
+                _grip_firmly(path, plan.gripper_joint, plan.gripper_open, plan.gripper_closed)
         (staging / "waypoints").mkdir()
         (staging / "waypoints" / "waypoints.yaml").write_text(_waypoints_yaml(plan))
         (staging / "objectives").mkdir()
@@ -568,6 +571,34 @@ def _add_objects_include(scene: Path) -> None:
         root.append(include)
     scene.write_text(etree.tostring(root, encoding="unicode") + "\n")
     (scene.parent / OBJECTS_FILE).write_text(_OBJECTS_TEXT)
+
+
+#: Share of the gripper's effort limit it squeezes with when closed on an object half as wide as it opens.
+GRIP_SHARE = 0.05
+
+
+def _grip_firmly(scene: Path, joint: str, opened: float, closed: float) -> None:
+    """Make the gripper's servo squeeze: a servo tuned for tracking, like the arm's, presses a held
+    object with under a newton, and MuJoCo's soft contacts let such a grasp creep until the object falls.
+
+    The gain is chosen so that closing on an object half as wide as the gripper opens presses with
+    GRIP_SHARE of the actuator's force limit; the damping keeps the servo's damping ratio.
+    """
+    tree = etree.parse(str(scene))
+    for actuator in tree.getroot().iter("position"):
+        if actuator.get("joint") != joint:
+            continue
+        limits = [abs(float(v)) for v in (actuator.get("forcerange") or "0 0").split()]
+        force = max(limits) if limits else 0.0
+        travel = abs(opened - closed) / 2.0
+        old_kp = float(actuator.get("kp") or 0.0)
+        if force <= 0.0 or travel <= 0.0 or old_kp <= 0.0:
+            return
+        kp = max(old_kp, GRIP_SHARE * force / travel)
+        kv = float(actuator.get("kv") or 0.0) * math.sqrt(kp / old_kp)
+        actuator.set("kp", f"{kp:.6g}")
+        actuator.set("kv", f"{kv:.6g}")
+    scene.write_text(etree.tostring(tree.getroot(), encoding="unicode") + "\n")
 
 
 def _locate(given: str | Path | None, index: PackageIndex) -> Path | None:
