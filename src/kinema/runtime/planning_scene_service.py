@@ -21,6 +21,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from kinema.transforms import pose_dict
 from kinema.viz.topics import PLANNING_SCENE_TOPIC, PLANNING_SCENE_TYPE
 
 if TYPE_CHECKING:
@@ -107,14 +108,6 @@ def serve_planning_scene(node: Any, context: Any) -> None:
     node.create_service(GET_PLANNING_SCENE_TYPE, GET_PLANNING_SCENE, on_request)
 
 
-def _pose_dict(matrix: np.ndarray) -> dict[str, Any]:
-    from scipy.spatial.transform import Rotation
-
-    x, y, z, w = Rotation.from_matrix(matrix[:3, :3]).as_quat()
-    px, py, pz = (float(v) for v in matrix[:3, 3])
-    return {"position": {"x": px, "y": py, "z": pz}, "orientation": {"x": x, "y": y, "z": z, "w": w}}
-
-
 def _primitive_dict(obj: CollisionObject) -> dict[str, Any]:
     if obj.shape == "box":
         return {"type": BOX, "dimensions": [2 * float(v) for v in obj.size]}
@@ -132,7 +125,7 @@ def collision_object_dict(object_id: str, primitives: list[CollisionObject]) -> 
         "pose": {"orientation": {"w": 1.0}},
         "id": object_id,
         "primitives": [_primitive_dict(p) for p in primitives],
-        "primitive_poses": [_pose_dict(np.asarray(p.world_T_object, float)) for p in primitives],
+        "primitive_poses": [pose_dict(np.asarray(p.world_T_object, float)) for p in primitives],
         "operation": ADD,
     }
 

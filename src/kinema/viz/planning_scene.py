@@ -7,12 +7,12 @@ redraws the layer: translucent green boxes, spheres and cylinders under ``<root>
 
 from __future__ import annotations
 
-import math
 from typing import Any
 
 import meshcat.geometry as g
 import numpy as np
 
+from kinema.transforms import pose_from_message
 from kinema.viz import scene_commands as sc
 from kinema.viz.geom_shapes import safe_name
 from kinema.viz.meshcat_server import Command
@@ -22,24 +22,6 @@ COLOR = 0x33CC66
 OPACITY = 0.45
 # meshcat's cylinders run along y; MoveIt's along z.
 _Y_TO_Z = np.array([[1.0, 0, 0, 0], [0, 0, -1.0, 0], [0, 1.0, 0, 0], [0, 0, 0, 1.0]])
-
-
-def pose_matrix(pose: Any) -> np.ndarray:
-    """4x4 from a ``geometry_msgs/Pose`` (an all-zero quaternion is the identity)."""
-    q = pose.orientation
-    x, y, z, w = float(q.x), float(q.y), float(q.z), float(q.w)
-    norm = math.sqrt(x * x + y * y + z * z + w * w)
-    matrix = np.eye(4)
-    if norm > 0:
-        x, y, z, w = x / norm, y / norm, z / norm, w / norm
-        matrix[:3, :3] = [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    p = pose.position
-    matrix[:3, 3] = [float(p.x), float(p.y), float(p.z)]
-    return matrix
 
 
 def _shape(primitive: Any) -> tuple[Any, np.ndarray] | None:
@@ -77,7 +59,7 @@ class PlanningSceneLayer:
                 world_T_frame = frame_pose(frame)
                 if world_T_frame is None:
                     continue
-            world_T_object = world_T_frame @ pose_matrix(obj.pose)
+            world_T_object = world_T_frame @ pose_from_message(obj.pose)
             base = f"{self.root}/{safe_name(str(obj.id), 'object')}"
             self.object_ids.append(str(obj.id))
             for k, (primitive, pose) in enumerate(zip(obj.primitives, obj.primitive_poses, strict=False)):
@@ -87,5 +69,5 @@ class PlanningSceneLayer:
                 mesh, correction = shape
                 path = f"{base}/{k}"
                 commands.append(sc.set_object(path, mesh))
-                commands.append(sc.set_transform(path, world_T_object @ pose_matrix(pose) @ correction))
+                commands.append(sc.set_transform(path, world_T_object @ pose_from_message(pose) @ correction))
         return commands

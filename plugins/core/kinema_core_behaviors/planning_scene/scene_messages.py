@@ -16,9 +16,8 @@ import numpy as np
 
 from kinema.errors import ObjectiveError
 from kinema.runtime.planning_scene_service import collision_object_dict, planning_scene_message
+from kinema.transforms import pose_from_message
 from kinema.viz.topics import PLANNING_SCENE_TOPIC, PLANNING_SCENE_TYPE
-
-from ..poses.frame_tree import pose_of
 
 if TYPE_CHECKING:
     from kinema.motion import CollisionObject, FrameTree
@@ -70,7 +69,7 @@ def object_pose_of(message: Any, frames: FrameTree | None) -> np.ndarray:
     """
     frame = str(message.header.frame_id)
     world_T_frame = np.eye(4) if frames is None else frames.world_T(frame)
-    return world_T_frame @ pose_of(message.pose.position, message.pose.orientation)
+    return world_T_frame @ pose_from_message(message.pose)
 
 
 def primitives_of(message: Any, frames: FrameTree | None) -> list[CollisionObject]:
@@ -88,7 +87,7 @@ def primitives_of(message: Any, frames: FrameTree | None) -> list[CollisionObjec
             f"{len(message.primitive_poses)} primitive_poses"
         )
     for k, (shape, pose) in enumerate(zip(message.primitives, message.primitive_poses, strict=True)):
-        placed = world_T_object @ pose_of(pose.position, pose.orientation)
+        placed = world_T_object @ pose_from_message(pose)
         shapes.append(
             primitive(int(shape.type), [float(d) for d in shape.dimensions], placed, f"{name} primitive {k}")
         )
@@ -104,7 +103,7 @@ def primitives_of(message: Any, frames: FrameTree | None) -> list[CollisionObjec
         low, high = vertices.min(axis=0), vertices.max(axis=0)
         centre = np.eye(4)
         centre[:3, 3] = 0.5 * (low + high)
-        placed = world_T_object @ pose_of(pose.position, pose.orientation) @ centre
+        placed = world_T_object @ pose_from_message(pose) @ centre
         from kinema.motion import CollisionObject
 
         half = tuple(max(0.5 * float(h - lo), 1e-4) for lo, h in zip(low, high, strict=True))

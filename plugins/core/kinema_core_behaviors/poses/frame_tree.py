@@ -19,6 +19,7 @@ import numpy as np
 
 import kinema.mujoco_gl  # noqa: F401  (MuJoCo's OpenGL backend is chosen before the lazy mujoco import below)
 from kinema.errors import KinemaError, ObjectiveError
+from kinema.transforms import pose_from_message
 
 from ..motion.joint_states import joint_state_monitor
 from ..motion.planning_resources import planning_scene, robot_model
@@ -30,18 +31,6 @@ BODIES_TIMEOUT = 1.0
 
 _CAMERAS: weakref.WeakKeyDictionary[Any, dict[str, np.ndarray]] = weakref.WeakKeyDictionary()
 _LOCK = threading.Lock()
-
-
-def pose_of(position: Any, orientation: Any) -> np.ndarray:
-    """4x4 from a position (x, y, z) and a quaternion (x, y, z, w)."""
-    from scipy.spatial.transform import Rotation
-
-    matrix = np.eye(4)
-    quaternion = np.array([orientation.x, orientation.y, orientation.z, orientation.w], dtype=float)
-    if np.linalg.norm(quaternion) > 1e-9:
-        matrix[:3, :3] = Rotation.from_quat(quaternion).as_matrix()
-    matrix[:3, 3] = [position.x, position.y, position.z]
-    return matrix
 
 
 def _camera_frames(context: Any) -> dict[str, np.ndarray]:
@@ -86,7 +75,7 @@ def _sim_bodies(behavior: Any) -> dict[str, np.ndarray]:
         response = client.call({}, timeout=BODIES_TIMEOUT)
     except KinemaError:
         return {}  # no simulator (a real robot): objects come from perception instead
-    return {str(body.name): pose_of(body.pose.position, body.pose.orientation) for body in response.bodies}
+    return {str(body.name): pose_from_message(body.pose) for body in response.bodies}
 
 
 def current_frame_tree(behavior: Any, joint_state: Any = None, at: float = 0.0) -> Any:
