@@ -9,8 +9,7 @@ it (:func:`scene_of`); every change is published, latched, on ``/monitored_plann
 ``/joint_states``), the world objects' names, or their names and geometry. The cell's own geometry is
 part of every plan but not listed, as MoveIt lists only objects added to the world.
 
-World objects become ``CollisionObject`` messages in ``world``: identity object pose, each primitive
-placed in the world.
+The messages are made by :mod:`kinema.motion.planning_scene_messages`.
 """
 
 from __future__ import annotations
@@ -19,24 +18,20 @@ import threading
 import weakref
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
-from kinema.transforms import pose_dict
-from kinema.viz.topics import PLANNING_SCENE_TOPIC, PLANNING_SCENE_TYPE
+from kinema.motion.planning_scene_messages import (
+    PLANNING_SCENE_TYPE,
+    planning_scene_dict,
+    planning_scene_message,
+)
+from kinema.viz.topics import PLANNING_SCENE_TOPIC
 
 if TYPE_CHECKING:
-    from kinema.motion import CollisionObject, PlanningScene, RobotModel
+    from kinema.motion import PlanningScene, RobotModel
 
 GET_PLANNING_SCENE = "/get_planning_scene"
 GET_PLANNING_SCENE_TYPE = "moveit_msgs/srv/GetPlanningScene"
 JOINT_STATES = "/joint_states"
 JOINT_STATES_TYPE = "sensor_msgs/msg/JointState"
-
-# moveit_msgs/PlanningSceneComponents bits this service honours.
-SCENE_SETTINGS, ROBOT_STATE, WORLD_OBJECT_NAMES, WORLD_OBJECT_GEOMETRY = 1, 2, 8, 16
-EVERYTHING = SCENE_SETTINGS | ROBOT_STATE | WORLD_OBJECT_NAMES | WORLD_OBJECT_GEOMETRY
-BOX, SPHERE, CYLINDER = 1, 2, 3
-ADD = 0
 
 _SCENES: weakref.WeakKeyDictionary[Any, PlanningScene] = weakref.WeakKeyDictionary()
 _SCENES_LOCK = threading.Lock()
@@ -101,74 +96,7 @@ def serve_planning_scene(node: Any, context: Any) -> None:
         model = context.robot_model
         scene = scene_of(context, model) if model is not None else PlanningScene()
         name = str(getattr(model, "name", "")) if model is not None else ""
-        components = int(request.components.components) or EVERYTHING
-        return {"scene": planning_scene_dict(scene, name, latest[0], components)}
+        return {"scene": planning_scene_dict(scene, name, latest[0], int(request.components.components))}
 
     node.create_subscription(JOINT_STATES_TYPE, JOINT_STATES, on_joint_states)
     node.create_service(GET_PLANNING_SCENE_TYPE, GET_PLANNING_SCENE, on_request)
-
-
-def _primitive_dict(obj: CollisionObject) -> dict[str, Any]:
-    if obj.shape == "box":
-        return {"type": BOX, "dimensions": [2 * float(v) for v in obj.size]}
-    if obj.shape == "sphere":
-        return {"type": SPHERE, "dimensions": [float(obj.size[0])]}
-    # cylinders, and capsules drawn as the cylinder around them
-    extra = float(obj.size[0]) if obj.shape == "capsule" else 0.0
-    return {"type": CYLINDER, "dimensions": [2 * float(obj.size[1]) + 2 * extra, float(obj.size[0])]}
-
-
-def collision_object_dict(object_id: str, primitives: list[CollisionObject]) -> dict[str, Any]:
-    """A ``moveit_msgs/CollisionObject`` dict of a world object, in ``world``."""
-    return {
-        "header": {"frame_id": "world"},
-        "pose": {"orientation": {"w": 1.0}},
-        "id": object_id,
-        "primitives": [_primitive_dict(p) for p in primitives],
-        "primitive_poses": [pose_dict(np.asarray(p.world_T_object, float)) for p in primitives],
-        "operation": ADD,
-    }
-
-
-def planning_scene_message(
-    scene: PlanningScene, robot_model_name: str = "", joint_state: Any = None, components: int = EVERYTHING
-) -> Any:
-    """A full ``moveit_msgs/PlanningScene`` (``is_diff`` false) of ``scene``'s world objects (see
-    :func:`planning_scene_dict`)."""
-    from kinema.transport import from_dict
-
-    return from_dict(
-        PLANNING_SCENE_TYPE, planning_scene_dict(scene, robot_model_name, joint_state, components)
-    )
-
-
-def planning_scene_dict(
-    scene: PlanningScene, robot_model_name: str = "", joint_state: Any = None, components: int = EVERYTHING
-) -> dict[str, Any]:
-    """A ``moveit_msgs/PlanningScene`` as a dict.
-
-    ``components`` (``moveit_msgs/PlanningSceneComponents`` bits) selects the parts, as move_group's
-    ``/get_planning_scene`` does: names only without ``WORLD_OBJECT_GEOMETRY``, no robot state without
-    ``ROBOT_STATE``.
-    """
-    data: dict[str, Any] = {"is_diff": False}
-    if components & SCENE_SETTINGS:
-        data["name"] = "kinema"
-        data["robot_model_name"] = robot_model_name
-    objects = sorted(scene.world_objects().items())
-    if components & WORLD_OBJECT_GEOMETRY:
-        data["world"] = {"collision_objects": [collision_object_dict(oid, prims) for oid, prims in objects]}
-    elif components & WORLD_OBJECT_NAMES:
-        data["world"] = {
-            "collision_objects": [
-                {"header": {"frame_id": "world"}, "id": oid, "operation": ADD} for oid, _ in objects
-            ]
-        }
-    if joint_state is not None and components & ROBOT_STATE:
-        data["robot_state"] = {
-            "joint_state": {
-                "name": [str(n) for n in joint_state.name],
-                "position": [float(p) for p in joint_state.position],
-            }
-        }
-    return data

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior
 from kinema.errors import KinemaError
+from kinema.motion.planning_scene_messages import PLANNING_SCENE_TYPE, planning_scene_message
 
 from ..messages.ports import message_output
 from ..motion.joint_states import joint_state_monitor
 from ..motion.planning_resources import planning_scene, robot_model
-from .scene_messages import PLANNING_SCENE_TYPE, planning_scene_message
 
 
 class GetCurrentPlanningScene(SyncBehavior):
