@@ -12,7 +12,7 @@ from kinema.motion.planning_scene_messages import (
 )
 
 from ..messages.ports import PortValueError, fails_on_bad_input, message_input, port_error, read_message
-from ..motion.planning_resources import planning_scene, robot_model
+from ..motion.planning_resources import robot_model
 from ..poses.frame_tree import current_frame_tree
 
 
@@ -48,8 +48,8 @@ class AddCollisionObject(SyncBehavior):
         ops = collision_object_message()
         valid = ", ".join(f"{op} ({getattr(ops, op)})" for op in ("ADD", "REMOVE", "APPEND", "MOVE"))
         try:
-            model = robot_model(self.context, "AddCollisionObject")
-            scene = planning_scene(self.context, model)
+            robot_model(self.context, "AddCollisionObject")
+            scene = self.context.planning_scene
             if operation not in (ops.ADD, ops.REMOVE, ops.APPEND, ops.MOVE):
                 raise port_error(
                     self, "collision_object", f"has operation {operation}", f"valid operations: {valid}"
