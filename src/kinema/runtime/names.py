@@ -48,7 +48,4 @@ GET_WAYPOINTS_TYPE = "moveit_studio_agent_msgs/srv/GetWaypoints"
 EDIT_WAYPOINTS = "/edit_waypoints"
 EDIT_WAYPOINTS_TYPE = "moveit_studio_agent_msgs/srv/EditWaypoints"
 
-CLOCK = "/clock"
-CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
-JOINT_STATES = "/joint_states"
-JOINT_STATES_TYPE = "sensor_msgs/msg/JointState"
+# Time (/clock) and the robot's state (/joint_states) are the drivers': kinema.drivers.mujoco.names.

@@ -205,6 +205,7 @@ class SdkConnection:
             self._stop.wait(0.2)
 
     def _connect(self) -> None:
+        from kinema.drivers.mujoco import names as driver_names
         from kinema.runtime import names
         from kinema.sdk import ObjectiveClient
         from kinema.sdk.client import NodeStatusSubscription
@@ -224,7 +225,7 @@ class SdkConnection:
                 names.BLACKBOARD_TYPE, names.BLACKBOARD, self._on_blackboard, latched=True
             )
             node.create_subscription(names.LOG_TYPE, names.LOG, self._on_log)
-            node.create_subscription(names.CLOCK_TYPE, names.CLOCK, self._on_clock)
+            node.create_subscription(driver_names.CLOCK_TYPE, driver_names.CLOCK_TOPIC, self._on_clock)
             node.create_subscription(TASK_PLANNING_TYPE, TASK_PLANNING_TOPIC, self._on_task_planning)
             # While the TUI is attached it is the user the approval behaviors ask (see ui/approval.py
             # of the core behaviors): each request waits for the dialog's answer.
