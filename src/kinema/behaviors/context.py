@@ -80,8 +80,12 @@ class BehaviorContext:
         self._robot_model_lock = threading.Lock()
         self._endpoints: dict[tuple[Any, ...], Any] = {}
         self._endpoints_lock = threading.Lock()
-        self._scene: Any = planning_scene
-        self._scene_made = planning_scene is not None and not callable(planning_scene)
+        self._scene: PlanningScene | None = None
+        self._scene_provider: Callable[[BehaviorContext], PlanningScene] = _default_planning_scene
+        if callable(planning_scene):
+            self._scene_provider = planning_scene
+        else:
+            self._scene = planning_scene
         self._scene_listeners: list[PlanningSceneListener] = []
         self._services: dict[str, Any] = {}
         # Re-entrant: a service made on first use may use another (the frames read the planning scene).
@@ -98,7 +102,8 @@ class BehaviorContext:
         with self._robot_model_lock:
             if callable(self._robot_model) and not isinstance(self._robot_model, type):
                 self._robot_model = self._robot_model()
-            return self._robot_model  # type: ignore[no-any-return]
+            model: RobotModel | None = self._robot_model
+            return model
 
     def set_robot_model(self, model_or_provider: Any) -> None:
         """Set the robot model, or a zero-argument callable that builds it on first use."""
@@ -112,27 +117,24 @@ class BehaviorContext:
         """The cell's planning scene: what planning checks, ``/monitored_planning_scene`` publishes and
         ``/get_planning_scene`` serves (made on first use; see the ``planning_scene`` argument)."""
         with self._services_lock:
-            if not self._scene_made:
-                provider = self._scene if callable(self._scene) else _default_planning_scene
-                self._scene = provider(self)
-                self._scene_made = True
-                listeners = list(self._scene_listeners)
-            else:
-                return self._scene  # type: ignore[no-any-return]
+            if self._scene is not None:
+                return self._scene
+            scene = self._scene = self._scene_provider(self)
+            listeners = list(self._scene_listeners)
         for listener in listeners:
-            listener(self._scene)
-        return self._scene  # type: ignore[no-any-return]
+            listener(scene)
+        return scene
 
     @property
     def loaded_planning_scene(self) -> PlanningScene | None:
         """The planning scene if it was made or set, else None (reading this loads nothing)."""
         with self._services_lock:
-            return self._scene if self._scene_made else None  # type: ignore[no-any-return]
+            return self._scene
 
     def set_planning_scene(self, scene: PlanningScene) -> None:
         """Plan against (and serve) ``scene`` in every behavior of this context from now on."""
         with self._services_lock:
-            self._scene, self._scene_made = scene, True
+            self._scene = scene
             listeners = list(self._scene_listeners)
         for listener in listeners:
             listener(scene)
@@ -142,7 +144,7 @@ class BehaviorContext:
         runtime publishes them)."""
         with self._services_lock:
             self._scene_listeners.append(listener)
-            scene = self._scene if self._scene_made else None
+            scene = self._scene
         if scene is not None:
             listener(scene)
 
@@ -179,7 +181,8 @@ class BehaviorContext:
         with self._services_lock:
             if key not in self._services:
                 self._services[key] = create()
-            return self._services[key]  # type: ignore[no-any-return]
+            value: T = self._services[key]
+            return value
 
     def require_node(self, behavior: str = "") -> Any:
         """Return the transport node, or raise a clear error when this context has none.

@@ -339,10 +339,10 @@ def _yaml_classes() -> tuple[type, type]:
     from ruamel.yaml.constructor import RoundTripConstructor
     from ruamel.yaml.representer import RoundTripRepresenter
 
-    class Constructor(RoundTripConstructor):  # type: ignore[misc]  # ruamel.yaml ships no stubs
+    class Constructor(RoundTripConstructor):
         pass
 
-    class Representer(RoundTripRepresenter):  # type: ignore[misc]
+    class Representer(RoundTripRepresenter):
         pass
 
     def construct_float(constructor: Any, node: Any) -> Any:

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
+from kinema.behaviors import BehaviorContext, NodeStatus, PortInfo, SyncBehavior, input_port
 
 from ..messages.ports import fails_on_bad_input, message_input, port_error, read_input, read_message
 from .markers import publish_markers
@@ -33,8 +33,8 @@ class _Snapshots:
         self.last_id = -1
 
 
-def _snapshots(context: Any) -> _Snapshots:
-    return context.shared("ui.point_cloud_snapshots", _Snapshots)  # type: ignore[no-any-return]
+def _snapshots(context: BehaviorContext) -> _Snapshots:
+    return context.shared("ui.point_cloud_snapshots", _Snapshots)
 
 
 def height_colors(xyz: np.ndarray) -> np.ndarray:
