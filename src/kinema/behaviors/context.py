@@ -22,6 +22,7 @@ if TYPE_CHECKING:
     import numpy as np
 
     from kinema.bt import Clock
+    from kinema.config.cell import CellSettings
     from kinema.config.inheritance import ResolvedConfig
     from kinema.interfaces.definition import (
         ActionDefinition,
@@ -40,6 +41,9 @@ if TYPE_CHECKING:
 
 T = TypeVar("T")
 PlanningSceneListener = Callable[["PlanningScene"], None]
+
+
+_UNSET = object()
 
 
 class BehaviorContext:
@@ -77,6 +81,7 @@ class BehaviorContext:
         self.clock = clock
         self.log_sink = log_sink if log_sink is not None else LogSink()
         self._robot_model: Any = robot_model
+        self._cell: Any = _UNSET
         self._robot_model_lock = threading.Lock()
         self._endpoints: dict[tuple[Any, ...], Any] = {}
         self._endpoints_lock = threading.Lock()
@@ -90,6 +95,20 @@ class BehaviorContext:
         self._services: dict[str, Any] = {}
         # Re-entrant: a service made on first use may use another (the frames read the planning scene).
         self._services_lock = threading.RLock()
+
+    @property
+    def cell(self) -> CellSettings | None:
+        """The cell's robot settings (planning group, tool frame, gripper, ...) from the config; None
+        without a config. Read once, on first use.
+
+        Raises:
+            ConfigError: the config's robot settings are wrong (the message names config.yaml's line).
+        """
+        if self._cell is _UNSET:
+            from kinema.config.cell import CellSettings
+
+            self._cell = CellSettings.from_config(self.config) if self.config is not None else None
+        return self._cell  # type: ignore[return-value]
 
     @classmethod
     def offline(cls) -> BehaviorContext:

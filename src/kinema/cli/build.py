@@ -43,13 +43,16 @@ def build(
        (already satisfied requirements are skipped, so it is fast and offline when nothing changed);
     2. loads the active config's behavior plugins and validates every objective of its objective
        library against them (unknown behaviors, ports, types, missing subtrees), printing file:line;
-    3. writes the TreeNodesModel XML of the config's behaviors and prints its path.
+    3. writes the TreeNodesModel XML of the config's behaviors and prints its path;
+    4. checks the robot: every name that crosses its files (URDF, SRDF, joint limits, MuJoCo scene,
+       waypoints, controllers, tool frame, sensor) and every file they name, printing file:line.
 
     TARGET is accepted for MoveIt Pro habits: `all` and `user_workspace` do the same here (there is no
     image to build; behavior packages are loaded from their folders). Exits 1 on any error.
     """
     from kinema.cli.options import print_warnings, resolve_selection
     from kinema.config import resolve_config
+    from kinema.config.robot_check import robot_report
     from kinema.plugins import BehaviorHost
     from kinema.plugins.dependencies import pip_install, unsatisfied, workspace_behavior_packages
     from kinema.plugins.validation import validate_objectives, write_tree_nodes_model
@@ -89,6 +92,13 @@ def build(
 
     model = write_tree_nodes_model(registry, _model_path(found.root, resolved.name))
     click.echo(f"TreeNodesModel for Groot2: {model}")
+
+    robot = robot_report(resolved)
+    print_warnings(robot.warnings)
+    for robot_problem in robot.problems:
+        click.secho(str(robot_problem), err=True, fg="red")
+    errors += len(robot.problems)
+    click.echo(f"checked the robot: {len(robot.problems)} problems")
     if errors:
         click.secho(f"build failed: {errors} errors", err=True, fg="red")
         raise click.exceptions.Exit(1)

@@ -92,6 +92,28 @@ class JointStateMonitor:
         """
         return self._named(self.latest(timeout), joint_names)
 
+    def current_positions(self, joint_names: Sequence[str], clock: Any, timeout: float = 2.0) -> np.ndarray:
+        """Positions of ``joint_names`` now, by ``clock`` (the agent's: sim time in simulation), as MoveIt's
+        current state monitor waits for a state at least as new as the request.
+
+        The latest message received can be older than the robot: after a motion the execution's result
+        may arrive before the last joint states do (a simulation far faster than real time publishes
+        thousands a second). A plan started from such a state begins where the arm no longer is. This
+        waits up to ``timeout`` for a state stamped at or after ``clock.now()``; a robot on another clock
+        (stamps more than 30 s away) gets the latest state.
+
+        Raises:
+            ObjectiveError: no message yet, or a joint is missing from it.
+        """
+        self.latest(timeout)
+        now = float(clock.now()) if clock is not None else 0.0
+        with self._changed:
+            newest = self._stamps[-1] if self._stamps else 0.0
+            if now > 0 and abs(now - newest) <= OTHER_CLOCK:
+                self._changed.wait_for(lambda: bool(self._stamps) and self._stamps[-1] >= now, timeout)
+            message = self._latest
+        return self._named(message, joint_names)
+
     def positions_at(self, joint_names: Sequence[str], stamp: float, timeout: float = 2.0) -> np.ndarray:
         """Positions of ``joint_names`` at ``stamp`` (s, the robot's clock), as TF looks up a transform at a
         message's stamp: a camera frame is placed where the camera was when it was taken, not where it

@@ -171,9 +171,15 @@ def _robot_model_provider(resolved: Any) -> Any:
         return None
 
     def load() -> Any:
+        from kinema.config.robot_description import package_index, planning_urdf
         from kinema.motion.robot_model import RobotModel
 
-        return RobotModel.from_urdf(resolved.urdf_path, resolved.srdf_path, resolved.joint_limits_path)
+        return RobotModel.from_urdf(
+            planning_urdf(resolved, check_meshes=False),
+            resolved.srdf_path,
+            resolved.joint_limits_path,
+            package_dirs=package_index(resolved).package_dirs(),
+        )
 
     return load
 
