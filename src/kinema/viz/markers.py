@@ -23,7 +23,7 @@ from typing import Any
 import meshcat.geometry as g
 import numpy as np
 
-from kinema.transforms import pose_from_message
+from kinema.transforms import TransformError, pose_from_message
 from kinema.viz import scene_commands as sc
 from kinema.viz.geom_shapes import rgb_to_int, safe_name
 from kinema.viz.meshcat_server import Command
@@ -228,7 +228,11 @@ class MarkerBoard:
         commands = [sc.delete(self.path(ns, marker_id))] if known else []
         if action == DELETE:
             return commands
-        shapes = marker_shapes(marker, frame)
+        try:
+            shapes = marker_shapes(marker, frame)
+        except TransformError as error:
+            log.warning("marker %s/%d is not drawn: its pose: %s", ns, marker_id, error)
+            return commands
         if not shapes:
             kind = int(marker.type)
             if kind not in self._unsupported_warned and kind in (TEXT_VIEW_FACING, MESH_RESOURCE):

@@ -16,7 +16,7 @@ import numpy as np
 
 from kinema.errors import ObjectiveError
 from kinema.motion.planning_scene_messages import object_pose_of, primitive
-from kinema.transforms import pose_from_message
+from kinema.transforms import TransformError, pose_from_message
 from kinema.viz import scene_commands as sc
 from kinema.viz.geom_shapes import safe_name
 from kinema.viz.meshcat_server import Command
@@ -64,7 +64,10 @@ class PlanningSceneLayer:
                 world_T_frame = frame_pose(frame)
                 if world_T_frame is None:
                     continue
-            world_T_object = world_T_frame @ object_pose_of(obj, None)
+            try:
+                world_T_object = world_T_frame @ object_pose_of(obj, None)
+            except TransformError:
+                continue  # a pose with a NaN in it: nothing to draw where the planner cannot place it
             base = f"{self.root}/{safe_name(str(obj.id), 'object')}"
             self.object_ids.append(str(obj.id))
             for k, (shape, pose) in enumerate(zip(obj.primitives, obj.primitive_poses, strict=False)):
@@ -73,8 +76,8 @@ class PlanningSceneLayer:
                     placed = primitive(
                         int(shape.type), dimensions, world_T_object @ pose_from_message(pose), ""
                     )
-                except ObjectiveError:
-                    continue
+                except (ObjectiveError, TransformError):
+                    continue  # a shape the planner cannot check (a cone), or a primitive pose with a NaN
                 mesh, correction = _shape(placed)
                 path = f"{base}/{k}"
                 commands.append(sc.set_object(path, mesh))
