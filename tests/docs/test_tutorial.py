@@ -78,7 +78,8 @@ class Reader:
             self.outputs.append((text, output))
             missing = missing_lines(command.expected, output)
             assert not missing, (
-                f"{self.document} line {step.line}: `{text}` did not print {missing[0]!r}; it printed:\n{output}"
+                f"{self.document} line {step.line}: `{text}` did not print {missing[0]!r}; "
+                f"it printed:\n{output}"
             )
 
     def _run_one(self, step: Step, text: str) -> str:

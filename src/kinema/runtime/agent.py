@@ -20,10 +20,11 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from kinema.drivers.mujoco.names import JOINT_STATES_TOPIC, JOINT_STATES_TYPE
 from kinema.errors import KinemaError, ObjectiveError
+from kinema.process.log_files import PLUGIN_LOGGER
 from kinema.runtime import names
 from kinema.runtime.error_codes import MoveItErrorCode
-from kinema.runtime.log_files import PLUGIN_LOGGER
 from kinema.runtime.node_status_cdr import NodeStatusCodesEncoder, generic_serializer, time_parts
 from kinema.runtime.objective_server import (
     ObjectiveRequest,
@@ -397,7 +398,7 @@ class Agent:
         node.create_service(names.GET_WAYPOINTS_TYPE, names.GET_WAYPOINTS, self._on_get_waypoints)
         node.create_service(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, self._on_edit_waypoints)
         if self.waypoints is not None:
-            node.create_subscription(names.JOINT_STATES_TYPE, names.JOINT_STATES, self._on_joint_states)
+            node.create_subscription(JOINT_STATES_TYPE, JOINT_STATES_TOPIC, self._on_joint_states)
         from kinema.runtime import quick_protocol as quick
 
         domain = self.session.domain_id

@@ -5,7 +5,7 @@ children; the agent and each driver run in processes of their own. The agent is 
 thread of the supervisor so that its 100 Hz tick thread never competes for the GIL with a UI running in
 the supervisor (the TUI), so a crashing behavior cannot take the router (and every client's connection)
 down with it, and so ``kinema down`` can stop it like any other process. Children get a parent-death
-signal and a lifeline (:mod:`kinema.runtime.lifeline`), so even a supervisor killed with SIGKILL leaves
+signal and a lifeline (:mod:`kinema.process.lifeline`), so even a supervisor killed with SIGKILL leaves
 no orphans behind: they end within about a second.
 
 A UI plugs in through :attr:`LaunchOptions.ui`: a callable that receives the started :class:`Launcher`
@@ -29,9 +29,9 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from kinema.errors import KinemaError, TransportError
+from kinema.process.lifeline import Lifeline
 from kinema.runtime.cell import CellError
 from kinema.runtime.instance import InstanceRecord
-from kinema.runtime.lifeline import Lifeline
 from kinema.runtime.run_folder import RunFolder, prune_runs
 
 if TYPE_CHECKING:
@@ -135,7 +135,7 @@ class Launcher:
             KinemaError: the router cannot be hosted or joined, or the agent failed to start (the message
                 carries the end of its log).
         """
-        from kinema.runtime.log_files import configure_process_logging
+        from kinema.process.log_files import configure_process_logging
 
         options = self.options
         # A config that does not resolve is refused before anything exists: no run folder, no router.
@@ -460,7 +460,7 @@ class Launcher:
 
         Without a UI this terminal is where the user looks; the log file (``kinema logs``) has them too.
         """
-        from kinema.runtime.log_files import PLUGIN_LOGGER, follow_entries
+        from kinema.process.log_files import PLUGIN_LOGGER, follow_entries
 
         assert self.run_folder is not None
         entries = follow_entries(self.run_folder.path, stop=self._echo_stop, from_start=True)

@@ -86,13 +86,25 @@ def test_interrupting_a_wait_cancels_the_objective(agent: Any, client: Objective
     # Ctrl-C in a script blocked in execute(): the objective must not keep the robot moving.
     from kinema.sdk import QuickClient
 
+    main = threading.main_thread()
+
+    def waiting_for_the_result() -> bool:
+        frame = sys._current_frames().get(main.ident or 0)
+        while frame is not None:
+            if frame.f_code.co_name == "_wait_or_cancel":
+                return True
+            frame = frame.f_back
+        return False
+
     def interrupt_once_it_runs() -> None:
         # The signal comes once execute() waits for the result (the run has started), as a user's would.
         with QuickClient(agent.endpoint, timeout=10) as quick:
             deadline = time.monotonic() + 30
             while quick.status() != (ObjectiveStatus.RUNNING, "Forever") and time.monotonic() < deadline:
                 time.sleep(0.02)
-        time.sleep(0.3)
+        deadline = time.monotonic() + 30
+        while not waiting_for_the_result() and time.monotonic() < deadline:
+            time.sleep(0.01)
         os.kill(os.getpid(), signal.SIGINT)
 
     if threading.current_thread() is not threading.main_thread():

@@ -9,6 +9,7 @@ import numpy as np
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
 from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError, ObjectiveError, did_you_mean
+from kinema.transforms import rotation_from_euler
 
 from ..messages.conversions import pose_matrix, trajectory_message
 from .joint_states import joint_state_monitor
@@ -199,15 +200,13 @@ class PlanCartesianPath(AsyncBehavior):
 
     def _tip_offset(self) -> Any:
         """``tip_T_point`` inverted (what the tip must do so the offset point follows the path)."""
-        from scipy.spatial.transform import Rotation
-
         values = [float(v) for v in self.get_input("tip_offset")]
         if len(values) not in (3, 6):
             return f"tip_offset needs 6 values x;y;z;roll;pitch;yaw (or 3, x;y;z), got {len(values)}"
         tip_T_point = np.eye(4)
         tip_T_point[:3, 3] = values[:3]
         if len(values) == 6:
-            tip_T_point[:3, :3] = Rotation.from_euler("xyz", values[3:]).as_matrix()
+            tip_T_point[:3, :3] = rotation_from_euler(values[3:])
         return np.linalg.inv(tip_T_point)
 
     def _poses(self) -> list[tuple[str, Any]]:

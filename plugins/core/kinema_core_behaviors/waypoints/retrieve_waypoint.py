@@ -10,6 +10,8 @@ from kinema.errors import did_you_mean
 
 from ..messages.conversions import joint_state_message
 
+# The agent's waypoint service (kinema.runtime.names.GET_WAYPOINTS, which a plugin does not import; a test
+# keeps the two equal).
 GET_WAYPOINTS = "/get_saved_waypoints"
 
 

@@ -13,6 +13,8 @@ JOINT_STATES_TYPE = "sensor_msgs/msg/JointState"
 FOLLOW_JOINT_TRAJECTORY_TYPE = "control_msgs/action/FollowJointTrajectory"
 GRIPPER_COMMAND_TYPE = "control_msgs/action/GripperCommand"
 
+# The node serving the controller manager's services (ros2_control's name).
+CONTROLLER_MANAGER_NODE = "controller_manager"
 LIST_CONTROLLERS_SERVICE = "/controller_manager/list_controllers"
 LIST_CONTROLLERS_TYPE = "controller_manager_msgs/srv/ListControllers"
 # ros2_control's controller_manager names the service in the singular; the plural spelling is served too
