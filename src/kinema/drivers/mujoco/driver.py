@@ -147,8 +147,6 @@ class MujocoDriver:
         self._nodes: list[Node] = []
         self._publishers: dict[str, Any] = {}
         self._joint_state_broadcaster: Controller | None = None
-        self._last_state_publish = 0.0
-        self._min_state_period = 1.0 / settings.max_state_rate if settings.max_state_rate > 0 else 0.0
         self._wrench_publishers: list[tuple[Any, Any]] = []
         # Running goals by goal id, with the controller that runs each (for cancel requests).
         self._executions: dict[bytes, tuple[Any, Execution]] = {}
@@ -556,29 +554,24 @@ class MujocoDriver:
 
     def _on_publish(self) -> None:
         data = self.data
+        now = float(data.time)
+        self._publishers["clock"].publish_raw(self._clock_encoder.encode(now))
+        broadcaster = self._joint_state_broadcaster
+        if broadcaster is not None and broadcaster.active:
+            self._publishers["joint_states"].publish_raw(
+                self._joint_state_encoder.encode(
+                    now,
+                    data.qpos[self._joint_qpos],
+                    data.qvel[self._joint_dofs],
+                    data.qfrc_actuator[self._joint_dofs],
+                )
+            )
+        for sensor_broadcaster, publisher in self._wrench_publishers:
+            if sensor_broadcaster.active:
+                publisher.publish(sensor_broadcaster.message(data))
         for controller in self._goal_controllers:
             controller.post_feedback(data)
         wall = time.perf_counter()
-        # Far faster than real time, the publish rate of sim time would be thousands of messages a wall
-        # second: subscribers (the agent's joint state monitor, its clock) fall behind, and a plan then
-        # starts from where the arm was a motion ago. The state topics are capped in wall time.
-        if wall - self._last_state_publish >= self._min_state_period:
-            self._last_state_publish = wall
-            now = float(data.time)
-            self._publishers["clock"].publish_raw(self._clock_encoder.encode(now))
-            broadcaster = self._joint_state_broadcaster
-            if broadcaster is not None and broadcaster.active:
-                self._publishers["joint_states"].publish_raw(
-                    self._joint_state_encoder.encode(
-                        now,
-                        data.qpos[self._joint_qpos],
-                        data.qvel[self._joint_dofs],
-                        data.qfrc_actuator[self._joint_dofs],
-                    )
-                )
-            for sensor_broadcaster, publisher in self._wrench_publishers:
-                if sensor_broadcaster.active:
-                    publisher.publish(sensor_broadcaster.message(data))
         if wall - self._last_scene_publish >= 1.0 / self.settings.scene_state_rate:
             self._publish_scene_state(wall)
 

@@ -37,9 +37,7 @@ class MujocoDriverSettings:
         sim_speed: sim seconds per wall second; ``math.inf`` for as fast as possible.
         publish_rate: rate of ``/clock``, ``/joint_states`` and action feedback, Hz of sim time.
         scene_state_rate: rate of the scene-state topic for viewers, Hz of wall time.
-        max_state_rate: most ``/clock``, ``/joint_states`` and wrench messages per wall second (0: no
-            cap); only a simulation far faster than real time reaches it (100 Hz of sim time at 10x
-            is 1,000 a wall second).
+
         cameras: serve the scene's cameras (rendered only while someone subscribes).
         camera_rate: most frames per camera per wall second while subscribed (MoveIt Pro's lab_sim
             renders at 10 Hz).
@@ -64,7 +62,6 @@ class MujocoDriverSettings:
     sim_speed: float = 1.0
     publish_rate: float = 100.0
     scene_state_rate: float = 30.0
-    max_state_rate: float = 500.0
     cameras: bool = True
     camera_rate: float = 10.0
     active_controllers: tuple[str, ...] = DEFAULT_CONTROLLERS
