@@ -30,7 +30,6 @@ if TYPE_CHECKING:
     from kinema.motion import PlanningScene
 
 
-
 def publish_planning_scene(context: BehaviorContext) -> None:
     """Publish ``context``'s planning scene (latched) on ``/monitored_planning_scene`` once a behavior
     makes it, and again on every change and every scene set in its place."""
