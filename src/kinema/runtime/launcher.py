@@ -306,6 +306,9 @@ class Launcher:
     ) -> Child:
         log.info("starting %s: %s", name, " ".join(argv))
         env = os.environ.copy()
+        if self.options.security_dir is not None:
+            # The agent's file rule refuses this folder too (kinema.behaviors.file_access).
+            env["KINEMA_SECURITY_DIR"] = str(self.options.security_dir)
         if self.lifeline is not None:
             env.update(self.lifeline.child_env())
             pass_fds = (*pass_fds, self.lifeline.read_fd)
