@@ -1,7 +1,8 @@
 """The agent: the objective server served on the transport, with its streams and library services.
 
 Serves (names in :mod:`kinema.runtime.names`): ``/execute_objective``, ``/cancel_objective``,
-``/do_objective`` (action), the objective list and XML services, ``/get_saved_waypoints`` and
+``/do_objective`` (action; by name or XML), ``/kinema/run_objective`` (the same action by name only: what
+an operator's certificate reaches), the objective list and XML services, ``/get_saved_waypoints`` and
 ``/edit_waypoints``. Publishes the heartbeat (10 Hz and on every change, latched), node status changes,
 a latched blackboard snapshot (at most 10 Hz, only when it changed) and the behaviors' log messages
 (toasts, plus hot-reload events).
@@ -52,6 +53,11 @@ MAX_VALUE_CHARS = 2000
 MAX_LIST_ITEMS = 16
 LOG_ERROR, LOG_WARN, LOG_INFO = 1, 2, 3
 DO_OBJECTIVE_RESULT_KEEP_S = 60.0
+# Ad-hoc XML is a grant of its own (kinema.transport.security_folder): the name-only doors refuse it.
+NO_XML_HERE = (
+    "{door} runs library objectives by name only; ad-hoc objective XML goes to /do_objective or the "
+    "start_xml key, a separate grant (`kinema security` lists who may use it)"
+)
 
 
 # Most node status changes in one ``/objective_server/node_status`` message (4 bytes each: 200 kB).
@@ -392,6 +398,13 @@ class Agent:
             # fetch a result, short enough that a busy server does not publish thousands of them.
             result_timeout=DO_OBJECTIVE_RESULT_KEEP_S,
         )
+        node.create_action_server(
+            names.DO_OBJECTIVE_TYPE,
+            names.RUN_OBJECTIVE,
+            self._on_run_objective,
+            cancel_callback=self._on_cancel_goal,
+            result_timeout=DO_OBJECTIVE_RESULT_KEEP_S,
+        )
         node.create_service(names.LIST_OBJECTIVES_TYPE, names.LIST_OBJECTIVES, self._on_list_objectives)
         node.create_service(names.GET_OBJECTIVE_XML_TYPE, names.GET_OBJECTIVE_XML, self._on_get_objective_xml)
         node.create_service(names.GET_WAYPOINTS_TYPE, names.GET_WAYPOINTS, self._on_get_waypoints)
@@ -405,6 +418,7 @@ class Agent:
             self.session.zenoh.declare_queryable(quick.key(domain, op), handler, complete=True)
             for op, handler in (
                 (quick.START, self._on_quick_start),
+                (quick.START_XML, self._on_quick_start_xml),
                 (quick.CANCEL, self._on_quick_cancel),
                 (quick.STATUS, self._on_quick_status),
             )
@@ -480,6 +494,14 @@ class Agent:
             return {"status": {"success": True, "error_message": ""}}
         return {"status": {"success": False, "error_message": "no objective is running"}}
 
+    def _on_run_objective(self, handle: Any) -> Any:
+        goal = handle.goal
+        if goal.objective_xml_string:
+            refused = ObjectiveResult.failure(NO_XML_HERE.format(door=names.RUN_OBJECTIVE), "<objective XML>")
+            handle.abort({"error_code": result_message(refused), "error_message": refused.error_message})
+            return None
+        return self._on_do_objective(handle)
+
     def _on_do_objective(self, handle: Any) -> Any:
         goal = handle.goal
         try:
@@ -521,10 +543,18 @@ class Agent:
     # -- the private JSON endpoints (kinema.runtime.quick_protocol) ----------------------------------------
 
     def _on_quick_start(self, query: Any) -> None:
+        self._quick_start(query, xml=False)
+
+    def _on_quick_start_xml(self, query: Any) -> None:
+        self._quick_start(query, xml=True)
+
+    def _quick_start(self, query: Any, *, xml: bool) -> None:
         from kinema.runtime import quick_protocol as quick
 
         try:
             body = quick.decode(query.payload.to_bytes() if query.payload is not None else b"")
+            if body.get("objective_xml") and not xml:
+                raise ValueError(NO_XML_HERE.format(door=quick.key(self.session.domain_id, quick.START)))
             overrides = tuple(
                 ParameterOverride(
                     str(item["name"]),
