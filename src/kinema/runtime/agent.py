@@ -23,6 +23,8 @@ from typing import TYPE_CHECKING, Any
 
 from kinema.errors import KinemaError, ObjectiveError
 from kinema.runtime import names
+from kinema.runtime.background_work import HandOff
+from kinema.runtime.blackboard_text import render_value
 from kinema.runtime.error_codes import MoveItErrorCode
 from kinema.runtime.log_files import PLUGIN_LOGGER
 from kinema.runtime.node_status_cdr import NodeStatusCodesEncoder, generic_serializer, time_parts
@@ -48,9 +50,6 @@ log = logging.getLogger("kinema.agent")
 # Plugin load and hot-reload outcomes have a logger of their own: `kinema run` echoes it in its terminal.
 plugin_log = logging.getLogger(PLUGIN_LOGGER)
 
-# Blackboard values are rendered for display; longer renderings are cut.
-MAX_VALUE_CHARS = 2000
-MAX_LIST_ITEMS = 16
 LOG_ERROR, LOG_WARN, LOG_INFO = 1, 2, 3
 DO_OBJECTIVE_RESULT_KEEP_S = 60.0
 # Ad-hoc XML is a grant of its own (kinema.transport.security_folder): the name-only doors refuse it.
@@ -102,77 +101,12 @@ def overrides_from_messages(parameters: Sequence[Any]) -> tuple[ParameterOverrid
     return tuple(result)
 
 
-# Texts of plain values already rendered (short str, int, bool, None: equal values of one type render
-# alike). Every blackboard snapshot renders every entry twice (stream and recording), YAML takes about
-# 100 µs for a short string, and a tree's scopes hold the same few strings and numbers snapshot after
-# snapshot.
-_RENDERED: dict[tuple[type, Any], str] = {}
-_RENDERED_MOST = 4096
-_PLAIN = frozenset({str, int, bool, type(None)})
-
-
-def render_value(value: Any) -> str:
-    """A blackboard value as one line of YAML flow text (messages as their fields), cut when long."""
-    kind = type(value)
-    if kind in _PLAIN and (kind is not str or len(value) <= MAX_VALUE_CHARS):
-        key = (kind, value)
-        text = _RENDERED.get(key)
-        if text is None:
-            if len(_RENDERED) >= _RENDERED_MOST:
-                _RENDERED.clear()
-            text = _RENDERED[key] = _render(value)
-        return text
-    return _render(value)
-
-
-def _render(value: Any) -> str:
-    import yaml
-
-    try:
-        data = _preview(value)
-        if isinstance(data, str | int | float | bool | list | dict | type(None)):
-            text = yaml.safe_dump(data, default_flow_style=True, width=1 << 30).strip()
-            if text.endswith("\n..."):
-                text = text[:-4].strip()
-            text = text.removesuffix("...").strip()
-        else:
-            text = repr(value)
-    except Exception:
-        text = repr(value)
-    return text if len(text) <= MAX_VALUE_CHARS else text[: MAX_VALUE_CHARS - 1] + "…"
-
-
-def _preview(value: Any) -> Any:
-    """``to_dict(value)`` with every list cut to MAX_LIST_ITEMS items (plus a "... N more" marker).
-
-    Lists are cut before their items are converted: the text is cut at MAX_VALUE_CHARS anyway, and
-    converting and YAML-dumping a whole trajectory (hundreds of points) on the tick thread at every
-    blackboard snapshot stalled the tree (and the simulation sharing the process) for most of each second.
-    """
-    import dataclasses
-
-    import numpy as np
-
-    from kinema.transport.messages import to_dict
-
-    if hasattr(value, "__msgtype__") and dataclasses.is_dataclass(value):
-        return {
-            field.name: _preview(getattr(value, field.name))
-            for field in dataclasses.fields(value)
-            if field.default is dataclasses.MISSING and field.name != "__msgtype__"
-        }
-    if isinstance(value, dict):
-        return {key: _preview(item) for key, item in value.items()}
-    if isinstance(value, list | tuple | np.ndarray):
-        head = [_preview(item) for item in value[:MAX_LIST_ITEMS]]
-        if len(value) > MAX_LIST_ITEMS:
-            return [*head, f"... {len(value) - MAX_LIST_ITEMS} more"]
-        return head
-    return to_dict(value)
-
-
 class _Streams:
-    """Publishes what the server reports (a :class:`ServerListener`, called on the tick thread)."""
+    """Publishes what the server reports (a :class:`ServerListener`, called on the tick thread).
+
+    Blackboard snapshots are rendered and published by a worker thread (:class:`HandOff`): the tick
+    thread only hands the entries over, the newest replacing one not yet published.
+    """
 
     def __init__(self, node: Node, clock: Clock | None, server: ObjectiveServer) -> None:
         self._node = node
@@ -191,6 +125,11 @@ class _Streams:
         self._last_blackboard: list[tuple[str, str, str, str]] | None = None
         self._render_cache: dict[int, tuple[Any, str]] = {}
         self._lock = threading.Lock()
+        self._work = HandOff("kinema-blackboard")
+
+    def close(self) -> None:
+        """Publish what was handed over, then stop the worker thread."""
+        self._work.close()
 
     def publish_heartbeat(self) -> None:
         from kinema.transport.messages import msg
@@ -277,6 +216,9 @@ class _Streams:
         return encoder
 
     def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
+        self._work.submit(lambda: self._publish_blackboard(objective_name, entries), key="blackboard")
+
+    def _publish_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
         from kinema.transport.messages import msg
 
         # Messages (trajectories, joint states) are rendered once per object: every subtree scope keeps
@@ -438,6 +380,7 @@ class Agent:
         for unsubscribe in self._unsubscribe:
             unsubscribe()
         self.server.stop()
+        self._streams.close()
         for close in self.on_close:
             try:
                 close()
