@@ -478,10 +478,14 @@ class Agent:
     def _on_cancel_goal(self, handle: Any) -> bool:
         with self._goal_lock:
             run = self._goal_runs.get(handle.goal_id)
-        if run is not None:
+        if run is None:
+            return True  # not started yet: the execute thread sees is_cancel_requested
+        # Accepted only while the outcome is open: an accepted cancel never ends as SUCCESS.
+        accepted = run.request_cancel("goal cancelled")
+        if accepted:
             # Non-blocking: the tick thread halts the tree right away; the execute thread reports it.
             self.server.cancel(run, reason="goal cancelled", timeout=0)
-        return True
+        return accepted
 
     # -- the private JSON endpoints (kinema.runtime.quick_protocol) ----------------------------------------
 

@@ -147,6 +147,10 @@ class ObjectiveRun:
         self._result: ObjectiveResult | None = None
         self._callbacks: list[Callable[[ObjectiveResult], None]] = []
         self._lock = threading.Lock()
+        # Set when a cancel of this run was accepted: from then on it can no longer end as SUCCESS (a
+        # tick stuck in C code that holds the interpreter may still complete after the cancel came).
+        self.cancel_reason: str | None = None
+        self._settled = False
 
     @property
     def done(self) -> bool:
@@ -166,6 +170,36 @@ class ObjectiveRun:
     def cancel(self) -> bool:
         """Ask the server to cancel this run; False when it already ended."""
         return self._server.cancel(self)
+
+    def request_cancel(self, reason: str) -> bool:
+        """Accept a cancel of this run unless its outcome is already settled; True when accepted.
+
+        An accepted cancel is honored even if the tree completes in the tick it came during: the run
+        then ends cancelled (PREEMPTED), never SUCCESS.
+        """
+        with self._lock:
+            if self._settled:
+                return False
+            if self.cancel_reason is None:
+                self.cancel_reason = reason
+            return True
+
+    def _settle(self, result: ObjectiveResult) -> ObjectiveResult:
+        """Fix the outcome (the tick thread, as the run ends): an accepted cancel turns SUCCESS into it."""
+        with self._lock:
+            self._settled = True
+            if not result.succeeded or self.cancel_reason is None:
+                return result
+            reason = self.cancel_reason
+        log.warning(
+            "objective %r completed after a cancel was accepted (%s); it ends cancelled",
+            self.objective_name,
+            reason,
+        )
+        return ObjectiveResult.preempted(
+            f"{reason} (accepted while its last tick ran: the tree completed, the cancel wins)",
+            self.objective_name,
+        )
 
     def add_done_callback(self, callback: Callable[[ObjectiveResult], None]) -> None:
         """Call ``callback(result)`` when the run ends (at once if it already has).
@@ -436,6 +470,9 @@ class ObjectiveServer:
         """
         if run is not None and run.done:
             return False
+        target = run if run is not None else self._run
+        if target is not None:
+            target.request_cancel(reason)
         request = _Cancel(run, reason)
         self._post(request)
         if threading.current_thread() is self._thread:
@@ -894,6 +931,9 @@ class ObjectiveServer:
         self._end(run, make(reason, run.objective_name), ObjectiveStatus.CANCELLED)
 
     def _end(self, run: ObjectiveRun, result: ObjectiveResult, status: ObjectiveStatus) -> None:
+        result = run._settle(result)
+        if result.cancelled and status is ObjectiveStatus.SUCCESS:
+            status = ObjectiveStatus.CANCELLED
         self._tree = None
         self._run_stuck = None
         self._run = None
