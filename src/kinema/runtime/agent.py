@@ -52,6 +52,8 @@ plugin_log = logging.getLogger(PLUGIN_LOGGER)
 
 LOG_ERROR, LOG_WARN, LOG_INFO = 1, 2, 3
 DO_OBJECTIVE_RESULT_KEEP_S = 60.0
+# How long close() lets running goals answer their clients.
+GOALS_ANSWER_AT_CLOSE_S = 2.0
 # Ad-hoc XML is a grant of its own (kinema.transport.security_folder): the name-only doors refuse it.
 NO_XML_HERE = (
     "{door} runs library objectives by name only; ad-hoc objective XML goes to /do_objective or the "
@@ -312,7 +314,7 @@ class Agent:
         self._quick: list[Any] = []
         # The JSON start queries of runs not yet ended: their clients also get the behaviors' toasts.
         self._quick_listeners: dict[int, Any] = {}
-        self._goal_lock = threading.Lock()
+        self._goal_lock = threading.Condition()
         self._stop = threading.Event()
         self._joint_state: Any = None
         self._unsubscribe: list[Any] = []
@@ -323,7 +325,10 @@ class Agent:
         self._heartbeat_thread = threading.Thread(
             target=self._heartbeat_loop, name="kinema-heartbeat", daemon=True
         )
+        self._drivers: dict[str, Any] = {}
+        self._drivers_watch: Any = None
         self._declare()
+        self._watch_drivers()
 
     def _declare(self) -> None:
         node = self.node
@@ -366,6 +371,45 @@ class Agent:
             )
         ]
 
+    def _watch_drivers(self) -> None:
+        """A driver that goes away (its process died, its link dropped) fails the running objective,
+        naming it: a motion whose controller vanished did not succeed, and nobody cancelled it."""
+        from kinema.runtime.cell import DRIVER, PRESENCE_PREFIX
+        from kinema.transport.dispatch import channel, dispatch
+
+        try:
+            self._drivers_watch = self.session.zenoh.liveliness().declare_subscriber(
+                f"{PRESENCE_PREFIX}/{self.session.domain_id}/*/{DRIVER}/**", channel(), history=True
+            )
+        except Exception:
+            log.warning("cannot watch the drivers' presence; a driver's death ends objectives late")
+            return
+        self.session._track_dispatcher(dispatch(self._drivers_watch, self._on_driver_presence, "-drivers"))
+
+    def _on_driver_presence(self, sample: Any) -> None:
+        import zenoh
+
+        from kinema.runtime.cell import parse_presence
+
+        key = str(sample.key_expr)
+        member = parse_presence(key)
+        if member is None:
+            return
+        if sample.kind != zenoh.SampleKind.DELETE:
+            self._drivers[key] = member
+            return
+        self._drivers.pop(key, None)
+        status, name = self.server.status
+        if status not in (ObjectiveStatus.RUNNING, ObjectiveStatus.LOADING) or self._stop.is_set():
+            log.info("%s went away", member.describe())
+            return
+        reason = (
+            f"objective {name!r} aborted: {member.describe()} went away while it ran (its process ended "
+            "or its link dropped); the robot's controllers are gone"
+        )
+        log.error("%s", reason)
+        self.server.abort(reason, timeout=0)  # never blocks the transport's thread
+
     # -- lifecycle -----------------------------------------------------------------------------------
 
     def start(self) -> None:
@@ -374,12 +418,23 @@ class Agent:
         self._streams.publish_heartbeat()
         self._heartbeat_thread.start()
 
-    def close(self) -> None:
-        """Stop the server (a running objective ends PREEMPTED) and withdraw every endpoint."""
+    def close(
+        self, reason: str = "the agent stopped (kinema down, Ctrl-C, or its supervisor stopped it)"
+    ) -> None:
+        """Stop the server (a running objective ends as FAILURE with ``reason``) and withdraw every
+        endpoint."""
         self._stop.set()
         for unsubscribe in self._unsubscribe:
             unsubscribe()
-        self.server.stop()
+        if self._drivers_watch is not None:
+            try:
+                self._drivers_watch.undeclare()
+            except Exception:
+                log.debug("driver watch already gone", exc_info=True)
+        self.server.stop(reason=reason)
+        with self._goal_lock:
+            # Goals answer their clients (the stopped run's FAILURE) before the endpoints go.
+            self._goal_lock.wait_for(lambda: not self._goal_runs, GOALS_ANSWER_AT_CLOSE_S)
         self._streams.close()
         for close in self.on_close:
             try:
@@ -461,18 +516,20 @@ class Agent:
             if handle.is_cancel_requested:
                 self.server.cancel(run, reason="goal cancelled", timeout=0)
             outcome = run.wait()
+            assert outcome is not None
+            result = outcome
+            payload = {"error_code": result_message(result), "error_message": result.error_message}
+            if result.succeeded:
+                handle.succeed(payload)
+            elif result.cancelled:
+                handle.canceled(payload)
+            else:
+                handle.abort(payload)
         finally:
+            # Only once the result is handed over: close() waits for this to answer waiting clients.
             with self._goal_lock:
                 self._goal_runs.pop(handle.goal_id, None)
-        assert outcome is not None
-        result = outcome
-        payload = {"error_code": result_message(result), "error_message": result.error_message}
-        if result.succeeded:
-            handle.succeed(payload)
-        elif result.cancelled:
-            handle.canceled(payload)
-        else:
-            handle.abort(payload)
+                self._goal_lock.notify_all()
         return None
 
     def _on_cancel_goal(self, handle: Any) -> bool:

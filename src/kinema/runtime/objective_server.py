@@ -245,6 +245,8 @@ class _Cancel:
     reason: str
     ack: threading.Event = field(default_factory=threading.Event)
     cancelled: bool = False
+    # An abort: something the run needs died (a driver); it ends as FAILURE, never as a cancel.
+    failure: bool = False
 
 
 @dataclass
@@ -340,6 +342,7 @@ class ObjectiveServer:
         self._woken = False
         self._tick_now = False
         self._stopping = False
+        self._stop_reason = "the objective server stopped"
         # Set by every request: a tree re-ticking itself stops between two iterations to serve it.
         self._interrupt = False
         # When the oldest request that a stuck tick thread would have to serve was posted.
@@ -389,11 +392,16 @@ class ObjectiveServer:
         )
         self._watchdog.start()
 
-    def stop(self, timeout: float = 5.0) -> None:
-        """Halt the running objective (its result is PREEMPTED) and stop the tick thread."""
+    def stop(self, timeout: float = 5.0, *, reason: str = "the objective server stopped") -> None:
+        """Halt the running objective and stop the tick thread.
+
+        The running objective ends as FAILURE with ``reason``: a stopping runtime is not a cancel its
+        client asked for (queued requests are refused with it too).
+        """
         if self._watchdog is None:
             return
         with self._wake:
+            self._stop_reason = reason
             self._stopping = True
             self._interrupt = True
             self._woken = True
@@ -474,6 +482,19 @@ class ObjectiveServer:
         if target is not None:
             target.request_cancel(reason)
         request = _Cancel(run, reason)
+        self._post(request)
+        if threading.current_thread() is self._thread:
+            return True
+        request.ack.wait(timeout)
+        return request.cancelled
+
+    def abort(self, reason: str, *, timeout: float = 5.0) -> bool:
+        """End whatever runs as FAILURE with ``reason`` (something it needs died: a driver, a link).
+
+        Returns:
+            True if something was running (it is halted when this returns, up to ``timeout``).
+        """
+        request = _Cancel(None, reason, failure=True)
         self._post(request)
         if threading.current_thread() is self._thread:
             return True
@@ -678,9 +699,9 @@ class ObjectiveServer:
                 if not stopping:
                     self._waiting_since = None
             if stopping:
-                self._finish_current(worker, ObjectiveResult.preempted, "the objective server stopped")
+                self._finish_current(worker, ObjectiveResult.failure, self._stop_reason)
                 for item in inbox:
-                    self._reject(item, "the objective server stopped")
+                    self._reject(item, self._stop_reason)
                 self._stopped.set()
                 return
             start = self._take_requests(worker, inbox)
@@ -721,7 +742,7 @@ class ObjectiveServer:
 
     def _reject(self, item: ObjectiveRun | _Cancel | _Call, reason: str) -> None:
         if isinstance(item, ObjectiveRun):
-            item._finish(ObjectiveResult.preempted(reason, item.objective_name))
+            item._finish(ObjectiveResult.failure(reason, item.objective_name))
         elif isinstance(item, _Cancel):
             item.ack.set()
         else:
@@ -748,12 +769,13 @@ class ObjectiveServer:
                     )
                 start = item
             elif isinstance(item, _Cancel):
-                if start is not None and (item.run is None or item.run is start):
-                    start._finish(ObjectiveResult.preempted(item.reason, start.objective_name))
+                make = ObjectiveResult.failure if item.failure else ObjectiveResult.preempted
+                if start is not None and (item.run is None or item.run is start) and not item.failure:
+                    start._finish(make(item.reason, start.objective_name))
                     start = None
                     item.cancelled = True
                 if self._run is not None and (item.run is None or item.run is self._run):
-                    self._finish_current(worker, ObjectiveResult.preempted, item.reason)
+                    self._finish_current(worker, make, item.reason)
                     item.cancelled = True
                 item.ack.set()
             else:
@@ -928,7 +950,8 @@ class ObjectiveServer:
                 waiting = any(not isinstance(item, _Call) for item in self._inbox) or self._stopping
                 self._waiting_since = time.monotonic() if waiting else None
             self._flush_node_changes(run)
-        self._end(run, make(reason, run.objective_name), ObjectiveStatus.CANCELLED)
+        result = make(reason, run.objective_name)
+        self._end(run, result, ObjectiveStatus.CANCELLED if result.cancelled else ObjectiveStatus.FAILURE)
 
     def _end(self, run: ObjectiveRun, result: ObjectiveResult, status: ObjectiveStatus) -> None:
         result = run._settle(result)
