@@ -10,7 +10,9 @@ no orphans behind: they end within about a second.
 
 A UI plugs in through :attr:`LaunchOptions.ui`: a callable that receives the started :class:`Launcher`
 (its ``session``, ``endpoint``, ``run_folder``) and runs in the main thread until the user quits; without
-one the supervisor blocks until Ctrl-C, SIGTERM (``kinema down``) or a child dies.
+one the supervisor blocks until Ctrl-C, SIGTERM (``kinema down``) or a child dies. A crashed agent
+(a behavior's ``os._exit``, a segfault in C code) is started again, up to :data:`AGENT_RESTARTS` times,
+each said on the terminal and in the supervisor's log; the drivers stop the goals it left running.
 """
 
 from __future__ import annotations
@@ -42,6 +44,9 @@ log = logging.getLogger("kinema.supervisor")
 READY_TIMEOUT_S = 120.0
 STOP_GRACE_S = 5.0
 VIEWER_READY_TIMEOUT_S = 30.0
+# A crashed agent is started again this many times per `kinema run` (the drivers hold the robot still
+# meanwhile: they stop the goals of an agent that went away); after that the run stops.
+AGENT_RESTARTS = 3
 
 
 @dataclass
@@ -125,6 +130,8 @@ class Launcher:
         self._stop_reason = ""
         self._echo_stop = threading.Event()
         self._config: Any = None
+        self._clock = "auto"
+        self.agent_restarts = 0
 
     # -- start --------------------------------------------------------------------------------------
 
@@ -164,6 +171,7 @@ class Launcher:
             starting = self._start_drivers() if options.drivers else []
             if options.drivers and not starting:
                 clock = "wall"  # no simulator will publish /clock: time must not freeze
+            self._clock = clock
             if options.agent:
                 starting.append(self._start_agent(clock))
             for child, stream in starting:
@@ -345,6 +353,10 @@ class Launcher:
                     log.warning("%s exited (code %s); the runtime keeps running", child.name, code)
                     self.children.remove(child)
                     continue
+                if code is not None and child.name == "agent" and self.agent_restarts < AGENT_RESTARTS:
+                    if self._restart_agent(child, code):
+                        continue
+                    return 1
                 if code is not None:
                     log.error("%s exited with code %s", child.name, code)
                     self.options.echo(
@@ -353,6 +365,30 @@ class Launcher:
                     return 1
         log.info("stopping (%s)", self._stop_reason or "requested")
         return 0
+
+    def _restart_agent(self, crashed: Child, code: int) -> bool:
+        """Start the agent again after it exited unexpectedly; False when the new one did not start."""
+        self.agent_restarts += 1
+        message = (
+            f"agent exited unexpectedly (code {code}); see {crashed.log_file}; restarting it "
+            f"({self.agent_restarts} of {AGENT_RESTARTS}); the drivers hold the robot still meanwhile"
+        )
+        log.error("%s", message)
+        self.options.echo(message)
+        self.children.remove(crashed)
+        if self.record is not None and crashed.process.pid in self.record.children:
+            self.record.children.remove(crashed.process.pid)
+            self.record.save()
+        try:
+            child, stream = self._start_agent(self._clock)
+            self._await_ready(child, stream)
+        except KinemaError as error:
+            log.error("the agent did not start again: %s", error)
+            self.options.echo(f"the agent did not start again: {error}; stopping")
+            return False
+        log.info("agent restarted (pid %d)", child.process.pid)
+        self.options.echo(f"agent restarted (pid {child.process.pid}); objectives can be started")
+        return True
 
     def stop(self) -> None:
         """Stop the children (SIGTERM, SIGKILL after a grace period), close the router, drop the record."""
