@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Any
 
 from kinema.errors import KinemaError, TransportError
 from kinema.runtime.cell import CellError
+from kinema.runtime.cell_claim import CellClaim
 from kinema.runtime.instance import InstanceRecord
 from kinema.runtime.lifeline import Lifeline
 from kinema.runtime.run_folder import RunFolder, prune_runs
@@ -47,6 +48,9 @@ VIEWER_READY_TIMEOUT_S = 30.0
 # A crashed agent is started again this many times per `kinema run` (the drivers hold the robot still
 # meanwhile: they stop the goals of an agent that went away); after that the run stops.
 AGENT_RESTARTS = 3
+# How long a `kinema run` that finds the cell's roles claimed on this machine waits for the claiming one's
+# agent or drivers to show on the network (so that it refuses with what runs there).
+CLAIM_WAIT_S = 60.0
 
 
 @dataclass
@@ -132,6 +136,7 @@ class Launcher:
         self._config: Any = None
         self._clock = "auto"
         self.agent_restarts = 0
+        self._claim = CellClaim()
 
     # -- start --------------------------------------------------------------------------------------
 
@@ -414,6 +419,7 @@ class Launcher:
         if self.record is not None:
             self.record.remove()
             self.record = None
+        self._claim.release()
 
     def run(self) -> int:
         """Start, block (or run the UI), stop; SIGINT and SIGTERM stop cleanly. Returns the exit code."""
@@ -451,6 +457,7 @@ class Launcher:
 
         bound_heap_growth()  # the router reassembles large messages too; see kinema.transport.heap
         plan = plan_router(self.options.endpoint, self.options.security_dir)
+        self._claim_cell(plan.local)
         session = open_router(plan, insecure=self.options.insecure, before_join=self._check_cell_is_free)
         self.endpoint = plan.local
         if session.exposed:
@@ -463,6 +470,37 @@ class Launcher:
                 f"{plan.config_file.parent} (mutual TLS, access rules of {plan.config_file})"
             )
         return session
+
+    def _claim_cell(self, endpoint: str) -> None:
+        """Take this machine's claim on the roles this run starts (see kinema.runtime.cell_claim).
+
+        Raises:
+            CellError: another `kinema run` holds one: the usual message once its members show on the
+                network, else one naming the process that holds the claim.
+        """
+        from kinema.runtime.cell_claim import AGENT, DRIVERS
+        from kinema.transport import resolve_domain_id
+
+        roles = [
+            role for role, wanted in ((AGENT, self.options.agent), (DRIVERS, self.options.drivers)) if wanted
+        ]
+        domain = resolve_domain_id(None)
+        holder = self._claim.take(endpoint, domain, roles)
+        if holder is None:
+            return
+        log.info("the cell at %s is claimed on this machine by pid %s; looking at it", endpoint, holder)
+        deadline = time.monotonic() + CLAIM_WAIT_S
+        while time.monotonic() < deadline and not self._stop.is_set():
+            self._check_cell_is_free(endpoint)  # raises the usual CellError once its members show
+            holder = self._claim.take(endpoint, domain, roles)
+            if holder is None:
+                return  # the other one gave up (or stopped) meanwhile
+            time.sleep(0.2)
+        raise CellError(
+            f"another kinema run (pid {holder}) is starting the {' and '.join(roles)} of the cell at "
+            f"{endpoint} on this machine, so nothing was started.\n  stop it: `kinema down`, or Ctrl-C in "
+            "its terminal\n  run a second cell beside it: `kinema run --connect tcp/127.0.0.1:<another port>`"
+        )
 
     def _check_cell_is_free(self, endpoint: str) -> None:
         """Refuse to start a second agent or second drivers on the router at ``endpoint`` that has them
