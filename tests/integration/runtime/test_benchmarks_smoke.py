@@ -15,7 +15,7 @@ import pytest
 BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks"
 
 
-@pytest.mark.parametrize("script", ["large_values.py"])
+@pytest.mark.parametrize("script", ["large_values.py", "soak.py"])
 def test_a_benchmark_runs_in_smoke_mode(script: str) -> None:
     done = subprocess.run(
         [sys.executable, str(BENCHMARKS / script), "--smoke"],
@@ -27,3 +27,4 @@ def test_a_benchmark_runs_in_smoke_mode(script: str) -> None:
     )
     assert done.returncode == 0, done.stdout + done.stderr
     assert "Traceback" not in done.stderr, done.stderr
+    assert done.stdout.strip(), "the benchmark printed no figures"
