@@ -44,7 +44,9 @@ def encode(payload: dict[str, Any]) -> bytes:
 
 def decode(data: bytes) -> dict[str, Any]:
     """A JSON object; raises ValueError for anything else."""
-    value = json.loads(data.decode() if data else "{}")
+    from kinema.nesting import loads_json
+
+    value = loads_json(data.decode() if data else "{}", "the request")
     if not isinstance(value, dict):
         raise ValueError("expected a JSON object")
     return value

@@ -392,6 +392,25 @@ def test_the_json_endpoints_start_cancel_and_refuse_garbage(agent: Any) -> None:
         assert quick.start("Quick").result().succeeded
 
 
+def test_deeply_nested_json_on_the_quick_keys_gets_an_answer(agent: Any) -> None:
+    """It raised RecursionError in the agent's handler, and the client got no answer at all."""
+    from kinema.runtime import quick_protocol
+    from kinema.sdk import QuickClient
+
+    deep = b"[" * 100_000 + b"]" * 100_000
+    with QuickClient(agent.endpoint, timeout=10) as quick:
+        for operation in (quick_protocol.START, quick_protocol.START_XML, quick_protocol.CANCEL):
+            replies = list(
+                quick._session.get(
+                    quick_protocol.key(quick.domain_id, operation),
+                    payload=b'{"objective_name": "Quick", "overrides": ' + deep + b"}",
+                    timeout=10,
+                )
+            )
+            assert len(replies) == 1 and "levels deep" in replies[0].err.payload.to_string(), operation
+        assert quick.start("Quick").result().succeeded
+
+
 def test_the_name_only_doors_refuse_xml(agent: Any, client: ObjectiveClient) -> None:
     """What an operator's certificate reaches runs library objectives by name; XML is a grant of its own."""
     from kinema.runtime import names, quick_protocol
