@@ -330,3 +330,26 @@ def test_a_config_allows_its_packages_and_the_data_folder(behavior: Any, node: A
         behavior("ReadTextFileAsString"), {"text_filename": "/etc/passwd"}, context=context
     )
     assert refused.status == NodeStatus.FAILURE and "refused by the file rule" in refused.toasts[-1]
+
+
+def test_a_parameter_override_is_held_to_the_file_rule_like_any_port(
+    registry: Any, node: Any, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A library objective run by name (what an operator may do) with its file parameter overridden."""
+    from kinema.config import resolve_config
+    from kinema.runtime.objective_server import FactoryTreeSource, ObjectiveRequest, ObjectiveServer
+    from kinema.runtime.overrides import ParameterOverride
+
+    factory = registry.create_factory(BehaviorContext(node, config=resolve_config("lab_sim")))
+    factory.register_behavior_tree_from_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Peek" _description="reads a note">'
+        '<ReadTextFileAsString text_filename="{file}" string_file_contents="{contents}"/>'
+        "</BehaviorTree></root>"
+    )
+    with ObjectiveServer(FactoryTreeSource(factory)) as server:
+        for path, rule in (("/etc/passwd", "file rule"), ("~/.config/kinema/security/ca.key", "file rule")):
+            overrides = (ParameterOverride("file", path),)
+            caplog.clear()
+            result = server.submit(ObjectiveRequest("Peek", "", overrides, "test")).wait(30)
+            assert result is not None and result.failed, result
+            assert f"refused by the {rule}" in caplog.text and "root:" not in caplog.text
