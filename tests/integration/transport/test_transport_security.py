@@ -223,6 +223,11 @@ def test_an_operator_runs_library_objectives_and_no_objective_reaches_files_outs
     assert through_sdk.returncode == 0 and through_sdk.stdout.strip() == "True", (
         through_sdk.stdout + through_sdk.stderr
     )
+    # ... cancels, and watches.
+    cancelled = _kinema(operator, "objective", "cancel")
+    assert "no Kinema runtime" not in cancelled.stderr and "Traceback" not in cancelled.stderr, cancelled
+    status = _kinema(operator, "objective", "status")
+    assert status.returncode == 0 and "Close Gripper" in status.stdout, status.stdout + status.stderr
     for xml in (_read_file_xml("/etc/passwd"), _read_file_xml(str(folder / "ca.key"))):
         refused = _kinema(operator, "objective", "do", "-", stdin=xml)
         assert refused.returncode == 1 and "lacks that grant" in refused.stderr, (
