@@ -282,7 +282,17 @@ class ObjectiveClient:
             "objective_xml_string": "" if name else xml,
             "parameter_overrides": parameter_messages(overrides),
         }
-        handle = action.send_goal(goal, timeout=self.timeout)
+        try:
+            handle = action.send_goal(goal, timeout=self.timeout)
+        except TransportError as error:
+            if name or "answered within" not in str(error):
+                raise
+            # The agent is there (wait_for_runtime) but its XML door did not answer: access rules.
+            raise TransportError(
+                f"the runtime answers, but not to ad-hoc objective XML on {names.DO_OBJECTIVE}: this "
+                "machine's certificate lacks that grant (`kinema security` on the robot lists the roles; "
+                "`kinema security init --allow-xml NAME` gives it). Run a library objective by name instead"
+            ) from error
         if not handle.accepted:
             raise TransportError(f"the agent rejected objective {name or '<XML>'!r}")
         return ObjectiveHandle(handle, name or _xml_name(xml))

@@ -216,12 +216,26 @@ def test_an_operator_runs_library_objectives_and_no_objective_reaches_files_outs
     # The operator: library objectives by name, through the CLI's JSON door and the SDK's action.
     closed = _kinema(operator, "objective", "run", "Close Gripper")
     assert closed.returncode == 0, closed.stdout + closed.stderr
-    sdk = "from kinema.sdk import ObjectiveClient\nprint(ObjectiveClient().execute('Close Gripper').succeeded)\n"
+    sdk = "from kinema.sdk import ObjectiveClient as C\nprint(C().execute('Close Gripper').succeeded)\n"
     through_sdk = subprocess.run(
         [sys.executable, "-c", sdk], capture_output=True, text=True, env=operator, timeout=120
     )
     assert through_sdk.returncode == 0 and through_sdk.stdout.strip() == "True", (
         through_sdk.stdout + through_sdk.stderr
+    )
+    xml_through_sdk = subprocess.run(
+        [
+            sys.executable,
+            "-c",
+            f"from kinema.sdk import ObjectiveClient\nObjectiveClient().do_xml({QUICK!r})\n",
+        ],
+        capture_output=True,
+        text=True,
+        env=operator,
+        timeout=120,
+    )
+    assert xml_through_sdk.returncode == 1 and "lacks that grant" in xml_through_sdk.stderr, (
+        xml_through_sdk.stdout + xml_through_sdk.stderr
     )
     # ... cancels, and watches.
     cancelled = _kinema(operator, "objective", "cancel")
