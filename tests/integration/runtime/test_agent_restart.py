@@ -128,3 +128,32 @@ def test_a_killed_agent_is_restarted_and_the_driver_holds_the_robot_still(
     assert "restarting it (1 of" in logs["supervisor.log"], sorted(logs)
     driver = next(text for name, text in logs.items() if name not in ("supervisor.log", "agent.log"))
     assert "went away with 1 goal(s) running: stopping them and holding the robot still" in driver
+
+
+def test_a_driver_killed_mid_motion_fails_the_objective_naming_it_never_preempted(
+    cell: KinemaRun, free_endpoint: str
+) -> None:
+    """The probe: a driver killed mid-motion ended the objective PREEMPTED (-7)."""
+    from kinema.runtime.error_codes import MoveItErrorCode
+    from kinema.sdk import ObjectiveClient, QuickClient
+    from kinema.transport import Node
+
+    states: queue.Queue[Any] = queue.Queue()
+    with (
+        ObjectiveClient(free_endpoint, timeout=20) as client,
+        QuickClient(free_endpoint, timeout=20) as quick,
+    ):
+        Node(client.session, "watch").create_subscription(
+            "sensor_msgs/msg/JointState", "/joint_states", states.put
+        )
+        run = quick.start("3 Waypoints Pick and Place")
+        deadline = time.monotonic() + 120
+        while _speed(states.get(timeout=10)) < 0.05:  # the arm moves
+            assert time.monotonic() < deadline, "the arm never moved"
+        pid = cell.process.pid
+        children = Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
+        driver = next(c for c in children if "kinema.drivers" in Path(f"/proc/{c}/cmdline").read_text())
+        os.kill(int(driver), signal.SIGKILL)
+        result = run.result()
+    assert result.error_code != MoveItErrorCode.PREEMPTED, result
+    assert result.error_code == MoveItErrorCode.FAILURE and "driver 'mujoco'" in result.error_message, result
