@@ -5,12 +5,8 @@ from __future__ import annotations
 import subprocess
 import sys
 import time
-from pathlib import Path
 from typing import Any
 
-import pytest
-
-from conftest import running_agent
 from kinema.runtime.error_codes import MoveItErrorCode
 from kinema.runtime.objective_status import ObjectiveStatus
 
@@ -25,15 +21,10 @@ time.sleep(600)
 """
 
 
-@pytest.fixture
-def agent(request: pytest.FixtureRequest, tmp_path: Path) -> Any:
-    with running_agent(request, tmp_path) as running:
-        yield running
-
-
-def test_a_driver_that_dies_mid_objective_ends_it_as_a_failure_naming_the_driver(agent: Any) -> None:
+def test_a_driver_that_dies_mid_objective_ends_it_as_a_failure_naming_the_driver(fresh_agent: Any) -> None:
     from kinema.sdk import QuickClient
 
+    agent = fresh_agent
     driver = subprocess.Popen(
         [sys.executable, "-c", FAKE_DRIVER, agent.endpoint], stdout=subprocess.PIPE, text=True
     )
@@ -56,13 +47,11 @@ def test_a_driver_that_dies_mid_objective_ends_it_as_a_failure_naming_the_driver
         driver.wait(10)
 
 
-def test_a_stopping_agent_ends_the_running_objective_as_a_failure(request: Any, tmp_path: Path) -> None:
+def test_a_stopping_agent_ends_the_running_objective_as_a_failure(fresh_agent: Any) -> None:
     from kinema.sdk import ObjectiveClient
 
-    with (
-        running_agent(request, tmp_path) as stopping,
-        ObjectiveClient(stopping.endpoint, timeout=10) as client,
-    ):
+    stopping = fresh_agent
+    with ObjectiveClient(stopping.endpoint, timeout=10) as client:
         handle = client.start("Forever")
         deadline = time.monotonic() + 10
         while handle.status != "EXECUTING":
