@@ -139,6 +139,7 @@ def init(
     from kinema.transport.exposure import is_loopback
     from kinema.transport.security_folder import (
         default_security_dir,
+        holders,
         init_security_folder,
         this_machines_addresses,
     )
@@ -166,6 +167,9 @@ def init(
     for client in result.clients:
         click.echo(f"client config: {client}")
     click.echo(f"router config: {result.router_config}")
+    for name, role in holders(result.path) or []:
+        click.echo(f"  {name}: {role}")
+    click.echo("`kinema security` lists what each role may do")
     click.echo("")
     click.echo(f"on this machine:  kinema run --connect {result.tls_endpoints[0]}")
     click.echo(
