@@ -17,6 +17,8 @@ The server runs behavior code on a :class:`TickWorker` thread with its state loc
   watchdog included, so it cannot look while it happens: :class:`StallDumps` keeps faulthandler's timer
   armed, whose own C thread needs no interpreter and writes every thread's stack when the watchdog has
   not re-armed it in time. The watchdog reads that afterwards and reports where the tick thread sat.
+  (faulthandler has one such timer per process: a program embedding the server should not use
+  ``faulthandler.dump_traceback_later`` itself while a server runs.)
 
 It also words the warnings the server's health report carries about all of the above.
 """
