@@ -104,7 +104,7 @@ def test_a_killed_agent_is_restarted_and_the_driver_holds_the_robot_still(
         with QuickClient(free_endpoint, timeout=20) as quick:
             quick.start("3 Waypoints Pick and Place")
             deadline = time.monotonic() + 120
-            while _speed(states.get(timeout=10)) < 0.05:  # the arm moves
+            while _speed(states.get(timeout=10)) < 0.3:  # the arm moves, mid-motion
                 assert time.monotonic() < deadline, "the arm never moved"
         os.kill(cell.agent_pid(), signal.SIGKILL)
         said = cell.wait_for("restarting it")
@@ -148,7 +148,7 @@ def test_a_driver_killed_mid_motion_fails_the_objective_naming_it_never_preempte
         )
         run = quick.start("3 Waypoints Pick and Place")
         deadline = time.monotonic() + 120
-        while _speed(states.get(timeout=10)) < 0.05:  # the arm moves
+        while _speed(states.get(timeout=10)) < 0.3:  # the arm moves, mid-motion
             assert time.monotonic() < deadline, "the arm never moved"
         pid = cell.process.pid
         children = Path(f"/proc/{pid}/task/{pid}/children").read_text().split()
