@@ -74,6 +74,7 @@ def build(
 
     resolved = resolve_config(name, found)
     print_warnings(resolved.warnings)
+    errors += _check_waypoints(resolved)
     host = BehaviorHost.for_config(resolved)
     report = host.load()
     print_warnings(report.warnings)
@@ -102,6 +103,23 @@ def build(
     if errors:
         click.secho(f"build failed: {errors} errors", err=True, fg="red")
         raise click.exceptions.Exit(1)
+
+
+def _check_waypoints(resolved: object) -> int:
+    """Read the config's waypoints as the runtime will; 1 (after printing why) when they do not load."""
+    from kinema.config.waypoint_location import waypoint_store_for
+    from kinema.errors import KinemaError
+
+    try:
+        store = waypoint_store_for(resolved)  # type: ignore[arg-type]
+        if store is None:
+            return 0
+        count = len(store.all())
+    except KinemaError as error:
+        click.secho(str(error), err=True, fg="red")
+        return 1
+    click.echo(f"read {count} waypoints from {store.read_path}")
+    return 0
 
 
 @click.command()

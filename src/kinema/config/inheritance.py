@@ -21,6 +21,7 @@ file or folder Kinema will use must exist.
 from __future__ import annotations
 
 import copy
+import os
 from collections.abc import Hashable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -313,6 +314,14 @@ def _resolve_ref(
         )
     package = workspace.package(ref.package)
     path = package.resolve_relative(ref.path)
+    # Lexically (symlinks a package holds are its own business): '..' and absolute paths leave it.
+    inside = Path(os.path.normpath(path)).is_relative_to(os.path.normpath(package.path))
+    if not inside:
+        raise ConfigError(
+            f"{label}: {ref} leaves package {package.name!r} ({os.path.normpath(path)} is outside "
+            f"{package.path}); a reference names a file inside its package",
+            location=location,
+        )
     if package.kind == "objectives" and path == package.path:
         return path  # the core library is always there, even before anything has been put into it
     if not path.exists():

@@ -13,6 +13,9 @@ CANCEL_OBJECTIVE = "/cancel_objective"
 CANCEL_OBJECTIVE_TYPE = "moveit_studio_sdk_msgs/srv/CancelObjective"
 DO_OBJECTIVE = "/do_objective"
 DO_OBJECTIVE_TYPE = "moveit_studio_sdk_msgs/action/DoObjectiveSequence"
+# /do_objective without its XML: library objectives by name (with overrides) only. An operator's
+# certificate reaches this one; ad-hoc XML through /do_objective is a separate grant (kinema security).
+RUN_OBJECTIVE = "/kinema/run_objective"
 
 HEARTBEAT = "/objective_server_heartbeat"
 HEARTBEAT_TYPE = "moveit_studio_agent_msgs/msg/ObjectiveServerStatus"

@@ -406,3 +406,48 @@ def test_a_tick_thread_dying_mid_motion_still_halts_the_motion() -> None:
         assert result is not None and result.failed and "died: KeyboardInterrupt" in result.error_message
         _wait(lambda: "motion halted" in EVENTS, "the motion of the dead thread's tree to be halted")
         assert _xml(server, QUICK).wait(5) == ObjectiveResult.success("Quick")
+
+
+# -- code that holds the interpreter (C code that does not release the GIL) --------------------------
+
+GO = threading.Event()
+
+
+class HoldsTheInterpreter(SyncBehavior):
+    """Waits for the test, then sits 1 s in C code that keeps the GIL (ctypes.PyDLL never releases it)."""
+
+    def tick(self) -> NodeStatus:
+        import ctypes
+
+        GO.wait(30)
+        ctypes.PyDLL(None).usleep(1_000_000)
+        return NodeStatus.SUCCESS
+
+
+def test_a_cancel_accepted_while_a_tick_holds_the_interpreter_wins_and_the_stack_is_reported() -> None:
+    """The probe: C code holding the GIL for 15 s lost a cancel, and the objective reported SUCCESS."""
+    GO.clear()
+    factory = registry_of([HoldsTheInterpreter]).create_factory(BehaviorContext.offline())
+    with ObjectiveServer(FactoryTreeSource(factory), watchdog_report_s=0.2, abandon_after_s=30) as server:
+        run = _xml(server, _tree("<HoldsTheInterpreter/>"))
+        _wait(lambda: _running(server), "the objective to run")
+        assert run.request_cancel("cancelled by the test")  # what /do_objective's cancel_goal does
+        server.cancel(run, reason="cancelled by the test", timeout=0)
+        GO.set()
+        result = run.wait(30)
+        assert result is not None and result.cancelled, result
+        assert "cancelled by the test" in result.error_message
+        assert not run.request_cancel("too late"), "a settled run accepts no cancel"
+
+        def reported() -> list[str]:
+            return [w for w in server.health().warnings if "the interpreter was held" in w]
+
+        _wait(lambda: bool(reported()), "the watchdog's report of the held interpreter")
+        assert "test_objective_server_watchdog.py" in reported()[0] and "in tick" in reported()[0], reported()
+    GO.set()
+
+
+def test_a_run_that_succeeded_accepts_no_cancel(server: ObjectiveServer) -> None:
+    run = _xml(server, QUICK)
+    assert run.wait(5) == ObjectiveResult.success("Quick")
+    assert not run.request_cancel("late") and not server.cancel(run)

@@ -158,6 +158,7 @@ class MujocoDriver:
             self.cameras = CameraServer(session, self.model, self._camera_snapshot, settings.camera_rate)
         self._started = False
         self._stopped = False
+        self._agent_watch: Any = None
 
     # -- public API ----------------------------------------------------------------------------------
 
@@ -192,6 +193,7 @@ class MujocoDriver:
             self.simulation.start()
             if self.cameras is not None:
                 self.cameras.start()
+            self._watch_agents()
         except BaseException:
             self.stop()
             raise
@@ -211,6 +213,11 @@ class MujocoDriver:
         if self._stopped:
             return
         self._stopped = True
+        if self._agent_watch is not None:
+            try:
+                self._agent_watch.undeclare()
+            except Exception:
+                log.debug("agent watch already gone", exc_info=True)
         if self.cameras is not None:
             self.cameras.stop()
         self.simulation.stop()
@@ -741,6 +748,40 @@ class MujocoDriver:
         if running is not None:
             self._queue_cancel(*running)
         return True
+
+    def _watch_agents(self) -> None:
+        """An agent that goes away (crashed, killed) can no longer cancel what it started: stop every
+        running goal then, braking to a stop and holding position, until a new agent commands."""
+        from kinema.runtime.cell import AGENT, PRESENCE_PREFIX
+        from kinema.transport.dispatch import channel, dispatch
+
+        try:
+            self._agent_watch = self.session.zenoh.liveliness().declare_subscriber(
+                f"{PRESENCE_PREFIX}/{self.session.domain_id}/*/{AGENT}/**", channel(), history=False
+            )
+        except Exception:
+            log.warning("cannot watch the agent's presence; its death will not stop running goals")
+            return
+        self.session._track_dispatcher(dispatch(self._agent_watch, self._on_agent_presence, "-agents"))
+
+    def _on_agent_presence(self, sample: Any) -> None:
+        import zenoh
+
+        from kinema.runtime.cell import parse_presence
+
+        member = parse_presence(str(sample.key_expr))
+        if member is None or sample.kind != zenoh.SampleKind.DELETE:
+            return
+        with self._goals_lock:
+            running = list(self._executions.values())
+        if running:
+            log.warning(
+                "%s went away with %d goal(s) running: stopping them and holding the robot still",
+                member.describe(),
+                len(running),
+            )
+        for controller, execution in running:
+            self._queue_cancel(controller, execution)
 
     def _queue_cancel(self, controller: Any, execution: Execution) -> bool:
         try:
