@@ -119,7 +119,8 @@ checker.scene.add_box("block", (0.03, 0.03, 0.03), block)
 cols = list(model.group("manipulator").indices)
 names = model.group("manipulator").joint_names
 options = PlanningOptions(timeout=5.0, seed=11)
-path = plan_joint_goal(checker, mid, dict(zip(names, goal[cols], strict=True)), options=options, group="manipulator")
+targets = dict(zip(names, goal[cols], strict=True))
+path = plan_joint_goal(checker, mid, targets, options=options, group="manipulator")
 print(json.dumps(path.positions.tolist()))
 """
 
