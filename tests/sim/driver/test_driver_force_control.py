@@ -122,7 +122,7 @@ def test_the_admittance_controller_aborts_a_trajectory_that_presses_too_hard(sim
     seed = model.configuration(dict(zip(ARM, _vfc_start(), strict=True)))
     target = fk(model, seed, "grasp_link")
     target[2, 3] = TABLE_TOP - 0.05  # 5 cm into the table
-    into_table = ik(model, target, seed, frame="grasp_link")
+    into_table = ik(model, target, seed, group="manipulator", frame="grasp_link")
     columns = [model.joint_names.index(j) for j in ARM]
     client = sim.action(n.FOLLOW_JOINT_TRAJECTORY_ADMITTANCE_ACTION, n.FOLLOW_JOINT_TRAJECTORY_TYPE)
     start = sim.joint_states.latest()

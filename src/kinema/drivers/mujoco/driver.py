@@ -752,8 +752,8 @@ class MujocoDriver:
     def _watch_agents(self) -> None:
         """An agent that goes away (crashed, killed) can no longer cancel what it started: stop every
         running goal then, braking to a stop and holding position, until a new agent commands."""
-        from kinema.runtime.cell import AGENT, PRESENCE_PREFIX
         from kinema.transport.dispatch import channel, dispatch
+        from kinema.transport.presence import AGENT, PRESENCE_PREFIX
 
         try:
             self._agent_watch = self.session.zenoh.liveliness().declare_subscriber(
@@ -767,7 +767,7 @@ class MujocoDriver:
     def _on_agent_presence(self, sample: Any) -> None:
         import zenoh
 
-        from kinema.runtime.cell import parse_presence
+        from kinema.transport.presence import parse_presence
 
         member = parse_presence(str(sample.key_expr))
         if member is None or sample.kind != zenoh.SampleKind.DELETE:
