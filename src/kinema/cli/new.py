@@ -31,18 +31,21 @@ def new() -> None:
     "--from-urdf",
     "urdf",
     type=str,
+    metavar="URDF",
     default=None,
     help="Make the package for your own robot from its URDF or .xacro, a path or package://PKG/PATH.",
 )
 @click.option(
     "--srdf",
     type=str,
+    metavar="SRDF",
     default=None,
     help="With --from-urdf: the robot's SRDF (planning groups, group states, end effector).",
 )
 @click.option(
     "--mjcf",
     type=str,
+    metavar="MJCF",
     default=None,
     help="With --from-urdf: a MuJoCo scene to simulate it in (default: one is generated).",
 )
