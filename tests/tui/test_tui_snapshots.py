@@ -68,7 +68,7 @@ def test_objectives_parameters_tab(snap_compare) -> None:  # type: ignore[no-unt
 
     async def run_before(pilot: Pilot[None]) -> None:
         await settle(pilot)
-        await pilot.press("p")
+        await pilot.press("f4")
         await settle(pilot)
 
     assert snap_compare(app, terminal_size=SIZE, run_before=run_before)

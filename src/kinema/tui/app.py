@@ -41,7 +41,7 @@ from kinema.tui.connection import (
     RuntimeEvent,
     TaskPlanning,
 )
-from kinema.tui.dialogs.confirm import ConfirmDialog
+from kinema.tui.dialogs.confirm import ConfirmDialog, MotionQuestionDialog
 from kinema.tui.messages import ModeSelected, RuntimeCallFailed, RuntimeCallSucceeded, RuntimeEventsArrived
 from kinema.tui.run_outcome import RunOutcome, parse_outcome
 from kinema.tui.runtime_status import ACTIVE_STATUSES, RuntimeStatus
@@ -155,13 +155,14 @@ class KinemaApp(App[None]):
             id="app.camera",
             tooltip="Show the latest image of a camera topic",
         ),
-        Binding("q", "quit", "Quit", id="app.quit", tooltip="Close the app"),
+        Binding("ctrl+q", "quit", "Quit", id="app.quit", tooltip="Close the app", priority=True),
+        # q too, where no text is typed (on the objective list, letters search).
+        Binding("q", "quit", "Quit", id="app.quit_q", show=False, tooltip="Close the app"),
         Binding(
             "ctrl+x",
             "cancel_objective",
-            "Cancel objective",
+            "Cancel",
             id="app.cancel",
-            show=False,
             tooltip="Cancel the running objective from any screen",
         ),
     ]
@@ -350,7 +351,7 @@ class KinemaApp(App[None]):
 
             self.push_screen(ApprovalDialog(question, request.steps, request.duration), answered)
             return
-        self.push_screen(ConfirmDialog(question, confirm_label="Approve"), answered)
+        self.push_screen(MotionQuestionDialog(question), answered)
 
     def add_log(self, entry: LogEntry, *, toast: bool = False) -> None:
         """Keep ``entry`` for the Logs screen and, for runtime toasts, show it as a notification."""
@@ -415,7 +416,9 @@ class KinemaApp(App[None]):
                 self.exit()
 
         self.push_screen(
-            ConfirmDialog("Close Kinema? This stops the runtime that `kinema run` started.", "Quit and stop"),
+            ConfirmDialog(
+                "Close Kinema? This stops the runtime that `kinema run` started.", "Quit and stop", "Stay"
+            ),
             answered,
         )
 

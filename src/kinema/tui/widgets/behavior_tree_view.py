@@ -17,6 +17,7 @@ from textual.widgets import Tree
 from textual.widgets.tree import TreeNode
 
 from kinema.tui.connection import NodeStatus, NodeStatusUpdate
+from kinema.tui.run_outcome import failure_text
 
 if TYPE_CHECKING:
     from kinema.tui.tree_outline import OutlineNode, TreeOutline
@@ -195,7 +196,18 @@ class BehaviorTreeView(Tree["OutlineNode"]):
             if not key.startswith("_"):
                 lines.append(Text.assemble((f"{key}", "bold"), (" = ", "dim"), value))
         if message:
-            lines.append(Text.assemble(("why: ", "bold red"), message))
+            # A tree line does not wrap: the exception first, then where, each wrapped to the view's width
+            # (at the depth of the failed node), so neither is cut at the edge.
+            explained = failure_text(message)
+            depth, parent = 0, item.parent
+            while parent is not None:
+                depth, parent = depth + 1, parent.parent
+            width = max(30, self.size.width - 4 * (depth + 1) - 2)
+            lines.extend(_wrapped("why: ", explained.headline, "bold red", width))
+            if explained.where:
+                lines.extend(_wrapped("at: ", explained.where, "bold", width))
+            for note in explained.notes:
+                lines.extend(_wrapped("note: ", note, "bold yellow", width))
         lines.append(Text(f"path: {node.path}" + (f"  (line {node.line})" if node.line else ""), style="dim"))
         for line in lines:
             self._details.append(item.add_leaf(line))
@@ -255,3 +267,23 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         if ports:
             text.append(f"  {ports}", style="dim")
         return text
+
+
+def _wrapped(label: str, text: str, style: str, width: int) -> list[Text]:
+    """``label`` and ``text`` as tree lines of at most ``width`` cells, the continuation lines indented."""
+    import textwrap
+
+    indent = " " * len(label)
+    pieces = textwrap.wrap(
+        text, width, initial_indent=label, subsequent_indent=indent, break_on_hyphens=False
+    )
+    lines = []
+    for index, piece in enumerate(pieces or [label]):
+        line = Text()
+        if index == 0:
+            line.append(label, style=style)
+            line.append(piece[len(label) :])
+        else:
+            line.append(piece)
+        lines.append(line)
+    return lines
