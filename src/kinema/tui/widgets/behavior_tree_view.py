@@ -141,8 +141,9 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         """The run ended with ``outcome`` (``Failure`` or ``Cancelled``): explain it on the tree.
 
         Nodes still shown RUNNING were halted. For a failure, the node named by ``message`` (else the
-        deepest node reported FAILURE) is marked failed, the path to it highlighted and expanded, and it
-        opens onto its ports and ``message``. Returns the failed node, if one was found.
+        deepest node reported FAILURE) is marked failed, the path to it highlighted and expanded (its
+        ancestors that were running failed with it), and it opens onto its ports and ``message``. Returns
+        the failed node, if one was found.
         """
         self.run_over = True
         for running, status in list(self.statuses.items()):
@@ -166,6 +167,12 @@ class BehaviorTreeView(Tree["OutlineNode"]):
             step = self._parents.get(step)
         self.failed_path = list(reversed(path))
         for uid in self.failed_path:
+            if uid in self.halted:
+                # Running when their descendant failed (an exception escaped through them): they failed
+                # with it, as BT.CPP leaves them, which never halts them itself. The runtime's halt that
+                # followed is how it stops a failed tree, not a cancel.
+                self.halted.discard(uid)
+                self.statuses[uid] = NodeStatus.FAILURE
             self._relabel(uid)
             item = self._by_uid.get(uid)
             if item is not None and uid != failed.uid:
