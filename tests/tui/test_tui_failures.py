@@ -336,7 +336,9 @@ def test_a_failure_whose_node_never_reported_it_is_still_shown(fake: FakeConnect
         await settle(pilot)
         view = app.screen.query_one(BehaviorTreeView)
         assert view.shown_as("Wait and Log::3/Sleep::5") == "FAILURE"
-        assert view.shown_as("TopLevelSequence") == "HALTED"
+        # The exception escaped through its ancestors: they failed with it (BT.CPP halts none of them).
+        assert view.shown_as("TopLevelSequence") == "FAILURE"
+        assert view.shown_as("Wait and Log::3") == "FAILURE"
         assert view.failed_path == [1, 3, 4, 5]
 
     drive(fake, scenario)

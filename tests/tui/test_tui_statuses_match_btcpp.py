@@ -34,7 +34,10 @@ from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
 
 
 def doc(body: str) -> str:
-    return f'<root BTCPP_format="4" main_tree_to_execute="Main"><BehaviorTree ID="Main">{body}</BehaviorTree></root>'
+    return (
+        '<root BTCPP_format="4" main_tree_to_execute="Main">'
+        f'<BehaviorTree ID="Main">{body}</BehaviorTree></root>'
+    )
 
 
 def last_results(record: RunRecord) -> dict[str, str]:
