@@ -39,7 +39,14 @@ HALT_WAITS_FOR_ABANDONED_S = 0.5
 # A stuck behavior is logged again this often while it stays stuck.
 WATCHDOG_LOG_EVERY_S = 10.0
 
-LOOP_BLOCKED = "blocking the event loop async behaviors share (new ones run on a fresh loop)"
+# What each warning adds is what the user can do about it: the warnings reach `kinema run`'s terminal, the
+# UI's status bar and log, and `kinema objective status`.
+LOOP_BLOCKED = (
+    "so no other async behavior could run meanwhile (they now run on a new loop): its code should await "
+    "(asyncio.sleep, not time.sleep); cancelling the objective (ctrl+x, kinema objective cancel) stops it"
+)
+STUCK_ADVICE = "the objective cannot stop until it returns: cancel it (ctrl+x, kinema objective cancel)"
+ABANDONED_ADVICE = "restart the runtime (kinema down, then kinema run) to free it"
 
 
 class Abandoned(BaseException):
@@ -167,13 +174,13 @@ class TickWatchdog:
         now = time.monotonic()
         warnings: list[str] = []
         if worker is not None and worker.stuck is not None and worker.busy_since is not None:
-            warnings.append(worker.stuck.describe(now - worker.busy_since))
+            warnings.append(f"{worker.stuck.describe(now - worker.busy_since)}; {STUCK_ADVICE}")
         for old in list(abandoned):
             stuck = old.stuck or StuckCode("", "", old.busy_stage)
             since = old.stuck_since
             warnings.append(
                 f"abandoned tick thread {old.name}: {stuck.describe(now - since)} "
-                f"(abandoned {now - old.abandoned_at:.1f} s ago)"
+                f"(abandoned {now - old.abandoned_at:.1f} s ago); {ABANDONED_ADVICE}"
             )
         warnings.extend(halted_work_warnings(self.report_after_s))
         runner = work_runner()
@@ -221,7 +228,8 @@ def halted_work_warnings(after_s: float) -> list[str]:
     if runner is None:
         return []
     return [
-        f"behavior '{behavior}' ({path}) has ignored a halt for {seconds:.1f} s: its do_work still runs"
+        f"behavior '{behavior}' ({path}) has ignored a halt for {seconds:.1f} s: its do_work still runs "
+        "(it should return when cancelled); restart the runtime if it never ends"
         for behavior, path, seconds in runner.halted_still_running()
         if seconds >= after_s
     ]

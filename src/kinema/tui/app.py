@@ -43,6 +43,7 @@ from kinema.tui.connection import (
 )
 from kinema.tui.dialogs.confirm import ConfirmDialog, MotionQuestionDialog
 from kinema.tui.messages import ModeSelected, RuntimeCallFailed, RuntimeCallSucceeded, RuntimeEventsArrived
+from kinema.tui.repeat_limiter import RepeatLimiter, held_back, watchdog_kind
 from kinema.tui.run_outcome import RunOutcome, parse_outcome
 from kinema.tui.runtime_status import ACTIVE_STATUSES, RuntimeStatus
 from kinema.tui.screens.base import KinemaScreen, RuntimeView
@@ -199,6 +200,7 @@ class KinemaApp(App[None]):
         # explanation the outcome put on the tree.
         self._ended_ahead: dict[str, tuple[str, str]] = {}
         self.inbox = EventInbox()
+        self.repeats = RepeatLimiter()
         self.views: list[RuntimeView] = []
         self.sub_title = connection.endpoint + ("  (closing stops the runtime)" if owns_runtime else "")
 
@@ -258,13 +260,16 @@ class KinemaApp(App[None]):
                 if event.state is ConnectionState.CONNECTED and was is not ConnectionState.CONNECTED:
                     self._views_call(lambda view: view.runtime_connected())
                 if event.state is ConnectionState.DISCONNECTED and was is ConnectionState.CONNECTED:
-                    self.notify(
-                        event.detail or "The runtime stopped answering.",
-                        title="Disconnected",
-                        severity="error",
+                    self._connection_message(
+                        f"Lost the runtime at {event.endpoint}: {plain_detail(event.detail)}. The app "
+                        "reconnects by itself; if it does not, check that `kinema run` still runs.",
+                        "Disconnected",
+                        LogLevel.WARN,
                     )
                 elif event.state is ConnectionState.CONNECTED and was is ConnectionState.DISCONNECTED:
-                    self.notify(f"Connected to {event.endpoint}", title="Reconnected")
+                    self._connection_message(
+                        f"Connected again to the runtime at {event.endpoint}.", "Reconnected", LogLevel.INFO
+                    )
             elif isinstance(event, Heartbeat):
                 was_connected = self.status.state is ConnectionState.CONNECTED
                 started = self.status.apply_heartbeat(event)
@@ -353,8 +358,28 @@ class KinemaApp(App[None]):
             return
         self.push_screen(MotionQuestionDialog(question), answered)
 
+    def _connection_message(self, text: str, title: str, level: LogLevel) -> None:
+        """A lost or found connection: a toast and a log line, at most one of each kind per period."""
+        held = self.repeats.admit(f"connection {title}", time.monotonic())
+        if held is None:
+            return
+        text += held_back(held)
+        self.add_log(LogEntry(f"{title}: {text}", level, time.time(), "ui"))
+        self.notify(text, title=title, severity="error" if level <= LogLevel.WARN else "information")
+
     def add_log(self, entry: LogEntry, *, toast: bool = False) -> None:
-        """Keep ``entry`` for the Logs screen and, for runtime toasts, show it as a notification."""
+        """Keep ``entry`` for the Logs screen and, for runtime toasts, show it as a notification.
+
+        A watchdog warning is kept and shown once per kind and period (it repeats under load)."""
+        kind = watchdog_kind(entry.message)
+        if kind is not None:
+            held = self.repeats.admit(kind, time.monotonic())
+            if held is None:
+                return
+            message = entry.message.removeprefix("watchdog: ")
+            entry = LogEntry(
+                message[:1].upper() + message[1:] + held_back(held), entry.level, entry.stamp, "watchdog"
+            )
         self.logs.append(entry)
         outcome = parse_outcome(entry.message) if entry.level <= LogLevel.WARN else None
         if outcome is not None:
@@ -486,6 +511,14 @@ class KinemaApp(App[None]):
                         waypoint.description or "Move the robot to this saved waypoint",
                         partial(view.move_to, waypoint.name),
                     )
+
+
+def plain_detail(detail: str) -> str:
+    """Why the connection was lost, in words: the heartbeat timeout says what it means."""
+    if detail.startswith("no heartbeat from the runtime for "):
+        seconds = detail.removeprefix("no heartbeat from the runtime for ").split(" ", 1)[0]
+        return f"no sign of life from it for {seconds} s (it stopped, or the machine is very busy)"
+    return detail or "it stopped answering"
 
 
 def run_app(
