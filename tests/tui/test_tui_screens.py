@@ -60,10 +60,11 @@ def test_configs_show_packages_chain_provenance_and_files(fake: FakeConnection) 
         assert [label.split()[0] for label in chain[1:]] == ["lab_sim", "example_config"]
         rows = table_rows(app.screen.query_one("#resolved-table", DataTable))
         by_key = {row[0]: row for row in rows}
-        assert by_key["based_on_package"][1:] == ["example_config", "lab_sim"]
-        assert by_key["hardware.robot_description.urdf"][1] == "lab_sim"  # inherited
+        # Key, value, and the package that set it.
+        assert by_key["based_on_package"][1:] == ["lab_sim", "example_config"]
+        assert by_key["hardware.robot_description.urdf"][2] == "lab_sim"  # inherited
         # Lists show as written (not swallowed as markup).
-        started = by_key["ros2_control.controllers_active_at_startup"][2]
+        started = by_key["ros2_control.controllers_active_at_startup"][1]
         assert started.startswith("[") and started.endswith("]") and len(started) > 2
         await pilot.press("i")
         await settle(pilot)

@@ -91,7 +91,7 @@ def test_a_person_browses_runs_and_quits_in_a_real_terminal(terminal: Terminal) 
     lines = first.rstrip().splitlines()  # the footer is the last line drawn
     assert "1 Configs" in lines[0] and "6 Waypoints" in lines[0]  # every screen is named, with its key
     assert "● connected fake://runtime" in first  # the status bar
-    assert "⏎ Run selected" in lines[-1] and "^p palette" in lines[-1]  # the footer lists the bindings
+    assert "⏎ Run" in lines[-1] and "^q Quit" in lines[-1] and "^x Cancel" in lines[-1]  # the footer
     terminal.wait_for(lambda s: "Enter or ctrl+r runs" in s, "the list saying what Enter runs")
     assert "○ MoveToWaypoint" in first and "○ Sleep" in first  # the tree, subtree expanded
 

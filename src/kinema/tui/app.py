@@ -126,6 +126,9 @@ class KinemaApp(App[None]):
     """
 
     TITLE = "Kinema"
+    # Screens lay out differently in a narrow (80 columns) or short (24 lines) terminal: app.tcss.
+    HORIZONTAL_BREAKPOINTS = [(0, "-narrow"), (100, "-normal")]
+    VERTICAL_BREAKPOINTS = [(0, "-short"), (32, "-tall")]
     # Absolute, so subclasses defined elsewhere (tests, embedding apps) find the stylesheet too.
     CSS_PATH = Path(__file__).with_name("app.tcss")
     MODES = {

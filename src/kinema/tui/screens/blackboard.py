@@ -53,7 +53,7 @@ class BlackboardScreen(KinemaScreen):
             with Horizontal(classes="toolbar"):
                 yield Input(placeholder="/ filter by key, scope, type or value", id="blackboard-filter")
                 yield Static("", id="blackboard-summary", classes="muted")
-            with Horizontal(classes="split"):
+            with Horizontal(classes="split", id="blackboard-split"):
                 yield BlackboardTable(self.kinema.blackboard, id="blackboard-table")
                 with Vertical(classes="side-panel"):
                     yield Label("History", classes="pane-title")

@@ -10,12 +10,13 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.message import Message
-from textual.widgets import DataTable, Label, OptionList, Static, TabbedContent, TabPane, Tree
+from textual.widgets import Label, OptionList, Static, TabbedContent, TabPane, Tree
 from textual.widgets.option_list import Option
 
 from kinema.errors import KinemaError
 from kinema.tui.config_view import ConfigRow, config_rows, package_files
 from kinema.tui.screens.base import KinemaScreen
+from kinema.tui.widgets.fitted_table import Column, FittedTable
 
 if TYPE_CHECKING:
     from kinema.config import Package, ResolvedConfig, Workspace
@@ -79,16 +80,19 @@ class ConfigsScreen(KinemaScreen):
                     with TabPane("Chain", id="chain"):
                         yield Tree("inheritance", id="chain-tree")
                     with TabPane("Resolved config", id="resolved"):
-                        yield DataTable(id="resolved-table", cursor_type="row", zebra_stripes=True)
+                        yield FittedTable(
+                            (
+                                Column("key", "Key", min_width=14, weight=1),
+                                Column("value", "Value", min_width=16, weight=3),
+                                Column("package", "Set by", min_width=14, weight=0),
+                            ),
+                            id="resolved-table",
+                        )
                     with TabPane("Files", id="files"):
                         yield Tree("files", id="file-tree")
 
     def on_mount(self) -> None:
         super().on_mount()
-        table = self.query_one("#resolved-table", DataTable)
-        table.add_column("Key", key="key")
-        table.add_column("Set by", key="package")
-        table.add_column("Value", key="value")
         self.action_reload()
 
     def action_reload(self) -> None:
@@ -137,11 +141,16 @@ class ConfigsScreen(KinemaScreen):
             title.append(f"  {details.error}", style="red")
         self.query_one("#config-title", Static).update(title)
         self._show_chain(details)
-        table = self.query_one("#resolved-table", DataTable)
-        table.clear()
-        for row in details.rows:
-            own = row.package == details.name
-            table.add_row(Text(row.key), Text(row.package, style="bold" if own else "dim"), Text(row.value))
+        self.query_one("#resolved-table", FittedTable).set_rows(
+            [
+                (
+                    Text(row.key),
+                    Text(row.value),
+                    Text(row.package, style="bold" if row.package == details.name else "dim"),
+                )
+                for row in details.rows
+            ]
+        )
         self._show_files(details)
 
     def _show_chain(self, details: ConfigDetails) -> None:

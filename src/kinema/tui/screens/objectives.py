@@ -11,7 +11,6 @@ from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.widgets import (
     Checkbox,
-    DataTable,
     Input,
     OptionList,
     Select,
@@ -35,6 +34,7 @@ from kinema.tui.messages import ObjectiveOutlineLoaded, ObjectiveRunRequested, O
 from kinema.tui.run_outcome import RunOutcome
 from kinema.tui.screens.base import LOAD_ATTEMPTS, KinemaScreen
 from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
+from kinema.tui.widgets.fitted_table import PORT_COLUMNS, FittedTable
 from kinema.tui.widgets.objective_list import ObjectiveList, ObjectiveSearch
 from kinema.tui.widgets.override_form import OverrideForm
 from kinema.tui.widgets.task_panel import TaskPanel
@@ -70,14 +70,17 @@ class ObjectivesScreen(KinemaScreen):
     # No printable key acts here: letters typed on the list search (ObjectiveList), and running moves the
     # robot, so it is Enter on the highlighted objective or ctrl+r, both naming what will run.
     BINDINGS = [
+        # Shown under the list ("Enter or ctrl+r runs ..."); the footer has Enter's "Run".
         Binding(
-            "ctrl+r", "run", "Run", id="objectives.run", tooltip="Run the selected objective (Enter too)"
+            "ctrl+r", "run", "Run", id="objectives.run", tooltip="Run the selected objective", show=False
         ),
         Binding("slash", "search", "Search", id="objectives.search", tooltip="Search objectives by name"),
         Binding("f2", "tab('tree')", "Tree", id="objectives.tree", tooltip="The behavior tree"),
         Binding("f3", "tab('xml')", "XML", id="objectives.xml", tooltip="The objective's XML"),
         Binding("f4", "tab('parameters')", "Params", id="objectives.parameters", tooltip="Overrides"),
-        Binding("f5", "reload", "Reload", id="objectives.reload", tooltip="List the objectives again"),
+        Binding(
+            "f5", "reload", "Reload", id="objectives.reload", tooltip="List the objectives again", show=False
+        ),
         Binding(
             "ctrl+o",
             "show_failure",
@@ -153,16 +156,10 @@ class ObjectivesScreen(KinemaScreen):
                     with TabPane("Parameters", id="parameters"):
                         yield OverrideForm(id="override-form")
                     with TabPane("Ports", id="ports"):
-                        yield DataTable(id="port-table", cursor_type="row", zebra_stripes=True)
+                        yield FittedTable(PORT_COLUMNS, id="port-table")
 
     def on_mount(self) -> None:
         super().on_mount()
-        ports = self.query_one("#port-table", DataTable)
-        ports.add_column("Port", key="name")
-        ports.add_column("Direction", key="direction")
-        ports.add_column("Type", key="type")
-        ports.add_column("Default", key="default")
-        ports.add_column("Description", key="description")
         self.query_one("#objective-list", OptionList).focus()
         self.query_one(TaskPanel).show_task(self.kinema.task_planning)
         if self.kinema.status.state is ConnectionState.CONNECTED:
@@ -277,11 +274,9 @@ class ObjectivesScreen(KinemaScreen):
             hint.append(f"{objective.name} is a subtree: run an objective that uses it", style="dim")
         self.query_one("#run-hint", Static).update(hint)
         self._show_outcome_of_selected()
-        ports = self.query_one("#port-table", DataTable)
-        ports.clear()
-        for port in objective.ports:
-            cells = (port.name, port.direction, port.type_name, port.default, port.description)
-            ports.add_row(*(Text(v) for v in cells))
+        self.query_one("#port-table", FittedTable).set_rows(
+            [(p.name, p.direction, p.type_name, p.default, p.description) for p in objective.ports]
+        )
         self.run_worker(self.query_one(OverrideForm).show_objective(objective), group="override-form")
         self.query_one(BehaviorTreeView).show_outline(None, "loading …")
         connection = self.kinema.connection

@@ -50,7 +50,7 @@ class ObjectiveList(OptionList):
 
     BINDINGS = [
         Binding(
-            "enter", "select", "Run selected", id="objectives.run_selected", tooltip="Run it on the robot"
+            "enter", "select", "Run", id="objectives.run_selected", tooltip="Run the selected objective"
         ),
     ]
 
