@@ -17,10 +17,12 @@ from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 
+from textual import events
 from textual.app import App, SystemCommand
 from textual.binding import Binding
 from textual.notifications import SeverityLevel
 from textual.screen import Screen
+from textual.timer import Timer
 
 from kinema.tui.blackboard_model import BlackboardModel
 from kinema.tui.connection import (
@@ -42,7 +44,13 @@ from kinema.tui.connection import (
     TaskPlanning,
 )
 from kinema.tui.dialogs.confirm import ConfirmDialog, MotionQuestionDialog
-from kinema.tui.messages import ModeSelected, RuntimeCallFailed, RuntimeCallSucceeded, RuntimeEventsArrived
+from kinema.tui.messages import (
+    KeyDelivered,
+    ModeSelected,
+    RuntimeCallFailed,
+    RuntimeCallSucceeded,
+    RuntimeEventsArrived,
+)
 from kinema.tui.repeat_limiter import RepeatLimiter, held_back, watchdog_kind
 from kinema.tui.run_outcome import RunOutcome, parse_outcome
 from kinema.tui.runtime_status import ACTIVE_STATUSES, RuntimeStatus
@@ -58,6 +66,8 @@ from kinema.tui.widgets.nav_bar import SCREENS
 log = logging.getLogger("kinema.tui")
 
 MAX_LOGS = 2000
+# Seconds the app waits for a key to go all the way up before it gives out the next one anyway.
+KEY_WAIT_S = 1.0
 MAX_RELOADS = 200
 TOAST_SEVERITY = {LogLevel.ERROR: "error", LogLevel.WARN: "warning"}
 # The uid of a tree's root node (BT.CPP numbers the nodes from 1, the root first).
@@ -204,6 +214,11 @@ class KinemaApp(App[None]):
         self._ended_ahead: dict[str, tuple[str, str]] = {}
         self.inbox = EventInbox()
         self.repeats = RepeatLimiter()
+        # Keys taken from the terminal and not yet given out (see on_event).
+        self._pending_keys: deque[events.Key] = deque()
+        self._key_in_flight = False
+        self._switching = False
+        self._key_timer: Timer | None = None
         self.views: list[RuntimeView] = []
         self.sub_title = connection.endpoint + ("  (closing stops the runtime)" if owns_runtime else "")
 
@@ -429,7 +444,61 @@ class KinemaApp(App[None]):
         self.notify(message.what, timeout=3)
 
     def on_mode_selected(self, message: ModeSelected) -> None:
-        self.switch_mode(message.mode)
+        self.run_worker(self.action_switch_mode(message.mode), group="switch-mode")
+
+    # -- one key at a time ------------------------------------------------------------------------------
+
+    # Textual hands a key to whatever has the focus when it takes the key from the terminal, and the key's
+    # bindings run later, when it has bubbled up. Keys typed in a burst (a busy machine, a fast typist)
+    # were all handed to the widget focused before the first of them ran: the letters typed after "/"
+    # went to the table instead of the filter it focuses, those after "3" to the screen being left. So
+    # the app gives out the next key only once the last one has gone all the way up (a KeyDelivered
+    # message sent behind it, along the same path), or its screen switch is done.
+
+    async def on_event(self, event: events.Event) -> None:
+        if isinstance(event, events.Key) and not event.is_forwarded:
+            self._pending_keys.append(event)
+            await self._next_key()
+            return
+        await super().on_event(event)
+
+    async def _next_key(self) -> None:
+        if self._key_in_flight or self._switching or not self._pending_keys:
+            return
+        key = self._pending_keys.popleft()
+        target = self.focused or self.screen
+        self._key_in_flight = True
+        await super().on_event(key)
+        if self._switching:  # a priority binding switched screens: the switch releases the keys
+            self._key_in_flight = False
+            return
+        target.post_message(KeyDelivered())
+        # A key whose widget went away (a dialog it closed) never sends its KeyDelivered up.
+        self._key_timer = self.set_timer(KEY_WAIT_S, self._key_came_back)
+
+    async def on_key_delivered(self, message: KeyDelivered) -> None:
+        message.stop()
+        await self._key_came_back()
+
+    async def _key_came_back(self) -> None:
+        if self._key_timer is not None:
+            self._key_timer.stop()
+            self._key_timer = None
+        self._key_in_flight = False
+        await self._next_key()
+
+    async def action_switch_mode(self, mode: str) -> None:
+        """Show screen ``mode``; the keys typed meanwhile go to it once it is up."""
+        self._switching = True
+        try:
+            await self.switch_mode(mode)
+        finally:
+            self.call_after_refresh(self._switched)
+
+    async def _switched(self) -> None:
+        self._switching = False
+        self._key_in_flight = False
+        await self._next_key()
 
     # -- actions and commands -----------------------------------------------------------------------
 
@@ -459,12 +528,20 @@ class KinemaApp(App[None]):
         """Open the newest recording (of a runtime on this machine) in the replay screen."""
         from kinema.errors import KinemaError
         from kinema.runtime.recordings import latest_recording
-        from kinema.tui.screens.replay import ReplayScreen
+        from kinema.tui.screens.replay import ReplayScreen, load_recording
 
-        try:
-            self.push_screen(ReplayScreen(latest_recording()))
-        except KinemaError as error:
-            self.notify(str(error), title="Nothing to replay", severity="warning", timeout=8)
+        def load() -> None:  # reading a recording takes a while: not on the UI thread
+            try:
+                path = latest_recording()
+                loaded = load_recording(path)
+            except KinemaError as error:
+                self.call_from_thread(
+                    self.notify, str(error), title="Nothing to replay", severity="warning", timeout=8
+                )
+                return
+            self.call_from_thread(lambda: self.push_screen(ReplayScreen(path, loaded)))
+
+        self.run_worker(load, thread=True, group="replay")
 
     def action_show_camera(self, topic: str | None = None) -> None:
         """Open the camera view (on ``topic``, else the last one shown)."""

@@ -56,7 +56,7 @@ class BehaviorsScreen(KinemaScreen):
         reloads.add_column("Message", key="message")
         for notice in self.kinema.reloads:
             self._add_reload(notice)
-        table.focus()
+        self.set_focus(table)
         if self.kinema.status.state is ConnectionState.CONNECTED:
             self.action_reload()
 
@@ -94,7 +94,7 @@ class BehaviorsScreen(KinemaScreen):
         self._refilter()
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
-        self.query_one("#behavior-table", DataTable).focus()
+        self.set_focus(self.query_one("#behavior-table", DataTable))
 
     def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
         if event.data_table.id != "behavior-table" or event.row_key.value is None:
@@ -137,4 +137,4 @@ class BehaviorsScreen(KinemaScreen):
         table.move_cursor(row=table.row_count - 1)
 
     def action_search(self) -> None:
-        self.query_one("#behavior-search", Input).focus()
+        self.set_focus(self.query_one("#behavior-search", Input))

@@ -160,7 +160,7 @@ class ObjectivesScreen(KinemaScreen):
 
     def on_mount(self) -> None:
         super().on_mount()
-        self.query_one("#objective-list", OptionList).focus()
+        self.set_focus(self.query_one("#objective-list", OptionList))
         self.query_one(TaskPanel).show_task(self.kinema.task_planning)
         if self.kinema.status.state is ConnectionState.CONNECTED:
             self.action_reload()

@@ -9,6 +9,7 @@ blackboard is the first snapshot taken after that transition (the end of its tic
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from rich.text import Text
 from textual.app import App, ComposeResult
@@ -19,6 +20,9 @@ from textual.widgets import DataTable, Footer, Static
 
 from kinema.tui.connection import NodeStatus, NodeStatusUpdate
 from kinema.tui.widgets.behavior_tree_view import STATUS_MARK, BehaviorTreeView
+
+if TYPE_CHECKING:
+    from kinema.tui.tree_outline import TreeOutline
 
 
 class ReplayScreen(Screen[None]):
@@ -55,17 +59,11 @@ class ReplayScreen(Screen[None]):
     ReplayScreen #replay-blackboard { width: 2fr; border-left: solid $primary-background; }
     """
 
-    def __init__(self, path: Path) -> None:
+    def __init__(self, path: Path, loaded: tuple[Any, TreeOutline] | None = None) -> None:
         super().__init__()
-        from kinema.runtime.recordings import load_replay
-        from kinema.tui.tree_outline import build_outline
-
         self.path = Path(path)
-        self.replay = load_replay(self.path)
+        self.replay, self.outline = loaded if loaded is not None else load_recording(self.path)
         self.position = 0
-        recording = self.replay.recording
-        main = _first_tree_id(recording.tree_xml)
-        self.outline = build_outline(recording.tree_xml, main, filename=str(self.path))
         self._paths = {node.uid: node for node in self.outline.nodes()}
 
     @property
@@ -194,6 +192,17 @@ class ReplayApp(App[None]):
 
     def on_mount(self) -> None:
         self.push_screen(ReplayScreen(self.path))
+
+
+def load_recording(path: Path) -> tuple[Any, TreeOutline]:
+    """The replay of the recording at ``path`` and its tree's outline (slow for a long run: off the UI)."""
+    from kinema.runtime.recordings import load_replay
+    from kinema.tui.tree_outline import build_outline
+
+    replay = load_replay(Path(path))
+    recording = replay.recording
+    main = _first_tree_id(recording.tree_xml)
+    return replay, build_outline(recording.tree_xml, main, filename=str(path))
 
 
 def _first_tree_id(xml: str) -> str | None:

@@ -63,7 +63,7 @@ class WaypointsScreen(KinemaScreen):
     def on_mount(self) -> None:
         super().on_mount()
         table = self.query_one("#waypoint-table", DataTable)
-        table.focus()
+        self.set_focus(table)
         if self.kinema.status.state is ConnectionState.CONNECTED:
             self.action_reload()
 

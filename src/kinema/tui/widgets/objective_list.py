@@ -49,9 +49,7 @@ class ObjectiveList(OptionList):
     """
 
     BINDINGS = [
-        Binding(
-            "enter", "select", "Run", id="objectives.run_selected", tooltip="Run the selected objective"
-        ),
+        Binding("enter", "select", "Run", id="objectives.run_selected", tooltip="Run the selected objective"),
     ]
 
     def __init__(self, *, search: str, id: str | None = None) -> None:
