@@ -404,3 +404,27 @@ def test_a_result_box_belongs_to_the_objective_it_describes(fake: FakeConnection
         assert panel.has_class("shown") and str(panel.render()).splitlines()[1].startswith("stuck")
 
     drive(fake, scenario)
+
+
+def test_a_run_on_code_whose_reload_failed_says_so_in_the_box_before_the_path(fake: FakeConnection) -> None:
+    # The runtime adds a note when the tree ran behaviors whose latest file failed to load.
+    message = (
+        "objective 'Pick Object' failed (FAILURE): /ws/o.xml:5: Exception in node 'Script::9' [Script]: "
+        "behavior 'Script' raised in tick at /ws/b.py:12: ValueError: version 1\n"
+        "note: /ws/b.py:11: plugin 'p': behavior package 'p' failed to import: SyntaxError: '(' was never "
+        "closed; Script runs the version from 08:01 instead"
+    )
+
+    async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
+        fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
+        fake.emit(Heartbeat(11.0, "Pick Object", "Failure"))
+        fake.emit(LogEntry(message, LogLevel.ERROR, 1.0))
+        await settle(pilot)
+        shown = str(app.screen.query_one("#failure-panel", Static).render()).splitlines()
+        assert shown[1] == "ValueError: version 1"
+        assert shown[2].startswith("note: /ws/b.py:11:") and "SyntaxError" in " ".join(shown[2:4])
+        view = app.screen.query_one(BehaviorTreeView)
+        # The exception escaped before any status was sent: its ancestors failed with it all the same.
+        assert view.shown_as("Script::9") == "FAILURE" and view.shown_as("TopLevelSequence") == "FAILURE"
+
+    drive(fake, scenario)

@@ -13,17 +13,18 @@ from kinema.tui.run_outcome import RunOutcome, failure_text
 
 
 def outcome_text(outcome: RunOutcome) -> Text:
-    """The exception (or the node's message) first, then where it happened, then the runtime's notes."""
+    """The exception (or the node's message) first, then the runtime's notes, then where it happened."""
     explained = failure_text(outcome.message)
     failed = outcome.outcome == "Failure"
     text = Text()
     text.append(explained.headline, style="bold red" if failed else "bold yellow")
-    if explained.where:
-        text.append("\nat ", style="dim")
-        text.append(explained.where)
+    # A note (older code runs: its file did not load) changes what the exception means: before the path.
     for note in explained.notes:
         text.append("\nnote: ", style="bold yellow")
         text.append(note, style="yellow")
+    if explained.where:
+        text.append("\nat ", style="dim")
+        text.append(explained.where)
     return text
 
 

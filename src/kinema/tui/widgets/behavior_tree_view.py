@@ -167,10 +167,12 @@ class BehaviorTreeView(Tree["OutlineNode"]):
             step = self._parents.get(step)
         self.failed_path = list(reversed(path))
         for uid in self.failed_path:
-            if uid in self.halted:
-                # Running when their descendant failed (an exception escaped through them): they failed
-                # with it, as BT.CPP leaves them, which never halts them itself. The runtime's halt that
-                # followed is how it stops a failed tree, not a cancel.
+            if uid != failed.uid and (
+                uid in self.halted or self.statuses.get(uid) in (None, NodeStatus.IDLE)
+            ):
+                # Running when their descendant failed (an exception escaped through them, maybe before
+                # their status was even sent): they failed with it; BT.CPP never halts them itself, and
+                # the runtime's halt that followed is how it stops a failed tree, not a cancel.
                 self.halted.discard(uid)
                 self.statuses[uid] = NodeStatus.FAILURE
             self._relabel(uid)
@@ -211,10 +213,10 @@ class BehaviorTreeView(Tree["OutlineNode"]):
                 depth, parent = depth + 1, parent.parent
             width = max(30, self.size.width - 4 * (depth + 1) - 2)
             lines.extend(_wrapped("why: ", explained.headline, "bold red", width))
-            if explained.where:
-                lines.extend(_wrapped("at: ", explained.where, "bold", width))
             for note in explained.notes:
                 lines.extend(_wrapped("note: ", note, "bold yellow", width))
+            if explained.where:
+                lines.extend(_wrapped("at: ", explained.where, "bold", width))
         lines.append(Text(f"path: {node.path}" + (f"  (line {node.line})" if node.line else ""), style="dim"))
         for line in lines:
             self._details.append(item.add_leaf(line))
