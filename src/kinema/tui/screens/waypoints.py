@@ -38,23 +38,23 @@ class WaypointsScreen(KinemaScreen):
         self.waypoints: list[WaypointSummary] = []
 
     def compose_body(self) -> ComposeResult:
-        with Horizontal(classes="split"):
+        with Horizontal(classes="split", id="waypoint-split"):
             with Vertical(classes="main"):
                 yield FittedTable(
                     (
                         Column("favorite", "", min_width=1, weight=0),
                         Column("name", "Waypoint", min_width=14, weight=1),
-                        Column("groups", "Groups", min_width=8, weight=1, drop=2),
+                        Column("groups", "Groups", min_width=8, weight=1, drop=2, wrap=False),
                         Column("description", "Description", min_width=14, weight=2, drop=1),
                     ),
                     id="waypoint-table",
                 )
             with Vertical(classes="side-panel"):
                 yield Static("", id="waypoint-title", classes="pane-title")
-                # A position is never cut: "-1.5708" shown as "-" says nothing (the joint name wraps).
+                # A position is never cut: "-1.5708" shown as "-" says nothing (a long joint name is).
                 yield FittedTable(
                     (
-                        Column("joint", "Joint", min_width=8, weight=1),
+                        Column("joint", "Joint", min_width=8, weight=1, wrap=False),
                         Column("position", "Position", min_width=9, weight=0),
                     ),
                     id="joint-table",

@@ -25,6 +25,8 @@ class Column:
         min_width: the narrowest it gets (never wider than its widest cell needs).
         weight: its share of the width left once every column has its minimum.
         drop: dropping order when the minimums do not fit: the highest goes first; 0 is never dropped.
+        wrap: a cell wider than the column wraps onto more lines; False cuts it with an ellipsis (a name
+            read at a glance, such as a joint's, beside a value that must never be cut).
     """
 
     key: str
@@ -32,6 +34,7 @@ class Column:
     min_width: int = 8
     weight: float = 1.0
     drop: int = 0
+    wrap: bool = True
 
 
 #: The ports of an objective or a behavior: the description stays, the direction goes first.
@@ -126,8 +129,18 @@ class FittedTable(DataTable[Text]):
             if column_width:
                 self.add_column(spec.label, key=spec.key, width=column_width)
         for row, key in zip(self.rows_data, self.row_keys_data, strict=True):
-            cells = [cell for cell, column_width in zip(row, widths, strict=True) if column_width]
-            wraps = any(cell.cell_len > w for cell, w in zip(row, widths, strict=True) if w)
+            cells = []
+            wraps = False
+            for cell, spec, column_width in zip(row, self.specs, widths, strict=True):
+                if not column_width:
+                    continue
+                if cell.cell_len > column_width:
+                    if spec.wrap:
+                        wraps = True
+                    else:
+                        cell = cell.copy()
+                        cell.truncate(column_width, overflow="ellipsis")
+                cells.append(cell)
             self.add_row(*cells, key=key, height=None if wraps else 1)
         if self.row_count:
             self.move_cursor(row=min(cursor, self.row_count - 1), animate=False)
