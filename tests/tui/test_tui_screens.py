@@ -42,6 +42,15 @@ def tree_labels(tree: Tree) -> list[str]:  # type: ignore[type-arg]
     return out
 
 
+def _nodes(tree: Tree) -> list:  # type: ignore[type-arg]
+    found, stack = [], [tree.root]
+    while stack:
+        node = stack.pop()
+        found.append(node)
+        stack.extend(node.children)
+    return found
+
+
 # -- Configs -------------------------------------------------------------------------------------
 
 
@@ -70,6 +79,20 @@ def test_configs_show_packages_chain_provenance_and_files(fake: FakeConnection) 
         await settle(pilot)
         files = tree_labels(app.screen.query_one("#file-tree", Tree))
         assert "config/" in files and "config.yaml" in files and "package.xml" in files
+        # Enter on a file opens it, read-only; Escape goes back (a new user found the tab opened nothing).
+        tree = app.screen.query_one("#file-tree", Tree)
+        package_xml = next(n for n in _nodes(tree) if str(n.label) == "package.xml")
+        tree.move_cursor(package_xml)
+        app.screen.set_focus(tree)
+        await pilot.press("enter")
+        await settle(pilot)
+        from kinema.tui.dialogs.file_view import FileViewDialog
+
+        assert isinstance(app.screen, FileViewDialog)
+        assert "<name>example_config</name>" in app.screen.query_one("#file-text").text
+        await pilot.press("escape")
+        await settle(pilot)
+        assert not isinstance(app.screen, FileViewDialog)
 
     drive(fake, scenario, mode="configs")
 
