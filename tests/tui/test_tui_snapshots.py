@@ -306,3 +306,18 @@ LAB_SIM_JOINTS = (
     "robotiq_85_left_knuckle_joint",
 )
 LAB_SIM_HOME = (0.0, -1.5708, -1.5708, 1.5708, -1.5708, -1.5708, 0.0, 0.7929)
+
+
+def test_camera_screen(snap_compare, size, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    from test_tui_camera import picture
+
+    monkeypatch.setenv("KINEMA_TUI_IMAGE", "halfcell")
+    fake = FakeConnection.demo()
+    fake.cameras = {"/wrist_camera/color": picture((200, 30, 30))}
+    app = QuietApp(fake, initial_mode="objectives", camera="/wrist_camera/color")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        await pilot.pause(0.5)  # the screen redraws every 0.2 s
+
+    assert snap_compare(app, terminal_size=size, run_before=run_before)

@@ -16,10 +16,11 @@ from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
-from textual.widgets import DataTable, Footer, Static
+from textual.widgets import Footer, Static
 
 from kinema.tui.connection import NodeStatus, NodeStatusUpdate
 from kinema.tui.widgets.behavior_tree_view import STATUS_MARK, BehaviorTreeView
+from kinema.tui.widgets.fitted_table import Column, FittedTable
 
 if TYPE_CHECKING:
     from kinema.tui.tree_outline import TreeOutline
@@ -79,7 +80,15 @@ class ReplayScreen(Screen[None]):
                 yield BehaviorTreeView(id="behavior-tree")
             with Vertical(id="replay-blackboard"):
                 yield Static("Blackboard", id="replay-blackboard-title", classes="pane-title")
-                yield DataTable(id="replay-entries", cursor_type="row", zebra_stripes=True)
+                yield FittedTable(
+                    (
+                        Column("scope", "Scope", min_width=8, weight=1, drop=1, wrap=False),
+                        Column("key", "Key", min_width=8, weight=1, wrap=False),
+                        Column("type", "Type", min_width=6, weight=0.5, drop=2, wrap=False),
+                        Column("value", "Value", min_width=10, weight=3),
+                    ),
+                    id="replay-entries",
+                )
         yield Footer()
 
     def on_mount(self) -> None:
@@ -91,9 +100,6 @@ class ReplayScreen(Screen[None]):
         if recording.trailing_bytes:
             title.append("  (the recording was cut short)", style="yellow")
         self.query_one("#replay-title", Static).update(title)
-        table = self.query_one("#replay-entries", DataTable)
-        for column in ("Scope", "Key", "Type", "Value"):
-            table.add_column(column, key=column.lower())
         self.query_one(BehaviorTreeView).show_outline(self.outline)
         self.show_position(0)
 
@@ -148,15 +154,16 @@ class ReplayScreen(Screen[None]):
         self.query_one("#replay-position", Static).update(text)
 
     def _show_blackboard(self, t_us: int) -> None:
-        table = self.query_one("#replay-entries", DataTable)
-        table.clear()
+        table = self.query_one("#replay-entries", FittedTable)
         frame = self.replay.blackboard_at(t_us) if self.position else None
         title = "Blackboard" if frame is None else f"Blackboard (snapshot at +{frame.t_us / 1e6:.3f} s)"
         self.query_one("#replay-blackboard-title", Static).update(title)
-        if frame is None:
-            return
-        for scope, key, type_name, value in frame.entries:
-            table.add_row(Text(scope), Text(key, style="bold"), Text(type_name, style="dim"), Text(value))
+        table.set_rows(
+            [
+                (Text(scope), Text(key, style="bold"), Text(type_name, style="dim"), Text(value))
+                for scope, key, type_name, value in (frame.entries if frame is not None else ())
+            ]
+        )
 
     def action_step(self, delta: int) -> None:
         self.show_position(self.position + delta)
