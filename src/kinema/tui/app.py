@@ -539,7 +539,10 @@ class KinemaApp(App[None]):
                     self.notify, str(error), title="Nothing to replay", severity="warning", timeout=8
                 )
                 return
-            self.call_from_thread(lambda: self.push_screen(ReplayScreen(path, loaded)))
+            def show() -> None:
+                self.push_screen(ReplayScreen(path, loaded))
+
+            self.call_from_thread(show)
 
         self.run_worker(load, thread=True, group="replay")
 
