@@ -119,7 +119,8 @@ class WaypointsScreen(KinemaScreen):
             joints.set_rows([])
             title.update(Text("No waypoint selected", style="dim"))
             return
-        title.update(Text(waypoint.name, style="bold"))
+        # Enter moves the robot: the panel says where to, before the key is pressed.
+        title.update(Text.assemble((waypoint.name, "bold"), ("\nEnter moves the robot here", "dim")))
         joints.set_rows(
             [
                 (Text(name), Text(f"{position:+.4f}"))
