@@ -145,7 +145,7 @@ def bench_ik(repeats: int) -> None:
     for T in targets:
         t0 = time.perf_counter()
         try:
-            ik(model, T, seed, options=opts)
+            ik(model, T, seed, options=opts, group="manipulator")
         except Exception:
             failures += 1
         times.append(time.perf_counter() - t0)
@@ -170,16 +170,26 @@ def bench_planning_and_timing(repeats: int) -> None:
     arm = model.group("manipulator").joint_names
     forced = PlanningOptions(try_direct=False)
     time_parameterize(  # warm-up: toppra and scipy import on first use
-        plan_joint_goal(checker, qs["Home"], {j: qs["3 Waypoint Mid Point"][model.index(j)] for j in arm}),
+        plan_joint_goal(
+            checker,
+            qs["Home"],
+            {j: qs["3 Waypoint Mid Point"][model.index(j)] for j in arm},
+            group="manipulator",
+        ),
         model,
     )
     print("Planning, manipulator group, padding 0.01 m (p50 over repeats)")
     paths = []
     for start, goal in QUERIES:
         goal_map = {j: float(qs[goal][model.index(j)]) for j in arm}
-        default_t, path = _time(lambda s=start, g=goal_map: plan_joint_goal(checker, qs[s], g), repeats)
+        default_t, path = _time(
+            lambda s=start, g=goal_map: plan_joint_goal(checker, qs[s], g, group="manipulator"), repeats
+        )
         ompl_t, _ = _time(
-            lambda s=start, g=goal_map: plan_joint_goal(checker, qs[s], g, options=forced), repeats
+            lambda s=start, g=goal_map: plan_joint_goal(
+                checker, qs[s], g, options=forced, group="manipulator"
+            ),
+            repeats,
         )
         paths.append((f"{start} -> {goal}", path))
         p50, peer = _p(default_t, 50) * 1e3, _p(ompl_t, 50) * 1e3

@@ -96,9 +96,16 @@ def main() -> None:
             name,
             [
                 CurrentState(start),
-                Connect(MotionSettings(link_padding=0.0)),
-                MoveAlongFrameAxis((0, 0, 1), "grasp_link", "grasp_link", APPROACH, APPROACH),
-                BatchPoseIK([("world", t) for t in targets], "grasp_link"),
+                Connect(MotionSettings(link_padding=0.0, group="manipulator")),
+                MoveAlongFrameAxis(
+                    (0, 0, 1),
+                    "grasp_link",
+                    "grasp_link",
+                    APPROACH,
+                    APPROACH,
+                    motion=MotionSettings(group="manipulator", link_padding=0.0),
+                ),
+                BatchPoseIK([("world", t) for t in targets], "grasp_link", group="manipulator"),
             ],
         )
 
@@ -130,12 +137,18 @@ def main() -> None:
         (
             "around a block, seeded",
             lambda: plan_joint_goal(
-                blocked, mid, pick, options=PlanningOptions(timeout=5.0, seed=next(seeds))
+                blocked,
+                mid,
+                pick,
+                options=PlanningOptions(timeout=5.0, seed=next(seeds)),
+                group="manipulator",
             ),
         ),
         (
             "around a block, OMPL",
-            lambda: plan_joint_goal(blocked, mid, pick, options=PlanningOptions(timeout=5.0)),
+            lambda: plan_joint_goal(
+                blocked, mid, pick, options=PlanningOptions(timeout=5.0), group="manipulator"
+            ),
         ),
     ]
     results = {}

@@ -41,7 +41,8 @@ def _faster(command: str) -> str:
 class Reader:
     """Types the tutorial's commands into a fresh environment and keeps what they print."""
 
-    def __init__(self, home: Path) -> None:
+    def __init__(self, home: Path, document: str = "tutorial") -> None:
+        self.document = document
         self.cwd = home
         bin_dir = str(Path(sys.executable).parent)
         self.env = {
@@ -57,6 +58,7 @@ class Reader:
         for variable in ("KINEMA_WORKSPACE", "KINEMA_CONFIG"):
             self.env.pop(variable, None)
         self.background: list[tuple[subprocess.Popen[bytes], Path]] = []
+        self.outputs: list[tuple[str, str]] = []  # (command, what it printed), in order
 
     def save(self, step: Step) -> None:
         path = self.cwd / step.path
@@ -73,9 +75,11 @@ class Reader:
                 output = self._start_background(step, text)
             else:
                 output = self._run_one(step, text)
+            self.outputs.append((text, output))
             missing = missing_lines(command.expected, output)
             assert not missing, (
-                f"tutorial line {step.line}: `{text}` did not print {missing[0]!r}; it printed:\n{output}"
+                f"{self.document} line {step.line}: `{text}` did not print {missing[0]!r}; "
+                f"it printed:\n{output}"
             )
 
     def _run_one(self, step: Step, text: str) -> str:

@@ -170,7 +170,7 @@ def test_approving_a_planned_task_shows_its_motions_and_draws_it_in_the_view(mon
     from kinema.testing import tick_behavior
     from kinema.transport import Node, free_endpoint, host_router, open_session
     from kinema.tui.sdk_connection import SdkConnection
-    from kinema.viz.topics import MARKER_ARRAY_TOPIC, MARKER_ARRAY_TYPE, PLANNED_TRAJECTORY_TOPIC
+    from kinema.ui_topics import MARKER_ARRAY_TOPIC, MARKER_ARRAY_TYPE, PLANNED_TRAJECTORY_TOPIC
 
     monkeypatch.delenv("KINEMA_AUTO_APPROVE", raising=False)
     model = RobotDescription.lab_sim().load_model()

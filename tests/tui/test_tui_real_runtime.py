@@ -6,6 +6,7 @@ Only built-in BT nodes are used, so no robot, simulator or behavior plugin is ne
 from __future__ import annotations
 
 import asyncio
+import contextlib
 import os
 import socket
 import subprocess
@@ -193,11 +194,16 @@ def test_saved_objective_files_show_up_and_a_broken_one_is_reported_with_its_lin
             screen = app.screen
             assert isinstance(screen, ObjectivesScreen)
             await wait_for(pilot, lambda: len(screen.objectives) == 1, "the objective list")
-            await asyncio.sleep(0.5)  # let the watcher settle before the first save
 
+            # The runtime's watcher may still be setting up when the list first shows: a save before it
+            # watches goes unseen, so the file is saved again until the list shows it.
             new = COUNT_UP.replace("Count Up", "Count Again")
-            (tmp_path / "count_again.xml").write_text(new)
-            await wait_for(pilot, lambda: len(screen.objectives) == 2, "the saved objective in the list")
+            deadline = time.monotonic() + 20.0
+            while len(screen.objectives) != 2:
+                assert time.monotonic() < deadline, "the saved objective never showed in the list"
+                (tmp_path / "count_again.xml").write_text(new)
+                with contextlib.suppress(AssertionError):
+                    await wait_for(pilot, lambda: len(screen.objectives) == 2, "the saved objective", 2.0)
             assert any(notice.ok and "count_again.xml" in notice.message for notice in app.reloads)
 
             (tmp_path / "broken.xml").write_text(

@@ -231,7 +231,7 @@ def test_the_arm_moves_while_a_trajectory_executes(
 
 def test_a_planned_trajectory_is_drawn_as_the_tool_path(runtime: Runtime, page: HeadlessChromium) -> None:
     from kinema.transport import Node, from_dict
-    from kinema.viz.topics import PLANNED_TRAJECTORY_TOPIC, PLANNED_TRAJECTORY_TYPE
+    from kinema.ui_topics import PLANNED_TRAJECTORY_TOPIC, PLANNED_TRAJECTORY_TYPE
 
     node = Node(runtime.router, "viz_test_planner")
     try:
@@ -253,7 +253,7 @@ def test_a_visualize_pose_triad_appears_and_expires_after_its_lifetime(
     runtime: Runtime, page: HeadlessChromium
 ) -> None:
     from kinema.transport import Node, from_dict
-    from kinema.viz.topics import MARKER_ARRAY_TOPIC, MARKER_ARRAY_TYPE
+    from kinema.ui_topics import MARKER_ARRAY_TOPIC, MARKER_ARRAY_TYPE
 
     triad = []
     for axis in range(3):

@@ -79,3 +79,13 @@ def test_same_key_replaces_and_delete_removes() -> None:
     assert replaced[0][:2] == ("delete", "/m/a/1")
     removed = board.update(_marker("a", 1, 0.0, action=2), np.eye(4))
     assert [c[:2] for c in removed] == [("delete", "/m/a/1")] and board.keys == []
+
+
+def test_a_marker_with_a_nan_orientation_is_skipped_and_the_rest_still_drawn() -> None:
+    board = MarkerBoard("/m", clock=FakeClock())
+    broken = _marker("bad", 0, 0.0)
+    broken.pose.orientation = NS(x=float("nan"), y=0.0, z=0.0, w=1.0)
+    assert board.update(broken, np.eye(4)) == [] and board.keys == []
+    unset = _marker("unset", 0, 0.0)
+    unset.pose.orientation = NS(x=0.0, y=0.0, z=0.0, w=0.0)  # never filled in: the identity, as in RViz
+    assert [c[0] for c in board.update(unset, np.eye(4))].count("set_object") == 2

@@ -55,3 +55,11 @@ def test_an_update_replaces_what_was_drawn_and_unknown_frames_are_skipped() -> N
     assert layer.object_ids == ["c"]
     assert [c[1] for c in commands if c[0] == "delete"] == ["/root"]
     assert not any(path.startswith("/root/b") for _, path, _ in commands)
+
+
+def test_an_object_whose_pose_has_a_nan_is_skipped() -> None:
+    bad = _box("bad")
+    bad["pose"]["orientation"] = {"x": float("nan"), "w": 1.0}
+    layer = PlanningSceneLayer("/root")
+    layer.update(_scene([bad, _box("good")]))
+    assert layer.object_ids == ["good"]

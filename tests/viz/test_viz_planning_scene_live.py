@@ -7,10 +7,11 @@ import time
 from typing import Any
 
 from kinema.resources import bundled_dir
+from kinema.runtime.names import PLANNING_SCENE as PLANNING_SCENE_TOPIC
+from kinema.runtime.names import PLANNING_SCENE_TYPE
 from kinema.transport import Node, from_dict, open_session
 from kinema.viz.scene_model import SceneModel
 from kinema.viz.scene_viewer import SceneViewer
-from kinema.viz.topics import PLANNING_SCENE_TOPIC, PLANNING_SCENE_TYPE
 
 
 class RecordingServer:

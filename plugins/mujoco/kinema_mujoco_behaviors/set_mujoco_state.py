@@ -5,8 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from kinema.behaviors import PortInfo, ServiceClientBehavior, input_port
-
-SET_STATE_SERVICE = "/mujoco/set_state"
+from kinema.drivers.mujoco.names import SET_STATE_SERVICE
 
 
 class SetMujocoState(ServiceClientBehavior["kinema_msgs/srv/SetMujocoState"]):

@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import inspect
 import re
+from builtins import type as type_of
 from typing import Any, ClassVar
 
 from kinema.behaviors.context import BehaviorContext
@@ -41,6 +42,43 @@ class Behavior:
     # Set on the per-registry subclass made by kinema.behaviors.binding (never by authors).
     kinema_context: ClassVar[BehaviorContext | None] = None
     kinema_plugin: ClassVar[str] = ""
+    # Port name -> (cell value key, empty reads as default), for ports declared with cell_input_port
+    # (set by the binding).
+    kinema_cell_ports: ClassVar[dict[str, tuple[str, bool]]] = {}
+
+    def get_input(self, name: str, type: Any = None) -> Any:
+        """The value of input port ``name`` (see the engine's ``TreeNode.get_input``).
+
+        A port declared with :func:`~kinema.behaviors.cell_ports.cell_input_port` that is empty or
+        missing reads as the cell's configured value; without one it fails naming the config key to set.
+        """
+        found = type_of(self).kinema_cell_ports.get(name)
+        if found is None:
+            return super().get_input(name, type)  # type: ignore[misc]
+        cell_key, empty_is_default = found
+        from kinema.bt.node import PortError
+
+        try:
+            value = super().get_input(name, type)  # type: ignore[misc]
+        except PortError:
+            value = None
+        if value is not None and (value != "" or not empty_is_default):
+            return value
+        context = self.context
+        from kinema.behaviors.cell_ports import missing_cell_value_message
+        from kinema.errors import ConfigError
+
+        try:
+            cell = context.cell
+        except ConfigError as error:
+            raise PortError(f"port [{name}]: the config's robot settings are wrong: {error}") from None
+        resolved = cell.value(cell_key) if cell is not None else None
+        if resolved is None:
+            config = getattr(context.config, "name", None)
+            raise PortError(
+                f"node '{self.full_path}': {missing_cell_value_message(name, cell_key, config)}"  # type: ignore[attr-defined]
+            )
+        return resolved
 
     @classmethod
     def metadata(cls) -> dict[str, str]:

@@ -14,6 +14,7 @@ from __future__ import annotations
 import functools
 from typing import TYPE_CHECKING, Any
 
+from kinema.behaviors.cell_ports import cell_ports, resolve_cell_ports
 from kinema.behaviors.faults import BehaviorExecutionError, behavior_fault
 from kinema.bt import NodeStatus
 from kinema.bt.errors import NodeExecutionError
@@ -49,7 +50,20 @@ def bind_behavior(registration: BehaviorRegistration, context: BehaviorContext) 
         except BaseException as error:
             raise behavior_fault(self, error, "halt") from error
 
-    namespace = {
+    namespace: dict[str, Any] = {}
+    declared = base.provided_ports()  # type: ignore[attr-defined]
+    by_cell = cell_ports(declared)
+    if by_cell:
+        # The ports' defaults are this cell's values (kinema.behaviors.cell_ports); the config is read
+        # when the factory registers the class, not per tick.
+        resolved = resolve_cell_ports(declared, _cell_of(context))
+
+        def provided_ports(cls: type) -> list[Any]:
+            return list(resolved)
+
+        namespace["provided_ports"] = classmethod(provided_ports)
+        namespace["kinema_cell_ports"] = by_cell
+    namespace |= {
         "__slots__": (),
         "__module__": base.__module__,
         "__qualname__": base.__qualname__,
@@ -60,3 +74,14 @@ def bind_behavior(registration: BehaviorRegistration, context: BehaviorContext) 
         "halt": halt,
     }
     return type(base.__name__, (base,), namespace)
+
+
+def _cell_of(context: BehaviorContext) -> Any:
+    """The context's cell settings; None when there are none or they cannot be read (the error shows
+    where the settings are checked: ``kinema build`` and the runtime's start)."""
+    from kinema.errors import ConfigError
+
+    try:
+        return context.cell
+    except ConfigError:
+        return None

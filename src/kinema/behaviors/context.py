@@ -1,22 +1,29 @@
-"""What a behavior reaches the world through: transport node, clock, robot model, log sink.
+"""What a behavior reaches its cell through: transport node, clock, robot model, planning scene, joint
+states, frames, cameras, config, log sink.
 
 One :class:`BehaviorContext` is shared by every behavior of a tree (MoveIt Pro's
-``BehaviorContext``/"shared resources"). The runtime builds it once with its transport node, the
-runtime clock (sim time in simulation) and the robot model provider, and passes it to
-:meth:`kinema.plugins.BehaviorRegistry.create_factory`.
+``BehaviorContext``/"shared resources"). The runtime builds it once per cell with its transport node, the
+runtime clock (sim time in simulation), the robot model provider and the config, and passes it to
+:meth:`kinema.plugins.BehaviorRegistry.create_factory`. The services a behavior uses are members of it,
+made on first use (a behavior that never plans never loads the planning scene); a behavior never keeps
+per-cell state in a module-level table, it asks its context (:meth:`BehaviorContext.shared`).
 """
 
 from __future__ import annotations
 
 import threading
 from collections.abc import Callable
-from typing import TYPE_CHECKING, Any, overload
+from typing import TYPE_CHECKING, Any, TypeVar, overload
 
 from kinema.behaviors.logger import BehaviorLogger, LogSink
 from kinema.errors import ObjectiveError
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from kinema.bt import Clock
+    from kinema.config.cell import CellSettings
+    from kinema.config.inheritance import ResolvedConfig
     from kinema.interfaces.definition import (
         ActionDefinition,
         FeedbackT,
@@ -26,7 +33,17 @@ if TYPE_CHECKING:
         ResultT,
         ServiceDefinition,
     )
-    from kinema.transport import ActionClient, QoS, ServiceClient
+    from kinema.motion.cell_frames import CellFrames
+    from kinema.motion.joint_state_monitor import JointStateMonitor
+    from kinema.motion.planning_scene import PlanningScene
+    from kinema.motion.robot_model import RobotModel
+    from kinema.transport import ActionClient, Node, QoS, ServiceClient
+
+T = TypeVar("T")
+PlanningSceneListener = Callable[["PlanningScene"], None]
+
+
+_UNSET = object()
 
 
 class BehaviorContext:
@@ -41,29 +58,57 @@ class BehaviorContext:
             (so a behavior that never asks for it never pays for loading it).
         config: the resolved config package the runtime runs (``kinema.config.ResolvedConfig``), for
             behaviors that need its files (the MuJoCo scene as planning scene, say); None without one.
+        planning_scene: the planning scene, or a callable of this context that makes it on first use;
+            by default the static geometry of the config's MuJoCo scene (empty without one).
     """
 
     def __init__(
         self,
-        node: Any = None,
+        node: Node | None = None,
         *,
         clock: Clock | None = None,
         log_sink: LogSink | None = None,
-        robot_model: Any = None,
-        config: Any = None,
+        robot_model: RobotModel | Callable[[], RobotModel | None] | None = None,
+        config: ResolvedConfig | None = None,
+        planning_scene: PlanningScene | Callable[[BehaviorContext], PlanningScene] | None = None,
     ) -> None:
         if clock is None:
             from kinema.bt import WallClock
 
             clock = WallClock()
-        self.node = node
-        self.config = config
+        self.node: Node | None = node
+        self.config: ResolvedConfig | None = config
         self.clock = clock
         self.log_sink = log_sink if log_sink is not None else LogSink()
-        self._robot_model = robot_model
+        self._robot_model: Any = robot_model
+        self._cell: Any = _UNSET
         self._robot_model_lock = threading.Lock()
         self._endpoints: dict[tuple[Any, ...], Any] = {}
         self._endpoints_lock = threading.Lock()
+        self._scene: PlanningScene | None = None
+        self._scene_provider: Callable[[BehaviorContext], PlanningScene] = _default_planning_scene
+        if callable(planning_scene):
+            self._scene_provider = planning_scene
+        else:
+            self._scene = planning_scene
+        self._scene_listeners: list[PlanningSceneListener] = []
+        self._services: dict[str, Any] = {}
+        # Re-entrant: a service made on first use may use another (the frames read the planning scene).
+        self._services_lock = threading.RLock()
+
+    @property
+    def cell(self) -> CellSettings | None:
+        """The cell's robot settings (planning group, tool frame, gripper, ...) from the config; None
+        without a config. Read once, on first use.
+
+        Raises:
+            ConfigError: the config's robot settings are wrong (the message names config.yaml's line).
+        """
+        if self._cell is _UNSET:
+            from kinema.config.cell import CellSettings
+
+            self._cell = CellSettings.from_config(self.config) if self.config is not None else None
+        return self._cell  # type: ignore[return-value]
 
     @classmethod
     def offline(cls) -> BehaviorContext:
@@ -71,17 +116,92 @@ class BehaviorContext:
         return cls()
 
     @property
-    def robot_model(self) -> Any:
+    def robot_model(self) -> RobotModel | None:
         """The robot model (built on first access when a provider callable was given); None if unset."""
         with self._robot_model_lock:
             if callable(self._robot_model) and not isinstance(self._robot_model, type):
                 self._robot_model = self._robot_model()
-            return self._robot_model
+            model: RobotModel | None = self._robot_model
+            return model
 
     def set_robot_model(self, model_or_provider: Any) -> None:
         """Set the robot model, or a zero-argument callable that builds it on first use."""
         with self._robot_model_lock:
             self._robot_model = model_or_provider
+
+    # -- the cell's services -------------------------------------------------------------------------
+
+    @property
+    def planning_scene(self) -> PlanningScene:
+        """The cell's planning scene: what planning checks, ``/monitored_planning_scene`` publishes and
+        ``/get_planning_scene`` serves (made on first use; see the ``planning_scene`` argument)."""
+        with self._services_lock:
+            if self._scene is not None:
+                return self._scene
+            scene = self._scene = self._scene_provider(self)
+            listeners = list(self._scene_listeners)
+        for listener in listeners:
+            listener(scene)
+        return scene
+
+    @property
+    def loaded_planning_scene(self) -> PlanningScene | None:
+        """The planning scene if it was made or set, else None (reading this loads nothing)."""
+        with self._services_lock:
+            return self._scene
+
+    def set_planning_scene(self, scene: PlanningScene) -> None:
+        """Plan against (and serve) ``scene`` in every behavior of this context from now on."""
+        with self._services_lock:
+            self._scene = scene
+            listeners = list(self._scene_listeners)
+        for listener in listeners:
+            listener(scene)
+
+    def on_planning_scene(self, listener: PlanningSceneListener) -> None:
+        """Call ``listener`` with the planning scene once it is made, and with each one set after it (the
+        runtime publishes them)."""
+        with self._services_lock:
+            self._scene_listeners.append(listener)
+            scene = self._scene
+        if scene is not None:
+            listener(scene)
+
+    @property
+    def joint_states(self) -> JointStateMonitor:
+        """The cell's joint state monitor (``/joint_states``, subscribed on first use).
+
+        Raises:
+            ObjectiveError: the context has no transport node.
+        """
+        from kinema.motion.joint_state_monitor import JointStateMonitor
+
+        return self.shared("joint_states", lambda: JointStateMonitor(self.require_node()))
+
+    @property
+    def frames(self) -> CellFrames:
+        """The cell's frames: robot links at a configuration, cameras, simulated and planning-scene
+        objects (``frames.tree(q)`` is a :class:`~kinema.motion.FrameTree`)."""
+        from kinema.motion.cell_frames import CellFrames
+
+        return self.shared("frames", lambda: CellFrames(self))
+
+    @property
+    def cameras(self) -> dict[str, np.ndarray]:
+        """``world_T_camera`` of the cell's world-fixed cameras (of the config's MuJoCo scene)."""
+        return self.frames.cameras
+
+    def shared(self, key: str, create: Callable[[], T]) -> T:
+        """The value this context keeps under ``key``, made by ``create`` on first use.
+
+        Per-cell state of a behavior family (a cache, a counter) lives here, so two cells in one process
+        never share it and it goes away with the context.
+        """
+        with self._services_lock:
+            if key not in self._services:
+                self._services[key] = create()
+            value: T = self._services[key]
+            return value
 
     def require_node(self, behavior: str = "") -> Any:
         """Return the transport node, or raise a clear error when this context has none.
@@ -161,11 +281,16 @@ class BehaviorContext:
             return endpoint
 
     def close(self) -> None:
-        """Close the clients and publishers this context created (the node itself is the caller's)."""
+        """Close the clients, publishers and subscriptions this context created (the node itself is the
+        caller's)."""
         with self._endpoints_lock:
             endpoints, self._endpoints = list(self._endpoints.values()), {}
         for endpoint in endpoints:
             endpoint.close()
+        with self._services_lock:
+            monitor = self._services.pop("joint_states", None)
+        if monitor is not None:
+            monitor.close()
 
     @property
     def logger(self) -> BehaviorLogger:
@@ -179,3 +304,16 @@ class BehaviorContext:
         return BehaviorLogger(
             self.log_sink, behavior_id=behavior_id, node_name=node_name, node_path=node_path, plugin=plugin
         )
+
+
+def _default_planning_scene(context: BehaviorContext) -> PlanningScene:
+    """The static geometry of the config's MuJoCo scene (tables, walls, trays), without the robot's own
+    links; an empty scene without a MuJoCo scene."""
+    from kinema.motion.planning_scene import PlanningScene
+
+    config = context.config
+    path = config.mujoco_model_path if config is not None else None
+    if path is None:
+        return PlanningScene()
+    model = context.robot_model
+    return PlanningScene.from_mjcf(path, model.link_names if model is not None else ())

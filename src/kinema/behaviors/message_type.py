@@ -17,6 +17,8 @@ from __future__ import annotations
 import json
 from typing import Any, ClassVar
 
+from kinema.nesting import loads_json
+
 _TYPES: dict[str, type] = {}
 
 
@@ -49,7 +51,7 @@ class MessageValue(metaclass=MessageTypeMeta):
 
         try:
             if text.startswith("json:"):
-                data = json.loads(text[5:])
+                data = loads_json(text[5:], f"the {cls.ros_type} JSON")
                 if not isinstance(data, dict):
                     raise ValueError(f"{cls.ros_type} JSON must be an object, got {text[5:][:80]}")
                 return from_dict(cls.ros_type, data)

@@ -6,7 +6,9 @@ at its next ``await``); plain functions run in a thread pool. Both are started l
 A coroutine that blocks instead of awaiting stalls every async behavior of the process. The loop beats
 every :data:`LOOP_BEAT_S`; the objective server's watchdog reads :meth:`WorkRunner.blocked_loop` and,
 when the loop has missed its beats for too long, calls :meth:`WorkRunner.retire_blocked_loop`: new work
-then runs on a fresh loop, and the blocked one is reported until it runs again.
+then runs on a fresh loop, and the blocked one is reported until it runs again. A retired loop is told to
+stop as soon as it runs again: it finishes the tasks it holds, then its thread ends and the loop closes
+(its selector and self-pipe with it), so a day of stuck coroutines leaves no threads or descriptors behind.
 """
 
 from __future__ import annotations
@@ -70,12 +72,16 @@ class WorkRunner:
             return time.monotonic() - self._beats[0], self._loop_thread.ident
 
     def retire_blocked_loop(self) -> None:
-        """Run new coroutines on a fresh event loop; the current one (blocked) keeps its thread."""
+        """Run new coroutines on a fresh event loop; the current one (blocked) stops once it unblocks."""
         with self._lock:
-            if self._loop is not None and self._loop_thread is not None:
-                self._retired.append((self._loop, self._loop_thread, self._beats, self._beats[0]))
+            loop = self._loop
+            if loop is not None and self._loop_thread is not None:
+                self._retired.append((loop, self._loop_thread, self._beats, self._beats[0]))
             self._loop = None
             self._loop_thread = None
+        if loop is not None:
+            # Runs when the blocking coroutine returns: the loop ends after the tasks it still holds.
+            loop.call_soon_threadsafe(_finish_then_stop, loop)
 
     def retired_loops(self) -> list[tuple[float, int | None]]:
         """``(seconds blocked, thread id)`` of retired loops that have not run again yet."""
@@ -100,13 +106,30 @@ class WorkRunner:
                     asyncio.set_event_loop(loop)
                     loop.call_soon(started.set)
                     loop.call_soon(beat)
-                    loop.run_forever()
+                    try:
+                        loop.run_forever()
+                    finally:
+                        loop.run_until_complete(loop.shutdown_asyncgens())
+                        loop.close()
 
                 thread = threading.Thread(target=run, name="kinema-behavior-loop", daemon=True)
                 thread.start()
                 started.wait()
                 self._loop, self._loop_thread, self._beats = loop, thread, beats
             return self._loop
+
+
+def _finish_then_stop(loop: asyncio.AbstractEventLoop) -> None:
+    """On a retired loop: wait for the tasks it holds, then stop it (its thread then closes it)."""
+
+    async def finish() -> None:
+        current = asyncio.current_task()
+        pending = [task for task in asyncio.all_tasks(loop) if task is not current]
+        if pending:
+            await asyncio.wait(pending)
+        loop.stop()
+
+    loop.create_task(finish())
 
 
 RUNNER = WorkRunner()

@@ -260,10 +260,14 @@ def number_to_string(value: int | float) -> str:
 
 def _convert_list(item_type: Any, text: str, enums: dict[str, int] | None) -> list[Any]:
     if text.startswith("json:"):
+        from kinema.nesting import loads_json  # beside the engine: kinema.bt imports only kinema.errors
+
         try:
-            data = json.loads(text[5:])
+            data = loads_json(text[5:], "the JSON value")
         except json.JSONDecodeError as error:
             raise ConversionError(f"invalid JSON in [{text}]: {error.msg}") from None
+        except ValueError as error:
+            raise ConversionError(f"[{text[:80]}...]: {error}") from None
         if not isinstance(data, list):
             raise ConversionError(f"[{text}] is not a JSON array")
         return [cast_value(item, item_type) for item in data]

@@ -43,13 +43,16 @@ def build(
        (already satisfied requirements are skipped, so it is fast and offline when nothing changed);
     2. loads the active config's behavior plugins and validates every objective of its objective
        library against them (unknown behaviors, ports, types, missing subtrees), printing file:line;
-    3. writes the TreeNodesModel XML of the config's behaviors and prints its path.
+    3. writes the TreeNodesModel XML of the config's behaviors and prints its path;
+    4. checks the robot: every name that crosses its files (URDF, SRDF, joint limits, MuJoCo scene,
+       waypoints, controllers, tool frame, sensor) and every file they name, printing file:line.
 
     TARGET is accepted for MoveIt Pro habits: `all` and `user_workspace` do the same here (there is no
     image to build; behavior packages are loaded from their folders). Exits 1 on any error.
     """
     from kinema.cli.options import print_warnings, resolve_selection
     from kinema.config import resolve_config
+    from kinema.config.robot_check import robot_report
     from kinema.plugins import BehaviorHost
     from kinema.plugins.dependencies import pip_install, unsatisfied, workspace_behavior_packages
     from kinema.plugins.validation import validate_objectives, write_tree_nodes_model
@@ -71,6 +74,7 @@ def build(
 
     resolved = resolve_config(name, found)
     print_warnings(resolved.warnings)
+    errors += _check_waypoints(resolved)
     host = BehaviorHost.for_config(resolved)
     report = host.load()
     print_warnings(report.warnings)
@@ -89,9 +93,33 @@ def build(
 
     model = write_tree_nodes_model(registry, _model_path(found.root, resolved.name))
     click.echo(f"TreeNodesModel for Groot2: {model}")
+
+    robot = robot_report(resolved)
+    print_warnings(robot.warnings)
+    for robot_problem in robot.problems:
+        click.secho(str(robot_problem), err=True, fg="red")
+    errors += len(robot.problems)
+    click.echo(f"checked the robot: {len(robot.problems)} problems")
     if errors:
         click.secho(f"build failed: {errors} errors", err=True, fg="red")
         raise click.exceptions.Exit(1)
+
+
+def _check_waypoints(resolved: object) -> int:
+    """Read the config's waypoints as the runtime will; 1 (after printing why) when they do not load."""
+    from kinema.config.waypoint_location import waypoint_store_for
+    from kinema.errors import KinemaError
+
+    try:
+        store = waypoint_store_for(resolved)  # type: ignore[arg-type]
+        if store is None:
+            return 0
+        count = len(store.all())
+    except KinemaError as error:
+        click.secho(str(error), err=True, fg="red")
+        return 1
+    click.echo(f"read {count} waypoints from {store.read_path}")
+    return 0
 
 
 @click.command()

@@ -44,7 +44,7 @@ def _run_folder(run_name: str | None) -> RunFolder:
 )
 def logs(follow: bool, level: str, run_name: str | None, list_recordings: bool) -> None:
     """Print the logs of the latest `kinema run` (agent, drivers, supervisor), merged in time order."""
-    from kinema.runtime.log_files import follow_entries, level_number, merged_entries
+    from kinema.process.log_files import follow_entries, level_number, merged_entries
 
     if list_recordings:
         _print_recordings(_run_folder(run_name))

@@ -27,6 +27,32 @@ def new() -> None:
 )
 @workspace_option
 @click.option("--no-input", is_flag=True, help="Do not ask anything; use defaults for what is not given.")
+@click.option(
+    "--from-urdf",
+    "urdf",
+    type=str,
+    default=None,
+    help="Make the package for your own robot from its URDF or .xacro, a path or package://PKG/PATH.",
+)
+@click.option(
+    "--srdf",
+    type=str,
+    default=None,
+    help="With --from-urdf: the robot's SRDF (planning groups, group states, end effector).",
+)
+@click.option(
+    "--mjcf",
+    type=str,
+    default=None,
+    help="With --from-urdf: a MuJoCo scene to simulate it in (default: one is generated).",
+)
+@click.option(
+    "--xacro-arg",
+    "xacro_args",
+    multiple=True,
+    metavar="NAME:=VALUE",
+    help="With --from-urdf: an argument of the .xacro (repeatable).",
+)
 def new_config(
     name: str | None,
     package_name: str | None,
@@ -34,12 +60,24 @@ def new_config(
     output_dir: Path | None,
     workspace: Path | None,
     no_input: bool,
+    urdf: str | None,
+    srdf: str | None,
+    mjcf: str | None,
+    xacro_args: tuple[str, ...],
 ) -> None:
-    """Create config package NAME based on PARENT.
+    """Create config package NAME based on PARENT, or for your own robot with --from-urdf.
 
     The package gets config/config.yaml with based_on_package, its own objectives/ folder registered
     under objective_library_paths, and package.xml. Nothing is written when the name is invalid or
     taken, the parent is unknown or the folder exists.
+
+    With --from-urdf URDF [--srdf SRDF] [--mjcf MJCF] it is a package for that robot, based on
+    kinema_base (Kinema's core behaviors and subtrees): the URDF (xacro expanded; package:// found in
+    the workspace, ROS_PACKAGE_PATH, AMENT_PREFIX_PATH and pip-installed description packages), the SRDF
+    (or one planning group over the URDF's longest chain), a MuJoCo scene with the robot on a table
+    (DAE meshes converted), joint limits, waypoints (Home and the SRDF's group states) and, for a
+    gripper, Open/Close Gripper. config.yaml says what was chosen; `kinema build -c NAME` checks it and
+    `kinema run -c NAME` simulates it.
     """
     from kinema.cli.options import resolve_selection
     from kinema.errors import ScaffoldError
@@ -51,6 +89,18 @@ def new_config(
         )
     name = name or package_name
     found, active = resolve_selection(workspace, None, need_config=False)
+    if urdf is None and (srdf or mjcf or xacro_args):
+        raise ScaffoldError("--srdf, --mjcf and --xacro-arg go with --from-urdf URDF")
+    if urdf is not None:
+        if based_on is not None:
+            raise ScaffoldError(
+                "a package made --from-urdf is based on kinema_base (Kinema's core behaviors and "
+                "subtrees); leave out --based-on"
+            )
+        if name is None:
+            raise ScaffoldError("the package name is missing: kinema new config NAME --from-urdf URDF")
+        _new_robot_config(name, urdf, srdf, mjcf, xacro_args, output_dir, found, workspace)
+        return
     if name is None:
         if no_input:
             raise ScaffoldError("the package name is missing: kinema new config NAME --based-on PARENT")
@@ -85,6 +135,59 @@ def new_config(
             f"note: {path.parent} is not a workspace's src/ folder, so kinema commands do not find {name} "
             "from here; create it inside a workspace (kinema init WS, then kinema new config ... -w WS)"
         )
+
+
+def _new_robot_config(
+    name: str,
+    urdf: str,
+    srdf: str | None,
+    mjcf: str | None,
+    xacro_args: tuple[str, ...],
+    output_dir: Path | None,
+    found: object,
+    workspace: Path | None,
+) -> None:
+    """``kinema new config NAME --from-urdf URDF``: write the package and say what was decided."""
+    import time
+
+    from kinema.errors import ScaffoldError
+    from kinema.scaffold.robot_package import new_robot_package
+
+    arguments: dict[str, str] = {}
+    for item in xacro_args:
+        key, sep, value = item.partition(":=")
+        if not sep or not key.strip():
+            raise ScaffoldError(f"--xacro-arg {item!r} is not NAME:=VALUE")
+        arguments[key.strip()] = value
+    started = time.monotonic()
+    path, plan = new_robot_package(
+        name,
+        urdf,
+        srdf=srdf,
+        mjcf=mjcf,
+        xacro_args=arguments,
+        output_dir=output_dir,
+        workspace=found,  # type: ignore[arg-type]
+        progress=lambda text: click.echo(f"... {text}", err=True),
+    )
+    click.echo(f"created config package {name} in {path} ({time.monotonic() - started:.1f} s)")
+    gripper = (
+        f"{plan.gripper_joint}: open {plan.gripper_open:g}, closed {plan.gripper_closed:g}"
+        if plan.gripper_joint
+        else "none"
+    )
+    for label, value in (
+        ("robot", f"{plan.robot.name} ({len(plan.robot.meshes)} meshes)"),
+        ("planning group", f"{plan.planning_group}: {', '.join(plan.group_joints)}"),
+        ("tool frame", plan.tool_frame),
+        ("gripper", gripper),
+        ("waypoints", ", ".join(plan.waypoints)),
+    ):
+        click.echo(f"  {label:<15} {value}")
+    for note in plan.notes:
+        click.echo(f"  note: {note}")
+    where = "" if workspace is None else f" -w {workspace}"
+    click.echo(f"try: kinema build -c {name}{where}, then kinema run -c {name}{where}")
 
 
 @new.command("behavior")

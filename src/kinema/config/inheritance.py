@@ -21,6 +21,7 @@ file or folder Kinema will use must exist.
 from __future__ import annotations
 
 import copy
+import os
 from collections.abc import Hashable, Iterator
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -212,9 +213,43 @@ class ResolvedConfig:
         return self.resolve_file("hardware.robot_description.srdf", kind="file")
 
     @property
+    def urdf_params(self) -> dict[str, str]:
+        """MoveIt Pro's xacro arguments (``hardware.robot_description.urdf_params``, a list of one-key
+        mappings), as ``{name: value}`` strings (``true``/``false`` for booleans, as xacro reads them)."""
+        params: dict[str, str] = {}
+        for item in self.get("hardware.robot_description.urdf_params") or []:
+            if isinstance(item, dict):
+                for key, value in item.items():
+                    text = str(value).lower() if isinstance(value, bool) else str(value)
+                    params[str(key)] = text
+        return params
+
+    @property
     def mujoco_model_path(self) -> Path | None:
-        """The MuJoCo scene (``hardware.simulation.mujoco_model``), or None for a config without one."""
-        return self.optional_file("hardware.simulation.mujoco_model")
+        """The MuJoCo scene, or None for a config without one.
+
+        ``hardware.simulation.mujoco_model`` (a file reference) when set; else MoveIt Pro's xacro argument
+        ``urdf_params: - mujoco_model: PATH``, a path inside package ``mujoco_model_package`` (another
+        urdf_params entry) or, without it, inside the package that set ``urdf_params``.
+
+        Raises:
+            ConfigError: the file named is not there.
+        """
+        if self.get("hardware.simulation.mujoco_model") is not None:
+            return self.optional_file("hardware.simulation.mujoco_model")
+        params = self.urdf_params
+        if "mujoco_model" not in params:
+            return None
+        key = ("hardware", "robot_description", "urdf_params")
+        package = params.get("mujoco_model_package") or self.origin_of(key) or self.name
+        return self.resolve_file({"package": package, "path": params["mujoco_model"]}, kind="file")
+
+    @property
+    def mujoco_keyframe(self) -> str | None:
+        """The keyframe the simulation starts from and resets to: ``hardware.simulation.mujoco_keyframe``,
+        else MoveIt Pro's ``urdf_params: - mujoco_keyframe: NAME``; None for the model's own state."""
+        value = self.get("hardware.simulation.mujoco_keyframe") or self.urdf_params.get("mujoco_keyframe")
+        return str(value) if value else None
 
     @property
     def joint_limits_path(self) -> Path | None:
@@ -279,6 +314,14 @@ def _resolve_ref(
         )
     package = workspace.package(ref.package)
     path = package.resolve_relative(ref.path)
+    # Lexically (symlinks a package holds are its own business): '..' and absolute paths leave it.
+    inside = Path(os.path.normpath(path)).is_relative_to(os.path.normpath(package.path))
+    if not inside:
+        raise ConfigError(
+            f"{label}: {ref} leaves package {package.name!r} ({os.path.normpath(path)} is outside "
+            f"{package.path}); a reference names a file inside its package",
+            location=location,
+        )
     if package.kind == "objectives" and path == package.path:
         return path  # the core library is always there, even before anything has been put into it
     if not path.exists():

@@ -114,7 +114,7 @@ SCHEMA = _map(
     ),
     ros2_control=_map(
         used=True,
-        config=_FILE,
+        config=Field("file", used=True),
         controllers_active_at_startup=Field("list_of", used=True, item=_STR),
         controllers_inactive_at_startup=Field("list_of", used=True, item=_STR),
         controllers_not_managed=_STR_LIST,
@@ -125,6 +125,31 @@ SCHEMA = _map(
         behavior_loader_plugins=Field("map_of", used=True, item=Field("list_of", used=True, item=_STR)),
         objective_library_paths=Field("map_of", used=True, item=Field("dir", used=True)),
         waypoints_file=Field("file", used=True),
+    ),
+    # Kinema: the robot's tool frame, gripper, F/T sensor, controllers and default camera
+    # (kinema.config.cell).
+    robot=_map(
+        used=True,
+        tool_frame=Field("str", used=True),
+        default_camera=Field("str", used=True),
+        gripper=_map(
+            used=True,
+            controller=Field("str", used=True),
+            joint=Field("str", used=True),
+            open_position=Field("number", used=True),
+            closed_position=Field("number", used=True),
+        ),
+        force_torque_sensor=_map(
+            used=True,
+            name=Field("str", used=True),
+            frame=Field("str", used=True),
+            control_site=Field("str", used=True),
+        ),
+        controllers=Field(
+            "map_of",
+            used=True,
+            item=_map(used=True, type=Field("str", used=True), joints=Field("list_of", used=True, item=_STR)),
+        ),
     ),
     optional_feature_params=Field("any"),
     octomap_manager=_map(input_point_cloud_topic=_STR),

@@ -15,18 +15,23 @@ Every change (save, rename, erase) takes the file's lock (a sidecar ``.lock`` fi
 :mod:`kinema.config.file_lock`), reads the current file, changes it and replaces it atomically, so
 concurrent writers in threads or processes never lose each other's waypoints and readers never see a
 half-written file.
+
+A change is a round trip through ruamel.yaml: the file's comments, the order of its waypoints and keys,
+its quoting and indentation stay as they were, and only the values that changed are written anew (an
+unchanged number keeps its digits). A new waypoint is appended with its keys sorted, as MoveIt Pro
+writes them.
 """
 
 from __future__ import annotations
 
 import copy
-from collections.abc import Iterator
+import functools
+import io
+from collections.abc import Iterator, MutableMapping
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
-
-import yaml
 
 from kinema.config.atomic_write import atomic_write_text, remove_temporaries_of
 from kinema.config.file_lock import locked
@@ -34,7 +39,6 @@ from kinema.config.yamlsource import YamlDocument, load_yaml_file
 from kinema.errors import ConfigError, SourceLocation, did_you_mean
 
 MAX_WAYPOINTS_BYTES = 64 * 1024 * 1024
-_Dumper: type[yaml.SafeDumper] = getattr(yaml, "CSafeDumper", yaml.SafeDumper)  # type: ignore[assignment]
 
 
 def _empty_header() -> dict[str, Any]:
@@ -223,13 +227,13 @@ class WaypointStore:
             )
         with self._locked():
             waypoints = self._read()
-            for index, existing in enumerate(waypoints):
-                if existing.name == waypoint.name:
-                    waypoints[index] = waypoint
-                    break
+            document, items = self._edit()
+            names = [existing.name for existing in waypoints]
+            if waypoint.name in names:
+                _update(items[names.index(waypoint.name)], waypoint.to_dict())
             else:
-                waypoints.append(waypoint)
-            self._write(waypoints)
+                items.append(_new_node(waypoint.to_dict()))
+            self._write(document)
 
     def rename(self, old: str, new: str) -> None:
         """Rename waypoint ``old`` to ``new``.
@@ -247,8 +251,9 @@ class WaypointStore:
                 raise ConfigError(f"no waypoint named {old!r} in {where}; {did_you_mean(old, names)}")
             if new != old and new in names:
                 raise ConfigError(f"a waypoint named {new!r} already exists in {self.path}")
-            waypoints[names.index(old)].name = new
-            self._write(waypoints)
+            document, items = self._edit()
+            items[names.index(old)]["name"] = new
+            self._write(document)
 
     def erase(self, name: str) -> None:
         """Remove waypoint ``name``.
@@ -262,8 +267,9 @@ class WaypointStore:
             if name not in names:
                 where = self.read_path
                 raise ConfigError(f"no waypoint named {name!r} in {where}; {did_you_mean(name, names)}")
-            del waypoints[names.index(name)]
-            self._write(waypoints)
+            document, items = self._edit()
+            del items[names.index(name)]
+            self._write(document)
 
     @contextmanager
     def _locked(self) -> Iterator[None]:
@@ -303,12 +309,133 @@ class WaypointStore:
             waypoints.append(waypoint)
         return waypoints
 
-    def _write(self, waypoints: list[Waypoint]) -> None:
-        text = yaml.dump(
-            [waypoint.to_dict() for waypoint in waypoints],
-            Dumper=_Dumper,
-            default_flow_style=False,
-            sort_keys=True,
-            allow_unicode=True,
+    def _edit(self) -> tuple[_RoundTrip, Any]:
+        """The file being changed, as a round trip, and its list of waypoints (called after :meth:`_read`
+        found the file valid, under the lock)."""
+        path = self.read_path
+        text = path.read_text(encoding="utf-8") if path.exists() else ""
+        return _RoundTrip.load(text)
+
+    def _write(self, document: _RoundTrip) -> None:
+        atomic_write_text(self.path, document.dump())
+
+
+class _SourceFloat(float):
+    """A float read from the file, which writes itself back with the file's own digits (ruamel.yaml 0.19
+    rewrites ``-2.9355287074907658e-05`` as ``-2.9355287074907657e-05``)."""
+
+    text: str
+
+    def __new__(cls, value: float, text: str) -> _SourceFloat:
+        number = super().__new__(cls, value)
+        number.text = text
+        return number
+
+
+@functools.cache
+def _yaml_classes() -> tuple[type, type]:
+    """ruamel.yaml's round-trip constructor and representer, keeping floats' digits (subclasses, so other
+    users of ruamel.yaml in the process are not affected)."""
+    from ruamel.yaml.constructor import RoundTripConstructor
+    from ruamel.yaml.representer import RoundTripRepresenter
+
+    class Constructor(RoundTripConstructor):
+        pass
+
+    class Representer(RoundTripRepresenter):
+        pass
+
+    def construct_float(constructor: Any, node: Any) -> Any:
+        value = constructor.construct_yaml_float(node)
+        return _SourceFloat(float(value), str(node.value)) if node.style is None else value
+
+    def represent_float(representer: Any, data: _SourceFloat) -> Any:
+        return representer.represent_scalar("tag:yaml.org,2002:float", data.text)
+
+    Constructor.add_constructor("tag:yaml.org,2002:float", construct_float)
+    Representer.add_representer(_SourceFloat, represent_float)
+    return Constructor, Representer
+
+
+def _round_trip_yaml() -> Any:
+    from ruamel.yaml import YAML
+
+    yaml = YAML()
+    yaml.Constructor, yaml.Representer = _yaml_classes()
+    yaml.preserve_quotes = True
+    yaml.width = 4096  # never fold a long line the file did not fold
+    return yaml
+
+
+class _RoundTrip:
+    """A waypoints file loaded with ruamel.yaml's round-trip loader, dumped with its own indentation."""
+
+    def __init__(self, items: Any, indent: int, block_seq_indent: int) -> None:
+        self.items = items
+        self.indent = indent
+        self.block_seq_indent = block_seq_indent
+
+    @classmethod
+    def load(cls, text: str) -> tuple[_RoundTrip, Any]:
+        from ruamel.yaml.comments import CommentedSeq
+        from ruamel.yaml.util import load_yaml_guess_indent
+
+        if text.strip():
+            items, indent, block_seq_indent = load_yaml_guess_indent(text, yaml=_round_trip_yaml())
+        else:
+            items, indent, block_seq_indent = None, 2, 0
+        if items is None:
+            items = CommentedSeq()
+        if isinstance(items, CommentedSeq) and not items:
+            items.fa.set_block_style()  # an empty file's `[]`: waypoints added to it are written as blocks
+        document = cls(items, indent or 2, block_seq_indent or 0)
+        return document, items
+
+    def dump(self) -> str:
+        yaml = _round_trip_yaml()
+        yaml.indent(
+            mapping=self.indent,
+            sequence=self.indent + self.block_seq_indent,
+            offset=self.block_seq_indent,
         )
-        atomic_write_text(self.path, text)
+        if not self.items:
+            return "[]\n"
+        buffer = io.StringIO()
+        yaml.dump(self.items, buffer)
+        return buffer.getvalue()
+
+
+def _update(node: MutableMapping[str, Any], values: dict[str, Any]) -> None:
+    """Write ``values`` into the round-trip ``node``, replacing only what differs (so the rest keeps its
+    comments and formatting)."""
+    for key, value in values.items():
+        current = node.get(key)
+        if isinstance(value, dict) and isinstance(current, MutableMapping):
+            _update(current, value)
+        elif isinstance(value, list) and isinstance(current, list) and current:
+            if not _same_list(current, value):
+                current[:] = [_new_node(v) for v in value]
+        elif key not in node or not _same_scalar(current, value):
+            node[key] = _new_node(value)
+
+
+def _same_scalar(a: Any, b: Any) -> bool:
+    return type(a) is type(b) and a == b if isinstance(a, bool) or isinstance(b, bool) else a == b
+
+
+def _same_list(current: list[Any], value: list[Any]) -> bool:
+    return len(current) == len(value) and all(
+        _same_scalar(a, b) if not isinstance(b, dict | list) else a == b
+        for a, b in zip(current, value, strict=True)
+    )
+
+
+def _new_node(value: Any) -> Any:
+    """A round-trip node of plain data, mappings with their keys sorted (MoveIt Pro's layout)."""
+    from ruamel.yaml.comments import CommentedMap, CommentedSeq
+
+    if isinstance(value, dict):
+        return CommentedMap((key, _new_node(value[key])) for key in sorted(value))
+    if isinstance(value, list):
+        return CommentedSeq(_new_node(v) for v in value)
+    return value

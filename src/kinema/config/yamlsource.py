@@ -9,6 +9,7 @@ message instead of a decoder traceback.
 
 from __future__ import annotations
 
+import math
 import os
 from collections.abc import Callable, Hashable, Sequence
 from dataclasses import dataclass, field
@@ -19,7 +20,31 @@ import yaml
 
 from kinema.errors import ConfigError, KinemaError, SourceLocation
 
-_Loader: type[yaml.SafeLoader] = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # type: ignore[assignment]
+_BaseLoader: type[yaml.SafeLoader] = getattr(yaml, "CSafeLoader", yaml.SafeLoader)  # type: ignore[assignment]
+
+
+class AngleLoader(_BaseLoader):  # type: ignore[valid-type,misc]
+    """PyYAML's safe loader plus MoveIt Pro's angle tags: ``!degrees 30`` is 30° in radians, ``!radians 0.5``
+    is 0.5 (MoveIt Pro's joint_limits.yaml and waypoint files write limits so). A subclass, so PyYAML's
+    own SafeLoader stays as it is for everyone else."""
+
+
+def _angle(scale: float) -> Callable[[yaml.SafeLoader, yaml.Node], float]:
+    def construct(loader: yaml.SafeLoader, node: yaml.Node) -> float:
+        text = loader.construct_scalar(node)  # type: ignore[arg-type]
+        try:
+            return float(text) * scale
+        except (TypeError, ValueError):
+            raise yaml.constructor.ConstructorError(
+                None, None, f"{node.tag} needs a number, got {text!r}", node.start_mark
+            ) from None
+
+    return construct
+
+
+AngleLoader.add_constructor("!degrees", _angle(math.pi / 180.0))
+AngleLoader.add_constructor("!radians", _angle(1.0))
+_Loader = AngleLoader
 
 #: Default size limit of a YAML file; config files are a few kB, waypoint files a few hundred kB.
 MAX_YAML_BYTES = 16 * 1024 * 1024

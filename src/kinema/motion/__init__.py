@@ -15,8 +15,9 @@ Names are imported lazily, so ``import kinema.motion.trajectory`` does not load 
 
 from __future__ import annotations
 
-import importlib
 from typing import Any
+
+from kinema.lazy_exports import LazyExports
 
 _EXPORTS = {
     "RobotModel": "robot_model",
@@ -26,6 +27,8 @@ _EXPORTS = {
     "fk": "kinematics",
     "frame_poses": "kinematics",
     "FrameTree": "frames",
+    "CellFrames": "cell_frames",
+    "JointStateMonitor": "joint_state_monitor",
     "ik": "inverse_kinematics",
     "IkOptions": "inverse_kinematics",
     "PlanningScene": "planning_scene",
@@ -44,12 +47,10 @@ _EXPORTS = {
     "JointPath": "trajectory",
     "JointTrajectory": "trajectory",
 }
+_lazy = LazyExports(__name__, _EXPORTS)
 
-__all__ = sorted(_EXPORTS)
+__all__ = _lazy.names
 
 
 def __getattr__(name: str) -> Any:
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'kinema.motion' has no attribute {name!r}")
-    return getattr(importlib.import_module(f"kinema.motion.{module}"), name)
+    return _lazy.attribute(name)

@@ -1,7 +1,7 @@
 """Corner blending: a waypoint path as straight pieces joined by circular arcs at its interior corners.
 
-Pure geometry (numpy and scipy), no robot model: :func:`blended_pieces` turns poses into pieces that the
-Cartesian planner samples and solves IK along.
+Pure geometry (:mod:`kinema.transforms`), no robot model: :func:`blended_pieces` turns poses into pieces
+that the Cartesian planner samples and solves IK along.
 """
 
 from __future__ import annotations
@@ -12,26 +12,17 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from kinema.transforms import (
+    angle_between,
+    quaternion_from_matrix,
+    rotation_from_rotvec,
+    rotation_matrix,
+    slerp,
+)
+
 # Corners straighter than this (rad of turning) need no blend; ones turning back by more than pi minus it
 # cannot be blended with a circle (the arc would shrink to a point), so the path stops there instead.
 _ANGLE_EPS = 1e-6
-
-
-def _rotation_between(qa: np.ndarray, qb: np.ndarray) -> float:
-    dot = abs(float(np.dot(qa, qb)))
-    return 2.0 * float(np.arccos(min(1.0, dot)))
-
-
-def slerp(qa: np.ndarray, qb: np.ndarray, t: float) -> np.ndarray:
-    """Spherical interpolation of unit quaternions (x, y, z, w) along the shorter way, ``t`` in [0, 1]."""
-    dot = float(np.dot(qa, qb))
-    if dot < 0:
-        qb, dot = -qb, -dot
-    if dot > 0.9995:
-        q = qa + t * (qb - qa)
-        return q / np.linalg.norm(q)
-    theta = np.arccos(dot)
-    return (np.sin((1 - t) * theta) * qa + np.sin(t * theta) * qb) / np.sin(theta)
 
 
 @dataclass(frozen=True, eq=False)  # holds numpy arrays
@@ -66,26 +57,18 @@ class PathPiece:
     @property
     def rotation(self) -> float:
         """How far the orientation turns along the piece (rad)."""
-        return _rotation_between(self.q_start, self.q_end)
+        return angle_between(self.q_start, self.q_end)
 
     def pose_at(self, t: float) -> np.ndarray:
         """The pose (4, 4) at fraction ``t`` in [0, 1] of the piece (uniform in arc length)."""
-        from scipy.spatial.transform import Rotation
-
         pose = np.eye(4)
         if self.center is None or self.axis is None:
             pose[:3, 3] = self.start + t * (self.end - self.start)
         else:
-            spin = Rotation.from_rotvec(self.axis * (t * self.turn))
-            pose[:3, 3] = self.center + spin.apply(self.start - self.center)
-        pose[:3, :3] = Rotation.from_quat(slerp(self.q_start, self.q_end, t)).as_matrix()
+            spin = rotation_from_rotvec(self.axis * (t * self.turn))
+            pose[:3, 3] = self.center + spin @ (self.start - self.center)
+        pose[:3, :3] = rotation_matrix(slerp(self.q_start, self.q_end, t))
         return pose
-
-
-def _quat(pose: np.ndarray) -> np.ndarray:
-    from scipy.spatial.transform import Rotation
-
-    return Rotation.from_matrix(pose[:3, :3]).as_quat()
 
 
 def _corner_blend(a: np.ndarray, p: np.ndarray, b: np.ndarray, radius: float) -> float:
@@ -119,7 +102,7 @@ def blended_pieces(poses: Sequence[np.ndarray], radius: float) -> list[PathPiece
     if radius < 0:
         raise ValueError(f"the blending radius must be >= 0, got {radius}")
     points = [np.asarray(T, dtype=float)[:3, 3] for T in poses]
-    quats = [_quat(np.asarray(T, dtype=float)) for T in poses]
+    quats = [quaternion_from_matrix(T) for T in poses]
     # Distance of each waypoint's blend from the waypoint (0 at the ends and at unblended corners).
     cut = [0.0] * len(points)
     for i in range(1, len(points) - 1):

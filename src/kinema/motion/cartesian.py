@@ -34,7 +34,7 @@ def plan_cartesian_path(
     checker: CollisionChecker,
     start: np.ndarray,
     world_T_waypoints: Sequence[np.ndarray],
-    group: str = "manipulator",
+    group: str,
     frame: str | None = None,
     *,
     max_step: float = 0.005,

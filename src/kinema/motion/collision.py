@@ -54,7 +54,10 @@ class CollisionChecker:
         self._padding = float(padding)
         try:
             self._robot_geoms = pin.buildGeomFromUrdf(
-                model.pin_model, str(model.urdf_path), pin.GeometryType.COLLISION
+                model.pin_model,
+                str(model.urdf_path),
+                pin.GeometryType.COLLISION,
+                package_dirs=list(getattr(model, "package_dirs", [])),
             )
         except (RuntimeError, ValueError) as exc:
             raise MotionError(f"cannot build collision geometry from {model.urdf_path}: {exc}") from exc

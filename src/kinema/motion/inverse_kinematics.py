@@ -45,7 +45,7 @@ def ik(
     model: RobotModel,
     world_T_target: np.ndarray,
     seed: np.ndarray,
-    group: str = "manipulator",
+    group: str,
     frame: str | None = None,
     *,
     position_only: bool = False,

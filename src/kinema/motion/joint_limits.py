@@ -8,6 +8,7 @@ from typing import Any
 
 import yaml
 
+from kinema.config.yamlsource import AngleLoader
 from kinema.errors import MotionError, SourceLocation
 
 
@@ -58,7 +59,7 @@ def parse_joint_limits(path: str | Path) -> LimitsFile:
     """
     path = Path(path)
     try:
-        data = yaml.safe_load(path.read_text()) or {}
+        data = yaml.load(path.read_text(), Loader=AngleLoader) or {}
     except OSError as exc:
         raise MotionError(f"cannot read joint limits {path}: {exc}") from exc
     except yaml.YAMLError as exc:

@@ -110,7 +110,7 @@ def plan_joint_goal(
     checker: CollisionChecker,
     start: np.ndarray,
     goal: Mapping[str, float] | np.ndarray,
-    group: str = "manipulator",
+    group: str,
     options: PlanningOptions | None = None,
 ) -> JointPath:
     """Plan a collision-free joint-space path for ``group`` from ``start`` to ``goal``.

@@ -106,6 +106,7 @@ class RobotModel:
     ) -> None:
         self.pin_model = pin_model
         self.urdf_path = urdf_path
+        self.package_dirs: list[str] = [str(urdf_path.parent)]
         self.name = pin_model.name
         self.semantic = semantic
         self._urdf_joints = urdf_joints
@@ -172,11 +173,15 @@ class RobotModel:
         urdf_path: str | Path,
         srdf_path: str | Path | None = None,
         joint_limits_path: str | Path | None = None,
+        package_dirs: Iterable[str | Path] = (),
     ) -> RobotModel:
         """Build the model from a URDF, plus an optional SRDF (groups) and MoveIt joint_limits.yaml.
 
         Raises:
             MotionError: a file is missing or malformed, a group names an unknown joint or link.
+
+        ``package_dirs`` are the folders holding the packages the URDF's ``package://`` meshes name
+        (:func:`kinema.config.robot_description.package_index` gives a config's).
         """
         pin = _pin()
         urdf_path = Path(urdf_path)
@@ -187,7 +192,10 @@ class RobotModel:
             raise MotionError(f"pinocchio cannot load URDF {urdf_path}: {exc}") from exc
         semantic = parse_srdf(srdf_path) if srdf_path is not None else SemanticDescription()
         limits = parse_joint_limits(joint_limits_path) if joint_limits_path is not None else None
-        return cls(model, urdf_path, joints, semantic, limits)
+        robot = cls(model, urdf_path, joints, semantic, limits)
+        # Where package:// and relative mesh paths of the URDF are found (the collision model's meshes).
+        robot.package_dirs = [str(urdf_path.parent), *(str(d) for d in package_dirs)]
+        return robot
 
     # -- groups and names -------------------------------------------------------------------------
 

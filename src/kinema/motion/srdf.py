@@ -78,22 +78,24 @@ def parse_srdf(path: str | Path) -> SemanticDescription:
             f"SRDF is not valid XML: {exc}", location=SourceLocation(str(path), exc.lineno or 0)
         ) from exc
     groups: dict[str, GroupDefinition] = {}
-    for g in root.iter("group"):
+    # Only the top-level <group> elements define groups: a <group name="arm"/> inside another group is a
+    # reference to "arm" (a composite group such as Franka's arm_and_hand), not a new, empty "arm".
+    for g in root.findall("group"):
         name = _required(g, "name", path)
         groups[name] = GroupDefinition(
             name=name,
             chains=tuple(
-                (_required(c, "base_link", path), _required(c, "tip_link", path)) for c in g.iter("chain")
+                (_required(c, "base_link", path), _required(c, "tip_link", path)) for c in g.findall("chain")
             ),
-            joints=tuple(_required(j, "name", path) for j in g.iter("joint")),
-            links=tuple(_required(link, "name", path) for link in g.iter("link")),
-            subgroups=tuple(_required(s, "name", path) for s in g.iter("group") if s is not g),
+            joints=tuple(_required(j, "name", path) for j in g.findall("joint")),
+            links=tuple(_required(link, "name", path) for link in g.findall("link")),
+            subgroups=tuple(_required(s, "name", path) for s in g.findall("group")),
         )
     states: dict[tuple[str, str], dict[str, float]] = {}
-    for s in root.iter("group_state"):
+    for s in root.findall("group_state"):
         key = (_required(s, "group", path), _required(s, "name", path))
         states[key] = {
-            _required(j, "name", path): float(_required(j, "value", path)) for j in s.iter("joint")
+            _required(j, "name", path): float(_required(j, "value", path)) for j in s.findall("joint")
         }
     effectors = tuple(
         EndEffector(

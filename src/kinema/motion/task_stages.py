@@ -50,7 +50,7 @@ class MotionSettings:
         max_iterations: samples the collision-free search draws before the stage fails.
     """
 
-    group: str = "manipulator"
+    group: str = ""  # the planning group that moves: behaviors pass the config's; "" is refused when it plans
     velocity_scale: float = 1.0
     acceleration_scale: float = 1.0
     link_padding: float = 0.01
@@ -157,7 +157,7 @@ class BatchPoseIK:
 
     targets: Sequence[Target]
     ik_frame: str
-    group: str = "manipulator"
+    group: str = ""  # the planning group that moves: behaviors pass the config's; "" is refused when it plans
     max_ik_solutions: int = 4
     ik_attempts: int = 20
     seed: int = 0

@@ -17,8 +17,9 @@ Heavy dependencies (scipy, trimesh) load inside the functions that need them.
 
 from __future__ import annotations
 
-import importlib
 from typing import Any
+
+from kinema.lazy_exports import LazyExports
 
 _EXPORTS = {
     "PointCloud": "point_cloud",
@@ -36,12 +37,10 @@ _EXPORTS = {
     "save_pcd": "pcd",
     "sample_mesh_surface": "mesh_sampling",
 }
+_lazy = LazyExports(__name__, _EXPORTS)
 
-__all__ = sorted(_EXPORTS)
+__all__ = _lazy.names
 
 
 def __getattr__(name: str) -> Any:
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'kinema.perception' has no attribute {name!r}")
-    return getattr(importlib.import_module(f"kinema.perception.{module}"), name)
+    return _lazy.attribute(name)

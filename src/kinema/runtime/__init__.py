@@ -6,8 +6,9 @@ Names are imported on first use, so light modules of this package (``names``, ``
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING, Any
+
+from kinema.lazy_exports import LazyExports
 
 _EXPORTS = {
     "Agent": "kinema.runtime.agent",
@@ -26,6 +27,7 @@ _EXPORTS = {
     "ParameterOverride": "kinema.runtime.overrides",
     "SimClock": "kinema.runtime.sim_clock",
 }
+_lazy = LazyExports(__name__, _EXPORTS)
 
 __all__ = [
     "Agent",
@@ -64,12 +66,7 @@ if TYPE_CHECKING:
 
 
 def __getattr__(name: str) -> Any:
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'kinema.runtime' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
+    return _lazy.attribute(name)
 
 
 def __dir__() -> list[str]:

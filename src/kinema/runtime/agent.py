@@ -1,7 +1,8 @@
 """The agent: the objective server served on the transport, with its streams and library services.
 
 Serves (names in :mod:`kinema.runtime.names`): ``/execute_objective``, ``/cancel_objective``,
-``/do_objective`` (action), the objective list and XML services, ``/get_saved_waypoints`` and
+``/do_objective`` (action; by name or XML), ``/kinema/run_objective`` (the same action by name only: what
+an operator's certificate reaches), the objective list and XML services, ``/get_saved_waypoints`` and
 ``/edit_waypoints``. Publishes the heartbeat (10 Hz and on every change, latched), node status changes,
 a latched blackboard snapshot (at most 10 Hz, only when it changed) and the behaviors' log messages
 (toasts, plus hot-reload events).
@@ -20,10 +21,13 @@ from collections.abc import Callable, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from kinema.drivers.mujoco.names import JOINT_STATES_TOPIC, JOINT_STATES_TYPE
 from kinema.errors import KinemaError, ObjectiveError
+from kinema.process.log_files import PLUGIN_LOGGER
 from kinema.runtime import names
+from kinema.runtime.background_work import HandOff
+from kinema.runtime.blackboard_text import render_value
 from kinema.runtime.error_codes import MoveItErrorCode
-from kinema.runtime.log_files import PLUGIN_LOGGER
 from kinema.runtime.node_status_cdr import NodeStatusCodesEncoder, generic_serializer, time_parts
 from kinema.runtime.objective_server import (
     ObjectiveRequest,
@@ -47,11 +51,15 @@ log = logging.getLogger("kinema.agent")
 # Plugin load and hot-reload outcomes have a logger of their own: `kinema run` echoes it in its terminal.
 plugin_log = logging.getLogger(PLUGIN_LOGGER)
 
-# Blackboard values are rendered for display; longer renderings are cut.
-MAX_VALUE_CHARS = 2000
-MAX_LIST_ITEMS = 16
 LOG_ERROR, LOG_WARN, LOG_INFO = 1, 2, 3
 DO_OBJECTIVE_RESULT_KEEP_S = 60.0
+# How long close() lets running goals answer their clients.
+GOALS_ANSWER_AT_CLOSE_S = 2.0
+# Ad-hoc XML is a grant of its own (kinema.transport.security_folder): the name-only doors refuse it.
+NO_XML_HERE = (
+    "{door} runs library objectives by name only; ad-hoc objective XML goes to /do_objective or the "
+    "start_xml key, a separate grant (`kinema security` lists who may use it)"
+)
 
 
 # Most node status changes in one ``/objective_server/node_status`` message (4 bytes each: 200 kB).
@@ -96,77 +104,12 @@ def overrides_from_messages(parameters: Sequence[Any]) -> tuple[ParameterOverrid
     return tuple(result)
 
 
-# Texts of plain values already rendered (short str, int, bool, None: equal values of one type render
-# alike). Every blackboard snapshot renders every entry twice (stream and recording), YAML takes about
-# 100 µs for a short string, and a tree's scopes hold the same few strings and numbers snapshot after
-# snapshot.
-_RENDERED: dict[tuple[type, Any], str] = {}
-_RENDERED_MOST = 4096
-_PLAIN = frozenset({str, int, bool, type(None)})
-
-
-def render_value(value: Any) -> str:
-    """A blackboard value as one line of YAML flow text (messages as their fields), cut when long."""
-    kind = type(value)
-    if kind in _PLAIN and (kind is not str or len(value) <= MAX_VALUE_CHARS):
-        key = (kind, value)
-        text = _RENDERED.get(key)
-        if text is None:
-            if len(_RENDERED) >= _RENDERED_MOST:
-                _RENDERED.clear()
-            text = _RENDERED[key] = _render(value)
-        return text
-    return _render(value)
-
-
-def _render(value: Any) -> str:
-    import yaml
-
-    try:
-        data = _preview(value)
-        if isinstance(data, str | int | float | bool | list | dict | type(None)):
-            text = yaml.safe_dump(data, default_flow_style=True, width=1 << 30).strip()
-            if text.endswith("\n..."):
-                text = text[:-4].strip()
-            text = text.removesuffix("...").strip()
-        else:
-            text = repr(value)
-    except Exception:
-        text = repr(value)
-    return text if len(text) <= MAX_VALUE_CHARS else text[: MAX_VALUE_CHARS - 1] + "…"
-
-
-def _preview(value: Any) -> Any:
-    """``to_dict(value)`` with every list cut to MAX_LIST_ITEMS items (plus a "... N more" marker).
-
-    Lists are cut before their items are converted: the text is cut at MAX_VALUE_CHARS anyway, and
-    converting and YAML-dumping a whole trajectory (hundreds of points) on the tick thread at every
-    blackboard snapshot stalled the tree (and the simulation sharing the process) for most of each second.
-    """
-    import dataclasses
-
-    import numpy as np
-
-    from kinema.transport.messages import to_dict
-
-    if hasattr(value, "__msgtype__") and dataclasses.is_dataclass(value):
-        return {
-            field.name: _preview(getattr(value, field.name))
-            for field in dataclasses.fields(value)
-            if field.default is dataclasses.MISSING and field.name != "__msgtype__"
-        }
-    if isinstance(value, dict):
-        return {key: _preview(item) for key, item in value.items()}
-    if isinstance(value, list | tuple | np.ndarray):
-        head = [_preview(item) for item in value[:MAX_LIST_ITEMS]]
-        if len(value) > MAX_LIST_ITEMS:
-            return [*head, f"... {len(value) - MAX_LIST_ITEMS} more"]
-        return head
-    return to_dict(value)
-
-
 class _Streams:
-    """Publishes what the server reports (a :class:`ServerListener`, called on the tick thread)."""
+    """Publishes what the server reports (a :class:`ServerListener`, called on the tick thread).
+
+    Blackboard snapshots are rendered and published by a worker thread (:class:`HandOff`): the tick
+    thread only hands the entries over, the newest replacing one not yet published.
+    """
 
     def __init__(self, node: Node, clock: Clock | None, server: ObjectiveServer) -> None:
         self._node = node
@@ -187,6 +130,11 @@ class _Streams:
         self._lock = threading.Lock()
         # Also tells the clients waiting for a run (set by the Agent).
         self.on_warning: Callable[[str], None] | None = None
+        self._work = HandOff("kinema-blackboard")
+
+    def close(self) -> None:
+        """Publish what was handed over, then stop the worker thread."""
+        self._work.close()
 
     def publish_heartbeat(self) -> None:
         from kinema.transport.messages import msg
@@ -273,6 +221,9 @@ class _Streams:
         return encoder
 
     def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
+        self._work.submit(lambda: self._publish_blackboard(objective_name, entries), key="blackboard")
+
+    def _publish_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
         from kinema.transport.messages import msg
 
         # Messages (trajectories, joint states) are rendered once per object: every subtree scope keeps
@@ -374,7 +325,7 @@ class Agent:
         self._quick: list[Any] = []
         # The JSON start queries of runs not yet ended: their clients also get the behaviors' toasts.
         self._quick_listeners: dict[int, Any] = {}
-        self._goal_lock = threading.Lock()
+        self._goal_lock = threading.Condition()
         self._stop = threading.Event()
         self._joint_state: Any = None
         self._unsubscribe: list[Any] = []
@@ -385,7 +336,10 @@ class Agent:
         self._heartbeat_thread = threading.Thread(
             target=self._heartbeat_loop, name="kinema-heartbeat", daemon=True
         )
+        self._drivers: dict[str, Any] = {}
+        self._drivers_watch: Any = None
         self._declare()
+        self._watch_drivers()
 
     def _declare(self) -> None:
         node = self.node
@@ -402,12 +356,19 @@ class Agent:
             # fetch a result, short enough that a busy server does not publish thousands of them.
             result_timeout=DO_OBJECTIVE_RESULT_KEEP_S,
         )
+        node.create_action_server(
+            names.DO_OBJECTIVE_TYPE,
+            names.RUN_OBJECTIVE,
+            self._on_run_objective,
+            cancel_callback=self._on_cancel_goal,
+            result_timeout=DO_OBJECTIVE_RESULT_KEEP_S,
+        )
         node.create_service(names.LIST_OBJECTIVES_TYPE, names.LIST_OBJECTIVES, self._on_list_objectives)
         node.create_service(names.GET_OBJECTIVE_XML_TYPE, names.GET_OBJECTIVE_XML, self._on_get_objective_xml)
         node.create_service(names.GET_WAYPOINTS_TYPE, names.GET_WAYPOINTS, self._on_get_waypoints)
         node.create_service(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, self._on_edit_waypoints)
         if self.waypoints is not None:
-            node.create_subscription(names.JOINT_STATES_TYPE, names.JOINT_STATES, self._on_joint_states)
+            node.create_subscription(JOINT_STATES_TYPE, JOINT_STATES_TOPIC, self._on_joint_states)
         from kinema.runtime import quick_protocol as quick
 
         domain = self.session.domain_id
@@ -415,10 +376,50 @@ class Agent:
             self.session.zenoh.declare_queryable(quick.key(domain, op), handler, complete=True)
             for op, handler in (
                 (quick.START, self._on_quick_start),
+                (quick.START_XML, self._on_quick_start_xml),
                 (quick.CANCEL, self._on_quick_cancel),
                 (quick.STATUS, self._on_quick_status),
             )
         ]
+
+    def _watch_drivers(self) -> None:
+        """A driver that goes away (its process died, its link dropped) fails the running objective,
+        naming it: a motion whose controller vanished did not succeed, and nobody cancelled it."""
+        from kinema.runtime.cell import DRIVER, PRESENCE_PREFIX
+        from kinema.transport.dispatch import channel, dispatch
+
+        try:
+            self._drivers_watch = self.session.zenoh.liveliness().declare_subscriber(
+                f"{PRESENCE_PREFIX}/{self.session.domain_id}/*/{DRIVER}/**", channel(), history=True
+            )
+        except Exception:
+            log.warning("cannot watch the drivers' presence; a driver's death ends objectives late")
+            return
+        self.session._track_dispatcher(dispatch(self._drivers_watch, self._on_driver_presence, "-drivers"))
+
+    def _on_driver_presence(self, sample: Any) -> None:
+        import zenoh
+
+        from kinema.runtime.cell import parse_presence
+
+        key = str(sample.key_expr)
+        member = parse_presence(key)
+        if member is None:
+            return
+        if sample.kind != zenoh.SampleKind.DELETE:
+            self._drivers[key] = member
+            return
+        self._drivers.pop(key, None)
+        status, name = self.server.status
+        if status not in (ObjectiveStatus.RUNNING, ObjectiveStatus.LOADING) or self._stop.is_set():
+            log.info("%s went away", member.describe())
+            return
+        reason = (
+            f"objective {name!r} aborted: {member.describe()} went away while it ran (its process ended "
+            "or its link dropped); the robot's controllers are gone"
+        )
+        log.error("%s", reason)
+        self.server.abort(reason, timeout=0)  # never blocks the transport's thread
 
     # -- lifecycle -----------------------------------------------------------------------------------
 
@@ -428,12 +429,24 @@ class Agent:
         self._streams.publish_heartbeat()
         self._heartbeat_thread.start()
 
-    def close(self) -> None:
-        """Stop the server (a running objective ends PREEMPTED) and withdraw every endpoint."""
+    def close(
+        self, reason: str = "the agent stopped (kinema down, Ctrl-C, or its supervisor stopped it)"
+    ) -> None:
+        """Stop the server (a running objective ends as FAILURE with ``reason``) and withdraw every
+        endpoint."""
         self._stop.set()
         for unsubscribe in self._unsubscribe:
             unsubscribe()
-        self.server.stop()
+        if self._drivers_watch is not None:
+            try:
+                self._drivers_watch.undeclare()
+            except Exception:
+                log.debug("driver watch already gone", exc_info=True)
+        self.server.stop(reason=reason)
+        with self._goal_lock:
+            # Goals answer their clients (the stopped run's FAILURE) before the endpoints go.
+            self._goal_lock.wait_for(lambda: not self._goal_runs, GOALS_ANSWER_AT_CLOSE_S)
+        self._streams.close()
         for close in self.on_close:
             try:
                 close()
@@ -490,6 +503,14 @@ class Agent:
             return {"status": {"success": True, "error_message": ""}}
         return {"status": {"success": False, "error_message": "no objective is running"}}
 
+    def _on_run_objective(self, handle: Any) -> Any:
+        goal = handle.goal
+        if goal.objective_xml_string:
+            refused = ObjectiveResult.failure(NO_XML_HERE.format(door=names.RUN_OBJECTIVE), "<objective XML>")
+            handle.abort({"error_code": result_message(refused), "error_message": refused.error_message})
+            return None
+        return self._on_do_objective(handle)
+
     def _on_do_objective(self, handle: Any) -> Any:
         goal = handle.goal
         try:
@@ -506,35 +527,49 @@ class Agent:
             if handle.is_cancel_requested:
                 self.server.cancel(run, reason="goal cancelled", timeout=0)
             outcome = run.wait()
+            assert outcome is not None
+            result = outcome
+            payload = {"error_code": result_message(result), "error_message": result.error_message}
+            if result.succeeded:
+                handle.succeed(payload)
+            elif result.cancelled:
+                handle.canceled(payload)
+            else:
+                handle.abort(payload)
         finally:
+            # Only once the result is handed over: close() waits for this to answer waiting clients.
             with self._goal_lock:
                 self._goal_runs.pop(handle.goal_id, None)
-        assert outcome is not None
-        result = outcome
-        payload = {"error_code": result_message(result), "error_message": result.error_message}
-        if result.succeeded:
-            handle.succeed(payload)
-        elif result.cancelled:
-            handle.canceled(payload)
-        else:
-            handle.abort(payload)
+                self._goal_lock.notify_all()
         return None
 
     def _on_cancel_goal(self, handle: Any) -> bool:
         with self._goal_lock:
             run = self._goal_runs.get(handle.goal_id)
-        if run is not None:
+        if run is None:
+            return True  # not started yet: the execute thread sees is_cancel_requested
+        # Accepted only while the outcome is open: an accepted cancel never ends as SUCCESS.
+        accepted = run.request_cancel("goal cancelled")
+        if accepted:
             # Non-blocking: the tick thread halts the tree right away; the execute thread reports it.
             self.server.cancel(run, reason="goal cancelled", timeout=0)
-        return True
+        return accepted
 
     # -- the private JSON endpoints (kinema.runtime.quick_protocol) ----------------------------------------
 
     def _on_quick_start(self, query: Any) -> None:
+        self._quick_start(query, xml=False)
+
+    def _on_quick_start_xml(self, query: Any) -> None:
+        self._quick_start(query, xml=True)
+
+    def _quick_start(self, query: Any, *, xml: bool) -> None:
         from kinema.runtime import quick_protocol as quick
 
         try:
             body = quick.decode(query.payload.to_bytes() if query.payload is not None else b"")
+            if body.get("objective_xml") and not xml:
+                raise ValueError(NO_XML_HERE.format(door=quick.key(self.session.domain_id, quick.START)))
             overrides = tuple(
                 ParameterOverride(
                     str(item["name"]),

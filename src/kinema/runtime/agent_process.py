@@ -63,6 +63,7 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
     from kinema.behaviors.context import BehaviorContext
     from kinema.behaviors.logger import LogSink
     from kinema.bt import WallClock
+    from kinema.drivers.mujoco import names as driver_names
     from kinema.runtime import names
     from kinema.runtime.agent import Agent, build_host
     from kinema.runtime.objective_server import ObjectiveServer
@@ -82,8 +83,8 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
     clock: Any = SimClock() if use_sim else WallClock()
     node = Node(session, names.NODE_NAME)
     if use_sim:
-        node.create_subscription(names.CLOCK_TYPE, names.CLOCK, clock.on_clock_message)
-        log.info("time follows %s (simulation time)", names.CLOCK)
+        node.create_subscription(driver_names.CLOCK_TYPE, driver_names.CLOCK_TOPIC, clock.on_clock_message)
+        log.info("time follows %s (simulation time)", driver_names.CLOCK_TOPIC)
         _warn_without_clock(clock)
     sink = LogSink()
     context = BehaviorContext(
@@ -151,13 +152,14 @@ def _waypoint_store(options: AgentOptions, resolved: Any) -> Any:
 
 def _warn_without_clock(clock: Any, after_s: float = 10.0) -> None:
     """Say so in the log when no simulator publishes time: Sleep and Timeout would wait forever."""
+    from kinema.drivers.mujoco.names import CLOCK_TOPIC
 
     def check() -> None:
         if not clock.wait_until_running(after_s):
             log.warning(
                 "no %s message after %.0f s: simulation time stands still, so Sleep/Timeout nodes wait "
                 "until a simulator runs (start its driver, or run the agent with --clock wall)",
-                "/clock",
+                CLOCK_TOPIC,
                 after_s,
             )
 
@@ -169,9 +171,15 @@ def _robot_model_provider(resolved: Any) -> Any:
         return None
 
     def load() -> Any:
+        from kinema.config.robot_description import package_index, planning_urdf
         from kinema.motion.robot_model import RobotModel
 
-        return RobotModel.from_urdf(resolved.urdf_path, resolved.srdf_path, resolved.joint_limits_path)
+        return RobotModel.from_urdf(
+            planning_urdf(resolved, check_meshes=False),
+            resolved.srdf_path,
+            resolved.joint_limits_path,
+            package_dirs=package_index(resolved).package_dirs(),
+        )
 
     return load
 
@@ -217,8 +225,8 @@ def _parser() -> argparse.ArgumentParser:
 
 def main(argv: list[str] | None = None) -> int:
     """Run the agent until SIGTERM/SIGINT; exit 1 with one line on stderr when it cannot start."""
-    from kinema.runtime import lifeline
-    from kinema.runtime.log_files import configure_process_logging
+    from kinema.process import lifeline
+    from kinema.process.log_files import configure_process_logging
 
     args = _parser().parse_args(argv)
     configure_process_logging(args.log_file, verbose=args.verbose)
@@ -249,7 +257,8 @@ def main(argv: list[str] | None = None) -> int:
         log.error("%s", error)
         print(f"error: {error}", file=sys.stderr)
         return 1
-    from kinema.runtime.cell import AGENT, CellWatch, declare_presence
+    from kinema.runtime.cell import CellWatch
+    from kinema.transport.presence import AGENT, declare_presence
 
     # Announced before its nodes exist, so whoever sees them also knows whose they are.
     declare_presence(

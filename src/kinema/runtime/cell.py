@@ -4,9 +4,8 @@ A *cell* is one robot (real or simulated) with one agent commanding it. Two agen
 on one zenoh network would share every topic: two controllers on one robot, ``/joint_states`` doubled,
 goals aborted by the other side. So:
 
-* each agent and driver process declares a **presence token** (a zenoh liveliness token, like the ROS
-  graph's), ``@kinema_lv/<domain>/<zid>/<role>/<name>/<pid>/<parent pid>/<host>/<config>/<endpoint>``,
-  which disappears when the process does;
+* each agent and driver process declares a **presence token** (:mod:`kinema.transport.presence`: a zenoh
+  liveliness token, like the ROS graph's), which disappears when the process does;
 * ``kinema run`` looks at the network before it starts anything (:func:`check_cell_is_free`) and refuses
   to start a second agent or second drivers, naming the running ones and how to stop or join them
   (``-n`` and ``-o`` start one part of a cell whose other part runs elsewhere, and stay allowed);
@@ -21,160 +20,54 @@ node is a driver.
 from __future__ import annotations
 
 import logging
-import os
-import socket
 import threading
 from collections.abc import Callable, Iterable
-from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any
-from urllib.parse import quote, unquote
 
+from kinema.drivers.mujoco.names import CONTROLLER_MANAGER_NODE, JOINT_STATES_TOPIC
 from kinema.errors import KinemaError
+from kinema.runtime.names import NODE_NAME
+from kinema.transport.presence import (
+    AGENT,
+    DRIVER,
+    PRESENCE_PREFIX,
+    ROLES,
+    Member,
+    declare_presence,
+    parse_presence,
+    presence_key,
+    query_presences,
+)
 
 if TYPE_CHECKING:
     from kinema.transport import Graph, Session
 
+__all__ = [
+    "AGENT",
+    "DRIVER",
+    "ROLES",
+    "CellError",
+    "CellWatch",
+    "Member",
+    "cell_members",
+    "check_cell_is_free",
+    "conflicts",
+    "declare_presence",
+    "parse_presence",
+    "presence_key",
+    "query_presences",
+]
+
 log = logging.getLogger(__name__)
 
-PRESENCE_PREFIX = "@kinema_lv"
-AGENT, DRIVER = "agent", "driver"
-ROLES = (AGENT, DRIVER)
-AGENT_NODE = "/objective_server"
-DRIVER_NODE = "/controller_manager"
-DRIVER_TOPIC = "/joint_states"
+# How a process without a presence token (an older Kinema, a ROS 2 driver) shows in the ROS graph.
+AGENT_NODE = f"/{NODE_NAME}"
+DRIVER_NODE = f"/{CONTROLLER_MANAGER_NODE}"
+DRIVER_TOPIC = JOINT_STATES_TOPIC
 
 
 class CellError(KinemaError):
     """A second agent or second drivers would join a cell that has them."""
-
-
-@dataclass(frozen=True)
-class Member:
-    """An agent or driver process seen on the network.
-
-    Attributes:
-        role: ``agent`` or ``driver``.
-        zid: its zenoh session id.
-        name: the driver's name (``mujoco``) or ``agent``; empty when only the ROS graph showed it.
-        pid: its process id (None when unknown: no presence token).
-        parent_pid: the ``kinema run`` supervisor that started it (None when unknown).
-        host: the machine's host name.
-        config: the config package it runs.
-        endpoint: the router endpoint it joined.
-    """
-
-    role: str
-    zid: str
-    name: str = ""
-    pid: int | None = None
-    parent_pid: int | None = None
-    host: str = ""
-    config: str = ""
-    endpoint: str = ""
-
-    def describe(self) -> str:
-        """One phrase for messages: ``agent of config lab_sim (pid 12, host robot, kinema run pid 10)``."""
-        what = self.role if self.role == AGENT or not self.name else f"driver {self.name!r}"
-        if self.pid is None:
-            return f"{what} (zenoh id {self.zid[:12]}; not a Kinema process or an older one)"
-        details = [f"pid {self.pid}"]
-        if self.host:
-            details.append(f"host {self.host}")
-        if self.parent_pid:
-            details.append(f"started by pid {self.parent_pid}")
-        config = f" of config {self.config}" if self.config else ""
-        return f"{what}{config} ({', '.join(details)})"
-
-
-def _chunk(text: str) -> str:
-    return quote(text, safe="") or "%"
-
-
-def _unchunk(text: str) -> str:
-    return "" if text == "%" else unquote(text)
-
-
-def presence_key(session: Session, member: Member) -> str:
-    """The liveliness key of ``member`` on ``session``."""
-    fields = (
-        member.role,
-        member.name,
-        str(member.pid or 0),
-        str(member.parent_pid or 0),
-        member.host,
-        member.config,
-        member.endpoint,
-    )
-    return "/".join((PRESENCE_PREFIX, str(session.domain_id), session.zid, *(_chunk(f) for f in fields)))
-
-
-def parse_presence(key: str) -> Member | None:
-    """The member a presence key announces (None for anything else)."""
-    parts = str(key).split("/")
-    if len(parts) != 10 or parts[0] != PRESENCE_PREFIX or parts[3] not in ROLES:
-        return None
-    try:
-        pid, parent = int(parts[5]), int(parts[6])
-    except ValueError:
-        return None
-    return Member(
-        role=parts[3],
-        zid=parts[2],
-        name=_unchunk(parts[4]),
-        pid=pid or None,
-        parent_pid=parent or None,
-        host=_unchunk(parts[7]),
-        config=_unchunk(parts[8]),
-        endpoint=_unchunk(parts[9]),
-    )
-
-
-def declare_presence(
-    session: Session, role: str, *, name: str = "", config: str = "", endpoint: str = ""
-) -> Any:
-    """Announce this process as the cell's ``role`` (``agent`` or ``driver``).
-
-    The announcement lives as long as the session (the session holds it and withdraws it when it
-    closes); ``close()`` on the returned object withdraws it earlier.
-    """
-    member = Member(
-        role=role,
-        zid=session.zid,
-        name=name or role,
-        pid=os.getpid(),
-        parent_pid=os.getppid(),
-        host=socket.gethostname(),
-        config=config,
-        endpoint=endpoint or ",".join(session.endpoints or session.listen),
-    )
-    return _Presence(session, session.zenoh.liveliness().declare_token(presence_key(session, member)))
-
-
-class _Presence:
-    """A declared presence token, held by its session (a dropped zenoh token is withdrawn at once)."""
-
-    def __init__(self, session: Session, token: Any) -> None:
-        self._session = session
-        self._token: Any = token
-        session._register_closer(self)
-
-    def close(self) -> None:
-        token, self._token = self._token, None
-        if token is not None:
-            self._session._unregister_closer(self)
-            token.undeclare()
-
-
-def query_presences(session: Session, timeout: float = 1.0) -> list[Member]:
-    """Every presence on the session's domain, asked of the network now."""
-    replies = session.zenoh.liveliness().get(f"{PRESENCE_PREFIX}/{session.domain_id}/**", timeout=timeout)
-    members = []
-    for reply in replies:
-        if reply.ok is not None:
-            member = parse_presence(str(reply.ok.key_expr))
-            if member is not None:
-                members.append(member)
-    return members
 
 
 def cell_members(graph: Graph, presences: Iterable[Member]) -> dict[str, list[Member]]:

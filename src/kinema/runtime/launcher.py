@@ -5,12 +5,14 @@ children; the agent and each driver run in processes of their own. The agent is 
 thread of the supervisor so that its 100 Hz tick thread never competes for the GIL with a UI running in
 the supervisor (the TUI), so a crashing behavior cannot take the router (and every client's connection)
 down with it, and so ``kinema down`` can stop it like any other process. Children get a parent-death
-signal and a lifeline (:mod:`kinema.runtime.lifeline`), so even a supervisor killed with SIGKILL leaves
+signal and a lifeline (:mod:`kinema.process.lifeline`), so even a supervisor killed with SIGKILL leaves
 no orphans behind: they end within about a second.
 
 A UI plugs in through :attr:`LaunchOptions.ui`: a callable that receives the started :class:`Launcher`
 (its ``session``, ``endpoint``, ``run_folder``) and runs in the main thread until the user quits; without
-one the supervisor blocks until Ctrl-C, SIGTERM (``kinema down``) or a child dies.
+one the supervisor blocks until Ctrl-C, SIGTERM (``kinema down``) or a child dies. A crashed agent
+(a behavior's ``os._exit``, a segfault in C code) is started again, up to :data:`AGENT_RESTARTS` times,
+each said on the terminal and in the supervisor's log; the drivers stop the goals it left running.
 """
 
 from __future__ import annotations
@@ -29,9 +31,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from kinema.errors import KinemaError, TransportError
+from kinema.process.lifeline import Lifeline
 from kinema.runtime.cell import CellError
+from kinema.runtime.cell_claim import CellClaim
 from kinema.runtime.instance import InstanceRecord
-from kinema.runtime.lifeline import Lifeline
 from kinema.runtime.run_folder import RunFolder, prune_runs
 
 if TYPE_CHECKING:
@@ -42,6 +45,12 @@ log = logging.getLogger("kinema.supervisor")
 READY_TIMEOUT_S = 120.0
 STOP_GRACE_S = 5.0
 VIEWER_READY_TIMEOUT_S = 30.0
+# A crashed agent is started again this many times per `kinema run` (the drivers hold the robot still
+# meanwhile: they stop the goals of an agent that went away); after that the run stops.
+AGENT_RESTARTS = 3
+# How long a `kinema run` that finds the cell's roles claimed on this machine waits for the claiming one's
+# agent or drivers to show on the network (so that it refuses with what runs there).
+CLAIM_WAIT_S = 60.0
 
 
 @dataclass
@@ -125,6 +134,9 @@ class Launcher:
         self._stop_reason = ""
         self._echo_stop = threading.Event()
         self._config: Any = None
+        self._clock = "auto"
+        self.agent_restarts = 0
+        self._claim = CellClaim()
 
     # -- start --------------------------------------------------------------------------------------
 
@@ -135,7 +147,7 @@ class Launcher:
             KinemaError: the router cannot be hosted or joined, or the agent failed to start (the message
                 carries the end of its log).
         """
-        from kinema.runtime.log_files import configure_process_logging
+        from kinema.process.log_files import configure_process_logging
 
         options = self.options
         # A config that does not resolve is refused before anything exists: no run folder, no router.
@@ -164,6 +176,7 @@ class Launcher:
             starting = self._start_drivers() if options.drivers else []
             if options.drivers and not starting:
                 clock = "wall"  # no simulator will publish /clock: time must not freeze
+            self._clock = clock
             if options.agent:
                 starting.append(self._start_agent(clock))
             for child, stream in starting:
@@ -306,6 +319,9 @@ class Launcher:
     ) -> Child:
         log.info("starting %s: %s", name, " ".join(argv))
         env = os.environ.copy()
+        if self.options.security_dir is not None:
+            # The agent's file rule refuses this folder too (kinema.behaviors.file_access).
+            env["KINEMA_SECURITY_DIR"] = str(self.options.security_dir)
         if self.lifeline is not None:
             env.update(self.lifeline.child_env())
             pass_fds = (*pass_fds, self.lifeline.read_fd)
@@ -342,6 +358,10 @@ class Launcher:
                     log.warning("%s exited (code %s); the runtime keeps running", child.name, code)
                     self.children.remove(child)
                     continue
+                if code is not None and child.name == "agent" and self.agent_restarts < AGENT_RESTARTS:
+                    if self._restart_agent(child, code):
+                        continue
+                    return 1
                 if code is not None:
                     log.error("%s exited with code %s", child.name, code)
                     self.options.echo(
@@ -350,6 +370,30 @@ class Launcher:
                     return 1
         log.info("stopping (%s)", self._stop_reason or "requested")
         return 0
+
+    def _restart_agent(self, crashed: Child, code: int) -> bool:
+        """Start the agent again after it exited unexpectedly; False when the new one did not start."""
+        self.agent_restarts += 1
+        message = (
+            f"agent exited unexpectedly (code {code}); see {crashed.log_file}; restarting it "
+            f"({self.agent_restarts} of {AGENT_RESTARTS}); the drivers hold the robot still meanwhile"
+        )
+        log.error("%s", message)
+        self.options.echo(message)
+        self.children.remove(crashed)
+        if self.record is not None and crashed.process.pid in self.record.children:
+            self.record.children.remove(crashed.process.pid)
+            self.record.save()
+        try:
+            child, stream = self._start_agent(self._clock)
+            self._await_ready(child, stream)
+        except KinemaError as error:
+            log.error("the agent did not start again: %s", error)
+            self.options.echo(f"the agent did not start again: {error}; stopping")
+            return False
+        log.info("agent restarted (pid %d)", child.process.pid)
+        self.options.echo(f"agent restarted (pid {child.process.pid}); objectives can be started")
+        return True
 
     def stop(self) -> None:
         """Stop the children (SIGTERM, SIGKILL after a grace period), close the router, drop the record."""
@@ -375,6 +419,7 @@ class Launcher:
         if self.record is not None:
             self.record.remove()
             self.record = None
+        self._claim.release()
 
     def run(self) -> int:
         """Start, block (or run the UI), stop; SIGINT and SIGTERM stop cleanly. Returns the exit code."""
@@ -412,6 +457,7 @@ class Launcher:
 
         bound_heap_growth()  # the router reassembles large messages too; see kinema.transport.heap
         plan = plan_router(self.options.endpoint, self.options.security_dir)
+        self._claim_cell(plan.local)
         session = open_router(plan, insecure=self.options.insecure, before_join=self._check_cell_is_free)
         self.endpoint = plan.local
         if session.exposed:
@@ -424,6 +470,37 @@ class Launcher:
                 f"{plan.config_file.parent} (mutual TLS, access rules of {plan.config_file})"
             )
         return session
+
+    def _claim_cell(self, endpoint: str) -> None:
+        """Take this machine's claim on the roles this run starts (see kinema.runtime.cell_claim).
+
+        Raises:
+            CellError: another `kinema run` holds one: the usual message once its members show on the
+                network, else one naming the process that holds the claim.
+        """
+        from kinema.runtime.cell_claim import AGENT, DRIVERS
+        from kinema.transport import resolve_domain_id
+
+        roles = [
+            role for role, wanted in ((AGENT, self.options.agent), (DRIVERS, self.options.drivers)) if wanted
+        ]
+        domain = resolve_domain_id(None)
+        holder = self._claim.take(endpoint, domain, roles)
+        if holder is None:
+            return
+        log.info("the cell at %s is claimed on this machine by pid %s; looking at it", endpoint, holder)
+        deadline = time.monotonic() + CLAIM_WAIT_S
+        while time.monotonic() < deadline and not self._stop.is_set():
+            self._check_cell_is_free(endpoint)  # raises the usual CellError once its members show
+            holder = self._claim.take(endpoint, domain, roles)
+            if holder is None:
+                return  # the other one gave up (or stopped) meanwhile
+            time.sleep(0.2)
+        raise CellError(
+            f"another kinema run (pid {holder}) is starting the {' and '.join(roles)} of the cell at "
+            f"{endpoint} on this machine, so nothing was started.\n  stop it: `kinema down`, or Ctrl-C in "
+            "its terminal\n  run a second cell beside it: `kinema run --connect tcp/127.0.0.1:<another port>`"
+        )
 
     def _check_cell_is_free(self, endpoint: str) -> None:
         """Refuse to start a second agent or second drivers on the router at ``endpoint`` that has them
@@ -460,7 +537,7 @@ class Launcher:
 
         Without a UI this terminal is where the user looks; the log file (``kinema logs``) has them too.
         """
-        from kinema.runtime.log_files import PLUGIN_LOGGER, follow_entries
+        from kinema.process.log_files import PLUGIN_LOGGER, follow_entries
 
         assert self.run_folder is not None
         entries = follow_entries(self.run_folder.path, stop=self._echo_stop, from_start=True)

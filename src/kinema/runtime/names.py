@@ -13,6 +13,9 @@ CANCEL_OBJECTIVE = "/cancel_objective"
 CANCEL_OBJECTIVE_TYPE = "moveit_studio_sdk_msgs/srv/CancelObjective"
 DO_OBJECTIVE = "/do_objective"
 DO_OBJECTIVE_TYPE = "moveit_studio_sdk_msgs/action/DoObjectiveSequence"
+# /do_objective without its XML: library objectives by name (with overrides) only. An operator's
+# certificate reaches this one; ad-hoc XML through /do_objective is a separate grant (kinema security).
+RUN_OBJECTIVE = "/kinema/run_objective"
 
 HEARTBEAT = "/objective_server_heartbeat"
 HEARTBEAT_TYPE = "moveit_studio_agent_msgs/msg/ObjectiveServerStatus"
@@ -31,9 +34,12 @@ BLACKBOARD = "/objective_server/blackboard"
 BLACKBOARD_TYPE = "kinema_msgs/msg/BlackboardSnapshot"
 LOG = "/objective_server/log"
 LOG_TYPE = "moveit_studio_agent_msgs/msg/Log"
-# The task PlanMTCTask plans, stage by stage, while it plans (the TUI's task panel).
-TASK_PLANNING = "/kinema/task_planning"
-TASK_PLANNING_TYPE = "kinema_msgs/msg/TaskPlanningStatus"
+# The agent's planning scene, as MoveIt's move_group serves it: published (latched) on every change, and
+# answered on request (kinema.runtime.planning_scene_service).
+PLANNING_SCENE = "/monitored_planning_scene"
+PLANNING_SCENE_TYPE = "moveit_msgs/msg/PlanningScene"
+GET_PLANNING_SCENE = "/get_planning_scene"
+GET_PLANNING_SCENE_TYPE = "moveit_msgs/srv/GetPlanningScene"
 
 LIST_OBJECTIVES = "/objective_server/list_objectives"
 LIST_OBJECTIVES_TYPE = "kinema_msgs/srv/ListObjectives"
@@ -45,7 +51,4 @@ GET_WAYPOINTS_TYPE = "moveit_studio_agent_msgs/srv/GetWaypoints"
 EDIT_WAYPOINTS = "/edit_waypoints"
 EDIT_WAYPOINTS_TYPE = "moveit_studio_agent_msgs/srv/EditWaypoints"
 
-CLOCK = "/clock"
-CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
-JOINT_STATES = "/joint_states"
-JOINT_STATES_TYPE = "sensor_msgs/msg/JointState"
+# Time (/clock) and the robot's state (/joint_states) are the drivers': kinema.drivers.mujoco.names.

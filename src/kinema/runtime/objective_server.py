@@ -150,6 +150,10 @@ class ObjectiveRun:
         self._result: ObjectiveResult | None = None
         self._callbacks: list[Callable[[ObjectiveResult], None]] = []
         self._lock = threading.Lock()
+        # Set when a cancel of this run was accepted: from then on it can no longer end as SUCCESS (a
+        # tick stuck in C code that holds the interpreter may still complete after the cancel came).
+        self.cancel_reason: str | None = None
+        self._settled = False
 
     @property
     def done(self) -> bool:
@@ -169,6 +173,36 @@ class ObjectiveRun:
     def cancel(self) -> bool:
         """Ask the server to cancel this run; False when it already ended."""
         return self._server.cancel(self)
+
+    def request_cancel(self, reason: str) -> bool:
+        """Accept a cancel of this run unless its outcome is already settled; True when accepted.
+
+        An accepted cancel is honored even if the tree completes in the tick it came during: the run
+        then ends cancelled (PREEMPTED), never SUCCESS.
+        """
+        with self._lock:
+            if self._settled:
+                return False
+            if self.cancel_reason is None:
+                self.cancel_reason = reason
+            return True
+
+    def _settle(self, result: ObjectiveResult) -> ObjectiveResult:
+        """Fix the outcome (the tick thread, as the run ends): an accepted cancel turns SUCCESS into it."""
+        with self._lock:
+            self._settled = True
+            if not result.succeeded or self.cancel_reason is None:
+                return result
+            reason = self.cancel_reason
+        log.warning(
+            "objective %r completed after a cancel was accepted (%s); it ends cancelled",
+            self.objective_name,
+            reason,
+        )
+        return ObjectiveResult.preempted(
+            f"{reason} (accepted while its last tick ran: the tree completed, the cancel wins)",
+            self.objective_name,
+        )
 
     def add_done_callback(self, callback: Callable[[ObjectiveResult], None]) -> None:
         """Call ``callback(result)`` when the run ends (at once if it already has).
@@ -214,6 +248,8 @@ class _Cancel:
     reason: str
     ack: threading.Event = field(default_factory=threading.Event)
     cancelled: bool = False
+    # An abort: something the run needs died (a driver); it ends as FAILURE, never as a cancel.
+    failure: bool = False
 
 
 @dataclass
@@ -309,6 +345,7 @@ class ObjectiveServer:
         self._woken = False
         self._tick_now = False
         self._stopping = False
+        self._stop_reason = "the objective server stopped"
         # Set by every request: a tree re-ticking itself stops between two iterations to serve it.
         self._interrupt = False
         # When the oldest request that a stuck tick thread would have to serve was posted.
@@ -358,11 +395,16 @@ class ObjectiveServer:
         )
         self._watchdog.start()
 
-    def stop(self, timeout: float = 5.0) -> None:
-        """Halt the running objective (its result is PREEMPTED) and stop the tick thread."""
+    def stop(self, timeout: float = 5.0, *, reason: str = "the objective server stopped") -> None:
+        """Halt the running objective and stop the tick thread.
+
+        The running objective ends as FAILURE with ``reason``: a stopping runtime is not a cancel its
+        client asked for (queued requests are refused with it too).
+        """
         if self._watchdog is None:
             return
         with self._wake:
+            self._stop_reason = reason
             self._stopping = True
             self._interrupt = True
             self._woken = True
@@ -439,7 +481,23 @@ class ObjectiveServer:
         """
         if run is not None and run.done:
             return False
+        target = run if run is not None else self._run
+        if target is not None:
+            target.request_cancel(reason)
         request = _Cancel(run, reason)
+        self._post(request)
+        if threading.current_thread() is self._thread:
+            return True
+        request.ack.wait(timeout)
+        return request.cancelled
+
+    def abort(self, reason: str, *, timeout: float = 5.0) -> bool:
+        """End whatever runs as FAILURE with ``reason`` (something it needs died: a driver, a link).
+
+        Returns:
+            True if something was running (it is halted when this returns, up to ``timeout``).
+        """
+        request = _Cancel(None, reason, failure=True)
         self._post(request)
         if threading.current_thread() is self._thread:
             return True
@@ -644,9 +702,9 @@ class ObjectiveServer:
                 if not stopping:
                     self._waiting_since = None
             if stopping:
-                self._finish_current(worker, ObjectiveResult.preempted, "the objective server stopped")
+                self._finish_current(worker, ObjectiveResult.failure, self._stop_reason)
                 for item in inbox:
-                    self._reject(item, "the objective server stopped")
+                    self._reject(item, self._stop_reason)
                 self._stopped.set()
                 return
             start = self._take_requests(worker, inbox)
@@ -687,7 +745,7 @@ class ObjectiveServer:
 
     def _reject(self, item: ObjectiveRun | _Cancel | _Call, reason: str) -> None:
         if isinstance(item, ObjectiveRun):
-            item._finish(ObjectiveResult.preempted(reason, item.objective_name))
+            item._finish(ObjectiveResult.failure(reason, item.objective_name))
         elif isinstance(item, _Cancel):
             item.ack.set()
         else:
@@ -714,12 +772,13 @@ class ObjectiveServer:
                     )
                 start = item
             elif isinstance(item, _Cancel):
-                if start is not None and (item.run is None or item.run is start):
-                    start._finish(ObjectiveResult.preempted(item.reason, start.objective_name))
+                make = ObjectiveResult.failure if item.failure else ObjectiveResult.preempted
+                if start is not None and (item.run is None or item.run is start) and not item.failure:
+                    start._finish(make(item.reason, start.objective_name))
                     start = None
                     item.cancelled = True
                 if self._run is not None and (item.run is None or item.run is self._run):
-                    self._finish_current(worker, ObjectiveResult.preempted, item.reason)
+                    self._finish_current(worker, make, item.reason)
                     item.cancelled = True
                 item.ack.set()
             else:
@@ -902,9 +961,13 @@ class ObjectiveServer:
                 waiting = any(not isinstance(item, _Call) for item in self._inbox) or self._stopping
                 self._waiting_since = time.monotonic() if waiting else None
             self._flush_node_changes(run)
-        self._end(run, make(reason, run.objective_name), ObjectiveStatus.CANCELLED)
+        result = make(reason, run.objective_name)
+        self._end(run, result, ObjectiveStatus.CANCELLED if result.cancelled else ObjectiveStatus.FAILURE)
 
     def _end(self, run: ObjectiveRun, result: ObjectiveResult, status: ObjectiveStatus) -> None:
+        result = run._settle(result)
+        if result.cancelled and status is ObjectiveStatus.SUCCESS:
+            status = ObjectiveStatus.CANCELLED
         if run.stale_note and not result.succeeded:
             # The exception may come from code no longer in the file: say that the file did not load.
             result = replace(result, error_message=f"{result.error_message}\nnote: {run.stale_note}")

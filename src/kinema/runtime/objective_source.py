@@ -147,6 +147,9 @@ class LibraryTreeSource:
                 log.warning("objective file %s not loaded: %s", path, error)
                 for objective_id in ids_by_file.get(path, []):
                     problems[objective_id] = LibraryProblem(str(path), str(error))
+        from kinema.config.cell import substitute_config_defaults
+
+        substitute_config_defaults(factory.library.subtree_models, getattr(self._library, "resolved", None))
         self._factory = factory
         self._registry = registry
         self._problems = problems

@@ -186,9 +186,10 @@ def parse_yaml_value(text: str, port_type: Any) -> Any:
     import yaml
 
     from kinema.bt.conversions import AnyValue, ConversionError, Unsigned, convert_from_string, has_converter
+    from kinema.nesting import load_yaml
 
     try:
-        parsed = yaml.safe_load(text) if text.strip() else text
+        parsed = load_yaml(text, "the value") if text.strip() else text
     except yaml.YAMLError as error:
         mark = getattr(error, "problem_mark", None)
         where = f" at column {mark.column + 1}" if mark is not None else ""

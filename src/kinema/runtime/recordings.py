@@ -25,6 +25,7 @@ from typing import TYPE_CHECKING, Any
 
 from kinema.bt.btlog import SUFFIX, BtlogWriter, Recording, coded_records, pack_coded_transitions, read_btlog
 from kinema.errors import KinemaError
+from kinema.runtime.background_work import HandOff
 
 if TYPE_CHECKING:
     from kinema.bt.tree import Tree
@@ -40,6 +41,8 @@ DEFAULT_MAX_FILE_BYTES = 16 * 1024 * 1024
 DEFAULT_MAX_TOTAL_BYTES = 256 * 1024 * 1024
 DEFAULT_KEEP = 200
 BLACKBOARD_SUFFIX = ".blackboard.jsonl"
+# How long the end of a run waits for its last blackboard snapshot to be written.
+DRAIN_AT_RUN_END_S = 0.5
 
 
 def blackboard_path(recording: Path) -> Path:
@@ -67,10 +70,49 @@ def list_recordings(folder: Path) -> list[RecordingFile]:
     return [RecordingFile(p, p.stat().st_size) for p in sorted(folder.glob(f"*{SUFFIX}"))]
 
 
+class _BlackboardFile:
+    """One run's ``.blackboard.jsonl``, written by the recorder's worker thread only."""
+
+    def __init__(self, file: Any, max_bytes: int) -> None:
+        self.file = file
+        self.max_bytes = max_bytes
+        self.size = 0
+        self.last: list[list[str]] | None = None
+
+    def write(self, offset_us: int, entries: list[tuple[str, str, str, Any]]) -> None:
+        from kinema.runtime.blackboard_text import render_value
+
+        if self.file is None:
+            return
+        rendered = [[scope, key, type_name, render_value(value)] for scope, key, type_name, value in entries]
+        if rendered == self.last:
+            return
+        self.last = rendered
+        line = json.dumps({"t_us": max(0, offset_us), "entries": rendered}, ensure_ascii=False) + "\n"
+        if self.size + len(line) > self.max_bytes:
+            return
+        try:
+            self.file.write(line)
+            self.file.flush()
+        except OSError as error:
+            log.warning("blackboard recording stopped: %s", error)
+            self.close()
+            return
+        self.size += len(line)
+
+    def close(self) -> None:
+        if self.file is not None:
+            self.file.close()
+            self.file = None
+
+
 class RunRecorder:
     """An objective-server listener writing each run's transitions into its own ``.btlog`` file.
 
-    All methods run on the tick thread (see :class:`~kinema.runtime.objective_server.TreeListener`).
+    Its listener methods run on the tick thread (see
+    :class:`~kinema.runtime.objective_server.TreeListener`); blackboard snapshots are rendered and written
+    by a worker thread of its own (:class:`~kinema.runtime.background_work.HandOff`): the tick thread only
+    hands them over. :meth:`close` stops that thread.
     """
 
     def __init__(
@@ -91,9 +133,8 @@ class RunRecorder:
         self.max_total_bytes = max_total_bytes
         self.keep = keep
         self._writer: BtlogWriter | None = None
-        self._blackboard: Any = None
-        self._blackboard_size = 0
-        self._last_entries: list[list[str]] | None = None
+        self._blackboard: _BlackboardFile | None = None
+        self._work = HandOff("kinema-recording")
         self._clock: Any = None
         self._tree: Tree | None = None
         self._t0 = 0.0
@@ -124,10 +165,10 @@ class RunRecorder:
         self._tree = tree
         self._t0 = tree.clock.now()
         self._objective = objective_name
-        self._last_entries = None
-        self._blackboard_size = 0
         try:
-            self._blackboard = open(blackboard_path(path), "w", encoding="utf-8")
+            self._blackboard = _BlackboardFile(
+                open(blackboard_path(path), "w", encoding="utf-8"), self.max_file_bytes
+            )
         except OSError as error:
             log.warning("not recording the blackboard of %r: %s", objective_name, error)
             self._blackboard = None
@@ -186,36 +227,24 @@ class RunRecorder:
         pass
 
     def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
-        file = self._blackboard
-        if file is None or self._writer is None:
+        target = self._blackboard
+        if target is None or self._writer is None:
             return
-        from kinema.runtime.agent import render_value
-
-        rendered = [[scope, key, type_name, render_value(value)] for scope, key, type_name, value in entries]
-        if rendered == self._last_entries:
-            return
-        self._last_entries = rendered
         offset = round((self._clock.now() - self._t0) * 1e6) if self._clock is not None else 0
-        line = json.dumps({"t_us": max(0, offset), "entries": rendered}, ensure_ascii=False) + "\n"
-        if self._blackboard_size + len(line) > self.max_file_bytes:
-            return
-        try:
-            file.write(line)
-            file.flush()
-        except OSError as error:
-            log.warning("blackboard recording stopped: %s", error)
-            self._close_blackboard()
-            return
-        self._blackboard_size += len(line)
+        self._work.submit(lambda: target.write(offset, entries), key=id(target))
 
     def close(self) -> None:
-        """Close the file being written."""
+        """Close the file being written and stop the worker thread."""
         self._close_writer()
+        self._work.close()
 
     def _close_blackboard(self) -> None:
-        if self._blackboard is not None:
-            self._blackboard.close()
-            self._blackboard = None
+        target, self._blackboard = self._blackboard, None
+        if target is not None:
+            self._work.submit(target.close)
+            # The run's last snapshot is written when the recording ends (rendering is capped: a few ms).
+            if not self._work.drain(DRAIN_AT_RUN_END_S):
+                log.warning("the blackboard recording was still being written when its run ended")
 
     def _close_writer(self) -> None:
         self._close_blackboard()

@@ -12,15 +12,25 @@ The server runs behavior code on a :class:`TickWorker` thread with its state loc
   when it comes back from behavior code, and its tree is disarmed and halted by
   :func:`release_stuck_tree`;
 - a tick thread that died without replacing itself is replaced (:meth:`WatchedServer.replace_dead_worker`);
-- a coroutine blocking the event loop that async behaviors share is reported and that loop retired.
+- a coroutine blocking the event loop that async behaviors share is reported and that loop retired;
+- code that holds the interpreter (C code that does not release the GIL) stops every Python thread, this
+  watchdog included, so it cannot look while it happens: :class:`StallDumps` keeps faulthandler's timer
+  armed, whose own C thread needs no interpreter and writes every thread's stack when the watchdog has
+  not re-armed it in time. The watchdog reads that afterwards and reports where the tick thread sat.
+  (faulthandler has one such timer per process: a program embedding the server should not use
+  ``faulthandler.dump_traceback_later`` itself while a server runs.)
 
 It also words the warnings the server's health report carries about all of the above.
 """
 
 from __future__ import annotations
 
+import faulthandler
 import logging
+import os
+import re
 import sys
+import tempfile
 import threading
 import time
 from typing import TYPE_CHECKING, Any, Protocol
@@ -47,6 +57,86 @@ LOOP_BLOCKED = (
 )
 STUCK_ADVICE = "the objective cannot stop until it returns: cancel it (ctrl+x, kinema objective cancel)"
 ABANDONED_ADVICE = "restart the runtime (kinema down, then kinema run) to free it"
+# faulthandler's timer is re-armed every this many watchdog rounds (arming costs about 0.1 ms).
+STALL_ARM_EVERY = 5
+# A stall report stays in the health warnings this long.
+STALL_SHOWN_S = 30.0
+# Frames of the tick thread's stack a stall report names (innermost first).
+STALL_FRAMES = 4
+# A tick thread with one of these server frames on its stack was running behavior code.
+RUNNING_BEHAVIORS = r"objective_server\.py\", line \d+ in (_tick|_load|_halt_quietly|_take_requests)$"
+
+
+class StallDumps:
+    """faulthandler's timer, kept armed by the watchdogs of this process (one timer, one file).
+
+    When no watchdog re-armed it for the threshold, something held the interpreter (or the process was
+    stopped): faulthandler's C thread, which needs no interpreter lock, wrote every thread's stack to the
+    file. :meth:`arm` collects such a dump before arming again; each watchdog reads the new ones.
+    """
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._fd: int | None = None
+        self.dumps: list[tuple[int, float, str]] = []  # (sequence number, when read, text)
+        self._sequence = 0
+        self._watchers = 0
+
+    def register(self) -> None:
+        with self._lock:
+            self._watchers += 1
+
+    def unregister(self) -> None:
+        """A watchdog stopped; the last one disarms the timer (an idle process is not a stalled one)."""
+        with self._lock:
+            self._watchers -= 1
+            if self._watchers <= 0:
+                self._watchers = 0
+                faulthandler.cancel_dump_traceback_later()
+                if self._fd is not None:
+                    os.ftruncate(self._fd, 0)
+                    os.lseek(self._fd, 0, os.SEEK_SET)
+
+    def arm(self, seconds: float) -> None:
+        with self._lock:
+            if self._fd is None:
+                handle, path = tempfile.mkstemp(prefix="kinema-stall-", suffix=".txt")
+                os.unlink(path)
+                self._fd = handle
+            faulthandler.cancel_dump_traceback_later()  # waits for a dump being written
+            size = os.lseek(self._fd, 0, os.SEEK_END)
+            if size:
+                text = os.pread(self._fd, size, 0).decode("utf-8", "replace")
+                os.ftruncate(self._fd, 0)
+                os.lseek(self._fd, 0, os.SEEK_SET)
+                self._sequence += 1
+                self.dumps = [*self.dumps[-7:], (self._sequence, time.monotonic(), text)]
+            faulthandler.dump_traceback_later(seconds, repeat=False, file=self._fd, exit=False)
+
+    def since(self, sequence: int) -> list[tuple[int, float, str]]:
+        with self._lock:
+            return [dump for dump in self.dumps if dump[0] > sequence]
+
+
+STALLS = StallDumps()
+
+
+def stack_in_dump(dump: str, ident: int | None) -> list[str]:
+    """The frames (innermost first) a faulthandler dump shows for thread ``ident``."""
+    if ident is None:
+        return []
+    wanted = f"0x{ident:016x}"
+    frames: list[str] = []
+    inside = False
+    for line in dump.splitlines():
+        if line.startswith(("Thread 0x", "Current thread 0x")):
+            inside = wanted in line
+            continue
+        if inside and line.strip().startswith("File "):
+            frames.append(line.strip())
+        elif inside and not line.strip():
+            break
+    return frames
 
 
 class Abandoned(BaseException):
@@ -119,20 +209,52 @@ class TickWatchdog:
         self.abandon_after_s = abandon_after_s
         # What blocked each retired event loop of async behaviors (by thread id).
         self._loop_codes: dict[int | None, StuckCode] = {}
+        self._rounds = 0
+        self._stall_seen = STALLS.since(-1)[-1][0] if STALLS.since(-1) else 0
+        self._stalls: list[tuple[float, str]] = []  # (when, sentence)
         self._thread = threading.Thread(target=self._watch, name="kinema-tick-watchdog", daemon=True)
 
     def start(self) -> None:
+        STALLS.register()
+        STALLS.arm(self.report_after_s)  # armed before the first tick, not a round later
         self._thread.start()
 
     def join(self, timeout: float | None = None) -> None:
         self._thread.join(timeout)
 
     def _watch(self) -> None:
+        try:
+            self._watch_loop()
+        finally:
+            STALLS.unregister()
+
+    def _watch_loop(self) -> None:
         while not self._stopped.wait(WATCHDOG_PERIOD_S):
             try:
+                if self._rounds % STALL_ARM_EVERY == 0:
+                    STALLS.arm(self.report_after_s)
+                self._rounds += 1
+                self._watch_stalls()
                 self._watch_once()
             except Exception:
                 log.exception("the tick watchdog raised")
+
+    def _watch_stalls(self) -> None:
+        """Report where the tick thread sat while something held the interpreter (see StallDumps)."""
+        for sequence, when, dump in STALLS.since(self._stall_seen):
+            self._stall_seen = sequence
+            worker = self._server.watched_worker()
+            ident = worker.thread.ident if worker is not None and worker.thread is not None else None
+            frames = stack_in_dump(dump, ident)
+            if not any(re.search(RUNNING_BEHAVIORS, frame) for frame in frames):
+                continue  # the tick thread was waiting, not running behavior code: not its stall
+            where = " ← ".join(frames[:STALL_FRAMES])
+            sentence = (
+                f"the interpreter was held for more than {self.report_after_s:g} s (C code that does not "
+                f"release the GIL?) while tick thread {worker.name if worker else '?'} sat in: {where}"
+            )
+            log.error("watchdog: %s", sentence)
+            self._stalls = [*self._stalls[-3:], (when, sentence)]
 
     def _watch_event_loop(self) -> None:
         """A coroutine that blocks the async behaviors' event loop: report it, move on to a fresh loop."""
@@ -182,6 +304,7 @@ class TickWatchdog:
                 f"abandoned tick thread {old.name}: {stuck.describe(now - since)} "
                 f"(abandoned {now - old.abandoned_at:.1f} s ago); {ABANDONED_ADVICE}"
             )
+        warnings.extend(sentence for when, sentence in self._stalls if now - when < STALL_SHOWN_S)
         warnings.extend(halted_work_warnings(self.report_after_s))
         runner = work_runner()
         if runner is not None:

@@ -10,8 +10,9 @@ Names are imported on first use, so ``import kinema.sdk.quick`` stays cheap.
 
 from __future__ import annotations
 
-import importlib
 from typing import TYPE_CHECKING, Any
+
+from kinema.lazy_exports import LazyExports
 
 _EXPORTS = {
     "BlackboardSnapshot": "kinema.sdk.streams",
@@ -33,6 +34,7 @@ _EXPORTS = {
     "QuickClient": "kinema.sdk.quick",
     "QuickRun": "kinema.sdk.quick",
 }
+_lazy = LazyExports(__name__, _EXPORTS)
 
 __all__ = [
     "BlackboardSnapshot",
@@ -75,12 +77,7 @@ if TYPE_CHECKING:
 
 
 def __getattr__(name: str) -> Any:
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'kinema.sdk' has no attribute {name!r}")
-    value = getattr(importlib.import_module(module), name)
-    globals()[name] = value
-    return value
+    return _lazy.attribute(name)
 
 
 def __dir__() -> list[str]:

@@ -45,6 +45,8 @@ if TYPE_CHECKING:
 Overrides = Mapping[str, Any] | Iterable[ParameterOverride] | None
 
 DEFAULT_TIMEOUT = 5.0
+# How long start() waits for /kinema/run_objective once the agent is seen (a MoveIt Pro agent has none).
+NAME_DOOR_GRACE_S = 1.0
 
 log = logging.getLogger(__name__)
 
@@ -188,6 +190,8 @@ class ObjectiveClient:
         self._lock = threading.Lock()
         self._clients: dict[str, ServiceClient] = {}
         self._action: ActionClient | None = None
+        self._run_action: ActionClient | None = None
+        self._by_name: bool | None = None  # whether the agent serves /kinema/run_objective
         self._ready = False
         self._action_ready = False
 
@@ -200,12 +204,6 @@ class ObjectiveClient:
                 client = self.node.create_client(srv_type, name)
                 self._clients[name] = client
             return client
-
-    def _do_objective(self) -> ActionClient:
-        with self._lock:
-            if self._action is None:
-                self._action = self.node.create_action_client(names.DO_OBJECTIVE_TYPE, names.DO_OBJECTIVE)
-            return self._action
 
     def wait_for_runtime(self, timeout: float | None = None) -> None:
         """Block until the agent's services are on the network.
@@ -269,24 +267,62 @@ class ObjectiveClient:
         return _wait_or_cancel(handle, timeout) if wait else handle
 
     def start(self, name: str = "", overrides: Overrides = None, *, xml: str = "") -> ObjectiveHandle:
-        """Start an objective through ``/do_objective`` and return its handle (name wins over ``xml``)."""
+        """Start an objective and return its handle (name wins over ``xml``).
+
+        A name goes to Kinema's ``/kinema/run_objective`` (what an operator's certificate reaches; a
+        MoveIt Pro agent's ``/do_objective`` when there is none), XML to ``/do_objective``: running ad-hoc
+        XML is a grant of its own (``kinema security``).
+        """
         if not name and not xml:
             raise TransportError("start() needs an objective name or an objective XML string")
         self.wait_for_runtime()
-        action = self._do_objective()
-        if not self._action_ready:
-            if not action.wait_for_server(self.timeout):
-                raise TransportError(f"the agent's {names.DO_OBJECTIVE} action is not available")
-            self._action_ready = True
+        action = self._action_for(by_name=bool(name))
         goal = {
             "objective_name": name,
-            "objective_xml_string": xml,
+            "objective_xml_string": "" if name else xml,
             "parameter_overrides": parameter_messages(overrides),
         }
-        handle = action.send_goal(goal, timeout=self.timeout)
+        try:
+            handle = action.send_goal(goal, timeout=self.timeout)
+        except TransportError as error:
+            if name or "answered within" not in str(error):
+                raise
+            # The agent is there (wait_for_runtime) but its XML door did not answer: access rules.
+            raise TransportError(
+                f"the runtime answers, but not to ad-hoc objective XML on {names.DO_OBJECTIVE}: this "
+                "machine's certificate lacks that grant (`kinema security` on the robot lists the roles; "
+                "`kinema security init --allow-xml NAME` gives it). Run a library objective by name instead"
+            ) from error
         if not handle.accepted:
             raise TransportError(f"the agent rejected objective {name or '<XML>'!r}")
         return ObjectiveHandle(handle, name or _xml_name(xml))
+
+    def _action_for(self, *, by_name: bool) -> ActionClient:
+        """The action to send a goal to, once its server is on the graph."""
+        with self._lock:
+            if self._action is None:
+                self._action = self.node.create_action_client(names.DO_OBJECTIVE_TYPE, names.DO_OBJECTIVE)
+            if self._run_action is None:
+                self._run_action = self.node.create_action_client(
+                    names.DO_OBJECTIVE_TYPE, names.RUN_OBJECTIVE
+                )
+            do, run = self._action, self._run_action
+        if by_name and self._by_name is None:
+            graph = self.session.graph_cache()
+            found = graph.wait_for(
+                lambda g: g.action_server_ready(run.name) or g.action_server_ready(do.name), self.timeout
+            )
+            if not found:
+                raise TransportError(f"the agent's {names.DO_OBJECTIVE} action is not available")
+            # The agent's endpoints appear on the graph one by one: give run_objective a moment.
+            self._by_name = run.wait_for_server(NAME_DOOR_GRACE_S)
+        if by_name and self._by_name:
+            return run
+        if not self._action_ready:
+            if not do.wait_for_server(self.timeout):
+                raise TransportError(f"the agent's {names.DO_OBJECTIVE} action is not available")
+            self._action_ready = True
+        return do
 
     @overload
     def do_xml(

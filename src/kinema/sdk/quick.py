@@ -174,7 +174,10 @@ class QuickClient:
         *,
         xml: str = "",
     ) -> QuickRun:
-        """Start an objective by name, or an XML string (the name wins if both are set)."""
+        """Start an objective by name, or an XML string (the name wins if both are set).
+
+        XML goes to the ``start_xml`` key: a separate grant, which an operator's certificate may lack.
+        """
         items = (
             [ParameterOverride(str(k), v) for k, v in overrides.items()]
             if isinstance(overrides, Mapping)
@@ -182,17 +185,35 @@ class QuickClient:
         )
         payload = {
             "objective_name": name,
-            "objective_xml": xml,
+            "objective_xml": "" if name else xml,
             "overrides": [
                 {"name": o.name, "value": o.value, "behavior_namespaces": list(o.behavior_namespaces)}
                 for o in items
             ],
         }
-        first, replies = self._get(quick.START, payload, _FOREVER)
+        try:
+            first, replies = self._get(quick.START if name else quick.START_XML, payload, _FOREVER)
+        except TransportError:
+            if name:
+                raise
+            self._explain_xml_refusal()
+            raise
         if first.ok is None:
             raise TransportError(f"the agent refused the request: {first.err.payload.to_string()}")
         body = quick.decode(first.ok.payload.to_bytes())
         return QuickRun(self, replies, int(body["run_id"]), name or xml_objective_name(xml))
+
+    def _explain_xml_refusal(self) -> None:
+        """When the runtime answers but not on ``start_xml``, the access rules dropped the XML: say so."""
+        try:
+            self._ask(quick.STATUS, {})
+        except TransportError:
+            return
+        raise TransportError(
+            "the runtime answers, but not to ad-hoc objective XML: this machine's certificate lacks that "
+            "grant (`kinema security` on the robot lists the roles; `kinema security init --allow-xml NAME` "
+            "gives it). Run a library objective by name instead: kinema objective run NAME"
+        )
 
     def cancel(self) -> tuple[bool, str]:
         """Cancel whatever runs; ``(cancelled, objective name)``."""

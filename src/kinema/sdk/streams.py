@@ -68,9 +68,11 @@ class BlackboardValue:
         """
         import yaml
 
+        from kinema.nesting import load_yaml
+
         try:
-            data = yaml.safe_load(self.value)
-        except yaml.YAMLError:
+            data = load_yaml(self.value, "the value")
+        except (yaml.YAMLError, ValueError):
             return self.value
         if self.type_name in _STRING_TYPES and not isinstance(data, str):
             return self.value if data is None else str(data)

@@ -197,8 +197,12 @@ def parse_yaml_flow(type_name: str, text: str | None, *, registry: TypeRegistry 
     """
     if text is None or not text.strip():
         return from_dict(type_name, {}, registry=registry)
+    from kinema.nesting import load_yaml
+
     try:
-        data = yaml.safe_load(text)
+        data = load_yaml(text, f"the YAML for {type_name}")
+    except ValueError as error:
+        raise TransportError(str(error)) from None
     except yaml.YAMLError as error:
         raise TransportError(f"cannot parse {text!r} as YAML for {type_name}: {error}") from error
     return from_dict(type_name, data, registry=registry)

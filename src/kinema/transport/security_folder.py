@@ -13,10 +13,14 @@ another machine runs ``KINEMA_ZENOH_CONFIG=<name>.json5 kinema ui`` (or any verb
 
 The access rules: processes on this machine (loopback interface, plain TCP) may do everything, and so
 may the other machines of the cell (``--machine``: one that runs ``kinema run -n`` or ``-o``); a client
-whose certificate's common name is one of the operators may start, cancel and watch objectives, read the
-waypoints and watch the robot's state, and nothing else (no controller calls, no publishing, no waypoint
-edits, no simulation services). Certificates are X.509 v3 with ECDSA P-256 keys (what rustls, zenoh's
-TLS, accepts), made with the ``cryptography`` package.
+whose certificate's common name is one of the operators holds the grants of :data:`ROLES`: it runs the
+library's objectives by name with parameters, cancels and watches (the objective streams, the waypoints,
+the robot's state), and nothing else (no ad-hoc XML, no controller calls, no publishing, no waypoint
+edits, no simulation services). Running ad-hoc XML is a grant of its own (``--allow-xml NAME``): the XML
+doors (``/do_objective`` goals, the ``start_xml`` JSON key) are keys apart from the name-only ones, so
+the router, which reads only keys, can tell them apart. ``kinema security`` prints the roles.
+Certificates are X.509 v3 with ECDSA P-256 keys (what rustls, zenoh's TLS, accepts), made with the
+``cryptography`` package.
 """
 
 from __future__ import annotations
@@ -98,6 +102,7 @@ def init_security_folder(
     addresses: Sequence[str],
     clients: Sequence[str] = ("operator",),
     machines: Sequence[str] = (),
+    xml_clients: Sequence[str] = (),
     port: int = DEFAULT_TLS_PORT,
     local_endpoint: str = DEFAULT_LOCAL_ENDPOINT,
     domain_id: int = 0,
@@ -112,6 +117,12 @@ def init_security_folder(
         TransportError: a bad address or client name, or the folder cannot be written.
     """
     _check_names([*clients, *machines])
+    unknown = [name for name in xml_clients if name not in clients]
+    if unknown:
+        raise TransportError(
+            f"--allow-xml {unknown[0]}: not one of the clients ({', '.join(clients)}); "
+            "name it with --client too"
+        )
     ips, names = _split_addresses(addresses)
     try:
         path.mkdir(parents=True, exist_ok=True)
@@ -127,7 +138,14 @@ def init_security_folder(
         _write_json5(
             path / ROUTER_CONFIG,
             "zenoh router config written by `kinema security init` (used by `kinema run --connect tls/…`).",
-            router_config(path, [local_endpoint, *tls_endpoints], list(clients), domain_id, list(machines)),
+            router_config(
+                path,
+                [local_endpoint, *tls_endpoints],
+                list(clients),
+                domain_id,
+                list(machines),
+                list(xml_clients),
+            ),
         )
         written = []
         for client in [*clients, *machines]:
@@ -155,6 +173,7 @@ def router_config(
     clients: Sequence[str],
     domain_id: int,
     machines: Sequence[str] = (),
+    xml_clients: Sequence[str] = (),
 ) -> dict[str, Any]:
     """The router's zenoh config: the listeners, mutual TLS with ``folder``'s files, the access rules."""
     return {
@@ -170,7 +189,7 @@ def router_config(
                 }
             }
         },
-        "access_control": access_rules(clients, domain_id, machines),
+        "access_control": access_rules(clients, domain_id, machines, xml_clients),
     }
 
 
@@ -196,49 +215,181 @@ def client_config(endpoint: str, ca_pem: bytes, cert_pem: bytes, key_pem: bytes)
     }
 
 
-def access_rules(clients: Iterable[str], domain_id: int, machines: Iterable[str] = ()) -> dict[str, Any]:
-    """The default rule set (see the module docstring); ``machines`` get what local processes get."""
+@dataclass(frozen=True)
+class Grant:
+    """One thing a role may do: a sentence for people and the keys it opens (``{d}``: the domain id).
+
+    The holder may ask on these keys (queries: service calls, action goals, the JSON endpoints) and
+    subscribe to them; it never publishes and never serves.
+    """
+
+    name: str
+    summary: str
+    keys: tuple[str, ...]
+
+    def key_exprs(self, domain_id: int) -> list[str]:
+        """The zenoh key expressions, each with its ``@adv`` cache keys (``**`` skips ``@`` chunks)."""
+        out: list[str] = []
+        for key in self.keys:
+            expr = key.format(d=domain_id)
+            out.append(expr)
+            if expr.endswith("/**") and not expr.startswith("@"):
+                out.append(expr + "/@adv/**")
+        return out
+
+
+GRANTS: dict[str, Grant] = {
+    grant.name: grant
+    for grant in (
+        Grant(
+            "run",
+            "run the library's objectives by name, with parameters (/execute_objective, "
+            "/kinema/run_objective, `kinema objective run`)",
+            (
+                "{d}/execute_objective/**",
+                "{d}/kinema/run_objective/**",
+                "kinema/{d}/objective_server/start",
+            ),
+        ),
+        Grant(
+            "cancel",
+            "cancel the running objective (/cancel_objective, a /do_objective goal's cancel, "
+            "`kinema objective cancel`)",
+            (
+                "{d}/cancel_objective/**",
+                "{d}/do_objective/_action/cancel_goal/**",
+                "kinema/{d}/objective_server/cancel",
+            ),
+        ),
+        Grant(
+            "watch",
+            "watch: the heartbeat and health, node states, the blackboard, logs, the objective list and "
+            "XML, saved waypoints (read), joint states, the clock, task planning, goals' results",
+            (
+                "{d}/objective_server_heartbeat/**",
+                "{d}/objective_server/node_status/**",
+                "{d}/objective_server/node_table/**",
+                "{d}/objective_server/blackboard/**",
+                "{d}/objective_server/log/**",
+                "{d}/objective_server/health/**",
+                "{d}/objective_server/list_objectives/**",
+                "{d}/objective_server/get_objective_xml/**",
+                "{d}/kinema/task_planning/**",
+                "{d}/do_objective/_action/status/**",
+                "{d}/do_objective/_action/feedback/**",
+                "{d}/do_objective/_action/get_result/**",
+                "{d}/get_saved_waypoints/**",
+                "{d}/joint_states/**",
+                "{d}/clock/**",
+                "kinema/{d}/objective_server/status",
+                "@ros2_lv/{d}/**",
+                "@kinema_lv/{d}/**",
+            ),
+        ),
+        Grant(
+            "xml",
+            "run ad-hoc objective XML (/do_objective goals, `kinema objective do`, the SDK's do_xml): "
+            "any behavior with any ports, within the file rule",
+            ("{d}/do_objective/_action/send_goal/**", "kinema/{d}/objective_server/start_xml"),
+        ),
+    )
+}
+
+ROLES: dict[str, tuple[str, ...]] = {
+    # --client NAME: the default operator.
+    "operator": ("run", "cancel", "watch"),
+    # --client NAME --allow-xml NAME.
+    "operator with XML": ("run", "cancel", "watch", "xml"),
+}
+EVERYTHING = (
+    "everything: processes on this machine (loopback) and the cell's other machines (--machine) may "
+    "publish, serve and call every key (waypoint edits, controllers, simulation services included)"
+)
+FILE_RULES = (
+    "whatever the role, a file path an objective gets (any port, any parameter override) resolves only "
+    "inside the workspace, the config packages and Kinema's data folder, and never inside this "
+    "security folder"
+)
+
+
+def describe_roles() -> list[str]:
+    """The roles as lines a person reads (``kinema security`` prints them)."""
+    lines = []
+    for role, grants in ROLES.items():
+        lines.append(f"{role}:")
+        lines += [f"  - {GRANTS[name].summary}" for name in grants]
+    lines.append("local processes and --machine:")
+    lines.append(f"  - {EVERYTHING}")
+    lines.append("every role:")
+    lines.append(f"  - {FILE_RULES}")
+    return lines
+
+
+def holders(folder: Path) -> list[tuple[str, str]] | None:
+    """``(client, role)`` for each client of ``folder``'s ``router.json5``; None when there is none."""
+    try:
+        text = (folder / ROUTER_CONFIG).read_text(encoding="utf-8")
+        # What _write_json5 wrote: '//' comment lines, then JSON.
+        config = json.loads("".join(line for line in text.splitlines(True) if not line.startswith("//")))
+    except (OSError, ValueError):
+        return None
+    roles = {
+        "operators": "operator",
+        "operators_with_xml": "operator with XML",
+        "cell_machines": "machine (everything)",
+    }
+    out = []
+    for subject in config.get("access_control", {}).get("subjects", []):
+        role = roles.get(subject.get("id", ""))
+        if role is not None:
+            out += [(str(name), role) for name in subject.get("cert_common_names", [])]
+    return out
+
+
+def access_rules(
+    clients: Iterable[str],
+    domain_id: int,
+    machines: Iterable[str] = (),
+    xml_clients: Iterable[str] = (),
+) -> dict[str, Any]:
+    """The rule set of :data:`ROLES`: ``clients`` are operators, ``xml_clients`` (some of them) may also
+    run ad-hoc XML, ``machines`` get what local processes get."""
     d = domain_id
-    operator_keys = [
-        f"{d}/execute_objective/**",
-        f"{d}/cancel_objective/**",
-        f"{d}/do_objective/**",
-        f"{d}/objective_server_heartbeat/**",
-        f"{d}/objective_server_heartbeat/**/@adv/**",
-        f"{d}/objective_server/**",  # node status, blackboard, logs, the objective list and XML
-        f"{d}/objective_server/**/@adv/**",  # caches of latched topics (zenoh-ext advanced pub/sub)
-        f"{d}/get_saved_waypoints/**",
-        f"{d}/joint_states/**",
-        f"{d}/clock/**",
-        f"kinema/{d}/objective_server/**",  # the JSON endpoints `kinema objective` uses
-        f"@ros2_lv/{d}/**",
-        f"@kinema_lv/{d}/**",
-    ]
+    clients, machines, xml_clients = list(clients), list(machines), list(xml_clients)
     loopback = [name for _index, name in socket.if_nameindex() if name.startswith("lo")] or ["lo"]
-    return {
-        "enabled": True,
-        "default_permission": "deny",
-        "rules": [
+    rules: list[dict[str, Any]] = [
+        {
+            "id": "everything",
+            "messages": [
+                "put",
+                "delete",
+                "declare_subscriber",
+                "query",
+                "reply",
+                "declare_queryable",
+                "liveliness_token",
+                "liveliness_query",
+                "declare_liveliness_subscriber",
+            ],
+            "flows": ["ingress", "egress"],
+            "permission": "allow",
+            "key_exprs": ["**", "**/@adv/**", "@ros2_lv/**", "@kinema_lv/**"],
+        },
+        {
+            # Its SDK nodes appear in the ROS graph like any other.
+            "id": "operator_graph",
+            "messages": ["liveliness_token"],
+            "flows": ["ingress"],
+            "permission": "allow",
+            "key_exprs": [f"@ros2_lv/{d}/**"],
+        },
+    ]
+    for grant in GRANTS.values():
+        keys = grant.key_exprs(d)
+        rules.append(
             {
-                "id": "everything",
-                "messages": [
-                    "put",
-                    "delete",
-                    "declare_subscriber",
-                    "query",
-                    "reply",
-                    "declare_queryable",
-                    "liveliness_token",
-                    "liveliness_query",
-                    "declare_liveliness_subscriber",
-                ],
-                "flows": ["ingress", "egress"],
-                "permission": "allow",
-                "key_exprs": ["**", "**/@adv/**", "@ros2_lv/**", "@kinema_lv/**"],
-            },
-            {
-                # What an operator sends: calls, subscriptions, graph lookups; never data or servers.
-                "id": "operator_requests",
+                # What the holder sends: calls, subscriptions, graph lookups; never data or servers.
+                "id": f"{grant.name}_requests",
                 "messages": [
                     "query",
                     "declare_subscriber",
@@ -247,19 +398,13 @@ def access_rules(clients: Iterable[str], domain_id: int, machines: Iterable[str]
                 ],
                 "flows": ["ingress"],
                 "permission": "allow",
-                "key_exprs": operator_keys,
-            },
+                "key_exprs": keys,
+            }
+        )
+        rules.append(
             {
-                # Its SDK nodes appear in the ROS graph like any other.
-                "id": "operator_graph",
-                "messages": ["liveliness_token"],
-                "flows": ["ingress"],
-                "permission": "allow",
-                "key_exprs": [f"@ros2_lv/{d}/**"],
-            },
-            {
-                # What an operator receives: the answers and the data it subscribed to.
-                "id": "operator_answers",
+                # What the holder receives: the answers and the data it subscribed to.
+                "id": f"{grant.name}_answers",
                 "messages": [
                     "put",
                     "delete",
@@ -271,21 +416,35 @@ def access_rules(clients: Iterable[str], domain_id: int, machines: Iterable[str]
                 ],
                 "flows": ["egress"],
                 "permission": "allow",
-                "key_exprs": operator_keys,
-            },
-        ],
-        "subjects": [
-            {"id": "local_processes", "interfaces": loopback, "link_protocols": ["tcp"]},
-            {"id": "operators", "cert_common_names": list(clients)},
-            *([{"id": "cell_machines", "cert_common_names": list(machines)}] if machines else []),
-        ],
-        "policies": [
-            {
-                "rules": ["everything"],
-                "subjects": ["local_processes", *(["cell_machines"] if machines else [])],
-            },
-            {"rules": ["operator_requests", "operator_graph", "operator_answers"], "subjects": ["operators"]},
-        ],
+                "key_exprs": keys,
+            }
+        )
+
+    def grant_rules(role: str) -> list[str]:
+        names = [r for g in ROLES[role] for r in (f"{g}_requests", f"{g}_answers")]
+        return ["operator_graph", *names]
+
+    operators = [name for name in clients if name not in xml_clients]
+    subjects: list[dict[str, Any]] = [
+        {"id": "local_processes", "interfaces": loopback, "link_protocols": ["tcp"]}
+    ]
+    policies: list[dict[str, Any]] = [
+        {"rules": ["everything"], "subjects": ["local_processes", *(["cell_machines"] if machines else [])]}
+    ]
+    if operators:
+        subjects.append({"id": "operators", "cert_common_names": operators})
+        policies.append({"rules": grant_rules("operator"), "subjects": ["operators"]})
+    if xml_clients:
+        subjects.append({"id": "operators_with_xml", "cert_common_names": xml_clients})
+        policies.append({"rules": grant_rules("operator with XML"), "subjects": ["operators_with_xml"]})
+    if machines:
+        subjects.append({"id": "cell_machines", "cert_common_names": machines})
+    return {
+        "enabled": True,
+        "default_permission": "deny",
+        "rules": rules,
+        "subjects": subjects,
+        "policies": policies,
     }
 
 

@@ -46,6 +46,7 @@ from kinema.tui.connection import (
     TaskStage,
     WaypointSummary,
 )
+from kinema.ui_topics import APPROVAL_SERVICE, APPROVAL_TYPE, TASK_PLANNING_TOPIC, TASK_PLANNING_TYPE
 
 if TYPE_CHECKING:
     from kinema.config import ResolvedConfig, Workspace
@@ -63,9 +64,6 @@ GRAPH_QUERY_S = 1.0
 RECONNECT_AFTER_S = 6.0
 RETRY_PERIOD_S = 1.0
 CALL_TIMEOUT_S = 5.0
-# The service the core approval behaviors call to ask the user (kinema_core_behaviors/ui/approval.py).
-APPROVAL_SERVICE = "/kinema/user_approval"
-APPROVAL_TYPE = "kinema_msgs/srv/RequestApproval"
 #: The objective MoveIt Pro (and Kinema's core library) moves to a waypoint with.
 MOVE_TO_WAYPOINT_OBJECTIVE = "Move to Waypoint"
 MOVE_TO_WAYPOINT_TREE = "Move to Waypoint (from the UI)"
@@ -207,6 +205,7 @@ class SdkConnection:
             self._stop.wait(0.2)
 
     def _connect(self) -> None:
+        from kinema.drivers.mujoco import names as driver_names
         from kinema.runtime import names
         from kinema.sdk import ObjectiveClient
         from kinema.sdk.client import NodeStatusSubscription
@@ -226,8 +225,8 @@ class SdkConnection:
                 names.BLACKBOARD_TYPE, names.BLACKBOARD, self._on_blackboard, latched=True
             )
             node.create_subscription(names.LOG_TYPE, names.LOG, self._on_log)
-            node.create_subscription(names.CLOCK_TYPE, names.CLOCK, self._on_clock)
-            node.create_subscription(names.TASK_PLANNING_TYPE, names.TASK_PLANNING, self._on_task_planning)
+            node.create_subscription(driver_names.CLOCK_TYPE, driver_names.CLOCK_TOPIC, self._on_clock)
+            node.create_subscription(TASK_PLANNING_TYPE, TASK_PLANNING_TOPIC, self._on_task_planning)
             # While the TUI is attached it is the user the approval behaviors ask (see ui/approval.py
             # of the core behaviors): each request waits for the dialog's answer.
             node.create_service(

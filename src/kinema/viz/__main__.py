@@ -26,8 +26,8 @@ def main(argv: list[str] | None = None) -> int:
     parser.add_argument("--ready-fd", type=int, help="write the URL to this file descriptor when serving")
     args = parser.parse_args(argv)
 
-    from kinema.runtime import lifeline
-    from kinema.runtime.log_files import configure_process_logging
+    from kinema.process import lifeline
+    from kinema.process.log_files import configure_process_logging
 
     configure_process_logging(args.log_file)
     lifeline.hold()  # before the slow imports: a view whose supervisor died while it started ends too

@@ -19,6 +19,8 @@ from typing import Any
 import meshcat.geometry as g
 import numpy as np
 
+from kinema.transforms import pose_matrix, quaternion_from_wxyz
+
 log = logging.getLogger("kinema.viz")
 
 # MuJoCo's compiled default geom rgba: a geom with this color and a material shows the material's color.
@@ -114,21 +116,6 @@ def safe_name(name: str, fallback: str) -> str:
     return cleaned or fallback
 
 
-def pose_matrix(position: Any, quaternion_wxyz: Any) -> np.ndarray:
-    """4x4 homogeneous transform from a position and a MuJoCo (w, x, y, z) quaternion."""
-    w, x, y, z = (float(v) for v in quaternion_wxyz)
-    norm = np.sqrt(w * w + x * x + y * y + z * z) or 1.0
-    w, x, y, z = w / norm, x / norm, y / norm, z / norm
-    matrix = np.eye(4)
-    matrix[:3, :3] = [
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ]
-    matrix[:3, 3] = [float(v) for v in position]
-    return matrix
-
-
 def geom_rgba(model: Any, geom_id: int) -> tuple[float, float, float, float]:
     """The color MuJoCo draws geom ``geom_id`` with (see the module docstring)."""
     rgba = np.asarray(model.geom_rgba[geom_id], dtype=float)
@@ -183,7 +170,7 @@ def geom_visual(
         name=name,
         kind=KIND_NAMES[kind],
         body_id=int(model.geom_bodyid[geom_id]),
-        transform=pose_matrix(model.geom_pos[geom_id], model.geom_quat[geom_id]),
+        transform=pose_matrix(model.geom_pos[geom_id], quaternion_from_wxyz(model.geom_quat[geom_id])),
         rgba=rgba if rgba is not None else geom_rgba(model, geom_id),
         parts=tuple(parts),
         texture_png=png,

@@ -14,7 +14,6 @@ sprites; the viewer does not resolve packages).
 from __future__ import annotations
 
 import logging
-import math
 import threading
 import time
 from collections.abc import Callable
@@ -24,6 +23,7 @@ from typing import Any
 import meshcat.geometry as g
 import numpy as np
 
+from kinema.transforms import TransformError, pose_from_message
 from kinema.viz import scene_commands as sc
 from kinema.viz.geom_shapes import rgb_to_int, safe_name
 from kinema.viz.meshcat_server import Command
@@ -52,25 +52,6 @@ def _seconds(duration: Any) -> float:
 
 def _point(p: Any) -> np.ndarray:
     return np.array([float(p.x), float(p.y), float(p.z)])
-
-
-def marker_pose(pose: Any) -> np.ndarray:
-    """4x4 from a ``geometry_msgs/Pose`` (an all-zero quaternion counts as identity, as in RViz)."""
-    q = pose.orientation
-    x, y, z, w = float(q.x), float(q.y), float(q.z), float(q.w)
-    norm = math.sqrt(x * x + y * y + z * z + w * w)
-    if norm == 0:
-        x, y, z, w = 0.0, 0.0, 0.0, 1.0
-    else:
-        x, y, z, w = x / norm, y / norm, z / norm, w / norm
-    matrix = np.eye(4)
-    matrix[:3, :3] = [
-        [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-        [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-        [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-    ]
-    matrix[:3, 3] = _point(pose.position)
-    return matrix
 
 
 def _material(color: Any) -> Any:
@@ -128,7 +109,7 @@ def arrow_shapes(
 def marker_shapes(marker: Any, frame: np.ndarray) -> list[MarkerShape]:
     """The meshcat objects drawing ``marker`` (``visualization_msgs/Marker``); its frame is at ``frame``."""
     kind = int(marker.type)
-    pose = frame @ marker_pose(marker.pose)
+    pose = frame @ pose_from_message(marker.pose)
     scale = marker.scale
     sx, sy, sz = float(scale.x), float(scale.y), float(scale.z)
     color = marker.color
@@ -247,7 +228,11 @@ class MarkerBoard:
         commands = [sc.delete(self.path(ns, marker_id))] if known else []
         if action == DELETE:
             return commands
-        shapes = marker_shapes(marker, frame)
+        try:
+            shapes = marker_shapes(marker, frame)
+        except TransformError as error:
+            log.warning("marker %s/%d is not drawn: its pose: %s", ns, marker_id, error)
+            return commands
         if not shapes:
             kind = int(marker.type)
             if kind not in self._unsupported_warned and kind in (TEXT_VIEW_FACING, MESH_RESOURCE):

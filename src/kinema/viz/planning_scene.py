@@ -2,56 +2,43 @@
 
 The agent publishes its planning scene (``moveit_msgs/PlanningScene``, latched) on
 ``/monitored_planning_scene`` whenever it changes; each message is the whole scene, so every message
-redraws the layer: translucent green boxes, spheres and cylinders under ``<root>/<object id>/<k>``.
+redraws the layer: translucent green boxes, spheres and cylinders under ``<root>/<object id>/<k>``,
+read by :mod:`kinema.motion.planning_scene_messages` as the planner reads them (a primitive the planner
+cannot check is not drawn).
 """
 
 from __future__ import annotations
 
-import math
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import meshcat.geometry as g
 import numpy as np
 
+from kinema.errors import ObjectiveError
+from kinema.motion.planning_scene_messages import object_pose_of, primitive
+from kinema.transforms import TransformError, pose_from_message
 from kinema.viz import scene_commands as sc
 from kinema.viz.geom_shapes import safe_name
 from kinema.viz.meshcat_server import Command
 
-BOX, SPHERE, CYLINDER = 1, 2, 3
+if TYPE_CHECKING:
+    from kinema.motion.planning_scene import CollisionObject
+
 COLOR = 0x33CC66
 OPACITY = 0.45
 # meshcat's cylinders run along y; MoveIt's along z.
 _Y_TO_Z = np.array([[1.0, 0, 0, 0], [0, 0, -1.0, 0], [0, 1.0, 0, 0], [0, 0, 0, 1.0]])
 
 
-def pose_matrix(pose: Any) -> np.ndarray:
-    """4x4 from a ``geometry_msgs/Pose`` (an all-zero quaternion is the identity)."""
-    q = pose.orientation
-    x, y, z, w = float(q.x), float(q.y), float(q.z), float(q.w)
-    norm = math.sqrt(x * x + y * y + z * z + w * w)
-    matrix = np.eye(4)
-    if norm > 0:
-        x, y, z, w = x / norm, y / norm, z / norm, w / norm
-        matrix[:3, :3] = [
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ]
-    p = pose.position
-    matrix[:3, 3] = [float(p.x), float(p.y), float(p.z)]
-    return matrix
-
-
-def _shape(primitive: Any) -> tuple[Any, np.ndarray] | None:
-    kind, dims = int(primitive.type), [float(d) for d in primitive.dimensions]
+def _shape(obj: CollisionObject) -> tuple[Any, np.ndarray]:
+    """The meshcat mesh of a placed primitive and the turn from meshcat's axes to the primitive's."""
     material = g.MeshPhongMaterial(color=COLOR, opacity=OPACITY, transparent=True)
-    if kind == BOX and len(dims) >= 3:
-        return g.Mesh(g.Box(dims[:3]), material), np.eye(4)
-    if kind == SPHERE and dims:
-        return g.Mesh(g.Sphere(dims[0]), material), np.eye(4)
-    if kind == CYLINDER and len(dims) >= 2:
-        return g.Mesh(g.Cylinder(dims[0], dims[1]), material), _Y_TO_Z
-    return None
+    if obj.shape == "box":
+        return g.Mesh(g.Box([2 * s for s in obj.size]), material), np.eye(4)
+    if obj.shape == "sphere":
+        return g.Mesh(g.Sphere(obj.size[0]), material), np.eye(4)
+    radius, half_length = obj.size
+    return g.Mesh(g.Cylinder(2 * half_length, radius), material), _Y_TO_Z
 
 
 class PlanningSceneLayer:
@@ -77,15 +64,22 @@ class PlanningSceneLayer:
                 world_T_frame = frame_pose(frame)
                 if world_T_frame is None:
                     continue
-            world_T_object = world_T_frame @ pose_matrix(obj.pose)
+            try:
+                world_T_object = world_T_frame @ object_pose_of(obj, None)
+            except TransformError:
+                continue  # a pose with a NaN in it: nothing to draw where the planner cannot place it
             base = f"{self.root}/{safe_name(str(obj.id), 'object')}"
             self.object_ids.append(str(obj.id))
-            for k, (primitive, pose) in enumerate(zip(obj.primitives, obj.primitive_poses, strict=False)):
-                shape = _shape(primitive)
-                if shape is None:
-                    continue
-                mesh, correction = shape
+            for k, (shape, pose) in enumerate(zip(obj.primitives, obj.primitive_poses, strict=False)):
+                dimensions = [float(d) for d in shape.dimensions]
+                try:
+                    placed = primitive(
+                        int(shape.type), dimensions, world_T_object @ pose_from_message(pose), ""
+                    )
+                except (ObjectiveError, TransformError):
+                    continue  # a shape the planner cannot check (a cone), or a primitive pose with a NaN
+                mesh, correction = _shape(placed)
                 path = f"{base}/{k}"
                 commands.append(sc.set_object(path, mesh))
-                commands.append(sc.set_transform(path, world_T_object @ pose_matrix(pose) @ correction))
+                commands.append(sc.set_transform(path, placed.world_T_object @ correction))
         return commands

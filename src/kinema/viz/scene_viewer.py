@@ -25,11 +25,11 @@ from typing import Any
 import meshcat.geometry as g
 import numpy as np
 
+from kinema import ui_topics as topics
 from kinema.drivers.mujoco import names as driver_names
 from kinema.runtime import names as agent_names
 from kinema.transport import Node, Session
 from kinema.viz import scene_commands as sc
-from kinema.viz import topics
 from kinema.viz.liveness import RuntimeLiveness
 from kinema.viz.markers import MarkerBoard
 from kinema.viz.meshcat_server import Command, MeshcatServer
@@ -117,7 +117,7 @@ class SceneViewer:
             topics.PLANNED_TRAJECTORY_TYPE, topics.PLANNED_TRAJECTORY_TOPIC, self._on_planned_trajectory
         )
         node.create_subscription(
-            topics.PLANNING_SCENE_TYPE, topics.PLANNING_SCENE_TOPIC, self._on_planning_scene, latched=True
+            agent_names.PLANNING_SCENE_TYPE, agent_names.PLANNING_SCENE, self._on_planning_scene, latched=True
         )
         self._thread.start()
 

@@ -116,6 +116,13 @@ def agent(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFacto
 
 
 @pytest.fixture
+def fresh_agent(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[AgentProcess]:
+    """An agent of the test's own (the test may kill or stop it)."""
+    with running_agent(request, tmp_path) as running:
+        yield running
+
+
+@pytest.fixture
 def client(agent: AgentProcess) -> Iterator[object]:
     from kinema.sdk import ObjectiveClient
 

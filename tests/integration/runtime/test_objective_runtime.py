@@ -86,13 +86,25 @@ def test_interrupting_a_wait_cancels_the_objective(agent: Any, client: Objective
     # Ctrl-C in a script blocked in execute(): the objective must not keep the robot moving.
     from kinema.sdk import QuickClient
 
+    main = threading.main_thread()
+
+    def waiting_for_the_result() -> bool:
+        frame = sys._current_frames().get(main.ident or 0)
+        while frame is not None:
+            if frame.f_code.co_name == "_wait_or_cancel":
+                return True
+            frame = frame.f_back
+        return False
+
     def interrupt_once_it_runs() -> None:
         # The signal comes once execute() waits for the result (the run has started), as a user's would.
         with QuickClient(agent.endpoint, timeout=10) as quick:
             deadline = time.monotonic() + 30
             while quick.status() != (ObjectiveStatus.RUNNING, "Forever") and time.monotonic() < deadline:
                 time.sleep(0.02)
-        time.sleep(0.3)
+        deadline = time.monotonic() + 30
+        while not waiting_for_the_result() and time.monotonic() < deadline:
+            time.sleep(0.01)
         os.kill(os.getpid(), signal.SIGINT)
 
     if threading.current_thread() is not threading.main_thread():
@@ -390,6 +402,49 @@ def test_the_json_endpoints_start_cancel_and_refuse_garbage(agent: Any) -> None:
         )
         assert len(replies) == 1 and "bad request" in replies[0].err.payload.to_string()
         assert quick.start("Quick").result().succeeded
+
+
+def test_deeply_nested_json_on_the_quick_keys_gets_an_answer(agent: Any) -> None:
+    """It raised RecursionError in the agent's handler, and the client got no answer at all."""
+    from kinema.runtime import quick_protocol
+    from kinema.sdk import QuickClient
+
+    deep = b"[" * 100_000 + b"]" * 100_000
+    with QuickClient(agent.endpoint, timeout=10) as quick:
+        for operation in (quick_protocol.START, quick_protocol.START_XML, quick_protocol.CANCEL):
+            replies = list(
+                quick._session.get(
+                    quick_protocol.key(quick.domain_id, operation),
+                    payload=b'{"objective_name": "Quick", "overrides": ' + deep + b"}",
+                    timeout=10,
+                )
+            )
+            assert len(replies) == 1 and "levels deep" in replies[0].err.payload.to_string(), operation
+        assert quick.start("Quick").result().succeeded
+
+
+def test_the_name_only_doors_refuse_xml(agent: Any, client: ObjectiveClient) -> None:
+    """What an operator's certificate reaches runs library objectives by name; XML is a grant of its own."""
+    from kinema.runtime import names, quick_protocol
+    from kinema.sdk import QuickClient
+
+    xml = '<root BTCPP_format="4"><BehaviorTree ID="X"><AlwaysSuccess/></BehaviorTree></root>'
+    with QuickClient(agent.endpoint, timeout=10) as quick:
+        replies = list(
+            quick._session.get(
+                quick_protocol.key(quick.domain_id, quick_protocol.START),
+                payload=quick_protocol.encode({"objective_xml": xml}),
+                timeout=5,
+            )
+        )
+        assert len(replies) == 1 and "by name only" in replies[0].err.payload.to_string()
+        assert quick.start(xml=xml).result().succeeded  # start_xml
+    by_name = client.node.create_action_client(names.DO_OBJECTIVE_TYPE, names.RUN_OBJECTIVE)
+    assert by_name.wait_for_server(10)
+    refused = by_name.send_goal({"objective_xml_string": xml}, timeout=10).result(10).result
+    assert "by name only" in refused.error_message and refused.error_code.val != 1
+    assert client.execute("Quick").succeeded and client._by_name  # the SDK's names go through it
+    assert client.do_xml(xml).succeeded
 
 
 def test_a_router_without_an_agent_is_reported_after_the_timeout(free_endpoint: str) -> None:

@@ -142,3 +142,49 @@ def test_two_agents_that_meet_anyway_are_reported_in_the_terminal_and_both_logs(
     finally:
         stray.terminate()
         stray.wait(20)
+
+
+SLOW_AGENT = """import sys, time
+if "kinema.runtime.agent_process" in sys.orig_argv:
+    time.sleep(6)  # a loaded machine: the agent announces itself after the other run has looked
+"""
+
+
+def test_two_runs_started_in_the_same_instant_leave_exactly_one_cell(
+    env: dict[str, str], tmp_path: Path
+) -> None:
+    """Both used to look at the still empty network, and both started an agent and drivers on one router."""
+    slow = tmp_path / "slow_agents"
+    slow.mkdir()
+    (slow / "sitecustomize.py").write_text(SLOW_AGENT)
+    path = os.pathsep.join(p for p in (str(slow), env.get("PYTHONPATH", "")) if p)
+    argv = [sys.executable, "-m", "kinema", "run", "--headless", "-n"]
+    runs = [
+        subprocess.Popen(
+            argv, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env={**env, "PYTHONPATH": path}
+        )
+        for _ in range(2)
+    ]
+    try:
+        # The refused one exits on its own; the other one runs until stopped.
+        deadline = time.monotonic() + 120
+        while all(run.poll() is None for run in runs):
+            assert time.monotonic() < deadline, "neither run was refused"
+            time.sleep(0.1)
+        refused = next(run for run in runs if run.poll() is not None)
+        running = next(run for run in runs if run is not refused)
+        out, err = refused.communicate(timeout=10)
+        assert refused.returncode == 1, out + err
+        assert "a Kinema runtime already runs on" in err and "nothing was started" in err, err
+        assert "Traceback" not in err and "Kinema is running" not in out
+        assert running.poll() is None
+        assert len(_agents(env["KINEMA_ZENOH_CONNECT"])) == 1
+    finally:
+        for run in runs:
+            if run.poll() is None:
+                run.send_signal(signal.SIGINT)
+                try:
+                    run.wait(30)
+                except subprocess.TimeoutExpired:
+                    run.kill()
+                    run.wait(10)

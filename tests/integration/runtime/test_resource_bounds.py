@@ -29,6 +29,39 @@ def rss_mb(pid: int) -> float:
     raise AssertionError(f"no VmRSS for pid {pid}")
 
 
+def steady_rss_mb(pid: int, timeout: float = 30.0) -> float:
+    """The RSS of ``pid`` once it has stopped changing (two readings 0.2 s apart within 0.5 MB)."""
+    previous = rss_mb(pid)
+    deadline = time.monotonic() + timeout
+    while True:
+        time.sleep(0.2)
+        current = rss_mb(pid)
+        if abs(current - previous) < 0.5 or time.monotonic() > deadline:
+            return current
+        previous = current
+
+
+TINY = '<root BTCPP_format="4"><BehaviorTree ID="Tiny"><AlwaysSuccess/></BehaviorTree></root>'
+
+
+def wait_until_streams_reach_the_agent(client: ObjectiveClient, timeout: float = 60.0) -> None:
+    """Return once node status streams opened so far receive what the agent publishes.
+
+    A probe stream, opened after them on the same session, sees a tiny objective's changes: their
+    subscriptions were declared before its own, so they are in place too.
+    """
+    probe = client.node_statuses(timeout=1.0)
+    deadline = time.monotonic() + timeout
+    try:
+        while True:
+            assert client.do_xml(TINY, timeout=timeout).succeeded
+            if next(probe, None) is not None:
+                return
+            assert time.monotonic() < deadline, "no node status reached the stream"
+    finally:
+        probe.close()
+
+
 @pytest.mark.slow
 @pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="needs Linux /proc to read the RSS")
 def test_memory_returns_to_baseline_after_refused_10_to_50_mb_requests(
@@ -37,8 +70,7 @@ def test_memory_returns_to_baseline_after_refused_10_to_50_mb_requests(
     pid = own_agent.process.pid
     with ObjectiveClient(own_agent.endpoint, timeout=10) as client:
         assert client.execute("Quick").succeeded
-        time.sleep(1.0)
-        baseline = rss_mb(pid)
+        baseline = steady_rss_mb(pid)
         seen = []
         for size in (10, 20, 30, 40, 50, 50, 50):
             result = client.do_xml("x" * (size * MB), timeout=60)
@@ -93,7 +125,7 @@ def test_trees_past_65535_nodes_are_refused_at_load_and_trees_at_the_limit_run(
     )
     # Building and running 65,535 nodes takes tens of seconds on a busy machine: the stream waits.
     stream = client.node_statuses(timeout=60)
-    time.sleep(0.5)  # let the subscription reach the agent
+    wait_until_streams_reach_the_agent(client)
     assert client.do_xml(at_limit, timeout=300).succeeded  # minutes when overloaded
     uids = set()
     for message in stream:

@@ -8,6 +8,7 @@ from typing import Any
 
 import yaml
 
+from kinema.drivers.mujoco import names as driver_names
 from kinema.runtime import names
 
 
@@ -24,7 +25,7 @@ def test_waypoints_are_saved_from_the_joint_states_renamed_and_erased(
         refused = edit.call({"operation": 0, "waypoint_name": "Home"}, timeout=10)
         assert not refused.status.success and "/joint_states" in refused.status.error_message
 
-        joints = node.create_publisher(names.JOINT_STATES_TYPE, names.JOINT_STATES)
+        joints = node.create_publisher(driver_names.JOINT_STATES_TYPE, driver_names.JOINT_STATES_TOPIC)
         state = {"name": ["shoulder_pan_joint", "elbow_joint"], "position": [0.5, -1.0]}
         deadline = time.monotonic() + 10
         while True:

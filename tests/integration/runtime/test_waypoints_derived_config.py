@@ -8,6 +8,7 @@ from typing import Any
 
 import yaml
 
+from kinema.drivers.mujoco import names as driver_names
 from kinema.resources import bundled_dir
 from kinema.runtime import names
 
@@ -29,7 +30,7 @@ def test_saving_a_waypoint_writes_the_derived_package_and_says_so(
         edit = node.create_client(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS)
         inherited = [w.name for w in get.call({}, timeout=10).waypoints]
         assert inherited and "Look at Table" in inherited, inherited
-        joints = node.create_publisher(names.JOINT_STATES_TYPE, names.JOINT_STATES)
+        joints = node.create_publisher(driver_names.JOINT_STATES_TYPE, driver_names.JOINT_STATES_TOPIC)
         deadline = time.monotonic() + 15
         while True:
             joints.publish({"name": ["linear_rail_joint"], "position": [0.3]})

@@ -188,11 +188,15 @@ def test_a_new_goal_can_preempt_the_running_one(connect: Callable[[], Session]) 
     running: list[ServerGoalHandle] = []
     lock = threading.Lock()
 
+    first_running = threading.Event()
+
     def one_at_a_time(handle: ServerGoalHandle) -> dict[str, list[int]]:
         with lock:
             for older in running:
                 older.request_cancel()
             running.append(handle)
+        if handle.goal.order == 1:
+            first_running.set()
         # The first goal runs until the second preempts it (30 s bounds a failure only); the second
         # finishes at once.
         if handle.cancel_requested_event.wait(30.0 if handle.goal.order == 1 else 0.0):
@@ -203,7 +207,7 @@ def test_a_new_goal_can_preempt_the_running_one(connect: Callable[[], Session]) 
     Node(connect(), "server").create_action_server(FIB, "/preempting", one_at_a_time)
     client = _client(connect, "/preempting")
     first = client.send_goal({"order": 1})
-    time.sleep(0.1)
+    assert first_running.wait(30), "the first goal never started"
     second = client.send_goal({"order": 2})
     assert first.result(timeout=30).status == STATUS_CANCELED
     outcome = second.result(timeout=30)

@@ -101,12 +101,23 @@ def _moving(cell: Cell, threshold: float = 0.05) -> bool:
     return len(stamps) > 0 and float(np.abs(velocities[-1]).max()) > threshold
 
 
+def _sim_time(cell: Cell) -> float:
+    """The stamp of the latest joint state received (s of sim time)."""
+    return float(cell.joint_history()[0][-1])
+
+
+def _wait_sim_time(cell: Cell, seconds: float, what: str) -> None:
+    """Wait until the simulation has run ``seconds`` further than now, by the joint states it publishes."""
+    until = _sim_time(cell) + seconds
+    wait_for(lambda: _sim_time(cell) >= until, 30.0, what)
+
+
 def test_cancelling_during_execution_stops_the_arm_within_50_ms_of_sim_time(slow_cell: Cell) -> None:
     cell = slow_cell
     handle = cell.client.start("Swing Slowly")
     try:
         wait_for(lambda: _moving(cell, 0.1), 30.0, "the arm to move")
-        time.sleep(0.4)  # inside the slow swing (40 ms of sim time)
+        _wait_sim_time(cell, 0.04, "40 ms of sim time inside the slow swing")
         assert _moving(cell, 0.1)
         cancelled_at = cell.joint_history()[0][-1]
     finally:
@@ -158,7 +169,7 @@ def test_a_driver_killed_mid_trajectory_fails_the_behavior_within_1_s(
         logs = cell.client.logs(timeout=30.0)
         handle = cell.client.start("Swing Slowly")
         wait_for(lambda: _moving(cell, 0.1), 30.0, "the arm to move")
-        time.sleep(0.3)
+        _wait_sim_time(cell, 0.3, "0.3 s of the swing")
         os.kill(driver.pid, signal.SIGKILL)
         killed_at = time.monotonic()
         result = handle.result(10.0)

@@ -19,6 +19,9 @@ from kinema.drivers.mujoco import MujocoDriver
 from kinema.drivers.mujoco import names as n
 from kinema.transport import Node
 
+# lab_sim's gripper controller (its config.yaml's robot.gripper.controller).
+LAB_SIM_GRIPPER = "robotiq_gripper_controller"
+
 ARM = (
     "linear_rail_joint",
     "shoulder_pan_joint",
@@ -113,7 +116,7 @@ class Sim:
 
     def gripper(self, position: float, max_effort: float = 0.0) -> Any:
         """Run a GripperCommand goal to the end; return its GoalResult."""
-        client = self.action(n.GRIPPER_COMMAND_ACTION, n.GRIPPER_COMMAND_TYPE)
+        client = self.action(n.gripper_command_action(LAB_SIM_GRIPPER), n.GRIPPER_COMMAND_TYPE)
         handle = client.send_goal({"command": {"position": position, "max_effort": max_effort}}, timeout=10.0)
         return handle.result(30.0)
 

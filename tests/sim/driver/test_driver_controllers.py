@@ -11,6 +11,9 @@ from driver_harness import ARM, GRIPPER, Sim, trajectory, wait_for
 from kinema.drivers.mujoco import names as n
 from kinema.transport import STATUS_ABORTED
 
+# lab_sim's gripper controller (its config.yaml's robot.gripper.controller).
+LAB_SIM_GRIPPER = "robotiq_gripper_controller"
+
 STRICT, BEST_EFFORT = 2, 1
 
 
@@ -20,7 +23,7 @@ def test_list_controllers_reports_the_config_controllers_active(sim: Sim) -> Non
         n.JOINT_STATE_BROADCASTER,
         n.FORCE_TORQUE_SENSOR_BROADCASTER,
         n.JOINT_TRAJECTORY_CONTROLLER,
-        n.GRIPPER_CONTROLLER,
+        LAB_SIM_GRIPPER,
     }
     inactive = {n.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER, n.VELOCITY_FORCE_CONTROLLER}
     assert set(controllers) == active | inactive
@@ -28,23 +31,23 @@ def test_list_controllers_reports_the_config_controllers_active(sim: Sim) -> Non
     trajectory_controller = controllers[n.JOINT_TRAJECTORY_CONTROLLER]
     assert trajectory_controller.type == "joint_trajectory_controller/JointTrajectoryController"
     assert list(trajectory_controller.claimed_interfaces) == [f"{j}/position" for j in ARM]
-    assert list(controllers[n.GRIPPER_CONTROLLER].claimed_interfaces) == [f"{GRIPPER}/position"]
+    assert list(controllers[LAB_SIM_GRIPPER].claimed_interfaces) == [f"{GRIPPER}/position"]
     assert list(controllers[n.JOINT_STATE_BROADCASTER].claimed_interfaces) == []
 
 
 def test_switching_off_and_on_again(sim: Sim) -> None:
-    response = sim.switch(deactivate=[n.JOINT_TRAJECTORY_CONTROLLER, n.GRIPPER_CONTROLLER])
+    response = sim.switch(deactivate=[n.JOINT_TRAJECTORY_CONTROLLER, LAB_SIM_GRIPPER])
     assert response.ok, response.message
     controllers = sim.controllers()
     assert controllers[n.JOINT_TRAJECTORY_CONTROLLER].state == "inactive"
     assert list(controllers[n.JOINT_TRAJECTORY_CONTROLLER].claimed_interfaces) == []
-    assert controllers[n.GRIPPER_CONTROLLER].state == "inactive"
+    assert controllers[LAB_SIM_GRIPPER].state == "inactive"
     assert controllers[n.JOINT_STATE_BROADCASTER].state == "active"
     # MoveIt Pro's objectives name controllers with a leading slash.
-    response = sim.switch(activate=["/joint_trajectory_controller", n.GRIPPER_CONTROLLER])
+    response = sim.switch(activate=["/joint_trajectory_controller", LAB_SIM_GRIPPER])
     assert response.ok, response.message
     states = {name: c.state for name, c in sim.controllers().items()}
-    assert states[n.JOINT_TRAJECTORY_CONTROLLER] == states[n.GRIPPER_CONTROLLER] == "active", states
+    assert states[n.JOINT_TRAJECTORY_CONTROLLER] == states[LAB_SIM_GRIPPER] == "active", states
 
 
 def test_a_goal_to_an_inactive_controller_is_rejected(sim: Sim) -> None:
@@ -60,7 +63,7 @@ def test_a_goal_to_an_inactive_controller_is_rejected(sim: Sim) -> None:
 
 
 def test_a_gripper_goal_to_an_inactive_controller_is_aborted(sim: Sim) -> None:
-    assert sim.switch(deactivate=[n.GRIPPER_CONTROLLER]).ok
+    assert sim.switch(deactivate=[LAB_SIM_GRIPPER]).ok
     assert sim.gripper(0.7929).status == STATUS_ABORTED
     sim.settle(0.3)
     assert sim.joint_states.latest((GRIPPER,))[0] < 0.01
@@ -97,12 +100,12 @@ def test_the_broadcaster_can_be_switched_off(sim: Sim) -> None:
 
 def test_the_controllers_can_start_inactive(start_sim: Callable[..., Sim]) -> None:
     sim = start_sim(
-        active_controllers=(n.JOINT_STATE_BROADCASTER, n.GRIPPER_CONTROLLER),
+        active_controllers=(n.JOINT_STATE_BROADCASTER, LAB_SIM_GRIPPER),
         inactive_controllers=(n.JOINT_TRAJECTORY_CONTROLLER,),
     )
     states = {name: c.state for name, c in sim.controllers().items()}
     assert states == {
         n.JOINT_STATE_BROADCASTER: "active",
-        n.GRIPPER_CONTROLLER: "active",
+        LAB_SIM_GRIPPER: "active",
         n.JOINT_TRAJECTORY_CONTROLLER: "inactive",
     }

@@ -16,6 +16,9 @@ from kinema.drivers import driver_spec
 from kinema.drivers.mujoco import names as n
 from kinema.transport import Node, open_session
 
+# lab_sim's gripper controller (its config.yaml's robot.gripper.controller).
+LAB_SIM_GRIPPER = "robotiq_gripper_controller"
+
 
 def _read_ready(fd: int, process: subprocess.Popen[bytes], timeout: float) -> str:
     ready, _, _ = select.select([fd], [], [], timeout)
@@ -62,7 +65,7 @@ def test_the_process_serves_and_stops_cleanly_on_sigterm(
             n.JOINT_STATE_BROADCASTER,
             n.FORCE_TORQUE_SENSOR_BROADCASTER,
             n.JOINT_TRAJECTORY_CONTROLLER,
-            n.GRIPPER_CONTROLLER,
+            LAB_SIM_GRIPPER,
             n.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER,
             n.VELOCITY_FORCE_CONTROLLER,
         }

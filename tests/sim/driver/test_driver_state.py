@@ -14,6 +14,9 @@ from kinema.drivers.mujoco import names as n
 from kinema.drivers.mujoco.simulation import MAX_LAG
 from kinema.transport import STATUS_ABORTED
 
+# lab_sim's gripper controller (its config.yaml's robot.gripper.controller).
+LAB_SIM_GRIPPER = "robotiq_gripper_controller"
+
 # "Reset MuJoCo Robot" (MoveIt Pro's lab_sim objective) sets exactly this state.
 RESET_STATE = dict(zip(ARM, (0.0, 0.0, -1.57, 0.0, 0.0, 0.0, 0.0), strict=True))
 DEFAULT_ARM = np.array([0.0, 0.0, -2.0, 2.0, -1.5708, -1.5708, 0.0])
@@ -180,7 +183,7 @@ def test_everything_the_driver_says_it_serves_is_on_the_graph(sim: Sim) -> None:
         ("topic", n.CLOCK_TOPIC),
         ("topic", n.JOINT_STATES_TOPIC),
         ("action", n.FOLLOW_JOINT_TRAJECTORY_ACTION),
-        ("action", n.GRIPPER_COMMAND_ACTION),
+        ("action", n.gripper_command_action(LAB_SIM_GRIPPER)),
         ("service", n.LIST_CONTROLLERS_SERVICE),
         ("service", n.SWITCH_CONTROLLERS_SERVICE),
         ("service", n.SET_STATE_SERVICE),

@@ -59,7 +59,7 @@ def _planned_move(cell, planning, goal: np.ndarray) -> None:
     start[model.index("robotiq_85_left_knuckle_joint")] = np.clip(
         cell.qpos("robotiq_85_left_knuckle_joint"), 0.0, CLOSED
     )
-    path: JointPath = plan_joint_goal(checker, start, dict(zip(ARM, goal, strict=True)))
+    path: JointPath = plan_joint_goal(checker, start, dict(zip(ARM, goal, strict=True)), group="manipulator")
     cell.track(time_parameterize(path, model))
 
 

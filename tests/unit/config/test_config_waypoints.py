@@ -1,5 +1,6 @@
 from __future__ import annotations
 
+import difflib
 import shutil
 import subprocess
 import sys
@@ -196,3 +197,72 @@ def test_an_unwritable_location_is_a_clear_error(tmp_path: Path):
     blocker.write_text("not a folder")
     with pytest.raises(ConfigError, match="cannot create the folder of the waypoints file"):
         WaypointStore(blocker / "waypoints.yaml").save(_waypoint("A"))
+
+
+# -- edits keep the file as its author wrote it -------------------------------------------------------------
+
+COMMENTED_HEAD = "# lab_sim's waypoints, as MoveIt Pro saved them\n# (comments added by the test)\n"
+
+
+@pytest.fixture
+def moveit_pro_waypoints(shared_dir: Path, tmp_path: Path) -> Path:
+    """MoveIt Pro's own lab_sim waypoints file, copied, with comments of the kinds people write."""
+    source = shared_dir / "compat" / "moveit_pro" / "lab_sim" / "waypoints" / "ur_waypoints.yaml"
+    lines = source.read_text().splitlines(keepends=True)
+    home = lines.index("  name: Home\n")
+    lines[home] = "  name: Home  # where every objective starts\n"
+    lines.insert(home + 1, "# the poses below are for the pick and place demos\n")
+    path = tmp_path / "ur_waypoints.yaml"
+    path.write_text(COMMENTED_HEAD + "".join(lines))
+    return path
+
+
+def _changes(before: str, after: str) -> list[tuple[str, list[str], list[str]]]:
+    """The changed line blocks between two texts: (kind, old lines, new lines)."""
+    old, new = before.splitlines(), after.splitlines()
+    matcher = difflib.SequenceMatcher(a=old, b=new, autojunk=False)
+    return [(tag, old[i1:i2], new[j1:j2]) for tag, i1, i2, j1, j2 in matcher.get_opcodes() if tag != "equal"]
+
+
+def test_saving_a_moveit_pro_waypoint_changes_only_its_changed_line(moveit_pro_waypoints: Path) -> None:
+    store = WaypointStore(moveit_pro_waypoints)
+    before = moveit_pro_waypoints.read_text()
+    home = store.get("Home")
+    rail = home.joint_names.index("linear_rail_joint")
+    old_rail = home.positions[rail]
+    home.positions[rail] = 0.25
+    store.save(home)
+    after = moveit_pro_waypoints.read_text()
+    assert _changes(before, after) == [("replace", [f"    - {old_rail!r}"], ["    - 0.25"])]
+    assert after.startswith(COMMENTED_HEAD)
+    assert "  name: Home  # where every objective starts\n# the poses below" in after
+
+
+def test_rename_erase_and_add_touch_only_their_own_lines(moveit_pro_waypoints: Path) -> None:
+    store = WaypointStore(moveit_pro_waypoints)
+    names = store.names()
+    before = moveit_pro_waypoints.read_text()
+
+    store.rename("Look at Table", "Look at the Table")
+    renamed = moveit_pro_waypoints.read_text()
+    assert _changes(before, renamed) == [
+        ("replace", ["  name: Look at Table"], ["  name: Look at the Table"])
+    ]
+
+    store.erase("Park Far Right")
+    erased = moveit_pro_waypoints.read_text()
+    ((kind, removed, added),) = _changes(renamed, erased)
+    assert kind == "delete" and added == []
+    assert removed[0].startswith("- description:") and removed[-1] == "  name: Park Far Right"
+    assert sum(line.startswith("- ") for line in removed) == 1  # the whole item, nothing around it
+
+    store.save(_waypoint("Kinema", 0.1, 0.2))
+    added_text = moveit_pro_waypoints.read_text()
+    ((kind, _, appended),) = _changes(erased, added_text)
+    assert kind == "insert" and added_text.startswith(erased)
+    assert appended[0] == "- description: ''" and appended[-1] == "  name: Kinema"
+    assert store.names() == [
+        "Look at the Table" if n == "Look at Table" else n for n in names if n != "Park Far Right"
+    ] + ["Kinema"]
+    assert added_text.startswith(COMMENTED_HEAD)
+    assert "  name: Home  # where every objective starts\n# the poses below" in added_text

@@ -67,3 +67,33 @@ def test_deeply_nested_yaml_does_not_crash():
         assert "deep.yaml" in str(error)
     else:
         assert document.data is not None
+
+
+def test_moveit_pro_angle_tags_are_radians() -> None:
+    import math
+
+    from kinema.config.yamlsource import parse_yaml
+
+    document = parse_yaml("a: !degrees 180\nb: !radians 0.5\nc: !degrees  30.0\n", "limits.yaml")
+    assert document.data == {"a": math.pi, "b": 0.5, "c": math.radians(30.0)}
+    assert document.line(("c",)) == 3
+
+
+def test_an_angle_tag_without_a_number_names_the_line() -> None:
+    import pytest
+
+    from kinema.config.yamlsource import parse_yaml
+    from kinema.errors import ConfigError
+
+    with pytest.raises(ConfigError, match=r"limits.yaml:2.*!degrees needs a number"):
+        parse_yaml("a: 1\nb: !degrees fast\n", "limits.yaml")
+
+
+def test_moveit_pro_joint_limits_with_degrees_load(tmp_path) -> None:
+    import math
+
+    from kinema.motion.joint_limits import parse_joint_limits
+
+    path = tmp_path / "joint_limits.yaml"
+    path.write_text("joint_limits:\n  j1:\n    has_velocity_limits: true\n    max_velocity: !degrees 90\n")
+    assert parse_joint_limits(path).joints["j1"]["max_velocity"] == math.pi / 2

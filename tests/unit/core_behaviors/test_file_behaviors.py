@@ -250,3 +250,106 @@ def test_package_paths_into_the_chains_objectives_find_the_configs_copy(
     while not received and time.monotonic() < deadline:
         time.sleep(0.01)
     assert received and received[0].mesh_resource == (package / "objectives" / "token.stl").resolve().as_uri()
+
+
+@pytest.fixture
+def outside(tmp_path_factory: pytest.TempPathFactory) -> Path:
+    """A folder that is neither the working directory, a package, nor Kinema's data folder."""
+    return tmp_path_factory.mktemp("outside")
+
+
+@pytest.mark.parametrize("name", ["/etc/passwd", "{outside}/secret.txt", "link/secret.txt", "link_file.txt"])
+def test_reads_outside_the_allowed_folders_are_refused_naming_the_rule(
+    behavior: Any, offline: BehaviorContext, folder: Path, outside: Path, name: str
+) -> None:
+    (outside / "secret.txt").write_text("top secret\n")
+    (folder / "link").symlink_to(outside, target_is_directory=True)
+    (folder / "link_file.txt").symlink_to(outside / "secret.txt")
+    path = name.format(outside=outside)
+    run = tick_behavior(behavior("ReadTextFileAsString"), {"text_filename": path}, context=offline)
+    assert run.status == NodeStatus.FAILURE
+    assert "string_file_contents" not in run.outputs
+    # A relative path that climbs out through a symlink already leaves its objectives folder.
+    rule = "leaves the folder" if name.startswith("link") else "refused by the file rule"
+    assert "port [text_filename]" in run.toasts[-1] and rule in run.toasts[-1], run.toasts[-1]
+
+
+def test_writes_outside_the_allowed_folders_are_refused(
+    behavior: Any, offline: BehaviorContext, folder: Path, outside: Path
+) -> None:
+    pose = tick_behavior(behavior("CreatePoseStamped"), {}, context=offline).outputs["pose_stamped"]
+    (folder / "link").symlink_to(outside, target_is_directory=True)
+    for name in (str(outside / "written"), "link/written"):
+        run = tick_behavior(
+            behavior("SavePoseStampedToYaml"), {"message": pose, "yaml_filename": name}, context=offline
+        )
+        assert run.status == NodeStatus.FAILURE
+        assert "refused by the file rule" in run.toasts[-1] or "leaves the folder" in run.toasts[-1]
+    assert list(outside.iterdir()) == []
+
+
+def test_the_security_folder_is_never_read_or_written_even_inside_the_workspace(
+    behavior: Any, offline: BehaviorContext, folder: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    security = folder / "security"
+    security.mkdir()
+    (security / "ca.key").write_text("-----BEGIN PRIVATE KEY-----\n")
+    monkeypatch.setenv("KINEMA_SECURITY_DIR", str(security))
+    read = tick_behavior(
+        behavior("ReadTextFileAsString"), {"text_filename": "security/ca.key"}, context=offline
+    )
+    assert read.status == NodeStatus.FAILURE and "refused by the security rule" in read.toasts[-1]
+    pose = tick_behavior(behavior("CreatePoseStamped"), {}, context=offline).outputs["pose_stamped"]
+    write = tick_behavior(
+        behavior("SavePoseStampedToYaml"),
+        {"message": pose, "yaml_filename": "security/pose"},
+        context=offline,
+    )
+    assert write.status == NodeStatus.FAILURE and "refused by the security rule" in write.toasts[-1]
+    assert sorted(p.name for p in security.iterdir()) == ["ca.key"]
+
+
+def test_a_config_allows_its_packages_and_the_data_folder(behavior: Any, node: Any) -> None:
+    import platformdirs
+
+    from kinema.config import resolve_config
+
+    context = BehaviorContext(node, config=resolve_config("lab_sim"))
+    data = platformdirs.user_data_path("kinema")
+    data.mkdir(parents=True, exist_ok=True)
+    (data / "note.txt").write_text("kept\n")
+    kept = tick_behavior(
+        behavior("ReadTextFileAsString"), {"text_filename": str(data / "note.txt")}, context=context
+    )
+    assert kept.outputs["string_file_contents"] == "kept\n"
+    inherited = tick_behavior(
+        behavior("ReadTextFileAsString"), {"text_filename": "close_gripper.xml"}, context=context
+    )
+    assert inherited.status == NodeStatus.SUCCESS, inherited.toasts
+    refused = tick_behavior(
+        behavior("ReadTextFileAsString"), {"text_filename": "/etc/passwd"}, context=context
+    )
+    assert refused.status == NodeStatus.FAILURE and "refused by the file rule" in refused.toasts[-1]
+
+
+def test_a_parameter_override_is_held_to_the_file_rule_like_any_port(
+    registry: Any, node: Any, caplog: pytest.LogCaptureFixture
+) -> None:
+    """A library objective run by name (what an operator may do) with its file parameter overridden."""
+    from kinema.config import resolve_config
+    from kinema.runtime.objective_server import FactoryTreeSource, ObjectiveRequest, ObjectiveServer
+    from kinema.runtime.overrides import ParameterOverride
+
+    factory = registry.create_factory(BehaviorContext(node, config=resolve_config("lab_sim")))
+    factory.register_behavior_tree_from_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Peek" _description="reads a note">'
+        '<ReadTextFileAsString text_filename="{file}" string_file_contents="{contents}"/>'
+        "</BehaviorTree></root>"
+    )
+    with ObjectiveServer(FactoryTreeSource(factory)) as server:
+        for path, rule in (("/etc/passwd", "file rule"), ("~/.config/kinema/security/ca.key", "file rule")):
+            overrides = (ParameterOverride("file", path),)
+            caplog.clear()
+            result = server.submit(ObjectiveRequest("Peek", "", overrides, "test")).wait(30)
+            assert result is not None and result.failed, result
+            assert f"refused by the {rule}" in caplog.text and "root:" not in caplog.text

@@ -308,9 +308,19 @@ def _box_stl(folder: Path) -> Path:
     return path
 
 
+def _in_data_folder(tmp_path: Path) -> Path:
+    """A fresh folder inside Kinema's data folder (the session's own, see tests/conftest.py)."""
+    import platformdirs
+
+    folder = platformdirs.user_data_path("kinema") / "test-files" / tmp_path.name
+    folder.mkdir(parents=True, exist_ok=True)
+    return folder
+
+
 def test_load_a_mesh_and_register_it_onto_a_moved_copy(
     behavior: Any, context: BehaviorContext, tmp_path: Path
 ) -> None:
+    tmp_path = _in_data_folder(tmp_path)  # the file rule: a lab_sim context reads only there
     stl = _box_stl(tmp_path)
     load = {"file_path": str(stl), "num_sampled_points": 3000, "random_seed": 7, "color": "255;0;0"}
     model = tick_behavior(behavior("LoadPointCloudFromFile"), load, context=context)
@@ -349,6 +359,7 @@ def test_load_a_mesh_and_register_it_onto_a_moved_copy(
 def test_load_a_pcd_file_and_bad_files_name_what_would_do(
     behavior: Any, context: BehaviorContext, tmp_path: Path
 ) -> None:
+    tmp_path = _in_data_folder(tmp_path)  # the file rule: a lab_sim context reads only there
     save_pcd(PointCloud(np.array([[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]], np.float32)), tmp_path / "two.pcd")
     run = tick_behavior(
         behavior("LoadPointCloudFromFile"),

@@ -215,12 +215,23 @@ def test_a_solution_is_replayed_only_from_where_it_starts(
     ]
     from kinema.motion import CollisionChecker
     from kinema.motion.task import Task, plan_task
-    from kinema.motion.task_stages import CurrentState, MoveAlongFrameAxis
+    from kinema.motion.task_stages import CurrentState, MotionSettings, MoveAlongFrameAxis
 
     checker = CollisionChecker(context.robot_model)
     elsewhere = plan_task(
         Task(
-            "up", [CurrentState(pick.end), MoveAlongFrameAxis((0, 0, 1), "world", "grasp_link", 0.05, 0.05)]
+            "up",
+            [
+                CurrentState(pick.end),
+                MoveAlongFrameAxis(
+                    (0, 0, 1),
+                    "world",
+                    "grasp_link",
+                    0.05,
+                    0.05,
+                    motion=MotionSettings(group="manipulator", link_padding=0.0),
+                ),
+            ],
         ),
         checker,
     )

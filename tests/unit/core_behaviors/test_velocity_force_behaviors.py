@@ -120,7 +120,10 @@ def _publish_forces(node: Any, forces: list[float], topic: str = "/ft/wrench") -
     publisher = node.create_publisher(WRENCH, topic)
 
     def loop() -> None:
-        time.sleep(0.3)  # the behavior subscribes first
+        # The behavior subscribes first: what is published before its subscription is on the graph is lost.
+        deadline = time.monotonic() + 30.0
+        while publisher.subscription_count() == 0 and time.monotonic() < deadline:
+            time.sleep(0.01)
         for force in forces:
             publisher.publish(
                 {"header": {"frame_id": "tool0"}, "wrench": {"force": {"x": 0.6 * force, "z": -0.8 * force}}}

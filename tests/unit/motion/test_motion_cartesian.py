@@ -12,7 +12,7 @@ def test_straight_descent_follows_the_line(model, checker, waypoint_q):
     T0 = fk(model, start, "grasp_link")
     T1 = T0.copy()
     T1[2, 3] -= 0.15
-    result = plan_cartesian_path(checker, start, [T1])
+    result = plan_cartesian_path(checker, start, [T1], group="manipulator")
     assert result.fraction == pytest.approx(1.0)
     assert result.reason == ""
     cols = list(model.group("manipulator").indices)
@@ -31,7 +31,7 @@ def test_path_into_the_table_stops_early_with_the_reason(model, checker, waypoin
     start = waypoint_q("3 Waypoint Pick Pose")
     T = fk(model, start, "grasp_link")
     T[2, 3] -= 0.10  # 10 cm down from 25 mm above the table
-    result = plan_cartesian_path(checker, start, [T])
+    result = plan_cartesian_path(checker, start, [T], group="manipulator")
     assert 0.0 < result.fraction < 0.3
     assert "collision" in result.reason and "table" in result.reason
 
@@ -45,9 +45,9 @@ def test_several_waypoints_and_empty_input(model, checker, waypoint_q):
         T[0, 3] += dx
         T[1, 3] += dy
         square.append(T)
-    assert plan_cartesian_path(checker, start, square).fraction == pytest.approx(1.0)
+    assert plan_cartesian_path(checker, start, square, group="manipulator").fraction == pytest.approx(1.0)
     with pytest.raises(MotionError, match="at least one waypoint"):
-        plan_cartesian_path(checker, start, [])
+        plan_cartesian_path(checker, start, [], group="manipulator")
 
 
 def _corner(model, start):
@@ -76,7 +76,7 @@ def test_a_blended_corner_is_cut_by_the_radius_and_keeps_moving(model, checker, 
 
     start = waypoint_q("3 Waypoint Mid Point")
     corner, end = _corner(model, start)
-    result = plan_cartesian_path(checker, start, [corner, end], blending_radius=radius)
+    result = plan_cartesian_path(checker, start, [corner, end], blending_radius=radius, group="manipulator")
     assert result.fraction == pytest.approx(1.0), result.reason
     tool = _tool_positions(model, start, result.path.positions)
     closest = np.linalg.norm(tool - corner[:3, 3], axis=1).min()
@@ -101,11 +101,11 @@ def test_a_blended_corner_is_cut_by_the_radius_and_keeps_moving(model, checker, 
 def test_radius_zero_is_the_exact_path_and_a_negative_radius_is_refused(model, checker, waypoint_q):
     start = waypoint_q("3 Waypoint Mid Point")
     corner, end = _corner(model, start)
-    exact = plan_cartesian_path(checker, start, [corner, end])
-    zero = plan_cartesian_path(checker, start, [corner, end], blending_radius=0.0)
+    exact = plan_cartesian_path(checker, start, [corner, end], group="manipulator")
+    zero = plan_cartesian_path(checker, start, [corner, end], blending_radius=0.0, group="manipulator")
     np.testing.assert_array_equal(exact.path.positions, zero.path.positions)
     with pytest.raises(MotionError, match="blending_radius must be >= 0"):
-        plan_cartesian_path(checker, start, [corner, end], blending_radius=-0.01)
+        plan_cartesian_path(checker, start, [corner, end], blending_radius=-0.01, group="manipulator")
 
 
 def test_an_ik_iteration_cap_too_small_for_the_steps_stops_the_path(model, checker, waypoint_q):
@@ -113,11 +113,13 @@ def test_an_ik_iteration_cap_too_small_for_the_steps_stops_the_path(model, check
     corner, end = _corner(model, start)
     # one IK sample every 10 cm: one damped least-squares step cannot land on it, fifty can
     hard = {"max_step": 0.1, "jump_threshold": 3.0}
-    capped = plan_cartesian_path(checker, start, [corner, end], max_iterations=1, **hard)
+    capped = plan_cartesian_path(checker, start, [corner, end], max_iterations=1, group="manipulator", **hard)
     assert capped.fraction < 1.0
     assert "the IK did not converge within 1 iteration(s)" in capped.reason, capped.reason
-    roomy = plan_cartesian_path(checker, start, [corner, end], max_iterations=50, **hard)
+    roomy = plan_cartesian_path(checker, start, [corner, end], max_iterations=50, group="manipulator", **hard)
     assert roomy.fraction == pytest.approx(1.0), roomy.reason
     # on this easy corner one step per default 5 mm sample is enough
-    fine = plan_cartesian_path(checker, start, [corner, end], blending_radius=0.02, max_iterations=1)
+    fine = plan_cartesian_path(
+        checker, start, [corner, end], blending_radius=0.02, max_iterations=1, group="manipulator"
+    )
     assert fine.fraction == pytest.approx(1.0), fine.reason

@@ -22,7 +22,7 @@ def test_ik_round_trip_from_random_reachable_poses(model, waypoint_q):
         q_true[arm] += rng.uniform(-0.6, 0.6, len(arm))
         q_true = np.clip(q_true, model.lower, model.upper)
         target = fk(model, q_true, "grasp_link")
-        q = ik(model, target, seed)
+        q = ik(model, target, seed, group="manipulator")
         pos, rot = _pose_error(fk(model, q, "grasp_link"), target)
         assert pos < 1e-4 and rot < 1e-3
         assert model.within_limits(q)
@@ -32,14 +32,14 @@ def test_ik_keeps_joints_outside_the_group(model, waypoint_q):
     seed = waypoint_q("3 Waypoint Mid Point")
     seed[model.index("robotiq_85_left_knuckle_joint")] = 0.4
     target = fk(model, waypoint_q("3 Waypoint Pick Pose"), "grasp_link")
-    q = ik(model, target, seed)
+    q = ik(model, target, seed, group="manipulator")
     assert q[model.index("robotiq_85_left_knuckle_joint")] == 0.4
 
 
 def test_ik_prefers_the_seed_branch(model, waypoint_q):
     """Solving for the pick pose from the mid point lands on the waypoint itself, not another branch."""
     pick = waypoint_q("3 Waypoint Pick Pose")
-    q = ik(model, fk(model, pick, "grasp_link"), waypoint_q("3 Waypoint Mid Point"))
+    q = ik(model, fk(model, pick, "grasp_link"), waypoint_q("3 Waypoint Mid Point"), group="manipulator")
     arm = list(model.group("manipulator").indices)[1:]  # the rail is redundant: it may settle elsewhere
     assert np.abs(q[arm] - pick[arm]).max() < 0.3
 
@@ -51,14 +51,14 @@ def test_ik_honours_tight_limits(model, waypoint_q):
     far[:3, :3] = fk(model, seed, "grasp_link")[:3, :3]
     far[:3, 3] = (0.5, 2.4, 0.95)  # 2.4 m along the rail: beyond the 1.2 m rail plus the arm's sideways reach
     with pytest.raises(MotionError, match="no IK solution for 'grasp_link' in group 'manipulator'"):
-        ik(model, far, seed, options=IkOptions(attempts=4))
+        ik(model, far, seed, options=IkOptions(attempts=4), group="manipulator")
 
 
 def test_ik_position_only(model, waypoint_q):
     seed = waypoint_q("3 Waypoint Mid Point")
     target = np.eye(4)
     target[:3, 3] = (0.55, 0.1, 1.0)
-    q = ik(model, target, seed, position_only=True)
+    q = ik(model, target, seed, position_only=True, group="manipulator")
     assert np.linalg.norm(fk(model, q, "grasp_link")[:3, 3] - target[:3, 3]) < 1e-4
 
 
@@ -71,6 +71,7 @@ def test_ik_accept_hook_rejects_solutions(model, waypoint_q):
             waypoint_q("3 Waypoint Mid Point"),
             options=IkOptions(attempts=2),
             accept=lambda q: False,
+            group="manipulator",
         )
 
 
@@ -86,7 +87,7 @@ def test_restarts_return_the_solution_closest_to_the_seed(model, waypoint_q):
     seed = waypoint_q("3 Waypoint Mid Point")
     few = IkOptions(max_iterations=1, attempts=3)
     with pytest.raises(MotionError, match="no IK solution"):
-        ik(model, target, seed, options=few)
+        ik(model, target, seed, options=few, group="manipulator")
     solutions = []
     opts = IkOptions(attempts=40, restart_solutions=3, rng_seed=3)
 
@@ -94,7 +95,7 @@ def test_restarts_return_the_solution_closest_to_the_seed(model, waypoint_q):
         solutions.append(q.copy())
         return len(solutions) > 1  # reject the seed's own solution so that restarts have to run
 
-    q = ik(model, target, seed, options=opts, accept=record)
+    q = ik(model, target, seed, options=opts, accept=record, group="manipulator")
     accepted = solutions[1:]
     assert len(accepted) == 3
     assert np.linalg.norm(q - seed) == pytest.approx(min(np.linalg.norm(s - seed) for s in accepted))

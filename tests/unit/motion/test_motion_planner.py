@@ -27,7 +27,7 @@ def _full(model, start, path):
 @pytest.mark.parametrize(("start", "goal"), PICK_AND_PLACE)
 def test_waypoint_moves_are_planned_and_collision_free(model, checker, waypoint_q, arm_goal, start, goal):
     q0 = waypoint_q(start)
-    path = plan_joint_goal(checker, q0, arm_goal(goal))
+    path = plan_joint_goal(checker, q0, arm_goal(goal), group="manipulator")
     assert path.joint_names == model.group("manipulator").joint_names
     np.testing.assert_allclose(path.positions[0], q0[:7])
     np.testing.assert_allclose(path.positions[-1], waypoint_q(goal)[:7], atol=1e-9)
@@ -39,7 +39,7 @@ def test_reset_mujoco_robot_pose_plans_to_every_waypoint(model, checker, waypoin
     reset = model.configuration({"shoulder_lift_joint": -1.57})
     assert not checker.in_collision(reset)
     for name in waypoints:
-        path = plan_joint_goal(checker, reset, arm_goal(name))
+        path = plan_joint_goal(checker, reset, arm_goal(name), group="manipulator")
         assert checker.first_invalid(_full(model, reset, path), max_step=0.005) is None
 
 
@@ -52,7 +52,11 @@ def test_planner_goes_around_an_obstacle(model, checker, waypoint_q, arm_goal):
     checker.scene.add_box("block", (0.03, 0.03, 0.03), block)
     assert checker.first_invalid(np.array([mid, pick]), 0.02) is not None
     path = plan_joint_goal(
-        checker, mid, arm_goal("3 Waypoint Pick Pose"), options=PlanningOptions(timeout=5.0)
+        checker,
+        mid,
+        arm_goal("3 Waypoint Pick Pose"),
+        options=PlanningOptions(timeout=5.0),
+        group="manipulator",
     )
     assert len(path.positions) > 2
     assert checker.first_invalid(_full(model, mid, path), max_step=0.005) is None
@@ -61,13 +65,13 @@ def test_planner_goes_around_an_obstacle(model, checker, waypoint_q, arm_goal):
 def test_goal_in_collision_names_the_links(model, checker, waypoint_q):
     goal = {"shoulder_lift_joint": -0.2, "elbow_joint": 0.5, "wrist_1_joint": -1.8}
     with pytest.raises(MotionError, match=r"goal state is in collision: .*table"):
-        plan_joint_goal(checker, waypoint_q("Home"), goal)
+        plan_joint_goal(checker, waypoint_q("Home"), goal, group="manipulator")
 
 
 def test_start_in_collision(model, checker, waypoint_q, arm_goal):
     start = model.configuration({"shoulder_lift_joint": -0.2, "elbow_joint": 0.5}, waypoint_q("Home"))
     with pytest.raises(MotionError, match=r"start state is in collision"):
-        plan_joint_goal(checker, start, arm_goal("Home"))
+        plan_joint_goal(checker, start, arm_goal("Home"), group="manipulator")
 
 
 def test_a_start_touching_the_scene_is_left_for_a_nearby_free_state(model, checker, waypoint_q, arm_goal):
@@ -84,9 +88,13 @@ def test_a_start_touching_the_scene_is_left_for_a_nearby_free_state(model, check
         assert checker.in_collision(start), "the fingertips should reach into the slab"
         with pytest.raises(MotionError, match=r"start state is in collision: .*slab"):
             plan_joint_goal(
-                checker, start, arm_goal("Home"), options=PlanningOptions(fix_start_collision=False)
+                checker,
+                start,
+                arm_goal("Home"),
+                options=PlanningOptions(fix_start_collision=False),
+                group="manipulator",
             )
-        path = plan_joint_goal(checker, start, arm_goal("Home"))
+        path = plan_joint_goal(checker, start, arm_goal("Home"), group="manipulator")
         cols = list(model.group("manipulator").indices)
         np.testing.assert_allclose(path.positions[0], start[cols])
         freed = _full(model, start, path)[1]
@@ -103,26 +111,30 @@ def test_unknown_joint_names_list_the_valid_ones(checker, waypoint_q):
     with pytest.raises(
         MotionError, match=r"unknown joint 'elbow'.*valid joints: linear_rail_joint, shoulder_pan"
     ):
-        plan_joint_goal(checker, waypoint_q("Home"), {"elbow": 1.0})
+        plan_joint_goal(checker, waypoint_q("Home"), {"elbow": 1.0}, group="manipulator")
 
 
 def test_joint_outside_the_group_is_rejected(checker, waypoint_q):
     with pytest.raises(
         MotionError, match=r"'robotiq_85_left_knuckle_joint' is not in planning group 'manipulator'"
     ):
-        plan_joint_goal(checker, waypoint_q("Home"), {"robotiq_85_left_knuckle_joint": 0.5})
+        plan_joint_goal(
+            checker, waypoint_q("Home"), {"robotiq_85_left_knuckle_joint": 0.5}, group="manipulator"
+        )
 
 
 def test_goal_outside_limits(checker, waypoint_q):
     with pytest.raises(MotionError, match=r"linear_rail_joint = 1.5000 is outside its limits"):
-        plan_joint_goal(checker, waypoint_q("Home"), {"linear_rail_joint": 1.5})
+        plan_joint_goal(checker, waypoint_q("Home"), {"linear_rail_joint": 1.5}, group="manipulator")
 
 
 def test_unknown_group_and_planner(checker, waypoint_q):
     with pytest.raises(MotionError, match=r"unknown planning group 'arm'"):
         plan_joint_goal(checker, waypoint_q("Home"), {}, group="arm")
     with pytest.raises(MotionError, match=r"unknown planner 'RRTConect'.*RRTConnect"):
-        plan_joint_goal(checker, waypoint_q("Home"), {}, options=PlanningOptions(planner="RRTConect"))
+        plan_joint_goal(
+            checker, waypoint_q("Home"), {}, options=PlanningOptions(planner="RRTConect"), group="manipulator"
+        )
 
 
 def test_unreachable_goal_times_out_with_a_reason(model, checker, waypoint_q):
@@ -156,7 +168,7 @@ def test_open_gripper_comes_down_around_the_cube_without_touching_it(
     scene = PlanningScene.from_mjcf(description.mjcf, model.link_names, include_free_bodies=True)
     cube = scene.objects.pop("cube")
     planner_checker = CollisionChecker(model, scene, padding=0.01)
-    path = plan_joint_goal(planner_checker, waypoint_q(start), arm_goal(goal))
+    path = plan_joint_goal(planner_checker, waypoint_q(start), arm_goal(goal), group="manipulator")
     if object_at == "tray":
         T = cube.world_T_object.copy()
         T[1, 3] = -T[1, 3]  # the tray spot mirrors the pick spot across the rail's middle

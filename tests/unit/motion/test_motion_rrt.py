@@ -86,12 +86,14 @@ def test_a_seeded_plan_is_repeated_exactly_after_other_plans(model, checker, way
     mid, _ = _blocked(model, checker, waypoint_q)
     goal = arm_goal("3 Waypoint Pick Pose")
     options = PlanningOptions(timeout=5.0, seed=11)
-    first = plan_joint_goal(checker, mid, goal, options=options)
+    first = plan_joint_goal(checker, mid, goal, options=options, group="manipulator")
     # OMPL plans in between advance OMPL's process-wide generator; the seeded plan must not care.
     for _ in range(2):
-        plan_joint_goal(checker, mid, goal, options=PlanningOptions(timeout=5.0))
-    again = plan_joint_goal(checker, mid, goal, options=options)
-    other = plan_joint_goal(checker, mid, goal, options=PlanningOptions(timeout=5.0, seed=12))
+        plan_joint_goal(checker, mid, goal, options=PlanningOptions(timeout=5.0), group="manipulator")
+    again = plan_joint_goal(checker, mid, goal, options=options, group="manipulator")
+    other = plan_joint_goal(
+        checker, mid, goal, options=PlanningOptions(timeout=5.0, seed=12), group="manipulator"
+    )
     np.testing.assert_array_equal(first.positions, again.positions)
     assert len(first.positions) > 2 and not np.array_equal(first.positions, other.positions)
     cols = list(model.group("manipulator").indices)
@@ -100,7 +102,9 @@ def test_a_seeded_plan_is_repeated_exactly_after_other_plans(model, checker, way
         rows[:, cols] = path.positions
         assert checker.first_invalid(rows, max_step=0.005) is None
     with pytest.raises(MotionError, match="planner 'PRM' cannot be seeded per plan"):
-        plan_joint_goal(checker, mid, goal, options=PlanningOptions(planner="PRM", seed=1))
+        plan_joint_goal(
+            checker, mid, goal, options=PlanningOptions(planner="PRM", seed=1), group="manipulator"
+        )
 
 
 _IN_ANOTHER_PROCESS = """
@@ -115,7 +119,8 @@ checker.scene.add_box("block", (0.03, 0.03, 0.03), block)
 cols = list(model.group("manipulator").indices)
 names = model.group("manipulator").joint_names
 options = PlanningOptions(timeout=5.0, seed=11)
-path = plan_joint_goal(checker, mid, dict(zip(names, goal[cols], strict=True)), options=options)
+targets = dict(zip(names, goal[cols], strict=True))
+path = plan_joint_goal(checker, mid, targets, options=options, group="manipulator")
 print(json.dumps(path.positions.tolist()))
 """
 
@@ -123,7 +128,11 @@ print(json.dumps(path.positions.tolist()))
 def test_a_seeded_plan_is_the_same_in_another_process(model, checker, waypoint_q, arm_goal):
     mid, pick = _blocked(model, checker, waypoint_q)
     here = plan_joint_goal(
-        checker, mid, arm_goal("3 Waypoint Pick Pose"), options=PlanningOptions(timeout=5.0, seed=11)
+        checker,
+        mid,
+        arm_goal("3 Waypoint Pick Pose"),
+        options=PlanningOptions(timeout=5.0, seed=11),
+        group="manipulator",
     )
     block = checker.scene.objects["block"].world_T_object[:3, 3].tolist()
     states = json.dumps([mid.tolist(), pick.tolist()])
@@ -142,10 +151,15 @@ def test_a_task_connect_around_an_obstacle_repeats_with_its_seed(model, checker,
     mid, pick = _blocked(model, checker, waypoint_q)
 
     def plan(seed: int) -> np.ndarray:
-        task = Task("around", [CurrentState(mid), Connect(MotionSettings(seed=seed)), CurrentState(pick)])
+        task = Task(
+            "around",
+            [CurrentState(mid), Connect(MotionSettings(seed=seed, group="manipulator")), CurrentState(pick)],
+        )
         return plan_task(task, checker).joined().positions
 
     first = plan(5)
-    plan_joint_goal(checker, mid, pick, options=PlanningOptions(timeout=5.0))  # OMPL, in between
+    plan_joint_goal(
+        checker, mid, pick, options=PlanningOptions(timeout=5.0), group="manipulator"
+    )  # OMPL, in between
     np.testing.assert_array_equal(plan(5), first)
     assert not np.array_equal(plan(6), first)

@@ -49,7 +49,10 @@ def pick_task(
             CurrentState(start),
             Connect(
                 MotionSettings(
-                    link_padding=0.0, velocity_scale=velocity_scale, acceleration_scale=acceleration_scale
+                    link_padding=0.0,
+                    velocity_scale=velocity_scale,
+                    acceleration_scale=acceleration_scale,
+                    group="manipulator",
                 )
             ),
             MoveAlongFrameAxis(
@@ -58,10 +61,12 @@ def pick_task(
                 "grasp_link",
                 0.1,
                 0.1,
-                MotionSettings(link_padding=0.0),
+                MotionSettings(link_padding=0.0, group="manipulator"),
                 name="approach",
             ),
-            BatchPoseIK([("world", p) for p in poses], "grasp_link", name="grasp pose IK"),
+            BatchPoseIK(
+                [("world", p) for p in poses], "grasp_link", name="grasp pose IK", group="manipulator"
+            ),
         ],
     )
 
@@ -185,7 +190,20 @@ def test_progress_reports_each_stage_waiting_planning_then_solved_or_failed(
 def test_moving_along_a_frame_axis_fails_below_min_distance_with_the_share_reached(
     checker: CollisionChecker, start: np.ndarray, model: RobotModel
 ) -> None:
-    task = Task("reach", [CurrentState(start), MoveAlongFrameAxis((1, 0, 0), "world", "tool0", 2.5, 3.0)])
+    task = Task(
+        "reach",
+        [
+            CurrentState(start),
+            MoveAlongFrameAxis(
+                (1, 0, 0),
+                "world",
+                "tool0",
+                2.5,
+                3.0,
+                motion=MotionSettings(group="manipulator", link_padding=0.0),
+            ),
+        ],
+    )
     with pytest.raises(TaskPlanningError) as failure:
         plan_task(task, checker)
     message = str(failure.value)
@@ -193,7 +211,20 @@ def test_moving_along_a_frame_axis_fails_below_min_distance_with_the_share_reach
     assert "%" in message and "at least 2.500 m needed" in message
     # With a lower minimum the same stage succeeds and goes as far as it can.
     partial = plan_task(
-        Task("reach", [CurrentState(start), MoveAlongFrameAxis((1, 0, 0), "world", "tool0", 0.05, 3.0)]),
+        Task(
+            "reach",
+            [
+                CurrentState(start),
+                MoveAlongFrameAxis(
+                    (1, 0, 0),
+                    "world",
+                    "tool0",
+                    0.05,
+                    3.0,
+                    motion=MotionSettings(group="manipulator", link_padding=0.0),
+                ),
+            ],
+        ),
         checker,
     )
     moved = fk(model, partial.end, "tool0")[:3, 3] - fk(model, start, "tool0")[:3, 3]
@@ -205,7 +236,21 @@ def test_a_square_of_moves_along_world_axes_closes(
 ) -> None:
     sides = [(0, 1, 0), (1, 0, 0), (0, -1, 0), (-1, 0, 0)]
     task = Task(
-        "square", [CurrentState(start), *(MoveAlongFrameAxis(a, "world", "tool0", 0.2, 0.2) for a in sides)]
+        "square",
+        [
+            CurrentState(start),
+            *(
+                MoveAlongFrameAxis(
+                    a,
+                    "world",
+                    "tool0",
+                    0.2,
+                    0.2,
+                    motion=MotionSettings(group="manipulator", link_padding=0.0),
+                )
+                for a in sides
+            ),
+        ],
     )
     solution = plan_task(task, checker)
     origin = fk(model, start, "tool0")[:3, 3]
@@ -229,8 +274,8 @@ def test_plan_to_pose_and_to_joint_state_go_forwards_and_a_pose_inside_an_obstac
         "moves",
         [
             CurrentState(start),
-            PlanToPose(("world", above), "grasp_link"),
-            PlanToJointState(home),
+            PlanToPose(("world", above), "grasp_link", motion=MotionSettings(group="manipulator")),
+            PlanToJointState(home, motion=MotionSettings(group="manipulator")),
         ],
     )
     solution = plan_task(task, checker)
@@ -247,7 +292,14 @@ def test_plan_to_pose_and_to_joint_state_go_forwards_and_a_pose_inside_an_obstac
         plan_task(
             Task(
                 "into the wall",
-                [CurrentState(start), PlanToPose(("world", _at(-0.3, 0.62, 0.924, grasp)), "grasp_link")],
+                [
+                    CurrentState(start),
+                    PlanToPose(
+                        ("world", _at(-0.3, 0.62, 0.924, grasp)),
+                        "grasp_link",
+                        motion=MotionSettings(group="manipulator"),
+                    ),
+                ],
             ),
             checker,
         )
@@ -274,7 +326,11 @@ def test_a_connect_with_no_way_through_fails_naming_it_after_its_planning_time(
     )
     task = Task(
         "cross",
-        [CurrentState(here), Connect(MotionSettings(planning_time=0.2)), CurrentState(there, name="there")],
+        [
+            CurrentState(here),
+            Connect(MotionSettings(planning_time=0.2, group="manipulator")),
+            CurrentState(there, name="there"),
+        ],
     )
     with pytest.raises(TaskPlanningError) as failure:
         plan_task(task, checker)
@@ -284,7 +340,12 @@ def test_a_connect_with_no_way_through_fails_naming_it_after_its_planning_time(
 
     # The task's timeout cuts a longer search short: the connect searches only what is left of it.
     patient = Task(
-        "cross", [CurrentState(here), Connect(MotionSettings(planning_time=30.0)), CurrentState(there)]
+        "cross",
+        [
+            CurrentState(here),
+            Connect(MotionSettings(planning_time=30.0, group="manipulator")),
+            CurrentState(there),
+        ],
     )
     with pytest.raises(TaskPlanningError) as failure:
         plan_task(patient, checker, timeout=0.3)
@@ -340,7 +401,18 @@ def test_a_task_can_go_on_from_an_earlier_solution(
 ) -> None:
     pick = plan_task(pick_task(start, [grasp]), checker)
     retreat = Task(
-        "retreat", [FromSolution(pick), MoveAlongFrameAxis((0, 0, 1), "world", "grasp_link", 0.1, 0.1)]
+        "retreat",
+        [
+            FromSolution(pick),
+            MoveAlongFrameAxis(
+                (0, 0, 1),
+                "world",
+                "grasp_link",
+                0.1,
+                0.1,
+                motion=MotionSettings(group="manipulator", link_padding=0.0),
+            ),
+        ],
     )
     solution = plan_task(retreat, checker)
     assert len(solution.sub_trajectories) == 3
@@ -364,18 +436,33 @@ def test_badly_built_tasks_fail_naming_the_stage(
     cases = [
         (Task("empty"), "the task has no stages"),
         (
-            Task("no start", [MoveAlongFrameAxis((0, 0, 1), "world", "tool0", 0.1, 0.1)]),
+            Task(
+                "no start",
+                [
+                    MoveAlongFrameAxis(
+                        (0, 0, 1),
+                        "world",
+                        "tool0",
+                        0.1,
+                        0.1,
+                        motion=MotionSettings(group="manipulator", link_padding=0.0),
+                    )
+                ],
+            ),
             "starts with a state",
         ),
-        (Task("dangling", [CurrentState(start), Connect()]), "needs a stage after it"),
+        (
+            Task("dangling", [CurrentState(start), Connect(motion=MotionSettings(group="manipulator"))]),
+            "needs a stage after it",
+        ),
         (
             Task(
                 "backwards",
                 [
                     CurrentState(start),
-                    Connect(),
-                    PlanToPose(("world", grasp), "grasp_link"),
-                    BatchPoseIK([("world", grasp)], "grasp_link"),
+                    Connect(motion=MotionSettings(group="manipulator")),
+                    PlanToPose(("world", grasp), "grasp_link", motion=MotionSettings(group="manipulator")),
+                    BatchPoseIK([("world", grasp)], "grasp_link", group="manipulator"),
                 ],
             ),
             "stage 3 of 4 ('plan to pose')",
@@ -396,10 +483,19 @@ def test_link_padding_is_honoured_per_stage(
 ) -> None:
     home = arm_goal("Home")
     plan_task(
-        Task("tight", [CurrentState(start), PlanToJointState(home, MotionSettings(link_padding=0.0))]),
+        Task(
+            "tight",
+            [
+                CurrentState(start),
+                PlanToJointState(home, MotionSettings(link_padding=0.0, group="manipulator")),
+            ],
+        ),
         checker,
     )
-    wide = Task("wide", [CurrentState(start), PlanToJointState(home, MotionSettings(link_padding=0.5))])
+    wide = Task(
+        "wide",
+        [CurrentState(start), PlanToJointState(home, MotionSettings(link_padding=0.5, group="manipulator"))],
+    )
     with pytest.raises(TaskPlanningError) as failure:
         plan_task(wide, checker)
     assert "stage 2 of 2 ('plan to joint state')" in str(failure.value) and "collision" in str(failure.value)

@@ -14,7 +14,9 @@ def _limits(model, names):
 
 @pytest.fixture
 def pick_path(checker, waypoint_q, arm_goal):
-    return plan_joint_goal(checker, waypoint_q("3 Waypoint Mid Point"), arm_goal("3 Waypoint Pick Pose"))
+    return plan_joint_goal(
+        checker, waypoint_q("3 Waypoint Mid Point"), arm_goal("3 Waypoint Pick Pose"), group="manipulator"
+    )
 
 
 @pytest.mark.parametrize(("vscale", "ascale"), [(1.0, 1.0), (0.5, 0.25), (0.1, 1.0)])

@@ -112,6 +112,29 @@ def test_build_validates_objectives_and_writes_the_model(ws: Path, capsys) -> No
     assert f"{broken}:5:" in err and "NoSuchBehavior" in err
 
 
+@pytest.mark.parametrize(
+    ("waypoints_file", "content", "said"),
+    [
+        ("config/waypoints.yaml", "- name: [unclosed\n  joints: {", "waypoints.yaml"),
+        ("config/waypoints.yaml", "just some words\n", "waypoints.yaml"),
+        ("../../../../etc/passwd", None, "leaves package 'my_config'"),
+        ("/etc/passwd", None, "leaves package 'my_config'"),
+    ],
+)
+def test_build_reads_the_waypoints_file_and_refuses_paths_outside_the_package(
+    ws: Path, capsys, waypoints_file: str, content: str | None, said: str
+) -> None:
+    """It said '0 problems' for a garbage waypoints file and a waypoints_file of ../../../../etc/passwd."""
+    config = ws / "src" / "my_config"
+    if content is not None:
+        (config / waypoints_file).write_text(content)
+    reference = f'  waypoints_file:\n    package_name: "my_config"\n    relative_path: "{waypoints_file}"\n'
+    (config / "config" / "config.yaml").write_text(CONFIG_YAML + reference)
+    assert main(["build", "--skip-install"]) == 1
+    err = capsys.readouterr().err
+    assert said in err and "Traceback" not in err, err
+
+
 def test_build_packages_select_names_the_valid_packages(ws: Path, capsys) -> None:
     assert main(["new", "behavior", "my_adder"]) == 0
     assert main(["build", "--packages-select", "my_added"]) == 1

@@ -9,6 +9,8 @@ from pathlib import Path
 from kinema.plugins import BehaviorHost, ReloadKind
 
 HANGS = "import threading\n\nthreading.Event().wait()  # waits for ever\n"
+# The same, leaving a file behind once its import has started (the test waits for that, not for a guess).
+HANGS_AFTER_SAYING_SO = "import pathlib\npathlib.Path({marker!r}).touch()\n" + HANGS
 
 
 def test_a_hanging_import_at_start_is_reported_and_the_others_load(workspace: Path, make_package) -> None:
@@ -34,8 +36,12 @@ def test_a_package_that_starts_hanging_does_not_block_the_reload_of_another(
     host.subscribe(events.put)
     host.watch(debounce=0.05)
     try:
-        (stuck / "stuck" / "behaviors.py").write_text(HANGS)
-        time.sleep(0.3)  # the stuck package's change is handled first
+        marker = workspace / "stuck_import_started"
+        (stuck / "stuck" / "behaviors.py").write_text(HANGS_AFTER_SAYING_SO.format(marker=str(marker)))
+        deadline = time.monotonic() + 30
+        while not marker.exists():  # the stuck package's change is handled first
+            assert time.monotonic() < deadline, "the stuck package's reload never started"
+            time.sleep(0.01)
         module = good / "good" / "behaviors.py"
         module.write_text(module.read_text().replace("2)", "3)"))
         seen = {}

@@ -60,7 +60,7 @@ def test_blackboard_values_render_as_yaml_flow(value: Any, text: str) -> None:
 
 def test_remembered_renderings_keep_equal_values_of_other_types_apart() -> None:
     """1 == True == 1.0 and 0.0 == -0.0, but they render differently; so do a string and its quoted twin."""
-    from kinema.runtime.agent import _render
+    from kinema.runtime.blackboard_text import _render
 
     values = [1, True, 1.0, 0, False, 0.0, -0.0, None, "yes", "1", "1", 1, True, "x" * 3000, "x" * 3000]
     for _ in range(2):

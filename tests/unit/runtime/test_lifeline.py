@@ -9,7 +9,7 @@ import time
 
 import pytest
 
-from kinema.runtime.lifeline import ENV, GRACE_S, Lifeline, hold
+from kinema.process.lifeline import ENV, GRACE_S, Lifeline, hold
 
 # Each child prints "held" once it watches the lifeline, then does something that would keep it alive.
 STUBBORN = {
@@ -25,7 +25,7 @@ STUBBORN = {
 def _child(lifeline: Lifeline, body: str) -> subprocess.Popen[str]:
     code = (
         "import signal, sys, threading, time\n"
-        "from kinema.runtime import lifeline\n"
+        "from kinema.process import lifeline\n"
         "print('held' if lifeline.hold() else 'not held', flush=True)\n" + body
     )
     return subprocess.Popen(

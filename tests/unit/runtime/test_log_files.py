@@ -8,7 +8,7 @@ from pathlib import Path
 
 import pytest
 
-from kinema.runtime.log_files import follow_entries, level_number, merged_entries
+from kinema.process.log_files import follow_entries, level_number, merged_entries
 
 
 def _write(path: Path, lines: list[str]) -> None:

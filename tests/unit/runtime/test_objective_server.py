@@ -300,16 +300,29 @@ def test_call_soon_runs_between_ticks(server: ObjectiveServer) -> None:
     server.cancel()
 
 
-def test_stopping_preempts_the_running_objective(recorder: Recorder) -> None:
+def test_stopping_fails_the_running_objective_with_the_reason(recorder: Recorder) -> None:
+    """A runtime that stops is not a cancel the objective's client asked for: never PREEMPTED."""
     factory = BehaviorTreeFactory()
     factory.register_behavior_tree_from_text(LIBRARY)
     server = ObjectiveServer(FactoryTreeSource(factory), listeners=[recorder])
     server.start()
     run = server.submit(ObjectiveRequest("Forever"))
     _wait_status(server, ObjectiveStatus.RUNNING)
-    server.stop()
+    server.stop(reason="the agent stopped")
     result = run.result
-    assert result is not None and result.cancelled
+    assert result is not None and result.failed and result.error_message == "the agent stopped", result
+
+
+def test_an_abort_fails_the_running_objective_naming_what_died(recorder: Recorder) -> None:
+    factory = BehaviorTreeFactory()
+    factory.register_behavior_tree_from_text(LIBRARY)
+    with ObjectiveServer(FactoryTreeSource(factory), listeners=[recorder]) as server:
+        run = server.submit(ObjectiveRequest("Forever"))
+        _wait_status(server, ObjectiveStatus.RUNNING)
+        assert server.abort("driver 'arm' went away")
+        result = run.wait(5)
+        assert result is not None and result.failed and "driver 'arm' went away" in result.error_message
+        assert server.status == (ObjectiveStatus.FAILURE, "Forever")
 
 
 def test_the_final_status_is_held_then_the_server_reports_idle(recorder: Recorder) -> None:

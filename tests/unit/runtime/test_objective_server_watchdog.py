@@ -25,8 +25,13 @@ SPIN = (
     '<root BTCPP_format="4"><BehaviorTree ID="Spin">'
     '<Repeat num_cycles="-1"><AlwaysSuccess/></Repeat></BehaviorTree></root>'
 )
+COUNTING_SPIN = SPIN.replace("<AlwaysSuccess/>", "<Counts/>")
 QUICK = '<root BTCPP_format="4"><BehaviorTree ID="Quick"><AlwaysSuccess/></BehaviorTree></root>'
 RELEASE = threading.Event()
+# Set by a behavior once it is inside the call that blocks (or the work that runs until halted): the test
+# acts on the stuck tree from then on, not after a guessed delay.
+STUCK = threading.Event()
+TICKS: list[int] = []
 # Longer than any served cancel, far shorter than the 30 s a stuck behavior blocks here.
 LATE = 2.0
 
@@ -35,7 +40,16 @@ class BlockingTick(SyncBehavior):
     """Blocks in tick until the test releases it (a careless author's socket read)."""
 
     def tick(self) -> NodeStatus:
+        STUCK.set()
         RELEASE.wait(30)
+        return NodeStatus.SUCCESS
+
+
+class Counts(SyncBehavior):
+    """Succeeds at once, counting its ticks (a Repeat of it re-ticks without end)."""
+
+    def tick(self) -> NodeStatus:
+        TICKS.append(1)
         return NodeStatus.SUCCESS
 
 
@@ -43,6 +57,7 @@ class BlockingHalt(AsyncBehavior):
     """Work that runs until halted; its do_halt then blocks."""
 
     def do_work(self) -> bool:
+        STUCK.set()
         while not self.stop_requested():
             time.sleep(0.01)
         return True
@@ -55,6 +70,7 @@ class IgnoresHalt(AsyncBehavior):
     """A plain-function do_work that never looks at stop_requested()."""
 
     def do_work(self) -> bool:
+        STUCK.set()
         RELEASE.wait(30)
         return True
 
@@ -115,6 +131,7 @@ class AsyncOk(AsyncBehavior):
 
 BEHAVIORS = [
     BlockingTick,
+    Counts,
     BlockingHalt,
     IgnoresHalt,
     Moves,
@@ -135,6 +152,8 @@ def _tree(node: str, tree_id: str = "T") -> str:
 @pytest.fixture
 def server() -> Iterator[ObjectiveServer]:
     RELEASE.clear()
+    STUCK.clear()
+    TICKS.clear()
     factory = registry_of(BEHAVIORS).create_factory(BehaviorContext.offline())
     with ObjectiveServer(FactoryTreeSource(factory), watchdog_report_s=0.2) as running:
         yield running
@@ -160,9 +179,8 @@ def _running(server: ObjectiveServer) -> bool:
 
 
 def test_cancel_stops_an_endless_synchronous_repeat(server: ObjectiveServer) -> None:
-    run = _xml(server, SPIN)
-    _wait(lambda: _running(server), "the Repeat to run")
-    time.sleep(0.05)
+    run = _xml(server, COUNTING_SPIN)
+    _wait(lambda: len(TICKS) > 100, "the Repeat to spin")
     started = time.monotonic()
     assert server.cancel(timeout=5), "the cancel was refused"
     result = run.wait(5)
@@ -237,7 +255,7 @@ def test_a_blocking_tick_is_reported_and_cancel_abandons_its_thread(server: Obje
 def test_a_new_objective_preempts_a_blocking_tick(server: ObjectiveServer) -> None:
     stuck = _xml(server, _tree('<BlockingTick name="stuck"/>'))
     _wait(lambda: _running(server), "the stuck objective to run")
-    time.sleep(0.05)
+    _wait(STUCK.is_set, "the behavior to be stuck")
     quick = _xml(server, QUICK)
     assert quick.wait(5) == ObjectiveResult.success("Quick"), quick.result
     result = stuck.result
@@ -247,7 +265,7 @@ def test_a_new_objective_preempts_a_blocking_tick(server: ObjectiveServer) -> No
 def test_a_blocking_halt_does_not_block_the_cancel(server: ObjectiveServer) -> None:
     run = _xml(server, _tree('<BlockingHalt name="halts slowly"/>'))
     _wait(lambda: _running(server), "the objective to run")
-    time.sleep(0.05)
+    _wait(STUCK.is_set, "the behavior to be stuck")
     assert server.cancel(timeout=5)
     result = run.wait(5)
     assert result is not None and result.cancelled, result
@@ -263,7 +281,7 @@ def test_the_abandoned_tree_stops_its_motion_and_starts_nothing_new(server: Obje
     )
     run = _xml(server, xml)
     _wait(lambda: _running(server), "the objective to run")
-    time.sleep(0.05)
+    _wait(STUCK.is_set, "the behavior to be stuck")
     assert server.cancel(timeout=5)
     result = run.wait(5)
     assert result is not None and result.cancelled, result
@@ -278,7 +296,7 @@ def test_the_abandoned_tree_stops_its_motion_and_starts_nothing_new(server: Obje
 def test_a_new_objective_preempts_a_tree_whose_halt_blocks(server: ObjectiveServer) -> None:
     run = _xml(server, _tree('<BlockingHalt name="halts slowly"/>'))
     _wait(lambda: _running(server), "the objective to run")
-    time.sleep(0.05)
+    _wait(STUCK.is_set, "the behavior to be stuck")
     assert _xml(server, QUICK).wait(5) == ObjectiveResult.success("Quick")
     result = run.result
     assert result is not None and result.cancelled and "newer objective" in result.error_message, result
@@ -288,7 +306,7 @@ def test_a_new_objective_preempts_a_tree_whose_halt_blocks(server: ObjectiveServ
 def test_do_work_that_ignores_halt_is_reported(server: ObjectiveServer) -> None:
     run = _xml(server, _tree('<IgnoresHalt name="deaf"/>'))
     _wait(lambda: _running(server), "the objective to run")
-    time.sleep(0.05)
+    _wait(STUCK.is_set, "the behavior to be stuck")
     assert server.cancel(timeout=5)
     result = run.wait(5)
     assert result is not None and result.cancelled
@@ -388,3 +406,48 @@ def test_a_tick_thread_dying_mid_motion_still_halts_the_motion() -> None:
         assert result is not None and result.failed and "died: KeyboardInterrupt" in result.error_message
         _wait(lambda: "motion halted" in EVENTS, "the motion of the dead thread's tree to be halted")
         assert _xml(server, QUICK).wait(5) == ObjectiveResult.success("Quick")
+
+
+# -- code that holds the interpreter (C code that does not release the GIL) --------------------------
+
+GO = threading.Event()
+
+
+class HoldsTheInterpreter(SyncBehavior):
+    """Waits for the test, then sits 1 s in C code that keeps the GIL (ctypes.PyDLL never releases it)."""
+
+    def tick(self) -> NodeStatus:
+        import ctypes
+
+        GO.wait(30)
+        ctypes.PyDLL(None).usleep(1_000_000)
+        return NodeStatus.SUCCESS
+
+
+def test_a_cancel_accepted_while_a_tick_holds_the_interpreter_wins_and_the_stack_is_reported() -> None:
+    """The probe: C code holding the GIL for 15 s lost a cancel, and the objective reported SUCCESS."""
+    GO.clear()
+    factory = registry_of([HoldsTheInterpreter]).create_factory(BehaviorContext.offline())
+    with ObjectiveServer(FactoryTreeSource(factory), watchdog_report_s=0.2, abandon_after_s=30) as server:
+        run = _xml(server, _tree("<HoldsTheInterpreter/>"))
+        _wait(lambda: _running(server), "the objective to run")
+        assert run.request_cancel("cancelled by the test")  # what /do_objective's cancel_goal does
+        server.cancel(run, reason="cancelled by the test", timeout=0)
+        GO.set()
+        result = run.wait(30)
+        assert result is not None and result.cancelled, result
+        assert "cancelled by the test" in result.error_message
+        assert not run.request_cancel("too late"), "a settled run accepts no cancel"
+
+        def reported() -> list[str]:
+            return [w for w in server.health().warnings if "the interpreter was held" in w]
+
+        _wait(lambda: bool(reported()), "the watchdog's report of the held interpreter")
+        assert "test_objective_server_watchdog.py" in reported()[0] and "in tick" in reported()[0], reported()
+    GO.set()
+
+
+def test_a_run_that_succeeded_accepts_no_cancel(server: ObjectiveServer) -> None:
+    run = _xml(server, QUICK)
+    assert run.wait(5) == ObjectiveResult.success("Quick")
+    assert not run.request_cancel("late") and not server.cancel(run)

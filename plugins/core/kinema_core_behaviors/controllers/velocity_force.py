@@ -14,6 +14,7 @@ from typing import Any
 import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, StatefulBehavior, input_port
+from kinema.behaviors.cell_ports import cell_input_port
 
 from ..messages.ports import (
     fails_on_bad_input,
@@ -204,10 +205,10 @@ class ForceExceedsThreshold(StatefulBehavior):
                 "The sensor's WrenchStamped topic.",
             ),
             input_port("wrench_frame_name", str, "tool0", "Frame the sensor's wrench is expressed in."),
-            input_port(
+            cell_input_port(
                 "hand_frame_name",
                 str,
-                "grasp_link",
+                "tool_frame",
                 "The tool frame (kept for MoveIt Pro's objectives: the force magnitude is the same in it).",
             ),
             input_port("force_threshold", float, 30.0, "Force magnitude (N) that counts as exceeded."),

@@ -9,7 +9,11 @@
   reads and writes its own config's files, never an installed package's. Other
   ``~/user_ws/src/<package>/<rest>`` paths are ``<rest>`` inside that package's folder.
 - With a ``package_name``, a relative path is inside that package's folder.
-- Any other absolute path (``/tmp/image.png``, ``~/file``) is used as written.
+- Any other absolute path (``~/file``, a folder of the workspace) is used as written.
+
+Whatever form, the file must then pass :func:`kinema.behaviors.file_access.check_file_access`: inside the
+workspace, the config packages or Kinema's data folder, never the security folder (``..`` and symlinks
+resolved first). A refusal names the rule.
 Saves need a library folder of the config's own package; without a config (offline runs, ``kinema tree
 run``) relative paths resolve against the working directory.
 """
@@ -19,6 +23,8 @@ from __future__ import annotations
 import re
 from pathlib import Path
 from typing import Any
+
+from kinema.behaviors.file_access import FileAccessError, check_file_access
 
 from ..messages.ports import PortValueError, port_error
 
@@ -127,6 +133,14 @@ def _inside(folder: Path, relative: str, node: Any, port: str) -> Path:
     return path
 
 
+def _allowed(node: Any, port: str, text: str, path: Path) -> Path:
+    """``path`` resolved, or a PortValueError naming the rule that refuses it."""
+    try:
+        return check_file_access(path, node.context.config)
+    except FileAccessError as error:
+        raise port_error(node, port, f"= {text!r}: {error}") from None
+
+
 def with_suffix(text: str, suffix: str) -> str:
     """``text`` with ``suffix`` appended unless it already ends with it (``.yaml``/``.yml`` both count)."""
     lowered = text.lower()
@@ -154,8 +168,9 @@ def file_to_read(node: Any, port: str, text: str, package: str = "") -> Path:
             _inside(folder, name, node, port) for folder in objective_folders(node) for name in names
         ]
     for candidate in candidates:
-        if candidate.is_file():
-            return candidate
+        allowed = _allowed(node, port, text, candidate)
+        if allowed.is_file():
+            return allowed
     looked = ", ".join(dict.fromkeys(str(c.parent) for c in candidates))
     raise port_error(node, port, f"= {text!r}: no such file", f"looked in {looked}")
 
@@ -171,6 +186,7 @@ def file_to_write(node: Any, port: str, text: str, suffix: str = "") -> Path:
     text = with_suffix(text, suffix) if suffix else text
     explicit = _explicit(node, port, text)
     path = explicit if explicit is not None else _inside(save_folder(node, port), _relative(text), node, port)
+    path = _allowed(node, port, text, path)
     if not path.parent.is_dir():
         raise port_error(node, port, f"= {text!r}: the folder {path.parent} does not exist", "")
     return path

@@ -17,6 +17,7 @@ from typing import Any
 import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, StatefulBehavior, input_port
+from kinema.behaviors.cell_ports import cell_input_port
 
 from ..messages.conversions import duration, seconds
 from ..messages.ports import PortValueError, message_output, port_error, read_input
@@ -80,11 +81,12 @@ class RecordJointTrajectory(StatefulBehavior):
     def provided_ports(cls) -> list[PortInfo]:
         return [
             input_port("joint_state_topic", str, "/joint_states", "Joint states to record."),
-            input_port(
+            cell_input_port(
                 "planning_group_name",
                 str,
-                "manipulator",
+                "planning_group",
                 "Group whose joints are recorded ('' = all joints).",
+                empty_is_default=False,
             ),
             input_port(
                 "start_recording_service", str, "/start_recording_joint_trajectory", "Trigger that starts."

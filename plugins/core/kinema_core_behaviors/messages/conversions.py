@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from kinema import transforms
 from kinema.errors import ObjectiveError
 
 if TYPE_CHECKING:
@@ -134,32 +135,22 @@ def trajectory_from_message(message: Any, what: str) -> JointTrajectory:
 
 def pose_stamped_message(frame_id: str, matrix: np.ndarray) -> Any:
     """A ``geometry_msgs/PoseStamped`` of a 4x4 homogeneous transform."""
-    from scipy.spatial.transform import Rotation
-
     from kinema.transport import from_dict
 
-    x, y, z, w = Rotation.from_matrix(matrix[:3, :3]).as_quat()
-    px, py, pz = (float(v) for v in matrix[:3, 3])
     return from_dict(
-        POSE_STAMPED_TYPE,
-        {
-            "header": {"frame_id": frame_id},
-            "pose": {
-                "position": {"x": px, "y": py, "z": pz},
-                "orientation": {"x": float(x), "y": float(y), "z": float(z), "w": float(w)},
-            },
-        },
+        POSE_STAMPED_TYPE, {"header": {"frame_id": frame_id}, "pose": transforms.pose_dict(matrix)}
     )
 
 
 def pose_matrix(pose_stamped: Any, what: str) -> tuple[str, np.ndarray]:
     """``(frame_id, 4x4 transform)`` of a ``geometry_msgs/PoseStamped``.
 
-    Raises:
-        ObjectiveError: not a PoseStamped, or a zero quaternion.
-    """
-    from scipy.spatial.transform import Rotation
+    The orientation is read as :mod:`kinema.transforms` reads every quaternion: normalised, all-zero (an
+    unset orientation) the identity.
 
+    Raises:
+        ObjectiveError: not a PoseStamped, or an orientation with a NaN or infinite component.
+    """
     pose = getattr(pose_stamped, "pose", None)
     header = getattr(pose_stamped, "header", None)
     if pose is None or header is None:
@@ -167,14 +158,10 @@ def pose_matrix(pose_stamped: Any, what: str) -> tuple[str, np.ndarray]:
             f"{what} must be a geometry_msgs/PoseStamped (e.g. from CreatePoseStamped), "
             f"got {type(pose_stamped).__name__}"
         )
-    q = pose.orientation
-    quaternion = np.array([q.x, q.y, q.z, q.w], dtype=float)
-    if np.linalg.norm(quaternion) < 1e-9:
-        raise ObjectiveError(f"{what} has a zero orientation quaternion")
-    matrix = np.eye(4)
-    matrix[:3, :3] = Rotation.from_quat(quaternion / np.linalg.norm(quaternion)).as_matrix()
-    matrix[:3, 3] = [pose.position.x, pose.position.y, pose.position.z]
-    return str(header.frame_id), matrix
+    try:
+        return str(header.frame_id), transforms.pose_from_message(pose)
+    except transforms.TransformError as error:
+        raise ObjectiveError(f"{what}: {error}") from None
 
 
 _POINT_FIELD_DTYPES = {1: "i1", 2: "u1", 3: "i2", 4: "u2", 5: "i4", 6: "u4", 7: "f4", 8: "f8"}

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from kinema import transforms
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
 from .conversions import pose_stamped_message
@@ -21,21 +22,21 @@ POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 
 
 def pose_from_ports(position: list[float], orientation: list[float], what: str) -> np.ndarray | str:
-    """A 4x4 transform from ``x;y;z`` and ``x;y;z;w``, or the reason it cannot be built."""
-    from scipy.spatial.transform import Rotation
+    """A 4x4 transform from ``x;y;z`` and ``x;y;z;w``, or the reason it cannot be built.
 
+    An all-zero quaternion typed into a port is refused (a typo more often than "no rotation"), although
+    :mod:`kinema.transforms` reads one in a message as the identity.
+    """
     if len(position) != 3:
         return f"{what} position must have 3 values (x;y;z), got {len(position)}"
     if len(orientation) != 4:
         return f"{what} orientation must have 4 values (x;y;z;w), got {len(orientation)}"
-    quaternion = np.asarray(orientation, dtype=float)
-    norm = float(np.linalg.norm(quaternion))
-    if norm < 1e-9:
+    if transforms.is_zero_quaternion(orientation):
         return f"{what} orientation is a zero quaternion"
-    matrix = np.eye(4)
-    matrix[:3, :3] = Rotation.from_quat(quaternion / norm).as_matrix()
-    matrix[:3, 3] = position
-    return matrix
+    try:
+        return transforms.pose_matrix(position, orientation)
+    except transforms.TransformError as error:
+        return f"{what} {error}"
 
 
 class CreatePoseStamped(SyncBehavior):

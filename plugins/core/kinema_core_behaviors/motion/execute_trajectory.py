@@ -8,6 +8,7 @@ from typing import Any
 
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port
 from kinema.behaviors.work_runner import RUNNER
+from kinema.drivers.mujoco.names import LIST_CONTROLLERS_SERVICE, SWITCH_CONTROLLERS_SERVICE
 from kinema.errors import KinemaError, ObjectiveError, TransportError
 
 from ..controllers.switch_controller import (
@@ -21,7 +22,6 @@ from ..messages.conversions import duration, trajectory_from_message
 from .planned_trajectory import publish_planned_trajectory
 
 FOLLOW_JOINT_TRAJECTORY = "control_msgs/action/FollowJointTrajectory"
-CONTROLLER_MANAGER = "/controller_manager"
 # Execution goes on without a switch when no controller manager is on the graph (another robot's
 # driver) or it does not answer in time.
 LIST_TIMEOUT = 2.0
@@ -196,7 +196,7 @@ class ExecuteTrajectory(AsyncBehavior):
         if len(parts) != 2 or parts[1] != "follow_joint_trajectory":
             return ""
         controller = parts[0]
-        lister = self.context.service_client(node, LIST_TYPE, f"{CONTROLLER_MANAGER}/list_controllers")
+        lister = self.context.service_client(node, LIST_TYPE, LIST_CONTROLLERS_SERVICE)
         if not lister.service_is_ready():
             return ""
         try:
@@ -207,7 +207,7 @@ class ExecuteTrajectory(AsyncBehavior):
         if controller not in controllers or controllers[controller].state == "active":
             return ""
         deactivate = conflicting_active(controllers, [controller])
-        switcher = self.context.service_client(node, SWITCH_TYPE, f"{CONTROLLER_MANAGER}/switch_controller")
+        switcher = self.context.service_client(node, SWITCH_TYPE, SWITCH_CONTROLLERS_SERVICE)
         request = switch_request([controller], deactivate, STRICT, True, 5.0)
         try:
             response = await asyncio.wrap_future(switcher.call_async(request, 10.0))

@@ -1,151 +1,23 @@
-"""The robot's current joint state, as the driver publishes it on ``/joint_states``.
+"""The robot's current joint state for behaviors: the cell's :class:`~kinema.motion.JointStateMonitor`.
 
-One :class:`JointStateMonitor` is shared by every behavior of a context (the subscription lives as long
-as the context's transport node), so planning behaviors can read the start state without waiting for
-the next message.
+The monitor is ``BehaviorContext.joint_states``, made by the context on first use; this accessor names the
+behavior when the context has no transport.
 """
 
 from __future__ import annotations
 
-import bisect
-import threading
-import time
-import weakref
-from collections import deque
-from collections.abc import Sequence
-from typing import Any
+from typing import TYPE_CHECKING
 
-import numpy as np
-
-from kinema.errors import ObjectiveError
-
-JOINT_STATES_TOPIC = "/joint_states"
-JOINT_STATES_TYPE = "sensor_msgs/msg/JointState"
-# Messages kept for lookups at a past stamp: 6 s of sim time at the driver's 100 Hz.
-HISTORY = 600
-# A stamp further than this from the robot's clock is another clock (a camera not synchronised with the
-# robot, or a zero stamp): the latest state is used for it.
-OTHER_CLOCK = 30.0
-
-_MONITORS: weakref.WeakKeyDictionary[Any, JointStateMonitor] = weakref.WeakKeyDictionary()
-_MONITORS_LOCK = threading.Lock()
+if TYPE_CHECKING:
+    from kinema.behaviors import BehaviorContext
+    from kinema.motion.joint_state_monitor import JointStateMonitor
 
 
-class JointStateMonitor:
-    """Keeps the latest ``/joint_states`` message, and the last few seconds of them for lookups at a stamp.
+def joint_state_monitor(context: BehaviorContext, behavior: str = "") -> JointStateMonitor:
+    """The monitor shared by every behavior of ``context``.
 
-    Args:
-        node: the transport node to subscribe on.
-        topic: the joint state topic.
+    Raises:
+        ObjectiveError: the context has no transport node (it names ``behavior``).
     """
-
-    def __init__(self, node: Any, topic: str = JOINT_STATES_TOPIC) -> None:
-        self.topic = topic
-        self._latest: Any = None
-        self._received_at = 0.0
-        self._stamps: deque[float] = deque(maxlen=HISTORY)
-        self._history: deque[Any] = deque(maxlen=HISTORY)
-        self._changed = threading.Condition()
-        self._subscription = node.create_subscription(JOINT_STATES_TYPE, topic, self._on_message)
-
-    def _on_message(self, message: Any) -> None:
-        stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
-        with self._changed:
-            self._latest = message
-            self._received_at = time.monotonic()
-            if self._stamps and stamp < self._stamps[-1]:
-                # The clock went back (a reset simulation): the old history is another timeline.
-                self._stamps.clear()
-                self._history.clear()
-            self._stamps.append(stamp)
-            self._history.append(message)
-            self._changed.notify_all()
-
-    def latest(self, timeout: float = 2.0) -> Any:
-        """The latest message; waits up to ``timeout`` s for the first one.
-
-        Raises:
-            ObjectiveError: nothing was received within ``timeout`` (no driver running).
-        """
-        with self._changed:
-            if self._latest is None and not self._changed.wait_for(lambda: self._latest is not None, timeout):
-                raise ObjectiveError(
-                    f"no joint state received on {self.topic} within {timeout:g} s; is the robot driver "
-                    "running (`kinema run`)?"
-                )
-            return self._latest
-
-    def fresh(self, timeout: float = 2.0) -> Any:
-        """The next message received from now on (a state at least as new as this call)."""
-        with self._changed:
-            since = self._received_at
-            if not self._changed.wait_for(lambda: self._received_at > since, timeout):
-                raise ObjectiveError(
-                    f"no joint state received on {self.topic} within {timeout:g} s; is the robot driver "
-                    "running (`kinema run`)?"
-                )
-            return self._latest
-
-    def positions(self, joint_names: Sequence[str], timeout: float = 2.0) -> np.ndarray:
-        """Latest positions of ``joint_names``, in that order.
-
-        Raises:
-            ObjectiveError: no message yet, or a joint is missing from it.
-        """
-        return self._named(self.latest(timeout), joint_names)
-
-    def positions_at(self, joint_names: Sequence[str], stamp: float, timeout: float = 2.0) -> np.ndarray:
-        """Positions of ``joint_names`` at ``stamp`` (s, the robot's clock), as TF looks up a transform at a
-        message's stamp: a camera frame is placed where the camera was when it was taken, not where it
-        is when the frame is read (the arm may have moved on, or the newest joint state may still be on
-        its way on a loaded machine).
-
-        Waits up to ``timeout`` for a state stamped at or after ``stamp``, then interpolates between the
-        two states around it. A stamp of 0, on another clock (more than 30 s from the robot's) or older
-        than the history gets the latest or the oldest kept state.
-
-        Raises:
-            ObjectiveError: no message yet, or a joint is missing from it.
-        """
-        self.latest(timeout)
-        if stamp <= 0:
-            return self.positions(joint_names, timeout)
-        with self._changed:
-            newest = self._stamps[-1]
-            if abs(stamp - newest) > OTHER_CLOCK:
-                return self._named(self._latest, joint_names)
-            self._changed.wait_for(lambda: self._stamps[-1] >= stamp, timeout)
-            stamps, history = list(self._stamps), list(self._history)
-        after = bisect.bisect_left(stamps, stamp)
-        if after >= len(stamps):
-            return self._named(history[-1], joint_names)
-        if after == 0 or stamps[after] == stamp:
-            return self._named(history[after], joint_names)
-        t0, t1 = stamps[after - 1], stamps[after]
-        q0, q1 = self._named(history[after - 1], joint_names), self._named(history[after], joint_names)
-        return q0 + (q1 - q0) * ((stamp - t0) / (t1 - t0))
-
-    def _named(self, message: Any, joint_names: Sequence[str]) -> np.ndarray:
-        index = {str(name): i for i, name in enumerate(message.name)}
-        missing = [name for name in joint_names if name not in index]
-        if missing:
-            raise ObjectiveError(
-                f"{self.topic} does not report joint(s) {', '.join(missing)} "
-                f"(it reports {', '.join(index) or 'none'})"
-            )
-        return np.array([float(message.position[index[name]]) for name in joint_names])
-
-    def close(self) -> None:
-        """Stop listening."""
-        self._subscription.close()
-
-
-def joint_state_monitor(context: Any, behavior: str = "") -> JointStateMonitor:
-    """The monitor shared by every behavior of ``context`` (created on first use)."""
-    node = context.require_node(behavior)
-    with _MONITORS_LOCK:
-        monitor = _MONITORS.get(context)
-        if monitor is None:
-            monitor = JointStateMonitor(node)
-            _MONITORS[context] = monitor
-        return monitor
+    context.require_node(behavior)
+    return context.joint_states

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from kinema.behaviors import ActionClientBehavior, PortInfo, input_port
+from kinema.behaviors.cell_ports import cell_input_port
 
 
 class MoveGripperAction(ActionClientBehavior["control_msgs/action/GripperCommand"]):
@@ -19,13 +20,19 @@ class MoveGripperAction(ActionClientBehavior["control_msgs/action/GripperCommand
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
         return [
-            input_port(
+            cell_input_port(
                 "gripper_command_action_name",
                 str,
-                "/robotiq_gripper_controller/gripper_cmd",
+                "gripper_action",
                 "The GripperCommand action of the gripper controller.",
             ),
-            input_port("position", float, 0.0, "Target position (lab_sim: 0 open, 0.7929 closed)."),
+            input_port(
+                "position",
+                float,
+                0.0,
+                "Target position of the gripper joint (m or rad; the config's robot.gripper says where "
+                "open and closed are).",
+            ),
             input_port("max_effort", float, 0.0, "Effort limit (0: the controller's default)."),
             input_port("timeout", float, 10.0, "Seconds to wait for the gripper to finish."),
         ]

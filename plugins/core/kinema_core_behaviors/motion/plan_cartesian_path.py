@@ -7,7 +7,9 @@ from typing import Any
 import numpy as np
 
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
+from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError, ObjectiveError, did_you_mean
+from kinema.transforms import rotation_from_euler
 
 from ..messages.conversions import pose_matrix, trajectory_message
 from .joint_states import joint_state_monitor
@@ -35,9 +37,13 @@ class PlanCartesianPath(AsyncBehavior):
             input_port(
                 "path", None, "{path}", "Poses to pass through (a list of geometry_msgs/PoseStamped)."
             ),
-            input_port("planning_group_name", str, "manipulator", "The planning group that moves."),
+            cell_input_port("planning_group_name", str, "planning_group", "The planning group that moves."),
             input_port(
-                "tip_links", list[str], "", "The tool frame that follows the path ('': the group's tip)."
+                "tip_links",
+                list[str],
+                "",
+                "The tool frame that follows the path ('': the config's robot.tool_frame, else the "
+                "group's tip).",
             ),
             input_port(
                 "position_only", bool, False, "Follow the positions only, leave the orientation free."
@@ -119,7 +125,9 @@ class PlanCartesianPath(AsyncBehavior):
             tips = [t.strip() for t in self.get_input_or("tip_links", []) if t.strip()]
             if len(tips) > 1:
                 return self._fail(f"one tip link at a time is supported, got {', '.join(tips)}")
-            tip = tips[0] if tips else model.group(group).tip_link
+            cell = self.context.cell
+            tip = tips[0] if tips else (cell.tool_frame if cell and cell.tool_frame else None)
+            tip = tip or model.group(group).tip_link
             timing = self._timing()
             if timing is not None:
                 return self._fail(timing)
@@ -133,7 +141,9 @@ class PlanCartesianPath(AsyncBehavior):
             if not radius >= 0:
                 return self._fail(f"blending_radius must be >= 0 (m), got {radius}")
             poses = self._poses()
-            start = joint_state_monitor(self.context, "PlanCartesianPath").positions(model.joint_names)
+            start = joint_state_monitor(self.context, "PlanCartesianPath").current_positions(
+                model.joint_names, self.context.clock
+            )
             targets = []
             for frame, matrix in poses:
                 world_T_point = matrix if frame in WORLD_FRAMES else fk(model, start, frame) @ matrix
@@ -190,15 +200,13 @@ class PlanCartesianPath(AsyncBehavior):
 
     def _tip_offset(self) -> Any:
         """``tip_T_point`` inverted (what the tip must do so the offset point follows the path)."""
-        from scipy.spatial.transform import Rotation
-
         values = [float(v) for v in self.get_input("tip_offset")]
         if len(values) not in (3, 6):
             return f"tip_offset needs 6 values x;y;z;roll;pitch;yaw (or 3, x;y;z), got {len(values)}"
         tip_T_point = np.eye(4)
         tip_T_point[:3, 3] = values[:3]
         if len(values) == 6:
-            tip_T_point[:3, :3] = Rotation.from_euler("xyz", values[3:]).as_matrix()
+            tip_T_point[:3, :3] = rotation_from_euler(values[3:])
         return np.linalg.inv(tip_T_point)
 
     def _poses(self) -> list[tuple[str, Any]]:

@@ -5,6 +5,7 @@ from __future__ import annotations
 from typing import Any
 
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
+from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError, did_you_mean
 
 from ..messages.conversions import joint_positions, trajectory_message
@@ -42,7 +43,7 @@ class PlanToJointGoal(AsyncBehavior):
             input_port(
                 "joint_goal", None, "{target_joint_state}", "Goal joint state (sensor_msgs/JointState)."
             ),
-            input_port("planning_group_name", str, "manipulator", "The planning group that moves."),
+            cell_input_port("planning_group_name", str, "planning_group", "The planning group that moves."),
             input_port("link_padding", float, 0.01, "Clearance (m) kept between the robot and the scene."),
             input_port(
                 "velocity_scale_factor", float, 1.0, "Fraction of the joints' velocity limits, (0, 1]."
@@ -91,7 +92,9 @@ class PlanToJointGoal(AsyncBehavior):
                 )
             if not goal:
                 return self._fail("joint_goal names no joint")
-            start = joint_state_monitor(self.context, "PlanToJointGoal").positions(model.joint_names)
+            start = joint_state_monitor(self.context, "PlanToJointGoal").current_positions(
+                model.joint_names, self.context.clock
+            )
             checker = collision_checker(self.context, "PlanToJointGoal", padding)
             options = PlanningOptions(planner=planner, timeout=float(self.get_input("planning_time")))
             path = plan_joint_goal(checker, start, goal, group, options)

@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from kinema.viz.topics import PLANNED_TRAJECTORY_TOPIC, PLANNED_TRAJECTORY_TYPE
+from kinema.ui_topics import PLANNED_TRAJECTORY_TOPIC, PLANNED_TRAJECTORY_TYPE
 
 
 def publish_planned_trajectory(behavior: Any, message: Any) -> None:

@@ -7,6 +7,7 @@ from typing import Any
 import numpy as np
 
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
+from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError, did_you_mean
 
 from ..messages.conversions import TRAJECTORY_TYPE, trajectory_from_message
@@ -38,8 +39,11 @@ class ValidateTrajectory(AsyncBehavior):
             message_input(
                 "joint_trajectory_msg", TRAJECTORY_TYPE, "{joint_trajectory_msg}", "The trajectory to check."
             ),
-            input_port(
-                "planning_group_name", str, "manipulator", "The group whose tip the Cartesian step measures."
+            cell_input_port(
+                "planning_group_name",
+                str,
+                "planning_group",
+                "The group whose tip the Cartesian step measures.",
             ),
             input_port(
                 "joint_space_step", float, 0.1, "Largest joint change between checked states (rad or m)."

@@ -17,6 +17,7 @@ import numpy as np
 
 from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import PerceptionError
+from kinema.transforms import pose_dict, pose_from_message
 
 from ..files.image_file import image_pixels
 from ..messages.conversions import pose_stamped_message
@@ -35,17 +36,6 @@ DETECTIONS = "vision_msgs/msg/Detection3DArray"
 POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 # A decision margin this high (or more) is scored 1.0; the library's margins run to a few hundred.
 _FULL_MARGIN = 100.0
-
-
-def _pose_dict(matrix: np.ndarray) -> dict[str, Any]:
-    from scipy.spatial.transform import Rotation
-
-    x, y, z, w = Rotation.from_matrix(matrix[:3, :3]).as_quat()
-    px, py, pz = (float(v) for v in matrix[:3, 3])
-    return {
-        "position": {"x": px, "y": py, "z": pz},
-        "orientation": {"x": float(x), "y": float(y), "z": float(z), "w": float(w)},
-    }
 
 
 def detections_message(detections: list[Any], header: Any, tag_size: float) -> Any:
@@ -67,11 +57,11 @@ def detections_message(detections: list[Any], header: Any, tag_size: float) -> A
                                 "class_id": tag.family,
                                 "score": min(1.0, tag.decision_margin / _FULL_MARGIN),
                             },
-                            "pose": {"pose": _pose_dict(tag.camera_T_tag)},
+                            "pose": {"pose": pose_dict(tag.camera_T_tag)},
                         }
                     ],
                     "bbox": {
-                        "center": _pose_dict(tag.camera_T_tag),
+                        "center": pose_dict(tag.camera_T_tag),
                         "size": {"x": tag_size, "y": tag_size, "z": 0.0},
                     },
                 }
@@ -223,14 +213,7 @@ class GetDetectionPose(SyncBehavior):
             return NodeStatus.FAILURE
         _score, detection, result = max(candidates, key=lambda item: item[0])
         frame = str(detection.header.frame_id) or str(detections.header.frame_id)
-        pose = result.pose.pose
-        matrix = np.eye(4)
-        from scipy.spatial.transform import Rotation
-
-        q = pose.orientation
-        matrix[:3, :3] = Rotation.from_quat([q.x, q.y, q.z, q.w]).as_matrix()
-        matrix[:3, 3] = [pose.position.x, pose.position.y, pose.position.z]
-        message = pose_stamped_message(frame, matrix)
+        message = pose_stamped_message(frame, pose_from_message(result.pose.pose))
         message.header.stamp = detection.header.stamp
         self.set_output("detection_pose", message)
         return NodeStatus.SUCCESS

@@ -17,6 +17,7 @@ import time
 from typing import Any, ClassVar
 
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port
+from kinema.behaviors.cell_ports import cell_input_port
 
 from ..messages.ports import fails_on_bad_input, message_output, port_error, read_input
 from .clouds import CAMERA_INFO, IMAGE, POINT_CLOUD
@@ -35,7 +36,7 @@ def taken_since(message: Any, start: float) -> bool:
 
 class _GetCameraMessage(AsyncBehavior):
     message_type: ClassVar[str] = ""
-    default_topic: ClassVar[str] = ""
+    default_topic_key: ClassVar[str] = ""
     default_output: ClassVar[str] = ""
     # Only messages stamped since the subscription (a frame, not a camera's constant intrinsics).
     taken_now: ClassVar[bool] = True
@@ -44,7 +45,7 @@ class _GetCameraMessage(AsyncBehavior):
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
         return [
-            input_port("topic_name", str, cls.default_topic, "The topic to take a message from."),
+            cell_input_port("topic_name", str, cls.default_topic_key, "The topic to take a message from."),
             input_port(
                 "message_timeout_sec",
                 float,
@@ -125,15 +126,15 @@ class _GetCameraMessage(AsyncBehavior):
 class GetPointCloud(_GetCameraMessage):
     """Waits for the next ``sensor_msgs/PointCloud2`` on ``topic_name`` and writes it to ``message_out``.
 
-    lab_sim's cameras publish ``/scene_camera/points`` and ``/wrist_camera/points`` (organised clouds in
-    the camera's optical frame). Fails when nothing publishes on the topic within
+    Simulated cameras publish ``/<camera>/points`` (organised clouds in the camera's optical frame; lab_sim:
+    ``/scene_camera/points`` and ``/wrist_camera/points``). Fails when nothing publishes on the topic within
     ``publisher_timeout_sec`` (naming the topics that carry clouds) or no cloud comes within
     ``message_timeout_sec``. The cloud must be stamped at or after the moment the behavior subscribed: a
     frame rendered before the last motion, still on its way, is skipped.
     """
 
     message_type = POINT_CLOUD
-    default_topic = "/wrist_camera/points"
+    default_topic_key = "camera_points_topic"  # the config's camera: /<robot.default_camera>/points
     default_output = "{point_cloud}"
     subcategory = "Perception - 3D Point Cloud"
 
@@ -145,7 +146,7 @@ class GetImage(_GetCameraMessage):
     """
 
     message_type = IMAGE
-    default_topic = "/wrist_camera/color"
+    default_topic_key = "camera_color_topic"
     default_output = "{image}"
     subcategory = "Perception - 2D Image"
 
@@ -155,6 +156,6 @@ class GetCameraInfo(_GetCameraMessage):
 
     message_type = CAMERA_INFO
     taken_now = False
-    default_topic = "/wrist_camera/camera_info"
+    default_topic_key = "camera_info_topic"
     default_output = "{camera_info}"
     subcategory = "Perception - 2D Image"

@@ -88,10 +88,13 @@ class FindMaskedObjects(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        from kinema.motion.planning_scene_messages import collision_object_message, shape_constants
         from kinema.perception.ros_messages import intrinsics_of
         from kinema.transport import from_dict
 
         from ..messages.conversions import pose_stamped_message
+
+        box, add = shape_constants().BOX, collision_object_message().ADD
 
         cloud = read_cloud(self, "point_cloud")
         camera = intrinsics_of(read_message(self, "camera_info", CAMERA_INFO))
@@ -129,9 +132,9 @@ class FindMaskedObjects(SyncBehavior):
                         "object": {
                             "header": {"frame_id": base},
                             "id": f"object_{index}",
-                            "primitives": [{"type": 1, "dimensions": [float(v) for v in size]}],
+                            "primitives": [{"type": box, "dimensions": [float(v) for v in size]}],
                             "primitive_poses": [stamped.pose],
-                            "operation": 0,
+                            "operation": add,
                         },
                         "object_color": {"r": 0.2, "g": 0.6, "b": 0.9, "a": 1.0},
                         "grasp_info": "",

@@ -25,6 +25,7 @@ import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import KinemaError
+from kinema.transforms import pose_from_message
 
 from ..files.image_file import image_message, image_pixels
 from ..messages.conversions import POSE_STAMPED_TYPE, pose_stamped_message
@@ -62,17 +63,6 @@ def place_poses_in_tag_frame(
         pose[:3, 3] = [x, tag_to_center + y, 0.0]
         poses.append(pose)
     return poses
-
-
-def _matrix_of(pose: Any) -> np.ndarray:
-    from scipy.spatial.transform import Rotation
-
-    q = pose.orientation
-    matrix = np.eye(4)
-    quaternion = np.array([q.x, q.y, q.z, q.w], dtype=float)
-    matrix[:3, :3] = Rotation.from_quat(quaternion / max(np.linalg.norm(quaternion), 1e-12)).as_matrix()
-    matrix[:3, 3] = [pose.position.x, pose.position.y, pose.position.z]
-    return matrix
 
 
 class ComputeTrayPlacePositionsUsingAprilTags(SyncBehavior):
@@ -171,7 +161,7 @@ class ComputeTrayPlacePositionsUsingAprilTags(SyncBehavior):
             if str(detection.id).strip() == str(tag_id) and detection.results:
                 best = max(detection.results, key=lambda r: float(r.hypothesis.score))
                 frame = str(detection.header.frame_id) or str(detections.header.frame_id)
-                return frame, detection.header.stamp, _matrix_of(best.pose.pose)
+                return frame, detection.header.stamp, pose_from_message(best.pose.pose)
         seen = ", ".join(str(d.id) for d in detections.detections) or "none"
         raise port_error(
             self,

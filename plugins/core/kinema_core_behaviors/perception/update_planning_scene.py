@@ -17,7 +17,7 @@ from kinema.errors import KinemaError
 
 from ..messages.ports import fails_on_bad_input, message_input, read_input
 from ..motion.joint_states import joint_state_monitor
-from ..motion.planning_resources import collision_checker, planning_scene, robot_model
+from ..motion.planning_resources import collision_checker, robot_model
 from .clouds import POINT_CLOUD, frame_of, read_cloud, target_T_source
 
 OCTOMAP_ID = "octomap"
@@ -65,7 +65,7 @@ class UpdatePlanningSceneService(AsyncBehavior):
         cells = occupied_cells(world.points, OCTOMAP_RESOLUTION, MIN_POINTS)
         try:
             model = robot_model(self.context, "UpdatePlanningSceneService")
-            scene = planning_scene(self.context, model)
+            scene = self.context.planning_scene
             q = joint_state_monitor(self.context, "UpdatePlanningSceneService").positions(model.joint_names)
             checker = collision_checker(self.context, "UpdatePlanningSceneService", 0.0)
             robot = checker.robot_bounds(q)

@@ -9,7 +9,7 @@ from kinema.errors import KinemaError
 
 from ..messages.conversions import POSE_STAMPED_TYPE, pose_matrix
 from ..messages.ports import fails_on_bad_input, message_input, port_error, read_floats, read_message
-from ..motion.planning_resources import planning_scene, robot_model
+from ..motion.planning_resources import robot_model
 from ..poses.frame_tree import current_frame_tree
 
 
@@ -49,14 +49,14 @@ class AddCollisionBox(SyncBehavior):
             raise port_error(self, "dimensions", f"= {size}", "each size must be > 0 m")
         frame, matrix = pose_matrix(read_message(self, "pose"), "pose")
         try:
-            model = robot_model(self.context, "AddCollisionBox")
+            robot_model(self.context, "AddCollisionBox")
             world_T_box = (
                 matrix
                 if frame in ("", "world")
                 else current_frame_tree(self).transform(matrix, frame, "world")
             )
             box = CollisionObject(object_id, "box", tuple(0.5 * v for v in size), world_T_box)
-            planning_scene(self.context, model).add_world_object(
+            self.context.planning_scene.add_world_object(
                 object_id, [box], replace=bool(self.get_input("overwrite"))
             )
         except KinemaError as error:

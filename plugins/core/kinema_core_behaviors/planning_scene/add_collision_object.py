@@ -4,13 +4,16 @@ from __future__ import annotations
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import KinemaError
+from kinema.motion.planning_scene_messages import (
+    COLLISION_OBJECT_TYPE,
+    collision_object_message,
+    object_pose_of,
+    primitives_of,
+)
 
 from ..messages.ports import PortValueError, fails_on_bad_input, message_input, port_error, read_message
-from ..motion.planning_resources import planning_scene, robot_model
+from ..motion.planning_resources import robot_model
 from ..poses.frame_tree import current_frame_tree
-from .scene_messages import ADD, APPEND, COLLISION_OBJECT_TYPE, MOVE, REMOVE, object_pose_of, primitives_of
-
-OPERATIONS = "ADD (0), REMOVE (1), APPEND (2), MOVE (3)"
 
 
 class AddCollisionObject(SyncBehavior):
@@ -42,26 +45,28 @@ class AddCollisionObject(SyncBehavior):
         if not object_id:
             raise port_error(self, "collision_object", "has an empty id", "set the message's id field")
         operation = int(message.operation)
+        ops = collision_object_message()
+        valid = ", ".join(f"{op} ({getattr(ops, op)})" for op in ("ADD", "REMOVE", "APPEND", "MOVE"))
         try:
-            model = robot_model(self.context, "AddCollisionObject")
-            scene = planning_scene(self.context, model)
-            if operation not in (ADD, REMOVE, APPEND, MOVE):
+            robot_model(self.context, "AddCollisionObject")
+            scene = self.context.planning_scene
+            if operation not in (ops.ADD, ops.REMOVE, ops.APPEND, ops.MOVE):
                 raise port_error(
-                    self, "collision_object", f"has operation {operation}", f"valid operations: {OPERATIONS}"
+                    self, "collision_object", f"has operation {operation}", f"valid operations: {valid}"
                 )
-            if operation == REMOVE:
+            if operation == ops.REMOVE:
                 scene.remove_world_object(object_id)
                 return NodeStatus.SUCCESS
             frame = str(message.header.frame_id)
             frames = None if frame in ("", "world") else current_frame_tree(self)
-            if operation == MOVE:
+            if operation == ops.MOVE:
                 if len(message.primitives) or len(message.meshes) or len(message.planes):
                     self.logger.publish_warn(
                         f"AddCollisionObject: MOVE of {object_id!r} ignores the shapes in the message"
                     )
                 scene.move_world_object(object_id, object_pose_of(message, frames))
                 return NodeStatus.SUCCESS
-            if operation == APPEND:
+            if operation == ops.APPEND:
                 scene.append_to_world_object(
                     object_id, primitives_of(message, frames), object_pose_of(message, frames)
                 )

@@ -4,11 +4,11 @@ from __future__ import annotations
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior
 from kinema.errors import KinemaError
+from kinema.motion.planning_scene_messages import PLANNING_SCENE_TYPE, planning_scene_message
 
 from ..messages.ports import message_output
 from ..motion.joint_states import joint_state_monitor
-from ..motion.planning_resources import planning_scene, robot_model
-from .scene_messages import PLANNING_SCENE_TYPE, planning_scene_message
+from ..motion.planning_resources import robot_model
 
 
 class GetCurrentPlanningScene(SyncBehavior):
@@ -32,7 +32,7 @@ class GetCurrentPlanningScene(SyncBehavior):
     def tick(self) -> NodeStatus:
         try:
             model = robot_model(self.context, "GetCurrentPlanningScene")
-            scene = planning_scene(self.context, model)
+            scene = self.context.planning_scene
         except KinemaError as error:
             self.logger.publish_failure(f"GetCurrentPlanningScene: {error}")
             return NodeStatus.FAILURE

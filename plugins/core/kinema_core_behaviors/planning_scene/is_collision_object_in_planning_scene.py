@@ -3,9 +3,9 @@
 from __future__ import annotations
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
+from kinema.motion.planning_scene_messages import PLANNING_SCENE_TYPE
 
 from ..messages.ports import fails_on_bad_input, message_input, read_message
-from .scene_messages import PLANNING_SCENE_TYPE
 
 
 class IsCollisionObjectInPlanningScene(SyncBehavior):

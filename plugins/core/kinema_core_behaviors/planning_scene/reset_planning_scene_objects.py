@@ -5,7 +5,7 @@ from __future__ import annotations
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import KinemaError
 
-from ..motion.planning_resources import planning_scene, robot_model
+from ..motion.planning_resources import robot_model
 
 
 class ResetPlanningSceneObjects(SyncBehavior):
@@ -31,7 +31,8 @@ class ResetPlanningSceneObjects(SyncBehavior):
 
     def tick(self) -> NodeStatus:
         try:
-            planning_scene(self.context, robot_model(self.context, "ResetPlanningSceneObjects")).reset_world()
+            robot_model(self.context, "ResetPlanningSceneObjects")
+            self.context.planning_scene.reset_world()
         except KinemaError as error:
             self.logger.publish_failure(f"ResetPlanningSceneObjects: {error}")
             return NodeStatus.FAILURE

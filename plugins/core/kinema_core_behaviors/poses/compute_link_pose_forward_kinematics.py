@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
+from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError
 
 from ..messages.conversions import JOINT_STATE_TYPE, POSE_STAMPED_TYPE, pose_stamped_message
@@ -26,7 +27,7 @@ class ComputeLinkPoseForwardKinematics(SyncBehavior):
     def provided_ports(cls) -> list[PortInfo]:
         return [
             message_input("joint_state", JOINT_STATE_TYPE, "{joint_state}", "The robot's joint positions."),
-            input_port("link_name", str, "grasp_link", "The link whose pose to compute."),
+            cell_input_port("link_name", str, "tool_frame", "The link whose pose to compute."),
             input_port(
                 "planning_scene",
                 None,

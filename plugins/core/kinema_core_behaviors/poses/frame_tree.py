@@ -1,92 +1,19 @@
-"""The frame tree a behavior sees now: robot links at the current joint state, simulated objects, cameras
-and planning-scene objects (:class:`kinema.motion.FrameTree` filled from the running cell).
-
-- robot links: the latest ``/joint_states`` through the robot model (``world``, ``base_link``, ``tool0``,
-  ``grasp_link``, ...);
-- simulated objects: the MuJoCo driver's free bodies (``/mujoco/bodies``), when a simulator runs;
-- cameras: the cameras of the config's MuJoCo scene that are fixed in the world (``scene_camera``), in
-  MuJoCo's camera convention (looking along -z, y up);
-- planning-scene objects: each world object's first primitive, under the object's id.
+"""The frame tree a behavior sees now: robot links at the current joint state (the latest ``/joint_states``
+through the robot model: ``world``, ``base_link``, ``tool0``, ``grasp_link``, ...), and the cell's other
+frames, ``context.frames`` (:class:`kinema.motion.cell_frames.CellFrames`: cameras, simulated objects,
+planning-scene objects).
 """
 
 from __future__ import annotations
 
-import threading
-import weakref
 from typing import Any
 
 import numpy as np
 
-import kinema.mujoco_gl  # noqa: F401  (MuJoCo's OpenGL backend is chosen before the lazy mujoco import below)
 from kinema.errors import KinemaError, ObjectiveError
 
 from ..motion.joint_states import joint_state_monitor
-from ..motion.planning_resources import planning_scene, robot_model
-
-BODIES_SERVICE = "/mujoco/bodies"
-BODIES_TYPE = "kinema_msgs/srv/GetSimBodies"
-# A simulator answers within milliseconds; a real robot has none, and the tree must not wait for it.
-BODIES_TIMEOUT = 1.0
-
-_CAMERAS: weakref.WeakKeyDictionary[Any, dict[str, np.ndarray]] = weakref.WeakKeyDictionary()
-_LOCK = threading.Lock()
-
-
-def pose_of(position: Any, orientation: Any) -> np.ndarray:
-    """4x4 from a position (x, y, z) and a quaternion (x, y, z, w)."""
-    from scipy.spatial.transform import Rotation
-
-    matrix = np.eye(4)
-    quaternion = np.array([orientation.x, orientation.y, orientation.z, orientation.w], dtype=float)
-    if np.linalg.norm(quaternion) > 1e-9:
-        matrix[:3, :3] = Rotation.from_quat(quaternion).as_matrix()
-    matrix[:3, 3] = [position.x, position.y, position.z]
-    return matrix
-
-
-def _camera_frames(context: Any) -> dict[str, np.ndarray]:
-    """World-fixed cameras of the config's MuJoCo scene (cached per context)."""
-    with _LOCK:
-        cached = _CAMERAS.get(context)
-        if cached is not None:
-            return cached
-    frames: dict[str, np.ndarray] = {}
-    config = getattr(context, "config", None)
-    path = getattr(config, "mujoco_model_path", None) if config is not None else None
-    if path is not None:
-        import mujoco
-
-        try:
-            model = mujoco.MjModel.from_xml_path(str(path))
-        except ValueError:
-            model = None
-        if model is not None:
-            data = mujoco.MjData(model)
-            mujoco.mj_forward(model, data)  # camera poses come from mj_camlight, which this runs
-            for index in range(model.ncam):
-                name = model.camera(index).name
-                if name and int(model.body_weldid[model.cam_bodyid[index]]) == 0:
-                    matrix = np.eye(4)
-                    matrix[:3, :3] = data.cam_xmat[index].reshape(3, 3)
-                    matrix[:3, 3] = data.cam_xpos[index]
-                    frames[name] = matrix
-    with _LOCK:
-        _CAMERAS[context] = frames
-    return frames
-
-
-def _sim_bodies(behavior: Any) -> dict[str, np.ndarray]:
-    node = behavior.context.node
-    if node is None:
-        return {}
-    try:
-        client = behavior.context.service_client(node, BODIES_TYPE, BODIES_SERVICE)
-        if not client.service_is_ready():
-            return {}  # no simulator on the graph (a real robot): objects come from perception instead
-        response = client.call({}, timeout=BODIES_TIMEOUT)
-    except KinemaError:
-        return {}  # no simulator (a real robot): objects come from perception instead
-    return {str(body.name): pose_of(body.pose.position, body.pose.orientation) for body in response.bodies}
+from ..motion.planning_resources import robot_model
 
 
 def current_frame_tree(behavior: Any, joint_state: Any = None, at: float = 0.0) -> Any:
@@ -103,20 +30,13 @@ def current_frame_tree(behavior: Any, joint_state: Any = None, at: float = 0.0) 
     Raises:
         ObjectiveError: no robot model, or no joint state to place the robot.
     """
-    from kinema.motion import FrameTree
-
     name = getattr(behavior, "registration_id", type(behavior).__name__)
     model = robot_model(behavior.context, name)
     if joint_state is None:
         q = joint_state_monitor(behavior.context, name).positions_at(model.joint_names, at)
     else:
         q = _positions_from(behavior, model, joint_state)
-    fixed: dict[str, np.ndarray] = dict(_camera_frames(behavior.context))
-    fixed.update(_sim_bodies(behavior))
-    for object_id, primitives in planning_scene(behavior.context, model).world_objects().items():
-        if primitives:
-            fixed[object_id] = primitives[0].world_T_object
-    return FrameTree(model, q, fixed)
+    return behavior.context.frames.tree(q)
 
 
 def _positions_from(behavior: Any, model: Any, joint_state: Any) -> np.ndarray:

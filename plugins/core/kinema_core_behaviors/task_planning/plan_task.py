@@ -83,7 +83,9 @@ class PlanMTCTask(AsyncBehavior):
                     f"max_solutions must be at least 1, got {self.get_input('max_solutions')}", progress
                 )
             model = robot_model(self.context, "PlanMTCTask")
-            q = joint_state_monitor(self.context, "PlanMTCTask").positions(model.joint_names)
+            q = joint_state_monitor(self.context, "PlanMTCTask").current_positions(
+                model.joint_names, self.context.clock
+            )
             tree = current_frame_tree(self)
             robot_frames = {frame.name for frame in model.pin_model.frames}
             fixed = {n: tree.world_T(n) for n in tree.names() if n not in robot_frames and n != "world"}

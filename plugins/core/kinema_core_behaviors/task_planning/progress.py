@@ -12,7 +12,7 @@ import time
 from collections.abc import Sequence
 from typing import Any
 
-from kinema.runtime.names import TASK_PLANNING, TASK_PLANNING_TYPE
+from kinema.ui_topics import TASK_PLANNING_TOPIC, TASK_PLANNING_TYPE
 
 #: Seconds between messages while nothing changes but the running stage's time.
 REFRESH_PERIOD_S = 0.25
@@ -28,7 +28,9 @@ class TaskProgress:
     def __init__(self, behavior: Any, task_id: str, node_path: str) -> None:
         node = behavior.context.node
         self._publisher = (
-            None if node is None else behavior.context.publisher(node, TASK_PLANNING_TYPE, TASK_PLANNING)
+            None
+            if node is None
+            else behavior.context.publisher(node, TASK_PLANNING_TYPE, TASK_PLANNING_TOPIC)
         )
         self.task_id = task_id
         self.node_path = node_path

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, bidirectional_port, input_port, output_port
+from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError
 
 from ..messages.conversions import joint_positions, pose_matrix
@@ -44,7 +45,9 @@ class MotionPorts:
     padding: float = 0.01
 
     def ports(self) -> list[PortInfo]:
-        ports = [input_port("planning_group_name", str, "manipulator", "The planning group that moves.")]
+        ports = [
+            cell_input_port("planning_group_name", str, "planning_group", "The planning group that moves.")
+        ]
         if self.velocity:
             ports.append(
                 input_port(self.velocity, float, 1.0, "Fraction of the joints' velocity limits, (0, 1].")
@@ -204,7 +207,7 @@ class SetupMTCPlanToPose(_SetupStage):
             message_input(
                 "target_pose", "geometry_msgs/msg/PoseStamped", "{target_pose}", "Where ik_frame goes."
             ),
-            input_port("ik_frame", str, "grasp_link", "The robot frame placed at the target pose."),
+            cell_input_port("ik_frame", str, "tool_frame", "The robot frame placed at the target pose."),
             input_port(
                 "monitored_stage",
                 str,
@@ -259,11 +262,11 @@ class SetupMTCMoveAlongFrameAxis(_SetupStage):
     @classmethod
     def stage_ports(cls) -> list[PortInfo]:
         return [
-            input_port("axis_frame", str, "grasp_link", "The frame the axis is given in."),
+            cell_input_port("axis_frame", str, "tool_frame", "The frame the axis is given in."),
             input_port("axis_x", float, 0.0, "Axis x component."),
             input_port("axis_y", float, 0.0, "Axis y component."),
             input_port("axis_z", float, 1.0, "Axis z component."),
-            input_port("hand_frame", str, "grasp_link", "The robot frame that moves along the axis."),
+            cell_input_port("hand_frame", str, "tool_frame", "The robot frame that moves along the axis."),
             input_port("min_distance", float, 0.1, "Least distance (m) the motion must cover."),
             input_port("max_distance", float, 0.1, "Distance (m) to cover when reachable."),
             input_port(
@@ -304,8 +307,8 @@ class SetupMTCBatchPoseIK(_SetupStage):
             message_vector_input(
                 "target_poses", "geometry_msgs/msg/PoseStamped", "{target_poses}", "Candidate poses."
             ),
-            input_port("ik_group", str, "manipulator", "The planning group IK moves."),
-            input_port("end_effector_link", str, "grasp_link", "The robot frame placed at a pose."),
+            cell_input_port("ik_group", str, "planning_group", "The planning group IK moves."),
+            cell_input_port("end_effector_link", str, "tool_frame", "The robot frame placed at a pose."),
             input_port(
                 "end_effector_group",
                 str,

@@ -25,11 +25,10 @@ from typing import Any
 
 from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, StatefulBehavior, input_port
 from kinema.errors import KinemaError, TransportError
+from kinema.ui_topics import APPROVAL_SERVICE, APPROVAL_TYPE
 
 from ..task_planning.solution_summary import show_solution, solution_steps
 
-APPROVAL_SERVICE = "/kinema/user_approval"
-APPROVAL_TYPE = "kinema_msgs/srv/RequestApproval"
 AUTO_APPROVE_ENV = "KINEMA_AUTO_APPROVE"
 # How long IsUserAvailable looks for the UI's service on the graph.
 DISCOVERY_SECONDS = 0.5

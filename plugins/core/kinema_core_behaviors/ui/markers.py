@@ -7,6 +7,7 @@ from typing import Any
 
 import numpy as np
 
+from kinema import transforms
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
 from ..files.locations import file_to_read, split_package_uri
@@ -33,16 +34,9 @@ def publish_markers(behavior: Any, markers: list[dict[str, Any]]) -> None:
 
 
 def pose_dict(frame_and_matrix: tuple[str, np.ndarray]) -> tuple[str, dict[str, Any]]:
-    """``(frame_id, Pose dict)`` of a 4x4 transform."""
-    from scipy.spatial.transform import Rotation
-
+    """``(frame_id, Pose dict)`` of a ``(frame_id, 4x4 transform)``."""
     frame, matrix = frame_and_matrix
-    x, y, z, w = Rotation.from_matrix(matrix[:3, :3]).as_quat()
-    px, py, pz = (float(v) for v in matrix[:3, 3])
-    return frame, {
-        "position": {"x": px, "y": py, "z": pz},
-        "orientation": {"x": float(x), "y": float(y), "z": float(z), "w": float(w)},
-    }
+    return frame, transforms.pose_dict(matrix)
 
 
 def _scales(behavior: Any, value: Any, count: int) -> list[list[float]]:

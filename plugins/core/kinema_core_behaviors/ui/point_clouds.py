@@ -13,10 +13,9 @@ from typing import Any
 
 import numpy as np
 
-from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
+from kinema.behaviors import BehaviorContext, NodeStatus, PortInfo, SyncBehavior, input_port
 
 from ..messages.ports import fails_on_bad_input, message_input, port_error, read_input, read_message
-from ..motion.planning_resources import existing_planning_scene
 from .markers import publish_markers
 
 # UpdatePlanningSceneService's world object (named here to keep ui free of the perception family).
@@ -25,7 +24,17 @@ OCTOMAP_ID = "octomap"
 POINT_CLOUD = "sensor_msgs/msg/PointCloud2"
 SNAPSHOT_NAMESPACE = "snapshot"
 MAX_DRAWN_POINTS = 20000
-_SNAPSHOT_IDS: dict[int, int] = {}
+
+
+class _Snapshots:
+    """The highest snapshot marker id drawn in a cell (-1: none), kept in its behavior context."""
+
+    def __init__(self) -> None:
+        self.last_id = -1
+
+
+def _snapshots(context: BehaviorContext) -> _Snapshots:
+    return context.shared("ui.point_cloud_snapshots", _Snapshots)
 
 
 def height_colors(xyz: np.ndarray) -> np.ndarray:
@@ -81,9 +90,9 @@ def _draw(behavior: Any, cloud: Any, *, keep_previous: bool) -> None:
         points = from_point_cloud2(cloud).finite()
     except Exception as error:
         raise port_error(behavior, "point_cloud", str(error), "") from None
-    context_key = id(behavior.context)
-    marker_id = _SNAPSHOT_IDS.get(context_key, -1) + 1 if keep_previous else 0
-    _SNAPSHOT_IDS[context_key] = marker_id
+    snapshots = _snapshots(behavior.context)
+    marker_id = snapshots.last_id + 1 if keep_previous else 0
+    snapshots.last_id = marker_id
     marker = cloud_marker(points.points, str(cloud.header.frame_id) or "world", marker_id, points.colors)
     publish_markers(behavior, [marker])
 
@@ -146,10 +155,11 @@ class ClearSnapshot(SyncBehavior):
         return []
 
     def tick(self) -> NodeStatus:
-        count = _SNAPSHOT_IDS.pop(id(self.context), -1) + 1
+        snapshots = _snapshots(self.context)
+        count, snapshots.last_id = snapshots.last_id + 1, -1
         markers = [{"ns": SNAPSHOT_NAMESPACE, "id": i, "action": 2} for i in range(max(count, 1))]
         publish_markers(self, markers)
-        scene = existing_planning_scene(self.context)
+        scene = self.context.loaded_planning_scene
         if scene is not None and OCTOMAP_ID in scene.world:
             scene.remove_world_object(OCTOMAP_ID)
         return NodeStatus.SUCCESS

@@ -8,11 +8,10 @@ import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import ObjectiveError
+from kinema.ui_topics import MARKER_ARRAY_TOPIC, MARKER_ARRAY_TYPE
 
 from ..messages.conversions import duration, pose_matrix
 
-MARKER_TOPIC = "/visualization_marker_array"
-MARKER_ARRAY_TYPE = "visualization_msgs/msg/MarkerArray"
 _AXES = ((1.0, 0.0, 0.0, 1.0), (0.0, 1.0, 0.0, 1.0), (0.0, 0.0, 1.0, 1.0))
 
 
@@ -65,7 +64,7 @@ def triad_markers(
 def publish_pose_marker(
     behavior: Any, pose: Any, name: str, size: float, lifetime: float, text: str = ""
 ) -> None:
-    """Publish the triad of ``pose`` on :data:`MARKER_TOPIC` through ``behavior``'s context."""
+    """Publish the triad of ``pose`` on the marker array topic through ``behavior``'s context."""
     from kinema.transport import from_dict
 
     frame_id, matrix = pose_matrix(pose, "pose")
@@ -77,7 +76,7 @@ def publish_pose_marker(
 
 
 def marker_publisher(behavior: Any, node: Any = None) -> Any:
-    """The context's publisher of marker arrays on :data:`MARKER_TOPIC`, keeping all of them.
+    """The context's publisher of marker arrays (:mod:`kinema.ui_topics`), keeping all of them.
 
     A drawing the objective asked for (or a DELETE of one) must not be dropped when the link is busy,
     as a large snapshot cloud would be under load with ROS's default keep-last profile.
@@ -86,7 +85,7 @@ def marker_publisher(behavior: Any, node: Any = None) -> Any:
 
     if node is None:
         node = behavior.context.require_node(behavior.registration_id)
-    return behavior.context.publisher(node, MARKER_ARRAY_TYPE, MARKER_TOPIC, qos=KEEP_ALL_QOS)
+    return behavior.context.publisher(node, MARKER_ARRAY_TYPE, MARKER_ARRAY_TOPIC, qos=KEEP_ALL_QOS)
 
 
 class VisualizePose(SyncBehavior):

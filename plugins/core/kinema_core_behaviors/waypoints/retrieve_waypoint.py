@@ -5,10 +5,13 @@ from __future__ import annotations
 from typing import Any
 
 from kinema.behaviors import PortInfo, ServiceClientBehavior, input_port, output_port
+from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import did_you_mean
 
 from ..messages.conversions import joint_state_message
 
+# The agent's waypoint service (kinema.runtime.names.GET_WAYPOINTS, which a plugin does not import; a test
+# keeps the two equal).
 GET_WAYPOINTS = "/get_saved_waypoints"
 
 
@@ -26,8 +29,11 @@ class RetrieveWaypoint(ServiceClientBehavior["moveit_studio_agent_msgs/srv/GetWa
     def provided_ports(cls) -> list[PortInfo]:
         return [
             input_port("waypoint_name", str, "", "Name of the waypoint, as saved in the waypoints file."),
-            input_port(
-                "joint_group_name", str, "manipulator", "Planning group whose joints are kept ('' keeps all)."
+            cell_input_port(
+                "joint_group_name",
+                str,
+                "planning_group",
+                "Planning group whose joints are kept (empty: the default below).",
             ),
             output_port(
                 "waypoint_joint_state",

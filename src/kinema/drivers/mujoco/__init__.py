@@ -14,10 +14,10 @@ Names are imported lazily, so importing this package (or ``names``) does not loa
 
 from __future__ import annotations
 
-import importlib
 from typing import Any
 
 import kinema.mujoco_gl  # noqa: F401  (picks MuJoCo's OpenGL backend before mujoco loads)
+from kinema.lazy_exports import LazyExports
 
 _EXPORTS = {
     "MujocoDriver": "driver",
@@ -25,12 +25,10 @@ _EXPORTS = {
     "parse_sim_speed": "sim_speed",
     "format_sim_speed": "sim_speed",
 }
+_lazy = LazyExports(__name__, _EXPORTS)
 
-__all__ = sorted(_EXPORTS)
+__all__ = _lazy.names
 
 
 def __getattr__(name: str) -> Any:
-    module = _EXPORTS.get(name)
-    if module is None:
-        raise AttributeError(f"module 'kinema.drivers.mujoco' has no attribute {name!r}")
-    return getattr(importlib.import_module(f"kinema.drivers.mujoco.{module}"), name)
+    return _lazy.attribute(name)

@@ -86,8 +86,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args = parser.parse_args(argv)
     if not args.camera_rate > 0:
         parser.error(f"--camera-rate must be a positive number of frames a second, got {args.camera_rate:g}")
-    from kinema.runtime import lifeline
-    from kinema.runtime.log_files import configure_process_logging
+    from kinema.process import lifeline
+    from kinema.process.log_files import configure_process_logging
 
     configure_process_logging(args.log_file, verbose=args.verbose)
     stop = threading.Event()
@@ -126,7 +126,7 @@ def _run(args: argparse.Namespace, stop: threading.Event) -> int:
     settings = MujocoDriverSettings.from_config(args.config, workspace, **overrides)
     session = host_router(args.host_router) if args.host_router else open_session(args.connect)
     with session:
-        from kinema.runtime.cell import DRIVER, declare_presence
+        from kinema.transport.presence import DRIVER, declare_presence
 
         # Announced before its nodes exist, so whoever sees them also knows whose they are.
         declare_presence(session, DRIVER, name="mujoco", config=args.config, endpoint=args.connect or "")

@@ -38,6 +38,7 @@ from kinema.perception.depth import depth_to_cloud
 from kinema.perception.intrinsics import CameraIntrinsics
 from kinema.perception.point_cloud import PointCloud
 from kinema.perception.ros_messages import camera_info_message, image_message, to_point_cloud2
+from kinema.transforms import pose_matrix, quaternion_from_wxyz
 from kinema.transport import Node, Session
 from kinema.transport.keys import EntityKind
 
@@ -81,7 +82,6 @@ class CameraSpec:
 
 def camera_specs(model: Any) -> list[CameraSpec]:
     """The named cameras of ``model``, at their ``resolution`` (else the offscreen buffer's size)."""
-    import mujoco
 
     specs = []
     for camera_id in range(model.ncam):
@@ -91,11 +91,8 @@ def camera_specs(model: Any) -> list[CameraSpec]:
         width, height = (int(v) for v in model.cam_resolution[camera_id])
         if width <= 1 or height <= 1:
             width, height = int(model.vis.global_.offwidth), int(model.vis.global_.offheight)
-        rotation = np.zeros(9)
-        mujoco.mju_quat2Mat(rotation, model.cam_quat[camera_id])
-        transform = np.eye(4)
-        transform[:3, :3] = rotation.reshape(3, 3) @ _OPTICAL_IN_MUJOCO_CAMERA
-        transform[:3, 3] = model.cam_pos[camera_id]
+        transform = pose_matrix(model.cam_pos[camera_id], quaternion_from_wxyz(model.cam_quat[camera_id]))
+        transform[:3, :3] = transform[:3, :3] @ _OPTICAL_IN_MUJOCO_CAMERA
         specs.append(
             CameraSpec(
                 camera.name,

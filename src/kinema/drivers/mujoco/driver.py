@@ -13,15 +13,16 @@ In-process::
 As a process: ``python -m kinema.drivers.mujoco --config lab_sim --sim-speed max`` (see ``--help``).
 
 What it serves (names in :mod:`kinema.drivers.mujoco.names`): ``/clock`` and ``/joint_states`` at the
-publish rate of sim time; ``/joint_trajectory_controller/follow_joint_trajectory`` and
-``/robotiq_gripper_controller/gripper_cmd``; ``/controller_manager/list_controllers`` and
-``/controller_manager/switch_controller(s)``; ``/mujoco/set_state`` (keyframe and/or joint positions),
-``/mujoco/bodies`` (free body poses), ``/mujoco/keyframes`` and the ``/mujoco/scene_state`` topic; per
-camera of the scene ``/<camera>/color``, ``/depth``, ``/camera_info`` and ``/points``, rendered only while
-subscribed (see :mod:`kinema.drivers.mujoco.cameras`). With the wrist force/torque sensor
-(lab_sim's ``tcp_fts_sensor``): ``/force_torque_sensor_broadcaster/wrench``, the admittance trajectory
-controller's ``/joint_trajectory_admittance_controller/follow_joint_trajectory``, and the velocity-force
-controller's ``/velocity_force_controller/command`` and ``/zero_fts`` (see
+publish rate of sim time; per controller of the config, by its ros2_control type: ``/<trajectory
+controller>/follow_joint_trajectory`` and ``/<gripper controller>/gripper_cmd`` (lab_sim:
+``/joint_trajectory_controller/...`` and ``/robotiq_gripper_controller/gripper_cmd``);
+``/controller_manager/list_controllers`` and ``/controller_manager/switch_controller(s)``;
+``/mujoco/set_state`` (keyframe and/or joint positions), ``/mujoco/bodies`` (free body poses),
+``/mujoco/keyframes`` and the ``/mujoco/scene_state`` topic; per camera of the scene ``/<camera>/color``,
+``/depth``, ``/camera_info`` and ``/points``, rendered only while subscribed (see
+:mod:`kinema.drivers.mujoco.cameras`). With the config's force/torque sensor (lab_sim's ``tcp_fts_sensor``):
+``/<broadcaster>/wrench``, the admittance trajectory controller's ``/<controller>/follow_joint_trajectory``,
+and the velocity-force controller's ``/<controller>/command`` and ``/<controller>/zero_fts`` (see
 :mod:`kinema.drivers.mujoco.force_control`).
 """
 
@@ -36,6 +37,7 @@ from typing import Any
 
 import numpy as np
 
+from kinema.config import cell
 from kinema.drivers.mujoco import names
 from kinema.drivers.mujoco.cameras import CameraServer, SimState
 from kinema.drivers.mujoco.cdr_templates import ClockEncoder, JointStateEncoder, generic_serializers
@@ -144,6 +146,8 @@ class MujocoDriver:
         self._joint_dofs = np.array([j.dof_address for j in self.index.joints], dtype=int)
         self._nodes: list[Node] = []
         self._publishers: dict[str, Any] = {}
+        self._joint_state_broadcaster: Controller | None = None
+        self._wrench_publishers: list[tuple[Any, Any]] = []
         # Running goals by goal id, with the controller that runs each (for cancel requests).
         self._executions: dict[bytes, tuple[Any, Execution]] = {}
         self._goals_running = 0
@@ -154,6 +158,7 @@ class MujocoDriver:
             self.cameras = CameraServer(session, self.model, self._camera_snapshot, settings.camera_rate)
         self._started = False
         self._stopped = False
+        self._agent_watch: Any = None
 
     # -- public API ----------------------------------------------------------------------------------
 
@@ -188,6 +193,7 @@ class MujocoDriver:
             self.simulation.start()
             if self.cameras is not None:
                 self.cameras.start()
+            self._watch_agents()
         except BaseException:
             self.stop()
             raise
@@ -207,6 +213,11 @@ class MujocoDriver:
         if self._stopped:
             return
         self._stopped = True
+        if self._agent_watch is not None:
+            try:
+                self._agent_watch.undeclare()
+            except Exception:
+                log.debug("agent watch already gone", exc_info=True)
         if self.cameras is not None:
             self.cameras.stop()
         self.simulation.stop()
@@ -251,54 +262,60 @@ class MujocoDriver:
                 "(de)activate controllers",
             ),
         ]
-        if names.JOINT_STATE_BROADCASTER in self._controllers:
-            served.append(
-                ServedInterface("topic", names.JOINT_STATES_TOPIC, names.JOINT_STATES_TYPE, "joint states")
-            )
-        if names.JOINT_TRAJECTORY_CONTROLLER in self._controllers:
-            served.append(
-                ServedInterface(
-                    "action",
-                    names.FOLLOW_JOINT_TRAJECTORY_ACTION,
-                    names.FOLLOW_JOINT_TRAJECTORY_TYPE,
-                    "track a timed joint trajectory",
+        for name, controller in self._controllers.items():
+            kind = controller.type_name
+            if kind == cell.JOINT_STATE_BROADCASTER:
+                served.append(
+                    ServedInterface(
+                        "topic", names.JOINT_STATES_TOPIC, names.JOINT_STATES_TYPE, "joint states"
+                    )
                 )
-            )
-        if names.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER in self._controllers:
-            served.append(
-                ServedInterface(
-                    "action",
-                    names.FOLLOW_JOINT_TRAJECTORY_ADMITTANCE_ACTION,
-                    names.FOLLOW_JOINT_TRAJECTORY_TYPE,
-                    "track a joint trajectory, aborting on a force/torque threshold",
+            elif kind in (cell.JOINT_TRAJECTORY_CONTROLLER, cell.ADMITTANCE_CONTROLLER):
+                served.append(
+                    ServedInterface(
+                        "action",
+                        names.follow_joint_trajectory_action(name),
+                        names.FOLLOW_JOINT_TRAJECTORY_TYPE,
+                        "track a timed joint trajectory"
+                        + (
+                            ", aborting on a force/torque threshold"
+                            if kind == cell.ADMITTANCE_CONTROLLER
+                            else ""
+                        ),
+                    )
                 )
-            )
-        if names.FORCE_TORQUE_SENSOR_BROADCASTER in self._controllers:
-            served.append(
-                ServedInterface(
-                    "topic", names.WRENCH_TOPIC, names.WRENCH_TYPE, "the wrist force/torque sensor"
+            elif kind == cell.FORCE_TORQUE_SENSOR_BROADCASTER:
+                served.append(
+                    ServedInterface(
+                        "topic", names.wrench_topic(name), names.WRENCH_TYPE, "the force/torque sensor"
+                    )
                 )
-            )
-        if names.VELOCITY_FORCE_CONTROLLER in self._controllers:
-            served.append(
-                ServedInterface(
-                    "topic",
-                    names.VELOCITY_FORCE_COMMAND_TOPIC,
-                    names.VELOCITY_FORCE_COMMAND_TYPE,
-                    "Cartesian velocity/force commands (subscribed)",
+            elif kind == cell.VELOCITY_FORCE_CONTROLLER:
+                served.append(
+                    ServedInterface(
+                        "topic",
+                        names.velocity_force_command_topic(name),
+                        names.VELOCITY_FORCE_COMMAND_TYPE,
+                        "Cartesian velocity/force commands (subscribed)",
+                    )
                 )
-            )
-            served.append(
-                ServedInterface(
-                    "service", names.ZERO_FTS_SERVICE, names.TRIGGER_TYPE, "zero the force/torque sensor"
+                served.append(
+                    ServedInterface(
+                        "service",
+                        names.zero_fts_service(name),
+                        names.TRIGGER_TYPE,
+                        "zero the force/torque sensor",
+                    )
                 )
-            )
-        if names.GRIPPER_CONTROLLER in self._controllers:
-            served.append(
-                ServedInterface(
-                    "action", names.GRIPPER_COMMAND_ACTION, names.GRIPPER_COMMAND_TYPE, "move the gripper"
+            elif kind == cell.GRIPPER_ACTION_CONTROLLER:
+                served.append(
+                    ServedInterface(
+                        "action",
+                        names.gripper_command_action(name),
+                        names.GRIPPER_COMMAND_TYPE,
+                        "move the gripper",
+                    )
                 )
-            )
         if self.cameras is not None and self.cameras.unavailable is None:
             for spec in self.cameras.specs:
                 for stream, type_name in names.CAMERA_STREAMS.items():
@@ -319,18 +336,28 @@ class MujocoDriver:
     # -- construction ------------------------------------------------------------------------------
 
     def _build_controllers(self) -> dict[str, Controller]:
+        """Make the controllers the settings name, each from its ros2_control type.
+
+        A trajectory controller commands the joints its spec lists, or else every actuated joint but the
+        gripper's. The F/T broadcaster, the admittance and the velocity-force controllers need the sensor
+        (and the latter a control site) in the scene; without them they are left out with a warning.
+        """
         settings = self.settings
-        wanted = list(dict.fromkeys([*settings.active_controllers, *settings.inactive_controllers]))
-        gripper_joint = None
-        if settings.gripper_joint:
-            found = [j for j in self.index.actuated_joints if j.name == settings.gripper_joint]
-            gripper_joint = found[0] if found else None
-        arm = [j for j in self.index.actuated_joints if gripper_joint is None or j.name != gripper_joint.name]
-        available: dict[str, Callable[[], Controller]] = {
-            names.JOINT_STATE_BROADCASTER: lambda: JointStateBroadcaster(
-                names.JOINT_STATE_BROADCASTER, self.index.joint_names
-            ),
-        }
+        wanted = list(
+            dict.fromkeys(
+                n.lstrip("/") for n in [*settings.active_controllers, *settings.inactive_controllers]
+            )
+        )
+        actuated = {j.name: j for j in self.index.actuated_joints}
+        gripper_joint = actuated.get(settings.gripper_joint) if settings.gripper_joint else None
+        if settings.gripper_joint and gripper_joint is None:
+            log.warning(
+                "the config's gripper joint %r has no actuator of its name in the scene "
+                "(actuated joints: %s): no gripper controller",
+                settings.gripper_joint,
+                ", ".join(actuated) or "none",
+            )
+        default_arm = [j for j in actuated.values() if gripper_joint is None or j.name != gripper_joint.name]
         sensor = None
         if settings.force_torque_sensor and ForceTorqueSensor.present(
             self.model, settings.force_torque_sensor
@@ -338,70 +365,114 @@ class MujocoDriver:
             site = self.model.site(settings.force_torque_sensor)
             frame = self.model.body(int(site.bodyid[0])).name
             sensor = ForceTorqueSensor(self.model, settings.force_torque_sensor, frame)
-            available[names.FORCE_TORQUE_SENSOR_BROADCASTER] = lambda: ForceTorqueSensorBroadcaster(
-                names.FORCE_TORQUE_SENSOR_BROADCASTER, sensor
-            )
-        if arm:
-            gains = np.array([self.model.actuator_gainprm[j.actuator, 0] for j in arm])
-            damping = np.array([-self.model.actuator_biasprm[j.actuator, 2] for j in arm])
-            feedforward = np.divide(damping, gains, out=np.zeros_like(gains), where=gains > 0)
-            touching = contact_reporter(self.model, [j.name for j in arm])
+        sites = {self.model.site(i).name for i in range(self.model.nsite)}
+        has_control_site = bool(settings.control_site) and settings.control_site in sites
+        arms: dict[tuple[str, ...], tuple[Any, ...]] = {}
 
-            def trajectory_controller(
-                name: str, kind: type[JointTrajectoryController] = JointTrajectoryController, **extra: Any
-            ) -> JointTrajectoryController:
-                return kind(
-                    name,
-                    arm,
-                    feedforward,
-                    self.index.timestep,
-                    gains=gains if np.all(gains > 0) else None,
-                    inertia=self._effective_inertia([j.dof_address for j in arm]),
-                    touching=touching,
-                    **extra,
+        def arm_of(spec_joints: tuple[str, ...], controller: str) -> list[Any]:
+            if not spec_joints:
+                return default_arm
+            unknown = [j for j in spec_joints if j not in actuated]
+            if unknown:
+                raise DriverError(
+                    f"controller {controller!r} commands {', '.join(map(repr, unknown))}, which the scene "
+                    f"{settings.model_path.name} does not actuate (an actuator named like the joint); "
+                    f"actuated joints: {', '.join(actuated) or 'none'}"
                 )
+            return [actuated[j] for j in spec_joints]
 
-            available[names.JOINT_TRAJECTORY_CONTROLLER] = lambda: trajectory_controller(
-                names.JOINT_TRAJECTORY_CONTROLLER
+        def tracking(arm: list[Any]) -> tuple[Any, ...]:
+            key = tuple(j.name for j in arm)
+            if key not in arms:
+                gains = np.array([self.model.actuator_gainprm[j.actuator, 0] for j in arm])
+                damping = np.array([-self.model.actuator_biasprm[j.actuator, 2] for j in arm])
+                feedforward = np.divide(damping, gains, out=np.zeros_like(gains), where=gains > 0)
+                arms[key] = (gains, feedforward, contact_reporter(self.model, list(key)))
+            return arms[key]
+
+        def trajectory_controller(
+            name: str,
+            arm: list[Any],
+            kind: type[JointTrajectoryController] = JointTrajectoryController,
+            **extra: Any,
+        ) -> JointTrajectoryController:
+            gains, feedforward, touching = tracking(arm)
+            return kind(
+                name,
+                arm,
+                feedforward,
+                self.index.timestep,
+                gains=gains if np.all(gains > 0) else None,
+                inertia=self._effective_inertia([j.dof_address for j in arm]),
+                touching=touching,
+                **extra,
             )
-            has_control_site = settings.control_site in {
-                self.model.site(i).name for i in range(self.model.nsite)
-            }
-            if sensor is not None:
-                available[names.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER] = lambda: trajectory_controller(
-                    names.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER,
-                    JointTrajectoryAdmittanceController,
-                    sensor=sensor,
-                )
-            if sensor is not None and has_control_site:
-                available[names.VELOCITY_FORCE_CONTROLLER] = lambda: VelocityForceController(
-                    names.VELOCITY_FORCE_CONTROLLER,
-                    self.model,
-                    arm,
-                    feedforward,
-                    settings.control_site,
-                    sensor,
-                )
-        if gripper_joint is not None:
-            available[names.GRIPPER_CONTROLLER] = lambda: GripperController(
-                names.GRIPPER_CONTROLLER, gripper_joint, self.model, settings.gripper
-            )
-        elif settings.gripper_joint:
-            log.warning(
-                "the scene has no actuated joint %r: no %s", settings.gripper_joint, names.GRIPPER_CONTROLLER
-            )
+
         controllers: dict[str, Controller] = {}
         for name in wanted:
-            factory = available.get(name.lstrip("/"))
-            if factory is None:
+            spec = settings.controllers.get(name)
+            kind = spec.type if spec is not None else cell.CONVENTIONAL_TYPES.get(name, "")
+            joints = spec.joints if spec is not None else ()
+            missing = ""
+            if kind == cell.JOINT_STATE_BROADCASTER:
+                controllers[name] = JointStateBroadcaster(name, self.index.joint_names)
+            elif kind == cell.GRIPPER_ACTION_CONTROLLER:
+                joint = actuated.get(joints[0]) if joints else gripper_joint
+                if joint is None:
+                    missing = f"an actuated gripper joint ({joints[0] if joints else 'robot.gripper.joint'})"
+                else:
+                    controllers[name] = GripperController(name, joint, self.model, settings.gripper)
+            elif kind == cell.JOINT_TRAJECTORY_CONTROLLER:
+                arm = arm_of(joints, name)
+                if arm:
+                    controllers[name] = trajectory_controller(name, arm)
+                else:
+                    missing = "actuated joints"
+            elif kind == cell.FORCE_TORQUE_SENSOR_BROADCASTER:
+                if sensor is None:
+                    missing = (
+                        f"the force/torque sensor site {settings.force_torque_sensor or '(none configured)'}"
+                    )
+                else:
+                    controllers[name] = ForceTorqueSensorBroadcaster(name, sensor)
+            elif kind == cell.ADMITTANCE_CONTROLLER:
+                arm = arm_of(joints, name)
+                if sensor is None or not arm:
+                    missing = (
+                        f"the force/torque sensor site {settings.force_torque_sensor or '(none configured)'}"
+                    )
+                else:
+                    controllers[name] = trajectory_controller(
+                        name, arm, JointTrajectoryAdmittanceController, sensor=sensor
+                    )
+            elif kind == cell.VELOCITY_FORCE_CONTROLLER:
+                arm = arm_of(joints, name)
+                if sensor is None or not has_control_site or not arm:
+                    missing = (
+                        f"the force/torque sensor site {settings.force_torque_sensor or '(none configured)'} "
+                        f"and the control site {settings.control_site or '(none configured)'}"
+                    )
+                else:
+                    _, feedforward, _ = tracking(arm)
+                    controllers[name] = VelocityForceController(
+                        name, self.model, arm, feedforward, settings.control_site, sensor
+                    )
+            else:
                 log.warning(
-                    "controller %r (from the config) is not simulated; the MuJoCo driver offers: %s",
+                    "controller %r (from the config) is not simulated: its type %s is not one the MuJoCo "
+                    "driver offers (%s)",
                     name,
-                    ", ".join(available),
+                    repr(kind) if kind else "is not given",
+                    ", ".join(cell.SIMULATED_TYPES),
                 )
                 continue
-            controllers[name.lstrip("/")] = factory()
+            if missing:
+                log.warning("controller %r (%s) is not simulated: the scene lacks %s", name, kind, missing)
         return controllers
+
+    def _of_type(self, *kinds: str) -> list[tuple[str, Controller]]:
+        """The controllers of the given ros2_control types, by name."""
+        return [(n, c) for n, c in self._controllers.items() if c.type_name in kinds]
 
     def _effective_inertia(self, dofs: list[int]) -> Callable[[Any], np.ndarray]:
         """Each dof's effective inertia in the current state: the diagonal of MuJoCo's mass matrix."""
@@ -431,49 +502,44 @@ class MujocoDriver:
         )
         for service in (names.SWITCH_CONTROLLERS_SERVICE, names.SWITCH_CONTROLLERS_ALIAS):
             manager_node.create_service(names.SWITCH_CONTROLLERS_TYPE, service, self._on_switch_controllers)
-        if names.JOINT_STATE_BROADCASTER in self._controllers:
-            self._publishers["joint_states"] = self._node(names.JOINT_STATE_BROADCASTER).create_publisher(
+        for name, controller in self._of_type(cell.JOINT_STATE_BROADCASTER)[:1]:
+            self._joint_state_broadcaster = controller
+            self._publishers["joint_states"] = self._node(name).create_publisher(
                 names.JOINT_STATES_TYPE, names.JOINT_STATES_TOPIC
             )
-        for name, action in (
-            (names.JOINT_TRAJECTORY_CONTROLLER, names.FOLLOW_JOINT_TRAJECTORY_ACTION),
-            (names.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER, names.FOLLOW_JOINT_TRAJECTORY_ADMITTANCE_ACTION),
-        ):
-            controller = self._controllers.get(name)
-            if controller is not None:
-                self._node(name).create_action_server(
-                    names.FOLLOW_JOINT_TRAJECTORY_TYPE,
-                    action,
-                    functools.partial(self._execute_trajectory, controller=controller),
-                    cancel_callback=self._cancel_goal,
-                )
-        if names.FORCE_TORQUE_SENSOR_BROADCASTER in self._controllers:
-            self._publishers["wrench"] = self._node(names.FORCE_TORQUE_SENSOR_BROADCASTER).create_publisher(
-                names.WRENCH_TYPE, names.WRENCH_TOPIC
+        for name, controller in self._of_type(cell.JOINT_TRAJECTORY_CONTROLLER, cell.ADMITTANCE_CONTROLLER):
+            self._node(name).create_action_server(
+                names.FOLLOW_JOINT_TRAJECTORY_TYPE,
+                names.follow_joint_trajectory_action(name),
+                functools.partial(self._execute_trajectory, controller=controller),
+                cancel_callback=self._cancel_goal,
             )
-        velocity_force = self._controllers.get(names.VELOCITY_FORCE_CONTROLLER)
-        if isinstance(velocity_force, VelocityForceController):
-            node = self._node(names.VELOCITY_FORCE_CONTROLLER)
+        for name, controller in self._of_type(cell.FORCE_TORQUE_SENSOR_BROADCASTER):
+            publisher = self._node(name).create_publisher(names.WRENCH_TYPE, names.wrench_topic(name))
+            self._wrench_publishers.append((controller, publisher))
+        for name, velocity_force in self._of_type(cell.VELOCITY_FORCE_CONTROLLER):
+            assert isinstance(velocity_force, VelocityForceController)
+            node = self._node(name)
             node.create_subscription(
                 names.VELOCITY_FORCE_COMMAND_TYPE,
-                names.VELOCITY_FORCE_COMMAND_TOPIC,
+                names.velocity_force_command_topic(name),
                 velocity_force.set_command,
             )
             node.create_service(
                 names.TRIGGER_TYPE,
-                names.ZERO_FTS_SERVICE,
-                lambda _request: {
-                    "success": True,
-                    "message": self.simulation.call(lambda: velocity_force.zero_sensor(self.data)),
-                },
+                names.zero_fts_service(name),
+                functools.partial(self._zero_sensor, velocity_force),
             )
-        if names.GRIPPER_CONTROLLER in self._controllers:
-            self._node(names.GRIPPER_CONTROLLER).create_action_server(
+        for name, controller in self._of_type(cell.GRIPPER_ACTION_CONTROLLER):
+            self._node(name).create_action_server(
                 names.GRIPPER_COMMAND_TYPE,
-                names.GRIPPER_COMMAND_ACTION,
-                self._execute_gripper,
+                names.gripper_command_action(name),
+                functools.partial(self._execute_gripper, controller=controller),
                 cancel_callback=self._cancel_goal,
             )
+
+    def _zero_sensor(self, controller: VelocityForceController, _request: Any) -> dict[str, Any]:
+        return {"success": True, "message": self.simulation.call(lambda: controller.zero_sensor(self.data))}
 
     def _camera_snapshot(self) -> SimState | None:
         try:
@@ -497,7 +563,7 @@ class MujocoDriver:
         data = self.data
         now = float(data.time)
         self._publishers["clock"].publish_raw(self._clock_encoder.encode(now))
-        broadcaster = self._controllers.get(names.JOINT_STATE_BROADCASTER)
+        broadcaster = self._joint_state_broadcaster
         if broadcaster is not None and broadcaster.active:
             self._publishers["joint_states"].publish_raw(
                 self._joint_state_encoder.encode(
@@ -507,9 +573,9 @@ class MujocoDriver:
                     data.qfrc_actuator[self._joint_dofs],
                 )
             )
-        sensor_broadcaster = self._controllers.get(names.FORCE_TORQUE_SENSOR_BROADCASTER)
-        if isinstance(sensor_broadcaster, ForceTorqueSensorBroadcaster) and sensor_broadcaster.active:
-            self._publishers["wrench"].publish(sensor_broadcaster.message(data))
+        for sensor_broadcaster, publisher in self._wrench_publishers:
+            if sensor_broadcaster.active:
+                publisher.publish(sensor_broadcaster.message(data))
         for controller in self._goal_controllers:
             controller.post_feedback(data)
         wall = time.perf_counter()
@@ -630,8 +696,7 @@ class MujocoDriver:
             {"error_code": INVALID_GOAL, "error_string": "the MuJoCo driver stopped"},
         )
 
-    def _execute_gripper(self, handle: ServerGoalHandle) -> None:
-        controller = self._controllers[names.GRIPPER_CONTROLLER]
+    def _execute_gripper(self, handle: ServerGoalHandle, controller: Controller) -> None:
         assert isinstance(controller, GripperController)
         command = handle.goal.command
         position, effort = float(command.position), float(command.max_effort)
@@ -683,6 +748,40 @@ class MujocoDriver:
         if running is not None:
             self._queue_cancel(*running)
         return True
+
+    def _watch_agents(self) -> None:
+        """An agent that goes away (crashed, killed) can no longer cancel what it started: stop every
+        running goal then, braking to a stop and holding position, until a new agent commands."""
+        from kinema.runtime.cell import AGENT, PRESENCE_PREFIX
+        from kinema.transport.dispatch import channel, dispatch
+
+        try:
+            self._agent_watch = self.session.zenoh.liveliness().declare_subscriber(
+                f"{PRESENCE_PREFIX}/{self.session.domain_id}/*/{AGENT}/**", channel(), history=False
+            )
+        except Exception:
+            log.warning("cannot watch the agent's presence; its death will not stop running goals")
+            return
+        self.session._track_dispatcher(dispatch(self._agent_watch, self._on_agent_presence, "-agents"))
+
+    def _on_agent_presence(self, sample: Any) -> None:
+        import zenoh
+
+        from kinema.runtime.cell import parse_presence
+
+        member = parse_presence(str(sample.key_expr))
+        if member is None or sample.kind != zenoh.SampleKind.DELETE:
+            return
+        with self._goals_lock:
+            running = list(self._executions.values())
+        if running:
+            log.warning(
+                "%s went away with %d goal(s) running: stopping them and holding the robot still",
+                member.describe(),
+                len(running),
+            )
+        for controller, execution in running:
+            self._queue_cancel(controller, execution)
 
     def _queue_cancel(self, controller: Any, execution: Execution) -> bool:
         try:

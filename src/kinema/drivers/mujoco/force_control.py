@@ -39,6 +39,7 @@ from kinema.drivers.mujoco.execution import Execution
 from kinema.drivers.mujoco.model_index import JointInfo
 from kinema.drivers.mujoco.trajectory_controller import JointTrajectoryController
 from kinema.drivers.mujoco.trajectory_goal import PATH_TOLERANCE_VIOLATED, TrajectoryGoal
+from kinema.transforms import rotate_twist
 
 log = logging.getLogger(__name__)
 
@@ -312,10 +313,10 @@ class VelocityForceController:
             desired = np.where(command.velocity_axes, command.twist, 0.0)
             if command.force_axes.any():
                 applied = self.applied_wrench(data)
-                applied_local = np.concatenate((rotation.T @ applied[:3], rotation.T @ applied[3:]))
+                applied_local = rotate_twist(rotation.T, applied)
                 force_velocity = command.wrench_gain * (command.wrench - applied_local)
                 desired = np.where(command.force_axes, force_velocity, desired)
-            desired_world = np.concatenate((rotation @ desired[:3], rotation @ desired[3:]))
+            desired_world = rotate_twist(rotation, desired)
         velocity = self._limit_cartesian(desired_world)
         self._cartesian_velocity = velocity
         joint_velocity = self._joint_velocities(data, velocity)

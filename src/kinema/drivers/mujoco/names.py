@@ -10,11 +10,11 @@ CLOCK_TYPE = "rosgraph_msgs/msg/Clock"
 JOINT_STATES_TOPIC = "/joint_states"
 JOINT_STATES_TYPE = "sensor_msgs/msg/JointState"
 
-FOLLOW_JOINT_TRAJECTORY_ACTION = "/joint_trajectory_controller/follow_joint_trajectory"
 FOLLOW_JOINT_TRAJECTORY_TYPE = "control_msgs/action/FollowJointTrajectory"
-GRIPPER_COMMAND_ACTION = "/robotiq_gripper_controller/gripper_cmd"
 GRIPPER_COMMAND_TYPE = "control_msgs/action/GripperCommand"
 
+# The node serving the controller manager's services (ros2_control's name).
+CONTROLLER_MANAGER_NODE = "controller_manager"
 LIST_CONTROLLERS_SERVICE = "/controller_manager/list_controllers"
 LIST_CONTROLLERS_TYPE = "controller_manager_msgs/srv/ListControllers"
 # ros2_control's controller_manager names the service in the singular; the plural spelling is served too
@@ -32,20 +32,52 @@ KEYFRAMES_TYPE = "kinema_msgs/srv/ListKeyframes"
 SCENE_STATE_TOPIC = "/mujoco/scene_state"
 SCENE_STATE_TYPE = "kinema_msgs/msg/SceneState"
 
+# ros2_control's conventional controller names (a config may name its controllers otherwise: what each
+# controller is comes from the config, kinema.config.cell). A controller serves its interfaces under its
+# own name, as ros2_control's do.
 JOINT_TRAJECTORY_CONTROLLER = "joint_trajectory_controller"
-# The wrist force/torque sensor and the controllers using it (MoveIt Pro's lab_sim names).
 JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER = "joint_trajectory_admittance_controller"
-FOLLOW_JOINT_TRAJECTORY_ADMITTANCE_ACTION = "/joint_trajectory_admittance_controller/follow_joint_trajectory"
 VELOCITY_FORCE_CONTROLLER = "velocity_force_controller"
-VELOCITY_FORCE_COMMAND_TOPIC = "/velocity_force_controller/command"
-VELOCITY_FORCE_COMMAND_TYPE = "moveit_pro_controllers_msgs/msg/VelocityForceCommand"
-ZERO_FTS_SERVICE = "/velocity_force_controller/zero_fts"
-TRIGGER_TYPE = "std_srvs/srv/Trigger"
 FORCE_TORQUE_SENSOR_BROADCASTER = "force_torque_sensor_broadcaster"
-WRENCH_TOPIC = "/force_torque_sensor_broadcaster/wrench"
-WRENCH_TYPE = "geometry_msgs/msg/WrenchStamped"
-GRIPPER_CONTROLLER = "robotiq_gripper_controller"
 JOINT_STATE_BROADCASTER = "joint_state_broadcaster"
+VELOCITY_FORCE_COMMAND_TYPE = "moveit_pro_controllers_msgs/msg/VelocityForceCommand"
+TRIGGER_TYPE = "std_srvs/srv/Trigger"
+WRENCH_TYPE = "geometry_msgs/msg/WrenchStamped"
+
+
+def follow_joint_trajectory_action(controller: str) -> str:
+    """A trajectory controller's FollowJointTrajectory action: ``/<controller>/follow_joint_trajectory``."""
+    return f"/{controller}/follow_joint_trajectory"
+
+
+def gripper_command_action(controller: str) -> str:
+    """A gripper controller's GripperCommand action: ``/<controller>/gripper_cmd``."""
+    return f"/{controller}/gripper_cmd"
+
+
+def wrench_topic(broadcaster: str) -> str:
+    """A force/torque sensor broadcaster's WrenchStamped topic: ``/<broadcaster>/wrench``."""
+    return f"/{broadcaster}/wrench"
+
+
+def velocity_force_command_topic(controller: str) -> str:
+    """A velocity-force controller's command topic: ``/<controller>/command``."""
+    return f"/{controller}/command"
+
+
+def zero_fts_service(controller: str) -> str:
+    """A velocity-force controller's sensor-zeroing service: ``/<controller>/zero_fts``."""
+    return f"/{controller}/zero_fts"
+
+
+# The names of ros2_control's conventional controllers, for clients that use those.
+FOLLOW_JOINT_TRAJECTORY_ACTION = follow_joint_trajectory_action(JOINT_TRAJECTORY_CONTROLLER)
+FOLLOW_JOINT_TRAJECTORY_ADMITTANCE_ACTION = follow_joint_trajectory_action(
+    JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER
+)
+VELOCITY_FORCE_COMMAND_TOPIC = velocity_force_command_topic(VELOCITY_FORCE_CONTROLLER)
+ZERO_FTS_SERVICE = zero_fts_service(VELOCITY_FORCE_CONTROLLER)
+WRENCH_TOPIC = wrench_topic(FORCE_TORQUE_SENSOR_BROADCASTER)
 
 # Each MuJoCo camera is served as MoveIt Pro's lab_sim serves it: /<camera>/color, /<camera>/depth,
 # /<camera>/camera_info and /<camera>/points (an organised cloud in the camera's optical frame).

@@ -1,0 +1,125 @@
+"""Nothing grows with use: the agent's threads, descriptors and memory over many start/cancel cycles.
+
+Starts ``kinema run --headless`` (lab_sim: the agent and the MuJoCo driver) on a free loopback port with
+private user folders, then runs cycles of: start "3 Waypoints Pick and Place" (a moving objective), let
+it run a moment (0.2 to 0.8 s, varying), cancel it, wait for its result. Every ``--every`` cycles it
+prints the agent process's threads, open descriptors and resident memory, each beside its value after the
+first cycles (the peer: the same process before the soak), so a leak shows as a growing difference.
+
+Target: after 500 cycles threads and descriptors within a handful of the start, RSS flat.
+Run: ``python benchmarks/soak.py [--cycles 500] [--every 50] [--smoke]`` (``--smoke``: 6 cycles, as the
+test suite does).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import signal
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from kinema.sdk import ObjectiveStatus, QuickClient
+from kinema.transport import free_endpoint
+
+OBJECTIVE = "3 Waypoints Pick and Place"
+READY = "objectives can be started"
+
+
+def _agent_pid(supervisor: int) -> int:
+    for child in Path(f"/proc/{supervisor}/task/{supervisor}/children").read_text().split():
+        if "kinema.runtime.agent_process" in Path(f"/proc/{child}/cmdline").read_text():
+            return int(child)
+    raise RuntimeError("kinema run has no agent child")
+
+
+def _sample(pid: int) -> tuple[int, int, int]:
+    """(threads, open descriptors, RSS in kB) of process ``pid``."""
+    fields = dict(
+        line.split(":", 1) for line in Path(f"/proc/{pid}/status").read_text().splitlines() if ":" in line
+    )
+    threads = int(fields["Threads"])
+    rss = int(fields["VmRSS"].split()[0])
+    return threads, len(os.listdir(f"/proc/{pid}/fd")), rss
+
+
+def _cycle(quick: QuickClient, hold_s: float) -> None:
+    run = quick.start(OBJECTIVE)
+    deadline = time.monotonic() + 60
+    while quick.status() != (ObjectiveStatus.RUNNING, OBJECTIVE):
+        if time.monotonic() > deadline:
+            raise RuntimeError(f"{OBJECTIVE!r} never ran: {quick.status()}")
+        time.sleep(0.01)
+    time.sleep(hold_s)
+    run.cancel()
+    result = run.result()
+    if result.succeeded:
+        raise RuntimeError(f"a cancelled run succeeded: {result}")
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--cycles", type=int, default=500)
+    parser.add_argument("--every", type=int, default=50, help="print a sample every this many cycles")
+    parser.add_argument("--smoke", action="store_true", help="6 cycles, a sample every 3 (the test suite)")
+    args = parser.parse_args()
+    cycles, every, warmup = (6, 3, 1) if args.smoke else (args.cycles, args.every, 5)
+    endpoint = free_endpoint()
+    with tempfile.TemporaryDirectory(prefix="kinema-soak-") as home:
+        env = {
+            **os.environ,
+            "KINEMA_ZENOH_CONNECT": endpoint,
+            "KINEMA_CONFIG": "lab_sim",
+            **{f"XDG_{n}_HOME": str(Path(home) / n.lower()) for n in ("CONFIG", "DATA", "STATE", "CACHE")},
+        }
+        supervisor = subprocess.Popen(
+            [sys.executable, "-m", "kinema", "run", "--headless"],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.STDOUT,
+            text=True,
+            env=env,
+        )
+        try:
+            assert supervisor.stdout is not None
+            for line in supervisor.stdout:
+                if READY in line:
+                    break
+            else:
+                raise RuntimeError("kinema run stopped before it was ready")
+            agent = _agent_pid(supervisor.pid)
+            with QuickClient(endpoint, timeout=30) as quick:
+                for number in range(warmup):
+                    _cycle(quick, 0.2 + 0.1 * (number % 7))
+                base = _sample(agent)
+                print(
+                    f"agent pid {agent}; after {warmup} warm-up cycles: threads {base[0]}, fds {base[1]}, "
+                    f"RSS {base[2] / 1024:.1f} MB\n"
+                )
+                print(
+                    f"{'cycle':>6} {'threads':>8} {'(+)':>5} {'fds':>6} {'(+)':>5} {'RSS MB':>8} {'ratio':>6}"
+                )
+                started = time.monotonic()
+                for number in range(1, cycles + 1):
+                    _cycle(quick, 0.2 + 0.1 * (number % 7))
+                    if number % every == 0 or number == cycles:
+                        threads, fds, rss = _sample(agent)
+                        print(
+                            f"{number:>6} {threads:>8} {threads - base[0]:>+5} {fds:>6} {fds - base[1]:>+5} "
+                            f"{rss / 1024:>8.1f} {rss / base[2]:>6.2f}",
+                            flush=True,
+                        )
+                print(f"\n{cycles} cycles in {time.monotonic() - started:.0f} s")
+        finally:
+            supervisor.send_signal(signal.SIGINT)
+            try:
+                supervisor.wait(30)
+            except subprocess.TimeoutExpired:
+                supervisor.kill()
+                supervisor.wait(10)
+
+
+if __name__ == "__main__":
+    main()

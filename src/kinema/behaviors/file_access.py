@@ -1,0 +1,84 @@
+"""Which files an objective may read or write: the file rule and the security rule.
+
+A path reaches a file behavior from an objective's XML or a parameter override, that is from whoever may
+start objectives; a running objective therefore never gets more of the disk than the cell's own folders.
+Whatever role asked, and whichever port carries the path:
+
+- **the security rule**: nothing inside the security folder (``kinema security init``'s CA key, the
+  router's key, the client configs) is read or written, wherever that folder is;
+- **the file rule**: once ``..`` and symlinks are resolved, the file is inside the workspace, one of the
+  config packages the workspace sees, or Kinema's data folder (``$XDG_DATA_HOME/kinema``); without a
+  config (``kinema tree run``, tests) the working directory stands for the workspace.
+
+:func:`check_file_access` is what :mod:`kinema_core_behaviors.files.locations` calls for every file
+behavior; a third-party behavior that opens a file named by a port should call it too.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable
+from pathlib import Path
+from typing import Any
+
+from kinema.errors import KinemaError
+
+SECURITY_RULE = "security rule: objectives never read or write the security folder"
+FILE_RULE = (
+    "file rule: objectives read and write only inside the workspace, the config packages and Kinema's "
+    "data folder"
+)
+
+
+class FileAccessError(KinemaError):
+    """A path an objective gave is outside what the file rule or the security rule allows."""
+
+
+def security_folders() -> list[Path]:
+    """Every folder that may hold the cell's keys: ``$KINEMA_SECURITY_DIR`` and the default one."""
+    import platformdirs
+
+    folders = [platformdirs.user_config_path("kinema") / "security"]
+    configured = os.environ.get("KINEMA_SECURITY_DIR")
+    if configured:
+        folders.append(Path(configured).expanduser())
+    return _unique(folders)
+
+
+def allowed_folders(config: Any) -> list[Path]:
+    """The folders the file rule allows for ``config`` (a ResolvedConfig, or None offline)."""
+    import platformdirs
+
+    folders = [platformdirs.user_data_path("kinema")]
+    if config is None:
+        folders.append(Path.cwd())
+        return _unique(folders)
+    workspace = config.workspace
+    if workspace.root is not None:
+        folders.append(Path(workspace.root))
+    folders += [Path(package.path) for package in workspace.packages.values()]
+    return _unique(folders)
+
+
+def check_file_access(path: Path, config: Any) -> Path:
+    """``path`` resolved (``..`` and symlinks followed) when the rules allow it.
+
+    Raises:
+        FileAccessError: inside a security folder, or outside every allowed folder; the message names
+            the rule and the folders allowed.
+    """
+    resolved = Path(path).expanduser().resolve()
+    for folder in security_folders():
+        if resolved.is_relative_to(folder.resolve()):
+            raise FileAccessError(f"{path} is refused by the {SECURITY_RULE} ({folder})")
+    allowed = allowed_folders(config)
+    if any(resolved.is_relative_to(folder.resolve()) for folder in allowed):
+        return resolved
+    where = f" (it resolves to {resolved})" if resolved != Path(path) else ""
+    raise FileAccessError(
+        f"{path}{where} is refused by the {FILE_RULE}: {', '.join(str(f) for f in allowed)}"
+    )
+
+
+def _unique(folders: Iterable[Path]) -> list[Path]:
+    return list(dict.fromkeys(folders))

@@ -1,0 +1,616 @@
+"""``kinema build``'s robot linter: every name that crosses a file of the robot is checked once.
+
+A config's robot is spread over files written by different people and tools: the URDF (or xacro) names
+joints and links, the SRDF groups them, joint_limits.yaml, the waypoints and the controllers name joints,
+the MuJoCo scene must simulate and actuate them, config.yaml names a planning group, a tool frame, a
+keyframe and a sensor site. A misspelt name in any of them fails late (when an objective runs) and far
+from its cause. :func:`check_robot` reads them all and reports every problem at once, each naming the
+file (and line where known) and the names that would have been valid:
+
+- the URDF: xacro expands with the config's ``urdf_params``, every mesh is found and is not a Git LFS
+  pointer, pinocchio loads it and its collision model builds;
+- the SRDF: each group's joints, links and chains are the URDF's, subgroups are groups, the planning
+  group (``moveit_params.joint_group_name``) is a group, group states and end effectors name URDF joints,
+  groups and links;
+- joint_limits.yaml names URDF joints;
+- the MuJoCo scene: every file it and its includes name (include, mesh, texture, hfield, skin) exists and
+  is not an LFS pointer, and no mesh is a text STL (MuJoCo reads binary STL only) — checked before MuJoCo
+  parses it, so the message is Kinema's — then it loads, simulates every active URDF joint (movable, not
+  a mimic) and has the configured keyframe;
+- the waypoints name URDF joints;
+- the controllers' and the gripper's joints are URDF joints actuated in the scene (by an actuator named
+  like the joint, as the MuJoCo driver finds them), the tool frame is a URDF link, the F/T sensor's sites
+  are in the scene.
+
+Where an ``<include>`` of the scene is looked for: beside the including file, then beside the scene (the
+two places MuJoCo itself looks), then in the ``mujoco_assets`` folder of each workspace package. The last
+is MoveIt Pro's layout, where a config's scene includes ``ur5e/...`` from ``picknik_accessories`` and its
+build installs those files beside the scene; asset files (meshes, textures) follow the same rule after
+the scene's folder, and files found there reach MuJoCo through its in-memory file system.
+
+A later check that needs an earlier one's result is skipped when that failed (no SRDF check without a
+URDF), so one mistake is reported once.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Callable, Iterable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from lxml import etree
+
+from kinema.config.robot_files import is_ascii_stl
+from kinema.errors import ConfigError, KinemaError, SourceLocation, did_you_mean
+
+if TYPE_CHECKING:
+    from kinema.config.inheritance import ResolvedConfig
+    from kinema.config.robot_files import PackageIndex
+
+#: Asset elements of MJCF that name a file, the attributes that do, and the compiler folder they use.
+_ASSET_FILES: dict[str, tuple[tuple[str, ...], str]] = {
+    "mesh": (("file",), "meshdir"),
+    "skin": (("file",), "meshdir"),
+    "hfield": (("file",), "meshdir"),
+    "texture": (
+        ("file", "fileright", "fileleft", "fileup", "filedown", "filefront", "fileback"),
+        "texturedir",
+    ),
+}
+_LFS_PREFIX = b"version https://git-lfs.github.com/spec/v1"
+#: LFS pointers named one by one before the rest are counted (a fresh clone has dozens).
+_POINTERS_SHOWN = 3
+
+
+@dataclass
+class RobotReport:
+    """What :func:`robot_report` found.
+
+    Attributes:
+        problems: errors a build fails on, each with ``file:line`` where known.
+        warnings: worth saying, not wrong (an SRDF disabling collisions of a link the URDF lacks).
+        checked: the files that were read, for a summary.
+    """
+
+    problems: list[ConfigError] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    checked: list[Path] = field(default_factory=list)
+
+    def problem(self, message: str, location: SourceLocation | str | Path | None = None) -> None:
+        if location is not None and not isinstance(location, SourceLocation):
+            location = SourceLocation(str(location))
+        self.problems.append(ConfigError(message, location=location))
+
+
+@dataclass(frozen=True)
+class _Urdf:
+    """The names the URDF defines."""
+
+    source: Path
+    joints: dict[str, Any]  # name -> kinema.config.robot_files.UrdfJoint
+    links: list[str]
+
+    @property
+    def movable_joints(self) -> list[str]:
+        """The joints a waypoint, a limit or a controller can name: revolute, continuous, prismatic."""
+        return [j.name for j in self.joints.values() if j.movable]
+
+    @property
+    def active_joints(self) -> list[str]:
+        return [j.name for j in self.joints.values() if j.movable and j.mimic is None]
+
+    def describe(self, what: str) -> str:
+        return f"{what} of {self.source.name}"
+
+
+def check_robot(resolved: ResolvedConfig) -> list[ConfigError]:
+    """Every problem of the config's robot files (see the module docstring); empty when all fit."""
+    return robot_report(resolved).problems
+
+
+def robot_report(resolved: ResolvedConfig) -> RobotReport:
+    """Check the config's robot files; problems and warnings, each naming file and line."""
+    from kinema.config.robot_description import package_index
+
+    report = RobotReport()
+    index = package_index(resolved)
+    urdf = _check_urdf(resolved, index, report)
+    scene = _check_scene(resolved, urdf, report)
+    if urdf is None:
+        return report
+    _check_srdf(resolved, urdf, report)
+    _check_joint_limits(resolved, urdf, report)
+    _check_waypoints(resolved, urdf, report)
+    _check_cell(resolved, urdf, scene, report)
+    return report
+
+
+def _attempt(report: RobotReport, action: Callable[[], Any]) -> Any:
+    """``action()``, or None after recording its KinemaError as a problem."""
+    try:
+        return action()
+    except KinemaError as error:
+        report.problems.append(
+            error if isinstance(error, ConfigError) else ConfigError(error.message, location=error.location)
+        )
+        return None
+
+
+# -- URDF ------------------------------------------------------------------------------------------------
+
+
+def _check_urdf(resolved: ResolvedConfig, index: PackageIndex, report: RobotReport) -> _Urdf | None:
+    from kinema.config.robot_files import parse_joints, process_xacro, resolve_robot_text
+
+    source = _attempt(report, lambda: resolved.urdf_path)
+    if source is None:
+        return None
+    report.checked.append(source)
+    text = _attempt(report, lambda: process_xacro(source, resolved.urdf_params, index=index))
+    if text is None:
+        return None
+    try:
+        root = etree.fromstring(text.encode("utf-8"))
+    except etree.XMLSyntaxError as exc:
+        report.problem(f"the URDF is not valid XML: {exc.msg}", SourceLocation(str(source), exc.lineno or 0))
+        return None
+    if root.tag != "robot":
+        report.problem(f"not a URDF: the root element is <{root.tag}>, not <robot>", source)
+        return None
+    urdf = _Urdf(
+        source=source,
+        joints={j.name: j for j in parse_joints(text)},
+        links=[link.get("name", "") for link in root.findall("link")],
+    )
+    if not urdf.active_joints:
+        report.problem("the URDF has no movable joints (revolute, continuous or prismatic)", source)
+    robot = _attempt(report, lambda: resolve_robot_text(source, text, index=index))
+    if robot is not None:
+        _check_pinocchio(resolved, index, report)
+    return urdf
+
+
+def _check_pinocchio(resolved: ResolvedConfig, index: PackageIndex, report: RobotReport) -> None:
+    """Pinocchio loads the URDF the planner loads, and its collision model builds."""
+    from kinema.config.robot_description import planning_urdf
+    from kinema.errors import MotionError
+    from kinema.motion.collision import CollisionChecker
+    from kinema.motion.robot_model import RobotModel
+
+    path = _attempt(report, lambda: planning_urdf(resolved, check_meshes=False))
+    if path is None:
+        return
+    try:
+        model = RobotModel.from_urdf(path, package_dirs=index.package_dirs())
+        CollisionChecker(model)
+    except MotionError as error:
+        report.problem(error.message, error.location or resolved.urdf_path)
+
+
+# -- SRDF ------------------------------------------------------------------------------------------------
+
+
+def _check_srdf(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport) -> None:
+    path = _attempt(report, lambda: resolved.srdf_path)
+    if path is None:
+        return
+    report.checked.append(path)
+    try:
+        root = etree.parse(str(path)).getroot()
+    except (OSError, etree.XMLSyntaxError) as exc:
+        line = getattr(exc, "lineno", 0) or 0
+        report.problem(f"the SRDF cannot be read: {exc}", SourceLocation(str(path), line))
+        return
+
+    def where(element: etree._Element) -> SourceLocation:
+        return SourceLocation(str(path), element.sourceline or 0)
+
+    def name_check(element: etree._Element, attribute: str, valid: Iterable[str], what: str) -> bool:
+        value = element.get(attribute, "")
+        if value in valid:
+            return True
+        report.problem(
+            f"<{element.tag} {attribute}={value!r}>: {value!r} is not a {what}; {did_you_mean(value, valid)}",
+            where(element),
+        )
+        return False
+
+    joints, links = list(urdf.joints), urdf.links
+    groups = {g.get("name", ""): g for g in root.findall("group")}
+    parent_of = {j.child: j.parent for j in urdf.joints.values()}
+    for group in groups.values():
+        for element in group.findall("joint"):
+            name_check(element, "name", joints, urdf.describe("joint"))
+        for element in group.findall("link"):
+            name_check(element, "name", links, urdf.describe("link"))
+        for element in group.findall("group"):
+            name_check(element, "name", groups, "group of the SRDF")
+        for chain in group.findall("chain"):
+            ends = [name_check(chain, end, links, urdf.describe("link")) for end in ("base_link", "tip_link")]
+            base, tip = chain.get("base_link", ""), chain.get("tip_link", "")
+            if all(ends) and not _is_below(tip, base, parent_of):
+                report.problem(
+                    f"group {group.get('name')!r}: the chain's tip {tip!r} is not below its base {base!r} in "
+                    f"the URDF",
+                    where(chain),
+                )
+    planning_group = resolved.get("moveit_params.joint_group_name")
+    if planning_group and str(planning_group) not in groups:
+        report.problem(
+            f"the planning group {planning_group!r} (moveit_params.joint_group_name) is not a group of the "
+            f"SRDF {path}; {did_you_mean(str(planning_group), groups)}",
+            resolved.location_of("moveit_params.joint_group_name"),
+        )
+    for state in root.findall("group_state"):
+        name_check(state, "group", groups, "group of the SRDF")
+        for element in state.findall("joint"):
+            name_check(element, "name", joints, urdf.describe("joint"))
+    for effector in root.iter("end_effector"):
+        name_check(effector, "parent_link", links, urdf.describe("link"))
+        name_check(effector, "group", groups, "group of the SRDF")
+        if effector.get("parent_group"):
+            name_check(effector, "parent_group", groups, "group of the SRDF")
+    for passive in root.iter("passive_joint"):
+        name_check(passive, "name", joints, urdf.describe("joint"))
+    known = set(links)
+    for pair in root.iter("disable_collisions"):
+        unknown = [pair.get(a, "") for a in ("link1", "link2") if pair.get(a, "") not in known]
+        if unknown:  # MoveIt ignores such a pair with a warning; so does Kinema
+            report.warnings.append(
+                f"{where(pair)}: <disable_collisions> names {', '.join(map(repr, unknown))}, not a link of "
+                f"{urdf.source.name}; the pair is ignored"
+            )
+
+
+def _is_below(tip: str, base: str, parent_of: Mapping[str, str]) -> bool:
+    link, seen = tip, set()
+    while link != base:
+        if link not in parent_of or link in seen:
+            return False
+        seen.add(link)
+        link = parent_of[link]
+    return True
+
+
+# -- joint limits and waypoints ----------------------------------------------------------------------------
+
+
+def _check_joint_limits(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport) -> None:
+    from kinema.config.yamlsource import load_yaml_file
+
+    path = _attempt(report, lambda: resolved.joint_limits_path)
+    if path is None:
+        return
+    report.checked.append(path)
+    document = _attempt(report, lambda: load_yaml_file(path))
+    if document is None:
+        return
+    limits = document.data.get("joint_limits") if isinstance(document.data, dict) else None
+    if not isinstance(limits, dict):
+        return
+    for joint in limits:
+        if str(joint) not in urdf.joints:
+            report.problem(
+                f"joint_limits names joint {joint!r}, which is not a {urdf.describe('joint')}; "
+                f"{did_you_mean(str(joint), urdf.movable_joints)}",
+                document.location(("joint_limits", joint)),
+            )
+
+
+def _check_waypoints(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport) -> None:
+    from kinema.config.waypoints import Waypoint
+    from kinema.config.yamlsource import load_yaml_file
+
+    path = _attempt(report, lambda: resolved.waypoints_path)
+    if path is None:
+        return
+    report.checked.append(path)
+    document = _attempt(report, lambda: load_yaml_file(path))
+    if document is None or not isinstance(document.data, list):
+        return
+    for number, item in enumerate(document.data):
+        try:
+            waypoint = Waypoint.from_dict(item, document, number)
+        except ConfigError as error:
+            report.problems.append(error)
+            continue
+        unknown = [j for j in waypoint.joint_names if j not in urdf.joints]
+        if unknown:
+            report.problem(
+                f"waypoint {waypoint.name!r} names {_joints(unknown)} not in {urdf.source.name}; "
+                f"{did_you_mean(unknown[0], urdf.movable_joints)}",
+                document.location((number, "joint_state", "name")),
+            )
+
+
+def _joints(names: list[str]) -> str:
+    return ("joint " if len(names) == 1 else "joints ") + ", ".join(map(repr, names))
+
+
+# -- the MuJoCo scene ---------------------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class _Scene:
+    """What the checks of the cell need from the loaded scene."""
+
+    path: Path
+    joints: list[str]
+    actuators: list[str]
+    sites: list[str]
+
+
+def _check_scene(resolved: ResolvedConfig, urdf: _Urdf | None, report: RobotReport) -> _Scene | None:
+    path = _attempt(report, lambda: resolved.mujoco_model_path)
+    if path is None:
+        return None
+    report.checked.append(path)
+    fallbacks = [
+        package.path / "mujoco_assets"
+        for package in resolved.workspace.packages.values()
+        if (package.path / "mujoco_assets").is_dir()
+    ]
+    files = _SceneFiles(path, fallbacks, report)
+    if not files.check():
+        return None
+    model = _load_mujoco(path, files.virtual, report)
+    if model is None:
+        return None
+    import mujoco
+
+    def names(kind: Any, count: int) -> list[str]:
+        return [mujoco.mj_id2name(model, kind, i) or "" for i in range(count)]
+
+    joints = [
+        model.joint(j).name
+        for j in range(model.njnt)
+        if int(model.jnt_type[j]) in (mujoco.mjtJoint.mjJNT_HINGE, mujoco.mjtJoint.mjJNT_SLIDE)
+    ]
+    scene = _Scene(
+        path=path,
+        joints=joints,
+        actuators=names(mujoco.mjtObj.mjOBJ_ACTUATOR, model.nu),
+        sites=names(mujoco.mjtObj.mjOBJ_SITE, model.nsite),
+    )
+    if urdf is not None:
+        missing = [j for j in urdf.active_joints if j not in joints]
+        if missing:
+            report.problem(
+                f"the MuJoCo scene does not simulate {_joints(missing)} of {urdf.source.name} (no hinge or "
+                f"slide joint of that name); {did_you_mean(missing[0], joints)}",
+                path,
+            )
+    keyframe = resolved.mujoco_keyframe
+    keyframes = names(mujoco.mjtObj.mjOBJ_KEY, model.nkey)
+    if keyframe and keyframe not in keyframes:
+        key = "hardware.simulation.mujoco_keyframe"
+        if resolved.get(key) is None:
+            key = "hardware.robot_description.urdf_params"
+        report.problem(
+            f"the MuJoCo keyframe {keyframe!r} is not in the scene {path}; "
+            f"{did_you_mean(keyframe, keyframes)}",
+            resolved.location_of(key),
+        )
+    return scene
+
+
+def _load_mujoco(path: Path, virtual: Mapping[str, Path], report: RobotReport) -> Any:
+    import mujoco
+
+    assets = {name: file.read_bytes() for name, file in virtual.items()}
+    try:
+        return mujoco.MjModel.from_xml_path(str(path), assets or None)
+    except (ValueError, RuntimeError) as exc:  # the files are there: what is left is the model itself
+        report.problem(f"MuJoCo cannot load the scene: {' '.join(str(exc).split())}", path)
+        return None
+
+
+class _SceneFiles:
+    """The files an MJCF scene and its includes name, found and checked before MuJoCo reads them.
+
+    Attributes:
+        virtual: files found only in a ``mujoco_assets`` folder, by the name MuJoCo will ask for.
+    """
+
+    def __init__(self, main: Path, fallbacks: list[Path], report: RobotReport) -> None:
+        self.main = main
+        self.fallbacks = fallbacks
+        self.report = report
+        self.virtual: dict[str, Path] = {}
+        self.documents: list[tuple[Path, etree._Element]] = []
+        self.pointers: list[tuple[str, Path, SourceLocation]] = []
+        self.ok = True
+
+    def check(self) -> bool:
+        """Read the scene and its includes and check every file; False when something is wrong."""
+        self._read(self.main, set())
+        compiler: dict[str, str] = {}
+        for _file, root in self.documents:
+            for element in root.iter("compiler"):
+                if element.get("assetdir"):
+                    compiler["meshdir"] = compiler["texturedir"] = element.get("assetdir", "")
+                for attribute in ("meshdir", "texturedir"):
+                    if element.get(attribute):
+                        compiler[attribute] = element.get(attribute, "")
+        for file, root in self.documents:
+            for element in root.iter(*_ASSET_FILES):
+                attributes, folder = _ASSET_FILES[str(element.tag)]
+                for attribute in attributes:
+                    if element.get(attribute):
+                        self._asset(element, attribute, compiler.get(folder, ""), file)
+        self._report_pointers()
+        return self.ok
+
+    def _problem(self, message: str, location: SourceLocation) -> None:
+        self.ok = False
+        self.report.problem(message, location)
+
+    def _read(self, file: Path, stack: set[Path]) -> None:
+        try:
+            root = etree.parse(str(file), etree.XMLParser(remove_comments=True)).getroot()
+        except etree.XMLSyntaxError as exc:
+            self._problem(
+                f"the MuJoCo scene is not valid XML: {exc.msg}", SourceLocation(str(file), exc.lineno or 0)
+            )
+            return
+        except OSError as exc:
+            self._problem(f"cannot read the MuJoCo scene: {exc}", SourceLocation(str(file)))
+            return
+        self.documents.append((file, root))
+        for include in root.iter("include"):
+            name = include.get("file", "")
+            where = SourceLocation(str(file), include.sourceline or 0)
+            places = [file.parent, self.main.parent, *self.fallbacks]
+            found = self._find(name, places, where, "include")
+            if found is None:
+                continue
+            if found.resolve() in stack:
+                self._problem(f"<include file={name!r}> includes itself ({found})", where)
+                continue
+            if self._pointer(found):
+                self.pointers.append(("include", found, where))
+                continue
+            if not _under(found, (file.parent, self.main.parent)):
+                self.virtual[name] = found
+            self._read(found, stack | {file.resolve()})
+
+    def _asset(self, element: etree._Element, attribute: str, folder: str, file: Path) -> None:
+        name = element.get(attribute, "")
+        relative = os.path.join(folder, name) if folder else name
+        where = SourceLocation(str(file), element.sourceline or 0)
+        found = self._find(relative, [self.main.parent, *self.fallbacks], where, str(element.tag))
+        if found is None:
+            return
+        if self._pointer(found):
+            self.pointers.append((str(element.tag), found, where))
+            return
+        if element.tag == "mesh" and is_ascii_stl(found):
+            self._problem(
+                f"mesh {found} is a text STL, which MuJoCo cannot read: save it as binary STL or OBJ", where
+            )
+        elif not _under(found, (self.main.parent,)):
+            self.virtual[relative] = found
+
+    def _find(self, name: str, places: list[Path], where: SourceLocation, kind: str) -> Path | None:
+        if not name:
+            self._problem(f"<{kind}> without a file name", where)
+            return None
+        candidates = [Path(name)] if Path(name).is_absolute() else [place / name for place in places]
+        for candidate in dict.fromkeys(candidates):
+            if candidate.is_file():
+                return candidate
+        looked = "; ".join(str(c) for c in dict.fromkeys(candidates))
+        self._problem(f"{kind} file {name!r} not found (looked for {looked})", where)
+        return None
+
+    @staticmethod
+    def _pointer(path: Path) -> bool:
+        try:
+            with path.open("rb") as handle:
+                return handle.read(len(_LFS_PREFIX)) == _LFS_PREFIX
+        except OSError:
+            return False
+
+    def _report_pointers(self) -> None:
+        for kind, path, where in self.pointers[:_POINTERS_SHOWN]:
+            self._problem(f"{kind} {path} is a Git LFS pointer file (run `git lfs pull`)", where)
+        rest = self.pointers[_POINTERS_SHOWN:]
+        if rest:
+            folders = sorted({str(path.parent) for _, path, _ in rest})
+            self._problem(
+                f"{len(rest)} more files the MuJoCo scene names are Git LFS pointer files (run `git lfs "
+                f"pull`), in {', '.join(folders)}",
+                rest[0][2],
+            )
+
+
+def _under(path: Path, folders: Iterable[Path]) -> bool:
+    resolved = path.resolve()
+    return any(resolved.is_relative_to(folder.resolve()) for folder in folders)
+
+
+# -- controllers, gripper, tool frame, sensor -------------------------------------------------------------
+
+
+def _check_cell(resolved: ResolvedConfig, urdf: _Urdf, scene: _Scene | None, report: RobotReport) -> None:
+    from kinema.config.cell import CellSettings
+
+    cell = _attempt(report, lambda: CellSettings.from_config(resolved))
+    if cell is None:
+        return
+    control = _ControlFile(resolved)
+
+    def joint_check(joint: str, what: str, location: SourceLocation) -> None:
+        if joint not in urdf.joints:
+            report.problem(
+                f"{what} names joint {joint!r}, which is not a {urdf.describe('joint')}; "
+                f"{did_you_mean(joint, urdf.movable_joints)}",
+                location,
+            )
+        elif scene is not None and joint not in scene.actuators:
+            report.problem(
+                f"{what} commands joint {joint!r}, which no actuator of the MuJoCo scene {scene.path.name} "
+                f"drives (the simulation drives a joint through an actuator named like it); actuators: "
+                f"{', '.join(scene.actuators) or 'none'}",
+                location,
+            )
+
+    for controller in cell.controllers.values():
+        for joint in controller.joints:
+            joint_check(joint, f"controller {controller.name!r}", control.joints_location(controller.name))
+    if cell.gripper is not None:
+        joint_check(cell.gripper.joint, "robot.gripper", resolved.location_of("robot.gripper"))
+    if cell.tool_frame and cell.tool_frame not in urdf.links:
+        report.problem(
+            f"robot.tool_frame {cell.tool_frame!r} is not a {urdf.describe('link')}; "
+            f"{did_you_mean(cell.tool_frame, urdf.links)}",
+            resolved.location_of("robot.tool_frame"),
+        )
+    sensor = cell.force_torque_sensor
+    if sensor is not None and scene is not None:
+        for site, key in ((sensor.name, "name"), (sensor.control_site, "control_site")):
+            if site and site not in scene.sites:
+                location = (
+                    resolved.location_of(f"robot.force_torque_sensor.{key}")
+                    if resolved.get(f"robot.force_torque_sensor.{key}") is not None
+                    else control.location(
+                        ("force_torque_sensor_broadcaster", "ros__parameters", "sensor_name")
+                    )
+                )
+                report.problem(
+                    f"the force/torque sensor's {key} {site!r} is not a site of the MuJoCo scene "
+                    f"{scene.path.name}; {did_you_mean(site, scene.sites)}",
+                    location,
+                )
+
+
+class _ControlFile:
+    """Where a controller's joints are written: config.yaml's robot.controllers, else ros2_control's yaml."""
+
+    def __init__(self, resolved: ResolvedConfig) -> None:
+        self.resolved = resolved
+        self.document: Any = None
+        if resolved.get("ros2_control.config") is not None:
+            from kinema.config.yamlsource import load_yaml_file
+
+            try:
+                self.document = load_yaml_file(resolved.resolve_file("ros2_control.config", kind="file"))
+            except ConfigError:
+                self.document = None  # CellSettings reported it
+
+    def location(self, key: tuple[str, ...]) -> SourceLocation:
+        if self.document is not None:
+            return self.document.location(key)  # type: ignore[no-any-return]
+        return self.resolved.location_of("ros2_control")
+
+    def joints_location(self, controller: str) -> SourceLocation:
+        own = ("robot", "controllers", controller, "joints")
+        if self.resolved.get(own) is not None:
+            return self.resolved.location_of(own)
+        if self.document is None:
+            return self.resolved.location_of("ros2_control")
+        lines = self.document.lines
+        key = (controller, "ros__parameters", "joints")
+        return self.location(key if key in lines else (controller, "ros__parameters", "joint"))

@@ -1,0 +1,109 @@
+"""The frame tree of a running cell: what :class:`~kinema.motion.FrameTree` is filled with for behaviors.
+
+- robot links: the robot model at a configuration the caller gives (the latest ``/joint_states``, or a
+  state at a camera frame's stamp);
+- cameras: the cameras of the config's MuJoCo scene that are fixed in the world (``scene_camera``), in
+  MuJoCo's camera convention (looking along -z, y up), read once per cell;
+- simulated objects: the MuJoCo driver's free bodies (``/mujoco/bodies``), when a simulator runs;
+- planning-scene objects: each world object's first primitive, under the object's id.
+
+One :class:`CellFrames` belongs to a :class:`~kinema.behaviors.BehaviorContext` (``context.frames``).
+"""
+
+from __future__ import annotations
+
+import threading
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+
+from kinema.drivers.mujoco.names import BODIES_SERVICE, BODIES_TYPE
+from kinema.errors import KinemaError
+from kinema.transforms import pose_from_message
+
+if TYPE_CHECKING:
+    from kinema.behaviors.context import BehaviorContext
+    from kinema.motion.frames import FrameTree
+
+__all__ = ["BODIES_TIMEOUT", "CellFrames", "fixed_camera_frames"]
+
+# A simulator answers within milliseconds; a real robot has none, and the tree must not wait for it.
+BODIES_TIMEOUT = 1.0
+
+
+def fixed_camera_frames(mjcf_path: Any) -> dict[str, np.ndarray]:
+    """``world_T_camera`` of each named camera of a MuJoCo scene that is fixed in the world (an unreadable
+    scene has none)."""
+    import mujoco
+
+    import kinema.mujoco_gl  # noqa: F401  (MuJoCo's OpenGL backend is chosen before mujoco loads)
+
+    try:
+        model = mujoco.MjModel.from_xml_path(str(mjcf_path))
+    except ValueError:
+        return {}
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)  # camera poses come from mj_camlight, which this runs
+    frames: dict[str, np.ndarray] = {}
+    for index in range(model.ncam):
+        name = model.camera(index).name
+        if name and int(model.body_weldid[model.cam_bodyid[index]]) == 0:
+            matrix = np.eye(4)
+            matrix[:3, :3] = data.cam_xmat[index].reshape(3, 3)
+            matrix[:3, 3] = data.cam_xpos[index]
+            frames[name] = matrix
+    return frames
+
+
+class CellFrames:
+    """The named frames of one cell, for :class:`~kinema.motion.FrameTree` s at a robot configuration.
+
+    Args:
+        context: the behavior context of the cell (its config, transport node, robot model and
+            planning scene).
+    """
+
+    def __init__(self, context: BehaviorContext) -> None:
+        self._context = context
+        self._cameras: dict[str, np.ndarray] | None = None
+        self._lock = threading.Lock()
+
+    @property
+    def cameras(self) -> dict[str, np.ndarray]:
+        """``world_T_camera`` of the world-fixed cameras of the config's MuJoCo scene (read on first use)."""
+        with self._lock:
+            if self._cameras is None:
+                config = self._context.config
+                path = config.mujoco_model_path if config is not None else None
+                self._cameras = fixed_camera_frames(path) if path is not None else {}
+            return self._cameras
+
+    def sim_bodies(self) -> dict[str, np.ndarray]:
+        """``world_T_body`` of the simulator's free bodies; none without a simulator on the network."""
+        node = self._context.node
+        if node is None:
+            return {}
+        try:
+            client = self._context.service_client(node, BODIES_TYPE, BODIES_SERVICE)
+            if not client.service_is_ready():
+                return {}  # no simulator on the graph (a real robot): objects come from perception instead
+            response = client.call({}, timeout=BODIES_TIMEOUT)
+        except KinemaError:
+            return {}  # no simulator (a real robot): objects come from perception instead
+        return {str(body.name): pose_from_message(body.pose) for body in response.bodies}
+
+    def fixed(self) -> dict[str, np.ndarray]:
+        """Every frame that is not a robot link: cameras, then simulated and planning-scene objects."""
+        frames: dict[str, np.ndarray] = dict(self.cameras)
+        frames.update(self.sim_bodies())
+        scene = self._context.planning_scene
+        for object_id, primitives in scene.world_objects().items():
+            if primitives:
+                frames[object_id] = primitives[0].world_T_object
+        return frames
+
+    def tree(self, q: np.ndarray) -> FrameTree:
+        """The frame tree with the robot at configuration ``q`` (over the robot model's joint names)."""
+        from kinema.motion.frames import FrameTree
+
+        return FrameTree(self._context.robot_model, q, self.fixed())

@@ -1,0 +1,628 @@
+"""``kinema new config NAME --from-urdf URDF``: a config package for a robot nobody wrote for Kinema.
+
+From a URDF (or xacro) and, optionally, its SRDF and a MuJoCo scene, this writes a package the normal
+loading path reads — there is no second path for generated robots::
+
+    NAME/package.xml
+    NAME/config/config.yaml            based on kinema_base (Kinema's core behaviors and subtrees)
+    NAME/description/NAME.urdf         the URDF, xacro expanded, mesh URIs as written
+    NAME/description/NAME.srdf         the given SRDF, or one made from the URDF's longest chain
+    NAME/description/joint_limits.yaml velocity limits from the URDF, accelerations (see below)
+    NAME/description/NAME_scene.xml    the MuJoCo scene (generated, or the one given) + meshes/
+    NAME/description/objects.xml       your objects in that world (a generated scene includes it)
+    NAME/waypoints/waypoints.yaml      Home and the SRDF's group states, under their own names
+    NAME/objectives/                   Open Gripper / Close Gripper when the robot has a gripper
+
+What it decides, and where a user changes it (config.yaml says it again beside each value):
+
+- the planning group: the SRDF's largest group of joints that names no other group; without an SRDF (or
+  an SRDF without groups) a group ``manipulator`` over the URDF's longest chain of movable joints;
+- the gripper: the movable joints outside the planning group that are no mimic of another; with one such
+  joint it is the gripper, open and closed from the SRDF group states called ``open``/``close(d)`` of a
+  group holding it, else from its limits (a prismatic finger opens at its upper limit, a revolute
+  knuckle at its lower one);
+- the tool frame: the SRDF end effector's parent link, else the planning group's tip;
+- ``Home``: the first SRDF group state named ``home``, ``ready`` or ``default`` that covers the planning
+  group, else every joint at 0 clipped into its limits. The simulation starts there;
+- accelerations: the URDF has none, so each joint's is twice its velocity limit per second.
+
+Nothing is written when anything fails: the package is made in a temporary folder and moved into place.
+"""
+
+from __future__ import annotations
+
+import math
+import shutil
+import tempfile
+from collections.abc import Callable, Mapping
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from lxml import etree
+
+from kinema.config.robot_files import PackageIndex, ResolvedRobot, UrdfJoint, resolve_robot
+from kinema.config.workspace import Workspace
+from kinema.errors import KinemaError, MotionError, ScaffoldError
+from kinema.motion.srdf import GroupDefinition, SemanticDescription, parse_srdf
+from kinema.scaffold.names import check_package_name
+
+#: The parent of every generated package.
+BASE_PACKAGE = "kinema_base"
+GRIPPER_CONTROLLER = "gripper_controller"
+ARM_CONTROLLER = "joint_trajectory_controller"
+HOME = "Home"
+
+
+@dataclass
+class RobotPlan:
+    """What the generator decided for one robot (also what ``--dry-run``-like callers can show)."""
+
+    name: str
+    robot: ResolvedRobot
+    semantic: SemanticDescription
+    srdf_text: str
+    planning_group: str
+    group_joints: list[str]
+    tool_frame: str
+    home: dict[str, float]
+    waypoints: dict[str, dict[str, float]]
+    gripper_joint: str | None = None
+    gripper_open: float = 0.0
+    gripper_closed: float = 0.0
+    notes: list[str] = field(default_factory=list)
+
+
+def _package_index(workspace: Workspace) -> PackageIndex:
+    return PackageIndex(packages={p.name: p.path for p in workspace.packages.values()})
+
+
+def _chain_joints(joints: Mapping[str, UrdfJoint], base: str, tip: str) -> list[str]:
+    by_child = {j.child: j for j in joints.values()}
+    chain: list[str] = []
+    link = tip
+    while link != base:
+        joint = by_child.get(link)
+        if joint is None:
+            raise ScaffoldError(
+                f"the SRDF names a chain from {base!r} to {tip!r}, which the URDF does not have"
+            )
+        chain.append(joint.name)
+        link = joint.parent
+    return [name for name in reversed(chain) if joints[name].movable]
+
+
+def _group_joints(
+    name: str,
+    groups: Mapping[str, GroupDefinition],
+    joints: Mapping[str, UrdfJoint],
+    seen: frozenset[str] = frozenset(),
+) -> list[str]:
+    group = groups[name]
+    out: list[str] = []
+    for base, tip in group.chains:
+        out += _chain_joints(joints, base, tip)
+    out += [j for j in group.joints if j in joints and joints[j].movable]
+    by_child = {j.child: j for j in joints.values()}
+    out += [by_child[link].name for link in group.links if link in by_child and by_child[link].movable]
+    for sub in group.subgroups:
+        if sub in groups and sub not in seen:
+            out += _group_joints(sub, groups, joints, seen | {name})
+    return list(dict.fromkeys(out))
+
+
+def _check_srdf_names(semantic: SemanticDescription, robot: ResolvedRobot, srdf: Path) -> None:
+    """Every joint and link the SRDF names must be the URDF's; one error lists them all."""
+    joints = {j.name for j in robot.joints()}
+    links = {j.child for j in robot.joints()} | {robot.root_link()}
+    parents = {j.child: j.parent for j in robot.joints()}
+    problems = []
+    for group in semantic.groups.values():
+        problems += [f"group {group.name!r} names joint {j!r}" for j in group.joints if j not in joints]
+        problems += [f"group {group.name!r} names link {lk!r}" for lk in group.links if lk not in links]
+        for base, tip in group.chains:
+            unknown = [lk for lk in (base, tip) if lk not in links]
+            problems += [f"group {group.name!r} chain names link {lk!r}" for lk in unknown]
+            if not unknown and not _below(tip, base, parents):
+                problems.append(f"group {group.name!r} chain's tip {tip!r} is not below its base {base!r}")
+    for (group_name, state), values in semantic.group_states.items():
+        problems += [
+            f"group state {state!r} ({group_name}) names joint {j!r}" for j in values if j not in joints
+        ]
+    for effector in semantic.end_effectors:
+        if effector.parent_link not in links:
+            problems.append(f"end effector {effector.name!r} names link {effector.parent_link!r}")
+    if problems:
+        raise ScaffoldError(
+            f"{srdf}: the SRDF does not fit the URDF {robot.source.name}: "
+            + "; ".join(problems[:8])
+            + (f" (and {len(problems) - 8} more)" if len(problems) > 8 else "")
+            + f". The URDF's joints: {', '.join(sorted(joints))}"
+        )
+
+
+def _below(tip: str, base: str, parents: Mapping[str, str]) -> bool:
+    """``tip`` is ``base`` or one of its descendants (following each link's parent)."""
+    link = tip
+    for _ in range(len(parents) + 1):
+        if link == base:
+            return True
+        if link not in parents:
+            return False
+        link = parents[link]
+    return False
+
+
+def _generated_srdf(
+    robot: ResolvedRobot, group: str, base: str, tip: str, semantic: SemanticDescription
+) -> str:
+    root = etree.Element("robot", name=robot.name)
+    root.append(
+        etree.Comment(
+            " Made by kinema new config from the URDF: the URDF's longest chain of movable joints. "
+        )
+    )
+    element = etree.SubElement(root, "group", name=group)
+    etree.SubElement(element, "chain", base_link=base, tip_link=tip)
+    pairs = {tuple(sorted(p)) for p in semantic.disabled_collisions}
+    for joint in robot.joints():
+        pairs.add(tuple(sorted((joint.parent, joint.child))))
+    for a, b in sorted(pairs):
+        if len({a, b}) == 2:
+            etree.SubElement(root, "disable_collisions", link1=a, link2=b, reason="Adjacent")
+    return '<?xml version="1.0"?>\n' + etree.tostring(root, pretty_print=True, encoding="unicode")
+
+
+def _clip(joint: UrdfJoint, value: float) -> float:
+    low = joint.lower if joint.lower is not None else -math.inf
+    high = joint.upper if joint.upper is not None else math.inf
+    return min(max(value, low), high)
+
+
+def plan_robot(
+    name: str, urdf: Path, *, srdf: Path | None, xacro_args: Mapping[str, str] | None, index: PackageIndex
+) -> RobotPlan:
+    """Read the robot and decide its group, gripper, tool frame, Home and waypoints (see the module doc).
+
+    Raises:
+        ConfigError: the URDF cannot be read, xacro fails, a mesh is missing or an LFS pointer.
+        ScaffoldError: no movable joints, or an SRDF naming what the URDF lacks.
+    """
+    from kinema.scaffold.mjcf_scene import longest_chain
+
+    robot = resolve_robot(urdf, xacro_args=xacro_args, index=index)
+    joints = {j.name: j for j in robot.joints()}
+    active = [j.name for j in joints.values() if j.movable and j.mimic is None]
+    if not active:
+        raise ScaffoldError(
+            f"{urdf}: the URDF has no movable joints (revolute, continuous or prismatic): nothing to "
+            "plan or simulate"
+        )
+    notes: list[str] = []
+    semantic = SemanticDescription()
+    srdf_text = ""
+    if srdf is not None:
+        try:
+            semantic = parse_srdf(srdf)
+        except MotionError as error:
+            raise ScaffoldError(str(error)) from None
+        _check_srdf_names(semantic, robot, srdf)
+        srdf_text = Path(srdf).read_text()
+    groups = {
+        n: _group_joints(n, semantic.groups, joints) for n, g in semantic.groups.items() if not g.subgroups
+    }
+    groups = {n: js for n, js in groups.items() if js}
+    if groups:
+        group = max(groups, key=lambda n: len(groups[n]))
+        group_joints = groups[group]
+    else:
+        base, tip, chain = longest_chain(robot.urdf_text)
+        group = "manipulator"
+        group_joints = [j for j in chain if joints[j].mimic is None]
+        srdf_text = _generated_srdf(robot, group, base, tip, semantic)
+        semantic = _parse_srdf_text(srdf_text)
+        notes.append(f"planning group {group!r}: the URDF's longest chain, {base} → {tip}")
+    effector = next((e for e in semantic.end_effectors if e.parent_link), None)
+    if effector is not None:
+        tool_frame = effector.parent_link
+    else:
+        definition = semantic.groups.get(group)
+        tip_links = [t for _, t in definition.chains] if definition else []
+        tool_frame = tip_links[-1] if tip_links else joints[group_joints[-1]].child
+    others = [j for j in active if j not in group_joints]
+    gripper = others[0] if len(others) == 1 else None
+    if len(others) > 1:
+        notes.append(
+            f"no gripper: {len(others)} movable joints are outside {group!r} ({', '.join(others)}); set "
+            "robot.gripper in config.yaml if one of them is the gripper"
+        )
+    home: dict[str, float] = {n: _clip(joints[n], 0.0) for n in active}
+    for state in ("home", "ready", "default"):
+        found = next(
+            (
+                v
+                for (g, s), v in semantic.group_states.items()
+                if s.lower() == state and set(group_joints) <= set(v)
+            ),
+            None,
+        )
+        if found is not None:
+            home.update({k: float(v) for k, v in found.items() if k in home})
+            notes.append(f"{HOME}: the SRDF group state {state!r}")
+            break
+    opened = closed = 0.0
+    if gripper is not None:
+        joint = joints[gripper]
+        states = {s.lower(): v for (g, s), v in semantic.group_states.items() if gripper in v}
+        open_state = states.get("open")
+        closed_state = states.get("close", states.get("closed"))
+        low = joint.lower if joint.lower is not None else 0.0
+        high = joint.upper if joint.upper is not None else 0.0
+        if joint.kind == "prismatic":
+            opened, closed = high, low
+        else:
+            opened, closed = low, high
+        if open_state is not None:
+            opened = float(open_state[gripper])
+        if closed_state is not None:
+            closed = float(closed_state[gripper])
+        home[gripper] = opened
+    waypoints = {HOME: dict(home)}
+    for (_group, state), values in semantic.group_states.items():
+        waypoint = dict(home)
+        waypoint.update({k: float(v) for k, v in values.items() if k in waypoint})
+        waypoints.setdefault(state, waypoint)
+    return RobotPlan(
+        name=name,
+        robot=robot,
+        semantic=semantic,
+        srdf_text=srdf_text,
+        planning_group=group,
+        group_joints=group_joints,
+        tool_frame=tool_frame,
+        home=home,
+        waypoints=waypoints,
+        gripper_joint=gripper,
+        gripper_open=opened,
+        gripper_closed=closed,
+        notes=notes,
+    )
+
+
+def _parse_srdf_text(text: str) -> SemanticDescription:
+    with tempfile.NamedTemporaryFile("w", suffix=".srdf", delete=False) as handle:
+        handle.write(text)
+    try:
+        return parse_srdf(handle.name)
+    finally:
+        Path(handle.name).unlink(missing_ok=True)
+
+
+def _yaml_number(value: float) -> str:
+    return repr(round(float(value), 6))
+
+
+def _joint_limits_yaml(plan: RobotPlan) -> str:
+    lines = [
+        "# Velocity limits from the URDF; the URDF gives no accelerations, so each is twice the velocity",
+        "# limit per second. Replace them with your robot's datasheet values.",
+        "default_velocity_scaling_factor: 1.0",
+        "default_acceleration_scaling_factor: 1.0",
+        "joint_limits:",
+    ]
+    for joint in plan.robot.joints():
+        if not joint.movable or joint.mimic is not None:
+            continue
+        velocity = joint.velocity if joint.velocity and joint.velocity > 0 else 1.0
+        lines += [
+            f"  {joint.name}:",
+            "    has_velocity_limits: true",
+            f"    max_velocity: {_yaml_number(velocity)}",
+            "    has_acceleration_limits: true",
+            f"    max_acceleration: {_yaml_number(2.0 * velocity)}",
+        ]
+    return "\n".join(lines) + "\n"
+
+
+def _waypoints_yaml(plan: RobotPlan) -> str:
+    lines = [
+        "# Waypoints of " + plan.name + ": Home (where the simulation starts) and the SRDF's group states.",
+        "# Saved and edited by the waypoint behaviors and kinema's UIs (MoveIt Pro's waypoint format).",
+    ]
+    for name, values in plan.waypoints.items():
+        joint_names = list(values)
+        lines += [
+            f"- name: {name!r}",
+            "  joint_group_names: [" + plan.planning_group + "]",
+            "  joint_state:",
+            "    header: {frame_id: ''}",
+            "    name: [" + ", ".join(joint_names) + "]",
+            "    position: [" + ", ".join(_yaml_number(values[j]) for j in joint_names) + "]",
+            "    velocity: []",
+            "    effort: []",
+        ]
+    return "\n".join(lines) + "\n"
+
+
+def _gripper_objective(plan: RobotPlan, objective: str, position: float) -> str:
+    return f"""<?xml version="1.0" encoding="UTF-8"?>
+<root BTCPP_format="4" main_tree_to_execute="{objective}">
+  <!-- Made by kinema new config (from the URDF): {plan.gripper_joint} to {position:g}. -->
+  <BehaviorTree ID="{objective}" _description="{objective.split()[0]} the gripper" _favorite="true">
+    <Action ID="MoveGripperAction" position="{position:g}"/>
+  </BehaviorTree>
+  <TreeNodesModel>
+    <SubTree ID="{objective}">
+      <MetadataFields>
+        <Metadata subcategory="Grasping"/>
+        <Metadata runnable="true"/>
+      </MetadataFields>
+    </SubTree>
+  </TreeNodesModel>
+</root>
+"""
+
+
+def _config_yaml(plan: RobotPlan, scene: str, source: str) -> str:
+    name = plan.name
+    controllers = [ARM_CONTROLLER] + ([GRIPPER_CONTROLLER] if plan.gripper_joint else [])
+    text = (
+        f"""#
+# {name}: made by `kinema new config {name} --from-urdf {source}`.
+# The schema is MoveIt Pro's config.yaml, with Kinema's hardware.simulation and robot sections.
+#
+based_on_package: "{BASE_PACKAGE}"
+
+hardware:
+  robot_description:
+    urdf:
+      package: "{name}"
+      path: "description/{name}.urdf"
+    srdf:
+      package: "{name}"
+      path: "description/{name}.srdf"
+  simulation:
+    mujoco_model:
+      package: "{name}"
+      path: "description/{scene}"
+    # The simulation starts in, and resets to, this keyframe ({HOME}'s joint values).
+    mujoco_keyframe: "home"
+
+ros_global_params:
+  use_sim_time: True
+
+moveit_params:
+  # The default planning group of behaviors and core subtrees ({", ".join(plan.group_joints)}).
+  joint_group_name: "{plan.planning_group}"
+  joint_limits:
+    package: "{name}"
+    path: "description/joint_limits.yaml"
+
+ros2_control:
+  controllers_active_at_startup:
+    - "joint_state_broadcaster"
+"""
+        + "".join(f'    - "{c}"\n' for c in controllers)
+        + f"""
+robot:
+  # The frame Cartesian moves and IK place when an objective names none.
+  tool_frame: "{plan.tool_frame}"
+  controllers:
+    {ARM_CONTROLLER}:
+      type: "joint_trajectory_controller/JointTrajectoryController"
+      joints: [{", ".join(plan.group_joints)}]
+"""
+    )
+    if plan.gripper_joint:
+        text += f"""    {GRIPPER_CONTROLLER}:
+      type: "position_controllers/GripperActionController"
+      joints: [{plan.gripper_joint}]
+  gripper:
+    # Serves /{GRIPPER_CONTROLLER}/gripper_cmd. Open and closed are the joint's positions.
+    controller: "{GRIPPER_CONTROLLER}"
+    joint: "{plan.gripper_joint}"
+    open_position: {_yaml_number(plan.gripper_open)}
+    closed_position: {_yaml_number(plan.gripper_closed)}
+"""
+    text += f"""
+objectives:
+  objective_library_paths:
+    {name}_objectives:
+      package_name: "{name}"
+      relative_path: "objectives"
+  waypoints_file:
+    package_name: "{name}"
+    relative_path: "waypoints/waypoints.yaml"
+"""
+    return text
+
+
+def _package_xml(name: str, robot: str) -> str:
+    return f"""<?xml version="1.0"?>
+<package format="3">
+  <name>{name}</name>
+  <version>0.1.0</version>
+  <description>Kinema config package for the robot {robot}, made from its URDF.</description>
+  <maintainer email="you@example.com">you</maintainer>
+  <license>Apache-2.0</license>
+  <export>
+    <kinema_config/>
+  </export>
+</package>
+"""
+
+
+def new_robot_package(
+    name: str,
+    urdf: str | Path,
+    *,
+    srdf: str | Path | None = None,
+    mjcf: str | Path | None = None,
+    xacro_args: Mapping[str, str] | None = None,
+    output_dir: str | Path | None = None,
+    workspace: Workspace | None = None,
+    progress: Callable[[str], None] | None = None,
+) -> tuple[Path, RobotPlan]:
+    """Write config package ``name`` for the robot in ``urdf`` (see the module's docstring).
+
+    Returns:
+        The package folder and what was decided.
+
+    Raises:
+        ScaffoldError, ConfigError: a bad name or a taken one, unreadable files, missing meshes, an SRDF
+            that does not fit; nothing is written then.
+    """
+    from kinema.scaffold.config_package import default_output_dir
+    from kinema.scaffold.mjcf_scene import generate_scene
+
+    say = progress or (lambda _text: None)
+    workspace = workspace if workspace is not None else Workspace.discover()
+    check_package_name(name)
+    if workspace.has_package(name):
+        existing = workspace.package(name)
+        raise ScaffoldError(f"a package named {name!r} already exists ({existing.path}); choose another name")
+    target_dir = Path(output_dir) if output_dir is not None else default_output_dir(workspace)
+    target = target_dir / name
+    if target.exists():
+        raise ScaffoldError(f"{target} already exists; choose another name or remove it")
+    index = _package_index(workspace)
+    urdf_path = _locate(urdf, index)
+    srdf_path, mjcf_path = _locate(srdf, index), _locate(mjcf, index)
+    for label, given in (("URDF", urdf_path), ("SRDF", srdf_path), ("MuJoCo scene", mjcf_path)):
+        if given is not None and not given.is_file():
+            raise ScaffoldError(f"{label} file not found: {given}")
+    assert urdf_path is not None
+    say(f"reading {urdf_path.name}")
+    plan = plan_robot(name, urdf_path, srdf=srdf_path, xacro_args=xacro_args, index=index)
+    target_dir.mkdir(parents=True, exist_ok=True)
+    staging = Path(tempfile.mkdtemp(prefix=f".{name}-", dir=target_dir))
+    try:
+        description = staging / "description"
+        description.mkdir()
+        (description / f"{name}.urdf").write_text(
+            '<?xml version="1.0"?>\n' + _strip_declaration(plan.robot.urdf_text)
+        )
+        (description / f"{name}.srdf").write_text(plan.srdf_text)
+        (description / "joint_limits.yaml").write_text(_joint_limits_yaml(plan))
+        if mjcf_path is not None:
+            scene = _copy_scene(mjcf_path, description)
+        else:
+            say("generating the MuJoCo scene (meshes are converted once)")
+            keyframes = {n.lower().replace(" ", "_"): v for n, v in plan.waypoints.items() if n != HOME}
+            path = generate_scene(
+                plan.robot,
+                description,
+                name=name,
+                home=plan.home,
+                keyframes=keyframes,
+                disabled_collisions=[tuple(sorted(p)) for p in plan.semantic.disabled_collisions],  # type: ignore[misc]
+            )
+            scene = path.name
+            _add_objects_include(path)
+            if plan.gripper_joint:
+                _grip_firmly(path, plan.gripper_joint, plan.gripper_open, plan.gripper_closed)
+        (staging / "waypoints").mkdir()
+        (staging / "waypoints" / "waypoints.yaml").write_text(_waypoints_yaml(plan))
+        (staging / "objectives").mkdir()
+        if plan.gripper_joint:
+            (staging / "objectives" / "open_gripper.xml").write_text(
+                _gripper_objective(plan, "Open Gripper", plan.gripper_open)
+            )
+            (staging / "objectives" / "close_gripper.xml").write_text(
+                _gripper_objective(plan, "Close Gripper", plan.gripper_closed)
+            )
+        (staging / "config").mkdir()
+        (staging / "config" / "config.yaml").write_text(_config_yaml(plan, scene, str(urdf)))
+        (staging / "package.xml").write_text(_package_xml(name, plan.robot.name))
+        staging.rename(target)
+    except (KinemaError, OSError) as error:
+        shutil.rmtree(staging, ignore_errors=True)
+        if isinstance(error, KinemaError):
+            raise
+        raise ScaffoldError(f"cannot write {target}: {error}") from error
+    except BaseException:
+        shutil.rmtree(staging, ignore_errors=True)
+        raise
+    return target, plan
+
+
+OBJECTS_FILE = "objects.xml"
+_OBJECTS_TEXT = """<mujoco>
+  <!--
+    Your objects in the simulated world: put bodies inside <worldbody> (a <freejoint/> makes one movable,
+    e.g. a cube to pick). The robot stands on the table top at z = 0, the table reaching in front of it
+    along +x. The scene includes this file; it is yours to edit (kinema new config never rewrites it).
+  -->
+  <worldbody>
+  </worldbody>
+</mujoco>
+"""
+
+
+def _add_objects_include(scene: Path) -> None:
+    """Make the generated scene include ``objects.xml`` (the user's objects), after the robot's bodies so
+    the keyframes' joint values keep their places."""
+    tree = etree.parse(str(scene))
+    root = tree.getroot()
+    worldbody = root.find("worldbody")
+    include = etree.Element("include", file=OBJECTS_FILE)
+    if worldbody is not None:
+        worldbody.addnext(include)
+    else:
+        root.append(include)
+    scene.write_text(etree.tostring(root, encoding="unicode") + "\n")
+    (scene.parent / OBJECTS_FILE).write_text(_OBJECTS_TEXT)
+
+
+#: Share of the gripper's effort limit it squeezes with when closed on an object half as wide as it opens.
+GRIP_SHARE = 0.05
+
+
+def _grip_firmly(scene: Path, joint: str, opened: float, closed: float) -> None:
+    """Make the gripper's servo squeeze: a servo tuned for tracking, like the arm's, presses a held
+    object with under a newton, and MuJoCo's soft contacts let such a grasp creep until the object falls.
+
+    The gain is chosen so that closing on an object half as wide as the gripper opens presses with
+    GRIP_SHARE of the actuator's force limit; the damping keeps the servo's damping ratio.
+    """
+    tree = etree.parse(str(scene))
+    for actuator in tree.getroot().iter("position"):
+        if actuator.get("joint") != joint:
+            continue
+        limits = [abs(float(v)) for v in (actuator.get("forcerange") or "0 0").split()]
+        force = max(limits) if limits else 0.0
+        travel = abs(opened - closed) / 2.0
+        old_kp = float(actuator.get("kp") or 0.0)
+        if force <= 0.0 or travel <= 0.0 or old_kp <= 0.0:
+            return
+        kp = max(old_kp, GRIP_SHARE * force / travel)
+        kv = float(actuator.get("kv") or 0.0) * math.sqrt(kp / old_kp)
+        actuator.set("kp", f"{kp:.6g}")
+        actuator.set("kv", f"{kv:.6g}")
+    scene.write_text(etree.tostring(tree.getroot(), encoding="unicode") + "\n")
+
+
+def _locate(given: str | Path | None, index: PackageIndex) -> Path | None:
+    """A path, or a ``package://PKG/PATH`` URI found through ``index`` (installed description packages,
+    the workspace, ROS_PACKAGE_PATH, AMENT_PREFIX_PATH)."""
+    if given is None:
+        return None
+    text = str(given)
+    if text.startswith("package://"):
+        from kinema.config.robot_files import resolve_uri
+
+        return resolve_uri(text, base_dir=Path.cwd(), index=index)
+    return Path(given)
+
+
+def _strip_declaration(text: str) -> str:
+    stripped = text.lstrip()
+    if stripped.startswith("<?xml"):
+        return stripped[stripped.index("?>") + 2 :].lstrip()
+    return stripped
+
+
+def _copy_scene(mjcf: Path, description: Path) -> str:
+    """Use the given MuJoCo scene: its folder (with its assets) is copied into ``description/mjcf/``."""
+    destination = description / "mjcf"
+    shutil.copytree(mjcf.parent, destination)
+    return f"mjcf/{mjcf.name}"

@@ -1,0 +1,29 @@
+"""The names between behaviors and Kinema's UIs: the 3D view (``kinema view``) and the terminal UI.
+
+Behaviors run in the agent and publish on these topics (the view and the TUI subscribe), or call the TUI's
+approval service. The names are defined here, below both, so a behavior reaches a UI without loading it and
+a UI listens without loading the behavior SDK. This module imports nothing. (The agent's own names are
+:mod:`kinema.runtime.names`, the drivers' :mod:`kinema.drivers.mujoco.names`.)
+"""
+
+from __future__ import annotations
+
+# The joint trajectory a planning behavior just produced (and ExecuteTrajectory is about to run); the view
+# draws the end effector's path along it.
+PLANNED_TRAJECTORY_TOPIC = "/kinema/planned_trajectory"
+PLANNED_TRAJECTORY_TYPE = "trajectory_msgs/msg/JointTrajectory"
+
+# RViz's marker topics (VisualizePose publishes on the array topic).
+MARKER_ARRAY_TOPIC = "/visualization_marker_array"
+MARKER_ARRAY_TYPE = "visualization_msgs/msg/MarkerArray"
+MARKER_TOPIC = "/visualization_marker"
+MARKER_TYPE = "visualization_msgs/msg/Marker"
+
+# The task PlanMTCTask plans, stage by stage, while it plans (the TUI's task panel).
+TASK_PLANNING_TOPIC = "/kinema/task_planning"
+TASK_PLANNING_TYPE = "kinema_msgs/msg/TaskPlanningStatus"
+
+# Served by the terminal UI while it runs: a behavior asking the operator (GetUserApproval and friends)
+# calls it, and fails over to its headless rule when nobody serves it.
+APPROVAL_SERVICE = "/kinema/user_approval"
+APPROVAL_TYPE = "kinema_msgs/srv/RequestApproval"
