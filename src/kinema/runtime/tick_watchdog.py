@@ -249,9 +249,11 @@ class TickWatchdog:
             if not any(re.search(RUNNING_BEHAVIORS, frame) for frame in frames):
                 continue  # the tick thread was waiting, not running behavior code: not its stall
             where = " ← ".join(frames[:STALL_FRAMES])
+            thread = worker.name if worker else "?"
             sentence = (
-                f"the interpreter was held for more than {self.report_after_s:g} s (C code that does not "
-                f"release the GIL?) while tick thread {worker.name if worker else '?'} sat in: {where}"
+                f"Kinema stood still for more than {self.report_after_s:g} s: the interpreter was held (C "
+                f"code that does not release Python's lock?) while tick thread {thread} sat in: {where}; "
+                "slow C work belongs in an AsyncBehavior's do_work, off the tick"
             )
             log.error("watchdog: %s", sentence)
             self._stalls = [*self._stalls[-3:], (when, sentence)]
