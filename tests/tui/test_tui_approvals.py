@@ -27,7 +27,12 @@ def test_the_user_approves_or_declines_in_a_dialog(fake: FakeConnection) -> None
         assert isinstance(app.screen, ConfirmDialog)
         assert "Approve the planned motion?" in app.screen.question
         assert "WaitForMTCSolutionApproval at Main/Approve" in app.screen.question
-        await pilot.press("y")
+        await pilot.press("y")  # a printable key never lets the robot move
+        await settle(pilot)
+        assert answers == [] and isinstance(app.screen, ConfirmDialog)
+        keys = " ".join(str(label.render()) for label in app.screen.query(".dialog-keys"))
+        assert "ctrl+y: Approve" in keys and "n or Esc: Reject" in keys
+        await pilot.press("ctrl+y")
         await settle(pilot)
         assert answers == [(True, "")]
         fake.emit(ask("Breakpoint at Main/Stop: resume?"))
@@ -124,7 +129,7 @@ def test_a_motion_to_approve_is_listed_step_by_step(fake: FakeConnection) -> Non
         ):
             assert expected in text, text
         assert "the gripper moves in 1 of them" in text, text
-        await pilot.press("y")
+        await pilot.press("ctrl+y")
         await settle(pilot)
         assert answers == [(True, "")]
 

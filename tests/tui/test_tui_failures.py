@@ -15,6 +15,7 @@ from kinema.tui.connection import (
     NodeStatusUpdate,
     RuntimeEvent,
 )
+from kinema.tui.dialogs.failure import FailureDialog
 from kinema.tui.fake_connection import FakeConnection
 from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
 
@@ -108,15 +109,30 @@ def test_a_failed_run_keeps_statuses_highlights_the_path_and_explains_the_node(f
         assert view.cursor_node is not None and view.cursor_node.data.path == "Script::9"
         lines = detail_lines(view)
         assert "code = grasp_pose := 'on the table'" in lines
-        assert any(line.startswith("why: objective 'Pick Object' failed") for line in lines)
+        # The node's own message first, then where: a line cut at the edge keeps what went wrong.
+        assert any(line.startswith("why: the script could not assign grasp_pose") for line in lines)
+        assert any(line.startswith("at: node 'Script::9' [Script]") for line in lines)
+        width = view.size.width
+        assert all(len(line) + 12 <= width for line in lines if not line.startswith("code")), lines
         panel = app.screen.query_one("#failure-panel", Static)
-        assert panel.has_class("shown") and "node 'Script::9'" in str(panel.render())
-        assert "the tree below shows the failed path" in str(panel.render())
-        # The failure stays: a later heartbeat (Idle) changes nothing; d dismisses the panel only.
+        shown = str(panel.render())
+        assert panel.has_class("shown") and "node 'Script::9'" in shown
+        assert shown.index("the script could not assign") < shown.index("node 'Script::9'")
+        assert "ctrl+o whole message" in shown
+        # ctrl+o opens the whole message, as the runtime wrote it too; Escape closes it.
+        await pilot.press("ctrl+o")
+        await settle(pilot)
+        assert isinstance(app.screen, FailureDialog)
+        whole = " ".join(str(w.render()) for w in app.screen.query(Static))
+        assert FAILED in " ".join(whole.split()) or FAILED.split(": ", 1)[1][:60] in whole
+        await pilot.press("escape")
+        await settle(pilot)
+        assert not isinstance(app.screen, FailureDialog)
+        # The failure stays: a later heartbeat (Idle) changes nothing; Escape dismisses the panel only.
         fake.emit(Heartbeat(13.0, "Pick Object", "Idle"))
         await settle(pilot)
         assert panel.has_class("shown") and view.shown_as("Script::9") == "FAILURE"
-        await pilot.press("d")
+        await pilot.press("escape")
         await settle(pilot)
         assert not panel.has_class("shown")
         assert view.shown_as("Script::9") == "FAILURE", "the tree keeps explaining until the next run"
@@ -191,7 +207,7 @@ def test_a_failure_whose_outcome_comes_before_the_run_itself_stays_explained(fak
         assert any(line.startswith("why: ") for line in detail_lines(view))
         # Outcome first again, and the whole run's statuses only after the heartbeat's end.
         fake.emit(Heartbeat(20.0, "Pick Object", "Idle"))
-        await pilot.press("r")
+        await pilot.press("ctrl+r")
         await settle(pilot)
         await deliver(
             fake,
@@ -253,9 +269,19 @@ def test_a_cancelled_run_shows_halted_nodes(fake: FakeConnection) -> None:
         assert view.failed_path == []
         panel = app.screen.query_one("#failure-panel", Static)
         assert panel.has_class("shown") and panel.has_class("cancelled")
-        # The next run starts: how the last one ended no longer describes what the screen shows.
+        # Another objective runs: the box is Pick Object's, shown with Pick Object only.
         fake.emit(Heartbeat(13.0, "", "Idle"))
         fake.emit(Heartbeat(14.0, "Open Gripper", "Running"))
+        await settle(pilot)
+        assert panel.has_class("shown")
+        await pilot.press("down")
+        await settle(pilot)
+        assert app.screen.selected.name == "Open Gripper" and not panel.has_class("shown")
+        await pilot.press("up")
+        await settle(pilot)
+        assert panel.has_class("shown") and "cancelled" in str(panel.render())
+        # Pick Object runs again: how its last run ended no longer describes it.
+        fake.emit(Heartbeat(15.0, "Pick Object", "Running"))
         await settle(pilot)
         assert not panel.has_class("shown")
 
@@ -310,7 +336,9 @@ def test_a_failure_whose_node_never_reported_it_is_still_shown(fake: FakeConnect
         await settle(pilot)
         view = app.screen.query_one(BehaviorTreeView)
         assert view.shown_as("Wait and Log::3/Sleep::5") == "FAILURE"
-        assert view.shown_as("TopLevelSequence") == "HALTED"
+        # The exception escaped through its ancestors: they failed with it (BT.CPP halts none of them).
+        assert view.shown_as("TopLevelSequence") == "FAILURE"
+        assert view.shown_as("Wait and Log::3") == "FAILURE"
         assert view.failed_path == [1, 3, 4, 5]
 
     drive(fake, scenario)
@@ -360,9 +388,8 @@ def test_long_log_lines_wrap(fake: FakeConnection) -> None:
     drive(fake, scenario)
 
 
-def test_the_failure_of_another_objective_than_the_selected_one_says_where_its_path_is(
-    fake: FakeConnection,
-) -> None:
+def test_a_result_box_belongs_to_the_objective_it_describes(fake: FakeConnection) -> None:
+    # A new user saw another objective's "cancelled" above the selected objective's tree.
     async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
         assert app.screen.selected.name == "Pick Object"
         fake.emit(Heartbeat(10.0, "Open Gripper", "Running"))
@@ -370,8 +397,34 @@ def test_the_failure_of_another_objective_than_the_selected_one_says_where_its_p
         fake.emit(LogEntry("objective 'Open Gripper' failed: node 'X' [Y]: stuck", LogLevel.ERROR, 1.0))
         await settle(pilot)
         panel = app.screen.query_one("#failure-panel", Static)
-        assert panel.has_class("shown") and "'Open Gripper' failed" in str(panel.render())
-        # The tree below is Pick Object's: the box does not claim it shows the failed path.
-        assert "select it to see the failed path" in str(panel.render())
+        assert not panel.has_class("shown")  # Pick Object did not fail
+        await pilot.press("down")
+        await settle(pilot)
+        assert app.screen.selected.name == "Open Gripper"
+        assert panel.has_class("shown") and str(panel.render()).splitlines()[1].startswith("stuck")
+
+    drive(fake, scenario)
+
+
+def test_a_run_on_code_whose_reload_failed_says_so_in_the_box_before_the_path(fake: FakeConnection) -> None:
+    # The runtime adds a note when the tree ran behaviors whose latest file failed to load.
+    message = (
+        "objective 'Pick Object' failed (FAILURE): /ws/o.xml:5: Exception in node 'Script::9' [Script]: "
+        "behavior 'Script' raised in tick at /ws/b.py:12: ValueError: version 1\n"
+        "note: /ws/b.py:11: plugin 'p': behavior package 'p' failed to import: SyntaxError: '(' was never "
+        "closed; Script runs the version from 08:01 instead"
+    )
+
+    async def scenario(app, pilot: Pilot[None]) -> None:  # type: ignore[no-untyped-def]
+        fake.emit(Heartbeat(10.0, "Pick Object", "Running"))
+        fake.emit(Heartbeat(11.0, "Pick Object", "Failure"))
+        fake.emit(LogEntry(message, LogLevel.ERROR, 1.0))
+        await settle(pilot)
+        shown = str(app.screen.query_one("#failure-panel", Static).render()).splitlines()
+        assert shown[1] == "ValueError: version 1"
+        assert shown[2].startswith("note: /ws/b.py:11:") and "SyntaxError" in " ".join(shown[2:4])
+        view = app.screen.query_one(BehaviorTreeView)
+        # The exception escaped before any status was sent: its ancestors failed with it all the same.
+        assert view.shown_as("Script::9") == "FAILURE" and view.shown_as("TopLevelSequence") == "FAILURE"
 
     drive(fake, scenario)

@@ -40,10 +40,10 @@ def test_search_and_filters_narrow_the_list(fake: FakeConnection) -> None:
         app.screen.query_one("#objective-search", Input).value = ""
         await pilot.press("escape")  # leave the search box; the list has the focus for the keys below
         app.screen.query_one("#objective-list", OptionList).focus()
-        await pilot.press("f")
+        await pilot.press("ctrl+f")
         await settle(pilot)
         assert listed(app) == ["Pick Object"]
-        await pilot.press("f", "u")
+        await pilot.press("ctrl+f", "ctrl+u")
         await settle(pilot)
         assert listed(app) == ["Pick Object", "Open Gripper"]
         assert app.screen.query_one("#runnable", Checkbox).value
@@ -57,7 +57,7 @@ def test_search_and_filters_narrow_the_list(fake: FakeConnection) -> None:
 
 def test_run_sends_the_filled_in_parameters_and_cancel_cancels(fake: FakeConnection) -> None:
     async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
-        await pilot.press("p")
+        await pilot.press("f4")
         await settle(pilot)
         assert app.screen.query_one(TabbedContent).active == "parameters"
         form = app.screen.query_one(OverrideForm)
@@ -65,11 +65,11 @@ def test_run_sends_the_filled_in_parameters_and_cancel_cancels(fake: FakeConnect
         assert set(inputs) == {"waypoint_name", "speed"}  # output ports get no input
         inputs["speed"].value = "0.25"
         app.screen.query_one("#objective-list", OptionList).focus()
-        await pilot.press("r")
+        await pilot.press("enter")
         await settle(pilot)
         assert fake.called("start_objective") == [("Pick Object", {"speed": "0.25"})]
         assert app.screen.query_one(TabbedContent).active == "tree"
-        await pilot.press("x")
+        await pilot.press("ctrl+x")
         await settle(pilot)
         assert fake.called("cancel_objective") == [()]
         assert any("Cancel the objective" in text for text in app.shown)
@@ -79,22 +79,63 @@ def test_run_sends_the_filled_in_parameters_and_cancel_cancels(fake: FakeConnect
 
 def test_the_parameters_key_puts_the_cursor_in_the_form_and_enter_runs(fake: FakeConnection) -> None:
     async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
-        await pilot.press("p")
+        await pilot.press("f4")
         await settle(pilot)
         form = app.screen.query_one(OverrideForm)
         first = form.query(Input).first()
         assert app.focused is first and first.name == "waypoint_name"
-        await pilot.press(*"box")  # x is the screen's cancel key, but here it is a letter of the value
+        await pilot.press(*"box")
         await settle(pilot)
         assert first.value == "box" and fake.called("cancel_objective") == []
         await pilot.press("enter")
         await settle(pilot)
         assert fake.called("start_objective") == [("Pick Object", {"waypoint_name": "box"})]
-        # The run shows its tree, and the keys are the screen's again: x cancels, not a letter typed.
+        # The run shows its tree, and the keys are the list's again, not the hidden field's.
         assert app.screen.query_one(TabbedContent).active == "tree"
-        await pilot.press("x")
+        assert app.focused is app.screen.query_one("#objective-list", OptionList)
+        await pilot.press("ctrl+x")
         await settle(pilot)
         assert fake.called("cancel_objective") == [()] and first.value == "box"
+
+    drive(fake, scenario)
+
+
+def test_letters_typed_on_the_list_search_and_never_run_or_switch_screens(fake: FakeConnection) -> None:
+    # A new user typed a name into what looked like the search box: `u` toggled a filter and `r` started
+    # an objective on the arm. Every letter on the list searches; once there, digits are typed too.
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        assert app.focused is app.screen.query_one("#objective-list", OptionList)
+        await pilot.press(*"run quickly 3")
+        await settle(pilot)
+        assert isinstance(app.screen, ObjectivesScreen)  # neither 3 (a screen) nor q (quit) acted
+        assert app.screen.query_one("#objective-search", Input).value == "run quickly 3"
+        assert fake.called("start_objective") == [] and fake.called("cancel_objective") == []
+        assert not app.screen.query_one("#runnable", Checkbox).value
+        search = app.screen.query_one("#objective-search", Input)
+        search.value = ""
+        await pilot.press(*"grip")
+        await settle(pilot)
+        assert listed(app) == ["Open Gripper"]
+        # Enter leaves the search box for the list; the hint names what Enter on the list runs.
+        await pilot.press("enter")
+        await settle(pilot)
+        assert fake.called("start_objective") == []
+        hint = str(app.screen.query_one("#run-hint").render())
+        assert "Enter or ctrl+r runs Open Gripper" in hint
+        await pilot.press("enter")
+        await settle(pilot)
+        assert fake.called("start_objective") == [("Open Gripper", {})]
+
+    drive(fake, scenario)
+
+
+def test_a_click_on_an_objective_selects_it_without_running_it(fake: FakeConnection) -> None:
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        options = app.screen.query_one("#objective-list", OptionList)
+        await pilot.click(options, offset=(4, 2))
+        await settle(pilot)
+        assert app.screen.selected.name == "Open Gripper"
+        assert fake.called("start_objective") == []
 
     drive(fake, scenario)
 
@@ -104,7 +145,7 @@ def test_a_subtree_only_objective_is_not_run(fake: FakeConnection) -> None:
         await pilot.press("down", "down")
         await settle(pilot)
         assert app.screen.selected.name == "Wait and Log"
-        await pilot.press("r")
+        await pilot.press("ctrl+r")
         await settle(pilot)
         assert fake.called("start_objective") == []
         assert any("subtree only" in text for text in app.shown)
@@ -152,7 +193,7 @@ def test_a_failing_runtime_call_is_shown_and_the_app_keeps_running(fake: FakeCon
     fake.failures["start_objective"] = TransportError("no runtime answered on tcp/127.0.0.1:7447 within 2 s")
 
     async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
-        await pilot.press("r")
+        await pilot.press("ctrl+r")
         await settle(pilot)
         assert any("Run 'Pick Object' failed: no runtime answered" in text for text in app.shown)
         assert any("no runtime answered" in entry.message for entry in app.logs)

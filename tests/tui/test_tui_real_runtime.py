@@ -149,7 +149,7 @@ def test_the_app_runs_an_objective_on_a_real_runtime_and_follows_a_restart(agent
                 return apply_statuses(updates)
 
             view.apply_statuses = applying  # type: ignore[method-assign]
-            await pilot.press("r")
+            await pilot.press("ctrl+r")
 
             def record() -> bool:
                 for node in view.outline.nodes():  # type: ignore[union-attr]
@@ -171,7 +171,7 @@ def test_the_app_runs_an_objective_on_a_real_runtime_and_follows_a_restart(agent
             )
             agent.start()
             await wait_for(pilot, lambda: app.status.state is ConnectionState.CONNECTED, "the reconnect", 30)
-            await pilot.press("r")
+            await pilot.press("ctrl+r")
             await wait_for(pilot, lambda: app.status.status == "Running", "a run after the restart")
 
     asyncio.run(main())
@@ -258,7 +258,7 @@ def test_the_tutorial_objective_runs_with_values_from_the_form_and_a_failure_sta
             assert [(p.name, p.type_name) for p in screen.selected.ports] == [("a", "int"), ("b", "int")]
             inputs = {field.name: field for field in form.query(Input)}
             inputs["a"].value, inputs["b"].value = "40", "2"
-            await pilot.press("r")
+            await pilot.press("ctrl+r")
             await wait_for(pilot, lambda: app.status.status == "Success", "Add Numbers to succeed")
             await wait_for(
                 pilot,
@@ -267,7 +267,7 @@ def test_the_tutorial_objective_runs_with_values_from_the_form_and_a_failure_sta
             )
 
             inputs["a"].value, inputs["b"].value = "", ""
-            await pilot.press("r")
+            await pilot.press("ctrl+r")
             panel = screen.query_one("#failure-panel", Static)
             await wait_for(pilot, lambda: panel.has_class("shown"), "the failure panel")
             assert "MyBehavior::2" in str(panel.render()) and "int_1" in str(panel.render())

@@ -6,6 +6,7 @@ import asyncio
 import json
 from pathlib import Path
 
+import pytest
 from textual.widgets import DataTable, Static
 
 from kinema.tui.screens.replay import ReplayApp, ReplayScreen
@@ -145,7 +146,8 @@ def write_fixed_recording(folder: Path) -> Path:
     return path
 
 
-def test_replay_snapshot(snap_compare, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+@pytest.mark.parametrize("size", [(80, 24), (120, 40)], ids=["80x24", "120x40"])
+def test_replay_snapshot(snap_compare, tmp_path: Path, size: tuple[int, int]) -> None:  # type: ignore[no-untyped-def]
     path = write_fixed_recording(tmp_path)
 
     async def run_before(pilot) -> None:  # type: ignore[no-untyped-def]
@@ -156,7 +158,7 @@ def test_replay_snapshot(snap_compare, tmp_path: Path) -> None:  # type: ignore[
 
     app = ReplayApp(path)
     app.title = "Kinema replay"
-    assert snap_compare(app, terminal_size=(120, 30), run_before=run_before)
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
 
 
 def test_the_app_opens_the_latest_recording_from_the_command_palette(tmp_path: Path, monkeypatch) -> None:  # type: ignore[no-untyped-def]

@@ -42,6 +42,15 @@ def tree_labels(tree: Tree) -> list[str]:  # type: ignore[type-arg]
     return out
 
 
+def _nodes(tree: Tree) -> list:  # type: ignore[type-arg]
+    found, stack = [], [tree.root]
+    while stack:
+        node = stack.pop()
+        found.append(node)
+        stack.extend(node.children)
+    return found
+
+
 # -- Configs -------------------------------------------------------------------------------------
 
 
@@ -60,15 +69,30 @@ def test_configs_show_packages_chain_provenance_and_files(fake: FakeConnection) 
         assert [label.split()[0] for label in chain[1:]] == ["lab_sim", "example_config"]
         rows = table_rows(app.screen.query_one("#resolved-table", DataTable))
         by_key = {row[0]: row for row in rows}
-        assert by_key["based_on_package"][1:] == ["example_config", "lab_sim"]
-        assert by_key["hardware.robot_description.urdf"][1] == "lab_sim"  # inherited
+        # Key, value, and the package that set it.
+        assert by_key["based_on_package"][1:] == ["lab_sim", "example_config"]
+        assert by_key["hardware.robot_description.urdf"][2] == "lab_sim"  # inherited
         # Lists show as written (not swallowed as markup).
-        started = by_key["ros2_control.controllers_active_at_startup"][2]
+        started = by_key["ros2_control.controllers_active_at_startup"][1]
         assert started.startswith("[") and started.endswith("]") and len(started) > 2
         await pilot.press("i")
         await settle(pilot)
         files = tree_labels(app.screen.query_one("#file-tree", Tree))
         assert "config/" in files and "config.yaml" in files and "package.xml" in files
+        # Enter on a file opens it, read-only; Escape goes back (a new user found the tab opened nothing).
+        tree = app.screen.query_one("#file-tree", Tree)
+        package_xml = next(n for n in _nodes(tree) if str(n.label) == "package.xml")
+        tree.move_cursor(package_xml)
+        app.screen.set_focus(tree)
+        await pilot.press("enter")
+        await settle(pilot)
+        from kinema.tui.dialogs.file_view import FileViewDialog
+
+        assert isinstance(app.screen, FileViewDialog)
+        assert "<name>example_config</name>" in app.screen.query_one("#file-text").text
+        await pilot.press("escape")
+        await settle(pilot)
+        assert not isinstance(app.screen, FileViewDialog)
 
     drive(fake, scenario, mode="configs")
 

@@ -6,6 +6,9 @@ the SVGs (``__snapshots__/``) before committing them.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
+import pytest
 from textual.pilot import Pilot
 from tui_pilot_harness import settle
 
@@ -23,7 +26,11 @@ from kinema.tui.connection import (
 )
 from kinema.tui.fake_connection import FakeConnection
 
-SIZE = (120, 34)
+
+@pytest.fixture(params=[(80, 24), (120, 40)], ids=["80x24", "120x40"])
+def size(request: pytest.FixtureRequest) -> tuple[int, int]:
+    """Every screen at the terminal people use (80x24) and a roomy one (120x40)."""
+    return request.param  # type: ignore[no-any-return]
 
 
 class QuietApp(KinemaApp):
@@ -38,7 +45,7 @@ def app_on(mode: str, fake: FakeConnection | None = None) -> tuple[QuietApp, Fak
     return QuietApp(fake, initial_mode=mode), fake
 
 
-def test_objectives_screen_with_a_running_tree(snap_compare) -> None:  # type: ignore[no-untyped-def]
+def test_objectives_screen_with_a_running_tree(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
     app, fake = app_on("objectives")
 
     async def run_before(pilot: Pilot[None]) -> None:
@@ -60,21 +67,21 @@ def test_objectives_screen_with_a_running_tree(snap_compare) -> None:  # type: i
         )
         await settle(pilot)
 
-    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
 
 
-def test_objectives_parameters_tab(snap_compare) -> None:  # type: ignore[no-untyped-def]
+def test_objectives_parameters_tab(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
     app, _ = app_on("objectives")
 
     async def run_before(pilot: Pilot[None]) -> None:
         await settle(pilot)
-        await pilot.press("p")
+        await pilot.press("f4")
         await settle(pilot)
 
-    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
 
 
-def test_configs_screen_resolved_values(snap_compare) -> None:  # type: ignore[no-untyped-def]
+def test_configs_screen_resolved_values(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
     app, _ = app_on("configs")
 
     async def run_before(pilot: Pilot[None]) -> None:
@@ -84,10 +91,10 @@ def test_configs_screen_resolved_values(snap_compare) -> None:  # type: ignore[n
         await pilot.press("v")
         await settle(pilot)
 
-    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
 
 
-def test_blackboard_screen(snap_compare) -> None:  # type: ignore[no-untyped-def]
+def test_blackboard_screen(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
     app, fake = app_on("blackboard")
 
     async def run_before(pilot: Pilot[None]) -> None:
@@ -112,10 +119,10 @@ def test_blackboard_screen(snap_compare) -> None:  # type: ignore[no-untyped-def
             await pilot.pause(0.25)
         await settle(pilot)
 
-    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
 
 
-def test_behaviors_screen_with_a_failed_reload(snap_compare) -> None:  # type: ignore[no-untyped-def]
+def test_behaviors_screen_with_a_failed_reload(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
     app, fake = app_on("behaviors")
 
     async def run_before(pilot: Pilot[None]) -> None:
@@ -131,10 +138,10 @@ def test_behaviors_screen_with_a_failed_reload(snap_compare) -> None:  # type: i
         )
         await settle(pilot)
 
-    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
 
 
-def test_logs_screen(snap_compare) -> None:  # type: ignore[no-untyped-def]
+def test_logs_screen(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
     app, fake = app_on("logs")
 
     async def run_before(pilot: Pilot[None]) -> None:
@@ -148,19 +155,19 @@ def test_logs_screen(snap_compare) -> None:  # type: ignore[no-untyped-def]
         )
         await settle(pilot)
 
-    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
 
 
-def test_waypoints_screen(snap_compare) -> None:  # type: ignore[no-untyped-def]
+def test_waypoints_screen(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
     app, _ = app_on("waypoints")
 
     async def run_before(pilot: Pilot[None]) -> None:
         await settle(pilot)
 
-    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
 
 
-def test_objectives_screen_after_a_failed_run(snap_compare) -> None:  # type: ignore[no-untyped-def]
+def test_objectives_screen_after_a_failed_run(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
     from test_tui_failures import failed_run
 
     app, fake = app_on("objectives")
@@ -170,10 +177,10 @@ def test_objectives_screen_after_a_failed_run(snap_compare) -> None:  # type: ig
         failed_run(fake)
         await settle(pilot)
 
-    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
 
 
-def test_objectives_screen_while_a_task_plans(snap_compare) -> None:  # type: ignore[no-untyped-def]
+def test_objectives_screen_while_a_task_plans(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
     from test_tui_task_planning import PLANNING
 
     app, fake = app_on("objectives")
@@ -184,10 +191,10 @@ def test_objectives_screen_while_a_task_plans(snap_compare) -> None:  # type: ig
         fake.emit(PLANNING)
         await settle(pilot)
 
-    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
 
 
-def test_objectives_screen_after_a_task_failed_to_plan(snap_compare) -> None:  # type: ignore[no-untyped-def]
+def test_objectives_screen_after_a_task_failed_to_plan(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
     from test_tui_task_planning import FAILED
 
     app, fake = app_on("objectives")
@@ -198,10 +205,10 @@ def test_objectives_screen_after_a_task_failed_to_plan(snap_compare) -> None:  #
         fake.emit(FAILED)
         await settle(pilot)
 
-    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
 
 
-def test_approval_of_a_planned_motion(snap_compare) -> None:  # type: ignore[no-untyped-def]
+def test_approval_of_a_planned_motion(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
     from test_tui_approvals import PICK_STEPS
 
     from kinema.tui.connection import ApprovalRequested
@@ -222,4 +229,95 @@ def test_approval_of_a_planned_motion(snap_compare) -> None:  # type: ignore[no-
         )
         await settle(pilot)
 
-    assert snap_compare(app, terminal_size=SIZE, run_before=run_before)
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
+
+
+def test_objectives_ports_tab(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
+    from textual.widgets import TabbedContent
+
+    app, _ = app_on("objectives")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        app.screen.query_one(TabbedContent).active = "ports"
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
+
+
+def test_the_whole_failure_message(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
+    from test_tui_failures import failed_run
+
+    app, fake = app_on("objectives")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        failed_run(fake)
+        await settle(pilot)
+        await pilot.press("ctrl+o")
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
+
+
+def test_the_quit_question(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
+    fake = FakeConnection.demo()
+    app = QuietApp(fake, initial_mode="waypoints", owns_runtime=True)
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        await pilot.press("ctrl+q")
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
+
+
+def test_configs_screen_files(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
+    app, _ = app_on("configs")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        await pilot.press("i")
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
+
+
+def test_waypoints_of_a_real_arm(snap_compare, size) -> None:  # type: ignore[no-untyped-def]
+    # lab_sim's joint names: the positions were cut to "+" and "-" at 120 columns.
+    fake = FakeConnection.demo()
+    fake.waypoints = [replace(w, joint_names=LAB_SIM_JOINTS, positions=LAB_SIM_HOME) for w in fake.waypoints]
+    app = QuietApp(fake, initial_mode="waypoints")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+
+    assert snap_compare(app, terminal_size=size, run_before=run_before)
+
+
+LAB_SIM_JOINTS = (
+    "linear_rail_joint",
+    "shoulder_pan_joint",
+    "shoulder_lift_joint",
+    "elbow_joint",
+    "wrist_1_joint",
+    "wrist_2_joint",
+    "wrist_3_joint",
+    "robotiq_85_left_knuckle_joint",
+)
+LAB_SIM_HOME = (0.0, -1.5708, -1.5708, 1.5708, -1.5708, -1.5708, 0.0, 0.7929)
+
+
+def test_camera_screen(snap_compare, size, monkeypatch) -> None:  # type: ignore[no-untyped-def]
+    from test_tui_camera import picture
+
+    monkeypatch.setenv("KINEMA_TUI_IMAGE", "halfcell")
+    fake = FakeConnection.demo()
+    fake.cameras = {"/wrist_camera/color": picture((200, 30, 30))}
+    app = QuietApp(fake, initial_mode="objectives", camera="/wrist_camera/color")
+
+    async def run_before(pilot: Pilot[None]) -> None:
+        await settle(pilot)
+        await pilot.pause(0.5)  # the screen redraws every 0.2 s
+
+    assert snap_compare(app, terminal_size=size, run_before=run_before)

@@ -91,11 +91,16 @@ def test_a_person_browses_runs_and_quits_in_a_real_terminal(terminal: Terminal) 
     lines = first.rstrip().splitlines()  # the footer is the last line drawn
     assert "1 Configs" in lines[0] and "6 Waypoints" in lines[0]  # every screen is named, with its key
     assert "● connected fake://runtime" in first  # the status bar
-    assert "r Run" in lines[-1] and "^p palette" in lines[-1]  # the footer lists the bindings
+    assert "⏎ Run" in lines[-1] and "^q Quit" in lines[-1] and "^x Cancel" in lines[-1]  # the footer
+    terminal.wait_for(lambda s: "Enter or ctrl+r runs" in s, "the list saying what Enter runs")
     assert "○ MoveToWaypoint" in first and "○ Sleep" in first  # the tree, subtree expanded
 
-    terminal.press("r")
+    terminal.press("r")  # a letter on the list searches; it never runs
+    searched = terminal.wait_for(lambda s: "of 3 objectives" in s, "the search")
+    assert "Run 'Pick Object'" not in searched
+    terminal.press("BSpace", "Enter", "Enter")
     terminal.wait_for(lambda s: "Run 'Pick Object'" in s, "the run notification")
+    terminal.press("Tab")  # away from the list: the digits are the screens' keys again
 
     terminal.press("3")
     terminal.wait_for(lambda s: "filter by key" in s and "History" in s, "the Blackboard screen")
@@ -135,8 +140,10 @@ def test_kinema_run_opens_the_app_and_closing_it_stops_the_runtime() -> None:
             lambda s: "● connected" in s and "Hello Tree" in s, "the app on the runtime", 90
         )
         assert f"tcp/127.0.0.1:{port}" in screen
-        term.press("q")
-        term.wait_for(lambda s: "This stops the runtime" in s, "the quit question")
+        term.press("q")  # on the objective list a letter searches; ctrl+q quits from anywhere
+        term.press("C-q")
+        question = term.wait_for(lambda s: "This stops the runtime" in s, "the quit question")
+        assert "y: Quit and stop" in question and "n or Esc: Stay" in question  # the dialog says its keys
         term.press("y")
         term.wait_for(lambda s: "KINEMA-EXIT=0" in s, "kinema run to exit", 30)
         with socket.socket() as probe:  # the router it hosted is gone: nothing listens on its port

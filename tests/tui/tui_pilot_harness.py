@@ -35,13 +35,18 @@ class RecordingApp(KinemaApp):
 
 
 def drive(
-    connection: FakeConnection, scenario: Scenario, *, mode: str = "objectives", **app_args: object
+    connection: FakeConnection,
+    scenario: Scenario,
+    *,
+    mode: str = "objectives",
+    size: tuple[int, int] = SIZE,
+    **app_args: object,
 ) -> None:
     """Run ``scenario`` against a headless app on ``connection``, opened on screen ``mode``."""
     app = RecordingApp(connection, initial_mode=mode, **app_args)
 
     async def main() -> None:
-        async with app.run_test(size=SIZE) as pilot:
+        async with app.run_test(size=size) as pilot:
             await settle(pilot)
             await scenario(app, pilot)
 

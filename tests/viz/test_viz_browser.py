@@ -364,3 +364,19 @@ def test_a_point_cloud_snapshot_is_drawn_coloured_and_decimated_and_cleared(
     finally:
         context.close()
         node.close()
+
+
+def test_every_page_load_starts_framed_from_the_front_and_names_the_config(viewer: Any) -> None:
+    # A new user saw the view start looking along the rail in 3 of 4 loads, and the wrong config named.
+    view = viewer.bridge.scene.camera_view()["camera"]
+    expected = [view["position"][0], view["position"][2], -view["position"][1]]  # meshcat's camera frame
+    assert CHROMIUM is not None
+    for _ in range(3):
+        with HeadlessChromium(CHROMIUM, width=800, height=600) as browser:
+            browser.navigate(viewer.url)
+            browser.wait_for("typeof viewer !== 'undefined' && kinema.framed", timeout=60)
+            time.sleep(1.0)  # meshcat's own start-up after the first framing
+            position = browser.evaluate("JSON.stringify(viewer.camera.position.toArray())")
+            np.testing.assert_allclose(json.loads(position), expected, atol=1e-6)
+            browser.wait_for("document.title.indexOf('lab_sim') >= 0", timeout=10)
+            assert "config lab_sim" in browser.evaluate("document.getElementById('kinema-info').textContent")

@@ -9,6 +9,8 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
+from kinema.cli.options import selection_options
+
 if TYPE_CHECKING:
     from kinema.bt import BehaviorTreeFactory, NodeStatus, TreeNode
 
@@ -121,15 +123,43 @@ def run(
 )
 @click.option("--json", "as_json", is_flag=True, help="Print the problems as a JSON list.")
 @behaviors_option
-def validate(files: tuple[Path, ...], as_json: bool, behaviors: bool) -> None:
+@click.option(
+    "--no-config",
+    is_flag=True,
+    help="Inside a workspace too, check against the built-in nodes only (plus --behaviors).",
+)
+@selection_options
+def validate(
+    files: tuple[Path, ...],
+    as_json: bool,
+    behaviors: bool,
+    no_config: bool,
+    workspace: Path | None,
+    config: str | None,
+) -> None:
     """Check objective FILES together: node IDs, ports, scripts, subtrees.
+
+    Inside a workspace (FILES under its src/, or one chosen with -w, $KINEMA_WORKSPACE or `kinema
+    configure`), or with -c, the files are checked against the active config's behaviors and the
+    subtrees of its objective libraries, as `kinema build` and the runtime load them. Elsewhere, or with
+    --no-config, against the built-in nodes (and the bundled behaviors with --behaviors).
 
     Every problem is printed as file:line: message. A SubTree may call a tree defined in another of
     the FILES. Exits 1 if any problem was found.
     """
     from kinema.bt.validation import count_trees, validate_files
 
-    problems = validate_files(list(files), _factory(behaviors))
+    factory = None if no_config else _config_factory(files, workspace, config)
+    built_in_only = factory is None and not behaviors
+    if factory is None:
+        factory = _factory(behaviors)
+    problems = validate_files(list(files), factory)
+    if built_in_only and any("Node not recognized" in p.message for p in problems):
+        click.echo(
+            "note: only the built-in nodes were known; -c NAME (or a file inside a workspace) checks "
+            "against a config's behaviors and subtrees, --behaviors adds the bundled behaviors",
+            err=True,
+        )
     if as_json:
         rows: list[dict[str, Any]] = [
             {"file": p.location.file, "line": p.location.line, "message": p.message} for p in problems
@@ -144,6 +174,63 @@ def validate(files: tuple[Path, ...], as_json: bool, behaviors: bool) -> None:
                 click.echo(f"{file}: OK ({count_trees(file)} trees)")
     if problems:
         sys.exit(1)
+
+
+def _config_factory(
+    files: tuple[Path, ...], workspace: Path | None, config: str | None
+) -> BehaviorTreeFactory | None:
+    """The active config's behaviors and library subtrees in one factory, when a workspace or a config is
+    chosen (see ``validate``); None otherwise. Says on stderr which config it is."""
+    from kinema.bt.xmlsource import parse_xml_file
+    from kinema.config import ObjectiveLibrary, Workspace, active_selection, resolve_config
+    from kinema.config.workspace import find_workspace_root
+    from kinema.errors import ConfigError, KinemaError
+    from kinema.plugins import BehaviorHost
+
+    selection = active_selection(workspace, config)
+    root = selection.workspace
+    if root is None:
+        for file in files:
+            try:
+                root = find_workspace_root(file.parent)
+                break
+            except ConfigError:
+                continue
+    if root is None and selection.config_source not in ("flag", "environment", "stored"):
+        return None
+    found = Workspace.discover(root) if root is not None else Workspace.bundled_only()
+    name = selection.require_config()
+    resolved = resolve_config(name, found)
+    library = ObjectiveLibrary.load(resolved)
+    host = BehaviorHost.for_config(resolved)
+    for error in host.load().errors:
+        click.echo(f"warning: {error}", err=True)
+    factory = host.registry.create_factory()
+
+    def tree_ids(path: Path) -> set[str]:
+        try:
+            return {str(node.get("ID")) for node in parse_xml_file(path).iter("BehaviorTree")}
+        except KinemaError:
+            return set()
+
+    own_files = {file.resolve() for file in files}
+    own_ids = set().union(*(tree_ids(file) for file in files))
+    for path in library.files():
+        # The files being checked stand for themselves: a library file that is one of them, or defines
+        # one of their trees (an edited copy), is left out.
+        if path.resolve() in own_files or tree_ids(path) & own_ids:
+            continue
+        try:
+            factory.register_behavior_tree_from_file(path)
+        except KinemaError:
+            pass  # `kinema build` and `kinema objective list` report the library's own problems
+    where = f" (workspace {found.root})" if found.root is not None else ""
+    click.echo(
+        f"checking against config {name}{where}: its behaviors and objective libraries (--no-config: "
+        "built-in nodes only)",
+        err=True,
+    )
+    return factory
 
 
 @tree.command()

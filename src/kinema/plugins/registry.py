@@ -7,8 +7,9 @@ touches the instances of a running objective; the next run uses the new classes.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
+import time
+from collections.abc import Iterable, Iterator, Mapping
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 from kinema.errors import PluginError
@@ -22,11 +23,16 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class PluginRecord:
-    """A plugin as loaded: where it came from, what it registered, or why it failed."""
+    """A plugin as loaded: where it came from, what it registered, or why it failed.
+
+    ``loaded_at`` is the wall time (``time.time()``) its registered behaviors were imported: after a failed
+    reload (``error`` set, ``behaviors`` kept) it dates the last good version, which is what still runs.
+    """
 
     spec: PluginSpec
     behaviors: tuple[str, ...] = ()
     error: PluginError | None = None
+    loaded_at: float = field(default_factory=time.time)
 
     @property
     def name(self) -> str:
@@ -97,8 +103,24 @@ class BehaviorRegistry(Mapping[str, BehaviorRegistration]):
         plugins = dict(self._plugins)
         previous = plugins.get(record.name)
         kept = previous.behaviors if previous is not None else ()
-        plugins[record.name] = PluginRecord(record.spec, kept, record.error)
+        loaded_at = previous.loaded_at if previous is not None else record.loaded_at
+        plugins[record.name] = PluginRecord(record.spec, kept, record.error, loaded_at)
         return BehaviorRegistry(self._registrations, plugins, self.generation)
+
+    def stale_behaviors(self, behavior_ids: Iterable[str]) -> list[tuple[PluginRecord, list[str]]]:
+        """Of ``behavior_ids``, those whose plugin's latest files failed to load, grouped by plugin.
+
+        Each still runs the version its plugin registered before (``PluginRecord.loaded_at``).
+        """
+        found: dict[str, list[str]] = {}
+        for behavior_id in sorted(set(behavior_ids)):
+            registration = self._registrations.get(behavior_id)
+            if registration is None:
+                continue
+            record = self._plugins.get(registration.plugin)
+            if record is not None and record.error is not None:
+                found.setdefault(record.name, []).append(behavior_id)
+        return [(self._plugins[name], ids) for name, ids in found.items()]
 
     def populate(self, factory: BehaviorTreeFactory, context: BehaviorContext | None = None) -> None:
         """Register every behavior into ``factory``, each bound to ``context``.

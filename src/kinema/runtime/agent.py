@@ -128,6 +128,8 @@ class _Streams:
         self._last_blackboard: list[tuple[str, str, str, str]] | None = None
         self._render_cache: dict[int, tuple[Any, str]] = {}
         self._lock = threading.Lock()
+        # Also tells the clients waiting for a run (set by the Agent).
+        self.on_warning: Callable[[str], None] | None = None
         self._work = HandOff("kinema-blackboard")
 
     def close(self) -> None:
@@ -252,6 +254,13 @@ class _Streams:
             )
         )
 
+    def on_stale_code(self, run: ObjectiveRun, note: str) -> None:
+        text = f"objective {run.objective_name!r} runs older code: {note}"
+        log.warning("%s", text)
+        self.publish_log(LOG_WARN, text)
+        if self.on_warning is not None:
+            self.on_warning(text)
+
     def on_run_finished(self, run: ObjectiveRun, result: ObjectiveResult) -> None:
         if result.succeeded:
             log.info("%s", result)
@@ -309,6 +318,7 @@ class Agent:
         self.clock = clock
         self.node = node if node is not None else Node(session, names.NODE_NAME)
         self._streams = _Streams(self.node, clock, server)
+        self._streams.on_warning = lambda text: self._tell_quick_clients("warn", text)
         server.add_listener(self._streams)
         self._goal_runs: dict[bytes, ObjectiveRun] = {}
         self._quick_runs: weakref.WeakValueDictionary[int, ObjectiveRun] = weakref.WeakValueDictionary()

@@ -142,6 +142,9 @@ class ObjectiveRun:
         # The objective's declared ports that nothing set (no default, no override): a failure that
         # names one of them gets a hint saying which parameter to give.
         self.unset_parameters: tuple[str, ...] = ()
+        # Set when the tree uses behaviors whose latest files failed to load (older code runs): said at
+        # the start and repeated in a failure's message.
+        self.stale_note = ""
         self._server = server
         self._done = threading.Event()
         self._result: ObjectiveResult | None = None
@@ -829,6 +832,8 @@ class ObjectiveServer:
             self._end(run, ObjectiveResult.failure(message, run.objective_name), ObjectiveStatus.FAILURE)
             return
         run.release_xml()
+        stale_note = getattr(self._source, "stale_note", None)
+        run.stale_note = stale_note(tree) if stale_note is not None else ""
         self._tree = tree
         self._recorder.detach()
         self._recorder = NodeStatusRecorder()
@@ -844,6 +849,12 @@ class ObjectiveServer:
                     loaded(name, tree)
                 except Exception:
                     log.exception("a tree listener raised")
+            stale = getattr(listener, "on_stale_code", None)
+            if stale is not None and run.stale_note:
+                try:
+                    stale(run, run.stale_note)
+                except Exception:
+                    log.exception("a listener raised on a stale-code note")
         self._set_status(ObjectiveStatus.RUNNING, name)
 
     def _build(self, request: ObjectiveRequest) -> tuple[Tree, str, SubtreeModel | None]:
@@ -957,6 +968,9 @@ class ObjectiveServer:
         result = run._settle(result)
         if result.cancelled and status is ObjectiveStatus.SUCCESS:
             status = ObjectiveStatus.CANCELLED
+        if run.stale_note and not result.succeeded:
+            # The exception may come from code no longer in the file: say that the file did not load.
+            result = replace(result, error_message=f"{result.error_message}\nnote: {run.stale_note}")
         self._tree = None
         self._run_stuck = None
         self._run = None

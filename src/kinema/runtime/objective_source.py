@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import logging
 import threading
+import time
 from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
@@ -18,7 +19,7 @@ from kinema.errors import KinemaError
 
 if TYPE_CHECKING:
     from kinema.behaviors.context import BehaviorContext
-    from kinema.bt import BehaviorTreeFactory, Clock
+    from kinema.bt import BehaviorTreeFactory, Clock, Tree
     from kinema.config import ObjectiveInfo, ObjectiveLibrary
     from kinema.plugins import BehaviorHost
 
@@ -84,6 +85,27 @@ class LibraryTreeSource:
         """Why ``objective_name`` (in the library) is not runnable, or None."""
         problem = self._problems.get(objective_name)
         return None if problem is None else f"{problem.file}: {problem.message}"
+
+    def stale_note(self, tree: Tree) -> str:
+        """What ``tree`` runs of a behavior package whose latest files failed to load ("" if nothing).
+
+        A failed hot reload keeps the last good version, so the tree runs older code than the file on
+        disk holds: the note names the package, the error with its file:line, and when the version that
+        runs instead was loaded.
+        """
+        registry = self._registry
+        if registry is None:
+            return ""
+        used = {node.registration_id for node in tree.nodes()}
+        notes = []
+        for record, behavior_ids in registry.stale_behaviors(used):
+            error = record.error
+            where = f"{error.location}: " if error.location is not None else ""
+            loaded = time.strftime("%H:%M", time.localtime(record.loaded_at))
+            # The error names the package ("plugin 'p': behavior package 'p' failed to import: ...").
+            ids = ", ".join(behavior_ids)
+            notes.append(f"{where}{error.message}; {ids} runs the version from {loaded} instead")
+        return "; ".join(notes)
 
     # -- library --------------------------------------------------------------------------------
 

@@ -49,7 +49,14 @@ HALT_WAITS_FOR_ABANDONED_S = 0.5
 # A stuck behavior is logged again this often while it stays stuck.
 WATCHDOG_LOG_EVERY_S = 10.0
 
-LOOP_BLOCKED = "blocking the event loop async behaviors share (new ones run on a fresh loop)"
+# What each warning adds is what the user can do about it: the warnings reach `kinema run`'s terminal, the
+# UI's status bar and log, and `kinema objective status`.
+LOOP_BLOCKED = (
+    "so no other async behavior could run meanwhile (they now run on a new loop): its code should await "
+    "(asyncio.sleep, not time.sleep); cancelling the objective (ctrl+x, kinema objective cancel) stops it"
+)
+STUCK_ADVICE = "the objective cannot stop until it returns: cancel it (ctrl+x, kinema objective cancel)"
+ABANDONED_ADVICE = "restart the runtime (kinema down, then kinema run) to free it"
 # faulthandler's timer is re-armed every this many watchdog rounds (arming costs about 0.1 ms).
 STALL_ARM_EVERY = 5
 # A stall report stays in the health warnings this long.
@@ -242,9 +249,11 @@ class TickWatchdog:
             if not any(re.search(RUNNING_BEHAVIORS, frame) for frame in frames):
                 continue  # the tick thread was waiting, not running behavior code: not its stall
             where = " ← ".join(frames[:STALL_FRAMES])
+            thread = worker.name if worker else "?"
             sentence = (
-                f"the interpreter was held for more than {self.report_after_s:g} s (C code that does not "
-                f"release the GIL?) while tick thread {worker.name if worker else '?'} sat in: {where}"
+                f"Kinema stood still for more than {self.report_after_s:g} s: the interpreter was held (C "
+                f"code that does not release Python's lock?) while tick thread {thread} sat in: {where}; "
+                "slow C work belongs in an AsyncBehavior's do_work, off the tick"
             )
             log.error("watchdog: %s", sentence)
             self._stalls = [*self._stalls[-3:], (when, sentence)]
@@ -289,13 +298,13 @@ class TickWatchdog:
         now = time.monotonic()
         warnings: list[str] = []
         if worker is not None and worker.stuck is not None and worker.busy_since is not None:
-            warnings.append(worker.stuck.describe(now - worker.busy_since))
+            warnings.append(f"{worker.stuck.describe(now - worker.busy_since)}; {STUCK_ADVICE}")
         for old in list(abandoned):
             stuck = old.stuck or StuckCode("", "", old.busy_stage)
             since = old.stuck_since
             warnings.append(
                 f"abandoned tick thread {old.name}: {stuck.describe(now - since)} "
-                f"(abandoned {now - old.abandoned_at:.1f} s ago)"
+                f"(abandoned {now - old.abandoned_at:.1f} s ago); {ABANDONED_ADVICE}"
             )
         warnings.extend(sentence for when, sentence in self._stalls if now - when < STALL_SHOWN_S)
         warnings.extend(halted_work_warnings(self.report_after_s))
@@ -344,7 +353,8 @@ def halted_work_warnings(after_s: float) -> list[str]:
     if runner is None:
         return []
     return [
-        f"behavior '{behavior}' ({path}) has ignored a halt for {seconds:.1f} s: its do_work still runs"
+        f"behavior '{behavior}' ({path}) has ignored a halt for {seconds:.1f} s: its do_work still runs "
+        "(it should return when cancelled); restart the runtime if it never ends"
         for behavior, path, seconds in runner.halted_still_running()
         if seconds >= after_s
     ]

@@ -17,10 +17,12 @@ from dataclasses import dataclass, field
 from functools import partial
 from pathlib import Path
 
+from textual import events
 from textual.app import App, SystemCommand
 from textual.binding import Binding
 from textual.notifications import SeverityLevel
 from textual.screen import Screen
+from textual.timer import Timer
 
 from kinema.tui.blackboard_model import BlackboardModel
 from kinema.tui.connection import (
@@ -41,8 +43,15 @@ from kinema.tui.connection import (
     RuntimeEvent,
     TaskPlanning,
 )
-from kinema.tui.dialogs.confirm import ConfirmDialog
-from kinema.tui.messages import ModeSelected, RuntimeCallFailed, RuntimeCallSucceeded, RuntimeEventsArrived
+from kinema.tui.dialogs.confirm import ConfirmDialog, MotionQuestionDialog
+from kinema.tui.messages import (
+    KeyDelivered,
+    ModeSelected,
+    RuntimeCallFailed,
+    RuntimeCallSucceeded,
+    RuntimeEventsArrived,
+)
+from kinema.tui.repeat_limiter import RepeatLimiter, held_back, watchdog_kind
 from kinema.tui.run_outcome import RunOutcome, parse_outcome
 from kinema.tui.runtime_status import ACTIVE_STATUSES, RuntimeStatus
 from kinema.tui.screens.base import KinemaScreen, RuntimeView
@@ -57,6 +66,8 @@ from kinema.tui.widgets.nav_bar import SCREENS
 log = logging.getLogger("kinema.tui")
 
 MAX_LOGS = 2000
+# Seconds the app waits for a key to go all the way up before it gives out the next one anyway.
+KEY_WAIT_S = 1.0
 MAX_RELOADS = 200
 TOAST_SEVERITY = {LogLevel.ERROR: "error", LogLevel.WARN: "warning"}
 # The uid of a tree's root node (BT.CPP numbers the nodes from 1, the root first).
@@ -125,6 +136,9 @@ class KinemaApp(App[None]):
     """
 
     TITLE = "Kinema"
+    # Screens lay out differently in a narrow (80 columns) or short (24 lines) terminal: app.tcss.
+    HORIZONTAL_BREAKPOINTS = [(0, "-narrow"), (100, "-normal")]
+    VERTICAL_BREAKPOINTS = [(0, "-short"), (32, "-tall")]
     # Absolute, so subclasses defined elsewhere (tests, embedding apps) find the stylesheet too.
     CSS_PATH = Path(__file__).with_name("app.tcss")
     MODES = {
@@ -155,13 +169,14 @@ class KinemaApp(App[None]):
             id="app.camera",
             tooltip="Show the latest image of a camera topic",
         ),
-        Binding("q", "quit", "Quit", id="app.quit", tooltip="Close the app"),
+        Binding("ctrl+q", "quit", "Quit", id="app.quit", tooltip="Close the app", priority=True),
+        # q too, where no text is typed (on the objective list, letters search).
+        Binding("q", "quit", "Quit", id="app.quit_q", show=False, tooltip="Close the app"),
         Binding(
             "ctrl+x",
             "cancel_objective",
-            "Cancel objective",
+            "Cancel",
             id="app.cancel",
-            show=False,
             tooltip="Cancel the running objective from any screen",
         ),
     ]
@@ -198,6 +213,12 @@ class KinemaApp(App[None]):
         # explanation the outcome put on the tree.
         self._ended_ahead: dict[str, tuple[str, str]] = {}
         self.inbox = EventInbox()
+        self.repeats = RepeatLimiter()
+        # Keys taken from the terminal and not yet given out (see on_event).
+        self._pending_keys: deque[events.Key] = deque()
+        self._key_in_flight = False
+        self._switching = False
+        self._key_timer: Timer | None = None
         self.views: list[RuntimeView] = []
         self.sub_title = connection.endpoint + ("  (closing stops the runtime)" if owns_runtime else "")
 
@@ -257,13 +278,16 @@ class KinemaApp(App[None]):
                 if event.state is ConnectionState.CONNECTED and was is not ConnectionState.CONNECTED:
                     self._views_call(lambda view: view.runtime_connected())
                 if event.state is ConnectionState.DISCONNECTED and was is ConnectionState.CONNECTED:
-                    self.notify(
-                        event.detail or "The runtime stopped answering.",
-                        title="Disconnected",
-                        severity="error",
+                    self._connection_message(
+                        f"Lost the runtime at {event.endpoint}: {plain_detail(event.detail)}. The app "
+                        "reconnects by itself; if it does not, check that `kinema run` still runs.",
+                        "Disconnected",
+                        LogLevel.WARN,
                     )
                 elif event.state is ConnectionState.CONNECTED and was is ConnectionState.DISCONNECTED:
-                    self.notify(f"Connected to {event.endpoint}", title="Reconnected")
+                    self._connection_message(
+                        f"Connected again to the runtime at {event.endpoint}.", "Reconnected", LogLevel.INFO
+                    )
             elif isinstance(event, Heartbeat):
                 was_connected = self.status.state is ConnectionState.CONNECTED
                 started = self.status.apply_heartbeat(event)
@@ -350,10 +374,30 @@ class KinemaApp(App[None]):
 
             self.push_screen(ApprovalDialog(question, request.steps, request.duration), answered)
             return
-        self.push_screen(ConfirmDialog(question, confirm_label="Approve"), answered)
+        self.push_screen(MotionQuestionDialog(question), answered)
+
+    def _connection_message(self, text: str, title: str, level: LogLevel) -> None:
+        """A lost or found connection: a toast and a log line, at most one of each kind per period."""
+        held = self.repeats.admit(f"connection {title}", time.monotonic())
+        if held is None:
+            return
+        text += held_back(held)
+        self.add_log(LogEntry(f"{title}: {text}", level, time.time(), "ui"))
+        self.notify(text, title=title, severity="error" if level <= LogLevel.WARN else "information")
 
     def add_log(self, entry: LogEntry, *, toast: bool = False) -> None:
-        """Keep ``entry`` for the Logs screen and, for runtime toasts, show it as a notification."""
+        """Keep ``entry`` for the Logs screen and, for runtime toasts, show it as a notification.
+
+        A watchdog warning is kept and shown once per kind and period (it repeats under load)."""
+        kind = watchdog_kind(entry.message)
+        if kind is not None:
+            held = self.repeats.admit(kind, time.monotonic())
+            if held is None:
+                return
+            message = entry.message.removeprefix("watchdog: ")
+            entry = LogEntry(
+                message[:1].upper() + message[1:] + held_back(held), entry.level, entry.stamp, "watchdog"
+            )
         self.logs.append(entry)
         outcome = parse_outcome(entry.message) if entry.level <= LogLevel.WARN else None
         if outcome is not None:
@@ -400,7 +444,61 @@ class KinemaApp(App[None]):
         self.notify(message.what, timeout=3)
 
     def on_mode_selected(self, message: ModeSelected) -> None:
-        self.switch_mode(message.mode)
+        self.run_worker(self.action_switch_mode(message.mode), group="switch-mode")
+
+    # -- one key at a time ------------------------------------------------------------------------------
+
+    # Textual hands a key to whatever has the focus when it takes the key from the terminal, and the key's
+    # bindings run later, when it has bubbled up. Keys typed in a burst (a busy machine, a fast typist)
+    # were all handed to the widget focused before the first of them ran: the letters typed after "/"
+    # went to the table instead of the filter it focuses, those after "3" to the screen being left. So
+    # the app gives out the next key only once the last one has gone all the way up (a KeyDelivered
+    # message sent behind it, along the same path), or its screen switch is done.
+
+    async def on_event(self, event: events.Event) -> None:
+        if isinstance(event, events.Key) and not event.is_forwarded:
+            self._pending_keys.append(event)
+            await self._next_key()
+            return
+        await super().on_event(event)
+
+    async def _next_key(self) -> None:
+        if self._key_in_flight or self._switching or not self._pending_keys:
+            return
+        key = self._pending_keys.popleft()
+        target = self.focused or self.screen
+        self._key_in_flight = True
+        await super().on_event(key)
+        if self._switching:  # a priority binding switched screens: the switch releases the keys
+            self._key_in_flight = False
+            return
+        target.post_message(KeyDelivered())
+        # A key whose widget went away (a dialog it closed) never sends its KeyDelivered up.
+        self._key_timer = self.set_timer(KEY_WAIT_S, self._key_came_back)
+
+    async def on_key_delivered(self, message: KeyDelivered) -> None:
+        message.stop()
+        await self._key_came_back()
+
+    async def _key_came_back(self) -> None:
+        if self._key_timer is not None:
+            self._key_timer.stop()
+            self._key_timer = None
+        self._key_in_flight = False
+        await self._next_key()
+
+    async def action_switch_mode(self, mode: str) -> None:
+        """Show screen ``mode``; the keys typed meanwhile go to it once it is up."""
+        self._switching = True
+        try:
+            await self.switch_mode(mode)
+        finally:
+            self.call_after_refresh(self._switched)
+
+    async def _switched(self) -> None:
+        self._switching = False
+        self._key_in_flight = False
+        await self._next_key()
 
     # -- actions and commands -----------------------------------------------------------------------
 
@@ -415,7 +513,9 @@ class KinemaApp(App[None]):
                 self.exit()
 
         self.push_screen(
-            ConfirmDialog("Close Kinema? This stops the runtime that `kinema run` started.", "Quit and stop"),
+            ConfirmDialog(
+                "Close Kinema? This stops the runtime that `kinema run` started.", "Quit and stop", "Stay"
+            ),
             answered,
         )
 
@@ -428,12 +528,23 @@ class KinemaApp(App[None]):
         """Open the newest recording (of a runtime on this machine) in the replay screen."""
         from kinema.errors import KinemaError
         from kinema.runtime.recordings import latest_recording
-        from kinema.tui.screens.replay import ReplayScreen
+        from kinema.tui.screens.replay import ReplayScreen, load_recording
 
-        try:
-            self.push_screen(ReplayScreen(latest_recording()))
-        except KinemaError as error:
-            self.notify(str(error), title="Nothing to replay", severity="warning", timeout=8)
+        def load() -> None:  # reading a recording takes a while: not on the UI thread
+            try:
+                path = latest_recording()
+                loaded = load_recording(path)
+            except KinemaError as error:
+                self.call_from_thread(
+                    self.notify, str(error), title="Nothing to replay", severity="warning", timeout=8
+                )
+                return
+            def show() -> None:
+                self.push_screen(ReplayScreen(path, loaded))
+
+            self.call_from_thread(show)
+
+        self.run_worker(load, thread=True, group="replay")
 
     def action_show_camera(self, topic: str | None = None) -> None:
         """Open the camera view (on ``topic``, else the last one shown)."""
@@ -483,6 +594,14 @@ class KinemaApp(App[None]):
                         waypoint.description or "Move the robot to this saved waypoint",
                         partial(view.move_to, waypoint.name),
                     )
+
+
+def plain_detail(detail: str) -> str:
+    """Why the connection was lost, in words: the heartbeat timeout says what it means."""
+    if detail.startswith("no heartbeat from the runtime for "):
+        seconds = detail.removeprefix("no heartbeat from the runtime for ").split(" ", 1)[0]
+        return f"no sign of life from it for {seconds} s (it stopped, or the machine is very busy)"
+    return detail or "it stopped answering"
 
 
 def run_app(

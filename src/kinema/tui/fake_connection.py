@@ -9,6 +9,7 @@ asked for from :attr:`FakeConnection.calls`. ``kinema ui --demo`` shows the app 
 from __future__ import annotations
 
 import threading
+import time
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
@@ -44,6 +45,7 @@ class FakeConnection:
         failures: method name -> the error that method raises (to test error display).
         calls: ``(method, args...)`` of every call the app made, in order.
         current_joints: what :meth:`save_waypoint` records.
+        delay: seconds every call to the runtime takes (a slow or loaded runtime).
         cameras: image topic -> the picture a new watcher gets first (HxWx3 uint8), as a camera that
             renders on demand sends one; :meth:`push_image` sends more.
     """
@@ -62,6 +64,7 @@ class FakeConnection:
     connected: bool = False
     listener: EventListener | None = None
     cameras: dict[str, object] = field(default_factory=dict)
+    delay: float = 0.0
     image_watchers: dict[str, list[ImageListener]] = field(default_factory=dict)
     _lock: threading.Lock = field(default_factory=threading.Lock, repr=False)
 
@@ -191,6 +194,8 @@ class FakeConnection:
     def _record(self, method: str, *args: object) -> None:
         with self._lock:
             self.calls.append((method, *args))
+        if self.delay and method not in ("open", "close"):
+            time.sleep(self.delay)  # a slow runtime: the app calls it off the UI thread
         failure = self.failures.get(method)
         if failure is not None:
             raise failure

@@ -93,3 +93,7 @@ class ModeSelected(Message):
     def __init__(self, mode: str) -> None:
         super().__init__()
         self.mode = mode
+
+
+class KeyDelivered(Message):
+    """Sent behind a key to the widget that got it: reaching the app, it says the key was handled."""

@@ -45,6 +45,10 @@ class BodyNode:
     static: bool
 
 
+#: A fixed geom this small (bounding sphere radius, m) is something the robot works on, and is framed.
+WORKSPACE_ITEM_RADIUS = 0.5
+
+
 class SceneModel:
     """A MuJoCo model prepared for meshcat (see the module docstring).
 
@@ -248,42 +252,82 @@ class SceneModel:
     # -- camera --------------------------------------------------------------------------------------
 
     def camera_view(self) -> dict[str, Any]:
-        """Where the page puts its camera: the model's first world-fixed camera, else MuJoCo's free camera.
+        """Where the page puts its camera: looking from the front at the robot and its workspace, whole.
 
-        World-fixed: on the world body or a body welded to it (lab_sim's scene camera sits in its optical
-        frame's body), whose pose no joint changes, so a fresh state gives it.
+        The direction is the model's first world-fixed camera's (on the world body or a body welded to it,
+        such as lab_sim's scene camera, whose pose no joint changes), else MuJoCo's free camera's (the
+        scene's ``<visual><global azimuth elevation>``). The camera looks at the centre of what the scene
+        draws at its start pose (floors left out) from the distance that fits all of it in the field of
+        view, so every page load starts on the same, whole picture of the cell.
         """
         import mujoco
 
         model = self.model
-        center = np.asarray(model.stat.center, dtype=float)
+        fov = float(model.vis.global_.fovy)
+        forward: np.ndarray | None = None
         for cam in range(model.ncam):
             if int(model.body_weldid[int(model.cam_bodyid[cam])]) != 0:
                 continue
             posed = mujoco.MjData(model)
             mujoco.mj_kinematics(model, posed)
             mujoco.mj_camlight(model, posed)
-            position = np.asarray(posed.cam_xpos[cam], dtype=float)
             rotation = np.asarray(posed.cam_xmat[cam], dtype=float).reshape(3, 3)
             forward = -rotation[:, 2]  # MuJoCo cameras look along their -z axis
-            distance = max(float(np.dot(center - position, forward)), 0.5)
-            return {
-                "camera": {
-                    "position": position.tolist(),
-                    "target": (position + forward * distance).tolist(),
-                    "fov": float(model.cam_fovy[cam]),
-                }
-            }
-        azimuth = np.radians(float(model.vis.global_.azimuth))
-        elevation = np.radians(float(model.vis.global_.elevation))
-        forward = np.array(
-            [np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation)]
-        )
-        distance = 1.5 * float(model.stat.extent)
+            fov = float(model.cam_fovy[cam])
+            break
+        if forward is None:
+            azimuth = np.radians(float(model.vis.global_.azimuth))
+            elevation = np.radians(float(model.vis.global_.elevation))
+            forward = np.array(
+                [np.cos(elevation) * np.cos(azimuth), np.cos(elevation) * np.sin(azimuth), np.sin(elevation)]
+            )
+        forward = forward / np.linalg.norm(forward)
+        center, radius = self._drawn_bounds()
+        # The sphere around what is drawn fits the (vertical) field of view, with a little margin.
+        distance = max(1.08 * radius / np.sin(np.radians(fov) / 2), 0.5)
         return {
             "camera": {
                 "position": (center - forward * distance).tolist(),
                 "target": center.tolist(),
-                "fov": float(model.vis.global_.fovy),
+                "fov": fov,
             }
         }
+
+    def _drawn_bounds(self) -> tuple[np.ndarray, float]:
+        """Centre and radius (m) of the box around the robot and what it works on at the start pose.
+
+        That is every drawn geom of a body that moves (the arm, the rail's carriage, free objects) and the
+        small fixed ones beside them (a tray, bottles: within :data:`WORKSPACE_ITEM_RADIUS`), each by its
+        own box turned into the world; large fixed scenery (a 3 m rail pedestal, the table, a floor) would
+        make the robot small. A scene where nothing moves is framed whole (planes aside).
+        """
+        model, data = self.model, self.data
+        drawn = [v.geom_id for v in self.visuals if v.kind not in ("plane", "hfield")]
+        moving = [g for g in drawn if int(model.body_weldid[int(model.geom_bodyid[g])]) != 0]
+        if not moving:
+            return self._box_of(drawn) if drawn else (np.asarray(model.stat.center, dtype=float), 1.0)
+        # Small fixed things beside what moves (a tray, bottles) belong to the workspace; a camera stand
+        # or a shelf across the room does not.
+        center, radius = self._box_of(moving)
+        near = [
+            g
+            for g in drawn
+            if g not in moving
+            and float(model.geom_rbound[g]) <= WORKSPACE_ITEM_RADIUS
+            and np.linalg.norm((np.asarray(data.geom_xpos[g]) - center)[:2]) <= radius
+        ]
+        return self._box_of(moving + near)
+
+    def _box_of(self, geoms: list[int]) -> tuple[np.ndarray, float]:
+        """Centre and half diagonal (m) of the world box around ``geoms`` (each by its own turned box)."""
+        model, data = self.model, self.data
+        signs = np.array([[x, y, z] for x in (-1, 1) for y in (-1, 1) for z in (-1, 1)], dtype=float)
+        corners = []
+        for geom in geoms:
+            box = np.asarray(model.geom_aabb[geom], dtype=float)  # centre, half sizes in the geom frame
+            local = box[:3] + signs * box[3:]
+            rotation = np.asarray(data.geom_xmat[geom], dtype=float).reshape(3, 3)
+            corners.append(np.asarray(data.geom_xpos[geom], dtype=float) + local @ rotation.T)
+        points = np.concatenate(corners)
+        low, high = points.min(axis=0), points.max(axis=0)
+        return (low + high) / 2, float(np.linalg.norm(high - low) / 2)

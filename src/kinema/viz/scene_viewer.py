@@ -152,6 +152,7 @@ class SceneViewer:
         parts.append(f"{self.frame_rate_measured():.0f} updates/s")
         return {
             "server_id": self.server_id,
+            "config": self.config,
             "level": level,
             "banner": banner,
             "info": " · ".join(parts),

@@ -75,8 +75,15 @@ def resolve_scene(config: str | None, workspace: Path | None, endpoint: str) -> 
     if name is None:
         from kinema.runtime.instance import running_instances
 
-        matching = [r for r in running_instances() if r.router == endpoint and r.config]
-        name = matching[-1].config if matching else selection.config
+        # What the runtime at the endpoint runs, in its workspace: `kinema run -c example_config` in a
+        # workspace is drawn and named as example_config, not as the selected (or default) config.
+        matching = [r for r in running_instances() if _same_endpoint(r.router, endpoint) and r.config]
+        if matching:
+            name = matching[-1].config
+            if workspace is None and matching[-1].workspace:
+                selection = active_selection(Path(matching[-1].workspace), name)
+        else:
+            name = selection.config
     if not name:
         raise ConfigError("no config selected: pass -c NAME (or select one with `kinema configure`)")
     found = Workspace.discover(selection.workspace) if selection.workspace else Workspace.bundled_only()
@@ -90,6 +97,17 @@ def resolve_scene(config: str | None, workspace: Path | None, endpoint: str) -> 
         )
     keyframe = resolved.get("hardware.simulation.mujoco_keyframe")
     return SceneSource(name, model_path, str(keyframe) if keyframe else None, _end_effector(resolved))
+
+
+def _same_endpoint(a: str, b: str) -> bool:
+    """``tcp/localhost:7447`` and ``tcp/127.0.0.1:7447`` name one router (as do 0.0.0.0 listeners)."""
+
+    def normal(endpoint: str) -> str:
+        for alias in ("localhost", "0.0.0.0", "[::1]", "[::]"):
+            endpoint = endpoint.replace(f"/{alias}:", "/127.0.0.1:")
+        return endpoint.strip()
+
+    return normal(a) == normal(b)
 
 
 def _end_effector(resolved: Any) -> str | None:

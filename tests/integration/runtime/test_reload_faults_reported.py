@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from collections.abc import Iterator
@@ -110,3 +111,34 @@ def test_reload_errors_appear_in_the_run_terminal_and_in_kinema_logs(
     for needle in ("SyntaxError", "no_such_module_anywhere", "objective broken.xml not reloaded"):
         assert needle in logs.stdout, logs.stdout
     assert "Traceback" not in "".join(terminal.lines) + logs.stdout
+
+
+def test_objective_run_says_when_it_runs_code_whose_latest_file_failed_to_load(
+    terminal: Terminal, workspace: Path, env: dict[str, str]
+) -> None:
+    # A new user's edit failed to import; `objective run` failed with the previous version's exception at
+    # a line that no longer held that code, and nothing said the file on disk had not loaded.
+    objective = workspace / "src" / "my_cell" / "objectives" / "wave.xml"
+    objective.write_text(
+        '<root BTCPP_format="4">\n  <BehaviorTree ID="Wave Once">\n    <Wave/>\n  </BehaviorTree>\n</root>\n'
+    )
+    behaviors = workspace / "src" / "waves" / "waves" / "behaviors.py"
+    behaviors.write_text(BEHAVIOR.replace("return NodeStatus.SUCCESS", "raise ValueError('old code')"))
+    terminal.wait_for("Reloaded waves: Wave")
+    behaviors.write_text(BEHAVIOR.replace("def tick(self):", "def tick(self:"))
+    terminal.wait_for("waves not reloaded")
+    line_no = BEHAVIOR.splitlines().index("    def tick(self):") + 1
+
+    run = subprocess.run(
+        [sys.executable, "-m", "kinema", "objective", "run", "Wave Once", "--timeout", "30"],
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
+    assert run.returncode == 1
+    said = run.stdout + run.stderr
+    assert "ValueError: old code" in said
+    assert f"{behaviors}:{line_no}" in said and "SyntaxError" in said, said
+    assert "runs older code" in said  # said as it starts
+    assert re.search(r"note: .*Wave runs the version from \d\d:\d\d instead", said), said

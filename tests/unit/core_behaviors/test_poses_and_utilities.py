@@ -110,3 +110,23 @@ def test_wait_for_duration_follows_the_runtime_clock(registry: Any) -> None:
     assert tree.tick_once() == NodeStatus.RUNNING
     clock.advance(0.6)
     assert tree.tick_once() == NodeStatus.SUCCESS
+
+
+def test_log_message_shows_blackboard_values_of_any_type(registry: Any, context: BehaviorContext) -> None:
+    # MoveIt Pro's ports as they are: a whole "{key}" is a string pointer; {key} inside a text is a value.
+    from kinema.testing import run_objective
+
+    xml = """<root BTCPP_format="4"><BehaviorTree ID="M"><Sequence>
+      <Script code="count := 3; ratio := 0.5; word := 'hi'"/>
+      <CreatePoseStamped position_xyz="1;2;3" pose_stamped="{pose}"/>
+      <LogMessage message="{word}"/>
+      <LogMessage message="count={count} ratio={ratio} word={word} missing={nope}"/>
+      <LogMessage message="picked at {pose}" log_level="warn"/>
+    </Sequence></BehaviorTree></root>"""
+    run = run_objective(xml, registry=registry, context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    assert run.toasts[0] == "hi"
+    assert run.toasts[1] == "count=3 ratio=0.5 word=hi missing={nope}: (not set)"
+    picked = run.toasts[2]
+    assert picked.startswith("picked at {header: {") and "position: {x: 1.0, y: 2.0, z: 3.0}" in picked
+    assert "frame_id: world" in picked and "object at 0x" not in picked

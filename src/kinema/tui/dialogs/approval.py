@@ -1,4 +1,4 @@
-"""Approve a planned motion: the question, the motion's steps (stage, duration, joints, gripper), y/n."""
+"""Approve a planned motion: the question, the motion's steps (stage, duration, joints, gripper), ctrl+y/n."""
 
 from __future__ import annotations
 
@@ -6,11 +6,11 @@ from rich.console import Group
 from rich.table import Table
 from rich.text import Text
 from textual.app import ComposeResult
-from textual.containers import Horizontal, Vertical
-from textual.widgets import Button, Label, Static
+from textual.containers import Vertical
+from textual.widgets import Static
 
 from kinema.tui.connection import SolutionStep
-from kinema.tui.dialogs.confirm import ConfirmDialog
+from kinema.tui.dialogs.confirm import MotionQuestionDialog
 
 
 def steps_table(steps: tuple[SolutionStep, ...], duration: float) -> Group:
@@ -46,18 +46,16 @@ def steps_table(steps: tuple[SolutionStep, ...], duration: float) -> Group:
     return Group(table, total)
 
 
-class ApprovalDialog(ConfirmDialog):
+class ApprovalDialog(MotionQuestionDialog):
     """A behavior's approval question with the planned motion it is about; returns True when approved."""
 
     def __init__(self, question: str, steps: tuple[SolutionStep, ...], duration: float) -> None:
-        super().__init__(question, confirm_label="Approve")
+        super().__init__(question)
         self.steps = steps
         self.duration = duration
 
     def compose(self) -> ComposeResult:
         with Vertical(classes="dialog wide"):
-            yield Label(self.question, classes="dialog-title")
+            yield from self.compose_question()
             yield Static(steps_table(self.steps, self.duration), id="approval-steps")
-            with Horizontal(classes="dialog-buttons"):
-                yield Button(self.confirm_label, variant="success", id="yes")
-                yield Button("Reject", id="no")
+            yield from self.compose_buttons("success")

@@ -13,6 +13,7 @@ from textual.widgets import DataTable, Input, Label, Static
 from kinema.tui.connection import BehaviorSummary, ConnectionState, ReloadNotice
 from kinema.tui.messages import BehaviorsLoaded
 from kinema.tui.screens.base import LOAD_ATTEMPTS, KinemaScreen
+from kinema.tui.widgets.fitted_table import PORT_COLUMNS, FittedTable
 
 
 class BehaviorsScreen(KinemaScreen):
@@ -38,7 +39,7 @@ class BehaviorsScreen(KinemaScreen):
             with Vertical(classes="main"):
                 yield Static("", id="behavior-title", classes="pane-title")
                 yield Static("", id="behavior-details")
-                yield DataTable(id="behavior-ports", cursor_type="row", zebra_stripes=True)
+                yield FittedTable(PORT_COLUMNS, id="behavior-ports")
                 yield Label("Hot reload", classes="pane-title")
                 yield DataTable(id="reload-table", cursor_type="row", zebra_stripes=True)
 
@@ -48,10 +49,6 @@ class BehaviorsScreen(KinemaScreen):
         table.add_column("Behavior", key="id")
         table.add_column("Plugin", key="plugin")
         table.add_column("Subcategory", key="subcategory")
-        ports = self.query_one("#behavior-ports", DataTable)
-        for label, key in (("Port", "name"), ("Dir", "direction"), ("Type", "type"), ("Default", "default")):
-            ports.add_column(label, key=key)
-        ports.add_column("Description", key="description")
         reloads = self.query_one("#reload-table", DataTable)
         reloads.add_column("Time", key="time", width=8)
         reloads.add_column("", key="ok", width=2)
@@ -59,7 +56,7 @@ class BehaviorsScreen(KinemaScreen):
         reloads.add_column("Message", key="message")
         for notice in self.kinema.reloads:
             self._add_reload(notice)
-        table.focus()
+        self.set_focus(table)
         if self.kinema.status.state is ConnectionState.CONNECTED:
             self.action_reload()
 
@@ -97,7 +94,7 @@ class BehaviorsScreen(KinemaScreen):
         self._refilter()
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
-        self.query_one("#behavior-table", DataTable).focus()
+        self.set_focus(self.query_one("#behavior-table", DataTable))
 
     def on_data_table_row_highlighted(self, event: DataTable.RowHighlighted) -> None:
         if event.data_table.id != "behavior-table" or event.row_key.value is None:
@@ -120,15 +117,9 @@ class BehaviorsScreen(KinemaScreen):
         if extra:
             details.append("\n" + "  ".join(f"{k}: {v}" for k, v in extra.items()), style="dim")
         self.query_one("#behavior-details", Static).update(details)
-        ports = self.query_one("#behavior-ports", DataTable)
-        ports.clear()
-        for port in behavior.ports:
-            ports.add_row(
-                *(
-                    Text(v)
-                    for v in (port.name, port.direction, port.type_name, port.default, port.description)
-                )
-            )
+        self.query_one("#behavior-ports", FittedTable).set_rows(
+            [(p.name, p.direction, p.type_name, p.default, p.description) for p in behavior.ports]
+        )
 
     def runtime_reload(self, notice: ReloadNotice) -> None:
         self._add_reload(notice)
@@ -146,4 +137,4 @@ class BehaviorsScreen(KinemaScreen):
         table.move_cursor(row=table.row_count - 1)
 
     def action_search(self) -> None:
-        self.query_one("#behavior-search", Input).focus()
+        self.set_focus(self.query_one("#behavior-search", Input))

@@ -53,7 +53,7 @@ class BlackboardScreen(KinemaScreen):
             with Horizontal(classes="toolbar"):
                 yield Input(placeholder="/ filter by key, scope, type or value", id="blackboard-filter")
                 yield Static("", id="blackboard-summary", classes="muted")
-            with Horizontal(classes="split"):
+            with Horizontal(classes="split", id="blackboard-split"):
                 yield BlackboardTable(self.kinema.blackboard, id="blackboard-table")
                 with Vertical(classes="side-panel"):
                     yield Label("History", classes="pane-title")
@@ -66,7 +66,7 @@ class BlackboardScreen(KinemaScreen):
         history.add_column("Time", key="time", width=12)
         history.add_column("Value", key="value")
         self.set_interval(REFRESH_PERIOD_S, self.flush)
-        self.query_one(BlackboardTable).focus()
+        self.set_focus(self.query_one(BlackboardTable))
         self.flush()
 
     def on_screen_resume(self) -> None:
@@ -111,7 +111,7 @@ class BlackboardScreen(KinemaScreen):
             self.flush()
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
-        self.query_one(BlackboardTable).focus()
+        self.set_focus(self.query_one(BlackboardTable))
 
     def on_blackboard_table_key_highlighted(self, event: BlackboardTable.KeyHighlighted) -> None:
         self.history_key = event.key
@@ -130,11 +130,11 @@ class BlackboardScreen(KinemaScreen):
             table.add_row(format_stamp(stamp), Text(value))
 
     def action_filter(self) -> None:
-        self.query_one("#blackboard-filter", Input).focus()
+        self.set_focus(self.query_one("#blackboard-filter", Input))
 
     def action_clear_filter(self) -> None:
         self.query_one("#blackboard-filter", Input).value = ""
-        self.query_one(BlackboardTable).focus()
+        self.set_focus(self.query_one(BlackboardTable))
 
     def action_focus_table(self) -> None:
-        self.query_one(BlackboardTable).focus()
+        self.set_focus(self.query_one(BlackboardTable))

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from dataclasses import dataclass
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 from rich.text import Text
@@ -10,12 +11,13 @@ from textual.app import ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.message import Message
-from textual.widgets import DataTable, Label, OptionList, Static, TabbedContent, TabPane, Tree
+from textual.widgets import Label, OptionList, Static, TabbedContent, TabPane, Tree
 from textual.widgets.option_list import Option
 
 from kinema.errors import KinemaError
 from kinema.tui.config_view import ConfigRow, config_rows, package_files
 from kinema.tui.screens.base import KinemaScreen
+from kinema.tui.widgets.fitted_table import Column, FittedTable
 
 if TYPE_CHECKING:
     from kinema.config import Package, ResolvedConfig, Workspace
@@ -31,6 +33,7 @@ class ConfigDetails:
     files: list[str]
     files_cut: bool
     error: str = ""
+    folder: Path | None = None
 
 
 class WorkspaceLoaded(Message):
@@ -48,6 +51,31 @@ class ConfigLoaded(Message):
     def __init__(self, details: ConfigDetails) -> None:
         super().__init__()
         self.details = details
+
+
+class FileOpened(Message):
+    """A file of a package was read to be shown."""
+
+    def __init__(self, path: Path, text: str) -> None:
+        super().__init__()
+        self.path = path
+        self.text = text
+
+
+#: A file larger than this shows only its start (the Files tab is for reading a config, not logs).
+MAX_SHOWN_BYTES = 256 * 1024
+
+
+def read_shown_file(path: Path) -> str:
+    """The text of ``path`` to show (its start when large; binary files say so)."""
+    with path.open("rb") as handle:
+        data = handle.read(MAX_SHOWN_BYTES + 1)
+    if b"\0" in data[:4096]:
+        return f"({path.name} is a binary file: {path.stat().st_size} bytes)"
+    text = data[:MAX_SHOWN_BYTES].decode("utf-8", errors="replace")
+    if len(data) > MAX_SHOWN_BYTES:
+        text += f"\n… (only the first {MAX_SHOWN_BYTES // 1024} kB are shown)"
+    return text
 
 
 class ConfigsScreen(KinemaScreen):
@@ -79,16 +107,19 @@ class ConfigsScreen(KinemaScreen):
                     with TabPane("Chain", id="chain"):
                         yield Tree("inheritance", id="chain-tree")
                     with TabPane("Resolved config", id="resolved"):
-                        yield DataTable(id="resolved-table", cursor_type="row", zebra_stripes=True)
+                        yield FittedTable(
+                            (
+                                Column("key", "Key", min_width=14, weight=1),
+                                Column("value", "Value", min_width=16, weight=3),
+                                Column("package", "Set by", min_width=14, weight=0),
+                            ),
+                            id="resolved-table",
+                        )
                     with TabPane("Files", id="files"):
                         yield Tree("files", id="file-tree")
 
     def on_mount(self) -> None:
         super().on_mount()
-        table = self.query_one("#resolved-table", DataTable)
-        table.add_column("Key", key="key")
-        table.add_column("Set by", key="package")
-        table.add_column("Value", key="value")
         self.action_reload()
 
     def action_reload(self) -> None:
@@ -99,6 +130,24 @@ class ConfigsScreen(KinemaScreen):
 
     def action_tab(self, tab: str) -> None:
         self.query_one(TabbedContent).active = tab
+
+    def on_tree_node_selected(self, event: Tree.NodeSelected[object]) -> None:
+        """Enter (or a click) on a file of the Files tab opens it, read-only."""
+        details = self.details
+        relative = event.node.data
+        if event.control.id != "file-tree" or not isinstance(relative, str) or details is None:
+            return
+        if details.folder is None:
+            return
+        path = details.folder / relative
+        self.call_runtime(
+            f"Open {relative}", lambda: read_shown_file(path), lambda text: FileOpened(path, text)
+        )
+
+    def on_file_opened(self, message: FileOpened) -> None:
+        from kinema.tui.dialogs.file_view import FileViewDialog
+
+        self.app.push_screen(FileViewDialog(message.path, message.text))
 
     def on_workspace_loaded(self, message: WorkspaceLoaded) -> None:
         self.workspace = message.workspace
@@ -137,11 +186,16 @@ class ConfigsScreen(KinemaScreen):
             title.append(f"  {details.error}", style="red")
         self.query_one("#config-title", Static).update(title)
         self._show_chain(details)
-        table = self.query_one("#resolved-table", DataTable)
-        table.clear()
-        for row in details.rows:
-            own = row.package == details.name
-            table.add_row(Text(row.key), Text(row.package, style="bold" if own else "dim"), Text(row.value))
+        self.query_one("#resolved-table", FittedTable).set_rows(
+            [
+                (
+                    Text(row.key),
+                    Text(row.value),
+                    Text(row.package, style="bold" if row.package == details.name else "dim"),
+                )
+                for row in details.rows
+            ]
+        )
         self._show_files(details)
 
     def _show_chain(self, details: ConfigDetails) -> None:
@@ -175,7 +229,7 @@ class ConfigsScreen(KinemaScreen):
                 if parent_key not in folders:
                     folders[parent_key] = parent.add(Text(f"{part}/"), expand=parent is tree.root)
                 parent = folders[parent_key]  # type: ignore[assignment]
-            parent.add_leaf(Text(parts[-1]))
+            parent.add_leaf(Text(parts[-1]), data=path)
         if details.files_cut:
             tree.root.add_leaf(Text(f"… (only the first {len(details.files)} files are listed)", style="dim"))
         tree.root.expand()
@@ -206,5 +260,5 @@ def _details(name: str, workspace: Workspace) -> ConfigDetails:
     try:
         resolved = resolve_config(name, workspace, check_files=False)
     except KinemaError as error:  # a broken config is shown with its file:line, next to its files
-        return ConfigDetails(name, None, [], files, cut, str(error))
-    return ConfigDetails(name, resolved, config_rows(resolved), files, cut)
+        return ConfigDetails(name, None, [], files, cut, str(error), package.path)
+    return ConfigDetails(name, resolved, config_rows(resolved), files, cut, folder=package.path)

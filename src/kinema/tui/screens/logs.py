@@ -66,7 +66,7 @@ class LogsScreen(KinemaScreen):
     def on_mount(self) -> None:
         super().on_mount()
         self._rewrite()
-        self.query_one(RichLog).focus()
+        self.set_focus(self.query_one(RichLog))
 
     def on_select_changed(self, event: Select.Changed) -> None:
         if isinstance(event.value, int) and event.value != self.level:

@@ -11,7 +11,6 @@ from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.widgets import (
     Checkbox,
-    DataTable,
     Input,
     OptionList,
     Select,
@@ -30,10 +29,13 @@ from kinema.tui.connection import (
     RuntimeConnection,
     TaskPlanning,
 )
+from kinema.tui.dialogs.failure import FailureDialog, outcome_text
 from kinema.tui.messages import ObjectiveOutlineLoaded, ObjectiveRunRequested, ObjectivesLoaded
 from kinema.tui.run_outcome import RunOutcome
 from kinema.tui.screens.base import LOAD_ATTEMPTS, KinemaScreen
 from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
+from kinema.tui.widgets.fitted_table import PORT_COLUMNS, FittedTable
+from kinema.tui.widgets.objective_list import ObjectiveList, ObjectiveSearch
 from kinema.tui.widgets.override_form import OverrideForm
 from kinema.tui.widgets.task_panel import TaskPanel
 
@@ -65,33 +67,51 @@ class ObjectivesScreen(KinemaScreen):
 
     MODE = "objectives"
     AUTO_FOCUS = "#objective-list"
+    # No printable key acts here: letters typed on the list search (ObjectiveList), and running moves the
+    # robot, so it is Enter on the highlighted objective or ctrl+r, both naming what will run.
     BINDINGS = [
+        # Shown under the list ("Enter or ctrl+r runs ..."); the footer has Enter's "Run".
         Binding(
-            "r", "run", "Run", id="objectives.run", tooltip="Run the selected objective with the parameters"
+            "ctrl+r", "run", "Run", id="objectives.run", tooltip="Run the selected objective", show=False
         ),
-        Binding("x", "cancel", "Cancel", id="objectives.cancel", tooltip="Cancel the running objective"),
         Binding("slash", "search", "Search", id="objectives.search", tooltip="Search objectives by name"),
+        Binding("f2", "tab('tree')", "Tree", id="objectives.tree", tooltip="The behavior tree"),
+        Binding("f3", "tab('xml')", "XML", id="objectives.xml", tooltip="The objective's XML"),
+        Binding("f4", "tab('parameters')", "Params", id="objectives.parameters", tooltip="Overrides"),
         Binding(
-            "f",
-            "toggle_filter('favorites')",
-            "Favorites",
-            id="objectives.favorites",
-            tooltip="Only favorites",
+            "f5", "reload", "Reload", id="objectives.reload", tooltip="List the objectives again", show=False
         ),
         Binding(
-            "u", "toggle_filter('runnable')", "Runnable", id="objectives.runnable", tooltip="Only runnable"
+            "ctrl+o",
+            "show_failure",
+            "Failure",
+            id="objectives.failure",
+            tooltip="The whole message of the last failed or cancelled run",
+            show=False,  # shown on the failure box itself, while there is one
         ),
-        Binding("t", "tab('tree')", "Tree", id="objectives.tree", tooltip="The behavior tree"),
-        Binding("m", "tab('xml')", "XML", id="objectives.xml", tooltip="The objective's XML"),
-        Binding("p", "tab('parameters')", "Parameters", id="objectives.parameters", tooltip="Overrides"),
-        Binding("f5", "reload", "Reload", id="objectives.reload", tooltip="List the objectives again"),
         Binding(
-            "d",
+            "escape",
             "dismiss_failure",
             "Dismiss",
             id="objectives.dismiss",
             tooltip="Hide the failure explanation of the last run",
             show=False,  # the failure panel says so; the footer has no room to spare
+        ),
+        Binding(
+            "ctrl+f",
+            "toggle_filter('favorites')",
+            "Favorites",
+            id="objectives.favorites",
+            tooltip="Only favorites",
+            show=False,
+        ),
+        Binding(
+            "ctrl+u",
+            "toggle_filter('runnable')",
+            "Runnable",
+            id="objectives.runnable",
+            tooltip="Only runnable",
+            show=False,
         ),
     ]
 
@@ -101,19 +121,28 @@ class ObjectivesScreen(KinemaScreen):
         self.shown_objectives: list[ObjectiveSummary] = []
         self.selected: ObjectiveSummary | None = None
         self.failure_shown: RunOutcome | None = None
+        # Outcomes the user hid (Esc): they stay hidden when the objective is selected again.
+        self._dismissed: set[int] = set()
 
     def compose_body(self) -> ComposeResult:
         with Horizontal(classes="split"):
             with Vertical(classes="sidebar"):
-                yield Input(placeholder="/ search objectives", id="objective-search")
+                yield ObjectiveSearch(
+                    objectives="objective-list",
+                    placeholder="type to search objectives",
+                    id="objective-search",
+                )
                 yield Select([], prompt="All subcategories", id="subcategory", allow_blank=True)
                 with Horizontal(classes="checks"):
-                    yield Checkbox("Favorites", id="favorites", compact=True, tooltip="Only favorites (f)")
                     yield Checkbox(
-                        "Runnable", id="runnable", compact=True, tooltip="Only runnable objectives (u)"
+                        "Favorites", id="favorites", compact=True, tooltip="Only favorites (ctrl+f)"
                     )
-                yield OptionList(id="objective-list")
+                    yield Checkbox(
+                        "Runnable", id="runnable", compact=True, tooltip="Only runnable objectives (ctrl+u)"
+                    )
+                yield ObjectiveList(search="objective-search", id="objective-list")
                 yield Static("", id="objective-count", classes="muted")
+                yield Static("", id="run-hint")
             with Vertical(classes="main"):
                 yield Static("", id="objective-title", classes="pane-title")
                 yield Static("", id="objective-description")
@@ -127,19 +156,11 @@ class ObjectivesScreen(KinemaScreen):
                     with TabPane("Parameters", id="parameters"):
                         yield OverrideForm(id="override-form")
                     with TabPane("Ports", id="ports"):
-                        yield DataTable(id="port-table", cursor_type="row", zebra_stripes=True)
+                        yield FittedTable(PORT_COLUMNS, id="port-table")
 
     def on_mount(self) -> None:
         super().on_mount()
-        ports = self.query_one("#port-table", DataTable)
-        ports.add_column("Port", key="name")
-        ports.add_column("Direction", key="direction")
-        ports.add_column("Type", key="type")
-        ports.add_column("Default", key="default")
-        ports.add_column("Description", key="description")
-        self.query_one("#objective-list", OptionList).focus()
-        if self.kinema.outcomes:
-            self._show_outcome(list(self.kinema.outcomes.values())[-1])
+        self.set_focus(self.query_one("#objective-list", OptionList))
         self.query_one(TaskPanel).show_task(self.kinema.task_planning)
         if self.kinema.status.state is ConnectionState.CONNECTED:
             self.action_reload()
@@ -204,11 +225,15 @@ class ObjectivesScreen(KinemaScreen):
 
     def on_input_submitted(self, event: Input.Submitted) -> None:
         if event.input.id == "objective-search":
-            self.query_one("#objective-list", OptionList).focus()
+            pass  # the search box gave the list the focus itself (ObjectiveSearch)
         elif event.input in self.query_one(OverrideForm).query(Input):
-            # Enter in a parameter runs the objective with the form's values. The keys are the screen's
-            # again (x cancels, r runs again): the field the run hides must not keep the focus.
-            self.query_one("#objective-list", OptionList).focus()
+            # Enter in a parameter runs the objective with the form's values. The keys are the list's
+            # again (Enter runs again): the field the run hides must not keep the focus.
+            self.set_focus(self.query_one("#objective-list", OptionList))
+            self.action_run()
+
+    def on_option_list_option_selected(self, event: OptionList.OptionSelected) -> None:
+        if event.option_list.id == "objective-list":  # Enter on the list (a click only highlights)
             self.action_run()
 
     def on_select_changed(self, event: Select.Changed) -> None:
@@ -238,11 +263,20 @@ class ObjectivesScreen(KinemaScreen):
         if where:
             description.append(f"\n{where}", style="dim")
         self.query_one("#objective-description", Static).update(description)
-        ports = self.query_one("#port-table", DataTable)
-        ports.clear()
-        for port in objective.ports:
-            cells = (port.name, port.direction, port.type_name, port.default, port.description)
-            ports.add_row(*(Text(v) for v in cells))
+        hint = Text()
+        if objective.runnable:
+            hint.append("Enter", style="bold")
+            hint.append(" or ")
+            hint.append("ctrl+r", style="bold")
+            hint.append(" runs ")
+            hint.append(objective.name, style="bold")
+        else:
+            hint.append(f"{objective.name} is a subtree: run an objective that uses it", style="dim")
+        self.query_one("#run-hint", Static).update(hint)
+        self._show_outcome_of_selected()
+        self.query_one("#port-table", FittedTable).set_rows(
+            [(p.name, p.direction, p.type_name, p.default, p.description) for p in objective.ports]
+        )
         self.run_worker(self.query_one(OverrideForm).show_objective(objective), group="override-form")
         self.query_one(BehaviorTreeView).show_outline(None, "loading …")
         connection = self.kinema.connection
@@ -298,7 +332,7 @@ class ObjectivesScreen(KinemaScreen):
         self.call_runtime("Cancel the objective", self.kinema.connection.cancel_objective, announce=True)
 
     def action_search(self) -> None:
-        self.query_one("#objective-search", Input).focus()
+        self.set_focus(self.query_one("#objective-search", Input))
 
     def action_toggle_filter(self, which: str) -> None:
         self.query_one(f"#{which}", Checkbox).toggle()
@@ -309,41 +343,52 @@ class ObjectivesScreen(KinemaScreen):
             # Typing goes into the form at once: a value's letters are not the screen's keys (x cancels).
             fields = self.query_one(OverrideForm).query(Input)
             if fields:
-                fields.first().focus()
+                self.set_focus(fields.first())
 
     # -- live status -------------------------------------------------------------------------------
 
     def runtime_run_started(self, objective_name: str) -> None:
         self.query_one(TaskPanel).show_task(None)
-        self.action_dismiss_failure()  # how the last run ended no longer describes what runs
+        # The app forgot the last outcome of objective_name: its box goes (another objective's stays).
+        self._show_outcome_of_selected()
         if self.selected is not None and self.selected.name == objective_name:
             self.query_one(BehaviorTreeView).reset_statuses()
 
     def runtime_run_ended(self, outcome: RunOutcome) -> None:
-        self._show_outcome(outcome)
+        self._show_outcome_of_selected()
         if self.selected is not None and self.selected.name == outcome.objective_name:
             self.query_one(BehaviorTreeView).finish_run(outcome.outcome, outcome.message)
 
-    def _show_outcome(self, outcome: RunOutcome) -> None:
+    def _show_outcome_of_selected(self) -> None:
+        """The result box belongs to the selected objective: its last failed or cancelled run, if any."""
+        outcome = self.kinema.outcomes.get(self.selected.name) if self.selected is not None else None
         panel = self.query_one("#failure-panel", Static)
+        if outcome is None or id(outcome) in self._dismissed:
+            panel.set_class(False, "shown")
+            self.failure_shown = None
+            return
         failed = outcome.outcome == "Failure"
         text = Text()
         text.append("✘ failed" if failed else "◼ cancelled", style="bold red" if failed else "bold yellow")
-        hint = "  (d dismisses)"
-        if failed:
-            shown = self.selected is not None and self.selected.name == outcome.objective_name
-            where = "the tree below shows the failed path" if shown else "select it to see the failed path"
-            hint = f"  (d dismisses; {where})"
-        text.append(hint + "\n", style="dim")
-        text.append(outcome.message)
+        text.append("  ctrl+o whole message · Esc hides\n", style="dim")
+        text.append_text(outcome_text(outcome))
         panel.update(text)
         panel.set_class(True, "shown")
         panel.set_class(not failed, "cancelled")
         self.failure_shown = outcome
 
     def action_dismiss_failure(self) -> None:
+        if self.failure_shown is not None:
+            self._dismissed.add(id(self.failure_shown))
         self.query_one("#failure-panel", Static).set_class(False, "shown")
         self.failure_shown = None
+
+    def action_show_failure(self) -> None:
+        outcome = self.kinema.outcomes.get(self.selected.name) if self.selected is not None else None
+        if outcome is None:
+            self.notify("The selected objective has no failed or cancelled run to show.")
+            return
+        self.app.push_screen(FailureDialog(outcome))
 
     def runtime_task_planning(self, task: TaskPlanning) -> None:
         self.query_one(TaskPanel).show_task(task)

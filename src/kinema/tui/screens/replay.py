@@ -9,16 +9,21 @@ blackboard is the first snapshot taken after that transition (the end of its tic
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING, Any
 
 from rich.text import Text
 from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
-from textual.widgets import DataTable, Footer, Static
+from textual.widgets import Footer, Static
 
 from kinema.tui.connection import NodeStatus, NodeStatusUpdate
 from kinema.tui.widgets.behavior_tree_view import STATUS_MARK, BehaviorTreeView
+from kinema.tui.widgets.fitted_table import Column, FittedTable
+
+if TYPE_CHECKING:
+    from kinema.tui.tree_outline import TreeOutline
 
 
 class ReplayScreen(Screen[None]):
@@ -55,17 +60,11 @@ class ReplayScreen(Screen[None]):
     ReplayScreen #replay-blackboard { width: 2fr; border-left: solid $primary-background; }
     """
 
-    def __init__(self, path: Path) -> None:
+    def __init__(self, path: Path, loaded: tuple[Any, TreeOutline] | None = None) -> None:
         super().__init__()
-        from kinema.runtime.recordings import load_replay
-        from kinema.tui.tree_outline import build_outline
-
         self.path = Path(path)
-        self.replay = load_replay(self.path)
+        self.replay, self.outline = loaded if loaded is not None else load_recording(self.path)
         self.position = 0
-        recording = self.replay.recording
-        main = _first_tree_id(recording.tree_xml)
-        self.outline = build_outline(recording.tree_xml, main, filename=str(self.path))
         self._paths = {node.uid: node for node in self.outline.nodes()}
 
     @property
@@ -81,7 +80,15 @@ class ReplayScreen(Screen[None]):
                 yield BehaviorTreeView(id="behavior-tree")
             with Vertical(id="replay-blackboard"):
                 yield Static("Blackboard", id="replay-blackboard-title", classes="pane-title")
-                yield DataTable(id="replay-entries", cursor_type="row", zebra_stripes=True)
+                yield FittedTable(
+                    (
+                        Column("scope", "Scope", min_width=8, weight=1, drop=1, wrap=False),
+                        Column("key", "Key", min_width=8, weight=1, wrap=False),
+                        Column("type", "Type", min_width=6, weight=0.5, drop=2, wrap=False),
+                        Column("value", "Value", min_width=10, weight=3),
+                    ),
+                    id="replay-entries",
+                )
         yield Footer()
 
     def on_mount(self) -> None:
@@ -93,9 +100,6 @@ class ReplayScreen(Screen[None]):
         if recording.trailing_bytes:
             title.append("  (the recording was cut short)", style="yellow")
         self.query_one("#replay-title", Static).update(title)
-        table = self.query_one("#replay-entries", DataTable)
-        for column in ("Scope", "Key", "Type", "Value"):
-            table.add_column(column, key=column.lower())
         self.query_one(BehaviorTreeView).show_outline(self.outline)
         self.show_position(0)
 
@@ -150,15 +154,16 @@ class ReplayScreen(Screen[None]):
         self.query_one("#replay-position", Static).update(text)
 
     def _show_blackboard(self, t_us: int) -> None:
-        table = self.query_one("#replay-entries", DataTable)
-        table.clear()
+        table = self.query_one("#replay-entries", FittedTable)
         frame = self.replay.blackboard_at(t_us) if self.position else None
         title = "Blackboard" if frame is None else f"Blackboard (snapshot at +{frame.t_us / 1e6:.3f} s)"
         self.query_one("#replay-blackboard-title", Static).update(title)
-        if frame is None:
-            return
-        for scope, key, type_name, value in frame.entries:
-            table.add_row(Text(scope), Text(key, style="bold"), Text(type_name, style="dim"), Text(value))
+        table.set_rows(
+            [
+                (Text(scope), Text(key, style="bold"), Text(type_name, style="dim"), Text(value))
+                for scope, key, type_name, value in (frame.entries if frame is not None else ())
+            ]
+        )
 
     def action_step(self, delta: int) -> None:
         self.show_position(self.position + delta)
@@ -194,6 +199,17 @@ class ReplayApp(App[None]):
 
     def on_mount(self) -> None:
         self.push_screen(ReplayScreen(self.path))
+
+
+def load_recording(path: Path) -> tuple[Any, TreeOutline]:
+    """The replay of the recording at ``path`` and its tree's outline (slow for a long run: off the UI)."""
+    from kinema.runtime.recordings import load_replay
+    from kinema.tui.tree_outline import build_outline
+
+    replay = load_replay(Path(path))
+    recording = replay.recording
+    main = _first_tree_id(recording.tree_xml)
+    return replay, build_outline(recording.tree_xml, main, filename=str(path))
 
 
 def _first_tree_id(xml: str) -> str | None:

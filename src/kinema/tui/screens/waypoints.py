@@ -15,6 +15,7 @@ from kinema.tui.dialogs.confirm import ConfirmDialog
 from kinema.tui.dialogs.text_prompt import TextPromptDialog
 from kinema.tui.messages import WaypointsLoaded
 from kinema.tui.screens.base import LOAD_ATTEMPTS, KinemaScreen
+from kinema.tui.widgets.fitted_table import Column, FittedTable
 
 
 class WaypointsScreen(KinemaScreen):
@@ -37,24 +38,32 @@ class WaypointsScreen(KinemaScreen):
         self.waypoints: list[WaypointSummary] = []
 
     def compose_body(self) -> ComposeResult:
-        with Horizontal(classes="split"):
+        with Horizontal(classes="split", id="waypoint-split"):
             with Vertical(classes="main"):
-                yield DataTable(id="waypoint-table", cursor_type="row", zebra_stripes=True)
+                yield FittedTable(
+                    (
+                        Column("favorite", "", min_width=1, weight=0),
+                        Column("name", "Waypoint", min_width=14, weight=1),
+                        Column("groups", "Groups", min_width=8, weight=1, drop=2, wrap=False),
+                        Column("description", "Description", min_width=14, weight=2, drop=1),
+                    ),
+                    id="waypoint-table",
+                )
             with Vertical(classes="side-panel"):
                 yield Static("", id="waypoint-title", classes="pane-title")
-                yield DataTable(id="joint-table", cursor_type="row", zebra_stripes=True)
+                # A position is never cut: "-1.5708" shown as "-" says nothing (a long joint name is).
+                yield FittedTable(
+                    (
+                        Column("joint", "Joint", min_width=8, weight=1, wrap=False),
+                        Column("position", "Position", min_width=9, weight=0),
+                    ),
+                    id="joint-table",
+                )
 
     def on_mount(self) -> None:
         super().on_mount()
         table = self.query_one("#waypoint-table", DataTable)
-        table.add_column("", key="favorite", width=2)
-        table.add_column("Waypoint", key="name")
-        table.add_column("Groups", key="groups")
-        table.add_column("Description", key="description")
-        joints = self.query_one("#joint-table", DataTable)
-        joints.add_column("Joint", key="joint")
-        joints.add_column("Position", key="position")
-        table.focus()
+        self.set_focus(table)
         if self.kinema.status.state is ConnectionState.CONNECTED:
             self.action_reload()
 
@@ -67,18 +76,21 @@ class WaypointsScreen(KinemaScreen):
         self.action_reload()
 
     def on_waypoints_loaded(self, message: WaypointsLoaded) -> None:
-        table = self.query_one("#waypoint-table", DataTable)
+        table = self.query_one("#waypoint-table", FittedTable)
         previous = self.selected()
         self.waypoints = sorted(message.waypoints, key=lambda w: (not w.favorite, w.name.lower()))
-        table.clear()
-        for waypoint in self.waypoints:
-            table.add_row(
-                Text("★", style="yellow") if waypoint.favorite else "",
-                Text(waypoint.name),
-                Text(", ".join(waypoint.joint_group_names)),
-                Text(waypoint.description),
-                key=waypoint.name,
-            )
+        table.set_rows(
+            [
+                (
+                    Text("★", style="yellow") if waypoint.favorite else Text(""),
+                    Text(waypoint.name),
+                    Text(", ".join(waypoint.joint_group_names)),
+                    Text(waypoint.description),
+                )
+                for waypoint in self.waypoints
+            ],
+            [waypoint.name for waypoint in self.waypoints],
+        )
         names = [w.name for w in self.waypoints]
         if previous is not None and previous.name in names:
             table.move_cursor(row=names.index(previous.name))
@@ -101,15 +113,20 @@ class WaypointsScreen(KinemaScreen):
             self.action_move()
 
     def _show(self, waypoint: WaypointSummary | None) -> None:
-        joints = self.query_one("#joint-table", DataTable)
-        joints.clear()
+        joints = self.query_one("#joint-table", FittedTable)
         title = self.query_one("#waypoint-title", Static)
         if waypoint is None:
+            joints.set_rows([])
             title.update(Text("No waypoint selected", style="dim"))
             return
-        title.update(Text(waypoint.name, style="bold"))
-        for name, position in zip(waypoint.joint_names, waypoint.positions, strict=False):
-            joints.add_row(Text(name), f"{position:+.4f}")
+        # Enter moves the robot: the panel says where to, before the key is pressed.
+        title.update(Text.assemble((waypoint.name, "bold"), ("\nEnter moves the robot here", "dim")))
+        joints.set_rows(
+            [
+                (Text(name), Text(f"{position:+.4f}"))
+                for name, position in zip(waypoint.joint_names, waypoint.positions, strict=False)
+            ]
+        )
 
     def action_move(self) -> None:
         waypoint = self.selected()

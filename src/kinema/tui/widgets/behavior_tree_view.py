@@ -17,6 +17,7 @@ from textual.widgets import Tree
 from textual.widgets.tree import TreeNode
 
 from kinema.tui.connection import NodeStatus, NodeStatusUpdate
+from kinema.tui.run_outcome import failure_text
 
 if TYPE_CHECKING:
     from kinema.tui.tree_outline import OutlineNode, TreeOutline
@@ -140,8 +141,9 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         """The run ended with ``outcome`` (``Failure`` or ``Cancelled``): explain it on the tree.
 
         Nodes still shown RUNNING were halted. For a failure, the node named by ``message`` (else the
-        deepest node reported FAILURE) is marked failed, the path to it highlighted and expanded, and it
-        opens onto its ports and ``message``. Returns the failed node, if one was found.
+        deepest node reported FAILURE) is marked failed, the path to it highlighted and expanded (its
+        ancestors that were running failed with it), and it opens onto its ports and ``message``. Returns
+        the failed node, if one was found.
         """
         self.run_over = True
         for running, status in list(self.statuses.items()):
@@ -165,6 +167,14 @@ class BehaviorTreeView(Tree["OutlineNode"]):
             step = self._parents.get(step)
         self.failed_path = list(reversed(path))
         for uid in self.failed_path:
+            if uid != failed.uid and (
+                uid in self.halted or self.statuses.get(uid) in (None, NodeStatus.IDLE)
+            ):
+                # Running when their descendant failed (an exception escaped through them, maybe before
+                # their status was even sent): they failed with it; BT.CPP never halts them itself, and
+                # the runtime's halt that followed is how it stops a failed tree, not a cancel.
+                self.halted.discard(uid)
+                self.statuses[uid] = NodeStatus.FAILURE
             self._relabel(uid)
             item = self._by_uid.get(uid)
             if item is not None and uid != failed.uid:
@@ -195,7 +205,18 @@ class BehaviorTreeView(Tree["OutlineNode"]):
             if not key.startswith("_"):
                 lines.append(Text.assemble((f"{key}", "bold"), (" = ", "dim"), value))
         if message:
-            lines.append(Text.assemble(("why: ", "bold red"), message))
+            # A tree line does not wrap: the exception first, then where, each wrapped to the view's width
+            # (at the depth of the failed node), so neither is cut at the edge.
+            explained = failure_text(message)
+            depth, parent = 0, item.parent
+            while parent is not None:
+                depth, parent = depth + 1, parent.parent
+            width = max(30, self.size.width - 4 * (depth + 1) - 2)
+            lines.extend(_wrapped("why: ", explained.headline, "bold red", width))
+            for note in explained.notes:
+                lines.extend(_wrapped("note: ", note, "bold yellow", width))
+            if explained.where:
+                lines.extend(_wrapped("at: ", explained.where, "bold", width))
         lines.append(Text(f"path: {node.path}" + (f"  (line {node.line})" if node.line else ""), style="dim"))
         for line in lines:
             self._details.append(item.add_leaf(line))
@@ -255,3 +276,23 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         if ports:
             text.append(f"  {ports}", style="dim")
         return text
+
+
+def _wrapped(label: str, text: str, style: str, width: int) -> list[Text]:
+    """``label`` and ``text`` as tree lines of at most ``width`` cells, the continuation lines indented."""
+    import textwrap
+
+    indent = " " * len(label)
+    pieces = textwrap.wrap(
+        text, width, initial_indent=label, subsequent_indent=indent, break_on_hyphens=False
+    )
+    lines = []
+    for index, piece in enumerate(pieces or [label]):
+        line = Text()
+        if index == 0:
+            line.append(label, style=style)
+            line.append(piece[len(label) :])
+        else:
+            line.append(piece)
+        lines.append(line)
+    return lines

@@ -23,9 +23,21 @@ from textual.strip import Strip
 
 from kinema.tui.blackboard_model import BlackboardDiff, BlackboardModel, RowKey, matches, row_key
 
-#: (title, width) of the fixed columns; the value takes the rest of the line.
+#: (title, widest) of the fixed columns; the value takes the rest of the line.
 COLUMNS: tuple[tuple[str, int], ...] = (("Scope", 22), ("Key", 28), ("Type", 14))
 MIN_VALUE_WIDTH = 10
+#: Below this width the scope column is left out (the history panel names the selected key's scope).
+SCOPE_FROM_WIDTH = 100
+
+
+def column_widths(width: int) -> tuple[int, int, int]:
+    """Scope, key and type widths for a table ``width`` cells wide (scope 0: not shown); the value gets
+    the rest, never less than about 40% of the line: at 80 columns the values are what a user reads."""
+    available = width - 1
+    scope = COLUMNS[0][1] if width >= SCOPE_FROM_WIDTH else 0
+    key = min(COLUMNS[1][1], max(10, int(available * 0.28)))
+    type_ = min(COLUMNS[2][1], max(6, int(available * 0.14)))
+    return scope, key, type_
 
 
 class BlackboardTable(ScrollView, can_focus=True):
@@ -191,9 +203,11 @@ class BlackboardTable(ScrollView, can_focus=True):
     def _strip(cells: list[str], width: int, style: Style, first_style: Style) -> Strip:
         segments = [Segment(" ", style)]
         used = 1
-        for (_, column_width), text, cell_style in zip(
-            COLUMNS, cells, (first_style, style, style), strict=False
+        for column_width, text, cell_style in zip(
+            column_widths(width), cells, (first_style, style, style), strict=False
         ):
+            if not column_width:
+                continue
             segments.append(Segment(_fit(text, column_width), cell_style))
             segments.append(Segment(" ", style))
             used += column_width + 1
