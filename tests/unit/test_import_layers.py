@@ -74,8 +74,10 @@ def test_each_transport_name_is_assigned_in_one_module() -> None:
     assert set(twice) <= CALLED_BY_NAME, twice
 
 
-def test_the_agent_names_a_behavior_calls_match() -> None:
+def test_the_waypoint_service_a_behavior_calls_is_the_one_the_agent_serves() -> None:
+    from kinema import waypoint_services as waypoints
     from kinema.runtime import names
 
+    assert names.GET_WAYPOINTS is waypoints.GET_WAYPOINTS_SERVICE
     path = REPO / "plugins" / "core" / "kinema_core_behaviors" / "waypoints" / "retrieve_waypoint.py"
-    assert f'GET_WAYPOINTS = "{names.GET_WAYPOINTS}"' in path.read_text(encoding="utf-8")
+    assert "GET_WAYPOINTS_SERVICE" in path.read_text(encoding="utf-8")

@@ -1,6 +1,7 @@
 """The names the agent serves and publishes (MoveIt Pro's where they exist, Kinema's otherwise).
 
-Clients (the SDK, the TUI, ``kinema objective``) import this module only; it imports nothing.
+Clients (the SDK, the TUI, ``kinema objective``) import this module only; it imports nothing but
+:mod:`kinema.waypoint_services` (which imports nothing).
 """
 
 from __future__ import annotations
@@ -46,9 +47,10 @@ LIST_OBJECTIVES_TYPE = "kinema_msgs/srv/ListObjectives"
 GET_OBJECTIVE_XML = "/objective_server/get_objective_xml"
 GET_OBJECTIVE_XML_TYPE = "kinema_msgs/srv/GetObjectiveXml"
 
-GET_WAYPOINTS = "/get_saved_waypoints"
-GET_WAYPOINTS_TYPE = "moveit_studio_agent_msgs/srv/GetWaypoints"
-EDIT_WAYPOINTS = "/edit_waypoints"
-EDIT_WAYPOINTS_TYPE = "moveit_studio_agent_msgs/srv/EditWaypoints"
+# The waypoint services are defined below the runtime (kinema.waypoint_services), where behaviors reach them.
+from kinema.waypoint_services import EDIT_WAYPOINTS_SERVICE as EDIT_WAYPOINTS  # noqa: E402, F401
+from kinema.waypoint_services import EDIT_WAYPOINTS_TYPE as EDIT_WAYPOINTS_TYPE  # noqa: E402
+from kinema.waypoint_services import GET_WAYPOINTS_SERVICE as GET_WAYPOINTS  # noqa: E402, F401
+from kinema.waypoint_services import GET_WAYPOINTS_TYPE as GET_WAYPOINTS_TYPE  # noqa: E402
 
 # Time (/clock) and the robot's state (/joint_states) are the drivers': kinema.drivers.mujoco.names.

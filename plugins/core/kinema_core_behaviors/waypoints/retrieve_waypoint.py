@@ -7,12 +7,9 @@ from typing import Any
 from kinema.behaviors import PortInfo, ServiceClientBehavior, input_port, output_port
 from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import did_you_mean
+from kinema.waypoint_services import GET_WAYPOINTS_SERVICE as GET_WAYPOINTS
 
 from ..messages.conversions import joint_state_message
-
-# The agent's waypoint service (kinema.runtime.names.GET_WAYPOINTS, which a plugin does not import; a test
-# keeps the two equal).
-GET_WAYPOINTS = "/get_saved_waypoints"
 
 
 class RetrieveWaypoint(ServiceClientBehavior["moveit_studio_agent_msgs/srv/GetWaypoints"]):
