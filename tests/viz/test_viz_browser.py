@@ -62,6 +62,15 @@ def _keep(name: str, png: bytes) -> None:
         (Path(folder) / f"{name}.png").write_bytes(png)
 
 
+def _wait_sim_time(runtime: Runtime, seconds: float, timeout: float = 60.0) -> None:
+    """Wait until the simulation has run ``seconds`` more (the arm moves on by that much)."""
+    until = runtime.driver.sim_time + seconds
+    deadline = time.monotonic() + timeout
+    while runtime.driver.sim_time < until:
+        assert time.monotonic() < deadline, f"the simulation did not run {seconds} s within {timeout} s"
+        time.sleep(0.02)
+
+
 def _changed(a: bytes, b: bytes) -> np.ndarray:
     return np.abs(_pixels(a) - _pixels(b)).max(axis=2) > PIXEL_DELTA
 
@@ -215,9 +224,9 @@ def test_the_arm_moves_while_a_trajectory_executes(
         moving = _trajectory(goal, 8.0, legs=4)
         handle = client.send_goal(moving, timeout=10.0)
         assert handle.accepted
-        time.sleep(1.5)
+        _wait_sim_time(runtime, 1.5)
         first = page.screenshot()
-        time.sleep(2.0)
+        _wait_sim_time(runtime, 2.0)
         second = page.screenshot()
         assert not handle.done(), "the trajectory ended before both screenshots were taken"
         _keep("moving_1", first)
