@@ -125,11 +125,15 @@ def validate(files: tuple[Path, ...], as_json: bool, behaviors: bool) -> None:
     """Check objective FILES together: node IDs, ports, scripts, subtrees.
 
     Every problem is printed as file:line: message. A SubTree may call a tree defined in another of
-    the FILES. Exits 1 if any problem was found.
+    the FILES. A node written in a former spelling (MoveIt Pro's CreateStampedPose, say) is checked as
+    today's and named in a warning on stderr. Exits 1 if any problem was found.
     """
-    from kinema.bt.validation import count_trees, validate_files
+    from kinema.bt.validation import Problem, count_trees, validate_files
+    from kinema.cli.options import print_warnings
 
-    problems = validate_files(list(files), _factory(behaviors))
+    spelled: list[Problem] = []
+    problems = validate_files(list(files), _factory(behaviors), warnings=spelled)
+    print_warnings(str(note) for note in spelled)
     if as_json:
         rows: list[dict[str, Any]] = [
             {"file": p.location.file, "line": p.location.line, "message": p.message} for p in problems

@@ -8,7 +8,7 @@ touches the instances of a running objective; the next run uses the new classes.
 from __future__ import annotations
 
 from collections.abc import Iterator, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 from kinema.errors import PluginError
@@ -18,6 +18,7 @@ from kinema.plugins.registration import BehaviorRegistration
 if TYPE_CHECKING:
     from kinema.behaviors.context import BehaviorContext
     from kinema.bt import BehaviorTreeFactory, Clock
+    from kinema.bt.spellings import FormerSpelling
 
 
 @dataclass(frozen=True)
@@ -37,6 +38,19 @@ class PluginRecord:
     def ok(self) -> bool:
         """True when the plugin loaded and registered without error."""
         return self.error is None
+
+
+def former_spellings_of(registration: BehaviorRegistration) -> list[FormerSpelling]:
+    """The former spellings a behavior class declares (``former_spellings``), for its registered ID.
+
+    Only the class's own attribute counts: a subclass registered under another ID does not inherit the
+    old names of its base.
+    """
+    declared = registration.cls.__dict__.get("former_spellings", ())
+    return [
+        spelling if spelling.current_id else replace(spelling, current_id=registration.behavior_id)
+        for spelling in declared
+    ]
 
 
 class BehaviorRegistry(Mapping[str, BehaviorRegistration]):
@@ -114,6 +128,9 @@ class BehaviorRegistry(Mapping[str, BehaviorRegistration]):
         context = context if context is not None else BehaviorContext.offline()
         for registration in self._registrations.values():
             factory.register_node_type(bind_behavior(registration, context), registration.behavior_id)
+        for registration in self._registrations.values():
+            for spelling in former_spellings_of(registration):
+                factory.register_former_spelling(spelling)
 
     def create_factory(
         self, context: BehaviorContext | None = None, *, clock: Clock | None = None
