@@ -10,7 +10,7 @@ from pathlib import Path
 
 from kinema.bt.blackboard import Blackboard
 from kinema.bt.clock import Clock, WallClock
-from kinema.bt.errors import BTLogicError, BTRuntimeError
+from kinema.bt.errors import BTLogicError, BTRuntimeError, TreeNotFoundError
 from kinema.bt.manifest import NodeManifest, NodeType
 from kinema.bt.names import model_name_problem, port_name_problem
 from kinema.bt.node import (
@@ -261,8 +261,9 @@ class BehaviorTreeFactory:
         from kinema.bt.builder import TreeBuilder
 
         if tree_id not in self.library.trees:
-            raise BTRuntimeError(
-                f"Can't find a tree with name: {tree_id}; {did_you_mean(tree_id, self.library.trees)}"
+            raise TreeNotFoundError(
+                tree_id,
+                f"Can't find a tree with name: {tree_id}; {did_you_mean(tree_id, self.library.trees)}",
             )
         return TreeBuilder(self).build(tree_id, blackboard if blackboard is not None else Blackboard.create())
 
