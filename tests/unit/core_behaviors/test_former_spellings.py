@@ -151,3 +151,30 @@ def test_keep_orientation_that_may_be_true_is_refused_not_dropped(
 def test_an_objective_in_current_spelling_leaves_no_note(registry: BehaviorRegistry) -> None:
     _, factory = _built(registry, '<Action ID="GetImage" message_timeout_sec="3"/>')
     assert not factory.library.spelling_notes
+
+
+def test_an_objective_file_in_old_spelling_runs_on_the_objective_server(
+    registry: BehaviorRegistry, tmp_path: Any
+) -> None:
+    from types import SimpleNamespace
+
+    from kinema.bt import WallClock
+    from kinema.runtime.objective_server import ObjectiveRequest, ObjectiveServer
+    from kinema.runtime.objective_source import LibraryTreeSource, library_from_folders
+
+    (tmp_path / "old.xml").write_text(
+        _tree(
+            '<Sequence><Action ID="CreateStampedPose" position_xyz="1;2;3" stamped_pose="{p}"/>'
+            '<Action ID="CreateStampedTwist" stamped_twist="{t}"/></Sequence>'
+        )
+    )
+    source = LibraryTreeSource(
+        lambda: library_from_folders([tmp_path]),
+        host=SimpleNamespace(registry=registry),
+        context=None,
+        clock=WallClock(),
+    )
+    assert source.objective_names() == ["Old"]
+    with ObjectiveServer(source) as server:
+        result = server.submit(ObjectiveRequest("Old")).wait(5)
+    assert result is not None and result.succeeded, result
