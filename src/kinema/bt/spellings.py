@@ -91,19 +91,21 @@ def rewrite_former_spellings(
     notes: list[SpellingNote] = []
     for tree in root.iterchildren("BehaviorTree"):
         for element in tree.iterdescendants(etree.Element):
-            tag = element.tag
-            if tag == "SubTree":
-                continue
-            spelled = element.get("ID") if tag in _EXPLICIT_TAGS else tag
-            found = spellings.get(spelled) if spelled else None
-            if not found:
-                continue
-            for spelling in found:
-                if spelling.old_id and spelling.old_id in registered:
-                    continue
-                message = _rewrite(element, spelling, filename)
-                if message:
-                    notes.append(SpellingNote(SourceLocation(filename, element.sourceline or 0), message))
+            read: set[str] = set()
+            # An old ID rewritten to today's may also carry today's ID's old port names: read again.
+            while True:
+                tag = element.tag
+                spelled = element.get("ID") if tag in _EXPLICIT_TAGS else tag
+                found = spellings.get(spelled) if tag != "SubTree" and spelled else None
+                if not found or spelled in read:
+                    break
+                read.add(spelled)
+                for spelling in found:
+                    if spelling.old_id and spelling.old_id in registered:
+                        continue
+                    message = _rewrite(element, spelling, filename)
+                    if message:
+                        notes.append(SpellingNote(SourceLocation(filename, element.sourceline or 0), message))
     return notes
 
 

@@ -74,3 +74,16 @@ def test_validation_reports_each_old_spelling_as_a_warning_not_a_problem(tmp_pat
         f"{path}:4: Old is MoveIt Pro's old name of Current (its port x is a); "
         "read as Current, write that instead"
     ]
+
+
+def test_an_old_id_also_gets_the_current_ids_old_port_names() -> None:
+    factory, seen = _factory()
+    factory.register_former_spelling(FormerSpelling(ports={"b": "a"}, current_id="Current"))
+    factory.register_former_spelling(FormerSpelling("Older", current_id="Current"))
+    tree = factory.create_tree_from_text(_xml('<Older b="5"/>'), filename="old.xml")
+    assert tree.tick_once() is NodeStatus.SUCCESS
+    assert seen == [5]
+    assert [note.message.split(";")[0] for note in factory.library.spelling_notes] == [
+        "Older is MoveIt Pro's old name of Current",
+        "Current's port b is MoveIt Pro's old name of a",
+    ]
