@@ -7,7 +7,7 @@ touches the instances of a running objective; the next run uses the new classes.
 
 from __future__ import annotations
 
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterable, Iterator, Mapping
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
@@ -51,6 +51,27 @@ def former_spellings_of(registration: BehaviorRegistration) -> list[FormerSpelli
         spelling if spelling.current_id else replace(spelling, current_id=registration.behavior_id)
         for spelling in declared
     ]
+
+
+def _check_old_ids(registrations: Iterable[BehaviorRegistration]) -> None:
+    """An old ID may be the former name of one behavior only (the factory could not tell which to read).
+
+    Raises:
+        PluginError: naming both behaviors, their plugins and where they are defined.
+    """
+    owners: dict[str, tuple[str, BehaviorRegistration]] = {}
+    for registration in registrations:
+        for spelling in former_spellings_of(registration):
+            if not spelling.old_id:
+                continue
+            owner = owners.setdefault(spelling.old_id, (spelling.current_id, registration))
+            if owner[0] != spelling.current_id:
+                other = owner[1]
+                raise PluginError(
+                    f"'{spelling.old_id}' is declared the former name of both '{owner[0]}' (plugin "
+                    f"'{other.plugin}', {other.location}) and '{spelling.current_id}' (plugin "
+                    f"'{registration.plugin}', {registration.location}); remove one of the declarations"
+                )
 
 
 class BehaviorRegistry(Mapping[str, BehaviorRegistration]):
@@ -102,6 +123,7 @@ class BehaviorRegistry(Mapping[str, BehaviorRegistration]):
                     "rename one of them or remove one loader from behavior_loader_plugins"
                 )
             merged[registration.behavior_id] = registration
+        _check_old_ids(merged.values())
         plugins = dict(self._plugins)
         plugins[record.name] = PluginRecord(record.spec, tuple(r.behavior_id for r in registrations), None)
         return BehaviorRegistry(merged, plugins, self.generation + 1)
