@@ -38,3 +38,21 @@ def test_the_reference_gives_each_behavior_its_ports_with_direction_type_and_def
     assert "| `element` | input | `BT::AnyTypeAllowed` | `{element}` |" in text
     assert "| `index` | output | `int` | `{index}` |" in text
     assert "Appends `element` to the end of `input_vector`" in text
+
+
+def test_the_reference_names_the_former_spellings_objectives_may_still_use() -> None:
+    from kinema.cli.main import cli
+
+    result = CliRunner().invoke(
+        cli, ["behaviors", "--markdown", "-c", "lab_sim", "CreatePoseStamped", "GetImage", "PushBackVector"]
+    )
+    assert result.exit_code == 0, result.output
+    lines = result.output.splitlines()
+    assert (
+        "Former spellings (MoveIt Pro), read with a warning: `CreateStampedPose` "
+        "(port `stamped_pose` is `pose_stamped`)."
+    ) in lines
+    assert (
+        "Former spellings (MoveIt Pro), read with a warning: port `timeout_sec` is `message_timeout_sec`."
+    ) in lines
+    assert sum(line.startswith("Former spellings") for line in lines) == 2  # none for PushBackVector

@@ -28,7 +28,10 @@ Base classes: :class:`SyncBehavior` (one tick), :class:`StatefulBehavior` (sever
 thread), :class:`AsyncBehavior` (work off the tick thread), :class:`ServiceClientBehavior`,
 :class:`ActionClientBehavior`, :class:`GetMessageFromTopicBehavior`, :class:`PublishToTopicBehavior`.
 Every behavior has ``self.context`` (:class:`BehaviorContext`), ``self.logger``
-(``publish_info/publish_warn/publish_failure`` → toasts) and ``self.get_required_inputs(...)``.
+(``publish_info/publish_warn/publish_failure`` → toasts) and ``self.get_required_inputs(...)``. A renamed
+behavior keeps its old spellings readable with ``former_spellings = (FormerSpelling("OldName",
+ports={"old_port": "new_port"}),)`` on its class; ``kinema build`` names the current spelling wherever
+an objective still uses an old one.
 """
 
 from __future__ import annotations
@@ -44,7 +47,7 @@ from kinema.behaviors.required_inputs import MissingInputsError, get_required_in
 from kinema.behaviors.service_client import ServiceClientBehavior
 from kinema.behaviors.sync import StatefulBehavior, SyncBehavior
 from kinema.behaviors.topic import GetMessageFromTopicBehavior, PublishToTopicBehavior
-from kinema.bt import NodeStatus, PortInfo, bidirectional_port, input_port, output_port
+from kinema.bt import FormerSpelling, NodeStatus, PortInfo, bidirectional_port, input_port, output_port
 
 __all__ = [
     "ActionClientBehavior",
@@ -53,6 +56,7 @@ __all__ = [
     "BehaviorContext",
     "BehaviorExecutionError",
     "BehaviorLogger",
+    "FormerSpelling",
     "GetMessageFromTopicBehavior",
     "LogLevel",
     "LogMessage",

@@ -15,6 +15,7 @@ from typing import Any, ClassVar
 from kinema.behaviors.context import BehaviorContext
 from kinema.behaviors.logger import BehaviorLogger
 from kinema.behaviors.required_inputs import get_required_inputs
+from kinema.bt.spellings import FormerSpelling
 
 _OFFLINE_CONTEXT: BehaviorContext | None = None
 
@@ -32,12 +33,15 @@ class Behavior:
     Class attributes:
         subcategory: where editors and ``kinema behaviors`` group it (MoveIt Pro's ``subcategory``).
         description: one paragraph for editors; defaults to the first paragraph of the docstring.
+        former_spellings: old IDs and port names objectives may still use, read as this behavior's
+            (:class:`~kinema.bt.FormerSpelling`); only the class's own value counts, not a base's.
     """
 
     __slots__ = ()
 
     subcategory: ClassVar[str] = "User Created Behaviors"
     description: ClassVar[str] = ""
+    former_spellings: ClassVar[tuple[FormerSpelling, ...]] = ()
 
     # Set on the per-registry subclass made by kinema.behaviors.binding (never by authors).
     kinema_context: ClassVar[BehaviorContext | None] = None

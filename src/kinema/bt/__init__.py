@@ -36,6 +36,7 @@ from kinema.bt.node import (
 )
 from kinema.bt.observer import NodeStatistics, TreeObserver
 from kinema.bt.ports import PortDirection, PortInfo, bidirectional_port, input_port, output_port
+from kinema.bt.spellings import FormerSpelling
 from kinema.bt.status import NodeStatus
 from kinema.bt.tree import Subtree, Tree
 
@@ -52,6 +53,7 @@ __all__ = [
     "ControlNode",
     "DecoratorNode",
     "Entry",
+    "FormerSpelling",
     "ManualClock",
     "NodeConfig",
     "NodeExecutionError",

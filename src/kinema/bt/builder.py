@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Any
 from kinema.bt.blackboard import Blackboard
 from kinema.bt.conversions import Unsigned, convert_from_string, parse_double_full, parse_int_full, type_name
 from kinema.bt.decorators import SubTreeNode
-from kinema.bt.errors import BTError, BTLogicError, BTRuntimeError, ScriptParseError
+from kinema.bt.errors import BTError, BTLogicError, BTRuntimeError, ScriptParseError, TreeNotFoundError
 from kinema.bt.limits import MAX_TREE_NODES
 from kinema.bt.names import (
     POST_CONDITIONS,
@@ -94,8 +94,9 @@ class TreeBuilder:
         if definition is None:
             from kinema.errors import did_you_mean
 
-            raise BTRuntimeError(
-                f"Can't find a tree with name: {tree_id}; {did_you_mean(tree_id, self.library.trees)}"
+            raise TreeNotFoundError(
+                tree_id,
+                f"Can't find a tree with name: {tree_id}; {did_you_mean(tree_id, self.library.trees)}",
             )
         plan = definition.plan if definition.plan_key == self.plan_key else None
         root_element = definition.root_element if plan is None else None  # a plan was compiled from one
@@ -231,7 +232,12 @@ class TreeBuilder:
                 "'name' attribute to auto-generate unique paths.",
                 location=SourceLocation(filename, line),
             )
-        self._create_subtree(subtree_id, path, path + "/", new_bb, node, ancestors)
+        try:
+            self._create_subtree(subtree_id, path, path + "/", new_bb, node, ancestors)
+        except TreeNotFoundError as error:
+            if error.location is None:  # this <SubTree> names the missing tree
+                error.location = SourceLocation(filename, line)
+            raise
 
     def _compile_kind(self, signature: tuple[Any, ...], filename: str, prefix: str, line: int) -> NodeKind:
         """What an element compiles to, from its signature: its tag, then its attributes' (name, value)."""

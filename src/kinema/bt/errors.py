@@ -29,6 +29,14 @@ class BTLogicError(BTError):
     btcpp_type = "LogicError"
 
 
+class TreeNotFoundError(BTRuntimeError):
+    """A tree (the one to create, or a ``<SubTree ID>``) is not loaded; ``tree_id`` names it."""
+
+    def __init__(self, tree_id: str, message: str, *, location: SourceLocation | None = None) -> None:
+        super().__init__(message, location=location)
+        self.tree_id = tree_id
+
+
 class ScriptError(BTRuntimeError):
     """A script failed to parse or to evaluate."""
 

@@ -10,7 +10,7 @@ from pathlib import Path
 
 from kinema.bt.blackboard import Blackboard
 from kinema.bt.clock import Clock, WallClock
-from kinema.bt.errors import BTLogicError, BTRuntimeError
+from kinema.bt.errors import BTLogicError, BTRuntimeError, TreeNotFoundError
 from kinema.bt.manifest import NodeManifest, NodeType
 from kinema.bt.names import model_name_problem, port_name_problem
 from kinema.bt.node import (
@@ -24,6 +24,7 @@ from kinema.bt.node import (
     TreeNode,
 )
 from kinema.bt.ports import PortInfo
+from kinema.bt.spellings import FormerSpelling
 from kinema.bt.status import NodeStatus
 from kinema.bt.tree import Tree
 from kinema.bt.xmlparser import TreeDefinition, TreeLibrary
@@ -73,6 +74,10 @@ class BehaviorTreeFactory:
         self._manifests: dict[str, NodeManifest] = {}
         self.enums: dict[str, int] = {}
         self.library = TreeLibrary()
+        # Spelled ID (an old one, or today's with old ports) -> its former spellings; the library
+        # reads XML through them (kinema.bt.spellings).
+        self.former_spellings: dict[str, list[FormerSpelling]] = {}
+        self.library.spellings = self.former_spellings
         # Bumped by every change of the node types or enums: compiled tree plans depend on them.
         self._generation = 0
         self._serial = next(_FACTORY_SERIALS)
@@ -148,6 +153,24 @@ class BehaviorTreeFactory:
         """Register a decorator calling ``fn(child_status, node)`` after ticking its child."""
         manifest = NodeManifest(id, NodeType.DECORATOR, _ports_dict(ports, id))
         self.register_builder(manifest, lambda name, config: SimpleDecoratorNode(name, config, fn))
+
+    def register_former_spelling(self, spelling: FormerSpelling) -> None:
+        """Read nodes written in ``spelling`` (an old ID, or today's ID with old port names) as today's.
+
+        Raises:
+            BTLogicError: no current ID, or the old ID already names another node type's old spelling.
+        """
+        if not spelling.current_id:
+            raise BTLogicError(f"former spelling {spelling.old_id or spelling.ports!r} names no current ID")
+        spelled = spelling.spelled_id
+        for other in self.former_spellings.get(spelled, []):
+            if spelling.old_id and other.current_id != spelling.current_id:
+                raise BTLogicError(
+                    f"{spelling.old_id} is declared the old name of both {other.current_id} and "
+                    f"{spelling.current_id}"
+                )
+        self.former_spellings.setdefault(spelled, []).append(spelling)
+        self._generation += 1
 
     def unregister(self, id: str) -> bool:
         """Forget node type ``id``; False if it was not registered."""
@@ -238,8 +261,9 @@ class BehaviorTreeFactory:
         from kinema.bt.builder import TreeBuilder
 
         if tree_id not in self.library.trees:
-            raise BTRuntimeError(
-                f"Can't find a tree with name: {tree_id}; {did_you_mean(tree_id, self.library.trees)}"
+            raise TreeNotFoundError(
+                tree_id,
+                f"Can't find a tree with name: {tree_id}; {did_you_mean(tree_id, self.library.trees)}",
             )
         return TreeBuilder(self).build(tree_id, blackboard if blackboard is not None else Blackboard.create())
 

@@ -42,11 +42,18 @@ class Problem:
         return f"{self.location}: {self.message}"
 
 
-def validate_files(paths: list[str | Path], factory: BehaviorTreeFactory | None = None) -> list[Problem]:
+def validate_files(
+    paths: list[str | Path],
+    factory: BehaviorTreeFactory | None = None,
+    *,
+    warnings: list[Problem] | None = None,
+) -> list[Problem]:
     """Validate objective files together (a SubTree may refer to a tree in another of the files).
 
     ``factory`` supplies the registered node types (default: the built-in nodes only); its
-    already-loaded trees count as known SubTree IDs. The factory itself is not modified.
+    already-loaded trees count as known SubTree IDs. The factory itself is not modified. Nodes written
+    in a former spelling (kinema.bt.spellings) are validated as today's; each is added to ``warnings``
+    when given.
     """
     from kinema.bt.factory import BehaviorTreeFactory
 
@@ -54,16 +61,19 @@ def validate_files(paths: list[str | Path], factory: BehaviorTreeFactory | None 
     problems: list[Problem] = []
     documents: list[tuple[str, etree._Element]] = []
     scratch = _scratch_factory(base)
+    notes = scratch.library.spelling_notes
     for path in paths:
         filename = str(path)
         try:
-            root = parse_xml_file(path)
-            scratch.library.load_file(path, scratch.manifests(), verify=False)
+            # The library's reading of the file, former spellings rewritten, is what is checked.
+            root = scratch.library.load_file(path, scratch.manifests(), verify=False)
         except KinemaError as error:
             location = error.location or SourceLocation(filename)
             problems.append(Problem(location, error.message))
             continue
         documents.append((filename, root))
+    if warnings is not None:
+        warnings.extend(Problem(note.location, note.message) for note in notes)
     manifests = scratch.manifests()
     known_trees = set(scratch.library.trees)
     for filename, root in documents:
@@ -101,6 +111,7 @@ def _scratch_factory(base: BehaviorTreeFactory) -> BehaviorTreeFactory:
     scratch._builders = dict(base._builders)
     scratch._manifests = dict(base._manifests)
     scratch.enums = dict(base.enums)
+    scratch.former_spellings.update(base.former_spellings)
     scratch.library.trees = dict(base.library.trees)
     scratch.library.subtree_models = dict(base.library.subtree_models)
     return scratch

@@ -9,7 +9,8 @@ models of ``<TreeNodesModel>``, then registers each ``<BehaviorTree>``.
 from __future__ import annotations
 
 import os
-from collections.abc import Callable
+from collections import deque
+from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -19,6 +20,7 @@ from kinema.bt.errors import BTRuntimeError
 from kinema.bt.manifest import NodeType
 from kinema.bt.names import model_name_problem, port_name_problem
 from kinema.bt.ports import NO_DEFAULT, PortDirection, PortInfo
+from kinema.bt.spellings import FormerSpelling, SpellingNote, rewrite_former_spellings
 from kinema.bt.xmlsource import MAX_DEPTH, parse_xml, parse_xml_file
 from kinema.errors import SourceLocation
 
@@ -31,6 +33,8 @@ Skeleton = tuple[list[tuple[Any, ...]], list[int], list[int]]
 
 # How many documents loaded from text a library keeps for loading them again (see TreeLibrary.load_text).
 _MAX_CACHED_DOCUMENTS = 32
+# How many notes of nodes read in a former spelling a library keeps (a runtime loads documents for days).
+_MAX_SPELLING_NOTES = 1000
 
 EXPLICIT_TAGS = frozenset({"Action", "Condition", "Control", "Decorator", "SubTree"})
 # Tags whose structural check reads more than the tag and the number of children: the ID, or (for a
@@ -161,6 +165,10 @@ class TreeLibrary:
         self.first_main_tree: str | None = None
         self.documents_loaded = 0
         self._suffix = 0
+        # Former spellings of node types (the factory's, shared): nodes written so are rewritten to
+        # today's spelling as each document loads, each leaving a note (kinema.bt.spellings).
+        self.spellings: Mapping[str, list[FormerSpelling]] = {}
+        self.spelling_notes: deque[SpellingNote] = deque(maxlen=_MAX_SPELLING_NOTES)
         # Documents loaded from text, by (text, filename, verify, registry), oldest first: loading the
         # same objective again (a hot reload of an unchanged file, /do_objective with the same XML)
         # skips parsing, verifying and compiling it. The cache is the library's own and goes with its
@@ -240,6 +248,8 @@ class TreeLibrary:
             raise located_error("The XML must have a root node called <root>", filename, line_of(root))
         for include in root.findall("include"):
             self._load_include(include, filename, manifests, include_stack, verify)
+        if self.spellings:
+            self.spelling_notes.extend(rewrite_former_spellings(root, filename, self.spellings, manifests))
         skeletons: dict[etree._Element, Skeleton] | None = {} if verify else None
         if verify:
             verify_document(root, filename, manifests, skeletons)

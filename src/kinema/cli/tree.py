@@ -145,15 +145,19 @@ def validate(
     --no-config, against the built-in nodes (and the bundled behaviors with --behaviors).
 
     Every problem is printed as file:line: message. A SubTree may call a tree defined in another of
-    the FILES. Exits 1 if any problem was found.
+    the FILES. A node written in a former spelling (MoveIt Pro's CreateStampedPose, say) is checked as
+    today's and named in a warning on stderr. Exits 1 if any problem was found.
     """
-    from kinema.bt.validation import count_trees, validate_files
+    from kinema.bt.validation import Problem, count_trees, validate_files
+    from kinema.cli.options import print_warnings
 
     factory = None if no_config else _config_factory(files, workspace, config)
     built_in_only = factory is None and not behaviors
     if factory is None:
         factory = _factory(behaviors)
-    problems = validate_files(list(files), factory)
+    spelled: list[Problem] = []
+    problems = validate_files(list(files), factory, warnings=spelled)
+    print_warnings(str(note) for note in spelled)
     if built_in_only and any("Node not recognized" in p.message for p in problems):
         click.echo(
             "note: only the built-in nodes were known; -c NAME (or a file inside a workspace) checks "

@@ -45,6 +45,7 @@ def behavior_markdown(record: Any) -> str:
     if description:
         lines += [description, ""]
     lines += [f"Plugin: `{record.plugin}`.", ""]
+    lines += [f"{line}" for line in _former_spellings(record)]
     ports = list(record.ports)
     if not ports:
         lines += ["No ports.", ""]
@@ -58,6 +59,32 @@ def behavior_markdown(record: Any) -> str:
         )
     lines.append("")
     return "\n".join(lines)
+
+
+def _former_spellings(record: Any) -> list[str]:
+    """Lines naming the old spellings objectives may still use (read as this behavior, with a warning)."""
+    from kinema.plugins.registry import former_spellings_of
+
+    parts: list[str] = []
+    for spelling in former_spellings_of(record):
+        ports = [f"`{old}` is `{new}`" for old, new in spelling.ports.items()]
+        for old, reason in spelling.dropped.items():
+            accepted = spelling.accepted_values.get(old)
+            if accepted is None:
+                ports.append(f"`{old}` is ignored — {reason}")
+            else:
+                ports.append(f"`{old}` is ignored when `{accepted[0]}`, refused otherwise — {reason}")
+        if spelling.old_id:
+            text = f"`{spelling.old_id}`" + (
+                f" is read as the SubTree `{spelling.current_id}`" if spelling.subtree else ""
+            )
+            parts.append(text + (f" (port {'; '.join(ports)})" if ports else ""))
+        elif ports:
+            parts.append("port " + "; ".join(ports))
+    if not parts:
+        return []
+    origin = former_spellings_of(record)[0].origin
+    return [f"Former spellings ({origin}), read with a warning: " + "; ".join(parts) + ".", ""]
 
 
 def reference_markdown(records: Iterable[Any], header: str = HEADER) -> str:

@@ -119,7 +119,27 @@ def validate_registration(cls: object, behavior_id: str | None, plugin: str) -> 
             )
         seen.add(port_name)
     metadata = _metadata_of(cls, name, plugin, location)
+    _check_former_spellings(cls, name, plugin, location)
     return BehaviorRegistration(name, cls, plugin, location, ports, metadata)
+
+
+def _check_former_spellings(cls: type, name: str, plugin: str, location: SourceLocation) -> None:
+    from kinema.bt.spellings import FormerSpelling
+
+    declared = cls.__dict__.get("former_spellings", ())
+    if not isinstance(declared, tuple | list) or not all(isinstance(s, FormerSpelling) for s in declared):
+        raise PluginError(
+            f"plugin '{plugin}': former_spellings of behavior '{name}' must be a tuple of "
+            f"kinema.behaviors.FormerSpelling, got {declared!r}",
+            location=location,
+        )
+    for spelling in declared:
+        if spelling.old_id and not _ID_PATTERN.match(spelling.old_id):
+            raise PluginError(
+                f"plugin '{plugin}': behavior '{name}' declares the former ID {spelling.old_id!r}, which is "
+                "not a valid behavior ID",
+                location=location,
+            )
 
 
 def _metadata_of(cls: type, name: str, plugin: str, location: SourceLocation) -> dict[str, str]:

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Iterable, Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 from kinema.errors import PluginError
@@ -19,6 +19,7 @@ from kinema.plugins.registration import BehaviorRegistration
 if TYPE_CHECKING:
     from kinema.behaviors.context import BehaviorContext
     from kinema.bt import BehaviorTreeFactory, Clock
+    from kinema.bt.spellings import FormerSpelling
 
 
 @dataclass(frozen=True)
@@ -43,6 +44,40 @@ class PluginRecord:
     def ok(self) -> bool:
         """True when the plugin loaded and registered without error."""
         return self.error is None
+
+
+def former_spellings_of(registration: BehaviorRegistration) -> list[FormerSpelling]:
+    """The former spellings a behavior class declares (``former_spellings``), for its registered ID.
+
+    Only the class's own attribute counts: a subclass registered under another ID does not inherit the
+    old names of its base.
+    """
+    declared = registration.cls.__dict__.get("former_spellings", ())
+    return [
+        spelling if spelling.current_id else replace(spelling, current_id=registration.behavior_id)
+        for spelling in declared
+    ]
+
+
+def _check_old_ids(registrations: Iterable[BehaviorRegistration]) -> None:
+    """An old ID may be the former name of one behavior only (the factory could not tell which to read).
+
+    Raises:
+        PluginError: naming both behaviors, their plugins and where they are defined.
+    """
+    owners: dict[str, tuple[str, BehaviorRegistration]] = {}
+    for registration in registrations:
+        for spelling in former_spellings_of(registration):
+            if not spelling.old_id:
+                continue
+            owner = owners.setdefault(spelling.old_id, (spelling.current_id, registration))
+            if owner[0] != spelling.current_id:
+                other = owner[1]
+                raise PluginError(
+                    f"'{spelling.old_id}' is declared the former name of both '{owner[0]}' (plugin "
+                    f"'{other.plugin}', {other.location}) and '{spelling.current_id}' (plugin "
+                    f"'{registration.plugin}', {registration.location}); remove one of the declarations"
+                )
 
 
 class BehaviorRegistry(Mapping[str, BehaviorRegistration]):
@@ -94,6 +129,7 @@ class BehaviorRegistry(Mapping[str, BehaviorRegistration]):
                     "rename one of them or remove one loader from behavior_loader_plugins"
                 )
             merged[registration.behavior_id] = registration
+        _check_old_ids(merged.values())
         plugins = dict(self._plugins)
         plugins[record.name] = PluginRecord(record.spec, tuple(r.behavior_id for r in registrations), None)
         return BehaviorRegistry(merged, plugins, self.generation + 1)
@@ -136,6 +172,9 @@ class BehaviorRegistry(Mapping[str, BehaviorRegistration]):
         context = context if context is not None else BehaviorContext.offline()
         for registration in self._registrations.values():
             factory.register_node_type(bind_behavior(registration, context), registration.behavior_id)
+        for registration in self._registrations.values():
+            for spelling in former_spellings_of(registration):
+                factory.register_former_spelling(spelling)
 
     def create_factory(
         self, context: BehaviorContext | None = None, *, clock: Clock | None = None

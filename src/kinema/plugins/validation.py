@@ -25,7 +25,8 @@ def validate_objectives(
     """Validate every objective file of ``resolved``; return (number of files, problems, warnings).
 
     Files that do not parse and duplicate definitions are problems too, with their ``file:line``. The
-    warnings (``file:line: ...``) are the library's: an objective ID defined twice in one folder.
+    warnings (``file:line: ...``) are the library's (an objective ID defined twice in one folder) and one
+    per node written in a former spelling (``CreateStampedPose is MoveIt Pro's old name of ...``).
     """
     from kinema.bt.validation import Problem, validate_files
     from kinema.config import ObjectiveLibrary
@@ -35,8 +36,9 @@ def validate_objectives(
         Problem(error.location or SourceLocation("<objectives>"), error.message) for error in library.errors
     ]
     files = library.files()
-    problems += validate_files(list(files), registry.create_factory())
-    return len(files), problems, list(library.warnings)
+    spelled: list[Problem] = []
+    problems += validate_files(list(files), registry.create_factory(), warnings=spelled)
+    return len(files), problems, [*library.warnings, *(str(note) for note in spelled)]
 
 
 def write_tree_nodes_model(registry: BehaviorRegistry, path: Path) -> Path:

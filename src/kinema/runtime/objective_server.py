@@ -41,6 +41,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any, Protocol
 
+from kinema.bt.errors import TreeNotFoundError
 from kinema.bt.status import NodeStatus
 from kinema.errors import KinemaError, ObjectiveError, did_you_mean
 from kinema.runtime.node_status import NodeStatusBatch, NodeStatusRecorder
@@ -858,7 +859,25 @@ class ObjectiveServer:
         self._set_status(ObjectiveStatus.RUNNING, name)
 
     def _build(self, request: ObjectiveRequest) -> tuple[Tree, str, SubtreeModel | None]:
-        """The tree of ``request``, its objective's name, and the model of its ports (None if undeclared)."""
+        """The tree of ``request``, its objective's name, and the model of its ports (None if undeclared).
+
+        A SubTree whose objective is in the library but did not load fails the build with that objective's
+        own reason, not with "Can't find a tree".
+        """
+        try:
+            return self._build_tree(request)
+        except TreeNotFoundError as error:
+            explain = getattr(self._source, "load_error", None)
+            reason = explain(error.tree_id) if explain is not None else None
+            if not reason:
+                raise
+            name = request.objective_name or main_tree_id(request.objective_xml)
+            raise ObjectiveError(
+                f"objective {name!r} cannot run: its SubTree {error.tree_id!r} did not load: {reason}",
+                location=error.location,
+            ) from None
+
+    def _build_tree(self, request: ObjectiveRequest) -> tuple[Tree, str, SubtreeModel | None]:
         factory = self._source.factory()
         if request.objective_name:
             names = self._source.objective_names()

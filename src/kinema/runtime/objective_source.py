@@ -147,6 +147,8 @@ class LibraryTreeSource:
                 log.warning("objective file %s not loaded: %s", path, error)
                 for objective_id in ids_by_file.get(path, []):
                     problems[objective_id] = LibraryProblem(str(path), str(error))
+        for note in factory.library.spelling_notes:
+            log.warning("objective library: %s", note)
         from kinema.config.cell import substitute_config_defaults
 
         substitute_config_defaults(factory.library.subtree_models, getattr(self._library, "resolved", None))

@@ -131,3 +131,21 @@ def test_validate_moveit_pro_objectives_against_the_bundled_behaviors() -> None:
     code, out = run_cli("tree", "validate", "--behaviors", *files)
     assert "Node not recognized" not in out
     assert code == 0, out
+
+
+def test_validate_reads_moveit_pros_old_names_and_warns_on_stderr(tmp_path: Path) -> None:
+    path = tmp_path / "old.xml"
+    path.write_text(
+        '<root BTCPP_format="4">\n'
+        '  <BehaviorTree ID="Old">\n'
+        '    <Action ID="CreateStampedWrench" force_xyz="0;0;1" stamped_wrench="{wrench}"/>\n'
+        "  </BehaviorTree>\n"
+        "</root>\n"
+    )
+    result = CliRunner().invoke(cli, ["tree", "validate", "--behaviors", str(path)])
+    assert result.exit_code == 0, result.output
+    assert f"{path}: OK (1 trees)" in result.stdout
+    assert (
+        f"warning: {path}:3: CreateStampedWrench is MoveIt Pro's old name of CreateWrenchStamped "
+        "(its port stamped_wrench is wrench_stamped)"
+    ) in result.stderr

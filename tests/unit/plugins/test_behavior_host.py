@@ -45,6 +45,66 @@ def test_two_plugins_registering_one_id_is_an_error_naming_both(workspace: Path,
     assert host.registry.plugins["second::TestLoader"].error is not None
 
 
+OLD_NAME_MODULE = """
+from kinema.behaviors import FormerSpelling, NodeStatus, SyncBehavior
+
+
+class Modern(SyncBehavior):
+    former_spellings = {spellings}
+
+    @classmethod
+    def provided_ports(cls):
+        return []
+
+    def tick(self):
+        return NodeStatus.SUCCESS
+"""
+
+
+def test_a_former_name_claimed_by_two_plugins_fails_the_second_naming_both(
+    workspace: Path, make_package
+) -> None:
+    make_package(
+        "second",
+        classes={"Modern": 0},
+        behaviors=OLD_NAME_MODULE.format(spellings='(FormerSpelling("Legacy"),)'),
+    )
+    make_package(
+        "third",
+        classes={"Modern": 0},
+        behaviors=OLD_NAME_MODULE.format(spellings='(FormerSpelling("Legacy"),)').replace("Modern", "Newer"),
+        init=INIT_OF_NEWER,
+    )
+    host = BehaviorHost(["second::TestLoader", "third::TestLoader"], workspace)
+    report = host.load()
+    (error,) = report.errors
+    assert "'Legacy' is declared the former name of both 'Modern'" in str(error) and "'Newer'" in str(error)
+    assert sorted(host.registry) == ["Modern"]
+
+
+def test_former_spellings_that_are_not_former_spellings_fail_the_plugin_at_load(
+    workspace: Path, make_package
+) -> None:
+    make_package("bad", classes={"Modern": 0}, behaviors=OLD_NAME_MODULE.format(spellings='("Legacy",)'))
+    host = BehaviorHost(["bad::TestLoader"], workspace)
+    (error,) = host.load().errors
+    assert "former_spellings of behavior 'Modern' must be a tuple of kinema.behaviors.FormerSpelling" in str(
+        error
+    )
+
+
+INIT_OF_NEWER = """
+from kinema.plugins import hookimpl
+
+from .behaviors import Newer
+
+
+@hookimpl
+def register_behaviors(register):
+    register(Newer)
+"""
+
+
 def test_a_plugin_that_raises_at_import_fails_alone_with_its_line(workspace: Path, make_package) -> None:
     make_package("good", classes={"Good": 1})
     make_package("bad", classes={"Bad": 2}, behaviors="import math\nRATIO = 1 / 0\n")

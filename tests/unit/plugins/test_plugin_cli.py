@@ -112,6 +112,30 @@ def test_build_validates_objectives_and_writes_the_model(ws: Path, capsys) -> No
     assert f"{broken}:5:" in err and "NoSuchBehavior" in err
 
 
+def test_build_accepts_moveit_pros_old_names_and_warns_with_the_current_ones(ws: Path, capsys) -> None:
+    old = ws / "src" / "my_config" / "objectives" / "old_names.xml"
+    old.write_text(
+        '<root BTCPP_format="4">\n'
+        '  <BehaviorTree ID="Old Names">\n'
+        "    <Sequence>\n"
+        '      <Action ID="CreateStampedPose" reference_frame="world" stamped_pose="{pose}"/>\n'
+        '      <Action ID="GetImage" topic_name="/wrist_camera/color" timeout_sec="2"/>\n'
+        "    </Sequence>\n"
+        "  </BehaviorTree>\n"
+        "</root>\n"
+    )
+    assert main(["build", "--skip-install"]) == 0
+    err = capsys.readouterr().err
+    assert (
+        f"warning: {old}:4: CreateStampedPose is MoveIt Pro's old name of CreatePoseStamped "
+        "(its port stamped_pose is pose_stamped); read as CreatePoseStamped, write that instead"
+    ) in err, err
+    assert (
+        f"warning: {old}:5: GetImage's port timeout_sec is MoveIt Pro's old name of message_timeout_sec"
+        in err
+    )
+
+
 @pytest.mark.parametrize(
     ("waypoints_file", "content", "said"),
     [

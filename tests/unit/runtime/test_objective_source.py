@@ -31,6 +31,31 @@ def test_only_objectives_whose_file_loads_are_runnable_and_the_others_say_why(tm
     assert "broken.xml" in result.error_message and "NoSuchBehavior" in result.error_message
 
 
+def test_a_subtree_that_did_not_load_is_reported_with_its_own_reason(tmp_path: Path) -> None:
+    # It said "Can't find a tree with name: Broken", as if the subtree did not exist.
+    (tmp_path / "caller.xml").write_text(
+        '<root BTCPP_format="4">\n'
+        '  <BehaviorTree ID="Caller">\n'
+        '    <SubTree ID="Broken"/>\n'
+        "  </BehaviorTree>\n"
+        "</root>\n"
+    )
+    (tmp_path / "broken.xml").write_text(BROKEN)
+    source = _source(tmp_path)
+    assert source.objective_names() == ["Caller"]
+    with ObjectiveServer(source) as server:
+        result = server.submit(ObjectiveRequest("Caller")).wait(5)
+        xml = (tmp_path / "caller.xml").read_text()
+        from_xml = server.submit(ObjectiveRequest(objective_xml=xml)).wait(5)
+    for outcome in (result, from_xml):
+        assert outcome is not None and outcome.failed
+        message = outcome.error_message
+        assert "objective 'Caller' cannot run: its SubTree 'Broken' did not load:" in message, message
+        assert "broken.xml" in message and "NoSuchBehavior" in message
+        assert "Can't find a tree" not in message
+    assert f"{tmp_path / 'caller.xml'}:3:" in result.error_message
+
+
 def test_changed_objective_files_are_picked_up_after_invalidation(tmp_path: Path) -> None:
     (tmp_path / "good.xml").write_text(GOOD)
     source = _source(tmp_path)

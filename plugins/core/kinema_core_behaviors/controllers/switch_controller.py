@@ -5,7 +5,7 @@ from __future__ import annotations
 import asyncio
 from typing import Any
 
-from kinema.behaviors import AsyncBehavior, PortInfo, input_port
+from kinema.behaviors import AsyncBehavior, FormerSpelling, PortInfo, input_port
 from kinema.errors import TransportError
 
 BEST_EFFORT = 1
@@ -61,6 +61,9 @@ class SwitchController(AsyncBehavior):
     """
 
     subcategory = "Controllers"
+    former_spellings = (
+        FormerSpelling("ActivateControllers", ports={"controller_names": "activate_controllers"}),
+    )
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 
 from kinema import transforms
-from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
+from kinema.behaviors import FormerSpelling, NodeStatus, PortInfo, SyncBehavior, input_port
 
 from .conversions import pose_stamped_message
 from .ports import (
@@ -43,6 +43,7 @@ class CreatePoseStamped(SyncBehavior):
     """Writes a ``geometry_msgs/PoseStamped`` in ``reference_frame`` (the quaternion is normalised)."""
 
     subcategory = "Math - Poses"
+    former_spellings = (FormerSpelling("CreateStampedPose", ports={"stamped_pose": "pose_stamped"}),)
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

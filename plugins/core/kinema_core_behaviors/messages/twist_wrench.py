@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from typing import ClassVar
 
-from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
+from kinema.behaviors import FormerSpelling, NodeStatus, PortInfo, SyncBehavior, input_port
 
 from .ports import fails_on_bad_input, message_output, read_floats, read_input
 from .unpacking import Field, UnpackMessage
@@ -55,6 +55,7 @@ class CreateTwistStamped(_CreateVectorPairStamped):
     noun = body = "twist"
     first = ("linear", "linear_velocity_xyz", "Linear velocity x;y;z (m/s).")
     second = ("angular", "angular_velocity_xyz", "Angular velocity x;y;z (rad/s).")
+    former_spellings = (FormerSpelling("CreateStampedTwist", ports={"stamped_twist": "twist_stamped"}),)
 
 
 class UnpackTwistStampedMessage(UnpackMessage):
@@ -77,6 +78,7 @@ class CreateWrenchStamped(_CreateVectorPairStamped):
     noun = body = "wrench"
     first = ("force", "force_xyz", "Force x;y;z (N).")
     second = ("torque", "torque_xyz", "Torque x;y;z (N m).")
+    former_spellings = (FormerSpelling("CreateStampedWrench", ports={"stamped_wrench": "wrench_stamped"}),)
 
 
 class UnpackWrenchStampedMessage(UnpackMessage):

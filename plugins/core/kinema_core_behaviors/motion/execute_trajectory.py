@@ -6,7 +6,7 @@ import asyncio
 import time
 from typing import Any
 
-from kinema.behaviors import AsyncBehavior, PortInfo, input_port
+from kinema.behaviors import AsyncBehavior, FormerSpelling, PortInfo, input_port
 from kinema.behaviors.work_runner import RUNNER
 from kinema.drivers.mujoco.names import LIST_CONTROLLERS_SERVICE, SWITCH_CONTROLLERS_SERVICE
 from kinema.errors import KinemaError, ObjectiveError, TransportError
@@ -46,6 +46,12 @@ class ExecuteTrajectory(AsyncBehavior):
     """
 
     subcategory = "Motion - Execute"
+    former_spellings = (
+        FormerSpelling(
+            "ExecuteFollowJointTrajectory",
+            ports={"execute_follow_joint_trajectory_action_name": "controller_action_name"},
+        ),
+    )
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

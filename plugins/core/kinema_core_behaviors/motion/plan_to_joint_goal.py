@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
+from kinema.behaviors import AsyncBehavior, FormerSpelling, PortInfo, input_port, output_port
 from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError, did_you_mean
 
@@ -36,6 +36,16 @@ class PlanToJointGoal(AsyncBehavior):
     """
 
     subcategory = "Motion - Planning"
+    former_spellings = (
+        FormerSpelling(
+            dropped={
+                "keep_orientation": "planning keeps no orientation constraint yet (orientation_constraint "
+                "takes only '[]')",
+                "keep_orientation_tolerance": "it only bounds keep_orientation",
+            },
+            accepted_values={"keep_orientation": ("false", "False", "FALSE", "0")},
+        ),
+    )
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

@@ -1,6 +1,6 @@
 """Perception: camera messages onto the blackboard, AprilTags found in images, point clouds transformed,
 cropped, merged, registered, loaded from files, cut out by image masks and turned into obstacles (planning
-scene, collision spheres).
+scene, collision spheres). The segmentation-model behaviors are known but fail when they run (no model).
 
 Ports hold ``sensor_msgs`` messages as MoveIt Pro's do; the work is done on numpy arrays by
 :mod:`kinema.perception`, with the conversions in :mod:`.clouds`.
@@ -18,6 +18,7 @@ from .load_point_cloud_from_file import LoadPointCloudFromFile
 from .masks import GetMasks3DFromMasks2D, GetPointCloudFromMask3D
 from .merge_point_clouds import MergePointClouds
 from .register_point_clouds import RegisterPointClouds
+from .segmentation import GetMasks2DFromExemplar, GetMasks2DFromPointQuery
 from .transform_point_cloud import TransformPointCloud, TransformPointCloudFrame
 from .tray_place_positions import ComputeTrayPlacePositionsUsingAprilTags
 from .update_planning_scene import UpdatePlanningSceneService
@@ -35,6 +36,8 @@ BEHAVIORS = (
     RegisterPointClouds,
     LoadPointCloudFromFile,
     UpdatePlanningSceneService,
+    GetMasks2DFromExemplar,
+    GetMasks2DFromPointQuery,
     GetMasks3DFromMasks2D,
     GetPointCloudFromMask3D,
     FindMaskedObjects,

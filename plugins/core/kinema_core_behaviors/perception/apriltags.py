@@ -15,7 +15,7 @@ from typing import Any
 
 import numpy as np
 
-from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, SyncBehavior, input_port
+from kinema.behaviors import AsyncBehavior, FormerSpelling, NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import PerceptionError
 from kinema.transforms import pose_dict, pose_from_message
 
@@ -75,6 +75,14 @@ class DetectAprilTags(AsyncBehavior):
     """Finds the AprilTags of one family in ``image`` and writes their poses to ``detections``."""
 
     subcategory = "Perception - 2D Image"
+    former_spellings = (
+        FormerSpelling(
+            dropped={
+                "parameters": "the detector's settings are its own ports today (apriltag_family_name, "
+                "tag_size, max_hamming, n_threads, quad_decimate, quad_sigma, refine_edges)"
+            }
+        ),
+    )
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

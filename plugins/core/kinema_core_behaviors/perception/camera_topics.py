@@ -16,7 +16,7 @@ import threading
 import time
 from typing import Any, ClassVar
 
-from kinema.behaviors import AsyncBehavior, PortInfo, input_port
+from kinema.behaviors import AsyncBehavior, FormerSpelling, PortInfo, input_port
 from kinema.behaviors.cell_ports import cell_input_port
 
 from ..messages.ports import fails_on_bad_input, message_output, port_error, read_input
@@ -32,6 +32,10 @@ def taken_since(message: Any, start: float) -> bool:
     """Whether ``message`` (with a header) was stamped at or after ``start`` on the robot's clock."""
     stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
     return stamp == 0 or stamp >= start - 1e-6 or stamp < start - _OTHER_TIME_BASE
+
+
+# MoveIt Pro's camera behaviors once had one timeout, for the message.
+_OLD_TIMEOUT = (FormerSpelling(ports={"timeout_sec": "message_timeout_sec"}),)
 
 
 class _GetCameraMessage(AsyncBehavior):
@@ -137,6 +141,7 @@ class GetPointCloud(_GetCameraMessage):
     default_topic_key = "camera_points_topic"  # the config's camera: /<robot.default_camera>/points
     default_output = "{point_cloud}"
     subcategory = "Perception - 3D Point Cloud"
+    former_spellings = _OLD_TIMEOUT
 
 
 class GetImage(_GetCameraMessage):
@@ -149,6 +154,7 @@ class GetImage(_GetCameraMessage):
     default_topic_key = "camera_color_topic"
     default_output = "{image}"
     subcategory = "Perception - 2D Image"
+    former_spellings = _OLD_TIMEOUT
 
 
 class GetCameraInfo(_GetCameraMessage):
@@ -159,3 +165,4 @@ class GetCameraInfo(_GetCameraMessage):
     default_topic_key = "camera_info_topic"
     default_output = "{camera_info}"
     subcategory = "Perception - 2D Image"
+    former_spellings = _OLD_TIMEOUT

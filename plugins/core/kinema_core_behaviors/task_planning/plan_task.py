@@ -4,7 +4,15 @@ from __future__ import annotations
 
 from typing import Any
 
-from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, SyncBehavior, input_port, output_port
+from kinema.behaviors import (
+    AsyncBehavior,
+    FormerSpelling,
+    NodeStatus,
+    PortInfo,
+    SyncBehavior,
+    input_port,
+    output_port,
+)
 from kinema.errors import KinemaError
 
 from ..messages.conversions import trajectory_message
@@ -188,6 +196,9 @@ class ConvertMtcSolutionToJointTrajectory(SyncBehavior):
     """
 
     subcategory = SUBCATEGORY
+    # MoveIt Pro's former ExecuteMTCTask behavior is the core "Execute MTC Solution" subtree today, which
+    # is built on this behavior.
+    former_spellings = (FormerSpelling("ExecuteMTCTask", current_id="Execute MTC Solution", subtree=True),)
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

@@ -10,7 +10,15 @@ from __future__ import annotations
 from dataclasses import dataclass
 from typing import Any
 
-from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, bidirectional_port, input_port, output_port
+from kinema.behaviors import (
+    FormerSpelling,
+    NodeStatus,
+    PortInfo,
+    SyncBehavior,
+    bidirectional_port,
+    input_port,
+    output_port,
+)
 from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError
 
@@ -164,6 +172,14 @@ class InitializeMTCTask(SyncBehavior):
     """Creates an empty MTC task on ``task``; SetupMTC* behaviors add its stages, PlanMTCTask plans it."""
 
     subcategory = SUBCATEGORY
+    former_spellings = (
+        FormerSpelling(
+            dropped={
+                "controller_names": "the controllers are chosen where the solution executes (the "
+                "controller_names of 'Execute MTC Solution')"
+            }
+        ),
+    )
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
@@ -226,8 +242,13 @@ class SetupMTCPlanToPose(_SetupStage):
 
 
 class SetupMTCPlanToRobotState(_SetupStage):
-    """Adds a stage that moves the planning group to ``joint_state`` (a collision-free motion)."""
+    """Adds a stage that moves the planning group to ``joint_state`` (a collision-free motion).
 
+    It is what MoveIt Pro's former SetupMTCInterpolateToJointState reads as: the straight joint-space
+    motion is tried first, and planned around obstacles only when it collides.
+    """
+
+    former_spellings = (FormerSpelling("SetupMTCInterpolateToJointState"),)
     MOTION = MotionPorts(velocity=None, acceleration=None, planning=False)
 
     @classmethod

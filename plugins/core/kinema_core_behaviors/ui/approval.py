@@ -23,7 +23,7 @@ import threading
 import time
 from typing import Any
 
-from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, StatefulBehavior, input_port
+from kinema.behaviors import AsyncBehavior, FormerSpelling, NodeStatus, PortInfo, StatefulBehavior, input_port
 from kinema.errors import KinemaError, TransportError
 from kinema.ui_topics import APPROVAL_SERVICE, APPROVAL_TYPE
 
@@ -136,6 +136,7 @@ class WaitForMTCSolutionApproval(_AskUser):
     """
 
     subcategory = "User Input"
+    former_spellings = (FormerSpelling("WaitForUserTrajectoryApproval"),)
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
