@@ -64,7 +64,7 @@ def test_a_damaged_cache_file_is_replaced(tmp_path: Path) -> None:
     purge_modules(module.__name__)
 
 
-def test_loading_the_bundled_behaviors_imports_no_numpy_zenoh_or_watchdog() -> None:
+def test_loading_the_bundled_behaviors_imports_no_numpy_zenoh_watchdog_or_asyncio() -> None:
     code = (
         "import sys\n"
         "from kinema.plugins import BehaviorHost\n"
@@ -73,7 +73,7 @@ def test_loading_the_bundled_behaviors_imports_no_numpy_zenoh_or_watchdog() -> N
         "assert not report.errors, report.errors\n"
         "assert len(host.registry.create_factory().manifests()) > 100\n"
         "from kinema.transport.session import resolve_endpoints\n"
-        "heavy = ('numpy', 'rosbags', 'zenoh', 'watchdog', 'mujoco', 'pinocchio')\n"
+        "heavy = ('numpy', 'rosbags', 'zenoh', 'watchdog', 'mujoco', 'pinocchio', 'asyncio')\n"
         "print(sorted(name for name in heavy if name in sys.modules))\n"
     )
     done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
