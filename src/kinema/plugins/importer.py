@@ -17,7 +17,6 @@ then compiled at every start).
 
 from __future__ import annotations
 
-import hashlib
 import importlib
 import importlib.abc
 import importlib.machinery
@@ -87,14 +86,16 @@ class _UserCacheSourceLoader(importlib.machinery.SourceFileLoader):
 
 
 def bytecode_cache_path(source_path: str) -> Path:
-    """Where the compiled code of the never-reloaded plugin source ``source_path`` is kept."""
+    """Where the compiled code of the never-reloaded plugin source ``source_path`` is kept.
+
+    The source's absolute path is mirrored under the cache folder, as ``sys.pycache_prefix`` does.
+    """
     import platformdirs
 
-    digest = hashlib.sha256(os.path.abspath(source_path).encode()).hexdigest()[:24]
+    source = Path(os.path.abspath(source_path))
     tag = sys.implementation.cache_tag or "python"
-    return (
-        platformdirs.user_cache_path("kinema") / "bytecode" / tag / f"{Path(source_path).stem}-{digest}.pyc"
-    )
+    mirrored = source.relative_to(source.anchor).with_name(f"{source.stem}.{tag}.pyc")
+    return platformdirs.user_cache_path("kinema") / "bytecode" / mirrored
 
 
 def _loader(fullname: str, path: str) -> importlib.abc.Loader:
