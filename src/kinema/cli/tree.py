@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -127,6 +126,8 @@ def validate(files: tuple[Path, ...], as_json: bool, behaviors: bool) -> None:
     Every problem is printed as file:line: message. A SubTree may call a tree defined in another of
     the FILES. Exits 1 if any problem was found.
     """
+    import json
+
     from kinema.bt.validation import count_trees, validate_files
 
     problems = validate_files(list(files), _factory(behaviors))
