@@ -358,7 +358,12 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=3.0, help="CPU seconds per engine and structure")
     parser.add_argument("--rounds", type=int, default=5, help="rounds per measurement (median)")
     parser.add_argument("--profile", choices=sorted(STRUCTURES), help="profile Kinema ticking STRUCTURE")
+    parser.add_argument(
+        "--smoke", action="store_true", help="tiny timings of each structure (the test suite)"
+    )
     args = parser.parse_args()
+    if args.smoke:
+        args.seconds, args.rounds = 0.02, 1
 
     if args.profile:
         tree = kinema_tree(STRUCTURES[args.profile]())

@@ -82,7 +82,10 @@ def measure(server: ObjectiveServer, body: str, runs: int) -> tuple[list[int], l
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--runs", type=int, default=20, help="cancels and preemptions per kind of tree")
+    parser.add_argument("--smoke", action="store_true", help="two runs of each kind (the test suite)")
     args = parser.parse_args()
+    if args.smoke:
+        args.runs = 2
     factory = registry_of([BlockingTick]).create_factory(BehaviorContext.offline())
     with ObjectiveServer(FactoryTreeSource(factory)) as server:
         budget = (server.tick_period + 0.1) * 1000

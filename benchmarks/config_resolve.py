@@ -166,7 +166,10 @@ def _median_ms(function, repeat: int) -> float:  # type: ignore[no-untyped-def]
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeat", type=int, default=7, help="runs per measurement (median is printed)")
+    parser.add_argument("--smoke", action="store_true", help="one run of each measurement (the test suite)")
     args = parser.parse_args()
+    if args.smoke:
+        args.repeat = 1
     with tempfile.TemporaryDirectory() as folder:
         root = Path(folder)
         files = build_workspace(root)

@@ -129,7 +129,10 @@ def measure_restart(workspace: Path, rounds: int) -> list[float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--rounds", type=int, default=20, help="saves per measurement (default 20)")
+    parser.add_argument("--smoke", action="store_true", help="two saves of each kind (the test suite)")
     args = parser.parse_args()
+    if args.smoke:
+        args.rounds = 2
     with tempfile.TemporaryDirectory(prefix="kinema-bench-") as scratch:
         workspace = Path(scratch)
         module = _write_package(workspace)

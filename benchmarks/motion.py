@@ -214,7 +214,12 @@ SECTIONS: list[Callable[[int], None]] = [bench_mj_step, bench_collision, bench_i
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=30, help="repetitions per measurement (default 30)")
+    parser.add_argument(
+        "--smoke", action="store_true", help="two repetitions of each measurement (the test suite)"
+    )
     args = parser.parse_args()
+    if args.smoke:
+        args.repeats = 2
     for section in SECTIONS:
         section(args.repeats)
 

@@ -230,7 +230,10 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=6.0, help="wall seconds per round (default 6)")
     parser.add_argument("--rounds", type=int, default=3, help="interleaved rounds (default 3)")
     parser.add_argument("--frames", type=int, default=20, help="frames per render timing (default 20)")
+    parser.add_argument("--smoke", action="store_true", help="short rounds, few frames (the test suite)")
     args = parser.parse_args()
+    if args.smoke:
+        args.seconds, args.rounds, args.frames = 1.0, 1, 2
     bench_perception(args.seconds, args.rounds, args.frames)
 
 

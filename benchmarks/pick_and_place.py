@@ -12,7 +12,7 @@ the planner up, then measures:
 
 It prints wall seconds per cycle, the sim seconds each represents (so the real-time factor), and the
 ratio objective / peer: what the runtime adds on top of planning and simulating. Numbers only, no
-assertions. Run: ``python benchmarks/pick_and_place.py [--cycles N] [--library kinema|moveit_pro]``
+assertions. Run: ``python benchmarks/pick_and_place.py [--cycles N] [--library kinema|moveit_pro] [--smoke]``
 (``moveit_pro`` runs a copy of ``../shared/compat/moveit_pro/objectives`` when that folder exists).
 
 :func:`measure_objective_cycles` is reusable (``benchmarks/motion.py`` may call it).
@@ -129,6 +129,8 @@ class Cell:
 
 def measure_objective_cycles(cell: Cell, cycles: int) -> list[Cycle]:
     """Run the objective until ``cycles`` passes of its loop body have finished; time each pass."""
+    from kinema.sdk.client import NodeStatusSubscription
+
     ends: list[tuple[float, float]] = []
     loop_uid: list[int] = []
     ended = threading.Condition()
@@ -143,9 +145,8 @@ def measure_objective_cycles(cell: Cell, cycles: int) -> list[Cycle]:
                     ends.append((time.monotonic(), cell.driver.sim_time))
                     ended.notify_all()
 
-    subscription = cell.node.create_subscription(
-        "kinema_msgs/msg/NodeStatusChanges", "/objective_server/node_status", on_changes
-    )
+    # The SDK's decoder: the agent publishes status codes and a node table, not named changes.
+    subscription = NodeStatusSubscription(cell.node, on_changes)
     handle = cell.client.start(OBJECTIVE)
     errors: list[float] = []
     try:
@@ -251,6 +252,7 @@ def _report(label: str, cycles: list[Cycle]) -> float:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--cycles", type=int, default=3, help="cycles to time per variant (default 3)")
+    parser.add_argument("--smoke", action="store_true", help="one cycle of each variant (the test suite)")
     parser.add_argument(
         "--library",
         choices=("kinema", "moveit_pro"),
@@ -258,6 +260,8 @@ def main() -> None:
         help="Kinema's own objectives (default) or MoveIt Pro's lab_sim files from ../shared",
     )
     args = parser.parse_args()
+    if args.smoke:
+        args.cycles = 1
     with tempfile.TemporaryDirectory() as tmp:
         config, workspace = _workspace(Path(tmp), args.library)
         cell = Cell(config, workspace)

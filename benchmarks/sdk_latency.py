@@ -86,7 +86,10 @@ def main() -> None:
     parser.add_argument("--calls", type=int, default=1000)
     parser.add_argument("--warmup", type=int, default=100)
     parser.add_argument("--cold", type=int, default=5, help="cold CLI runs")
+    parser.add_argument("--smoke", action="store_true", help="few calls, one cold run (the test suite)")
     args = parser.parse_args()
+    if args.smoke:
+        args.calls, args.warmup, args.cold = 40, 8, 1
 
     from kinema.sdk import ObjectiveClient
     from kinema.transport import free_endpoint

@@ -66,7 +66,10 @@ def _time(fn: Callable[[], object], repeats: int) -> list[float]:
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--repeats", type=int, default=20)
+    parser.add_argument("--smoke", action="store_true", help="two repeats of each (the test suite)")
     args = parser.parse_args()
+    if args.smoke:
+        args.repeats = 2
 
     description = RobotDescription.lab_sim()
     model = description.load_model()

@@ -47,7 +47,10 @@ def main() -> None:
     parser.add_argument("--calls", type=int, default=3000, help="timed calls per case")
     parser.add_argument("--warmup", type=int, default=300, help="untimed calls before each case")
     parser.add_argument("--serve", metavar="ENDPOINT", help=argparse.SUPPRESS)
+    parser.add_argument("--smoke", action="store_true", help="few calls per case (the test suite)")
     args = parser.parse_args()
+    if args.smoke:
+        args.calls, args.warmup = 50, 10
     if args.serve:
         serve(args.serve)
         return

@@ -242,7 +242,12 @@ def main() -> None:
     )
     parser.add_argument("--runs", type=int, default=5, help="first-paint runs (median is printed)")
     parser.add_argument("--seconds", type=float, default=10.0, help="seconds of streaming per latency run")
+    parser.add_argument(
+        "--smoke", action="store_true", help="one first-paint run, a short latency run (the test suite)"
+    )
     args = parser.parse_args()
+    if args.smoke:
+        args.runs, args.seconds = 1, 1.0
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else float("nan")
     print(f"{os.cpu_count()} CPUs, load average {load:.1f}")
     first_paint(args.runs)

@@ -241,7 +241,10 @@ def main() -> None:
     parser.add_argument("--seconds", type=float, default=4.0, help="wall seconds per measurement (default 4)")
     parser.add_argument("--rounds", type=int, default=3, help="off/on rounds (default 3)")
     parser.add_argument("--browser", action="store_true", help="also render the page in headless Chromium")
+    parser.add_argument("--smoke", action="store_true", help="one short round (the test suite)")
     args = parser.parse_args()
+    if args.smoke:
+        args.seconds, args.rounds = 1.0, 1
     measure_cost(args.seconds, args.rounds, args.browser)
     measure_rate(args.seconds, args.browser)
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 import concurrent.futures
 import threading
 from typing import TYPE_CHECKING, Any, ClassVar, Generic
@@ -15,6 +14,8 @@ from kinema.errors import TransportError
 from kinema.interfaces.definition import FeedbackT, GoalT, ResultT
 
 if TYPE_CHECKING:
+    import asyncio
+
     from kinema.transport import GoalResult
 
 
@@ -78,6 +79,8 @@ class ActionClientBehavior(AsyncBehavior, Generic[GoalT, ResultT, FeedbackT]):
 
     async def do_work(self) -> bool:
         """Send the goal, wait for the result and process it (no need to override)."""
+        import asyncio
+
         if not self.action_type:
             raise BehaviorExecutionError(
                 f"behavior '{self.registration_id}' does not say which action type it calls; derive "

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 import concurrent.futures
 import inspect
 import threading
@@ -81,6 +80,8 @@ class AsyncBehavior(Behavior, StatefulActionNode):
     async def _guarded(self, work: Awaitable[bool]) -> bool:
         # asyncio lets SystemExit and KeyboardInterrupt out of the event loop, which would end it for
         # every async behavior of the process: they become this behavior's fault instead.
+        import asyncio
+
         try:
             return await work
         except asyncio.CancelledError:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 from typing import Any, ClassVar, Generic
 
 from kinema.behaviors.asynchronous import AsyncBehavior
@@ -59,6 +58,8 @@ class ServiceClientBehavior(AsyncBehavior, Generic[RequestT, ResponseT]):
 
     async def do_work(self) -> bool:
         """Call the service and process the response (no need to override)."""
+        import asyncio
+
         if not self.service_type:
             raise BehaviorExecutionError(
                 f"behavior '{self.registration_id}' does not say which service type it calls; derive "

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 import threading
 from typing import Any, ClassVar
 
@@ -45,6 +44,8 @@ class GetMessageFromTopicBehavior(AsyncBehavior):
 
     async def do_work(self) -> bool:
         """Subscribe, wait for one message, process it (no need to override)."""
+        import asyncio
+
         if not self.message_type:
             raise BehaviorExecutionError(
                 f"behavior '{self.registration_id}' does not say which message type it reads; derive "

@@ -13,12 +13,14 @@ stop as soon as it runs again: it finishes the tasks it holds, then its thread e
 
 from __future__ import annotations
 
-import asyncio
 import concurrent.futures
 import threading
 import time
 from collections.abc import Callable, Coroutine
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:
+    import asyncio
 
 _MAX_THREADS = 32
 LOOP_BEAT_S = 0.05
@@ -40,6 +42,8 @@ class WorkRunner:
 
     def run_coroutine(self, coroutine: Coroutine[Any, Any, Any]) -> concurrent.futures.Future[Any]:
         """Schedule ``coroutine`` on the shared event loop."""
+        import asyncio
+
         return asyncio.run_coroutine_threadsafe(coroutine, self._event_loop())
 
     def run_function(self, function: Callable[[], Any]) -> concurrent.futures.Future[Any]:
@@ -92,6 +96,8 @@ class WorkRunner:
             return [(now - beats[0], thread.ident) for _loop, thread, beats, _last in self._retired]
 
     def _event_loop(self) -> asyncio.AbstractEventLoop:
+        import asyncio
+
         with self._lock:
             if self._loop is None:
                 loop = asyncio.new_event_loop()
@@ -121,6 +127,7 @@ class WorkRunner:
 
 def _finish_then_stop(loop: asyncio.AbstractEventLoop) -> None:
     """On a retired loop: wait for the tasks it holds, then stop it (its thread then closes it)."""
+    import asyncio
 
     async def finish() -> None:
         current = asyncio.current_task()

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -36,6 +35,8 @@ def list_(workspace: Path | None, include_hidden: bool, as_json: bool, verbose: 
     The active config is marked with *. Packages with a KINEMA_IGNORE or MOVEIT_PRO_IGNORE file are
     hidden unless --all is given.
     """
+    import json
+
     from kinema.config import list_config_packages
     from kinema.config.inheritance import load_config_source
     from kinema.errors import ConfigError
@@ -93,6 +94,8 @@ def show(
     Without --json it is readable YAML; --provenance adds, for each value, the package that set it
     (as a comment, or in JSON as {"config", "chain", "provenance"} with dotted key paths).
     """
+    import json
+
     from kinema.config import resolve_config
 
     found, name = resolve_selection(workspace, config)
@@ -112,6 +115,8 @@ def show(
 @click.option("--json", "as_json", is_flag=True, help="Print a JSON list, root first.")
 def chain(workspace: Path | None, config: str | None, as_json: bool) -> None:
     """Print the inheritance chain of a config package, root first."""
+    import json
+
     from kinema.config.inheritance import resolve_chain
 
     found, name = resolve_selection(workspace, config)

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -67,6 +66,8 @@ def list_(workspace: Path | None, config: str | None, as_json: bool, no_check: b
     is listed after the table, one line each, with the first problem as file:line: message. Files that
     cannot be read are reported as file:line: message on stderr; the other objectives are still listed.
     """
+    import json
+
     library = _load_library(workspace, config, verbose)
     objectives = library.sorted()
     problems = {} if no_check else _load_problems(library)
@@ -127,6 +128,7 @@ def show(
     same list the SDK's `objectives()` and the terminal UI's override form give. A run without `-p`
     for a port starts from the default shown.
     """
+    import json
     from dataclasses import replace
 
     from kinema.config.objective_parameters import objective_interface
@@ -306,6 +308,7 @@ def cancel_(connect: str | None, timeout: float) -> None:
 def status_(follow: bool, as_json: bool, connect: str | None, timeout: float) -> None:
     """Print the objective server's status: Idle, Loading, Running, Success, Failure or Cancelled."""
     import dataclasses
+    import json
 
     def show(status) -> None:  # type: ignore[no-untyped-def]
         if as_json:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 from pathlib import Path
 from typing import Any
 
@@ -41,6 +40,8 @@ def plugins(workspace: Path | None, config: str | None, as_json: bool) -> None:
     the plugins among the bundled ones, installed entry points (kinema.behaviors) and the behavior
     packages of the workspace. Exits 1 when a plugin failed to load.
     """
+    import json
+
     host, report, name = _load(workspace, config)
     records = host.plugins
     if as_json:
@@ -101,6 +102,8 @@ def behaviors(
 
     With --markdown, print them as a behavior reference (docs/behavior-reference.md is this for lab_sim).
     """
+    import json
+
     from kinema.errors import PluginError, did_you_mean
 
     host, report, _name = _load(workspace, config)

@@ -8,10 +8,8 @@ nothing answers within ``--timeout``.
 from __future__ import annotations
 
 import itertools
-import json
 import math
 import os
-import statistics
 import sys
 import threading
 import time
@@ -75,6 +73,8 @@ def _graph(node: Node, timeout: float) -> Graph:
 
 
 def _print_names(names_and_types: dict[str, list[str]], show_types: bool, as_json: bool) -> None:
+    import json
+
     if as_json:
         click.echo(json.dumps(names_and_types, indent=2))
         return
@@ -298,6 +298,8 @@ def topic_hz(
     topic_name: str, msg_type: str | None, window: int, duration: float, connect: str | None, timeout: float
 ) -> None:
     """Print the publishing rate of TOPIC_NAME once a second."""
+    import statistics
+
     with _node(connect, timeout) as node:
         name = node.resolve(topic_name)
         type_name = msg_type or _discover_type(node, name, "topic", lambda g: g.topics(hidden=True), timeout)
@@ -473,6 +475,8 @@ def node() -> None:
 @_common(2.0)
 def node_list(show_all: bool, as_json: bool, connect: str | None, timeout: float) -> None:
     """List the nodes on the network."""
+    import json
+
     with _node(connect, timeout) as cli_node:
         names = _graph(cli_node, timeout).nodes()
     names = [n for n in names if show_all or not n.rsplit("/", 1)[-1].startswith("_")]

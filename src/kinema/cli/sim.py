@@ -6,7 +6,6 @@ with one line when no simulation answers within ``--timeout``.
 
 from __future__ import annotations
 
-import json
 import os
 from collections.abc import Callable, Iterator
 from contextlib import contextmanager
@@ -52,6 +51,8 @@ def sim() -> None:
 @_common
 def bodies(as_json: bool, connect: str | None, timeout: float) -> None:
     """Print each free body's name and world position (m), from the running simulator."""
+    import json
+
     with _client(connect, timeout) as client:
         sim_time, found = client.bodies()
     if as_json:
@@ -72,6 +73,8 @@ def bodies(as_json: bool, connect: str | None, timeout: float) -> None:
 @_common
 def keyframes(as_json: bool, connect: str | None, timeout: float) -> None:
     """List the simulation's keyframes (the one it started from is marked with *)."""
+    import json
+
     with _client(connect, timeout) as client:
         found, initial = client.keyframes()
     if as_json:

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import json
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
@@ -148,6 +147,8 @@ def validate(
     the FILES. A node written in a former spelling (MoveIt Pro's CreateStampedPose, say) is checked as
     today's and named in a warning on stderr. Exits 1 if any problem was found.
     """
+    import json
+
     from kinema.bt.validation import Problem, count_trees, validate_files
     from kinema.cli.options import print_warnings
 

@@ -22,12 +22,11 @@ from __future__ import annotations
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from kinema.errors import ObjectiveError
-from kinema.transforms import pose_dict, pose_from_message
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from kinema.motion.frames import FrameTree
     from kinema.motion.planning_scene import CollisionObject, PlanningScene
 
@@ -123,6 +122,10 @@ def object_pose_of(message: Any, frames: FrameTree | Callable[[str], np.ndarray]
     Raises:
         ObjectiveError: a frame the tree does not know.
     """
+    import numpy as np
+
+    from kinema.transforms import pose_from_message
+
     frame = str(message.header.frame_id)
     if frames is None:
         world_T_frame = np.eye(4)
@@ -142,7 +145,10 @@ def primitives_of(
     Raises:
         ObjectiveError: unsupported shapes, mismatched pose lists, or a frame the tree does not know.
     """
+    import numpy as np
+
     from kinema.motion.planning_scene import CollisionObject
+    from kinema.transforms import pose_from_message
 
     world_T_object = object_pose_of(message, frames)
     shapes: list[CollisionObject] = []
@@ -199,6 +205,10 @@ def _primitive_dict(obj: CollisionObject) -> dict[str, Any]:
 
 def collision_object_dict(object_id: str, primitives: list[CollisionObject]) -> dict[str, Any]:
     """A ``moveit_msgs/CollisionObject`` dict of a world object, in ``world``."""
+    import numpy as np
+
+    from kinema.transforms import pose_dict
+
     return {
         "header": {"frame_id": "world"},
         "pose": {"orientation": {"w": 1.0}},

@@ -19,7 +19,6 @@ from typing import TYPE_CHECKING
 from kinema.errors import KinemaError, PluginError
 from kinema.plugins.discovery import PluginSpec, available_plugins, select_loaders
 from kinema.plugins.events import ReloadEvent, ReloadKind
-from kinema.plugins.hot_reload import DirectoryWatcher
 from kinema.plugins.import_deadline import IMPORT_TIME_LIMIT_S, call_with_deadline
 from kinema.plugins.importer import describe_exception, import_fresh, purge_modules
 from kinema.plugins.manager import KinemaPluginManager
@@ -28,6 +27,7 @@ from kinema.plugins.registry import BehaviorRegistry, PluginRecord
 
 if TYPE_CHECKING:
     from kinema.config import ResolvedConfig
+    from kinema.plugins.hot_reload import DirectoryWatcher
 
 ReloadSubscriber = Callable[[ReloadEvent], None]
 
@@ -185,6 +185,9 @@ class BehaviorHost:
         with self._lock:
             if self._watcher is not None:
                 return self._watcher
+            # watchdog only when watching: a one-shot command that loads plugins never needs it.
+            from kinema.plugins.hot_reload import DirectoryWatcher
+
             watcher = DirectoryWatcher(debounce=debounce, polling=polling)
             roots = {r.spec.root for r in self._registry.plugins.values() if r.spec.hot_reloadable}
             for root in sorted(root for root in roots if root is not None):

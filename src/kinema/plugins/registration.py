@@ -18,6 +18,8 @@ from typing import Protocol
 from kinema.errors import PluginError, SourceLocation
 
 _ID_PATTERN = re.compile(r"[A-Za-z_][A-Za-z0-9_]*\Z")
+# One pattern for every class statement: compiling one per registered class cost a start-up 100+ compiles.
+_CLASS_STATEMENT = re.compile(r"\s*class\s+(\w+)")
 
 
 class RegisterBehavior(Protocol):
@@ -54,9 +56,10 @@ def class_location(cls: type) -> SourceLocation:
         return SourceLocation("<built-in>")
     # Scanning for the class statement is much cheaper than inspect.getsourcelines (which tokenizes the
     # whole class), and loading plugins registers many classes.
-    pattern = re.compile(rf"\s*class\s+{re.escape(cls.__name__)}\b")
+    name = cls.__name__
     for number, text in enumerate(linecache.getlines(file), start=1):
-        if pattern.match(text):
+        statement = _CLASS_STATEMENT.match(text)
+        if statement is not None and statement.group(1) == name:
             return SourceLocation(file, number)
     return SourceLocation(file, 0)
 

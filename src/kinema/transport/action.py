@@ -25,6 +25,7 @@ import numpy as np
 from kinema.errors import TransportError
 from kinema.interfaces import ActionType
 from kinema.interfaces.definition import FeedbackT, GoalT, ResultT
+from kinema.transport.goal_status_cdr import decode_goal_statuses, encode_goal_statuses
 from kinema.transport.keys import LATCHED_QOS, QoS, fully_qualified
 from kinema.transport.messages import from_dict, type_of
 from kinema.transport.pubsub import Publisher, Subscription
@@ -273,8 +274,6 @@ class ActionServer:
         self._result_timeout = result_timeout
         self._max_finished = max_finished_goals
         self._feedback_class = registry.message_class(self.action.feedback_message)
-        self._status_class = registry.message_class(self.action.status)
-        self._goal_status_class = registry.message_class("action_msgs/msg/GoalStatus")
         self._goals: dict[bytes, ServerGoalHandle] = {}
         self._lock = threading.RLock()
         self._closed = False
@@ -416,10 +415,12 @@ class ActionServer:
             ]
             for handle in expired:
                 del self._goals[handle.goal_id]
-            make = self._goal_status_class
-            statuses = [make(goal_info=h.goal_info, status=h.status) for h in self._goals.values()]
+            # Laid out directly: through the generic serializer a full array cost 0.3 ms per change.
+            payload = encode_goal_statuses(
+                (h.goal_id, h.stamp["sec"], h.stamp["nanosec"], h.status) for h in self._goals.values()
+            )
             try:
-                self._status.publish(self._status_class(status_list=statuses))
+                self._status.publish_raw(payload)
             except TransportError:
                 log.debug("status publisher of %s closed", self.name)
 
@@ -570,7 +571,9 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         self._feedback_sub = Subscription(
             node, action.feedback_message, f"{base}/feedback", self._on_feedback, QoS()
         )
-        self._status_sub = Subscription(node, action.status, f"{base}/status", self._on_status, LATCHED_QOS)
+        self._status_sub = Subscription(
+            node, action.status, f"{base}/status", self._on_status, LATCHED_QOS, raw=True
+        )
         node._adopt(self)
 
     def wait_for_server(self, timeout: float = 5.0) -> bool:
@@ -679,13 +682,24 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         if handle is not None:
             handle._on_feedback(message.feedback)
 
-    def _on_status(self, message: Any) -> None:
+    def _on_status(self, payload: bytes) -> None:
         with self._lock:
+            if not self._handles:
+                return
             handles = dict(self._handles)
-        for status in message.status_list:
-            handle = handles.get(_uuid_bytes(status.goal_info.goal_id))
-            if handle is not None and not handle.done():
-                handle.status = int(status.status)
+        try:
+            statuses = decode_goal_statuses(payload)
+            if statuses is None:  # not little-endian CDR: the generic deserializer reads it
+                message = self._status_sub._registry.deserialize(payload, self.action.status)
+                statuses = iter(
+                    [(_uuid_bytes(s.goal_info.goal_id), int(s.status)) for s in message.status_list]
+                )
+            for goal_id, status in statuses:
+                handle = handles.get(goal_id)
+                if handle is not None and not handle.done():
+                    handle.status = status
+        except Exception:
+            log.warning("%s: unreadable goal status message ignored", self.name, exc_info=True)
 
     def close(self) -> None:
         """Stop; waiting ``result()`` calls raise TransportError."""

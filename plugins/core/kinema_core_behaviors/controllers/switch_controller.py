@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 from typing import Any
 
 from kinema.behaviors import AsyncBehavior, FormerSpelling, PortInfo, input_port
@@ -106,6 +105,8 @@ class SwitchController(AsyncBehavior):
         ]
 
     async def do_work(self) -> bool:
+        import asyncio
+
         node = self.context.require_node(self.registration_id)
         activate = _names(self.get_input_or("activate_controllers", []))
         deactivate = _names(self.get_input_or("deactivate_controllers", []))

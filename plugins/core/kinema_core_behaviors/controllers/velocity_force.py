@@ -11,8 +11,6 @@ import threading
 import time
 from typing import Any
 
-import numpy as np
-
 from kinema.behaviors import NodeStatus, PortInfo, StatefulBehavior, input_port
 from kinema.behaviors.cell_ports import cell_input_port
 
@@ -261,6 +259,8 @@ class ForceExceedsThreshold(StatefulBehavior):
         return NodeStatus.RUNNING
 
     def _on_wrench(self, message: Any) -> None:
+        import numpy as np
+
         force = message.wrench.force
         magnitude = float(np.linalg.norm((force.x, force.y, force.z)))
         with self._lock:

@@ -3,9 +3,10 @@
 from __future__ import annotations
 
 import io
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port
 from kinema.config.atomic_write import atomic_write_bytes
@@ -35,6 +36,8 @@ ENCODINGS = {
 
 def image_message(pixels: np.ndarray, encoding: str, frame_id: str = "") -> Any:
     """A ``sensor_msgs/Image`` of an ``(h, w[, c])`` uint8 array."""
+    import numpy as np
+
     from kinema.transport import from_dict
 
     height, width = pixels.shape[:2]
@@ -55,6 +58,8 @@ def image_message(pixels: np.ndarray, encoding: str, frame_id: str = "") -> Any:
 
 def image_pixels(node: Any, port: str, image: Any) -> tuple[np.ndarray, str]:
     """``(pixels, Pillow mode)`` of an 8-bit ``sensor_msgs/Image`` (BGR turned into RGB)."""
+    import numpy as np
+
     encoding = str(image.encoding)
     if encoding not in ENCODINGS:
         raise port_error(node, port, f"has encoding {encoding!r}", f"valid: {', '.join(ENCODINGS)}")
@@ -90,6 +95,7 @@ class LoadImageFromFile(AsyncBehavior):
 
     @fails_on_bad_input
     def do_work(self) -> bool:
+        import numpy as np
         from PIL import Image, UnidentifiedImageError
 
         package = read_text(self, "package_name")

@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import threading
 import time
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, StatefulBehavior, input_port
 from kinema.behaviors.cell_ports import cell_input_port
@@ -38,6 +39,8 @@ class _Recording:
         self.start_time: float | None = None
 
     def on_state(self, message: Any) -> None:
+        import numpy as np
+
         with self.lock:
             if not self.started or self.stopped:
                 return

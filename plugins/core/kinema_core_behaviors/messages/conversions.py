@@ -10,12 +10,11 @@ from __future__ import annotations
 from collections.abc import Mapping, Sequence
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
-from kinema import transforms
 from kinema.errors import ObjectiveError
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from kinema.motion import JointTrajectory
 
 JOINT_STATE_TYPE = "sensor_msgs/msg/JointState"
@@ -135,6 +134,7 @@ def trajectory_from_message(message: Any, what: str) -> JointTrajectory:
 
 def pose_stamped_message(frame_id: str, matrix: np.ndarray) -> Any:
     """A ``geometry_msgs/PoseStamped`` of a 4x4 homogeneous transform."""
+    from kinema import transforms
     from kinema.transport import from_dict
 
     return from_dict(
@@ -151,6 +151,8 @@ def pose_matrix(pose_stamped: Any, what: str) -> tuple[str, np.ndarray]:
     Raises:
         ObjectiveError: not a PoseStamped, or an orientation with a NaN or infinite component.
     """
+    from kinema import transforms
+
     pose = getattr(pose_stamped, "pose", None)
     header = getattr(pose_stamped, "header", None)
     if pose is None or header is None:
@@ -173,6 +175,8 @@ def point_cloud_xyz(cloud: Any) -> np.ndarray:
     Raises:
         ObjectiveError: not a point cloud, or without x, y and z fields.
     """
+    import numpy as np
+
     fields = {str(f.name): f for f in getattr(cloud, "fields", [])}
     if not all(axis in fields for axis in "xyz"):
         raise ObjectiveError(
@@ -196,6 +200,8 @@ def point_cloud_xyz(cloud: Any) -> np.ndarray:
 
 def point_cloud_message(xyz: np.ndarray, frame_id: str) -> Any:
     """A dense ``sensor_msgs/PointCloud2`` of ``(N, 3)`` points (float32 x, y, z)."""
+    import numpy as np
+
     from kinema.transport import from_dict
 
     points = np.ascontiguousarray(xyz, dtype="<f4")

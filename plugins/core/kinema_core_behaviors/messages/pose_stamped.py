@@ -2,9 +2,11 @@
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
-from kinema import transforms
+if TYPE_CHECKING:
+    import numpy as np
+
 from kinema.behaviors import FormerSpelling, NodeStatus, PortInfo, SyncBehavior, input_port
 
 from .conversions import pose_stamped_message
@@ -27,6 +29,8 @@ def pose_from_ports(position: list[float], orientation: list[float], what: str) 
     An all-zero quaternion typed into a port is refused (a typo more often than "no rotation"), although
     :mod:`kinema.transforms` reads one in a message as the identity.
     """
+    from kinema import transforms
+
     if len(position) != 3:
         return f"{what} position must have 3 values (x;y;z), got {len(position)}"
     if len(orientation) != 4:

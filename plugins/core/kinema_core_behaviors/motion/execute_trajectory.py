@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import asyncio
 import time
 from typing import Any
 
@@ -142,6 +141,8 @@ class ExecuteTrajectory(AsyncBehavior):
         return goal
 
     async def do_work(self) -> bool:
+        import asyncio
+
         node = self.context.require_node(self.registration_id)
         name = str(self.get_input("controller_action_name"))
         try:
@@ -198,6 +199,8 @@ class ExecuteTrajectory(AsyncBehavior):
 
         Returns why that failed, or '' (also when there is no controller manager to ask).
         """
+        import asyncio
+
         parts = action.strip("/").split("/")
         if len(parts) != 2 or parts[1] != "follow_joint_trajectory":
             return ""

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
 from ..messages.conversions import (
@@ -42,6 +40,8 @@ class GetRobotStateFromTrajectory(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        import numpy as np
+
         message = read_message(self, "joint_trajectory_msg")
         from kinema.errors import ObjectiveError
 

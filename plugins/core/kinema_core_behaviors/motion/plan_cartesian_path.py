@@ -4,12 +4,9 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
 from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError, ObjectiveError, did_you_mean
-from kinema.transforms import rotation_from_euler
 
 from ..messages.conversions import pose_matrix, trajectory_message
 from .joint_states import joint_state_monitor
@@ -200,6 +197,10 @@ class PlanCartesianPath(AsyncBehavior):
 
     def _tip_offset(self) -> Any:
         """``tip_T_point`` inverted (what the tip must do so the offset point follows the path)."""
+        import numpy as np
+
+        from kinema.transforms import rotation_from_euler
+
         values = [float(v) for v in self.get_input("tip_offset")]
         if len(values) not in (3, 6):
             return f"tip_offset needs 6 values x;y;z;roll;pitch;yaw (or 3, x;y;z), got {len(values)}"

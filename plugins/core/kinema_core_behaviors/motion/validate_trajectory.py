@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
 from kinema.behaviors.cell_ports import cell_input_port
@@ -62,6 +63,8 @@ class ValidateTrajectory(AsyncBehavior):
 
     @fails_on_bad_input
     def do_work(self) -> bool:
+        import numpy as np
+
         from kinema.motion import fk
 
         message = read_message(self, "joint_trajectory_msg")

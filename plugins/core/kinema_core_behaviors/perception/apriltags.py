@@ -13,11 +13,8 @@ from __future__ import annotations
 
 from typing import Any
 
-import numpy as np
-
 from kinema.behaviors import AsyncBehavior, FormerSpelling, NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import PerceptionError
-from kinema.transforms import pose_dict, pose_from_message
 
 from ..files.image_file import image_pixels
 from ..messages.conversions import pose_stamped_message
@@ -40,6 +37,7 @@ _FULL_MARGIN = 100.0
 
 def detections_message(detections: list[Any], header: Any, tag_size: float) -> Any:
     """The ``vision_msgs/Detection3DArray`` of :class:`~kinema.perception.apriltags.TagDetection` s."""
+    from kinema.transforms import pose_dict
     from kinema.transport import from_dict, to_dict
 
     header_dict = to_dict(header)
@@ -118,6 +116,8 @@ class DetectAprilTags(AsyncBehavior):
 
     @fails_on_bad_input
     def do_work(self) -> bool:
+        import numpy as np
+
         from kinema.perception.apriltags import DetectorSettings, detect_tags, family_name
         from kinema.perception.ros_messages import intrinsics_of
 
@@ -188,6 +188,8 @@ class GetDetectionPose(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        from kinema.transforms import pose_from_message
+
         detections = read_message(self, "detections")
         target_id = int(read_input(self, "target_id"))
         label = read_text(self, "target_label").strip()

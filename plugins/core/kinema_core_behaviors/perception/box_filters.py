@@ -2,7 +2,10 @@
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
@@ -12,6 +15,8 @@ from .clouds import POINT_CLOUD, frame_of, pose_in_frame, read_cloud, write_clou
 
 
 def _box(behavior: SyncBehavior, cloud: object, pose_port: str, size_port: str) -> tuple[np.ndarray, tuple]:
+    import numpy as np
+
     size = read_floats(behavior, size_port, 3, "x;y;z (m)")
     if not all(np.isfinite(v) and v >= 0 for v in size):
         raise port_error(behavior, size_port, f"= {size}", "each size must be a length >= 0 m")

@@ -11,7 +11,6 @@ before it is another time base, a camera clock not synchronised with the robot's
 
 from __future__ import annotations
 
-import asyncio
 import threading
 import time
 from typing import Any, ClassVar
@@ -67,6 +66,8 @@ class _GetCameraMessage(AsyncBehavior):
 
     @fails_on_bad_input
     async def do_work(self) -> bool:
+        import asyncio
+
         topic = str(read_input(self, "topic_name")).strip()
         if not topic.startswith("/"):
             raise port_error(

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior
 
 from ..messages.conversions import POSE_STAMPED_TYPE, pose_stamped_message
@@ -26,6 +24,8 @@ class GetCentroidFromPointCloud(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        import numpy as np
+
         from kinema.errors import PerceptionError
 
         cloud = read_cloud(self, "point_cloud")

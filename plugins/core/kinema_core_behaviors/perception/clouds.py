@@ -8,9 +8,10 @@ frames asks the frame tree of the cell as it is now.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 from kinema.errors import KinemaError
 
@@ -69,6 +70,8 @@ def target_T_source(node: Any, source: str, target: str, port: str, at: float = 
     Raises:
         PortValueError: either frame is unknown (the frame tree's message lists the known ones).
     """
+    import numpy as np
+
     if source == target or {source, target} <= {"", "world"}:
         return np.eye(4)
     from ..poses.frame_tree import current_frame_tree

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
 
 from ..messages.conversions import POSE_STAMPED_TYPE, pose_stamped_message
@@ -50,6 +48,8 @@ class CreateCollisionSpheresAtClosestPoints(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        import numpy as np
+
         from kinema.transport import from_dict
 
         cloud = read_cloud(self, "point_cloud").finite()

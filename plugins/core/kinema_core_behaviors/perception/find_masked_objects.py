@@ -2,9 +2,10 @@
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
 
@@ -26,6 +27,8 @@ GRASPABLE_OBJECT = "moveit_studio_vision_msgs/msg/GraspableObject"
 def fit_box(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """``(pose 4x4, full sizes 3)`` of the box around ``points`` (Nx3) aligned with their principal axes
     in the horizontal plane and with the frame's z (objects stand on a table)."""
+    import numpy as np
+
     centre_xy = points[:, :2].mean(axis=0)
     flat = points[:, :2] - centre_xy
     _, _, axes = np.linalg.svd(flat, full_matrices=False)
@@ -88,6 +91,8 @@ class FindMaskedObjects(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        import numpy as np
+
         from kinema.motion.planning_scene_messages import collision_object_message, shape_constants
         from kinema.perception.ros_messages import intrinsics_of
         from kinema.transport import from_dict
@@ -146,6 +151,7 @@ class FindMaskedObjects(SyncBehavior):
 
     @staticmethod
     def _support_height(cloud: Any, pixels: np.ndarray, camera: Any) -> float | None:
+        import numpy as np
         from scipy.ndimage import binary_dilation
 
         mask = pixels.reshape(camera.height, camera.width)

@@ -5,8 +5,6 @@ from __future__ import annotations
 from dataclasses import replace
 from pathlib import Path
 
-import numpy as np
-
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import PerceptionError
 
@@ -49,6 +47,8 @@ class LoadPointCloudFromFile(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        import numpy as np
+
         from kinema.perception import load_pcd, sample_mesh_surface
 
         package, text = split_package_uri(str(read_input(self, "file_path")))

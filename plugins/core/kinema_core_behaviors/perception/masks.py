@@ -9,9 +9,10 @@ optical frame).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port, output_port
 
@@ -34,6 +35,8 @@ MASK3D = "moveit_studio_vision_msgs/msg/Mask3D"
 def mask_image(node: Any, port: str, index: int, mask: Any, width: int, height: int) -> np.ndarray:
     """The HxW boolean image of Mask2D ``mask`` placed at its (x, y) offset in a ``width`` x ``height``
     image."""
+    import numpy as np
+
     if getattr(mask, "__msgtype__", None) != MASK2D:
         raise port_error(
             node, port, f"element {index} is not a {MASK2D}", "give masks from a GetMasks2D behavior"
@@ -66,6 +69,8 @@ class GetMasks3DFromMasks2D(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        import numpy as np
+
         from kinema.perception.ros_messages import intrinsics_of
         from kinema.transport import from_dict
 
@@ -130,6 +135,8 @@ class GetPointCloudFromMask3D(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        import numpy as np
+
         cloud = read_cloud(self, "point_cloud")
         indices = np.asarray(read_message(self, "mask3d", MASK3D).point_indices, dtype=np.int64)
         if len(indices) and int(indices.max()) >= len(cloud):

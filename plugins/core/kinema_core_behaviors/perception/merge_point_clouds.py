@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import PerceptionError
 
@@ -47,6 +45,8 @@ class MergePointClouds(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        import numpy as np
+
         from kinema.perception import merge_clouds, register_icp
         from kinema.perception.ros_messages import from_point_cloud2
 

@@ -5,8 +5,6 @@ from __future__ import annotations
 from dataclasses import replace
 from typing import Any
 
-import numpy as np
-
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port
 from kinema.errors import PerceptionError
 
@@ -33,6 +31,7 @@ def refine_from_the_target(base: Any, target: Any, coarse: Any, iterations: int)
     seen point, though, has its true partner on the model, so the reverse match is unbiased once the two
     are close. Returns ``coarse`` when too few target points are near the base to refine with.
     """
+    import numpy as np
     from scipy.spatial import cKDTree
 
     from kinema.perception import register_icp

@@ -19,13 +19,13 @@ repeated in each port's description:
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import KinemaError
-from kinema.transforms import pose_from_message
 
 from ..files.image_file import image_message, image_pixels
 from ..messages.conversions import POSE_STAMPED_TYPE, pose_stamped_message
@@ -42,11 +42,13 @@ from .apriltags import DETECTIONS
 from .clouds import CAMERA_INFO, IMAGE
 
 # The place frame in the tag's frame: a half turn about x, z into the tray.
-_FLIP = np.diag([1.0, -1.0, -1.0])
+_FLIP = (1.0, -1.0, -1.0)  # the diagonal (a tuple: loading the plugin must not import numpy)
 
 
 def slot_offsets(rows: int, columns: int, row_spacing: float, column_spacing: float) -> np.ndarray:
     """``(rows * columns, 2)`` slot centres (x, y) about the tray's centre, row by row."""
+    import numpy as np
+
     xs = (np.arange(rows) - (rows - 1) / 2) * row_spacing
     ys = (np.arange(columns) - (columns - 1) / 2) * column_spacing
     return np.array([(x, y) for x in xs for y in ys], dtype=float)
@@ -56,10 +58,12 @@ def place_poses_in_tag_frame(
     rows: int, columns: int, row_spacing: float, column_spacing: float, tag_to_center: float
 ) -> list[np.ndarray]:
     """The 4x4 place poses in the tag's frame (see the module's docstring for the layout)."""
+    import numpy as np
+
     poses = []
     for x, y in slot_offsets(rows, columns, row_spacing, column_spacing):
         pose = np.eye(4)
-        pose[:3, :3] = _FLIP
+        pose[:3, :3] = np.diag(_FLIP)
         pose[:3, 3] = [x, tag_to_center + y, 0.0]
         poses.append(pose)
     return poses
@@ -128,6 +132,8 @@ class ComputeTrayPlacePositionsUsingAprilTags(SyncBehavior):
         ]
 
     def _layout(self) -> tuple[int, int, float, float, float, float]:
+        import numpy as np
+
         rows = int(read_input(self, "num_rows"))
         columns = int(read_input(self, "columns_per_row"))
         row_spacing = float(read_input(self, "row_spacing"))
@@ -157,6 +163,8 @@ class ComputeTrayPlacePositionsUsingAprilTags(SyncBehavior):
         return rows, columns, row_spacing, column_spacing, tag_to_center, diameter
 
     def _tag_pose(self, detections: Any, tag_id: int) -> tuple[str, Any, np.ndarray]:
+        from kinema.transforms import pose_from_message
+
         for detection in detections.detections:
             if str(detection.id).strip() == str(tag_id) and detection.results:
                 best = max(detection.results, key=lambda r: float(r.hypothesis.score))
@@ -210,6 +218,7 @@ class ComputeTrayPlacePositionsUsingAprilTags(SyncBehavior):
     def _publish_drawing(
         self, topic: str, camera_T_tag: np.ndarray, camera_T_slots: list[np.ndarray], diameter: float
     ) -> None:
+        import numpy as np
         from PIL import Image, ImageDraw
 
         from kinema.perception.ros_messages import intrinsics_of

@@ -10,8 +10,6 @@ new cloud remove them.
 
 from __future__ import annotations
 
-import numpy as np
-
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port
 from kinema.errors import KinemaError
 
@@ -56,6 +54,8 @@ class UpdatePlanningSceneService(AsyncBehavior):
 
     @fails_on_bad_input
     def do_work(self) -> bool:
+        import numpy as np
+
         from kinema.motion import CollisionObject
         from kinema.perception.occupancy import aabb_of_box, occupied_cells, outside_boxes
 

@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import KinemaError
 
@@ -39,6 +37,8 @@ class AddCollisionBox(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        import numpy as np
+
         from kinema.motion import CollisionObject
 
         object_id = str(self.get_input("object_id")).strip()

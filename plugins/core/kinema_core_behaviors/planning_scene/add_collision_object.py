@@ -4,12 +4,6 @@ from __future__ import annotations
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import KinemaError
-from kinema.motion.planning_scene_messages import (
-    COLLISION_OBJECT_TYPE,
-    collision_object_message,
-    object_pose_of,
-    primitives_of,
-)
 
 from ..messages.ports import PortValueError, fails_on_bad_input, message_input, port_error, read_message
 from ..motion.planning_resources import robot_model
@@ -31,6 +25,10 @@ class AddCollisionObject(SyncBehavior):
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
+        from kinema.motion.planning_scene_messages import (
+            COLLISION_OBJECT_TYPE,
+        )
+
         return [
             message_input(
                 "collision_object", COLLISION_OBJECT_TYPE, "{collision_object}", "The object to add."
@@ -40,6 +38,12 @@ class AddCollisionObject(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        from kinema.motion.planning_scene_messages import (
+            collision_object_message,
+            object_pose_of,
+            primitives_of,
+        )
+
         message = read_message(self, "collision_object")
         object_id = str(message.id)
         if not object_id:

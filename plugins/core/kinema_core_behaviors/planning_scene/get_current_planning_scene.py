@@ -4,7 +4,6 @@ from __future__ import annotations
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior
 from kinema.errors import KinemaError
-from kinema.motion.planning_scene_messages import PLANNING_SCENE_TYPE, planning_scene_message
 
 from ..messages.ports import message_output
 from ..motion.joint_states import joint_state_monitor
@@ -23,6 +22,8 @@ class GetCurrentPlanningScene(SyncBehavior):
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
+        from kinema.motion.planning_scene_messages import PLANNING_SCENE_TYPE
+
         return [
             message_output(
                 "planning_scene_msg", PLANNING_SCENE_TYPE, "{planning_scene}", "The current planning scene."
@@ -30,6 +31,8 @@ class GetCurrentPlanningScene(SyncBehavior):
         ]
 
     def tick(self) -> NodeStatus:
+        from kinema.motion.planning_scene_messages import planning_scene_message
+
         try:
             model = robot_model(self.context, "GetCurrentPlanningScene")
             scene = self.context.planning_scene

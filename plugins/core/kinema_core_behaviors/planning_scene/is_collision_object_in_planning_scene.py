@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
-from kinema.motion.planning_scene_messages import PLANNING_SCENE_TYPE
 
 from ..messages.ports import fails_on_bad_input, message_input, read_message
 
@@ -16,6 +15,8 @@ class IsCollisionObjectInPlanningScene(SyncBehavior):
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
+        from kinema.motion.planning_scene_messages import PLANNING_SCENE_TYPE
+
         return [
             message_input("planning_scene", PLANNING_SCENE_TYPE, "{planning_scene}", "The scene to look in."),
             input_port("collision_object_name", str, "", "The id to look for."),

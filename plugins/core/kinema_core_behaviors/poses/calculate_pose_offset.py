@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-import numpy as np
-
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior
 from kinema.errors import KinemaError
 
@@ -39,6 +37,8 @@ class CalculatePoseOffset(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        import numpy as np
+
         source_frame, source = pose_matrix(read_message(self, "source_pose"), "source_pose")
         destination_frame, destination = pose_matrix(
             read_message(self, "destination_pose"), "destination_pose"

@@ -6,9 +6,10 @@ planning-scene objects).
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 from kinema.errors import KinemaError, ObjectiveError
 
@@ -40,6 +41,8 @@ def current_frame_tree(behavior: Any, joint_state: Any = None, at: float = 0.0) 
 
 
 def _positions_from(behavior: Any, model: Any, joint_state: Any) -> np.ndarray:
+    import numpy as np
+
     names = [str(n) for n in getattr(joint_state, "name", [])]
     values = [float(v) for v in getattr(joint_state, "position", [])]
     if len(names) != len(values):

@@ -17,7 +17,6 @@ Resume button publishes.
 
 from __future__ import annotations
 
-import asyncio
 import os
 import threading
 import time
@@ -104,6 +103,8 @@ class _AskUser(AsyncBehavior):
 
     async def ask(self, details: dict[str, Any] | None = None) -> bool:
         """Ask the user; ``details`` adds request fields (the steps and duration of a motion)."""
+        import asyncio
+
         client = approval_client(self)
         if client is None or not await asyncio.to_thread(client.wait_for_service, DISCOVERY_SECONDS):
             return self.granted_without_user()
@@ -187,6 +188,8 @@ class BreakpointSubscriber(_AskUser):
         return f"Breakpoint at {self.full_path}: resume?"
 
     async def do_work(self) -> bool:
+        import asyncio
+
         node = self.context.require_node(self.registration_id)
         resumed = threading.Event()
         subscription = node.create_subscription(

@@ -7,9 +7,10 @@ as Kinema's UIs go today.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
@@ -24,12 +25,13 @@ from ..messages.ports import (
 )
 
 IMAGE = "sensor_msgs/msg/Image"
-_PALETTE = np.array(
-    [[230, 25, 75], [60, 180, 75], [255, 225, 25], [0, 130, 200], [245, 130, 48], [145, 30, 180]]
-)
+# RGB per detection, in turn (plain tuples: loading the plugin must not import numpy)
+_PALETTE = ((230, 25, 75), (60, 180, 75), (255, 225, 25), (0, 130, 200), (245, 130, 48), (145, 30, 180))
 
 
 def _rgb(behavior: Any) -> np.ndarray:
+    import numpy as np
+
     pixels, mode = image_pixels(behavior, "image", read_message(behavior, "image"))
     if mode == "L":
         pixels = np.repeat(pixels[:, :, None], 3, axis=2)
@@ -54,7 +56,7 @@ def _box(mask_or_box: Any) -> tuple[int, int, int, int] | None:
     return None
 
 
-def _outline(pixels: np.ndarray, box: tuple[int, int, int, int], color: np.ndarray) -> None:
+def _outline(pixels: np.ndarray, box: tuple[int, int, int, int], color: tuple[int, int, int]) -> None:
     h, w = pixels.shape[:2]
     x0, y0, x1, y1 = max(box[0], 0), max(box[1], 0), min(box[2], w - 1), min(box[3], h - 1)
     if x0 > x1 or y0 > y1:
@@ -116,6 +118,8 @@ class PublishMask2D(SyncBehavior):
 
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
+        import numpy as np
+
         pixels = _rgb(self).astype(float)
         opacity = float(read_input(self, "opacity"))
         if not 0.0 <= opacity <= 1.0:
@@ -132,7 +136,7 @@ class PublishMask2D(SyncBehavior):
             lh, lw = min(layer.shape[0], h - y0), min(layer.shape[1], w - x0)
             if lh > 0 and lw > 0:
                 region[y0 : y0 + lh, x0 : x0 + lw] = layer[:lh, :lw] > 0
-            color = _PALETTE[index % len(_PALETTE)]
+            color = np.array(_PALETTE[index % len(_PALETTE)])
             pixels[region] = pixels[region] * (1 - opacity) + color * opacity
         frame = str(read_message(self, "image").header.frame_id)
         _publish(self, str(read_input(self, "masks_visualization_topic")), pixels.astype(np.uint8), frame)

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
-from kinema import transforms
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
 
 from ..files.locations import file_to_read, split_package_uri
@@ -35,6 +35,8 @@ def publish_markers(behavior: Any, markers: list[dict[str, Any]]) -> None:
 
 def pose_dict(frame_and_matrix: tuple[str, np.ndarray]) -> tuple[str, dict[str, Any]]:
     """``(frame_id, Pose dict)`` of a ``(frame_id, 4x4 transform)``."""
+    from kinema import transforms
+
     frame, matrix = frame_and_matrix
     return frame, transforms.pose_dict(matrix)
 

@@ -9,9 +9,10 @@ UpdatePlanningSceneService made of a cloud.
 
 from __future__ import annotations
 
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-import numpy as np
+if TYPE_CHECKING:
+    import numpy as np
 
 from kinema.behaviors import BehaviorContext, NodeStatus, PortInfo, SyncBehavior, input_port
 
@@ -39,6 +40,8 @@ def _snapshots(context: BehaviorContext) -> _Snapshots:
 
 def height_colors(xyz: np.ndarray) -> np.ndarray:
     """Nx3 colours (0..1) for a cloud without its own: blue at its lowest point to yellow at its highest."""
+    import numpy as np
+
     z = xyz[:, 2] if len(xyz) else np.zeros(0)
     span = float(z.max() - z.min()) if len(z) else 0.0
     t = (z - z.min()) / span if span > 0 else np.zeros_like(z)
@@ -51,6 +54,8 @@ def cloud_marker(
 ) -> dict[str, Any]:
     """A POINTS marker of the cloud, sub-sampled evenly to at most MAX_DRAWN_POINTS so the view stays
     smooth, each point in its own colour (``colors``: Nx3 uint8 RGB; by height when None)."""
+    import numpy as np
+
     if len(xyz) > MAX_DRAWN_POINTS:
         keep = np.linspace(0, len(xyz) - 1, MAX_DRAWN_POINTS).astype(int)
         xyz = xyz[keep]

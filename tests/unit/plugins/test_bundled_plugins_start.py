@@ -1,0 +1,81 @@
+"""What loading the bundled plugins costs a one-shot command: no compiling at every start, no heavy imports.
+
+``kinema objective list`` loads every behavior of the config to say which objectives cannot load; it should
+start in a small multiple of the interpreter's own start (issue 31).
+"""
+
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from kinema.plugins import importer
+from kinema.plugins.importer import bytecode_cache_path, import_fresh, purge_modules
+
+
+def _package(root: Path) -> Path:
+    (root / "pkg").mkdir(parents=True)
+    (root / "pkg" / "__init__.py").write_text("from .values import VALUE\n")
+    (root / "pkg" / "values.py").write_text("VALUE = 1\n")
+    return root
+
+
+def test_a_never_reloaded_package_is_compiled_once_into_the_user_cache(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # PYTHONDONTWRITEBYTECODE (or a read-only checkout) must not make the bundled plugins compile each start.
+    monkeypatch.setattr(sys, "dont_write_bytecode", True)
+    root = _package(tmp_path / "src")
+    first = import_fresh(root, "pkg", "pkg", cache_bytecode=True)
+    values = str(root / "pkg" / "values.py")
+    assert bytecode_cache_path(values).is_file()
+    assert not (root / "pkg" / "__pycache__").exists()
+
+    def no_compiling(*args: object, **kwargs: object) -> None:
+        raise AssertionError("compiled although the user cache holds the code")
+
+    monkeypatch.setattr(importer._UserCacheSourceLoader, "source_to_code", no_compiling)
+    second = import_fresh(root, "pkg", "pkg", cache_bytecode=True)
+    assert (first.VALUE, second.VALUE) == (1, 1)
+    purge_modules(first.__name__)
+    purge_modules(second.__name__)
+
+
+def test_a_changed_source_is_compiled_again_not_served_stale(tmp_path: Path) -> None:
+    root = _package(tmp_path / "src")
+    first = import_fresh(root, "pkg", "pkg", cache_bytecode=True)
+    (root / "pkg" / "values.py").write_text("VALUE = 22\n")
+    second = import_fresh(root, "pkg", "pkg", cache_bytecode=True)
+    assert (first.VALUE, second.VALUE) == (1, 22)
+    purge_modules(first.__name__)
+    purge_modules(second.__name__)
+
+
+def test_a_damaged_cache_file_is_replaced(tmp_path: Path) -> None:
+    root = _package(tmp_path / "src")
+    purge_modules(import_fresh(root, "pkg", "pkg", cache_bytecode=True).__name__)
+    cached = bytecode_cache_path(str(root / "pkg" / "values.py"))
+    cached.write_bytes(cached.read_bytes()[:-8])
+    module = import_fresh(root, "pkg", "pkg", cache_bytecode=True)
+    assert module.VALUE == 1
+    purge_modules(module.__name__)
+
+
+def test_loading_the_bundled_behaviors_imports_no_numpy_zenoh_watchdog_or_asyncio() -> None:
+    code = (
+        "import sys\n"
+        "from kinema.plugins import BehaviorHost\n"
+        "host = BehaviorHost(['kinema::CoreBehaviorsLoader', 'kinema::MujocoBehaviorsLoader'], None)\n"
+        "report = host.load()\n"
+        "assert not report.errors, report.errors\n"
+        "assert len(host.registry.create_factory().manifests()) > 100\n"
+        "from kinema.transport.session import resolve_endpoints\n"
+        "heavy = ('numpy', 'rosbags', 'zenoh', 'watchdog', 'mujoco', 'pinocchio', 'asyncio')\n"
+        "print(sorted(name for name in heavy if name in sys.modules))\n"
+    )
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.strip() == "[]"
