@@ -25,22 +25,44 @@ def type_fast(app, keys: str | list[str]) -> None:  # type: ignore[no-untyped-de
         app.post_message(events.Key(name, character))
 
 
+async def wait_until(pilot, predicate, what: str, timeout: float = 5.0) -> None:  # type: ignore[no-untyped-def]
+    """Let the app run until ``predicate()`` holds (keys in a burst are handled one per message)."""
+    from textual.css.query import NoMatches
+
+    for _ in range(int(timeout / 0.05)):
+        try:
+            if predicate():
+                return
+        except NoMatches:
+            pass  # the screen is still being composed
+        await pilot.pause(0.05)
+    raise AssertionError(f"not within {timeout} s: {what}")
+
+
 def test_typing_and_switching_screens_while_every_call_is_slow() -> None:
     fake = FakeConnection.demo()
-    fake.delay = 2.0
+    # Slow enough that the listing still runs after the keys are handled on a loaded machine.
+    fake.delay = 6.0
 
     async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
         # F5 lists the objectives again (two seconds): meanwhile the search box takes letters at once.
         await pilot.press("f5")
         type_fast(app, "grip")
-        await pilot.pause(0.3)
+        search = app.screen.query_one("#objective-search", Input)
+        await wait_until(
+            pilot, lambda: search.value == "grip", f"'grip' in the search box (it has {search.value!r})"
+        )
         listing = [w for w in app.workers if w.name == "List objectives" and not w.is_finished]
         assert listing, "the slow call should still run, off the UI thread"
-        assert app.screen.query_one("#objective-search", Input).value == "grip"
         # "3" switches screens; "/" and the letters typed right after belong to the Blackboard screen.
         await pilot.press("escape", "tab")
         type_fast(app, ["3", "/", *"count"])
-        await pilot.pause(0.5)
+        await wait_until(pilot, lambda: isinstance(app.screen, BlackboardScreen), "the Blackboard screen")
+        await wait_until(
+            pilot,
+            lambda: app.screen.query_one("#blackboard-filter", Input).value == "count",
+            "'count' in the blackboard filter",
+        )
         await settle(pilot)
         assert isinstance(app.screen, BlackboardScreen)
         assert app.screen.query_one("#blackboard-filter", Input).value == "count"
