@@ -39,6 +39,7 @@ def build(
 ) -> None:
     """Install dependencies, validate the objectives and export the TreeNodesModel for Groot2.
 
+    \b
     1. pip-installs what each behavior package of the workspace declares in [project] dependencies
        (already satisfied requirements are skipped, so it is fast and offline when nothing changed);
     2. loads the active config's behavior plugins and validates every objective of its objective

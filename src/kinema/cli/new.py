@@ -11,7 +11,7 @@ from kinema.cli.options import workspace_option
 
 @click.group()
 def new() -> None:
-    """Generate a new package from a template."""
+    """Generate a new package: from a template, or a robot's config package from its URDF."""
 
 
 @new.command("config")
