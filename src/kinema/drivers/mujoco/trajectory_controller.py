@@ -380,17 +380,19 @@ class JointTrajectoryController:
         running = self._running
         if running is None:
             return
-        elapsed = float(data.time) - running.start
-        row = running.table.index_at(elapsed)
-        desired = running.table.positions[row]
-        desired_velocity = running.table.velocities[row]
-        actual = data.qpos[running.qpos]
-        actual_velocity = data.qvel[running.qvel]
         stamp = float(data.time)
-        running.execution.post_feedback(
-            {
+        row = running.table.index_at(stamp - running.start)
+        # Copies of what changes; the message is built only when the goal's thread takes it.
+        actual = data.qpos[running.qpos].copy()
+        actual_velocity = data.qvel[running.qvel].copy()
+        table, joint_names = running.table, running.goal.joint_names
+
+        def feedback() -> dict[str, Any]:
+            desired = table.positions[row]
+            desired_velocity = table.velocities[row]
+            return {
                 "header": {"stamp": {"sec": int(stamp), "nanosec": int((stamp % 1.0) * 1e9)}},
-                "joint_names": list(running.goal.joint_names),
+                "joint_names": list(joint_names),
                 "desired": {"positions": desired.tolist(), "velocities": desired_velocity.tolist()},
                 "actual": {"positions": actual.tolist(), "velocities": actual_velocity.tolist()},
                 "error": {
@@ -398,7 +400,8 @@ class JointTrajectoryController:
                     "velocities": (desired_velocity - actual_velocity).tolist(),
                 },
             }
-        )
+
+        running.execution.post_feedback(feedback)
 
     # -- internals -------------------------------------------------------------------------------
 
