@@ -20,6 +20,7 @@ from kinema.errors import DriverError
 # CDR little endian (XCDR1), as rmw_zenoh writes it.
 _ENCAPSULATION = b"\x00\x01\x00\x00"
 _STAMP = struct.Struct("<iI")
+_FLOAT64 = np.dtype("<f8")
 
 
 def _split_stamp(seconds: float) -> tuple[int, int]:
@@ -70,6 +71,16 @@ class JointStateEncoder:
             self._arrays.append(len(_ENCAPSULATION) + len(body))
             body += bytes(8 * self.count)
         self._template = bytes(_ENCAPSULATION + body)
+        # The fixed bytes around the stamp and the arrays, joined with them at every encode.
+        size = 8 * self.count
+        stamp_end = len(_ENCAPSULATION) + _STAMP.size
+        ends = [offset + size for offset in self._arrays]
+        self._fixed = (
+            self._template[: len(_ENCAPSULATION)],
+            self._template[stamp_end : self._arrays[0]],
+            self._template[ends[0] : self._arrays[1]],
+            self._template[ends[1] : self._arrays[2]],
+        )
         sample = np.linspace(-1.0, 1.0, self.count)
         _check(
             self.encode(3.25, sample, 2 * sample, 3 * sample),
@@ -79,12 +90,19 @@ class JointStateEncoder:
 
     def encode(self, seconds: float, position: np.ndarray, velocity: np.ndarray, effort: np.ndarray) -> bytes:
         """The CDR payload of a JointState stamped ``seconds`` (each array has one value per name)."""
-        buffer = bytearray(self._template)
-        _STAMP.pack_into(buffer, len(_ENCAPSULATION), *_split_stamp(seconds))
-        size = 8 * self.count
-        for offset, values in zip(self._arrays, (position, velocity, effort), strict=True):
-            buffer[offset : offset + size] = np.ascontiguousarray(values, dtype="<f8").tobytes()
-        return bytes(buffer)
+        encapsulation, after_stamp, after_position, after_velocity = self._fixed
+        return b"".join(
+            (
+                encapsulation,
+                _STAMP.pack(*_split_stamp(seconds)),
+                after_stamp,
+                _doubles(position, self.count),
+                after_position,
+                _doubles(velocity, self.count),
+                after_velocity,
+                _doubles(effort, self.count),
+            )
+        )
 
 
 class WrenchStampedEncoder:
@@ -104,6 +122,7 @@ class WrenchStampedEncoder:
         self._wrench = len(_ENCAPSULATION) + len(body)
         body += bytes(8 * 6)
         self._template = bytes(_ENCAPSULATION + body)
+        self._frame = self._template[len(_ENCAPSULATION) + _STAMP.size : self._wrench]
         sample = np.array([1.5, -2.25, 3.0, -0.125, 0.5, 7.75])
         _check(
             self.encode(3, 250_000_000, sample),
@@ -113,10 +132,7 @@ class WrenchStampedEncoder:
 
     def encode(self, sec: int, nanosec: int, wrench: np.ndarray) -> bytes:
         """The CDR payload stamped ``sec``/``nanosec`` with force x, y, z then torque x, y, z."""
-        buffer = bytearray(self._template)
-        _STAMP.pack_into(buffer, len(_ENCAPSULATION), sec, nanosec)
-        buffer[self._wrench : self._wrench + 48] = np.ascontiguousarray(wrench, dtype="<f8").tobytes()
-        return bytes(buffer)
+        return b"".join((_ENCAPSULATION, _STAMP.pack(sec, nanosec), self._frame, _doubles(wrench, 6)))
 
 
 def wrench_serializer(registry: Any) -> Callable[[int, int, str, np.ndarray], bytes]:
@@ -135,6 +151,16 @@ def wrench_serializer(registry: Any) -> Callable[[int, int, str, np.ndarray], by
         return bytes(registry.serialize(message, "geometry_msgs/msg/WrenchStamped"))
 
     return wrench_stamped
+
+
+def _doubles(values: np.ndarray, count: int) -> bytes:
+    """``count`` little-endian float64 values (a float64 array is taken as it is: no conversion)."""
+    if isinstance(values, np.ndarray) and values.dtype == _FLOAT64 and values.shape == (count,):
+        return values.tobytes()
+    array = np.ascontiguousarray(values, dtype=_FLOAT64)
+    if array.shape != (count,):
+        raise ValueError(f"expected {count} values, got an array of shape {array.shape}")
+    return array.tobytes()
 
 
 def _check(fast: bytes, generic: bytes, type_name: str) -> None:
