@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import threading
 from pathlib import Path
 
 import click
@@ -69,6 +70,15 @@ def ui(
     if replay is not None:
         _replay(replay)
         return
+    # Ask the terminal what images it can draw while the app's modules load: the questions wait for
+    # answers (up to 0.1 s each in a terminal that gives none) and must be asked before the app owns the
+    # terminal; run_app imports the camera screen, which then finds the answers cached. Rich (which both
+    # sides import, and Textual needs first anyway) is loaded before, so the two threads do not import
+    # the same modules at once: the probe's own are PIL, numpy and textual_image.
+    import rich.console  # noqa: F401
+
+    probe = threading.Thread(target=_probe_image_support, name="kinema-ui-image-probe", daemon=True)
+    probe.start()
     from kinema.tui.app import run_app
     from kinema.tui.connection import RuntimeConnection
 
@@ -84,7 +94,15 @@ def ui(
         from kinema.tui.sdk_connection import SdkConnection
 
         connection = SdkConnection(endpoint=endpoint, workspace=workspace, config=config)
+    probe.join()
     run_app(connection, owns_runtime=False, initial_mode=screen, camera=camera)
+
+
+def _probe_image_support() -> None:
+    try:
+        import textual_image.renderable  # noqa: F401  (queries the terminal once, on import)
+    except Exception:
+        pass  # the camera screen imports it again and says what is wrong
 
 
 def _replay(which: str) -> None:

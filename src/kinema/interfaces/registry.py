@@ -10,6 +10,7 @@ the same synthetic wrapper types rosidl generates, so they match what a ROS 2 no
 
 from __future__ import annotations
 
+import struct
 import threading
 from collections.abc import Iterable
 from dataclasses import dataclass, field
@@ -25,6 +26,10 @@ from kinema.interfaces.typehash import rihs01
 
 _UUID = "unique_identifier_msgs/msg/UUID"
 _TIME = "builtin_interfaces/msg/Time"
+_CLOCK = "rosgraph_msgs/msg/Clock"
+# CDR little endian (XCDR1) encapsulation, and a Time's two fields after it.
+_CDR_LE = b"\x00\x01\x00\x00"
+_STAMP = struct.Struct("<iI")
 _SERVICE_EVENT_INFO = "service_msgs/msg/ServiceEventInfo"
 _KINDS = ("msg", "srv", "action")
 
@@ -483,6 +488,12 @@ class TypeRegistry:
     def deserialize(self, data: bytes | memoryview, type_name: str) -> Any:
         """Decode CDR bytes of ``type_name`` into its rosbags dataclass."""
         self._ensure_for(type_name)
+        if type_name == _CLOCK and len(data) == 12 and data[:4] == _CDR_LE:
+            # /clock arrives at 100 Hz of sim time, often many times real time: read its two integers
+            # directly (the same dataclasses the generic deserializer makes; other layouts go there).
+            types = self.typestore.types
+            sec, nanosec = _STAMP.unpack_from(data, 4)
+            return types[_CLOCK](clock=types[_TIME](sec=sec, nanosec=nanosec))
         try:
             return self.typestore.deserialize_cdr(data, type_name)
         except Exception as error:

@@ -20,7 +20,7 @@ from zenoh import ext
 
 from kinema.errors import TransportError
 from kinema.interfaces import dds_type_name
-from kinema.transport.attachment import Attachment, new_gid
+from kinema.transport.attachment import Attachment, encode_attachment, new_gid
 from kinema.transport.dispatch import channel, dispatch
 from kinema.transport.keys import EntityKind, QoS, data_key, entity_token
 from kinema.transport.messages import from_dict, type_of
@@ -146,7 +146,7 @@ class Publisher(Entity):
         if self._closed:
             raise TransportError(f"publisher on {self.name} is closed")
         with self._lock:
-            attachment = Attachment(next(self._sequence), gid=self.gid).encode()
+            attachment = encode_attachment(next(self._sequence), self.gid)
             self._publisher.put(payload, attachment=attachment)
 
     def subscription_count(self) -> int:

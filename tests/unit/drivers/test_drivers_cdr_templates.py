@@ -51,3 +51,40 @@ def test_clock_payloads_match_the_serializer(serializers: tuple[object, object])
     encoder = ClockEncoder(clock)  # type: ignore[arg-type]
     for stamp in (0.0, 0.01, 99.999999999, 1e6 + 0.5):
         assert encoder.encode(stamp) == clock(stamp)  # type: ignore[operator]
+
+
+class _Data:
+    """What the broadcaster reads of MjData: the time and the sensor values."""
+
+    def __init__(self, time: float, sensordata: np.ndarray) -> None:
+        self.time = time
+        self.sensordata = sensordata
+
+
+class _Sensor:
+    def __init__(self, frame_id: str) -> None:
+        self.frame_id = frame_id
+
+    def read(self, data: _Data) -> np.ndarray:
+        return data.sensordata
+
+
+@pytest.mark.parametrize("frame_id", ["", "tool0", "x" * 5, "x" * 6, "x" * 7, "sensor_ä"])
+def test_wrench_payloads_match_what_the_broadcaster_publishes(frame_id: str) -> None:
+    """The template's bytes equal the broadcaster's message dict through the generic publisher path."""
+    from kinema.drivers.mujoco.cdr_templates import WrenchStampedEncoder, wrench_serializer
+    from kinema.drivers.mujoco.force_control import ForceTorqueSensorBroadcaster
+    from kinema.transport import from_dict
+
+    registry = load_interfaces()
+    encoder = WrenchStampedEncoder(frame_id, wrench_serializer(registry))
+    broadcaster = ForceTorqueSensorBroadcaster("ft", _Sensor(frame_id))  # type: ignore[arg-type]
+    rng = np.random.default_rng(3)
+    for now in (0.0, 0.002, 1234.5678, 1.9999999999, 86400.999999999):
+        data = _Data(now, rng.normal(size=6))
+        generic = registry.serialize(
+            from_dict("geometry_msgs/msg/WrenchStamped", broadcaster.message(data)),
+            "geometry_msgs/msg/WrenchStamped",
+        )
+        sec, nanosec = broadcaster.stamp(data)
+        assert encoder.encode(sec, nanosec, broadcaster.sensor.read(data)) == bytes(generic)

@@ -52,3 +52,19 @@ def test_legacy_jazzy_format_is_read() -> None:
 def test_garbage_is_reported(raw: bytes | None) -> None:
     with pytest.raises(TransportError):
         Attachment.decode(raw)
+
+
+def test_encode_attachment_writes_what_the_dataclass_writes() -> None:
+    """The publishers' hot path (no object built) equals Attachment(...).encode() byte for byte."""
+    import time
+
+    from kinema.transport.attachment import Attachment, encode_attachment, new_gid
+
+    gid = new_gid()
+    before = time.time_ns()
+    raw = encode_attachment(12345, gid)
+    after = time.time_ns()
+    decoded = Attachment.decode(raw)
+    assert decoded.sequence_number == 12345 and decoded.gid == gid
+    assert before <= decoded.source_timestamp <= after
+    assert raw == Attachment(12345, decoded.source_timestamp, gid).encode()

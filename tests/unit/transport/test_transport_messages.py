@@ -101,3 +101,22 @@ def test_a_numpy_array_that_fits_the_field_is_taken_whole_and_one_that_does_not_
         msg("kinema_msgs/msg/NodeStatusCodes", codes=np.array([-1]))
     with pytest.raises(TransportError):
         msg("kinema_msgs/msg/NodeStatusCodes", codes=np.zeros((2, 2), dtype=np.uint32))
+
+
+def test_clock_payloads_decode_directly_to_what_the_generic_deserializer_makes() -> None:
+    """/clock's 12-byte payloads take a short path; the message equals the generic decoder's."""
+    import struct
+
+    from kinema.interfaces import load_interfaces
+
+    registry = load_interfaces()
+    for sec, nanosec in ((0, 0), (12, 500_000_000), (-3, 999_999_999), (2**31 - 1, 1)):
+        payload = b"\x00\x01\x00\x00" + struct.pack("<iI", sec, nanosec)
+        fast = registry.deserialize(payload, "rosgraph_msgs/msg/Clock")
+        generic = registry.typestore.deserialize_cdr(payload, "rosgraph_msgs/msg/Clock")
+        assert fast == generic and type(fast) is type(generic)
+        assert (fast.clock.sec, fast.clock.nanosec) == (sec, nanosec)
+    # Big endian (and any other layout) still goes through the generic deserializer.
+    big = b"\x00\x00\x00\x00" + struct.pack(">iI", 7, 8)
+    decoded = registry.deserialize(big, "rosgraph_msgs/msg/Clock")
+    assert (decoded.clock.sec, decoded.clock.nanosec) == (7, 8)

@@ -1,9 +1,10 @@
-"""Pre-laid-out CDR payloads for the two messages the physics thread publishes at every publish period.
+"""Pre-laid-out CDR payloads for the messages the physics thread publishes at every publish period.
 
 ``/joint_states`` always names the same joints, so everything but the stamp and the three number arrays
-is fixed. Filling a template costs a few microseconds, where the generic serializer takes about a
-hundred — at ``--sim-speed max`` that is the difference between publishing and stepping. Each encoder
-checks itself against the generic serializer when built, so a layout mistake fails loudly at start.
+is fixed; a force/torque broadcaster's ``WrenchStamped`` always has the same frame id. Filling a
+template costs a few microseconds, where the generic serializer takes about a hundred — at
+``--sim-speed max`` that is the difference between publishing and stepping. Each encoder checks itself
+against the generic serializer when built, so a layout mistake fails loudly at start.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from kinema.errors import DriverError
 # CDR little endian (XCDR1), as rmw_zenoh writes it.
 _ENCAPSULATION = b"\x00\x01\x00\x00"
 _STAMP = struct.Struct("<iI")
+_FLOAT64 = np.dtype("<f8")
 
 
 def _split_stamp(seconds: float) -> tuple[int, int]:
@@ -69,6 +71,16 @@ class JointStateEncoder:
             self._arrays.append(len(_ENCAPSULATION) + len(body))
             body += bytes(8 * self.count)
         self._template = bytes(_ENCAPSULATION + body)
+        # The fixed bytes around the stamp and the arrays, joined with them at every encode.
+        size = 8 * self.count
+        stamp_end = len(_ENCAPSULATION) + _STAMP.size
+        ends = [offset + size for offset in self._arrays]
+        self._fixed = (
+            self._template[: len(_ENCAPSULATION)],
+            self._template[stamp_end : self._arrays[0]],
+            self._template[ends[0] : self._arrays[1]],
+            self._template[ends[1] : self._arrays[2]],
+        )
         sample = np.linspace(-1.0, 1.0, self.count)
         _check(
             self.encode(3.25, sample, 2 * sample, 3 * sample),
@@ -78,12 +90,77 @@ class JointStateEncoder:
 
     def encode(self, seconds: float, position: np.ndarray, velocity: np.ndarray, effort: np.ndarray) -> bytes:
         """The CDR payload of a JointState stamped ``seconds`` (each array has one value per name)."""
-        buffer = bytearray(self._template)
-        _STAMP.pack_into(buffer, len(_ENCAPSULATION), *_split_stamp(seconds))
-        size = 8 * self.count
-        for offset, values in zip(self._arrays, (position, velocity, effort), strict=True):
-            buffer[offset : offset + size] = np.ascontiguousarray(values, dtype="<f8").tobytes()
-        return bytes(buffer)
+        encapsulation, after_stamp, after_position, after_velocity = self._fixed
+        return b"".join(
+            (
+                encapsulation,
+                _STAMP.pack(*_split_stamp(seconds)),
+                after_stamp,
+                _doubles(position, self.count),
+                after_position,
+                _doubles(velocity, self.count),
+                after_velocity,
+                _doubles(effort, self.count),
+            )
+        )
+
+
+class WrenchStampedEncoder:
+    """``geometry_msgs/msg/WrenchStamped`` payloads for a fixed frame id.
+
+    Args:
+        frame_id: the header's frame id.
+        serialize: the generic serializer, ``serialize(sec, nanosec, frame_id, wrench)``, used once to
+            check the layout.
+    """
+
+    def __init__(self, frame_id: str, serialize: Callable[[int, int, str, np.ndarray], bytes]) -> None:
+        body = bytearray(_STAMP.pack(0, 0))
+        encoded = frame_id.encode("utf-8") + b"\x00"
+        body += struct.pack("<I", len(encoded)) + encoded
+        body += bytes(_align(len(body), 8) - len(body))
+        self._wrench = len(_ENCAPSULATION) + len(body)
+        body += bytes(8 * 6)
+        self._template = bytes(_ENCAPSULATION + body)
+        self._frame = self._template[len(_ENCAPSULATION) + _STAMP.size : self._wrench]
+        sample = np.array([1.5, -2.25, 3.0, -0.125, 0.5, 7.75])
+        _check(
+            self.encode(3, 250_000_000, sample),
+            serialize(3, 250_000_000, frame_id, sample),
+            "geometry_msgs/msg/WrenchStamped",
+        )
+
+    def encode(self, sec: int, nanosec: int, wrench: np.ndarray) -> bytes:
+        """The CDR payload stamped ``sec``/``nanosec`` with force x, y, z then torque x, y, z."""
+        return b"".join((_ENCAPSULATION, _STAMP.pack(sec, nanosec), self._frame, _doubles(wrench, 6)))
+
+
+def wrench_serializer(registry: Any) -> Callable[[int, int, str, np.ndarray], bytes]:
+    """The generic serializer of WrenchStamped through ``registry`` (to check the template against)."""
+    types = registry.typestore.types
+
+    def wrench_stamped(sec: int, nanosec: int, frame_id: str, wrench: np.ndarray) -> bytes:
+        vector = types["geometry_msgs/msg/Vector3"]
+        values = [float(v) for v in wrench]
+        message = types["geometry_msgs/msg/WrenchStamped"](
+            header=types["std_msgs/msg/Header"](
+                stamp=types["builtin_interfaces/msg/Time"](sec=sec, nanosec=nanosec), frame_id=frame_id
+            ),
+            wrench=types["geometry_msgs/msg/Wrench"](force=vector(*values[:3]), torque=vector(*values[3:])),
+        )
+        return bytes(registry.serialize(message, "geometry_msgs/msg/WrenchStamped"))
+
+    return wrench_stamped
+
+
+def _doubles(values: np.ndarray, count: int) -> bytes:
+    """``count`` little-endian float64 values (a float64 array is taken as it is: no conversion)."""
+    if isinstance(values, np.ndarray) and values.dtype == _FLOAT64 and values.shape == (count,):
+        return values.tobytes()
+    array = np.ascontiguousarray(values, dtype=_FLOAT64)
+    if array.shape != (count,):
+        raise ValueError(f"expected {count} values, got an array of shape {array.shape}")
+    return array.tobytes()
 
 
 def _check(fast: bytes, generic: bytes, type_name: str) -> None:

@@ -40,7 +40,13 @@ import numpy as np
 from kinema.config import cell
 from kinema.drivers.mujoco import names
 from kinema.drivers.mujoco.cameras import CameraServer, SimState
-from kinema.drivers.mujoco.cdr_templates import ClockEncoder, JointStateEncoder, generic_serializers
+from kinema.drivers.mujoco.cdr_templates import (
+    ClockEncoder,
+    JointStateEncoder,
+    WrenchStampedEncoder,
+    generic_serializers,
+    wrench_serializer,
+)
 from kinema.drivers.mujoco.contacts import contact_reporter
 from kinema.drivers.mujoco.controller_manager import Controller, ControllerManager, JointStateBroadcaster
 from kinema.drivers.mujoco.execution import Execution
@@ -147,7 +153,8 @@ class MujocoDriver:
         self._nodes: list[Node] = []
         self._publishers: dict[str, Any] = {}
         self._joint_state_broadcaster: Controller | None = None
-        self._wrench_publishers: list[tuple[Any, Any]] = []
+        # (broadcaster, publisher, its WrenchStamped template) per force/torque broadcaster.
+        self._wrench_publishers: list[tuple[Any, Any, WrenchStampedEncoder]] = []
         # Running goals by goal id, with the controller that runs each (for cancel requests).
         self._executions: dict[bytes, tuple[Any, Execution]] = {}
         self._goals_running = 0
@@ -515,8 +522,12 @@ class MujocoDriver:
                 cancel_callback=self._cancel_goal,
             )
         for name, controller in self._of_type(cell.FORCE_TORQUE_SENSOR_BROADCASTER):
+            assert isinstance(controller, ForceTorqueSensorBroadcaster)
             publisher = self._node(name).create_publisher(names.WRENCH_TYPE, names.wrench_topic(name))
-            self._wrench_publishers.append((controller, publisher))
+            encoder = WrenchStampedEncoder(
+                controller.sensor.frame_id, wrench_serializer(self.session.registry)
+            )
+            self._wrench_publishers.append((controller, publisher, encoder))
         for name, velocity_force in self._of_type(cell.VELOCITY_FORCE_CONTROLLER):
             assert isinstance(velocity_force, VelocityForceController)
             node = self._node(name)
@@ -573,9 +584,10 @@ class MujocoDriver:
                     data.qfrc_actuator[self._joint_dofs],
                 )
             )
-        for sensor_broadcaster, publisher in self._wrench_publishers:
+        for sensor_broadcaster, publisher, encoder in self._wrench_publishers:
             if sensor_broadcaster.active:
-                publisher.publish(sensor_broadcaster.message(data))
+                sec, nanosec = sensor_broadcaster.stamp(data)
+                publisher.publish_raw(encoder.encode(sec, nanosec, sensor_broadcaster.sensor.read(data)))
         for controller in self._goal_controllers:
             controller.post_feedback(data)
         wall = time.perf_counter()

@@ -104,17 +104,20 @@ class ForceTorqueSensorBroadcaster(Broadcaster):
     def message(self, data: Any) -> dict[str, Any]:
         """The ``geometry_msgs/WrenchStamped`` of the current reading."""
         wrench = self.sensor.read(data)
-        now = float(data.time)
+        sec, nanosec = self.stamp(data)
         return {
-            "header": {
-                "stamp": {"sec": int(now), "nanosec": round((now % 1.0) * 1e9) % 1_000_000_000},
-                "frame_id": self.sensor.frame_id,
-            },
+            "header": {"stamp": {"sec": sec, "nanosec": nanosec}, "frame_id": self.sensor.frame_id},
             "wrench": {
                 "force": dict(zip("xyz", wrench[:3].tolist(), strict=True)),
                 "torque": dict(zip("xyz", wrench[3:].tolist(), strict=True)),
             },
         }
+
+    @staticmethod
+    def stamp(data: Any) -> tuple[int, int]:
+        """The header stamp of the current reading (sec, nanosec)."""
+        now = float(data.time)
+        return int(now), round((now % 1.0) * 1e9) % 1_000_000_000
 
 
 @dataclass(frozen=True)

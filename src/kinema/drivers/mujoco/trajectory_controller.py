@@ -47,6 +47,8 @@ from kinema.drivers.mujoco.trajectory_sampling import SampledTrajectory, sample_
 
 log = logging.getLogger(__name__)
 
+count_nonzero = np.count_nonzero
+
 
 Index = np.ndarray | slice
 
@@ -343,9 +345,11 @@ class JointTrajectoryController:
             velocity_error = (
                 data.qvel[running.qvel] - table.velocities[row] if running.check_path_velocity else None
             )
-            # ndarray.any() rather than np.any(): this runs every physics step.
-            if (np.abs(error) > goal.path_position_tolerance).any() or (
-                velocity_error is not None and (np.abs(velocity_error) > goal.path_velocity_tolerance).any()
+            # np.count_nonzero rather than ndarray.any() (~0.2 against ~1 us on a handful of joints): this
+            # runs every physics step.
+            if count_nonzero(np.abs(error) > goal.path_position_tolerance) or (
+                velocity_error is not None
+                and count_nonzero(np.abs(velocity_error) > goal.path_velocity_tolerance)
             ):
                 self._fail(
                     data,
@@ -359,8 +363,9 @@ class JointTrajectoryController:
                 return
         else:
             speed = data.qvel[running.qvel]
-            if np.all(np.abs(error) <= goal.goal_position_tolerance) and np.all(
-                np.abs(speed) <= goal.goal_velocity_tolerance
+            # All within (a NaN is not): counted, as above.
+            if count_nonzero(np.abs(error) <= goal.goal_position_tolerance) == error.size and (
+                count_nonzero(np.abs(speed) <= goal.goal_velocity_tolerance) == speed.size
             ):
                 self._end(data, "succeeded", _result(SUCCESSFUL, ""), hold=False)
                 return
@@ -380,17 +385,19 @@ class JointTrajectoryController:
         running = self._running
         if running is None:
             return
-        elapsed = float(data.time) - running.start
-        row = running.table.index_at(elapsed)
-        desired = running.table.positions[row]
-        desired_velocity = running.table.velocities[row]
-        actual = data.qpos[running.qpos]
-        actual_velocity = data.qvel[running.qvel]
         stamp = float(data.time)
-        running.execution.post_feedback(
-            {
+        row = running.table.index_at(stamp - running.start)
+        # Copies of what changes; the message is built only when the goal's thread takes it.
+        actual = data.qpos[running.qpos].copy()
+        actual_velocity = data.qvel[running.qvel].copy()
+        table, joint_names = running.table, running.goal.joint_names
+
+        def feedback() -> dict[str, Any]:
+            desired = table.positions[row]
+            desired_velocity = table.velocities[row]
+            return {
                 "header": {"stamp": {"sec": int(stamp), "nanosec": int((stamp % 1.0) * 1e9)}},
-                "joint_names": list(running.goal.joint_names),
+                "joint_names": list(joint_names),
                 "desired": {"positions": desired.tolist(), "velocities": desired_velocity.tolist()},
                 "actual": {"positions": actual.tolist(), "velocities": actual_velocity.tolist()},
                 "error": {
@@ -398,7 +405,8 @@ class JointTrajectoryController:
                     "velocities": (desired_velocity - actual_velocity).tolist(),
                 },
             }
-        )
+
+        running.execution.post_feedback(feedback)
 
     # -- internals -------------------------------------------------------------------------------
 
