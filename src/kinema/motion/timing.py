@@ -126,7 +126,11 @@ def time_parameterize(
     wp = _densify(points, max_step)
     # Chord length in joint units (not normalised to [0, 1]): toppra's automatic grid is spaced in s units.
     s = np.r_[0.0, np.cumsum(np.linalg.norm(np.diff(wp, axis=0), axis=1))]
-    ta.setup_logging("WARNING")
+    # Only toppra's level: ta.setup_logging() adds a stderr handler to the "toppra" logger at every call,
+    # so a long-running agent gained one (with its formatter and lock) per timed path, without bound, and
+    # printed each toppra warning once per handler. Its records reach the process's own log through the
+    # root logger.
+    logging.getLogger("toppra").setLevel(logging.WARNING)
     spline = ta.SplineInterpolator(s, wp, bc_type="clamped")
     derate = _DERATE
     for _ in range(4):

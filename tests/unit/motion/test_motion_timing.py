@@ -133,3 +133,18 @@ def test_a_grid_toppra_cannot_solve_is_retried_on_a_finer_uniform_one(model, pic
     # every waypoint of the path is passed, at rest
     for waypoint in pick_path.positions:
         assert np.min(np.abs(slow.positions - waypoint).max(axis=1)) < 1e-3
+
+
+def test_timing_many_paths_adds_no_log_handlers(model, pick_path):
+    """Nothing grows with use: timing a path once per run must not add a handler to toppra's logger each
+    time (``toppra.setup_logging`` did: one StreamHandler per timed path in a long-running agent)."""
+    import logging
+
+    toppra_logger = logging.getLogger("toppra")
+    time_parameterize(pick_path, model)
+    before = list(toppra_logger.handlers)
+    for _ in range(20):
+        time_parameterize(pick_path, model)
+    assert toppra_logger.handlers == before
+    assert len(toppra_logger.handlers) <= 1
+    assert toppra_logger.level == logging.WARNING
