@@ -4,7 +4,8 @@ Every name a behavior, a core subtree or the simulation driver needs about the r
 this reads them from the config package (never from a constant in code). The sources, most specific
 first:
 
-1. ``config.yaml``'s Kinema section ``robot:``::
+1. ``config.yaml``'s Kinema section ``robot:`` (lab_sim's values here, as an example; nothing in code
+   defaults to them)::
 
        robot:
          tool_frame: grasp_link                  # the frame Cartesian moves and IK place (a URDF link)
@@ -39,7 +40,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
-from kinema.errors import ConfigError, SourceLocation, did_you_mean
+from kinema.errors import ConfigError, did_you_mean
 
 if TYPE_CHECKING:
     from kinema.config.inheritance import ResolvedConfig
@@ -226,16 +227,16 @@ def setting_key_path(key: str) -> str:
     return str(CELL_VALUE_KEYS[key][1])
 
 
-def _ros2_control_yaml(resolved: ResolvedConfig) -> tuple[dict[str, Any], SourceLocation | None]:
+def _ros2_control_yaml(resolved: ResolvedConfig) -> dict[str, Any]:
     """MoveIt Pro's ros2_control yaml (``ros2_control.config``), or ``{}``."""
     if resolved.get("ros2_control.config") is None:
-        return {}, None
+        return {}
     from kinema.config.yamlsource import load_yaml_file
 
     path = resolved.resolve_file("ros2_control.config", kind="file")
     document = load_yaml_file(path)
     data = document.data if isinstance(document.data, dict) else {}
-    return data, SourceLocation(str(path))
+    return data
 
 
 def _params(control: dict[str, Any], name: str) -> dict[str, Any]:
@@ -245,9 +246,8 @@ def _params(control: dict[str, Any], name: str) -> dict[str, Any]:
 
 
 def _controllers(
-    resolved: ResolvedConfig, robot: Mapping[str, Any], control_file: tuple[dict[str, Any], Any]
+    resolved: ResolvedConfig, robot: Mapping[str, Any], control: dict[str, Any]
 ) -> dict[str, ControllerSpec]:
-    control, _ = control_file
     declared_types = _params(control, "controller_manager")
     own = robot.get("controllers") or {}
     if not isinstance(own, Mapping):
@@ -303,11 +303,10 @@ def _number(resolved: ResolvedConfig, value: Any, key: str) -> float:
 def _gripper(
     resolved: ResolvedConfig,
     robot: Mapping[str, Any],
-    control_file: tuple[dict[str, Any], Any],
+    control: dict[str, Any],
     controllers: Mapping[str, ControllerSpec],
 ) -> GripperConfig | None:
     entry = robot.get("gripper")
-    control, _ = control_file
     grippers = [c for c in controllers.values() if c.type == GRIPPER_ACTION_CONTROLLER]
     if entry is None:
         if not grippers:
@@ -346,9 +345,8 @@ def _gripper(
 
 
 def _force_torque_sensor(
-    resolved: ResolvedConfig, robot: Mapping[str, Any], control_file: tuple[dict[str, Any], Any]
+    resolved: ResolvedConfig, robot: Mapping[str, Any], control: dict[str, Any]
 ) -> ForceTorqueSensorConfig | None:
-    control, _ = control_file
     entry = robot.get("force_torque_sensor")
     params = _params(control, "force_torque_sensor_broadcaster")
     if entry is None and not params.get("sensor_name"):
