@@ -47,14 +47,7 @@ def test_the_panda_picks_the_cube_as_the_page_says(
     steps = parse_steps(DOCUMENT.read_text(encoding="utf-8"))
     reader = Reader(tmp_path, "own-robot.md")
     show_on_failure(request.node, "the runtimes' logs", lambda: _run_logs(tmp_path))
-    try:
-        for step in steps:
-            if step.kind == "file":
-                reader.save(step)
-            else:
-                reader.run(step)
-    finally:
-        reader.stop_everything()
+    reader.follow(steps)
     heights = [_cube_height(output) for text, output in reader.outputs if text == "kinema sim bodies"]
     assert len(heights) == 2, reader.outputs
     before, after = heights

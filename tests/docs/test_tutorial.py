@@ -123,6 +123,17 @@ class Reader:
             if process.poll() is not None or time.monotonic() > deadline:
                 return output  # the caller reports what is missing, with this output
 
+    def follow(self, steps: list[Step]) -> None:
+        """Save every file and type every command of ``steps`` in order; stop what runs at the end."""
+        try:
+            for step in steps:
+                if step.kind == "file":
+                    self.save(step)
+                else:
+                    self.run(step)
+        finally:
+            self.stop_everything()
+
     def stop_everything(self) -> None:
         """`kinema down` for runtimes, then Ctrl-C (SIGINT) and SIGKILL for every background command."""
         subprocess.run(
@@ -170,13 +181,6 @@ def test_every_command_of_the_tutorial_prints_what_the_tutorial_says(
     steps = parse_steps(tutorial_path().read_text(encoding="utf-8"))
     reader = Reader(tmp_path)
     show_on_failure(request.node, "the runtimes' logs", lambda: _run_logs(tmp_path))
-    try:
-        for step in steps:
-            if step.kind == "file":
-                reader.save(step)
-            else:
-                reader.run(step)
-    finally:
-        reader.stop_everything()
+    reader.follow(steps)
     leftover = [process.pid for process, _ in reader.background if process.poll() is None]
     assert not leftover, f"background commands still running: {leftover}"
