@@ -59,6 +59,11 @@ class JointStateMonitor:
             self._history.append(message)
             self._changed.notify_all()
 
+    @property
+    def received(self) -> bool:
+        """Whether a message has arrived yet."""
+        return self._latest is not None
+
     def latest(self, timeout: float = 2.0) -> Any:
         """The latest message; waits up to ``timeout`` s for the first one.
 

@@ -250,6 +250,40 @@ def test_execute_trajectory_sends_the_trajectory_and_tolerances(
     assert len(goal.path_tolerance) == 0
 
 
+def test_execute_trajectory_ends_once_the_joint_states_show_the_arm_at_the_end(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    """The controller's result can overtake its last joint states (a loaded machine); the next behavior
+    plans from the latest state, so success waits until that state is the trajectory's end."""
+    state = {"name": ARM, "position": [0.0] * len(ARM)}
+    arrived = threading.Event()
+
+    def report_the_end_late() -> None:
+        state["position"] = [0.1] * len(ARM)
+        arrived.set()
+
+    def succeed_before_the_state_arrives(handle: Any) -> Any:
+        threading.Timer(0.5, report_the_end_late).start()
+        return {"error_code": 0, "error_string": ""}
+
+    action = "/late_reporting_controller/follow_joint_trajectory"
+    server = context.node.create_action_server(
+        "control_msgs/action/FollowJointTrajectory", action, succeed_before_the_state_arrives
+    )
+    with publish_repeatedly(context.node, "sensor_msgs/msg/JointState", "/joint_states", state):
+        context.joint_states.latest(timeout=5.0)  # in a cell, planning subscribed long before
+        run = tick_behavior(
+            behavior("ExecuteTrajectory"),
+            {"joint_trajectory_msg": _trajectory(), "controller_action_name": action},
+            context=context,
+        )
+        server.close()
+        assert run.status == NodeStatus.SUCCESS, run.toasts
+        assert arrived.is_set(), "ExecuteTrajectory succeeded while /joint_states still showed the start"
+        monitor = context.joint_states
+        assert monitor.positions(ARM) == pytest.approx([0.1] * len(ARM))
+
+
 def test_a_rejected_trajectory_fails_with_the_controllers_error(
     behavior: Any, context: BehaviorContext
 ) -> None:

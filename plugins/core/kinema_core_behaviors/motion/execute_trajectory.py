@@ -5,6 +5,8 @@ from __future__ import annotations
 import time
 from typing import Any
 
+import numpy as np
+
 from kinema.behaviors import AsyncBehavior, FormerSpelling, PortInfo, input_port
 from kinema.behaviors.work_runner import RUNNER
 from kinema.drivers.mujoco.names import LIST_CONTROLLERS_SERVICE, SWITCH_CONTROLLERS_SERVICE
@@ -18,6 +20,7 @@ from ..controllers.switch_controller import (
     switch_request,
 )
 from ..messages.conversions import duration, trajectory_from_message
+from .joint_states import joint_state_monitor
 from .planned_trajectory import publish_planned_trajectory
 
 FOLLOW_JOINT_TRAJECTORY = "control_msgs/action/FollowJointTrajectory"
@@ -28,6 +31,11 @@ LIST_TIMEOUT = 2.0
 # enough to ride out a liveliness hiccup, short enough that a crashed driver fails the run within 1 s.
 SERVER_LOST_AFTER = 0.3
 _POLL = 0.01
+# After success, how long to wait for /joint_states to show the arm at the trajectory's end, and how many
+# times the goal tolerance counts as there (the controller's default goal tolerance is 0.01 rad or m).
+SETTLE_TIMEOUT = 2.0
+SETTLE_FACTOR = 3.0
+DEFAULT_GOAL_TOLERANCE = 0.01
 
 
 class ExecuteTrajectory(AsyncBehavior):
@@ -150,6 +158,7 @@ class ExecuteTrajectory(AsyncBehavior):
         except KinemaError as error:
             return self._fail(str(error))
         publish_planned_trajectory(self, goal["trajectory"])
+        joint_state_monitor(self.context, "ExecuteTrajectory")  # listening before the arm moves
         refused = await self._activate(node, name)
         if refused:
             return self._fail(refused)
@@ -190,9 +199,48 @@ class ExecuteTrajectory(AsyncBehavior):
             return self._fail(f"the controller {name} failed: {error}")
         result = outcome.result
         if outcome.succeeded and int(result.error_code) == 0:
+            await self._until_reported(goal)
             return True
         detail = str(result.error_string) or f"error code {int(result.error_code)}"
         return self._fail(f"the controller {name} ended the trajectory {outcome.status_name}: {detail}")
+
+    async def _until_reported(self, goal: dict[str, Any]) -> None:
+        """Wait until ``/joint_states`` shows the arm at the trajectory's last point.
+
+        The controller's result can arrive before its last joint states do (on a loaded machine, or a
+        simulation far faster than real time), and the next behavior plans from the latest state: a
+        Cartesian move planned from where the arm was before this motion starts where the arm no longer
+        is. Success means the controller saw the arm within its goal tolerance, so this waits, up to
+        SETTLE_TIMEOUT, for the joint states to agree within a few times that tolerance, then goes on.
+        """
+        import asyncio
+
+        trajectory = goal["trajectory"]
+        if not trajectory.points:
+            return
+        names = [str(n) for n in trajectory.joint_names]
+        target = np.array([float(p) for p in trajectory.points[-1].positions])
+        tolerance = np.full(len(names), DEFAULT_GOAL_TOLERANCE)
+        for entry in goal.get("goal_tolerance", []):
+            tolerance[names.index(entry["name"])] = max(float(entry["position"]), DEFAULT_GOAL_TOLERANCE)
+        monitor = joint_state_monitor(self.context, "ExecuteTrajectory")
+        if not monitor.received:
+            return  # this robot publishes no /joint_states
+        deadline = time.monotonic() + SETTLE_TIMEOUT
+        while True:
+            try:
+                gap = np.abs(monitor.positions(names, timeout=0.0) - target)
+            except ObjectiveError:
+                return  # /joint_states names other joints: nothing here to wait for
+            if (gap <= SETTLE_FACTOR * tolerance).all():
+                return
+            if time.monotonic() > deadline:
+                self.logger.publish_info(
+                    f"ExecuteTrajectory: /joint_states still shows the arm {gap.max():.3g} from the "
+                    f"trajectory's end {SETTLE_TIMEOUT:g} s after the controller reported success"
+                )
+                return
+            await asyncio.sleep(_POLL)
 
     async def _activate(self, node: Any, action: str) -> str:
         """Activate the controller behind ``action`` when the controller manager has it inactive.
