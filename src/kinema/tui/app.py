@@ -18,7 +18,7 @@ from functools import partial
 from pathlib import Path
 
 from textual import events
-from textual.app import App, SystemCommand
+from textual.app import App, SuspendNotSupported, SystemCommand
 from textual.binding import Binding
 from textual.notifications import SeverityLevel
 from textual.screen import Screen
@@ -220,6 +220,8 @@ class KinemaApp(App[None]):
         self._switching = False
         self._key_timer: Timer | None = None
         self.views: list[RuntimeView] = []
+        self._connection_open = False
+        self._closing = False
         self.sub_title = connection.endpoint + ("  (closing stops the runtime)" if owns_runtime else "")
 
     def _run_started(self, name: str) -> None:
@@ -233,7 +235,9 @@ class KinemaApp(App[None]):
 
     def on_mount(self) -> None:
         self.switch_mode(self.initial_mode)
-        self.connection.open(self._receive)
+        # Joining the runtime imports the transport (zenoh, numpy) on the connection's thread; begun
+        # after the first frame, it does not hold the interpreter while the screen is being drawn.
+        self.call_after_refresh(self._open_connection)
         if self.camera_topic:
             self.action_show_camera(self.camera_topic)
         # Textual, the stylesheets and the screens make ~10^5 long-lived objects; every full garbage
@@ -241,7 +245,15 @@ class KinemaApp(App[None]):
         # the first frame keeps those collections to what was allocated since.
         self.call_after_refresh(gc.freeze)
 
+    def _open_connection(self) -> None:
+        if not self._closing:
+            self.connection.open(self._receive)
+            self._connection_open = True
+
     def on_unmount(self) -> None:
+        self._closing = True
+        if not self._connection_open:
+            return
         try:
             self.connection.close()
         except Exception:
@@ -548,10 +560,18 @@ class KinemaApp(App[None]):
 
     def action_show_camera(self, topic: str | None = None) -> None:
         """Open the camera view (on ``topic``, else the last one shown)."""
-        from kinema.tui.screens.camera import CameraScreen
+        from kinema.tui.screens.camera import CameraScreen, image_support_loaded, load_image_support
 
         if isinstance(self.screen, CameraScreen):
             return
+        if not image_support_loaded():
+            # textual-image asks the terminal what it can draw, and the answers come on the input the app
+            # reads: ask with the terminal handed back for a moment (once, on the first camera view).
+            try:
+                with self.suspend():
+                    load_image_support()
+            except SuspendNotSupported:  # headless (tests) or a web driver: nothing to ask
+                load_image_support()
         try:
             self.push_screen(CameraScreen(topic or self.camera_topic))
         except ValueError as error:  # KINEMA_TUI_IMAGE names no drawing method
@@ -620,8 +640,10 @@ def run_app(
             ``logs``, ``waypoints``).
         camera: an image topic to show in the camera view on top of it.
     """
-    # The camera view's image library asks the terminal what it can draw; that must happen before the
-    # app takes the terminal over.
-    import kinema.tui.screens.camera  # noqa: F401
+    if camera:
+        # The camera view's image library asks the terminal what it can draw; with a camera on the first
+        # screen that must happen before the app takes the terminal over (else on the first camera view).
+        from kinema.tui.screens.camera import load_image_support
 
+        load_image_support()
     KinemaApp(connection, owns_runtime=owns_runtime, initial_mode=initial_mode, camera=camera).run()
