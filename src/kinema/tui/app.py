@@ -55,15 +55,33 @@ from kinema.tui.repeat_limiter import RepeatLimiter, held_back, watchdog_kind
 from kinema.tui.run_outcome import RunOutcome, parse_outcome
 from kinema.tui.runtime_status import ACTIVE_STATUSES, RuntimeStatus
 from kinema.tui.screens.base import KinemaScreen, RuntimeView
-from kinema.tui.screens.behaviors import BehaviorsScreen
-from kinema.tui.screens.blackboard import BlackboardScreen
-from kinema.tui.screens.configs import ConfigsScreen
-from kinema.tui.screens.logs import LogsScreen
-from kinema.tui.screens.objectives import ObjectivesScreen
-from kinema.tui.screens.waypoints import WaypointsScreen
 from kinema.tui.widgets.nav_bar import SCREENS
 
 log = logging.getLogger("kinema.tui")
+
+# The app's screens (modes): module in kinema.tui.screens and class, imported when first shown.
+SCREEN_CLASSES = {
+    "configs": ("configs", "ConfigsScreen"),
+    "objectives": ("objectives", "ObjectivesScreen"),
+    "blackboard": ("blackboard", "BlackboardScreen"),
+    "behaviors": ("behaviors", "BehaviorsScreen"),
+    "logs": ("logs", "LogsScreen"),
+    "waypoints": ("waypoints", "WaypointsScreen"),
+}
+
+
+def screen_class(mode: str) -> type[Screen[None]]:
+    """The class of the screen for ``mode`` (a key of :data:`SCREEN_CLASSES`), its module imported now."""
+    import importlib
+
+    module, name = SCREEN_CLASSES[mode]
+    cls: type[Screen[None]] = getattr(importlib.import_module(f"kinema.tui.screens.{module}"), name)
+    return cls
+
+
+def _new_screen(mode: str) -> Screen[None]:
+    return screen_class(mode)()
+
 
 MAX_LOGS = 2000
 # Seconds the app waits for a key to go all the way up before it gives out the next one anyway.
@@ -141,14 +159,8 @@ class KinemaApp(App[None]):
     VERTICAL_BREAKPOINTS = [(0, "-short"), (32, "-tall")]
     # Absolute, so subclasses defined elsewhere (tests, embedding apps) find the stylesheet too.
     CSS_PATH = Path(__file__).with_name("app.tcss")
-    MODES = {
-        "configs": ConfigsScreen,
-        "objectives": ObjectivesScreen,
-        "blackboard": BlackboardScreen,
-        "behaviors": BehaviorsScreen,
-        "logs": LogsScreen,
-        "waypoints": WaypointsScreen,
-    }
+    # Each screen's module is imported when the screen is first shown: the first frame needs only one.
+    MODES = {mode: partial(_new_screen, mode) for mode in SCREEN_CLASSES}
     BINDINGS = [
         *(
             Binding(
@@ -551,6 +563,7 @@ class KinemaApp(App[None]):
                     self.notify, str(error), title="Nothing to replay", severity="warning", timeout=8
                 )
                 return
+
             def show() -> None:
                 self.push_screen(ReplayScreen(path, loaded))
 
@@ -598,6 +611,9 @@ class KinemaApp(App[None]):
             "Step through the newest recorded run of this machine (`kinema ui --replay FILE` for another)",
             self.action_replay_latest,
         )
+        from kinema.tui.screens.objectives import ObjectivesScreen
+        from kinema.tui.screens.waypoints import WaypointsScreen
+
         for view in self.views:
             if isinstance(view, ObjectivesScreen):
                 for objective in view.objectives:
