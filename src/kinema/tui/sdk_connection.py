@@ -17,7 +17,6 @@ from collections import deque
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
-from xml.sax.saxutils import quoteattr
 
 from kinema.errors import KinemaError, ObjectiveError, TransportError
 from kinema.tui.connection import (
@@ -427,6 +426,8 @@ class SdkConnection:
                 f"the runtime has no {MOVE_TO_WAYPOINT_OBJECTIVE!r} objective to move with; "
                 "run a config whose objective library includes Kinema's core objectives"
             )
+        from xml.sax.saxutils import quoteattr  # here: it imports urllib, 30 ms the first frame need not wait
+
         # Wrapped as a SubTree, as MoveIt Pro's UI does: the subtree's other ports then take the defaults
         # its TreeNodesModel declares (planning group, controller, ...), which a direct run would not.
         xml = (
