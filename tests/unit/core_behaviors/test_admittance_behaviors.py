@@ -144,3 +144,27 @@ def test_bad_admittance_ports_fail_naming_the_port(
     )
     assert run.status == NodeStatus.FAILURE
     assert expected in run.toasts[-1], run.toasts
+
+
+def test_parameters_naming_a_controller_that_is_no_admittance_controller_fail(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    parameters = from_dict(
+        PARAMETERS, {"controller_name": "joint_trajectory_controller", "selected_axes": {"z": True}}
+    )
+    run = tick_behavior(
+        behavior("ExecuteTrajectory"),
+        {"joint_trajectory_msg": _trajectory(), "admittance_parameters_msg": parameters},
+        context=context,
+    )
+    assert run.status == NodeStatus.FAILURE
+    assert "controller_name 'joint_trajectory_controller'" in run.toasts[-1], run.toasts
+    assert "admittance controllers: joint_trajectory_admittance_controller" in run.toasts[-1], run.toasts
+
+
+def test_with_admittance_defaults_to_the_configs_admittance_controller(registry: Any, context: Any) -> None:
+    from kinema.behaviors.cell_ports import resolve_cell_ports
+
+    ports = resolve_cell_ports(registry["ExecuteTrajectoryWithAdmittance"].cls.provided_ports(), context.cell)
+    action = next(p for p in ports if p.name == "controller_action_name")
+    assert action.default == "/joint_trajectory_admittance_controller/follow_joint_trajectory"

@@ -52,6 +52,11 @@ class ExecuteTrajectory(AsyncBehavior):
     objectives rely on it: lab_sim's "Pick All Bottles with AprilTags" retracts on the admittance
     controller right after "Pick from Pose" executed on the default one, with no SwitchController between.
 
+    With ``admittance_parameters_msg`` or ``absolute_force_torque_threshold`` set, the trajectory travels
+    with them in one FollowJointTrajectoryWithAdmittance goal to the joint trajectory admittance
+    controller, which lets the arm give way to the wrench the wrist senses for this trajectory and aborts
+    past the threshold (lab_sim's "Push Button With a Trajectory" and "Stationary Admittance").
+
     Halting the behavior (cancelling the objective) cancels the controller's goal, which stops the
     arm where it is. Fails with the controller's error when it rejects the trajectory (unknown joints,
     limits) or aborts it (tolerances), and fails within a second when the controller goes away.
@@ -167,7 +172,8 @@ class ExecuteTrajectory(AsyncBehavior):
             if admittance is not None:
                 goal.update(admittance)
                 action_type = FOLLOW_JOINT_TRAJECTORY_WITH_ADMITTANCE
-                requested, name = name, self.admittance_action(name)
+                requested = name
+                name = self.admittance_action(name, admittance.get("admittance_parameters"))
                 if name != requested:
                     self.logger.publish_info(
                         f"{self.registration_id}: admittance ports set: executing on {name} (the admittance "
@@ -331,12 +337,14 @@ class ExecuteTrajectory(AsyncBehavior):
             fields["admittance_parameters"] = parameters
         return fields
 
-    def admittance_action(self, requested: str) -> str:
+    def admittance_action(self, requested: str, parameters: Any = None) -> str:
         """The admittance controller's action for a goal with admittance: ``requested`` when it is one of
-        the config's admittance controllers (or there is no config to ask), else the config's first.
+        the config's admittance controllers (or there is no config to ask), else the one the parameters'
+        ``controller_name`` names, else the config's first.
 
         Raises:
-            ObjectiveError: the config names no admittance controller.
+            ObjectiveError: the config names no admittance controller, or the parameters name a controller
+                that is not one.
         """
         cell = self.context.cell
         if cell is None:
@@ -347,6 +355,15 @@ class ExecuteTrajectory(AsyncBehavior):
         ]
         if "/" + requested.lstrip("/") in actions:
             return requested
+        named = str(getattr(parameters, "controller_name", "") or "").strip("/")
+        if named:
+            if f"/{named}/follow_joint_trajectory" in actions:
+                return f"/{named}/follow_joint_trajectory"
+            raise ObjectiveError(
+                f"port [admittance_parameters_msg] names controller_name {named!r}, which config "
+                f"{cell.config!r} has not as an admittance controller; admittance controllers: "
+                f"{', '.join(a.split('/')[1] for a in actions) or 'none'}"
+            )
         if not actions:
             raise ObjectiveError(
                 f"the admittance ports are set, but config {cell.config!r} has no controller of type "
