@@ -91,8 +91,8 @@ def test_push_button_with_a_trajectory_pushes_11_cm_and_gives_way_along_z(librar
     # Nothing in the way: the straight line went 11 cm down grasp_link's z (world down at VFC Start).
     assert free.last[2] == pytest.approx(0.62 - 0.11, abs=0.006), free.last
     # Again, pushed up with 20 N while the compliant trajectory runs. Compliant along z (0.1 kg, 180 N/m,
-    # damping ratio 100: 849 N s/m), the tool gives way upward as that spring does over the push; x and y
-    # are rigid and end where they did.
+    # damping ratio 100: 849 N s/m), the tool gives way upward as that spring does over the push (about
+    # 1.2 cm in the 0.54 s the push takes); x and y are rigid and end about where they did.
     result, pushed = _run(library_cell, "Push Button With a Trajectory", (0.0, 0.0, 20.0))
     assert result.succeeded, result
     assert pushed.compliant, "the admittance controller never ran a compliant goal"
@@ -100,7 +100,7 @@ def test_push_button_with_a_trajectory_pushes_11_cm_and_gives_way_along_z(librar
     expected = _spring(20.0, 180.0, 2 * 100 * np.sqrt(0.1 * 180.0), pushed.compliant_for)
     assert gave[2] == pytest.approx(expected, rel=0.3), (gave, expected, pushed.compliant_for)
     assert gave[2] > 0.005, gave
-    assert np.abs(gave[:2]).max() < 0.003, gave
+    assert np.abs(gave[:2]).max() < 0.3 * gave[2], gave
 
 
 def test_stationary_admittance_holds_the_arm_and_lets_a_push_move_it(library_cell: LibraryCell) -> None:
