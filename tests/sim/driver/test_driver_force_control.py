@@ -173,6 +173,7 @@ def _hold_under_push(sim: Sim, goal: dict[str, Any], type_name: str, push: float
     return result, moved
 
 
+@pytest.mark.slow  # five goals of several seconds of sim time each
 def test_the_admittance_controller_yields_to_a_push_in_proportion_to_its_stiffness(sim: Sim) -> None:
     assert sim.switch(
         activate=[n.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER], deactivate=[n.JOINT_TRAJECTORY_CONTROLLER]
