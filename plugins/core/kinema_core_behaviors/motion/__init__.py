@@ -4,6 +4,7 @@ from __future__ import annotations
 
 from .create_stationary_trajectory import CreateStationaryTrajectory
 from .execute_trajectory import ExecuteTrajectory
+from .execute_trajectory_with_admittance import ExecuteTrajectoryWithAdmittance
 from .get_joint_state import GetJointState
 from .get_robot_state_from_trajectory import GetRobotStateFromTrajectory
 from .move_gripper_action import MoveGripperAction
@@ -14,6 +15,7 @@ from .validate_trajectory import ValidateTrajectory
 BEHAVIORS = (
     CreateStationaryTrajectory,
     ExecuteTrajectory,
+    ExecuteTrajectoryWithAdmittance,
     GetJointState,
     GetRobotStateFromTrajectory,
     MoveGripperAction,
