@@ -88,12 +88,16 @@ class ControllerSpec:
         type: the ros2_control type, e.g. ``joint_trajectory_controller/JointTrajectoryController``.
         joints: the joints it commands (empty: the driver decides, e.g. every arm joint).
         active: started with the cell (``controllers_active_at_startup``), else loaded inactive.
+        parameters: its ``ros__parameters`` in MoveIt Pro's ros2_control yaml (empty without one); the
+            driver reads the ones it simulates (e.g. the admittance controller's
+            ``default_absolute_force_torque_threshold``).
     """
 
     name: str
     type: str
     joints: tuple[str, ...] = ()
     active: bool = True
+    parameters: Mapping[str, Any] = field(default_factory=dict, compare=False)
 
 
 @dataclass(frozen=True)
@@ -299,7 +303,11 @@ def _controllers(
         if isinstance(joints, str):
             joints = [joints]
         out[name] = ControllerSpec(
-            name=name, type=type_name, joints=tuple(str(j) for j in joints), active=name not in inactive
+            name=name,
+            type=type_name,
+            joints=tuple(str(j) for j in joints),
+            active=name not in inactive,
+            parameters=params,
         )
     return out
 

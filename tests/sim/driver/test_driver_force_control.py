@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Callable
+from dataclasses import replace
 from typing import Any
 
 import numpy as np
@@ -11,7 +12,9 @@ import pytest
 from driver_harness import ARM, Sim, trajectory, wait_for
 
 from kinema.config import WaypointStore, resolve_config
+from kinema.drivers.mujoco import MujocoDriver
 from kinema.drivers.mujoco import names as n
+from kinema.errors import DriverError
 from kinema.transport import STATUS_ABORTED
 
 GRAVITY = 9.81
@@ -225,3 +228,29 @@ def test_a_goals_force_threshold_aborts_it_and_bad_parameters_are_rejected(sim: 
     result, _ = _hold_under_push(sim, {"admittance_parameters": bad}, with_admittance, 0.0)
     assert result.status == STATUS_ABORTED
     assert "mass x = 0 (must be positive)" in result.result.error_string, result.result.error_string
+
+
+def test_the_controllers_ros2_control_parameters_set_its_defaults(start_sim: Callable[..., Sim]) -> None:
+    """MoveIt Pro's ros2_control parameters of the admittance controller (default threshold, ee_frame)
+    reach the simulated one: here a 5 N default threshold stops a 10 N push no goal limits."""
+    from kinema.config import resolve_config
+    from kinema.config.cell import CellSettings
+
+    controllers = dict(CellSettings.from_config(resolve_config("lab_sim")).controllers)
+    name = n.JOINT_TRAJECTORY_ADMITTANCE_CONTROLLER
+    controllers[name] = replace(
+        controllers[name],
+        parameters={"default_absolute_force_torque_threshold": [5.0, 5.0, 5.0, 10.0, 10.0, 10.0]},
+    )
+    sim = start_sim(controllers=controllers)
+    assert sim.switch(activate=[name], deactivate=[n.JOINT_TRAJECTORY_CONTROLLER]).ok
+    compliant = {"admittance_parameters": _admittance(400.0)}
+    result, _ = _hold_under_push(sim, compliant, n.FOLLOW_JOINT_TRAJECTORY_WITH_ADMITTANCE_TYPE, 10.0)
+    assert result.status == STATUS_ABORTED
+    assert "(limit 5)" in result.result.error_string, result.result.error_string
+    controllers[name] = replace(
+        controllers[name], parameters={"default_absolute_force_torque_threshold": [5.0]}
+    )
+    bad = sim.driver.settings.with_changes(controllers=controllers)
+    with pytest.raises(DriverError, match="default_absolute_force_torque_threshold must be six positive"):
+        MujocoDriver(sim.driver.session, bad)  # refused while building its controllers, before serving

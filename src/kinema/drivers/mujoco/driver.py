@@ -33,14 +33,14 @@ import functools
 import logging
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
 from kinema.config import cell
 from kinema.drivers.mujoco import names
-from kinema.drivers.mujoco.admittance import AdmittanceError, AdmittanceParameters
+from kinema.drivers.mujoco.admittance import AdmittanceError, AdmittanceParameters, ControlFrame
 from kinema.drivers.mujoco.cameras import CameraServer, SimState
 from kinema.drivers.mujoco.cdr_templates import (
     ClockEncoder,
@@ -111,6 +111,45 @@ def _admittance_of(goal: Any) -> tuple[AdmittanceParameters | None, np.ndarray |
             f"got {values}",
         )
     return admittance, np.array(values)
+
+
+def _admittance_options(
+    name: str, parameters: Mapping[str, Any], control_site: str, model: Any
+) -> dict[str, Any]:
+    """The admittance controller's options from its ros2_control parameters (MoveIt Pro's names):
+    ``default_absolute_force_torque_threshold``, ``jacobian_damping`` and ``ee_frame`` (the control frame
+    when the config gives no control site; it must be a site or body of the scene).
+
+    Raises:
+        DriverError: a parameter of the wrong shape, naming the controller and the parameter.
+    """
+    options: dict[str, Any] = {"control_frame": control_site}
+    threshold = parameters.get("default_absolute_force_torque_threshold")
+    if threshold is not None:
+        if (
+            not isinstance(threshold, list)
+            or len(threshold) != 6
+            or not all(isinstance(v, int | float) and not isinstance(v, bool) and v > 0 for v in threshold)
+        ):
+            raise DriverError(
+                f"controller {name!r}: default_absolute_force_torque_threshold must be six positive numbers "
+                f"(fx, fy, fz, tx, ty, tz in N and N m), got {threshold!r}"
+            )
+        options["threshold"] = tuple(float(v) for v in threshold)
+    damping = parameters.get("jacobian_damping")
+    if damping is not None:
+        if isinstance(damping, bool) or not isinstance(damping, int | float) or damping < 0:
+            raise DriverError(f"controller {name!r}: jacobian_damping must be a number >= 0, got {damping!r}")
+        options["jacobian_damping"] = float(damping)
+    ee_frame = str(parameters.get("ee_frame") or "")
+    if not control_site and ee_frame:
+        try:
+            ControlFrame(model, ee_frame)
+        except AdmittanceError as error:
+            log.warning("controller %r: its ee_frame is no control frame: %s", name, error)
+        else:
+            options["control_frame"] = ee_frame
+    return options
 
 
 def _load_model(settings: MujocoDriverSettings) -> Any:
@@ -499,7 +538,12 @@ class MujocoDriver:
                         JointTrajectoryAdmittanceController,
                         sensor=sensor,
                         model=self.model,
-                        control_frame=settings.control_site if has_control_site else "",
+                        **_admittance_options(
+                            name,
+                            spec.parameters if spec is not None else {},
+                            settings.control_site if has_control_site else "",
+                            self.model,
+                        ),
                     )
             elif kind == cell.VELOCITY_FORCE_CONTROLLER:
                 arm = arm_of(joints, name)
