@@ -178,7 +178,8 @@ class MpcPlan:
         cost: the plan's weighted tracking cost, summed over its steps (as linearised).
         position_error: the tracked frame's distance to the target at ``start``, m.
         orientation_error: its angle to the target's orientation at ``start``, rad.
-        clearance: the smallest predicted distance of a clearance frame to an obstacle (inf without).
+        clearance: the smallest distance of a clearance frame to an obstacle's surface at ``start`` (the
+            measured configuration; inf without obstacles or clearance frames).
     """
 
     joint_names: tuple[str, ...]
@@ -257,6 +258,8 @@ class PoseTrackingMpc:
         self._previous: tuple[float, np.ndarray, np.ndarray, np.ndarray] | None = None
         self._qp: Any = None
         self._qp_shape = (0, 0)
+        #: Steps whose QP had no solution with every bound and was solved again relaxed.
+        self.relaxed_steps = 0
 
     @property
     def joint_names(self) -> tuple[str, ...]:
@@ -313,7 +316,6 @@ class PoseTrackingMpc:
         q = q0.copy()
         cartesian_jacobians: list[np.ndarray] = []
         tracking: list[tuple[np.ndarray, np.ndarray]] = []
-        clearance = np.inf
         for k in range(n):
             block = slice(k * m, (k + 1) * m)
             q[cols] = guess[k]
@@ -333,12 +335,11 @@ class PoseTrackingMpc:
             if self._cartesian_id is not None:
                 cartesian_jacobians.append(self._linear_jacobian(self._cartesian_id, cols))
             if obstacles is not None and self._clearance_ids:
-                row, low, closest, push = self._clearance_rows(obstacles, guess[k], cols, k, size)
+                row, low, push = self._clearance_rows(obstacles, guess[k], cols, k, size)
                 gradient[block] -= push
                 rows_c.append(row)
                 lower_c.append(low)
                 upper_c.append(np.full(len(low), np.inf))
-                clearance = min(clearance, closest)
 
         # Smoothness: velocity and acceleration penalties over the plan.
         c1 = np.zeros(n * m)
@@ -380,8 +381,16 @@ class PoseTrackingMpc:
         hessian += 1e-9 * np.eye(size)
         positions = self._solve(hessian, gradient, list(blocks.values()), box)
         if positions is None:
-            # Near a limit at speed the acceleration bound can leave no plan: drop it and try again.
+            # The bounds can leave no plan: near a limit at speed (acceleration), or where the guess the
+            # clearance is linearised at lies beyond what the joints can reach this step. Without the
+            # acceleration bound and with the clearance relaxed to what holding still keeps, standing
+            # still is a plan, so the QP has one.
+            self.relaxed_steps += 1
             del blocks["acceleration"]
+            if "clearance" in blocks:
+                rows, lower, upper = blocks["clearance"]
+                hold = rows @ np.tile(start_group, n)
+                blocks["clearance"] = (rows, np.minimum(lower, hold), upper)
             positions = self._solve(hessian, gradient, list(blocks.values()), box)
         if positions is None:
             raise MotionError("the MPC's QP has no solution within the joint limits from this state")
@@ -393,8 +402,7 @@ class PoseTrackingMpc:
         velocities = (plan_positions - previous) / dt
         self._previous = (float(start), start_group, plan_positions, velocities)
         now_error = self._error_now(q0, world_T_target)
-        if obstacles is not None:
-            clearance = min(clearance, self._clearance_at(q0, obstacles))
+        clearance = self._clearance_at(q0, obstacles) if obstacles is not None else np.inf
         return MpcPlan(
             self.group.joint_names,
             float(start),
@@ -457,7 +465,7 @@ class PoseTrackingMpc:
 
     def _clearance_rows(
         self, obstacles: Obstacles, guess: np.ndarray, cols: np.ndarray, step: int, size: int
-    ) -> tuple[np.ndarray, np.ndarray, float, np.ndarray]:
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
         """The clearance constraints of one step, linearised at the step's guess ``q̄_k``.
 
         For each clearance frame and each of its nearest obstacles: ``d(q̄_k) + ∇d (q_k - q̄_k) >=
@@ -466,19 +474,15 @@ class PoseTrackingMpc:
         away (returned as the gradient to subtract), so the robot moves out as fast as tracking lets it.
 
         Returns:
-            rows ``(F*K, size)``, their lower bounds (-inf for unused rows), the nearest surface distance,
-            and the push ``(m,)``.
+            rows ``(F*K, size)``, their lower bounds (-inf for unused rows) and the push ``(m,)``.
         """
         settings, m = self.settings, self._m
         rows = np.zeros((len(self._clearance_ids) * NEAREST_OBSTACLES, size))
         lower = np.full(len(rows), -np.inf)
         push = np.zeros(m)
-        closest = np.inf
         for f, frame_id in enumerate(self._clearance_ids):
             point = np.asarray(self._data.oMf[frame_id].translation)
             index, distance = obstacles.nearest(point, NEAREST_OBSTACLES)
-            if len(distance):
-                closest = min(closest, float(distance[0]))
             jacobian = self._linear_jacobian(frame_id, cols)
             for j, (i, d) in enumerate(zip(index, distance, strict=True)):
                 away = point - obstacles.centres[i]
@@ -491,7 +495,7 @@ class PoseTrackingMpc:
                 lower[r] = min(settings.safe_distance, float(d)) - float(d) + grad @ guess
                 if d < settings.safe_distance:
                     push += CLEARANCE_PUSH * grad
-        return rows, lower, closest, push
+        return rows, lower, push
 
     def _solve(
         self,

@@ -1,4 +1,4 @@
-"""MoveIt Pro's "MPC Pose Tracking", unchanged, on Kinema's lab_sim headless in real time.
+"""MoveIt Pro's MPC objectives, unchanged, on Kinema's lab_sim headless in real time.
 
 The objective moves to "Pose Tracking", then sweeps a target pose along a straight line while turning it
 (a Parallel branch moves ``{pose_stamped}`` every few ms) while ``MPCPoseTracking`` tracks it with
@@ -6,12 +6,17 @@ The objective moves to "Pose Tracking", then sweeps a target pose along a straig
 current pinch pose (VisualizePose "target" and "current_pinch", one after the other in the same tick): the
 tracking error is measured from those two markers. A second run is cancelled mid-sweep: the arm must stop.
 
+"MPC Pose Tracking Static Point Cloud Avoidance with Sphere Down Sample" puts 300 spheres (5 cm) on the
+cloud points nearest the gripper and runs ``MPCSphereClearance`` with a 25 cm safe distance for 20 s: the
+gripper starts inside that distance, must come no closer, and must back out to it.
+
 The MPC runs in the agent against the simulation's clock, so the simulation runs at real time here (at
 max speed the sim would race ahead of the solver).
 """
 
 from __future__ import annotations
 
+import threading
 import time
 from typing import Any
 
@@ -108,3 +113,59 @@ def test_cancelling_mpc_pose_tracking_stops_the_arm(library_cell: LibraryCell) -
     wait_for(lambda: _arm_state(library_cell)[0] > cancelled_at + 1.5, 10.0, "another second of sim time")
     _, later, _ = _arm_state(library_cell)
     assert np.abs(later - stopped).max() < 1e-3, later - stopped
+
+
+def test_mpc_sphere_clearance_backs_the_gripper_out_to_the_safe_distance(library_cell: LibraryCell) -> None:
+    driver = library_cell.driver
+    sites = ("pinch", "attachment_site")  # the objective's gripper_site_name and link_sites
+    bodies = [int(driver.model.body(name).id) for name in sites]
+    spheres: list[tuple[float, np.ndarray, float]] = []  # (wall time, centres, radius)
+
+    def on_markers(message: Any) -> None:
+        drawn = [m for m in message.markers if m.ns == "obstacles2"]
+        if drawn:
+            centres = np.array([[m.pose.position.x, m.pose.position.y, m.pose.position.z] for m in drawn])
+            frames = {m.header.frame_id for m in drawn}
+            assert frames <= {"world", ""}, frames
+            spheres.append((time.monotonic(), centres, drawn[0].scale.x / 2))
+
+    subscription = library_cell.node.create_subscription(MARKER_ARRAY_TYPE, MARKER_ARRAY_TOPIC, on_markers)
+    samples: list[tuple[float, np.ndarray]] = []
+    stop = threading.Event()
+
+    def sample() -> None:
+        def read() -> np.ndarray:
+            return np.array([driver.data.xpos[b] for b in bodies])
+
+        while not stop.is_set():
+            samples.append((time.monotonic(), driver.simulation.call(read)))
+            time.sleep(0.01)
+
+    sampler = threading.Thread(target=sample, daemon=True)
+    sampler.start()
+    try:
+        result = library_cell.client.execute(
+            "MPC Pose Tracking Static Point Cloud Avoidance with Sphere Down Sample", timeout=240.0
+        )
+    finally:
+        stop.set()
+        sampler.join()
+        subscription.close()
+    assert result.succeeded, result
+    assert spheres, "the objective drew no obstacle spheres"
+    drawn_at, centres, radius = spheres[-1]
+    assert len(centres) == 300 and radius == pytest.approx(0.05)
+
+    def clearance(positions: np.ndarray) -> float:
+        return min(float(np.min(np.linalg.norm(centres - p, axis=1))) - radius for p in positions)
+
+    # From when the spheres were drawn (right before MPCSphereClearance starts) to the end of the run.
+    during = [clearance(positions) for t, positions in samples if t >= drawn_at]
+    assert len(during) > 100
+    print(
+        f"MPCSphereClearance: clearance {during[0]:.3f} m at the start, {min(during):.3f} at least, "
+        f"{during[-1]:.3f} at the end"
+    )
+    assert during[0] < 0.25  # it starts inside the safe distance ...
+    assert min(during) > during[0] - 0.01  # ... comes no closer ...
+    assert during[-1] > 0.25 - 0.01  # ... and backs out to it

@@ -278,6 +278,7 @@ class MpcControlLoop(AsyncBehavior):
         started = clock.now()
         due = started
         errors: list[float] = []
+        closest = float("inf")
         plan: MpcPlan | None = None
         while not self.stop_requested():
             now = clock.now()
@@ -293,17 +294,25 @@ class MpcControlLoop(AsyncBehavior):
             if not self._publish(plan):
                 return False
             errors.append(plan.position_error)
+            closest = min(closest, plan.clearance)
             # The next step's slot on the timestep grid; slots missed while solving are not made up.
             due += settings.timestep * max(1, int((clock.now() - due) / settings.timestep) + 1)
         self._stop_arm()
-        if plan is None or self.stop_requested():
-            return not self.stop_requested()
-        self.set_output("total_return", plan.cost)
-        self.logger.publish_info(
-            f"{name}: tracked for {timeout:g} s ({len(errors)} steps); position error now "
-            f"{1000 * errors[-1]:.1f} mm, median {1000 * float(np.median(errors)):.1f} mm"
-        )
-        return True
+        if plan is not None:
+            halted = self.stop_requested()
+            summary = (
+                f"{name}: {'halted' if halted else 'done'} after {clock.now() - started:.1f} s "
+                f"({len(errors)} steps, {mpc.relaxed_steps} relaxed); position error now "
+                f"{1000 * errors[-1]:.1f} mm, median {1000 * float(np.median(errors)):.1f} mm"
+            )
+            if closest < float("inf"):
+                summary += (
+                    f"; closest to an obstacle {closest:.3f} m (safe distance {settings.safe_distance:g} m)"
+                )
+            self.logger.publish_info(summary)
+            if not halted:
+                self.set_output("total_return", plan.cost)
+        return not self.stop_requested()
 
     def _settings(self) -> MpcSettings:
         from kinema.motion.mpc import MpcSettings
