@@ -22,8 +22,6 @@ from __future__ import annotations
 import threading
 from typing import TYPE_CHECKING, Any
 
-import numpy as np
-
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
 from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError, ObjectiveError
@@ -34,6 +32,8 @@ from ..motion.joint_states import joint_state_monitor
 from ..motion.planning_resources import robot_model
 
 if TYPE_CHECKING:
+    import numpy as np
+
     from kinema.motion.mpc import MpcPlan, MpcSettings, Obstacles
 
 JOINT_TRAJECTORY_TYPE = "trajectory_msgs/msg/JointTrajectory"
@@ -303,7 +303,7 @@ class MpcControlLoop(AsyncBehavior):
             summary = (
                 f"{name}: {'halted' if halted else 'done'} after {clock.now() - started:.1f} s "
                 f"({len(errors)} steps, {mpc.relaxed_steps} relaxed); position error now "
-                f"{1000 * errors[-1]:.1f} mm, median {1000 * float(np.median(errors)):.1f} mm"
+                f"{1000 * errors[-1]:.1f} mm, median {1000 * sorted(errors)[len(errors) // 2]:.1f} mm"
             )
             if closest < float("inf"):
                 summary += (
@@ -365,6 +365,8 @@ class MpcControlLoop(AsyncBehavior):
 
     @staticmethod
     def _positions(message: Any, joint_names: tuple[str, ...]) -> np.ndarray:
+        import numpy as np
+
         index = {str(n): i for i, n in enumerate(message.name)}
         missing = [n for n in joint_names if n not in index]
         if missing:
@@ -378,6 +380,8 @@ class MpcControlLoop(AsyncBehavior):
 
     def _twist(self) -> np.ndarray | None:
         """The target twist in world axes (None when the port is unset)."""
+        import numpy as np
+
         message = self.get_input_or("target_twist", None)
         if message is None:
             return None
@@ -392,6 +396,8 @@ class MpcControlLoop(AsyncBehavior):
         return np.concatenate((rotation @ vector[:3], rotation @ vector[3:]))
 
     def _world_T(self, frame: str) -> np.ndarray:
+        import numpy as np
+
         if frame in ("", "world"):
             return np.eye(4)
         from ..poses.frame_tree import current_frame_tree

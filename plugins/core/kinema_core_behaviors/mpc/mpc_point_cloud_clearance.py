@@ -22,7 +22,8 @@ class MPCPointCloudClearance(MpcControlLoop):
     ``gripper_site_name`` and each frame of ``link_sites`` keep ``safe_distance`` from every point (the
     nearest points each step, through a k-d tree), a constraint of each step's QP: a target inside the
     clearance is approached only to its edge, and a frame that starts inside backs out. The rest (loop,
-    controller, halting, ports) is as in MPCPoseTracking.
+    controller, halting, ports) is as in MPCPoseTracking; defaults are the values lab_sim's objectives
+    give (MoveIt Pro's own are not public).
     """
 
     clearance_weight_port = "point_cloud_clearance"

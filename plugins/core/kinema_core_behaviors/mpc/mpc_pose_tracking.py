@@ -21,7 +21,7 @@ class MPCPoseTracking(MpcControlLoop):
     Where MoveIt Pro's semantics are not public (its planner samples trajectories on a MuJoCo model and
     weighs residuals): Kinema's weights ``site_tracking``, ``velocity`` and ``acceleration`` are costs of a
     QP, the Cartesian speed and joint limits are hard constraints, and the sampler's tuning ports are
-    accepted and unused.
+    accepted and unused. Port defaults are the values lab_sim's MPC objectives give.
     """
 
     @classmethod

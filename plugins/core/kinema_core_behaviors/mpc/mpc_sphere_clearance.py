@@ -23,7 +23,8 @@ class MPCSphereClearance(MpcControlLoop):
     read again whenever the port's value changes. ``gripper_site_name`` and each frame of ``link_sites``
     keep ``safe_distance`` from every sphere's surface, a constraint of each step's QP (linearised at the
     frames' planned positions): a target inside the clearance is approached only to its edge, and a frame
-    that starts inside backs out. The rest (loop, controller, halting, ports) is as in MPCPoseTracking.
+    that starts inside backs out. The rest (loop, controller, halting, ports) is as in MPCPoseTracking;
+    defaults are the values lab_sim's objectives give (MoveIt Pro's own are not public).
     """
 
     clearance_weight_port = "sphere_clearance"
