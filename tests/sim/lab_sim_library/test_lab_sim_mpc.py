@@ -169,3 +169,101 @@ def test_mpc_sphere_clearance_backs_the_gripper_out_to_the_safe_distance(library
     assert during[0] < 0.25  # it starts inside the safe distance ...
     assert min(during) > during[0] - 0.01  # ... comes no closer ...
     assert during[-1] > 0.25 - 0.01  # ... and backs out to it
+
+
+# MoveIt Pro's "Look at Base" joint values (its ur_waypoints.yaml); collision-free on Kinema's lab_sim.
+LOOK_AT_BASE = {
+    "robotiq_85_left_knuckle_joint": 0.0125324474858072,
+    "linear_rail_joint": 0.0,
+    "shoulder_pan_joint": 1.570785841301689,
+    "shoulder_lift_joint": -1.8849672195965093,
+    "elbow_joint": 1.107847094370458,
+    "wrist_1_joint": -0.7406642377583046,
+    "wrist_2_joint": -1.5708034344833448,
+    "wrist_3_joint": 0.0,
+}
+
+
+def _ensure_look_at_base(cell: LibraryCell) -> None:
+    """lab_sim's waypoints may lack "Look at Base" (the objective's first move): add MoveIt Pro's."""
+    from kinema.config import Waypoint, Workspace, resolve_config
+    from kinema.config.waypoint_location import waypoint_store_for
+
+    resolved = resolve_config("lab_sim", Workspace.discover(cell.objectives.parents[2]))
+    store = waypoint_store_for(resolved)
+    assert store is not None
+    if "Look at Base" not in store.names():
+        store.save(
+            Waypoint(
+                "Look at Base",
+                list(LOOK_AT_BASE),
+                list(LOOK_AT_BASE.values()),
+                ["gripper", "linear_actuator", "manipulator"],
+            )
+        )
+
+
+def test_mpc_point_cloud_clearance_keeps_the_gripper_and_base_clear_of_the_cloud(
+    library_cell: LibraryCell,
+) -> None:
+    from lab_sim_library_cell import lab_sim_model
+
+    from kinema.motion import fk
+    from kinema.perception.ros_messages import from_point_cloud2
+
+    library_cell.render_each_camera_once((("sensor_msgs/msg/PointCloud2", "/wrist_camera/points"),), 60.0)
+    _ensure_look_at_base(library_cell)
+    driver = library_cell.driver
+    model = lab_sim_model()
+    sites = ("pinch", "base_site")  # the objective's gripper_site_name and link_sites
+    bodies = [int(driver.model.body(name).id) for name in sites]
+    clouds: list[tuple[float, np.ndarray]] = []  # (wall time, points in the world)
+
+    def on_cloud(message: Any) -> None:
+        _, q_arm, _ = _arm_state(library_cell)  # the arm stands at "Look at Base" while it looks
+        q = model.configuration(dict(zip(ARM, q_arm, strict=True)))
+        cloud = from_point_cloud2(message).finite()
+        world_T_camera = fk(model, q, cloud.frame_id)
+        points = cloud.points @ world_T_camera[:3, :3].T + world_T_camera[:3, 3]
+        clouds.append((time.monotonic(), points))
+
+    subscription = library_cell.node.create_subscription(
+        "sensor_msgs/msg/PointCloud2", "/pcd_pointcloud_captures", on_cloud
+    )
+    samples: list[tuple[float, np.ndarray]] = []
+    stop = threading.Event()
+
+    def sample() -> None:
+        def read() -> np.ndarray:
+            return np.array([driver.data.xpos[b] for b in bodies])
+
+        while not stop.is_set():
+            samples.append((time.monotonic(), driver.simulation.call(read)))
+            time.sleep(0.01)
+
+    sampler = threading.Thread(target=sample, daemon=True)
+    sampler.start()
+    try:
+        result = library_cell.client.execute("MPC Pose Tracking With Point Cloud Avoidance", timeout=240.0)
+    finally:
+        stop.set()
+        sampler.join()
+        subscription.close()
+    assert result.succeeded, result
+    assert clouds, "the objective sent no point cloud to the UI"
+    sent_at, points = clouds[-1]
+    assert len(points) > 100, len(points)
+
+    def clearance(positions: np.ndarray) -> float:
+        return min(float(np.min(np.linalg.norm(points - p, axis=1))) for p in positions)
+
+    during = [(clearance(positions), positions) for t, positions in samples if t >= sent_at]
+    assert len(during) > 100
+    distances = [d for d, _ in during]
+    moved = float(np.linalg.norm(during[-1][1][0] - during[0][1][0]))
+    print(
+        f"MPCPointCloudClearance: {len(points)} points; clearance {distances[0]:.3f} m at the start, "
+        f"{min(distances):.3f} at least, {distances[-1]:.3f} at the end; the pinch moved {moved:.2f} m"
+    )
+    assert moved > 0.1  # it went after the target (50 cm beside the gripper, 10 cm above) ...
+    assert min(distances) > min(distances[0], 0.25) - 0.01  # ... never inside the 25 cm it keeps
