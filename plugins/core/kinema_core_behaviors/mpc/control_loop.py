@@ -12,9 +12,12 @@ behavior runs) and the obstacles, solves, and streams the plan to the trajectory
 ``follow_joint_trajectory_topic`` on that controller's ``joint_trajectory`` topic (stamped with the joint
 state's time, so the controller starts it where the robot was measured; each plan replaces the last).
 When solving takes longer than a timestep the loop runs as fast as it can and the plan, which covers the
-whole horizon, keeps the arm moving meanwhile. The behavior stays RUNNING until halted (a ``Timeout`` or
-a ``Parallel``), and succeeds after ``timeout`` seconds; halting it, its timeout and any failure stop the
-arm (an empty trajectory: the controller brakes and holds).
+whole horizon, keeps the arm moving meanwhile. The solver runs on wall time: a simulation faster than real
+time (``--sim-speed``) leaves it behind, so run MPC objectives at real time (the default).
+
+The behavior stays RUNNING until halted (a ``Timeout`` or a ``Parallel``) and succeeds after ``timeout``
+seconds; halting it, its timeout and any failure stop the arm (an empty trajectory: the controller brakes
+and holds).
 """
 
 from __future__ import annotations
