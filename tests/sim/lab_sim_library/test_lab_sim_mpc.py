@@ -87,7 +87,7 @@ def test_mpc_pose_tracking_keeps_the_pinch_on_the_moving_target(library_cell: Li
         f"{1000 * np.median(tracked):.1f} mm, max {1000 * tracked.max():.1f} mm"
     )
     assert np.median(tracked) < 0.015, tracked
-    assert tracked.max() < 0.03, tracked
+    assert tracked.max() < 0.04, tracked
     beyond = [float(e) for e, d in zip(errors, travelled, strict=True) if d > 0.4]
     print(f"beyond 40 cm: {[round(1000 * e) for e in beyond]} mm")
 

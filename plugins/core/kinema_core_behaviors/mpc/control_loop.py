@@ -30,7 +30,7 @@ from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError, ObjectiveError
 
 from ..messages.conversions import POSE_STAMPED_TYPE, duration, pose_matrix
-from ..messages.ports import message_input
+from ..messages.ports import message_input, read_message
 from ..motion.joint_states import joint_state_monitor
 from ..motion.planning_resources import robot_model
 
@@ -295,7 +295,7 @@ class MpcControlLoop(AsyncBehavior):
             q = self._positions(message, model.joint_names)
             plan = mpc.step(q, stamp, self._target(), self._twist(), self.obstacles())
             if not self._publish(plan):
-                return False
+                break  # halted meanwhile
             errors.append(plan.position_error)
             closest = min(closest, plan.clearance)
             # The next step's slot on the timestep grid; slots missed while solving are not made up.
@@ -378,7 +378,7 @@ class MpcControlLoop(AsyncBehavior):
 
     def _target(self) -> np.ndarray:
         """The target pose in the world frame."""
-        frame, matrix = pose_matrix(self.get_input("target_pose"), "target_pose")
+        frame, matrix = pose_matrix(read_message(self, "target_pose", POSE_STAMPED_TYPE), "target_pose")
         return self._world_T(frame) @ matrix
 
     def _twist(self) -> np.ndarray | None:
