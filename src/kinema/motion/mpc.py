@@ -506,8 +506,8 @@ class PoseTrackingMpc:
     ) -> np.ndarray | None:
         """ProxQP on ``0.5 x'Hx + g'x`` with ``lower <= rows x <= upper`` per block and the box.
 
-        The solver is kept from step to step while the problem keeps its size, so each solve starts from
-        the previous one's primal and dual solution (a few iterations instead of dozens).
+        The solver object is kept while the problem keeps its size (no reallocation per step); each solve
+        starts cold, with its scaling recomputed for the new rows (see the module docstring).
         """
         from proxsuite import proxqp
 
@@ -526,7 +526,18 @@ class PoseTrackingMpc:
             qp.init(hessian, gradient, None, None, rows, lower, upper, lower_box, upper_box)
             self._qp, self._qp_shape = qp, shape
         else:
-            qp.update(hessian, gradient, None, None, rows, lower, upper, lower_box, upper_box)
+            qp.update(
+                hessian,
+                gradient,
+                None,
+                None,
+                rows,
+                lower,
+                upper,
+                lower_box,
+                upper_box,
+                update_preconditioner=True,
+            )
         qp.solve()
         if qp.results.info.status != proxqp.QPSolverOutput.PROXQP_SOLVED:
             self._qp = None  # start afresh next time
