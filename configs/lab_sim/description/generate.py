@@ -351,6 +351,11 @@ LINKS: tuple[Link, ...] = (
     Link("grasp_link", "robotiq_85_base_link", xyz=(0.0, 0.0, TCP_DEPTH)),
     # MoveIt Pro's lab_sim calls the point between the fingertips "pinch" too.
     Link("pinch", "grasp_link"),
+    # Sites and bodies of MoveIt Pro's lab_sim MuJoCo model that its MPC objectives name (the flange's
+    # attachment_site and tool_changer, the arm's base_site), as frames at the same places.
+    Link("attachment_site", "tool0"),
+    Link("tool_changer", "tool0"),
+    Link("base_site", "base_link"),
     Link("wrist_camera_optical_frame", "tool0", xyz=WRIST_CAMERA_POS, quat=WRIST_CAMERA_QUAT),
     Link("scene_camera_optical_frame", "world", xyz=SCENE_CAMERA_POS, quat=SCENE_CAMERA_QUAT),
 )

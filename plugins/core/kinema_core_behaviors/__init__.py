@@ -16,6 +16,7 @@ from . import (
     io,
     messages,
     motion,
+    mpc,
     perception,
     planning_scene,
     poses,
@@ -29,6 +30,7 @@ from . import (
 FAMILIES = (controllers, files, io, messages, motion, planning_scene, poses, ui, vectors, waiting, waypoints)
 FAMILIES += (task_planning,)  # issue 13's family, kept on its own line
 FAMILIES += (perception,)  # issue 14's family, kept on its own line
+FAMILIES += (mpc,)  # issue 30's MPC family, kept on its own line
 
 BEHAVIORS = tuple(behavior for family in FAMILIES for behavior in family.BEHAVIORS)
 

@@ -221,6 +221,16 @@ CELL_VALUE_KEYS: dict[str, tuple[Any, str]] = {
         ),
         "ros2_control (a controller of type " + ADMITTANCE_CONTROLLER + ")",
     ),
+    "trajectory_action": (
+        lambda c: next(
+            (
+                f"/{spec.name}/follow_joint_trajectory"
+                for spec in c.controllers_of_type(JOINT_TRAJECTORY_CONTROLLER)
+            ),
+            None,
+        ),
+        "ros2_control controllers (the first JointTrajectoryController)",
+    ),
     "camera_color_topic": (
         lambda c: f"/{c.default_camera}/color" if c.default_camera else None,
         "robot.default_camera",

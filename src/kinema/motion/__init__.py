@@ -1,4 +1,4 @@
-"""Motion: the robot model (pinocchio), kinematics, collision checking, OMPL planning and toppra timing.
+"""Motion: the robot model (pinocchio), kinematics, collision checking, OMPL planning, toppra timing, MPC.
 
 Typical use::
 
@@ -44,6 +44,10 @@ _EXPORTS = {
     "TaskSolution": "task",
     "TaskPlanningError": "task",
     "plan_task": "task",
+    "PoseTrackingMpc": "mpc",
+    "MpcSettings": "mpc",
+    "MpcPlan": "mpc",
+    "Obstacles": "mpc",
     "JointPath": "trajectory",
     "JointTrajectory": "trajectory",
 }

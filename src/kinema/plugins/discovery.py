@@ -33,6 +33,8 @@ ENTRY_POINT_GROUP = "kinema.behaviors"
 LOADER_ALIASES: Mapping[str, str] = {
     "moveit_pro::behaviors::CoreBehaviorsLoader": "kinema::CoreBehaviorsLoader",
     "moveit_pro::behaviors::MujocoBehaviorsLoader": "kinema::MujocoBehaviorsLoader",
+    # MoveIt Pro's MPC behaviors are in Kinema's core plugin (family mpc).
+    "moveit_pro::behaviors::MPCBehaviorsLoader": "kinema::CoreBehaviorsLoader",
     "moveit_studio::behaviors::CoreBehaviorsLoader": "kinema::CoreBehaviorsLoader",
     "moveit_studio::behaviors::MujocoBehaviorsLoader": "kinema::MujocoBehaviorsLoader",
 }

@@ -31,8 +31,11 @@ def _workspace(root: Path) -> Path:
 
 
 @pytest.fixture(scope="module")
-def library_cell(tmp_path_factory: pytest.TempPathFactory) -> Iterator[LibraryCell]:
-    """Router, MuJoCo driver (max sim speed), agent and SDK client on a free loopback port."""
+def library_cell(
+    tmp_path_factory: pytest.TempPathFactory, request: pytest.FixtureRequest
+) -> Iterator[LibraryCell]:
+    """Router, MuJoCo driver (max sim speed, or the test module's ``SIM_SPEED``), agent and SDK client on a
+    free loopback port."""
     if not CORPUS.is_dir():
         pytest.skip(f"MoveIt Pro's lab_sim objectives are not at {CORPUS}")
     import math
@@ -52,7 +55,8 @@ def library_cell(tmp_path_factory: pytest.TempPathFactory) -> Iterator[LibraryCe
         cleanup.append(router.close)
         driver_session = open_session(endpoint)
         cleanup.append(driver_session.close)
-        settings = MujocoDriverSettings.from_config("lab_sim", Workspace.discover(root), sim_speed=math.inf)
+        speed = getattr(request.module, "SIM_SPEED", math.inf)
+        settings = MujocoDriverSettings.from_config("lab_sim", Workspace.discover(root), sim_speed=speed)
         driver = MujocoDriver(driver_session, settings)
         driver.start()
         cleanup.append(driver.stop)

@@ -12,6 +12,7 @@ FAMILIES = (
     "io",
     "messages",
     "motion",
+    "mpc",
     "perception",
     "planning_scene",
     "poses",

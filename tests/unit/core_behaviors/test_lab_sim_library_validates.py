@@ -4,8 +4,8 @@ The 83 public lab_sim objectives (and picknik_ur_base_config's, which their SubT
 into a config package based on Kinema's lab_sim, then every objective is validated with its SubTree
 closure against the config's behaviors. Issue 12 requires 27 of them, issue 14's point-cloud half 13
 more, its AprilTag half 5 more and its force objectives 3 more, issue 30's segmentation behaviors 9 more
-(which fail when run: Kinema runs no segmentation model); ``kinema objective list`` must say in one
-line why each of the others cannot load.
+(which fail when run: Kinema runs no segmentation model) and its MPC behaviors 5 more; ``kinema objective
+list`` must say in one line why each of the others cannot load.
 """
 
 from __future__ import annotations
@@ -106,6 +106,28 @@ ML_BASE = {
     "segment_point_cloud_from_text_prompt_subtree",
 }
 
+# Issue 30's MPC objectives: MPCPoseTracking, MPCSphereClearance and MPCPointCloudClearance.
+MPC = {
+    "mpc_pose_tracking",
+    "mpc_pose_tracking_dynamic_point_cloud_avoidance_with_sphere_down_sample",
+    "mpc_pose_tracking_static_point_cloud_avoidance_with_sphere_down_sample",
+    "mpc_pose_tracking_with_point_cloud_avoidance",
+    "mpc_pose_tracking_with_static_sphere_point_cloud_avoidance",
+}
+
+BROKEN = """<?xml version="1.0" encoding="UTF-8" ?>
+<root BTCPP_format="4" main_tree_to_execute="Unknown Behavior Example">
+  <BehaviorTree ID="Unknown Behavior Example">
+    <Action ID="NoSuchBehavior" />
+  </BehaviorTree>
+  <TreeNodesModel>
+    <SubTree ID="Unknown Behavior Example">
+      <MetadataFields><Metadata runnable="true" /></MetadataFields>
+    </SubTree>
+  </TreeNodesModel>
+</root>
+"""
+
 
 @pytest.fixture(scope="module")
 def corpus_workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
@@ -118,6 +140,9 @@ def corpus_workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
     (package / "config").mkdir(parents=True)
     shutil.copytree(corpus / "lab_sim" / "objectives", package / "objectives")
     shutil.copytree(corpus / "picknik_ur_base_config" / "objectives", package / "base_objectives")
+    # One objective that cannot load whatever Kinema grows to: the listing's example of a reason.
+    (package / "broken_objectives").mkdir()
+    (package / "broken_objectives" / "unknown_behavior.xml").write_text(BROKEN)
     (package / "package.xml").write_text(
         f'<?xml version="1.0"?>\n<package format="3"><name>{CONFIG}</name><version>0.0.0</version>'
         "<description>MoveIt Pro's lab_sim objectives</description>"
@@ -130,6 +155,7 @@ def corpus_workspace(tmp_path_factory: pytest.TempPathFactory) -> Path:
                 # Replaces Kinema's own lab_sim library (same key); Kinema's core library stays.
                 "lab_sim_objectives": {"package_name": CONFIG, "relative_path": "objectives"},
                 "base_objectives": {"package_name": CONFIG, "relative_path": "base_objectives"},
+                "broken_objectives": {"package_name": CONFIG, "relative_path": "broken_objectives"},
             }
         },
     }
@@ -153,10 +179,10 @@ def test_the_required_lab_sim_objectives_validate_with_their_subtrees(corpus_wor
     problems = {path.stem: file_problem(library, path, factory) for path in files}
     valid = {stem for stem, problem in problems.items() if problem is None}
     failing = {stem: problem for stem, problem in problems.items() if problem is not None}
-    missing = sorted((BEFORE | ADDED | POINT_CLOUDS | APRILTAGS | FORCE | ML) - valid)
+    missing = sorted((BEFORE | ADDED | POINT_CLOUDS | APRILTAGS | FORCE | ML | MPC) - valid)
     report = "\n".join(f"  {stem}: {failing.get(stem, '?')}" for stem in missing)
     assert not missing, f"{len(valid)} of 83 validate; these required ones do not:\n{report}"
-    assert len(valid) >= len(BEFORE | ADDED | POINT_CLOUDS | APRILTAGS | FORCE | ML)
+    assert len(valid) >= len(BEFORE | ADDED | POINT_CLOUDS | APRILTAGS | FORCE | ML | MPC)
     base = corpus_workspace / "src" / CONFIG / "base_objectives"
     base_problems = {stem: file_problem(library, base / f"{stem}.xml", factory) for stem in sorted(ML_BASE)}
     assert base_problems == dict.fromkeys(ML_BASE), base_problems
@@ -173,17 +199,18 @@ def test_objective_list_says_why_each_objective_cannot_load(corpus_workspace: Pa
     reasons = lines[header + 1 : header + 1 + count]
     assert len(reasons) == count > 0, result.output
     # One line each: the objective, then file:line: the first problem.
-    mpc = next(line for line in reasons if line.strip().startswith("MPC Pose Tracking:"))
-    assert "mpc_pose_tracking.xml:" in mpc and "Node not recognized: MPCPoseTracking" in mpc, mpc
+    broken = next(line for line in reasons if line.strip().startswith("Unknown Behavior Example:"))
+    assert "unknown_behavior.xml:" in broken and "Node not recognized: NoSuchBehavior" in broken, broken
     table = {line[4:].split("  ")[0].strip(): line[:3] for line in lines[:header] if line[:1] in "R-"}
-    assert table["MPC Pose Tracking"].endswith("!")
+    assert table["Unknown Behavior Example"].endswith("!")
+    assert not table["MPC Pose Tracking"].endswith("!")
     assert not table["Take Scene Camera Snapshot"].endswith("!")
     assert not table["Vector and String Example"].endswith("!")
     as_json = CliRunner().invoke(
         cli, ["objective", "list", "-w", str(corpus_workspace), "-c", CONFIG, "--json"]
     )
     cannot_load = json.loads(as_json.output)["cannot_load"]
-    assert len(cannot_load) == count and "MPCPoseTracking" in cannot_load["MPC Pose Tracking"]
+    assert len(cannot_load) == count and "NoSuchBehavior" in cannot_load["Unknown Behavior Example"]
 
 
 def test_every_port_the_corpus_sets_on_a_kinema_behavior_is_declared(registry: Any) -> None:

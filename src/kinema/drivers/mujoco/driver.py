@@ -14,7 +14,9 @@ As a process: ``python -m kinema.drivers.mujoco --config lab_sim --sim-speed max
 
 What it serves (names in :mod:`kinema.drivers.mujoco.names`): ``/clock`` and ``/joint_states`` at the
 publish rate of sim time; per controller of the config, by its ros2_control type: ``/<trajectory
-controller>/follow_joint_trajectory`` and ``/<gripper controller>/gripper_cmd`` (lab_sim:
+controller>/follow_joint_trajectory`` (and its streaming input ``/<trajectory
+controller>/joint_trajectory``, each trajectory replacing the last, an empty one stopping the arm) and
+``/<gripper controller>/gripper_cmd`` (lab_sim:
 ``/joint_trajectory_controller/...`` and ``/robotiq_gripper_controller/gripper_cmd``);
 ``/controller_manager/list_controllers`` and ``/controller_manager/switch_controller(s)``;
 ``/mujoco/set_state`` (keyframe and/or joint positions), ``/mujoco/bodies`` (free body poses),
@@ -34,6 +36,7 @@ import logging
 import threading
 import time
 from collections.abc import Callable, Mapping
+from types import SimpleNamespace
 from typing import Any
 
 import numpy as np
@@ -374,6 +377,14 @@ class MujocoDriver:
                             "zero the force/torque sensor",
                         )
                     )
+                served.append(
+                    ServedInterface(
+                        "topic",
+                        names.joint_trajectory_topic(name),
+                        names.JOINT_TRAJECTORY_TYPE,
+                        "streamed trajectories, each replacing the last (subscribed; empty: stop)",
+                    )
+                )
             elif kind == cell.FORCE_TORQUE_SENSOR_BROADCASTER:
                 served.append(
                     ServedInterface(
@@ -627,6 +638,11 @@ class MujocoDriver:
                     names.admittance_zero_fts_service(name, controller.sensor.frame_id),
                     functools.partial(self._zero_sensor, controller),
                 )
+            node.create_subscription(
+                names.JOINT_TRAJECTORY_TYPE,
+                names.joint_trajectory_topic(name),
+                functools.partial(self._stream_trajectory, controller=controller),
+            )
         for name, controller in self._of_type(cell.FORCE_TORQUE_SENSOR_BROADCASTER):
             assert isinstance(controller, ForceTorqueSensorBroadcaster)
             publisher = self._node(name).create_publisher(names.WRENCH_TYPE, names.wrench_topic(name))
@@ -831,6 +847,28 @@ class MujocoDriver:
         self._run_goal(
             handle, controller, lambda execution: controller.start(execution, position, effort, self.data), {}
         )
+
+    def _stream_trajectory(self, message: Any, controller: Any) -> None:
+        """A trajectory on ``/<controller>/joint_trajectory``: replaces the running one (empty: stop)."""
+        assert isinstance(controller, JointTrajectoryController)
+        goal = None
+        if message.points:
+            limits = {j.name: j.limits for j in controller.joints if j.limits is not None}
+            request = SimpleNamespace(
+                trajectory=message,
+                multi_dof_trajectory=SimpleNamespace(joint_names=[], points=[]),
+                path_tolerance=[],
+                goal_tolerance=[],
+                goal_time_tolerance=SimpleNamespace(sec=0, nanosec=0),
+            )
+            try:
+                goal = parse_trajectory_goal(
+                    request, controller.joint_names, limits, self.settings.tolerances, self.index.timestep
+                )
+            except GoalRejected as rejected:
+                log.warning("%s: trajectory on its topic rejected: %s", controller.name, rejected.message)
+                return
+        self.simulation.submit(lambda: controller.stream(goal, self.data))
 
     def _run_goal(
         self,

@@ -11,6 +11,7 @@ JOINT_STATES_TOPIC = "/joint_states"
 JOINT_STATES_TYPE = "sensor_msgs/msg/JointState"
 
 FOLLOW_JOINT_TRAJECTORY_TYPE = "control_msgs/action/FollowJointTrajectory"
+JOINT_TRAJECTORY_TYPE = "trajectory_msgs/msg/JointTrajectory"
 GRIPPER_COMMAND_TYPE = "control_msgs/action/GripperCommand"
 
 # The node serving the controller manager's services (ros2_control's name).
@@ -51,6 +52,11 @@ WRENCH_TYPE = "geometry_msgs/msg/WrenchStamped"
 def follow_joint_trajectory_action(controller: str) -> str:
     """A trajectory controller's FollowJointTrajectory action: ``/<controller>/follow_joint_trajectory``."""
     return f"/{controller}/follow_joint_trajectory"
+
+
+def joint_trajectory_topic(controller: str) -> str:
+    """A trajectory controller's streaming input: ``/<controller>/joint_trajectory``."""
+    return f"/{controller}/joint_trajectory"
 
 
 def gripper_command_action(controller: str) -> str:

@@ -315,6 +315,25 @@ class JointTrajectoryController:
             now,
         )
 
+    def stream(self, goal: TrajectoryGoal | None, data: Any) -> None:
+        """A trajectory from the controller's ``joint_trajectory`` topic (ros2_control's streaming input).
+
+        It replaces whatever runs, as a goal nobody waits on; ``None`` (an empty trajectory) stops the arm:
+        it brakes, then holds. An inactive controller ignores the topic, as ros2_control's does.
+        """
+        if not self.active:
+            log.warning("%s: ignoring a trajectory on its topic: the controller is inactive", self.name)
+            return
+        if goal is not None:
+            self.start(Execution(f"{self.name} joint_trajectory topic"), goal, data)
+        elif self._running is not None:
+            self._end(
+                data,
+                "aborted",
+                _result(SUCCESSFUL, "stopped by an empty trajectory on the joint_trajectory topic"),
+                hold=True,
+            )
+
     def cancel(self, execution: Execution, data: Any) -> None:
         """Stop the goal of ``execution`` now: brake the joints to a stop and hold them there."""
         running = self._running
