@@ -5,8 +5,6 @@ from __future__ import annotations
 import time
 from typing import Any
 
-import numpy as np
-
 from kinema.behaviors import AsyncBehavior, FormerSpelling, PortInfo, input_port
 from kinema.behaviors.work_runner import RUNNER
 from kinema.config.cell import ADMITTANCE_CONTROLLER
@@ -239,6 +237,8 @@ class ExecuteTrajectory(AsyncBehavior):
         SETTLE_TIMEOUT, for the joint states to agree within a few times that tolerance, then goes on.
         """
         import asyncio
+
+        import numpy as np
 
         trajectory = goal["trajectory"]
         if not trajectory.points:
