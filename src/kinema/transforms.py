@@ -112,7 +112,8 @@ def quaternion_from_matrix(rotation: np.ndarray) -> np.ndarray:
 
 
 def rotation_from_rotvec(rotation_vector: Any) -> np.ndarray:
-    """The ``(3, 3)`` rotation about ``rotation_vector``'s axis by its length (rad)."""
+    """The ``(3, 3)`` rotation about ``rotation_vector``'s axis by its length (rad); ``(N, 3)`` vectors give
+    ``(N, 3, 3)`` rotations."""
     from scipy.spatial.transform import Rotation
 
     return Rotation.from_rotvec(np.asarray(rotation_vector, dtype=float)).as_matrix()

@@ -201,13 +201,13 @@ def target_path(world_T_target: np.ndarray, twist: np.ndarray, times: np.ndarray
         twist: its linear (m/s) and angular (rad/s) velocity in the world frame, ``(6,)``.
         times: seconds from now.
     """
-    from scipy.spatial.transform import Rotation
+    from kinema.transforms import rotation_from_rotvec
 
     twist = np.asarray(twist, dtype=float)
     poses = np.repeat(np.asarray(world_T_target, dtype=float)[None], len(times), axis=0)
     poses[:, :3, 3] += np.outer(times, twist[:3])
     if twist[3:].any():
-        turns = Rotation.from_rotvec(np.outer(times, twist[3:])).as_matrix()
+        turns = rotation_from_rotvec(np.outer(times, twist[3:]))
         poses[:, :3, :3] = turns @ poses[:, :3, :3]
     return poses
 
