@@ -5,7 +5,10 @@
 - cameras: the cameras of the config's MuJoCo scene that are fixed in the world (``scene_camera``), in
   MuJoCo's camera convention (looking along -z, y up), read once per cell;
 - simulated objects: the MuJoCo driver's free bodies (``/mujoco/bodies``), when a simulator runs;
-- planning-scene objects: each world object's first primitive, under the object's id.
+- planning-scene objects: each world object's first primitive, under the object's id; an object attached
+  to the robot at its own pose on its link, at the configuration;
+- published frames: frames a behavior broadcasts while it runs (``PublishTF``), each a pose in a parent
+  frame of the tree (a robot link, the world, another frame), so later behaviors can name them.
 
 One :class:`CellFrames` belongs to a :class:`~kinema.behaviors.BehaviorContext` (``context.frames``).
 """
@@ -67,6 +70,26 @@ class CellFrames:
         self._context = context
         self._cameras: dict[str, np.ndarray] | None = None
         self._lock = threading.Lock()
+        self._published: dict[str, tuple[str, np.ndarray]] = {}
+
+    def publish(self, child: str, parent: str, parent_T_child: np.ndarray) -> None:
+        """Make frame ``child`` known at ``parent_T_child`` in frame ``parent`` until :meth:`withdraw`.
+
+        A frame published again moves. ``parent`` is resolved whenever a tree is made, so a frame published
+        in a robot link's frame moves with the robot.
+        """
+        with self._lock:
+            self._published[child] = (parent, np.array(parent_T_child, dtype=float))
+
+    def withdraw(self, child: str) -> None:
+        """Forget published frame ``child`` (nothing happens when it is not published)."""
+        with self._lock:
+            self._published.pop(child, None)
+
+    def published(self) -> dict[str, tuple[str, np.ndarray]]:
+        """The published frames: child -> (parent, ``parent_T_child``), a snapshot."""
+        with self._lock:
+            return dict(self._published)
 
     @property
     def cameras(self) -> dict[str, np.ndarray]:
@@ -106,4 +129,29 @@ class CellFrames:
         """The frame tree with the robot at configuration ``q`` (over the robot model's joint names)."""
         from kinema.motion.frames import FrameTree
 
-        return FrameTree(self._context.robot_model, q, self.fixed())
+        model = self._context.robot_model
+        fixed = self.fixed()
+        base = FrameTree(model, q, fixed)
+        attached = self._context.planning_scene.attached_objects()
+        published = self.published()
+        if not attached and not published:
+            return base
+        extra: dict[str, np.ndarray] = {}
+        for object_id, item in attached.items():
+            if item.link in base:
+                extra[object_id] = base.world_T(item.link) @ item.link_T_object
+        # A published frame may hang from another published frame: resolve in passes.
+        pending = dict(published)
+        while pending:
+            resolved = False
+            for child, (parent, parent_T_child) in list(pending.items()):
+                if parent in base or parent in extra:
+                    world_T_parent = extra[parent] if parent in extra else base.world_T(parent)
+                    extra[child] = world_T_parent @ parent_T_child
+                    del pending[child]
+                    resolved = True
+            if not resolved:
+                break  # frames whose parent nobody knows (any more) stay unknown
+        if not extra:
+            return base
+        return FrameTree(model, q, {**fixed, **extra})

@@ -284,6 +284,7 @@ class SceneViewer:
             self._follow_joint_states()
         if changed:
             commands += self.scene.body_commands()
+            commands += self.planning_scene.follow(self.scene.frame_pose)
             now = time.monotonic()
             with self._lock:
                 self._rate_window = [t for t in self._rate_window if now - t <= 1.0] + [now]
