@@ -130,11 +130,20 @@ def test_a_carried_urdf_tool_is_checked_by_the_planner_and_left_where_it_is_deta
     assert "rod - table" in carried.toasts[-1]
 
     cell.move_to(OVER_TABLE)
-    detached = tick_behavior(behavior("DetachURDF"), {"urdf_name": "rod"}, context=cell.context)
-    assert detached.status == NodeStatus.SUCCESS, detached.toasts
     over_grasp = fk(
         lab_sim_model, lab_sim_model.configuration(dict(zip(ARM, OVER_TABLE, strict=True))), "grasp_link"
     )
+    # the carried object is a frame of the cell that moves with its link
+    in_rod = from_dict("geometry_msgs/msg/PoseStamped", {"header": {"frame_id": "rod"}, "pose": {}})
+    seen = tick_behavior(
+        behavior("TransformPoseFrame"),
+        {"input_pose": in_rod, "target_frame_id": "world"},
+        context=cell.context,
+    )
+    position = seen.outputs["output_pose"].pose.position
+    np.testing.assert_allclose([position.x, position.y, position.z], over_grasp[:3, 3], atol=1e-6)
+    detached = tick_behavior(behavior("DetachURDF"), {"urdf_name": "rod"}, context=cell.context)
+    assert detached.status == NodeStatus.SUCCESS, detached.toasts
     np.testing.assert_allclose(cell.scene.world_poses["rod"], over_grasp, atol=1e-6)
     removed = tick_behavior(behavior("RemoveURDFFromScene"), {"urdf_name": "rod"}, context=cell.context)
     assert removed.status == NodeStatus.SUCCESS and "rod" not in cell.scene.world

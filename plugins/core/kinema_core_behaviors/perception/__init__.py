@@ -19,6 +19,7 @@ from .masks import GetMasks3DFromMasks2D, GetPointCloudFromMask3D
 from .merge_point_clouds import MergePointClouds
 from .register_point_clouds import RegisterPointClouds
 from .segmentation import GetMasks2DFromExemplar, GetMasks2DFromPointQuery
+from .synced_image_and_cloud import GetSyncedImageAndPointCloud
 from .transform_point_cloud import TransformPointCloud, TransformPointCloudFrame
 from .tray_place_positions import ComputeTrayPlacePositionsUsingAprilTags
 from .update_planning_scene import UpdatePlanningSceneService
@@ -45,4 +46,5 @@ BEHAVIORS = (
     DetectAprilTags,
     GetDetectionPose,
     ComputeTrayPlacePositionsUsingAprilTags,
+    GetSyncedImageAndPointCloud,
 )
