@@ -41,6 +41,7 @@ _EXPORTS = {
     "PlanningOptions": "planner",
     "PLANNERS": "planner",
     "plan_cartesian_path": "cartesian",
+    "raster_poses": "coverage",
     "CartesianResult": "cartesian",
     "time_parameterize": "timing",
     "Task": "task",

@@ -10,9 +10,11 @@ from __future__ import annotations
 
 from .apriltags import DetectAprilTags, GetDetectionPose
 from .box_filters import CropPointsInBox, RemovePointsInBox
+from .calibrate_camera_pose import CalibrateCameraPose
 from .camera_topics import GetCameraInfo, GetImage, GetPointCloud
 from .centroid import GetCentroidFromPointCloud
 from .collision_spheres import CreateCollisionSpheresAtClosestPoints
+from .contour_from_slice import GetContourFromPointCloudSlice
 from .find_masked_objects import FindMaskedObjects
 from .load_point_cloud_from_file import LoadPointCloudFromFile
 from .masks import GetMasks3DFromMasks2D, GetPointCloudFromMask3D
@@ -47,4 +49,6 @@ BEHAVIORS = (
     GetDetectionPose,
     ComputeTrayPlacePositionsUsingAprilTags,
     GetSyncedImageAndPointCloud,
+    GetContourFromPointCloudSlice,
+    CalibrateCameraPose,
 )
