@@ -244,12 +244,14 @@ class SetupMTCPlanToPose(_SetupStage):
 class SetupMTCPlanToRobotState(_SetupStage):
     """Adds a stage that moves the planning group to ``joint_state`` (a collision-free motion).
 
-    It is what MoveIt Pro's former SetupMTCInterpolateToJointState reads as: the straight joint-space
-    motion is tried first, and planned around obstacles only when it collides.
+    The straight joint-space motion is tried first, and planned around obstacles (keeping ``link_padding``,
+    drawing at most ``max_iterations`` samples from ``seed``) only when it collides; the motion is timed
+    under the scaled limits and sampled ``trajectory_sampling_rate`` times a second. It is also what
+    MoveIt Pro's former SetupMTCInterpolateToJointState reads as.
     """
 
     former_spellings = (FormerSpelling("SetupMTCInterpolateToJointState"),)
-    MOTION = MotionPorts(velocity=None, acceleration=None, planning=False)
+    MOTION = MotionPorts(seed=True)
 
     @classmethod
     def stage_ports(cls) -> list[PortInfo]:
