@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from kinema.behaviors import NodeStatus, PortInfo, StatefulBehavior, input_port
+from kinema.behaviors import FormerSpelling, NodeStatus, PortInfo, StatefulBehavior, input_port
 from kinema.ui_topics import TF_TOPIC, TF_TYPE
 
 from ..messages.conversions import POSE_STAMPED_TYPE, pose_matrix
@@ -24,6 +24,8 @@ class PublishTF(StatefulBehavior):
     """
 
     subcategory = "Math - Poses"
+    # MoveIt Pro's older broadcaster of a pose as a (static) frame, with the same ports but the rate.
+    former_spellings = (FormerSpelling("PublishStaticFrame"),)
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

@@ -250,7 +250,10 @@ class SetupMTCPlanToRobotState(_SetupStage):
     MoveIt Pro's former SetupMTCInterpolateToJointState reads as.
     """
 
-    former_spellings = (FormerSpelling("SetupMTCInterpolateToJointState"),)
+    former_spellings = (
+        FormerSpelling("SetupMTCInterpolateToJointState"),
+        FormerSpelling("SetupMTCPlanToJointState"),
+    )
     MOTION = MotionPorts(seed=True)
 
     @classmethod
@@ -323,6 +326,20 @@ class SetupMTCBatchPoseIK(_SetupStage):
     """Adds a stage that solves IK for each of ``target_poses`` and keeps the solutions closest to the
     state before (up to ``max_ik_solutions``); the stages around it plan to or from the closest that works.
     """
+
+    # MoveIt Pro's old one-stage pick (approach, close the gripper, lift, set by LoadObjectiveParameters)
+    # became a few stages and behaviors, this one among them; Kinema plans no gripper motion inside a
+    # task, so the old stage is refused with how to write it today rather than half done.
+    former_spellings = (
+        FormerSpelling(
+            "SetupMTCPickObject",
+            refused="it planned the approach, closed the gripper and lifted in one MTC stage, and Kinema's "
+            "task planner moves no gripper; write it as MoveIt Pro's lab_sim 'Pick from Pose' does today: "
+            "SetupMTCConnectWithProRRT, SetupMTCMoveAlongFrameAxis (the approach), SetupMTCBatchPoseIK "
+            "(the grasp pose), PlanMTCTask and 'Execute MTC Solution', then 'Close Gripper' and a "
+            "PlanCartesianPath + ExecuteTrajectory to lift",
+        ),
+    )
 
     @classmethod
     def stage_ports(cls) -> list[PortInfo]:
