@@ -146,6 +146,7 @@ class CollisionChecker:
             for d in carried:
                 if d > c and gm.geometryObjects[d].parentJoint != gc.parentJoint:
                     gm.addCollisionPair(pin.CollisionPair(c, d))
+        self._carried = sorted(carried)
         self._geom_model = gm
         self._geom_data = pin.GeometryData(gm)
         self._scene_pairs = scene_pairs
@@ -229,12 +230,15 @@ class CollisionChecker:
         return pairs
 
     def robot_bounds(self, q: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
-        """World-axis-aligned bounds ``(lower, upper)`` of each robot collision geometry at ``q`` (m).
+        """World-axis-aligned bounds ``(lower, upper)`` of each robot collision geometry at ``q`` (m), the
+        shapes of the objects it carries included.
 
         Loose for tilted shapes; meant for filtering the robot out of what its cameras see.
         """
         import pinocchio as pin
 
+        if self.scene.version != self._scene_version:
+            self._build()
         pin.updateGeometryPlacements(
             self.model.pin_model,
             self._data,
@@ -243,7 +247,7 @@ class CollisionChecker:
             self.model.pin_configuration(np.asarray(q, dtype=float)),
         )
         bounds = []
-        for index in range(self._n_robot):
+        for index in [*range(self._n_robot), *self._carried]:
             geometry = self._geom_model.geometryObjects[index].geometry
             geometry.computeLocalAABB()
             box = geometry.aabb_local

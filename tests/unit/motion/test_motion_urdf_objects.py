@@ -183,3 +183,19 @@ def test_the_scene_message_lists_attached_objects_in_their_links_frame(model: Ro
     assert item.link_name == "tool0" and sorted(item.touch_links) == ["tool0", "wrist_3_link"]
     assert item.object.id == "rod" and item.object.header.frame_id == "tool0"
     assert [p.position.z for p in item.object.primitive_poses] == pytest.approx([0.22, 0.43])
+
+
+def test_the_robots_bounds_include_what_it_carries(model: RobotModel) -> None:
+    scene = PlanningScene()
+    checker = CollisionChecker(model, scene)
+    home = _q(model, HOME)
+    bare = checker.robot_bounds(home)
+    world_T_grasp = fk(model, home, "grasp_link")
+    rod = urdf_object_from_text(ROD, base_dir=".")
+    scene.add_world_object("rod", rod.placed(world_T_grasp), pose=world_T_grasp, urdf=True)
+    assert len(checker.robot_bounds(home)) == len(bare)  # in the world it is not the robot's
+    scene.attach("rod", "grasp_link", world_T_grasp)
+    carried = checker.robot_bounds(home)
+    assert len(carried) == len(bare) + 2
+    tip = (world_T_grasp @ [0, 0, 0.43, 1])[:3]
+    assert any(np.all(low <= tip) and np.all(tip <= high) for low, high in carried[len(bare) :])
