@@ -1,7 +1,8 @@
 """Speed of the terminal UI: time to first paint, and input latency while the blackboard streams.
 
-1. **First paint.** ``kinema ui --demo`` runs in a pseudo-terminal; the clock stops when the screen's
-   first frame (the navigation bar) arrives, and again when the objective list and tree are shown. The
+1. **First paint.** ``kinema ui`` (the real app, attached to an endpoint where no runtime answers yet) and
+   ``kinema ui --demo`` run in a pseudo-terminal; the clock stops when the screen's first frame (the
+   navigation bar) arrives, and for the demo again when the objective list and tree are shown. The
    peer, measured in the same run the same way, is a bare Textual app showing one line, so the ratio says
    what Kinema adds on top of Textual's own start. Target: under 1.5 s.
 2. **Input latency under load.** The app runs (headless, rendering included) on the Blackboard screen while
@@ -86,20 +87,34 @@ def _strip_escapes(data: bytes) -> bytes:
     return re.sub(rb"\x1b\[[0-9;?]*[A-Za-z]|\x1b[()][A-Za-z0-9]|\x1b\][^\x07]*\x07", b"", data)
 
 
+def _free_port() -> int:
+    import socket
+
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
 def first_paint(runs: int) -> None:
-    kinema = [sys.executable, "-m", "kinema.cli.main", "ui", "--demo"]
+    # The real app (`kinema ui`), attached to an endpoint where no runtime answers yet: what a user sees
+    # first whether or not the runtime is up (the screen is drawn before the connection is made).
+    real = [sys.executable, "-m", "kinema.cli.main", "ui", "--connect", f"tcp/127.0.0.1:{_free_port()}"]
+    demo = [sys.executable, "-m", "kinema.cli.main", "ui", "--demo"]
     bare = [sys.executable, "-c", BARE_APP]
-    paint, ready, peer = [], [], []
+    paint, demo_paint, ready, peer = [], [], [], []
     for _ in range(runs):
-        first, shown = time_to_output(kinema, [b"Objectives", b"MoveToWaypoint"])
-        paint.append(first)
+        paint.append(time_to_output(real, [b"Objectives"])[0])
+        first, shown = time_to_output(demo, [b"Objectives", b"MoveToWaypoint"])
+        demo_paint.append(first)
         ready.append(shown)
         peer.append(time_to_output(bare, [b"Objectives ready"])[0])
-    print(f"First paint (pseudo-terminal, median of {runs} runs)")
-    print(f"  kinema ui --demo   first frame  {statistics.median(paint) * 1000:7.0f} ms   (target < 1500 ms)")
+    print(f"First paint (pseudo-terminal, median of {runs} runs, interleaved)")
+    print(f"  kinema ui          first frame  {statistics.median(paint) * 1000:7.0f} ms   (target < 1500 ms)")
+    print(f"  kinema ui --demo   first frame  {statistics.median(demo_paint) * 1000:7.0f} ms")
     print(f"  kinema ui --demo   tree shown   {statistics.median(ready) * 1000:7.0f} ms")
     print(f"  bare Textual app   first frame  {statistics.median(peer) * 1000:7.0f} ms")
-    print(f"  ratio kinema / bare Textual     {statistics.median(paint) / statistics.median(peer):7.2f}x")
+    ratio = statistics.median(paint) / statistics.median(peer)
+    print(f"  ratio kinema ui / bare Textual  {ratio:7.2f}x   (target 2x)")
 
 
 # -- input latency under a blackboard stream -----------------------------------------------------------

@@ -228,3 +228,32 @@ def test_the_status_line_shows_the_watchdog_warning_until_it_clears() -> None:
     assert "⚠ behavior 'Block' (main/block) has been in tick for 3 s (+1 more)" in line, line
     status.apply_heartbeat(Heartbeat(2.0, "Pick", "Cancelled"))
     assert "⚠" not in render_status(status).plain
+
+
+def test_closing_while_the_runtime_is_unreachable_does_not_wait_for_the_attempt() -> None:
+    """Quitting `kinema ui` that is still trying to reach a runtime: joining a router that does not answer
+    takes zenoh about 2 s, and the app used to wait for the attempt (up to 5 s) before it closed."""
+    import socket
+    import time
+
+    from kinema.tui.sdk_connection import SdkConnection
+
+    with socket.socket() as probe:  # a free port: nothing answers there
+        probe.bind(("127.0.0.1", 0))
+        port = probe.getsockname()[1]
+    connection = SdkConnection(f"tcp/127.0.0.1:{port}")
+    events: list[object] = []
+    connection.open(events.append)
+    attempt = connection._thread
+    assert attempt is not None
+    time.sleep(0.3)  # the attempt is under way
+    closed = time.monotonic()
+    connection.close()
+    took = time.monotonic() - closed
+    events_at_close = len(events)
+    attempt.join(30.0)
+    assert not attempt.is_alive(), "the connection thread never ended after close()"
+    # A generous bound: the attempt alone takes ~2 s, which close() used to wait out.
+    assert took < 1.5, f"close() took {took:.1f} s"
+    assert len(events) == events_at_close, "the app got events after it closed the connection"
+    assert connection._client is None

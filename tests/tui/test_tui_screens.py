@@ -313,10 +313,10 @@ def test_status_bar_shows_heartbeat_sim_time_and_a_lost_runtime_then_reloads_on_
 
 
 def test_every_binding_has_an_id_and_a_tooltip() -> None:
-    from kinema.tui.app import KinemaApp
+    from kinema.tui.app import SCREEN_CLASSES, KinemaApp, screen_class
 
-    for screen in KinemaApp.MODES.values():
-        for binding in [*KinemaApp.BINDINGS, *screen.BINDINGS]:  # type: ignore[union-attr]
+    for mode in SCREEN_CLASSES:
+        for binding in [*KinemaApp.BINDINGS, *screen_class(mode).BINDINGS]:
             assert binding.id and binding.tooltip, binding
 
 

@@ -70,15 +70,17 @@ def ui(
     if replay is not None:
         _replay(replay)
         return
-    # Ask the terminal what images it can draw while the app's modules load: the questions wait for
-    # answers (up to 0.1 s each in a terminal that gives none) and must be asked before the app owns the
-    # terminal; run_app imports the camera screen, which then finds the answers cached. Rich (which both
-    # sides import, and Textual needs first anyway) is loaded before, so the two threads do not import
-    # the same modules at once: the probe's own are PIL, numpy and textual_image.
-    import rich.console  # noqa: F401
+    # With --camera the first screen draws images: ask the terminal what it can draw while the app's
+    # modules load. The questions wait for answers (up to 0.1 s each in a terminal that gives none) and
+    # must be asked before the app owns the terminal. Without --camera the app asks when the camera view
+    # first opens. Rich (which both sides import, and Textual needs first anyway) is loaded before, so
+    # the two threads do not import the same modules at once.
+    probe: threading.Thread | None = None
+    if camera:
+        import rich.console  # noqa: F401
 
-    probe = threading.Thread(target=_probe_image_support, name="kinema-ui-image-probe", daemon=True)
-    probe.start()
+        probe = threading.Thread(target=_probe_image_support, name="kinema-ui-image-probe", daemon=True)
+        probe.start()
     from kinema.tui.app import run_app
     from kinema.tui.connection import RuntimeConnection
 
@@ -94,15 +96,15 @@ def ui(
         from kinema.tui.sdk_connection import SdkConnection
 
         connection = SdkConnection(endpoint=endpoint, workspace=workspace, config=config)
-    probe.join()
+    if probe is not None:
+        probe.join()
     run_app(connection, owns_runtime=False, initial_mode=screen, camera=camera)
 
 
 def _probe_image_support() -> None:
-    try:
-        import textual_image.renderable  # noqa: F401  (queries the terminal once, on import)
-    except Exception:
-        pass  # the camera screen imports it again and says what is wrong
+    from kinema.tui.screens.camera import load_image_support
+
+    load_image_support()
 
 
 def _replay(which: str) -> None:

@@ -88,12 +88,16 @@ class ControllerSpec:
         type: the ros2_control type, e.g. ``joint_trajectory_controller/JointTrajectoryController``.
         joints: the joints it commands (empty: the driver decides, e.g. every arm joint).
         active: started with the cell (``controllers_active_at_startup``), else loaded inactive.
+        parameters: its ``ros__parameters`` in MoveIt Pro's ros2_control yaml (empty without one); the
+            driver reads the ones it simulates (e.g. the admittance controller's
+            ``default_absolute_force_torque_threshold``).
     """
 
     name: str
     type: str
     joints: tuple[str, ...] = ()
     active: bool = True
+    parameters: Mapping[str, Any] = field(default_factory=dict, compare=False)
 
 
 @dataclass(frozen=True)
@@ -207,6 +211,16 @@ CELL_VALUE_KEYS: dict[str, tuple[Any, str]] = {
         lambda c: c.gripper.closed_position if c.gripper else None,
         "robot.gripper.closed_position",
     ),
+    "admittance_controller_action": (
+        lambda c: next(
+            (
+                f"/{spec.name}/follow_joint_trajectory"
+                for spec in c.controllers_of_type(ADMITTANCE_CONTROLLER)
+            ),
+            None,
+        ),
+        "ros2_control (a controller of type " + ADMITTANCE_CONTROLLER + ")",
+    ),
     "camera_color_topic": (
         lambda c: f"/{c.default_camera}/color" if c.default_camera else None,
         "robot.default_camera",
@@ -289,7 +303,11 @@ def _controllers(
         if isinstance(joints, str):
             joints = [joints]
         out[name] = ControllerSpec(
-            name=name, type=type_name, joints=tuple(str(j) for j in joints), active=name not in inactive
+            name=name,
+            type=type_name,
+            joints=tuple(str(j) for j in joints),
+            active=name not in inactive,
+            parameters=params,
         )
     return out
 

@@ -10,6 +10,8 @@ transport's registry (so ``AddTwoInts.Response`` *is* the class responses are bu
 importing this module registers nothing).
 """
 
+# ruff: noqa: E501  (generated: a line holds a type name as long as ROS spells it)
+
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
@@ -846,6 +848,102 @@ if TYPE_CHECKING:
         __msgtype__: ClassVar[str] = "moveit_msgs/srv/GetPlanningScene_Response"
 
     @dataclass
+    class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Feedback:
+        """moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_Feedback."""
+
+        header: std_msgs__msg__Header
+        joint_names: list[str]
+        desired: trajectory_msgs__msg__JointTrajectoryPoint
+        actual: trajectory_msgs__msg__JointTrajectoryPoint
+        error: trajectory_msgs__msg__JointTrajectoryPoint
+        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_Feedback"
+
+    @dataclass
+    class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_FeedbackMessage:
+        """moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_FeedbackMessage."""
+
+        goal_id: unique_identifier_msgs__msg__UUID
+        feedback: moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Feedback
+        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_FeedbackMessage"
+
+    @dataclass
+    class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_GetResult_Request:
+        """moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_GetResult_Request."""
+
+        goal_id: unique_identifier_msgs__msg__UUID
+        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_GetResult_Request"
+
+    @dataclass
+    class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_GetResult_Response:
+        """moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_GetResult_Response."""
+
+        status: int
+        result: moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Result
+        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_GetResult_Response"
+
+    @dataclass
+    class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Goal:
+        """moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_Goal."""
+
+        trajectory: trajectory_msgs__msg__JointTrajectory
+        multi_dof_trajectory: trajectory_msgs__msg__MultiDOFJointTrajectory
+        path_tolerance: list[control_msgs__msg__JointTolerance]
+        component_path_tolerance: list[control_msgs__msg__JointComponentTolerance]
+        goal_tolerance: list[control_msgs__msg__JointTolerance]
+        component_goal_tolerance: list[control_msgs__msg__JointComponentTolerance]
+        goal_time_tolerance: builtin_interfaces__msg__Duration
+        admittance_parameters: moveit_pro_controllers_msgs__msg__AdmittanceParameters
+        absolute_force_torque_threshold: np.ndarray[tuple[int, ...], np.dtype[np.float64]]
+        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_Goal"
+
+    @dataclass
+    class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Result:
+        """moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_Result."""
+
+        error_code: int
+        error_string: str
+        SUCCESSFUL: ClassVar[int] = 0
+        INVALID_GOAL: ClassVar[int] = -1
+        INVALID_JOINTS: ClassVar[int] = -2
+        OLD_HEADER_TIMESTAMP: ClassVar[int] = -3
+        PATH_TOLERANCE_VIOLATED: ClassVar[int] = -4
+        GOAL_TOLERANCE_VIOLATED: ClassVar[int] = -5
+        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_Result"
+
+    @dataclass
+    class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_SendGoal_Request:
+        """moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_SendGoal_Request."""
+
+        goal_id: unique_identifier_msgs__msg__UUID
+        goal: moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Goal
+        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_SendGoal_Request"
+
+    @dataclass
+    class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_SendGoal_Response:
+        """moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_SendGoal_Response."""
+
+        accepted: bool
+        stamp: builtin_interfaces__msg__Time
+        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_SendGoal_Response"
+
+    @dataclass
+    class moveit_pro_controllers_msgs__msg__AdmittanceParameters:
+        """moveit_pro_controllers_msgs/msg/AdmittanceParameters."""
+
+        controller_name: str
+        end_effector_frame: str
+        control_frame: str
+        selected_axes: moveit_pro_controllers_msgs__msg__CartesianSelectionVector
+        mass_position: geometry_msgs__msg__Vector3
+        mass_rotation: geometry_msgs__msg__Vector3
+        stiffness_position: geometry_msgs__msg__Vector3
+        stiffness_rotation: geometry_msgs__msg__Vector3
+        damping_ratio_position: geometry_msgs__msg__Vector3
+        damping_ratio_rotation: geometry_msgs__msg__Vector3
+        joint_damping: float
+        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/msg/AdmittanceParameters"
+
+    @dataclass
     class moveit_pro_controllers_msgs__msg__CartesianSelectionVector:
         """moveit_pro_controllers_msgs/msg/CartesianSelectionVector."""
 
@@ -1426,6 +1524,20 @@ if TYPE_CHECKING:
         Result: TypeAlias = example_interfaces__action__Fibonacci_Result
         Feedback: TypeAlias = example_interfaces__action__Fibonacci_Feedback
 
+    class FollowJointTrajectoryWithAdmittance(
+        ActionDefinition[
+            moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Goal,
+            moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Result,
+            moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Feedback,
+        ]
+    ):
+        """moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance."""
+
+        type_name: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance"
+        Goal: TypeAlias = moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Goal
+        Result: TypeAlias = moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Result
+        Feedback: TypeAlias = moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Feedback
+
     class DoObjectiveSequence(
         ActionDefinition[
             moveit_studio_sdk_msgs__action__DoObjectiveSequence_Goal,
@@ -1567,6 +1679,15 @@ _MESSAGES = frozenset(
         "moveit_msgs__msg__RobotState",
         "moveit_msgs__srv__GetPlanningScene_Request",
         "moveit_msgs__srv__GetPlanningScene_Response",
+        "moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Feedback",
+        "moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_FeedbackMessage",
+        "moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_GetResult_Request",
+        "moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_GetResult_Response",
+        "moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Goal",
+        "moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Result",
+        "moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_SendGoal_Request",
+        "moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_SendGoal_Response",
+        "moveit_pro_controllers_msgs__msg__AdmittanceParameters",
         "moveit_pro_controllers_msgs__msg__CartesianSelectionVector",
         "moveit_pro_controllers_msgs__msg__VelocityForceCommand",
         "moveit_studio_agent_msgs__msg__Log",
@@ -1631,5 +1752,6 @@ _ACTIONS: dict[str, str] = {
     "FollowJointTrajectory": "control_msgs/action/FollowJointTrajectory",
     "GripperCommand": "control_msgs/action/GripperCommand",
     "Fibonacci": "example_interfaces/action/Fibonacci",
+    "FollowJointTrajectoryWithAdmittance": "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance",
     "DoObjectiveSequence": "moveit_studio_sdk_msgs/action/DoObjectiveSequence",
 }

@@ -34,6 +34,8 @@ transport's registry (so ``AddTwoInts.Response`` *is* the class responses are bu
 importing this module registers nothing).
 """
 
+# ruff: noqa: E501  (generated: a line holds a type name as long as ROS spells it)
+
 from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any

@@ -18,7 +18,7 @@ from functools import partial
 from pathlib import Path
 
 from textual import events
-from textual.app import App, SystemCommand
+from textual.app import App, SuspendNotSupported, SystemCommand
 from textual.binding import Binding
 from textual.notifications import SeverityLevel
 from textual.screen import Screen
@@ -55,15 +55,33 @@ from kinema.tui.repeat_limiter import RepeatLimiter, held_back, watchdog_kind
 from kinema.tui.run_outcome import RunOutcome, parse_outcome
 from kinema.tui.runtime_status import ACTIVE_STATUSES, RuntimeStatus
 from kinema.tui.screens.base import KinemaScreen, RuntimeView
-from kinema.tui.screens.behaviors import BehaviorsScreen
-from kinema.tui.screens.blackboard import BlackboardScreen
-from kinema.tui.screens.configs import ConfigsScreen
-from kinema.tui.screens.logs import LogsScreen
-from kinema.tui.screens.objectives import ObjectivesScreen
-from kinema.tui.screens.waypoints import WaypointsScreen
 from kinema.tui.widgets.nav_bar import SCREENS
 
 log = logging.getLogger("kinema.tui")
+
+# The app's screens (modes): module in kinema.tui.screens and class, imported when first shown.
+SCREEN_CLASSES = {
+    "configs": ("configs", "ConfigsScreen"),
+    "objectives": ("objectives", "ObjectivesScreen"),
+    "blackboard": ("blackboard", "BlackboardScreen"),
+    "behaviors": ("behaviors", "BehaviorsScreen"),
+    "logs": ("logs", "LogsScreen"),
+    "waypoints": ("waypoints", "WaypointsScreen"),
+}
+
+
+def screen_class(mode: str) -> type[Screen[None]]:
+    """The class of the screen for ``mode`` (a key of :data:`SCREEN_CLASSES`), its module imported now."""
+    import importlib
+
+    module, name = SCREEN_CLASSES[mode]
+    cls: type[Screen[None]] = getattr(importlib.import_module(f"kinema.tui.screens.{module}"), name)
+    return cls
+
+
+def _new_screen(mode: str) -> Screen[None]:
+    return screen_class(mode)()
+
 
 MAX_LOGS = 2000
 # Seconds the app waits for a key to go all the way up before it gives out the next one anyway.
@@ -141,14 +159,8 @@ class KinemaApp(App[None]):
     VERTICAL_BREAKPOINTS = [(0, "-short"), (32, "-tall")]
     # Absolute, so subclasses defined elsewhere (tests, embedding apps) find the stylesheet too.
     CSS_PATH = Path(__file__).with_name("app.tcss")
-    MODES = {
-        "configs": ConfigsScreen,
-        "objectives": ObjectivesScreen,
-        "blackboard": BlackboardScreen,
-        "behaviors": BehaviorsScreen,
-        "logs": LogsScreen,
-        "waypoints": WaypointsScreen,
-    }
+    # Each screen's module is imported when the screen is first shown: the first frame needs only one.
+    MODES = {mode: partial(_new_screen, mode) for mode in SCREEN_CLASSES}
     BINDINGS = [
         *(
             Binding(
@@ -220,6 +232,8 @@ class KinemaApp(App[None]):
         self._switching = False
         self._key_timer: Timer | None = None
         self.views: list[RuntimeView] = []
+        self._connection_open = False
+        self._closing = False
         self.sub_title = connection.endpoint + ("  (closing stops the runtime)" if owns_runtime else "")
 
     def _run_started(self, name: str) -> None:
@@ -233,7 +247,9 @@ class KinemaApp(App[None]):
 
     def on_mount(self) -> None:
         self.switch_mode(self.initial_mode)
-        self.connection.open(self._receive)
+        # Joining the runtime imports the transport (zenoh, numpy) on the connection's thread; begun
+        # after the first frame, it does not hold the interpreter while the screen is being drawn.
+        self.call_after_refresh(self._open_connection)
         if self.camera_topic:
             self.action_show_camera(self.camera_topic)
         # Textual, the stylesheets and the screens make ~10^5 long-lived objects; every full garbage
@@ -241,7 +257,15 @@ class KinemaApp(App[None]):
         # the first frame keeps those collections to what was allocated since.
         self.call_after_refresh(gc.freeze)
 
+    def _open_connection(self) -> None:
+        if not self._closing:
+            self.connection.open(self._receive)
+            self._connection_open = True
+
     def on_unmount(self) -> None:
+        self._closing = True
+        if not self._connection_open:
+            return
         try:
             self.connection.close()
         except Exception:
@@ -539,6 +563,7 @@ class KinemaApp(App[None]):
                     self.notify, str(error), title="Nothing to replay", severity="warning", timeout=8
                 )
                 return
+
             def show() -> None:
                 self.push_screen(ReplayScreen(path, loaded))
 
@@ -548,10 +573,18 @@ class KinemaApp(App[None]):
 
     def action_show_camera(self, topic: str | None = None) -> None:
         """Open the camera view (on ``topic``, else the last one shown)."""
-        from kinema.tui.screens.camera import CameraScreen
+        from kinema.tui.screens.camera import CameraScreen, image_support_loaded, load_image_support
 
         if isinstance(self.screen, CameraScreen):
             return
+        if not image_support_loaded():
+            # textual-image asks the terminal what it can draw, and the answers come on the input the app
+            # reads: ask with the terminal handed back for a moment (once, on the first camera view).
+            try:
+                with self.suspend():
+                    load_image_support()
+            except SuspendNotSupported:  # headless (tests) or a web driver: nothing to ask
+                load_image_support()
         try:
             self.push_screen(CameraScreen(topic or self.camera_topic))
         except ValueError as error:  # KINEMA_TUI_IMAGE names no drawing method
@@ -578,6 +611,9 @@ class KinemaApp(App[None]):
             "Step through the newest recorded run of this machine (`kinema ui --replay FILE` for another)",
             self.action_replay_latest,
         )
+        from kinema.tui.screens.objectives import ObjectivesScreen
+        from kinema.tui.screens.waypoints import WaypointsScreen
+
         for view in self.views:
             if isinstance(view, ObjectivesScreen):
                 for objective in view.objectives:
@@ -620,8 +656,10 @@ def run_app(
             ``logs``, ``waypoints``).
         camera: an image topic to show in the camera view on top of it.
     """
-    # The camera view's image library asks the terminal what it can draw; that must happen before the
-    # app takes the terminal over.
-    import kinema.tui.screens.camera  # noqa: F401
+    if camera:
+        # The camera view's image library asks the terminal what it can draw; with a camera on the first
+        # screen that must happen before the app takes the terminal over (else on the first camera view).
+        from kinema.tui.screens.camera import load_image_support
 
+        load_image_support()
     KinemaApp(connection, owns_runtime=owns_runtime, initial_mode=initial_mode, camera=camera).run()

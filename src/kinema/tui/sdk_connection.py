@@ -17,7 +17,6 @@ from collections import deque
 from collections.abc import Callable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
-from xml.sax.saxutils import quoteattr
 
 from kinema.errors import KinemaError, ObjectiveError, TransportError
 from kinema.tui.connection import (
@@ -63,6 +62,8 @@ GRAPH_QUERY_S = 1.0
 #: After this long without heartbeats the session is dropped and a new one is opened.
 RECONNECT_AFTER_S = 6.0
 RETRY_PERIOD_S = 1.0
+# How long closing waits for the supervisor thread (it may be joining a router that does not answer).
+CLOSE_WAIT_S = 0.2
 CALL_TIMEOUT_S = 5.0
 #: The objective MoveIt Pro (and Kinema's core library) moves to a waypoint with.
 MOVE_TO_WAYPOINT_OBJECTIVE = "Move to Waypoint"
@@ -160,12 +161,15 @@ class SdkConnection:
         self._thread.start()
 
     def close(self) -> None:
+        """Stop listening. Returns at once even while a connection attempt is under way (joining a router
+        that does not answer takes zenoh about 2 s): the supervisor thread closes what it opens after
+        this and ends."""
         self._stop.set()
+        self._listener = None
         if self._thread is not None:
-            self._thread.join(timeout=5.0)
+            self._thread.join(timeout=CLOSE_WAIT_S)
             self._thread = None
         self._drop_client()
-        self._listener = None
 
     def _emit(self, event: RuntimeEvent) -> None:
         listener = self._listener
@@ -185,13 +189,16 @@ class SdkConnection:
             if self._client is None:
                 try:
                     self._connect()
-                except KinemaError as error:
-                    self._set_state(ConnectionState.DISCONNECTED, str(error))
-                    self._stop.wait(RETRY_PERIOD_S)
-                    continue
-                except Exception as error:  # keep retrying; the app shows why
-                    log.exception("connecting to the runtime failed")
-                    self._set_state(ConnectionState.DISCONNECTED, f"{type(error).__name__}: {error}")
+                    if self._stop.is_set():  # closed while joining: nobody will drop this client
+                        self._drop_client()
+                        break
+                except Exception as error:
+                    if self._stop.is_set():  # closed while joining: the failure is the close's
+                        self._drop_client()
+                        break
+                    if not isinstance(error, KinemaError):  # keep retrying; the app shows why
+                        log.exception("connecting to the runtime failed")
+                    self._set_state(ConnectionState.DISCONNECTED, describe(error))
                     self._stop.wait(RETRY_PERIOD_S)
                     continue
             silent = time.monotonic() - self._last_heartbeat
@@ -419,6 +426,8 @@ class SdkConnection:
                 f"the runtime has no {MOVE_TO_WAYPOINT_OBJECTIVE!r} objective to move with; "
                 "run a config whose objective library includes Kinema's core objectives"
             )
+        from xml.sax.saxutils import quoteattr  # here: it imports urllib, 30 ms the first frame need not wait
+
         # Wrapped as a SubTree, as MoveIt Pro's UI does: the subtree's other ports then take the defaults
         # its TreeNodesModel declares (planning group, controller, ...), which a direct run would not.
         xml = (
@@ -621,3 +630,8 @@ def _waypoint_summary(message: Any) -> WaypointSummary:
         positions=tuple(float(p) for p in state.position),
         joint_group_names=tuple(str(g) for g in message.joint_group_names),
     )
+
+
+def describe(error: Exception) -> str:
+    """What the app shows for a failed connection attempt: Kinema's own message, else the type too."""
+    return str(error) if isinstance(error, KinemaError) else f"{type(error).__name__}: {error}"

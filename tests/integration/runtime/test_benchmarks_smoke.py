@@ -35,7 +35,7 @@ RATIO_LINES = {
     "soak.py": "ratio",
     "task_planning.py": "task / separate calls",
     "transport_rtt.py": "Kinema call / raw query",
-    "tui.py": "ratio kinema / bare Textual",
+    "tui.py": "ratio kinema ui / bare Textual",
     "viewer.py": "drop with the view on",
 }
 # Scripts in benchmarks/ that are not benchmarks, or whose smoke run another test owns (and why).

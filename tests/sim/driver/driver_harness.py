@@ -95,11 +95,12 @@ class Sim:
     clients: dict[str, Any] = field(default_factory=dict)
 
     def action(self, name: str, type_name: str) -> Any:
-        if name not in self.clients:
+        key = f"{type_name}:{name}"  # one action name may be served with two types (the admittance's)
+        if key not in self.clients:
             client = self.node.create_action_client(type_name, name)
             assert client.wait_for_server(10.0), f"{name} is not served"
-            self.clients[name] = client
-        return self.clients[name]
+            self.clients[key] = client
+        return self.clients[key]
 
     def service(self, name: str, type_name: str) -> Any:
         key = f"srv:{name}"

@@ -109,6 +109,10 @@ def test_moveit_pros_ros2_control_yaml_gives_types_joints_and_the_sensor(ws: Wor
               ros__parameters:
                 sensor_name: wrist_fts
                 frame_id: tool0
+            joint_trajectory_admittance_controller:
+              ros__parameters:
+                ee_frame: tcp
+                default_absolute_force_torque_threshold: [30.0, 30.0, 30.0, 5.0, 5.0, 5.0]
             """
         )
     )
@@ -116,6 +120,7 @@ def test_moveit_pros_ros2_control_yaml_gives_types_joints_and_the_sensor(ws: Wor
     data["ros2_control"] = {
         "config": {"package": "ctl", "path": "config/control.yaml"},
         "controllers_active_at_startup": ["my_jtc", "grip"],
+        "controllers_inactive_at_startup": ["joint_trajectory_admittance_controller"],
     }
     data["robot"] = {"gripper": {"controller": "grip", "open_position": 0.0, "closed_position": 0.8}}
     ws.config("ctl", data)
@@ -125,6 +130,13 @@ def test_moveit_pros_ros2_control_yaml_gives_types_joints_and_the_sensor(ws: Wor
     assert cell.gripper is not None and cell.gripper.joint == "finger"
     assert cell.force_torque_sensor is not None and cell.force_torque_sensor.name == "wrist_fts"
     assert cell.force_torque_sensor.frame == "tool0"
+    # A controller's own parameters travel with it, for the driver to read what it simulates.
+    admittance = cell.controllers["joint_trajectory_admittance_controller"]
+    assert admittance.parameters["ee_frame"] == "tcp" and not admittance.active
+    assert admittance.parameters["default_absolute_force_torque_threshold"][3] == 5.0
+    assert cell.value("admittance_controller_action") == (
+        "/joint_trajectory_admittance_controller/follow_joint_trajectory"
+    )
 
 
 def test_a_cell_port_defaults_to_the_config_value_and_has_none_without_it() -> None:

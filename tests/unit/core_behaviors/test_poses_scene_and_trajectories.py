@@ -445,16 +445,6 @@ def test_stationary_trajectory_holds_the_state(behavior: Any, context: BehaviorC
     assert bad.status == NodeStatus.FAILURE and "[trajectory_duration]" in bad.toasts[-1]
 
 
-def test_admittance_ports_fail_at_run_time_naming_the_port(behavior: Any, context: BehaviorContext) -> None:
-    run = tick_behavior(
-        behavior("ExecuteTrajectory"),
-        {"joint_trajectory_msg": _trajectory(), "absolute_force_torque_threshold": "45;45;45;10;10;10"},
-        context=context,
-    )
-    assert run.status == NodeStatus.FAILURE
-    assert "absolute_force_torque_threshold" in run.toasts[-1]
-
-
 def test_cartesian_path_honours_tip_offset_and_refuses_unknown_timing(
     behavior: Any, context: BehaviorContext, at_home: Any, lab_sim_model: Any
 ) -> None:

@@ -63,6 +63,15 @@ PORTS = {
         "goal_position_tolerance": IN,
         "path_position_tolerance": IN,
     },
+    "ExecuteTrajectoryWithAdmittance": {
+        "joint_trajectory_msg": IN,
+        "controller_action_name": IN,
+        "absolute_force_torque_threshold": IN,
+        "admittance_parameters_msg": IN,
+        "goal_position_tolerance": IN,
+        "path_position_tolerance": IN,
+    },
+    "SetAdmittanceParameters": {"admittance_parameters_msg": OUT, "config_file_name": IN},
 }
 
 

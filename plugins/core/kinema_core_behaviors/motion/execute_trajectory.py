@@ -9,6 +9,7 @@ import numpy as np
 
 from kinema.behaviors import AsyncBehavior, FormerSpelling, PortInfo, input_port
 from kinema.behaviors.work_runner import RUNNER
+from kinema.config.cell import ADMITTANCE_CONTROLLER
 from kinema.drivers.mujoco.names import LIST_CONTROLLERS_SERVICE, SWITCH_CONTROLLERS_SERVICE
 from kinema.errors import KinemaError, ObjectiveError, TransportError
 
@@ -24,6 +25,10 @@ from .joint_states import joint_state_monitor
 from .planned_trajectory import publish_planned_trajectory
 
 FOLLOW_JOINT_TRAJECTORY = "control_msgs/action/FollowJointTrajectory"
+FOLLOW_JOINT_TRAJECTORY_WITH_ADMITTANCE = (
+    "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance"
+)
+ADMITTANCE_PARAMETERS = "moveit_pro_controllers_msgs/msg/AdmittanceParameters"
 # Execution goes on without a switch when no controller manager is on the graph (another robot's
 # driver) or it does not answer in time.
 LIST_TIMEOUT = 2.0
@@ -46,6 +51,11 @@ class ExecuteTrajectory(AsyncBehavior):
     deactivated, as MoveIt's trajectory execution manager does with managed controllers. MoveIt Pro's
     objectives rely on it: lab_sim's "Pick All Bottles with AprilTags" retracts on the admittance
     controller right after "Pick from Pose" executed on the default one, with no SwitchController between.
+
+    With ``admittance_parameters_msg`` or ``absolute_force_torque_threshold`` set, the trajectory travels
+    with them in one FollowJointTrajectoryWithAdmittance goal to the joint trajectory admittance
+    controller, which lets the arm give way to the wrench the wrist senses for this trajectory and aborts
+    past the threshold (lab_sim's "Push Button With a Trajectory" and "Stationary Admittance").
 
     Halting the behavior (cancelling the objective) cancels the controller's goal, which stops the
     arm where it is. Fails with the controller's error when it rejects the trajectory (unknown joints,
@@ -106,16 +116,21 @@ class ExecuteTrajectory(AsyncBehavior):
                 "absolute_force_torque_threshold",
                 list[float],
                 "",
-                "Stop when the wrist force/torque exceeds fx;fy;fz;tx;ty;tz (N, Nm). Kinema's admittance "
-                "controller stops at fixed limits (45 N, 10 N m, MoveIt Pro's defaults) and takes none per "
-                "trajectory: a non-empty value fails the behavior when it runs.",
+                "Abort when the wrench on the tool exceeds fx;fy;fz;tx;ty;tz (N, N m) along any axis of the "
+                "wrist sensor's frame, counted from the sensor's zero (its reading less the tool's weight). "
+                "Empty: the admittance controller's default (45 N, 10 N m, MoveIt Pro's). Given, the "
+                "trajectory goes to the admittance controller as admittance_parameters_msg says.",
             ),
             input_port(
                 "admittance_parameters_msg",
                 None,
                 "",
-                "Admittance parameters (from SetAdmittanceParameters): Kinema's admittance controller does "
-                "not simulate compliance, so a value fails the behavior when it runs.",
+                "Compliance for this trajectory (moveit_pro_controllers_msgs/AdmittanceParameters, from "
+                "SetAdmittanceParameters). Given, the trajectory and these parameters travel together in "
+                "one FollowJointTrajectoryWithAdmittance goal to the admittance controller: the one "
+                "controller_action_name names when it is one, else the config's controller of type "
+                "joint_trajectory_admittance_controller/JointTrajectoryAdmittanceController (activated "
+                "when inactive). The compliance lasts for this trajectory only.",
             ),
         ]
 
@@ -130,9 +145,6 @@ class ExecuteTrajectory(AsyncBehavior):
             message, "joint_trajectory_msg"
         )  # reject malformed input here, not in the driver
         names = [str(n) for n in message.joint_names]
-        unsupported = self._unsupported_port()
-        if unsupported:
-            raise ObjectiveError(unsupported)
         goal: dict[str, Any] = {"trajectory": message}
         for port, key in (
             ("path_position_tolerance", "path_tolerance"),
@@ -153,8 +165,20 @@ class ExecuteTrajectory(AsyncBehavior):
 
         node = self.context.require_node(self.registration_id)
         name = str(self.get_input("controller_action_name"))
+        action_type = FOLLOW_JOINT_TRAJECTORY
         try:
             goal = self.create_goal()
+            admittance = self.admittance_fields()
+            if admittance is not None:
+                goal.update(admittance)
+                action_type = FOLLOW_JOINT_TRAJECTORY_WITH_ADMITTANCE
+                requested = name
+                name = self.admittance_action(name, admittance.get("admittance_parameters"))
+                if name != requested:
+                    self.logger.publish_info(
+                        f"{self.registration_id}: admittance ports set: executing on {name} (the admittance "
+                        f"controller) instead of {requested}"
+                    )
         except KinemaError as error:
             return self._fail(str(error))
         publish_planned_trajectory(self, goal["trajectory"])
@@ -162,7 +186,7 @@ class ExecuteTrajectory(AsyncBehavior):
         refused = await self._activate(node, name)
         if refused:
             return self._fail(refused)
-        client = self.context.action_client(node, FOLLOW_JOINT_TRAJECTORY, name)
+        client = self.context.action_client(node, action_type, name)
         sending = RUNNER.run_function(lambda: client.send_goal(goal, timeout=5.0))
         try:
             handle = await asyncio.shield(asyncio.wrap_future(sending))
@@ -199,7 +223,8 @@ class ExecuteTrajectory(AsyncBehavior):
             return self._fail(f"the controller {name} failed: {error}")
         result = outcome.result
         if outcome.succeeded and int(result.error_code) == 0:
-            await self._until_reported(goal)
+            if "admittance_parameters" not in goal:  # a compliant arm ends where the wrench put it
+                await self._until_reported(goal)
             return True
         detail = str(result.error_string) or f"error code {int(result.error_code)}"
         return self._fail(f"the controller {name} ended the trajectory {outcome.status_name}: {detail}")
@@ -285,22 +310,66 @@ class ExecuteTrajectory(AsyncBehavior):
         self.logger.publish_failure(f"ExecuteTrajectory: {reason}")
         return False
 
-    def _unsupported_port(self) -> str:
-        """Why a set admittance port cannot be honoured ('' when none is set)."""
+    def admittance_fields(self) -> dict[str, Any] | None:
+        """The admittance part of the goal (parameters, threshold), or None when no admittance port is set.
+
+        Raises:
+            ObjectiveError: a threshold of another count than six or not positive, or parameters that are
+                not an AdmittanceParameters message; the message names the port.
+        """
         threshold = self.get_input_or("absolute_force_torque_threshold", [])
-        if isinstance(threshold, list) and threshold:
-            return (
-                f"port [absolute_force_torque_threshold] = {threshold}: Kinema's admittance controller "
-                "stops at fixed force-torque limits (45 N, 10 N m) and takes none per trajectory; leave "
-                "it empty"
-            )
+        threshold = threshold if isinstance(threshold, list) else [threshold]
         parameters = self.get_input_or("admittance_parameters_msg", "")
-        if parameters not in ("", None):
-            return (
-                "port [admittance_parameters_msg] is set: Kinema's admittance controller does not simulate "
-                "compliance; remove the port to run the trajectory without it"
+        if not threshold and parameters in ("", None):
+            return None
+        if threshold and (len(threshold) != 6 or not all(float(v) > 0 for v in threshold)):
+            raise ObjectiveError(
+                f"port [absolute_force_torque_threshold] = {threshold}: give six positive values "
+                "fx;fy;fz;tx;ty;tz (N, N m), or leave it empty for the controller's default"
             )
-        return ""
+        fields: dict[str, Any] = {"absolute_force_torque_threshold": [float(v) for v in threshold]}
+        if parameters not in ("", None):
+            if getattr(parameters, "__msgtype__", "") != ADMITTANCE_PARAMETERS:
+                raise ObjectiveError(
+                    f"port [admittance_parameters_msg] holds {type(parameters).__name__}, not a "
+                    f"{ADMITTANCE_PARAMETERS}; SetAdmittanceParameters writes one"
+                )
+            fields["admittance_parameters"] = parameters
+        return fields
+
+    def admittance_action(self, requested: str, parameters: Any = None) -> str:
+        """The admittance controller's action for a goal with admittance: ``requested`` when it is one of
+        the config's admittance controllers (or there is no config to ask), else the one the parameters'
+        ``controller_name`` names, else the config's first.
+
+        Raises:
+            ObjectiveError: the config names no admittance controller, or the parameters name a controller
+                that is not one.
+        """
+        cell = self.context.cell
+        if cell is None:
+            return requested
+        actions = [
+            f"/{spec.name}/follow_joint_trajectory"
+            for spec in cell.controllers_of_type(ADMITTANCE_CONTROLLER)
+        ]
+        if "/" + requested.lstrip("/") in actions:
+            return requested
+        named = str(getattr(parameters, "controller_name", "") or "").strip("/")
+        if named:
+            if f"/{named}/follow_joint_trajectory" in actions:
+                return f"/{named}/follow_joint_trajectory"
+            raise ObjectiveError(
+                f"port [admittance_parameters_msg] names controller_name {named!r}, which config "
+                f"{cell.config!r} has not as an admittance controller; admittance controllers: "
+                f"{', '.join(a.split('/')[1] for a in actions) or 'none'}"
+            )
+        if not actions:
+            raise ObjectiveError(
+                f"the admittance ports are set, but config {cell.config!r} has no controller of type "
+                f"{ADMITTANCE_CONTROLLER} to run them (controllers: {', '.join(cell.controllers) or 'none'})"
+            )
+        return actions[0]
 
 
 def _per_joint(values: list[float], names: list[str], port: str) -> list[float]:

@@ -21,7 +21,8 @@ controller>/follow_joint_trajectory`` and ``/<gripper controller>/gripper_cmd`` 
 ``/mujoco/keyframes`` and the ``/mujoco/scene_state`` topic; per camera of the scene ``/<camera>/color``,
 ``/depth``, ``/camera_info`` and ``/points``, rendered only while subscribed (see
 :mod:`kinema.drivers.mujoco.cameras`). With the config's force/torque sensor (lab_sim's ``tcp_fts_sensor``):
-``/<broadcaster>/wrench``, the admittance trajectory controller's ``/<controller>/follow_joint_trajectory``,
+``/<broadcaster>/wrench``, the admittance trajectory controller's ``/<controller>/follow_joint_trajectory``
+(FollowJointTrajectory and FollowJointTrajectoryWithAdmittance) and ``/<controller>/zero_fts/<sensor frame>``,
 and the velocity-force controller's ``/<controller>/command`` and ``/<controller>/zero_fts`` (see
 :mod:`kinema.drivers.mujoco.force_control`).
 """
@@ -32,13 +33,14 @@ import functools
 import logging
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
 from kinema.config import cell
 from kinema.drivers.mujoco import names
+from kinema.drivers.mujoco.admittance import AdmittanceError, AdmittanceParameters, ControlFrame
 from kinema.drivers.mujoco.cameras import CameraServer, SimState
 from kinema.drivers.mujoco.cdr_templates import (
     ClockEncoder,
@@ -84,6 +86,70 @@ RESULT_GRACE = 1.0
 def _stamp(seconds: float) -> dict[str, int]:
     nanoseconds = round(seconds * 1e9)
     return {"sec": nanoseconds // 1_000_000_000, "nanosec": nanoseconds % 1_000_000_000}
+
+
+def _admittance_of(goal: Any) -> tuple[AdmittanceParameters | None, np.ndarray | None]:
+    """The admittance and threshold of a FollowJointTrajectoryWithAdmittance goal ((None, None) for a
+    plain FollowJointTrajectory goal).
+
+    Raises:
+        GoalRejected: unusable admittance parameters, or a threshold of another length than 6.
+    """
+    if not hasattr(goal, "admittance_parameters"):
+        return None, None
+    try:
+        admittance = AdmittanceParameters.from_message(goal.admittance_parameters)
+    except AdmittanceError as error:
+        raise GoalRejected(INVALID_GOAL, str(error)) from None
+    values = [float(v) for v in goal.absolute_force_torque_threshold]
+    if not values:
+        return admittance, None
+    if len(values) != 6 or not all(v > 0 for v in values):
+        raise GoalRejected(
+            INVALID_GOAL,
+            f"absolute_force_torque_threshold must be six positive values fx, fy, fz, tx, ty, tz (N, N m); "
+            f"got {values}",
+        )
+    return admittance, np.array(values)
+
+
+def _admittance_options(
+    name: str, parameters: Mapping[str, Any], control_site: str, model: Any
+) -> dict[str, Any]:
+    """The admittance controller's options from its ros2_control parameters (MoveIt Pro's names):
+    ``default_absolute_force_torque_threshold``, ``jacobian_damping`` and ``ee_frame`` (the control frame
+    when the config gives no control site; it must be a site or body of the scene).
+
+    Raises:
+        DriverError: a parameter of the wrong shape, naming the controller and the parameter.
+    """
+    options: dict[str, Any] = {"control_frame": control_site}
+    threshold = parameters.get("default_absolute_force_torque_threshold")
+    if threshold is not None:
+        if (
+            not isinstance(threshold, list)
+            or len(threshold) != 6
+            or not all(isinstance(v, int | float) and not isinstance(v, bool) and v > 0 for v in threshold)
+        ):
+            raise DriverError(
+                f"controller {name!r}: default_absolute_force_torque_threshold must be six positive numbers "
+                f"(fx, fy, fz, tx, ty, tz in N and N m), got {threshold!r}"
+            )
+        options["threshold"] = tuple(float(v) for v in threshold)
+    damping = parameters.get("jacobian_damping")
+    if damping is not None:
+        if isinstance(damping, bool) or not isinstance(damping, int | float) or damping < 0:
+            raise DriverError(f"controller {name!r}: jacobian_damping must be a number >= 0, got {damping!r}")
+        options["jacobian_damping"] = float(damping)
+    ee_frame = str(parameters.get("ee_frame") or "")
+    if not control_site and ee_frame:
+        try:
+            ControlFrame(model, ee_frame)
+        except AdmittanceError as error:
+            log.warning("controller %r: its ee_frame is no control frame: %s", name, error)
+        else:
+            options["control_frame"] = ee_frame
+    return options
 
 
 def _load_model(settings: MujocoDriverSettings) -> Any:
@@ -291,6 +357,23 @@ class MujocoDriver:
                         ),
                     )
                 )
+                if isinstance(controller, JointTrajectoryAdmittanceController):
+                    served.append(
+                        ServedInterface(
+                            "action",
+                            names.follow_joint_trajectory_action(name),
+                            names.FOLLOW_JOINT_TRAJECTORY_WITH_ADMITTANCE_TYPE,
+                            "track a timed joint trajectory with compliance and a force/torque threshold",
+                        )
+                    )
+                    served.append(
+                        ServedInterface(
+                            "service",
+                            names.admittance_zero_fts_service(name, controller.sensor.frame_id),
+                            names.TRIGGER_TYPE,
+                            "zero the force/torque sensor",
+                        )
+                    )
             elif kind == cell.FORCE_TORQUE_SENSOR_BROADCASTER:
                 served.append(
                     ServedInterface(
@@ -450,7 +533,17 @@ class MujocoDriver:
                     )
                 else:
                     controllers[name] = trajectory_controller(
-                        name, arm, JointTrajectoryAdmittanceController, sensor=sensor
+                        name,
+                        arm,
+                        JointTrajectoryAdmittanceController,
+                        sensor=sensor,
+                        model=self.model,
+                        **_admittance_options(
+                            name,
+                            spec.parameters if spec is not None else {},
+                            settings.control_site if has_control_site else "",
+                            self.model,
+                        ),
                     )
             elif kind == cell.VELOCITY_FORCE_CONTROLLER:
                 arm = arm_of(joints, name)
@@ -515,12 +608,25 @@ class MujocoDriver:
                 names.JOINT_STATES_TYPE, names.JOINT_STATES_TOPIC
             )
         for name, controller in self._of_type(cell.JOINT_TRAJECTORY_CONTROLLER, cell.ADMITTANCE_CONTROLLER):
-            self._node(name).create_action_server(
+            node = self._node(name)
+            node.create_action_server(
                 names.FOLLOW_JOINT_TRAJECTORY_TYPE,
                 names.follow_joint_trajectory_action(name),
                 functools.partial(self._execute_trajectory, controller=controller),
                 cancel_callback=self._cancel_goal,
             )
+            if isinstance(controller, JointTrajectoryAdmittanceController):
+                node.create_action_server(
+                    names.FOLLOW_JOINT_TRAJECTORY_WITH_ADMITTANCE_TYPE,
+                    names.follow_joint_trajectory_action(name),
+                    functools.partial(self._execute_trajectory, controller=controller),
+                    cancel_callback=self._cancel_goal,
+                )
+                node.create_service(
+                    names.TRIGGER_TYPE,
+                    names.admittance_zero_fts_service(name, controller.sensor.frame_id),
+                    functools.partial(self._zero_sensor, controller),
+                )
         for name, controller in self._of_type(cell.FORCE_TORQUE_SENSOR_BROADCASTER):
             assert isinstance(controller, ForceTorqueSensorBroadcaster)
             publisher = self._node(name).create_publisher(names.WRENCH_TYPE, names.wrench_topic(name))
@@ -549,7 +655,9 @@ class MujocoDriver:
                 cancel_callback=self._cancel_goal,
             )
 
-    def _zero_sensor(self, controller: VelocityForceController, _request: Any) -> dict[str, Any]:
+    def _zero_sensor(
+        self, controller: VelocityForceController | JointTrajectoryAdmittanceController, _request: Any
+    ) -> dict[str, Any]:
         return {"success": True, "message": self.simulation.call(lambda: controller.zero_sensor(self.data))}
 
     def _camera_snapshot(self) -> SimState | None:
@@ -697,14 +805,22 @@ class MujocoDriver:
             goal = parse_trajectory_goal(
                 handle.goal, controller.joint_names, limits, self.settings.tolerances, self.index.timestep
             )
+            admittance, threshold = _admittance_of(handle.goal)
         except GoalRejected as rejected:
             log.warning("%s: goal rejected: %s", controller.name, rejected.message)
             handle.abort({"error_code": rejected.code, "error_string": rejected.message})
             return
+
+        def start(execution: Execution) -> None:
+            if isinstance(controller, JointTrajectoryAdmittanceController):
+                controller.start(execution, goal, self.data, admittance, threshold)
+            else:
+                controller.start(execution, goal, self.data)
+
         self._run_goal(
             handle,
             controller,
-            lambda execution: controller.start(execution, goal, self.data),
+            start,
             {"error_code": INVALID_GOAL, "error_string": "the MuJoCo driver stopped"},
         )
 

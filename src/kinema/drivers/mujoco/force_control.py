@@ -15,12 +15,17 @@
   MuJoCo's site Jacobian, limited per joint, and integrated into position set points. Commands must keep
   coming: when none arrived for ``command_timeout`` of sim time the arm decelerates to a stop and holds.
   ``zero_fts`` (a ``std_srvs/Trigger`` service) takes the current reading as the zero; activation does too.
-- :class:`JointTrajectoryAdmittanceController` is the trajectory controller MoveIt Pro's objectives name
-  ``joint_trajectory_admittance_controller``: it tracks trajectories like ``joint_trajectory_controller``
-  and aborts one when the wrist senses more than its absolute force/torque threshold (MoveIt Pro's
-  default, 45 N and 10 N m per axis, measured from the reading when the goal started). The admittance
-  itself (compliant tracking with SetAdmittanceParameters) is not simulated: ExecuteTrajectory refuses
-  admittance parameters with a message saying so.
+- :class:`JointTrajectoryAdmittanceController` is MoveIt Pro's joint trajectory admittance controller
+  (``joint_trajectory_admittance_controller``, "JTAC"): it tracks trajectories like
+  ``joint_trajectory_controller`` and serves two goal types under ``/<controller>/follow_joint_trajectory``:
+  ``control_msgs/FollowJointTrajectory`` (tracked rigidly) and
+  ``moveit_pro_controllers_msgs/FollowJointTrajectoryWithAdmittance``, whose goal carries the admittance
+  parameters (the trajectory gives way to the measured wrench as a mass-spring-damper in the control frame,
+  :mod:`kinema.drivers.mujoco.admittance`) and the absolute force/torque threshold of that goal. Either goal
+  aborts when the wrench the surroundings apply to the tool (the reading less the tool's weight, counted
+  from the sensor's zero) passes the threshold on any axis of the sensor frame (default 45 N and 10 N m,
+  MoveIt Pro's ``default_absolute_force_torque_threshold``). ``/<controller>/zero_fts/<sensor frame>``
+  (``std_srvs/Trigger``) takes the current reading as the zero; activation does too.
 
 All methods but :meth:`VelocityForceController.set_command` run on the physics thread.
 """
@@ -34,11 +39,18 @@ from typing import Any
 
 import numpy as np
 
+from kinema.drivers.mujoco.admittance import (
+    Admittance,
+    AdmittanceError,
+    AdmittanceParameters,
+    ControlFrame,
+    wrench_at,
+)
 from kinema.drivers.mujoco.controller_manager import Broadcaster
 from kinema.drivers.mujoco.execution import Execution
 from kinema.drivers.mujoco.model_index import JointInfo
 from kinema.drivers.mujoco.trajectory_controller import JointTrajectoryController
-from kinema.drivers.mujoco.trajectory_goal import PATH_TOLERANCE_VIOLATED, TrajectoryGoal
+from kinema.drivers.mujoco.trajectory_goal import INVALID_GOAL, PATH_TOLERANCE_VIOLATED, TrajectoryGoal
 from kinema.transforms import rotate_twist
 
 log = logging.getLogger(__name__)
@@ -85,6 +97,16 @@ class ForceTorqueSensor:
     def read(self, data: Any) -> np.ndarray:
         """Force (N) and torque (N m) in the site frame."""
         return np.concatenate((data.sensordata[self._force], data.sensordata[self._torque]))
+
+    def gravity_load(self, model: Any, data: Any) -> np.ndarray:
+        """What the sensor reads when it only holds the tool up (6,), in the site frame: the weight of the
+        bodies below it (the model's masses, so a held object is not included) and its moment about the
+        site."""
+        body = int(model.site_bodyid[self.site])
+        rotation = data.site_xmat[self.site].reshape(3, 3)
+        force = -float(model.body_subtreemass[body]) * np.asarray(model.opt.gravity, dtype=float)
+        torque = np.cross(data.subtree_com[body] - data.site_xpos[self.site], force)
+        return np.concatenate((rotation.T @ force, rotation.T @ torque))
 
 
 class ForceTorqueSensorBroadcaster(Broadcaster):
@@ -386,11 +408,16 @@ def _deadband(vector: np.ndarray, band: float) -> np.ndarray:
 
 
 class JointTrajectoryAdmittanceController(JointTrajectoryController):
-    """``joint_trajectory_controller`` plus a force/torque guard (see the module docstring).
+    """``joint_trajectory_controller`` with compliance and a force/torque guard (see the module docstring).
 
     Args:
         sensor: the wrist force/torque sensor.
-        threshold: the largest change of each force (N) and torque (N m) component, in the sensor frame.
+        model: the MuJoCo model (the control frame's Jacobian).
+        control_frame: the MuJoCo site or body the admittance acts in when a goal names none (the config's
+            ``robot.force_torque_sensor.control_site``; "" for none: such goals are rejected).
+        threshold: the default largest force (N) and torque (N m) on each axis of the sensor frame, counted
+            from the sensor's zero (MoveIt Pro's ``default_absolute_force_torque_threshold``).
+        jacobian_damping: the damping of the least-squares inverse (lab_sim's value in MoveIt Pro).
         others: as :class:`JointTrajectoryController`.
     """
 
@@ -400,29 +427,105 @@ class JointTrajectoryAdmittanceController(JointTrajectoryController):
         self,
         *args: Any,
         sensor: ForceTorqueSensor,
+        model: Any,
+        control_frame: str = "",
         threshold: tuple[float, ...] = (45.0, 45.0, 45.0, 10.0, 10.0, 10.0),
+        jacobian_damping: float = 0.01,
         **kwargs: Any,
     ) -> None:
         super().__init__(*args, **kwargs)
         self.sensor = sensor
-        self.threshold = np.asarray(threshold, dtype=float)
+        self.model = model
+        self.control_frame = control_frame
+        self.default_threshold = np.asarray(threshold, dtype=float)
+        self.jacobian_damping = jacobian_damping
+        self._threshold = self.default_threshold
+        # The reading, less the tool's weight, taken as zero (activation, the zero_fts service).
         self._zero = np.zeros(6)
+        self._admittance: Admittance | None = None
+        self._lower = np.array([j.limits[0] if j.limits else -np.inf for j in self.joints], dtype=float)
+        self._upper = np.array([j.limits[1] if j.limits else np.inf for j in self.joints], dtype=float)
 
     @property
     def state_interfaces(self) -> list[str]:
         """Position and velocity of each joint, and the sensor."""
         return super().state_interfaces + self.sensor.interfaces
 
-    def start(self, execution: Execution, goal: TrajectoryGoal, data: Any) -> None:
-        """Begin tracking ``goal``, measuring forces from the reading now."""
-        self._zero = self.sensor.read(data)
+    @property
+    def compliant(self) -> bool:
+        """True while a goal runs with admittance."""
+        return self._admittance is not None
+
+    def activate(self, data: Any) -> None:
+        """Start commanding (hold where the arm is) and take the sensor's reading as its zero."""
+        super().activate(data)
+        self.zero_sensor(data)
+
+    def zero_sensor(self, data: Any) -> str:
+        """Take the current reading (less the tool's weight) as the zero (``zero_fts``); returns a summary."""
+        reading = self.sensor.read(data)
+        self._zero = reading - self.sensor.gravity_load(self.model, data)
+        force, torque = np.linalg.norm(reading[:3]), np.linalg.norm(reading[3:])
+        return f"force/torque sensor {self.sensor.name} zeroed (reading {force:.2f} N, {torque:.3f} N m)"
+
+    def external_wrench(self, data: Any) -> np.ndarray:
+        """The wrench the surroundings apply to the tool, in the sensor frame (6,): the reading less the
+        tool's weight, less the zero, with the sign turned (the sensor reads the arm's push on the tool)."""
+        return -(self.sensor.read(data) - self.sensor.gravity_load(self.model, data) - self._zero)
+
+    def start(
+        self,
+        execution: Execution,
+        goal: TrajectoryGoal,
+        data: Any,
+        admittance: AdmittanceParameters | None = None,
+        threshold: np.ndarray | None = None,
+    ) -> None:
+        """Begin tracking ``goal`` with ``admittance`` (None: rigidly) and ``threshold`` (None: default)."""
+        frame = None
+        if admittance is not None:
+            name = admittance.control_frame or self.control_frame
+            if not name:
+                execution.finish(
+                    "aborted",
+                    {
+                        "error_code": INVALID_GOAL,
+                        "error_string": f"{self.name} has no control frame: the admittance parameters name "
+                        "none and the config sets no robot.force_torque_sensor.control_site",
+                    },
+                )
+                return
+            try:
+                frame = ControlFrame(self.model, name)
+            except AdmittanceError as error:
+                execution.finish("aborted", {"error_code": INVALID_GOAL, "error_string": str(error)})
+                return
         super().start(execution, goal, data)
+        running = self._running
+        if running is None or running.execution is not execution:
+            return
+        self._threshold = self.default_threshold if threshold is None else np.asarray(threshold, dtype=float)
+        if admittance is None or frame is None:
+            self._admittance = self._offset = self._offset_command = None
+            return
+        columns = goal.joint_indices
+        self._admittance = Admittance(
+            admittance,
+            frame,
+            self._qvel[columns],
+            self._lower[columns],
+            self._upper[columns],
+            self.jacobian_damping,
+        )
+        self._offset = np.zeros(len(columns))
+        self._offset_command = np.zeros(len(columns))
 
     def update(self, data: Any) -> None:
-        """One control period: the guard, then the trajectory."""
-        if self.busy:
-            change = np.abs(self.sensor.read(data) - self._zero)
-            over = change > self.threshold
+        """One control period: the guard, the admittance, then the trajectory."""
+        running = self._running
+        if running is not None:
+            external = self.external_wrench(data)
+            over = np.abs(external) > self._threshold
             if over.any():
                 names = [f"{'force' if i < 3 else 'torque'} {'xyz'[i % 3]}" for i in np.flatnonzero(over)]
                 self._fail(
@@ -430,9 +533,46 @@ class JointTrajectoryAdmittanceController(JointTrajectoryController):
                     PATH_TOLERANCE_VIOLATED,
                     "force/torque threshold exceeded",
                     [
-                        f"{name} changed by {change[i]:.1f} (limit {self.threshold[i]:g})"
+                        f"{name} {external[i]:+.1f} (limit {self._threshold[i]:g})"
                         for name, i in zip(names, np.flatnonzero(over), strict=True)
                     ],
                 )
                 return
+            admittance = self._admittance
+            elapsed = float(data.time) - running.start
+            if admittance is not None and elapsed >= 0.0:
+                reference = running.table.positions[running.table.index_at(elapsed)]
+                frame_position, _ = admittance.frame.pose(data)
+                wrench = wrench_at(
+                    external,
+                    data.site_xpos[self.sensor.site],
+                    data.site_xmat[self.sensor.site].reshape(3, 3),
+                    frame_position,
+                )
+                offset = admittance.step(self.model, data, wrench, reference, self.dt)
+                columns = running.goal.joint_indices
+                self._offset_command = offset + self._feedforward[columns] * admittance.joint_velocity
+                # The tolerances compare the joints with the compliant set point where the position servos
+                # hold them under the measured load: a servo gives tau / kp (MuJoCo's actuators are far
+                # softer than a real arm's, and a held push would otherwise fail the goal tolerance).
+                self._offset = offset + self._servo_give(data, external, columns)
         super().update(data)
+
+    def _servo_give(self, data: Any, external: np.ndarray, columns: np.ndarray) -> np.ndarray:
+        """How far the goal's joints give under ``external`` (the sensor-frame wrench on the tool)."""
+        if self._gains is None:
+            return np.zeros(len(columns))
+        import mujoco
+
+        jacp = np.zeros((3, self.model.nv))
+        jacr = np.zeros((3, self.model.nv))
+        mujoco.mj_jacSite(self.model, data, jacp, jacr, self.sensor.site)
+        rotation = data.site_xmat[self.sensor.site].reshape(3, 3)
+        dofs = self._qvel[columns]
+        torque = jacp[:, dofs].T @ (rotation @ external[:3]) + jacr[:, dofs].T @ (rotation @ external[3:])
+        return np.asarray(torque / self._gains[columns])
+
+    def _end(self, data: Any, status: Any, result: dict[str, Any], *, hold: bool) -> None:
+        super()._end(data, status, result, hold=hold)
+        if self._running is None:
+            self._admittance = self._offset = self._offset_command = None

@@ -41,6 +41,9 @@ VELOCITY_FORCE_CONTROLLER = "velocity_force_controller"
 FORCE_TORQUE_SENSOR_BROADCASTER = "force_torque_sensor_broadcaster"
 JOINT_STATE_BROADCASTER = "joint_state_broadcaster"
 VELOCITY_FORCE_COMMAND_TYPE = "moveit_pro_controllers_msgs/msg/VelocityForceCommand"
+FOLLOW_JOINT_TRAJECTORY_WITH_ADMITTANCE_TYPE = (
+    "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance"
+)
 TRIGGER_TYPE = "std_srvs/srv/Trigger"
 WRENCH_TYPE = "geometry_msgs/msg/WrenchStamped"
 
@@ -68,6 +71,11 @@ def velocity_force_command_topic(controller: str) -> str:
 def zero_fts_service(controller: str) -> str:
     """A velocity-force controller's sensor-zeroing service: ``/<controller>/zero_fts``."""
     return f"/{controller}/zero_fts"
+
+
+def admittance_zero_fts_service(controller: str, sensor_frame: str) -> str:
+    """An admittance controller's sensor-zeroing service: ``/<controller>/zero_fts/<sensor frame>``."""
+    return f"/{controller}/zero_fts/{sensor_frame}"
 
 
 # The names of ros2_control's conventional controllers, for clients that use those.

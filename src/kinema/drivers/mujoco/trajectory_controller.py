@@ -175,6 +175,10 @@ class JointTrajectoryController:
         self._inertia = inertia
         self._touching = touching
         self._brake: _Brake | None = None
+        # Added to the running goal's set points (its joints), e.g. by the admittance: the position offset,
+        # and the offset with its velocity feed-forward for ctrl. None: the trajectory as it is.
+        self._offset: np.ndarray | None = None
+        self._offset_command: np.ndarray | None = None
 
     @property
     def command_interfaces(self) -> list[str]:
@@ -339,6 +343,9 @@ class JointTrajectoryController:
         table = running.table
         row = running.row = table.index_at(elapsed)
         desired = table.positions[row]
+        offset = self._offset
+        if offset is not None:
+            desired = desired + offset
         goal = running.goal
         error = data.qpos[running.qpos] - desired
         if elapsed <= table.duration:
@@ -378,7 +385,10 @@ class JointTrajectoryController:
                     + _violations(goal.joint_names, speed, goal.goal_velocity_tolerance, "still moving at"),
                 )
                 return
-        data.ctrl[running.ctrl] = running.commands[row]
+        if self._offset_command is None:
+            data.ctrl[running.ctrl] = running.commands[row]
+        else:
+            data.ctrl[running.ctrl] = running.commands[row] + self._offset_command
 
     def post_feedback(self, data: Any) -> None:
         """Post the running goal's desired, actual and error state (called at the publish rate)."""
@@ -391,9 +401,10 @@ class JointTrajectoryController:
         actual = data.qpos[running.qpos].copy()
         actual_velocity = data.qvel[running.qvel].copy()
         table, joint_names = running.table, running.goal.joint_names
+        offset = None if self._offset is None else self._offset.copy()
 
         def feedback() -> dict[str, Any]:
-            desired = table.positions[row]
+            desired = table.positions[row] if offset is None else table.positions[row] + offset
             desired_velocity = table.velocities[row]
             return {
                 "header": {"stamp": {"sec": int(stamp), "nanosec": int((stamp % 1.0) * 1e9)}},
@@ -438,6 +449,8 @@ class JointTrajectoryController:
             columns = running.goal.joint_indices
             self._command[columns] = running.table.positions[running.row]
             self._command_velocity[columns] = running.table.velocities[running.row]
+            if self._offset is not None:
+                self._command[columns] += self._offset
 
     def _stop(self, data: Any) -> None:
         """Brake the joints to a stop (then hold), or hold at once when braking is not configured."""

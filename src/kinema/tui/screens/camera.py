@@ -24,14 +24,33 @@ from textual.widgets import Footer, Select, Static
 from kinema.tui.connection import CameraImage, ConnectionState
 from kinema.tui.screens.base import RuntimeView
 
-image_widgets: Any
-try:  # Queries the terminal once; it must happen before the app starts (textual-image's rule).
-    import textual_image.widget as image_widgets
-except Exception as error:  # a closed stdout and the like: the screen says why instead
-    image_widgets = None
-    IMAGE_UNAVAILABLE = f"cannot draw images in this terminal: {error}"
-else:
-    IMAGE_UNAVAILABLE = ""
+_image_widgets: Any = None
+_image_unavailable = ""
+
+
+def load_image_support() -> str:
+    """Import textual-image, which asks the terminal once what images it can draw; '' when it can, else
+    why not.
+
+    Its questions are answered on the terminal's input, so they must be asked while no app reads it:
+    before an app starts (``kinema ui --camera``), or inside ``App.suspend()`` (the app's first camera
+    view). Later calls return the first answer.
+    """
+    global _image_widgets, _image_unavailable
+    if _image_widgets is None and not _image_unavailable:
+        try:
+            import textual_image.widget as widgets
+        except Exception as error:  # a closed stdout and the like: the screen says why instead
+            _image_unavailable = f"cannot draw images in this terminal: {error}"
+        else:
+            _image_widgets = widgets
+    return _image_unavailable
+
+
+def image_support_loaded() -> bool:
+    """Whether textual-image was imported (and the terminal asked) already."""
+    return _image_widgets is not None or bool(_image_unavailable)
+
 
 REDRAW_PERIOD_S = 0.2
 METHODS = ("auto", "sixel", "tgp", "halfcell", "unicode")
@@ -46,14 +65,14 @@ def image_widget_class(method: str | None = None) -> Any:
     chosen = (method or os.environ.get("KINEMA_TUI_IMAGE", "") or "auto").strip().lower()
     if chosen not in METHODS:
         raise ValueError(f"KINEMA_TUI_IMAGE={chosen!r} is not a drawing method; valid: {', '.join(METHODS)}")
-    if image_widgets is None:
+    if load_image_support():
         return None
     return {
-        "auto": image_widgets.Image,
-        "sixel": image_widgets.SixelImage,
-        "tgp": image_widgets.TGPImage,
-        "halfcell": image_widgets.HalfcellImage,
-        "unicode": image_widgets.UnicodeImage,
+        "auto": _image_widgets.Image,
+        "sixel": _image_widgets.SixelImage,
+        "tgp": _image_widgets.TGPImage,
+        "halfcell": _image_widgets.HalfcellImage,
+        "unicode": _image_widgets.UnicodeImage,
     }[chosen]
 
 
@@ -109,7 +128,7 @@ class CameraScreen(RuntimeView, Screen[None]):
                 yield Select[str]([], prompt="Image topic", id="camera-topic")
                 yield Static("", id="camera-caption", classes="muted")
             if self.widget_class is None:
-                yield Static(IMAGE_UNAVAILABLE, id="camera-placeholder")
+                yield Static(load_image_support(), id="camera-placeholder")
             else:
                 yield Static("Choose an image topic.", id="camera-placeholder")
                 picture = self.widget_class(id="camera-picture")
