@@ -80,6 +80,12 @@ RENAMED = [
         ("joint_trajectory_msg", "{t}"),
     ),
     ('<Action ID="DetectAprilTags" apriltag_size="0.051"/>', "DetectAprilTags", ("tag_size", "0.051")),
+    (
+        '<Action ID="SetupMTCUpdateGroupCollisionRule" group_name="gripper" object_name="&lt;octomap&gt;" '
+        'allow_collision="true" task="{t}"/>',
+        "SetupMTCSetCollisionRule",
+        ("name_b", "<octomap>"),
+    ),
     ('<Action ID="GetImage" timeout_sec="3"/>', "GetImage", ("message_timeout_sec", "3")),
     ('<Action ID="GetPointCloud" timeout_sec="4"/>', "GetPointCloud", ("message_timeout_sec", "4")),
     ('<Action ID="GetCameraInfo" timeout_sec="6"/>', "GetCameraInfo", ("message_timeout_sec", "6")),

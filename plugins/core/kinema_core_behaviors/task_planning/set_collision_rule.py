@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from kinema.behaviors import PortInfo, input_port
+from kinema.behaviors import FormerSpelling, PortInfo, input_port
 from kinema.errors import KinemaError
 
 from .mtc_task import MtcTask, stage_name
@@ -29,6 +29,15 @@ class SetupMTCSetCollisionRule(_SetupStage):
     be given separated by ``;``. The task fails to plan, naming the stage, when a name is none of these.
     The rule changes the task's planning only; the live planning scene is left as it is.
     """
+
+    # MoveIt Pro 9.4 folded its group/object collision-rule stages into this one (its migration guide).
+    former_spellings = (
+        FormerSpelling(
+            "SetupMTCUpdateGroupCollisionRule",
+            ports={"group_name": "name_a", "object_name": "name_b"},
+            dropped={"parameters": "the rule's settings are its ports (name_a, name_b, allow_collision)"},
+        ),
+    )
 
     @classmethod
     def stage_ports(cls) -> list[PortInfo]:
