@@ -37,6 +37,8 @@ __all__ = [
     "ZERO_NORM",
     "TransformError",
     "angle_between",
+    "average_pose",
+    "euler_from_rotation",
     "invert",
     "is_zero_quaternion",
     "pose_dict",
@@ -126,6 +128,14 @@ def rotation_from_euler(roll_pitch_yaw: Any) -> np.ndarray:
     return Rotation.from_euler("xyz", np.asarray(roll_pitch_yaw, dtype=float)).as_matrix()
 
 
+def euler_from_rotation(rotation: np.ndarray) -> np.ndarray:
+    """Roll, pitch, yaw (rad) of a rotation (the upper-left ``(3, 3)`` of a pose): the inverse of
+    :func:`rotation_from_euler`, URDF's ``rpy``."""
+    from scipy.spatial.transform import Rotation
+
+    return Rotation.from_matrix(np.asarray(rotation, dtype=float)[:3, :3]).as_euler("xyz")
+
+
 def pose_matrix(position: Any, quaternion_xyzw: Any) -> np.ndarray:
     """The ``(4, 4)`` pose of a position ``(x, y, z)`` (m) and a quaternion ``(x, y, z, w)``."""
     matrix = np.eye(4)
@@ -184,6 +194,30 @@ def slerp(start_xyzw: Any, end_xyzw: Any, t: float) -> np.ndarray:
 def angle_between(start_xyzw: Any, end_xyzw: Any) -> float:
     """The angle (rad, in [0, pi]) of the rotation that takes orientation ``start`` to ``end``."""
     return float((_rotation(end_xyzw) * _rotation(start_xyzw).inv()).magnitude())
+
+
+def average_pose(poses: Sequence[np.ndarray], weights: Sequence[float] | None = None) -> np.ndarray:
+    """The mean of ``(4, 4)`` poses: the (weighted) mean position and the rotation closest to the mean of
+    the rotations (the chordal L2 mean, scipy's ``Rotation.mean``: for rotations a few degrees apart it is
+    their average, and it does not depend on a quaternion's sign).
+
+    Raises:
+        TransformError: no poses, or weights that do not match them or do not add up to more than 0.
+    """
+    from scipy.spatial.transform import Rotation
+
+    matrices = np.asarray([np.asarray(p, dtype=float) for p in poses])
+    if matrices.ndim != 3 or matrices.shape[1:] != (4, 4) or not len(matrices):
+        raise TransformError(
+            f"average_pose needs one or more 4x4 poses, got an array of shape {matrices.shape}"
+        )
+    w = np.ones(len(matrices)) if weights is None else np.asarray(weights, dtype=float)
+    if w.shape != (len(matrices),) or not np.all(w >= 0) or not w.sum() > 0:
+        raise TransformError(f"average_pose needs one weight >= 0 a pose, not all 0; got {list(w)}")
+    mean = np.eye(4)
+    mean[:3, 3] = np.average(matrices[:, :3, 3], axis=0, weights=w)
+    mean[:3, :3] = Rotation.from_matrix(matrices[:, :3, :3]).mean(weights=w).as_matrix()
+    return mean
 
 
 def rotate_twist(rotation: np.ndarray, twist: Sequence[float] | np.ndarray) -> np.ndarray:

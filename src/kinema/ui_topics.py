@@ -19,6 +19,10 @@ MARKER_ARRAY_TYPE = "visualization_msgs/msg/MarkerArray"
 MARKER_TOPIC = "/visualization_marker"
 MARKER_TYPE = "visualization_msgs/msg/Marker"
 
+# ROS's transform topic: PublishTF sends the frames it publishes here; the view places markers in them.
+TF_TOPIC = "/tf"
+TF_TYPE = "tf2_msgs/msg/TFMessage"
+
 # The task PlanMTCTask plans, stage by stage, while it plans (the TUI's task panel).
 TASK_PLANNING_TOPIC = "/kinema/task_planning"
 TASK_PLANNING_TYPE = "kinema_msgs/msg/TaskPlanningStatus"

@@ -63,3 +63,43 @@ def test_an_object_whose_pose_has_a_nan_is_skipped() -> None:
     layer = PlanningSceneLayer("/root")
     layer.update(_scene([bad, _box("good")]))
     assert layer.object_ids == ["good"]
+
+
+def test_an_attached_object_is_drawn_on_its_link_and_follows_it() -> None:
+    scene = from_dict(
+        "moveit_msgs/msg/PlanningScene",
+        {
+            "robot_state": {
+                "attached_collision_objects": [
+                    {
+                        "link_name": "tool0",
+                        "object": {
+                            "id": "rod",
+                            "header": {"frame_id": "tool0"},
+                            "primitives": [{"type": 1, "dimensions": [0.04, 0.04, 0.4]}],
+                            "primitive_poses": [{"position": {"z": 0.22}, "orientation": {"w": 1.0}}],
+                        },
+                    }
+                ]
+            }
+        },
+    )
+    link = np.eye(4)
+    link[:3, 3] = [0.5, 0.0, 1.0]
+    poses = {"tool0": link}
+    layer = PlanningSceneLayer("/root")
+    commands = layer.update(scene, poses.get)
+    moves = {p: umsgpack.unpackb(x)["matrix"] for kind, p, x in commands if kind == "set_transform"}
+    shape = np.array(moves["/root/attached/rod/0"]).reshape(4, 4).T
+    assert np.allclose(shape[:3, 3], [0, 0, 0.22])  # in the link's frame
+    placed = np.array(moves["/root/attached/rod"]).reshape(4, 4).T
+    assert np.allclose(placed[:3, 3], [0.5, 0.0, 1.0])
+    assert layer.follow(poses.get) == []  # the link has not moved
+    moved = link.copy()
+    moved[:3, 3] = [0.6, 0.1, 0.9]
+    (command,) = layer.follow({"tool0": moved}.get)
+    assert command[1] == "/root/attached/rod"
+    assert np.allclose(
+        np.array(umsgpack.unpackb(command[2])["matrix"]).reshape(4, 4).T[:3, 3], [0.6, 0.1, 0.9]
+    )
+    assert layer.follow({}.get) == []  # a link the view does not know: left where it was

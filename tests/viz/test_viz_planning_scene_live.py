@@ -80,3 +80,43 @@ def test_a_scene_published_before_the_view_started_is_drawn_and_updates_replace_
             viewer.stop()
         publisher_node.close()
         session.close()
+
+
+def test_frames_heard_on_tf_place_markers_through_their_parent() -> None:
+    import numpy as np
+
+    session = open_session([])
+    publisher_node = Node(session, "tf_stand_in")
+    viewer = None
+    try:
+        model = SceneModel.from_file(bundled_dir("configs") / "lab_sim" / "description" / "lab_sim_scene.xml")
+        viewer = SceneViewer(session, model, RecordingServer())  # type: ignore[arg-type]
+        viewer.start()
+        assert viewer.frame_pose("local") is None
+        tf = publisher_node.create_publisher("tf2_msgs/msg/TFMessage", "/tf")
+        message = from_dict(
+            "tf2_msgs/msg/TFMessage",
+            {
+                "transforms": [
+                    {
+                        "header": {"frame_id": "tray"},
+                        "child_frame_id": "local",
+                        "transform": {"translation": {"z": 0.1}, "rotation": {"w": 1.0}},
+                    }
+                ]
+            },
+        )
+
+        def heard() -> bool:
+            tf.publish(message)
+            return viewer.frame_pose("local") is not None
+
+        _wait(heard, "the frame on /tf")
+        tray = model.frame_pose("tray")
+        assert tray is not None
+        np.testing.assert_allclose(viewer.frame_pose("local")[:3, 3], tray[:3, 3] + tray[:3, 2] * 0.1)
+    finally:
+        if viewer is not None:
+            viewer.stop()
+        publisher_node.close()
+        session.close()

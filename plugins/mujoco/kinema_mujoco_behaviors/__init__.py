@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from kinema.plugins import RegisterBehavior, hookimpl
 
+from .reset_mujoco_keyframe import ResetMujocoKeyframe
 from .set_mujoco_state import SetMujocoState
 
 
@@ -14,3 +15,4 @@ from .set_mujoco_state import SetMujocoState
 def register_behaviors(register: RegisterBehavior) -> None:
     """Register the MuJoCo behaviors."""
     register(SetMujocoState)
+    register(ResetMujocoKeyframe)

@@ -13,7 +13,14 @@ values mean nothing today (``keep_orientation="false"``), dropped for those valu
 reason for the others: an objective never silently loses what it asked for.
 
 An old ID that is registered as a node type of its own is left alone: a plugin that still provides the
-old behavior wins over the rename.
+old behavior wins over the rename. An old ID whose behavior has no counterpart Kinema can run is refused
+at load with its reason and how MoveIt Pro writes it today (``refused``), instead of "unknown node".
+
+MoveIt Pro's removed ``LoadObjectiveParameters`` (a YAML file beside the objective, one section per
+behavior name, handed to the behaviors that take ``parameters="{parameters}"``) is read by
+:func:`apply_objective_parameters`, before the renames: each section's values become the ports of the
+behaviors it names (today's way of giving them), the loader becomes ``AlwaysSuccess``, and a note lists
+what was set and what has no port.
 """
 
 from __future__ import annotations
@@ -44,6 +51,8 @@ class FormerSpelling:
         subtree: ``current_id`` is a SubTree (the old behavior became an objective): the node is
             rewritten to ``<SubTree ID=current_id>`` with the same ports.
         origin: whose old spelling it is, for the note.
+        refused: the old ID has no counterpart Kinema can run: loading refuses it with this reason (and
+            what to write today), naming the file and line.
     """
 
     old_id: str = ""
@@ -53,6 +62,7 @@ class FormerSpelling:
     current_id: str = ""
     subtree: bool = False
     origin: str = "MoveIt Pro"
+    refused: str = ""
 
     @property
     def spelled_id(self) -> str:
@@ -113,6 +123,11 @@ def _rewrite(element: etree._Element, spelling: FormerSpelling, filename: str) -
     """Rewrite one element to today's spelling; the note's text ('' when nothing was old)."""
     old_id, current_id, origin = spelling.old_id, spelling.current_id, spelling.origin
     line = element.sourceline or 0
+    if old_id and spelling.refused:
+        raise BTRuntimeError(
+            f"{old_id} is {origin}'s removed behavior and Kinema cannot run it: {spelling.refused}",
+            location=SourceLocation(filename, line),
+        )
     renamed: list[tuple[str, str]] = []
     for old_port, new_port in spelling.ports.items():
         value = element.get(old_port)
@@ -170,4 +185,147 @@ def _rewrite(element: etree._Element, spelling: FormerSpelling, filename: str) -
     return message
 
 
-__all__ = ["FormerSpelling", "SpellingNote", "rewrite_former_spellings"]
+OBJECTIVE_PARAMETERS_LOADER = "LoadObjectiveParameters"
+_PARAMETERS_PORT = "parameters"
+
+
+def _element_id(element: etree._Element) -> str | None:
+    return element.get("ID") if element.tag in _EXPLICIT_TAGS else str(element.tag)
+
+
+def _blackboard_key(value: str) -> str:
+    text = value.strip()
+    return text[1:-1].strip() if text.startswith("{") and text.endswith("}") else text
+
+
+def _attribute_text(value: object) -> str | None:
+    """A YAML value as a port's text, as MoveIt Pro's parameter reader took it; None for a mapping."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    if isinstance(value, list | tuple):
+        parts = [_attribute_text(v) for v in value]
+        return None if any(p is None for p in parts) else ";".join(p for p in parts if p is not None)
+    if isinstance(value, dict):
+        return None
+    return str(value)
+
+
+def _load_parameters(element: etree._Element, filename: str) -> tuple[str, dict[str, dict[str, object]]]:
+    """The file a LoadObjectiveParameters node names (beside the objective) and its sections."""
+    from pathlib import Path
+
+    import yaml
+
+    line = element.sourceline or 0
+    name = (element.get("config_file_name") or "").strip()
+    where = SourceLocation(filename, line)
+    if not name or "{" in name:
+        raise BTRuntimeError(
+            f"{OBJECTIVE_PARAMETERS_LOADER} needs config_file_name as a file name written in the objective "
+            f"(got {name!r}): Kinema reads the file when the objective loads",
+            location=where,
+        )
+    folder = Path(filename).resolve().parent
+    path = folder / name
+    if not path.is_file():
+        raise BTRuntimeError(
+            f"{OBJECTIVE_PARAMETERS_LOADER}: no file {name!r} beside the objective (looked in {folder})",
+            location=where,
+        )
+    try:
+        data = yaml.safe_load(path.read_text(encoding="utf-8"))
+    except (OSError, yaml.YAMLError) as error:
+        raise BTRuntimeError(
+            f"{OBJECTIVE_PARAMETERS_LOADER}: {path} cannot be read as YAML: {error}", location=where
+        ) from None
+    if not isinstance(data, dict) or not all(isinstance(v, dict) for v in data.values()):
+        raise BTRuntimeError(
+            f"{OBJECTIVE_PARAMETERS_LOADER}: {path} must map behavior names to their parameters "
+            "(DetectAprilTags: {tag_size: 0.05, ...})",
+            location=where,
+        )
+    return name, {str(k): dict(v) for k, v in data.items()}
+
+
+def apply_objective_parameters(
+    root: etree._Element,
+    filename: str,
+    registered: Mapping[str, object],
+    spellings: Mapping[str, list[FormerSpelling]],
+) -> list[SpellingNote]:
+    """Read MoveIt Pro's ``LoadObjectiveParameters`` as the ports it gave (see the module docstring).
+
+    A node with ``parameters="{key}"`` after a loader writing ``{key}`` (its ``parameters`` port, default
+    ``{parameters}``) takes the section named like the node's ``name`` (else its ID): each value becomes
+    the port of that name (or the port a former spelling renames it to) unless the node sets the port
+    itself; a value with no such port is left out and named in the note.
+
+    Raises:
+        BTRuntimeError: the file is not named literally, is not beside the objective, or is not a mapping
+            of behavior names to parameters (naming the file and line).
+    """
+    if OBJECTIVE_PARAMETERS_LOADER in registered:
+        return []  # a plugin provides the old behavior itself
+    notes: list[SpellingNote] = []
+    for tree in root.iterchildren("BehaviorTree"):
+        loaded: dict[str, dict[str, dict[str, object]]] = {}
+        for element in tree.iterdescendants(etree.Element):
+            behavior = _element_id(element)
+            location = SourceLocation(filename, element.sourceline or 0)
+            if behavior == OBJECTIVE_PARAMETERS_LOADER:
+                name, sections = _load_parameters(element, filename)
+                key = _blackboard_key(element.get(_PARAMETERS_PORT) or "{parameters}")
+                loaded[key] = sections
+                label = element.get("name")
+                element.attrib.clear()
+                if label:
+                    element.set("name", label)
+                if element.tag in _EXPLICIT_TAGS:
+                    element.set("ID", "AlwaysSuccess")
+                else:
+                    element.tag = "AlwaysSuccess"
+                message = (
+                    f"{OBJECTIVE_PARAMETERS_LOADER} is MoveIt Pro's removed way of giving behaviors "
+                    f"their settings from a file; Kinema reads {name} when the objective loads and gives "
+                    f"its values as the ports of the behaviors that take {{{key}}}; write them as those "
+                    "ports instead"
+                )
+                notes.append(SpellingNote(location, message))
+                continue
+            value = element.get(_PARAMETERS_PORT)
+            if value is None or behavior is None or _blackboard_key(value) not in loaded:
+                continue
+            sections = loaded[_blackboard_key(value)]
+            section = sections.get(element.get("name") or "") or sections.get(behavior) or {}
+            manifest = registered.get(behavior)
+            ports = set(getattr(manifest, "ports", {}) or {})
+            renamed = {
+                old: new for spelling in spellings.get(behavior, []) for old, new in spelling.ports.items()
+            }
+            given, ignored = [], []
+            for parameter, setting in section.items():
+                text = _attribute_text(setting)
+                port = renamed.get(parameter, parameter)
+                if text is None or port not in ports:
+                    ignored.append(parameter)
+                    continue
+                if element.get(parameter) is None and element.get(port) is None:
+                    element.set(parameter, text)
+                    given.append(f"{port}={text}")
+            del element.attrib[_PARAMETERS_PORT]
+            message = f"{behavior}'s parameters come from the objective's parameter file: " + (
+                ", ".join(given) or "none for it"
+            )
+            if ignored:
+                message += f"; it has no port for {', '.join(ignored)}, which Kinema leaves out"
+            notes.append(SpellingNote(location, message + "; write them as its ports instead"))
+    return notes
+
+
+__all__ = [
+    "OBJECTIVE_PARAMETERS_LOADER",
+    "FormerSpelling",
+    "SpellingNote",
+    "apply_objective_parameters",
+    "rewrite_former_spellings",
+]

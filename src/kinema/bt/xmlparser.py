@@ -20,7 +20,12 @@ from kinema.bt.errors import BTRuntimeError
 from kinema.bt.manifest import NodeType
 from kinema.bt.names import model_name_problem, port_name_problem
 from kinema.bt.ports import NO_DEFAULT, PortDirection, PortInfo
-from kinema.bt.spellings import FormerSpelling, SpellingNote, rewrite_former_spellings
+from kinema.bt.spellings import (
+    FormerSpelling,
+    SpellingNote,
+    apply_objective_parameters,
+    rewrite_former_spellings,
+)
 from kinema.bt.xmlsource import MAX_DEPTH, parse_xml, parse_xml_file
 from kinema.errors import SourceLocation
 
@@ -248,6 +253,7 @@ class TreeLibrary:
             raise located_error("The XML must have a root node called <root>", filename, line_of(root))
         for include in root.findall("include"):
             self._load_include(include, filename, manifests, include_stack, verify)
+        self.spelling_notes.extend(apply_objective_parameters(root, filename, manifests, self.spellings))
         if self.spellings:
             self.spelling_notes.extend(rewrite_former_spellings(root, filename, self.spellings, manifests))
         skeletons: dict[etree._Element, Skeleton] | None = {} if verify else None

@@ -5,7 +5,12 @@
 - cameras: the cameras of the config's MuJoCo scene that are fixed in the world (``scene_camera``), in
   MuJoCo's camera convention (looking along -z, y up), read once per cell;
 - simulated objects: the MuJoCo driver's free bodies (``/mujoco/bodies``), when a simulator runs;
-- planning-scene objects: each world object's first primitive, under the object's id.
+- planning-scene objects: each world object's first primitive, under the object's id; an object attached
+  to the robot at its own pose on its link, at the configuration;
+- published frames: frames a behavior broadcasts while it runs (``PublishTF``), each a pose in a parent
+  frame of the tree (a robot link, the world, another frame), so later behaviors can name them. When the
+  behavior stops, the frame stays known for :data:`TF_LINGER` seconds, as a TF listener's buffer keeps
+  the last transform it heard (tf2's default cache is 10 s).
 
 One :class:`CellFrames` belongs to a :class:`~kinema.behaviors.BehaviorContext` (``context.frames``).
 """
@@ -13,6 +18,7 @@ One :class:`CellFrames` belongs to a :class:`~kinema.behaviors.BehaviorContext` 
 from __future__ import annotations
 
 import threading
+import time
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -25,10 +31,12 @@ if TYPE_CHECKING:
     from kinema.behaviors.context import BehaviorContext
     from kinema.motion.frames import FrameTree
 
-__all__ = ["BODIES_TIMEOUT", "CellFrames", "fixed_camera_frames"]
+__all__ = ["BODIES_TIMEOUT", "TF_LINGER", "CellFrames", "fixed_camera_frames"]
 
 # A simulator answers within milliseconds; a real robot has none, and the tree must not wait for it.
 BODIES_TIMEOUT = 1.0
+# Seconds a published frame stays known after its publisher stops (tf2's default buffer length).
+TF_LINGER = 10.0
 
 
 def fixed_camera_frames(mjcf_path: Any) -> dict[str, np.ndarray]:
@@ -67,6 +75,33 @@ class CellFrames:
         self._context = context
         self._cameras: dict[str, np.ndarray] | None = None
         self._lock = threading.Lock()
+        # child -> (parent, parent_T_child, monotonic time it is forgotten at; inf while published)
+        self._published: dict[str, tuple[str, np.ndarray, float]] = {}
+
+    def publish(self, child: str, parent: str, parent_T_child: np.ndarray) -> None:
+        """Make frame ``child`` known at ``parent_T_child`` in frame ``parent`` until :meth:`release`.
+
+        A frame published again moves. ``parent`` is resolved whenever a tree is made, so a frame published
+        in a robot link's frame moves with the robot.
+        """
+        with self._lock:
+            self._published[child] = (parent, np.array(parent_T_child, dtype=float), float("inf"))
+
+    def release(self, child: str, linger: float = TF_LINGER) -> None:
+        """Stop publishing ``child``: it stays known for ``linger`` seconds (0: forgotten at once)."""
+        with self._lock:
+            entry = self._published.get(child)
+            if entry is not None:
+                self._published[child] = (entry[0], entry[1], time.monotonic() + max(0.0, linger))
+
+    def published(self) -> dict[str, tuple[str, np.ndarray]]:
+        """The frames published (or released less than their linger ago): child -> (parent,
+        ``parent_T_child``), a snapshot."""
+        now = time.monotonic()
+        with self._lock:
+            for child in [c for c, (_, _, until) in self._published.items() if until <= now]:
+                del self._published[child]
+            return {child: (parent, pose) for child, (parent, pose, _) in self._published.items()}
 
     @property
     def cameras(self) -> dict[str, np.ndarray]:
@@ -106,4 +141,29 @@ class CellFrames:
         """The frame tree with the robot at configuration ``q`` (over the robot model's joint names)."""
         from kinema.motion.frames import FrameTree
 
-        return FrameTree(self._context.robot_model, q, self.fixed())
+        model = self._context.robot_model
+        fixed = self.fixed()
+        base = FrameTree(model, q, fixed)
+        attached = self._context.planning_scene.attached_objects()
+        published = self.published()
+        if not attached and not published:
+            return base
+        extra: dict[str, np.ndarray] = {}
+        for object_id, item in attached.items():
+            if item.link in base:
+                extra[object_id] = base.world_T(item.link) @ item.link_T_object
+        # A published frame may hang from another published frame: resolve in passes.
+        pending = dict(published)
+        while pending:
+            resolved = False
+            for child, (parent, parent_T_child) in list(pending.items()):
+                if parent in base or parent in extra:
+                    world_T_parent = extra[parent] if parent in extra else base.world_T(parent)
+                    extra[child] = world_T_parent @ parent_T_child
+                    del pending[child]
+                    resolved = True
+            if not resolved:
+                break  # frames whose parent nobody knows (any more) stay unknown
+        if not extra:
+            return base
+        return FrameTree(model, q, {**fixed, **extra})

@@ -4,6 +4,10 @@ Self-collision pairs are every pair of robot links that can move relative to eac
 the SRDF disables. Robot-scene pairs carry the ``padding`` as a safety margin, so the robot keeps that
 distance from obstacles while self-collision stays exact (padding links against each other would make
 folded but valid poses, and the gripper's own fingers, "collide").
+
+Objects attached to a link (:class:`~kinema.motion.planning_scene.AttachedObject`) ride on that link's
+joint: they are checked against the world (padded, as the robot is), against the robot's links other than
+their own link and its touch links (exact, as self-collision is), and against other attached objects.
 """
 
 from __future__ import annotations
@@ -92,6 +96,25 @@ class CollisionChecker:
         for obj in self.scene.objects.values():
             placement = pin.SE3(np.asarray(obj.world_T_object, dtype=float))
             gm.addGeometryObject(pin.GeometryObject(obj.name, 0, 0, placement, _coal_shape(obj)))
+        n_world = gm.ngeoms
+        # attached shape index -> (its object's link, the links it may touch)
+        carried: dict[int, tuple[str, frozenset[str]]] = {}
+        pin_model = self.model.pin_model
+        for attached in self.scene.attached_objects().values():
+            if not pin_model.existFrame(attached.link):
+                raise MotionError(
+                    f"collision object {attached.object_id!r} is attached to {attached.link!r}, which is no "
+                    "link of the robot"
+                )
+            frame_id = pin_model.getFrameId(attached.link)
+            frame = pin_model.frames[frame_id]
+            joint_T_link = np.asarray(frame.placement.homogeneous)
+            for shape in attached.primitives:
+                placement = pin.SE3(joint_T_link @ np.asarray(shape.world_T_object, dtype=float))
+                carried[gm.ngeoms] = (attached.link, attached.touch_links | {attached.link})
+                gm.addGeometryObject(
+                    pin.GeometryObject(shape.name, frame.parentJoint, frame_id, placement, _coal_shape(shape))
+                )
         semantic = self.model.semantic
         robot = list(range(self._n_robot))
         scene_pairs = []
@@ -106,9 +129,24 @@ class CollisionChecker:
                 gm.addCollisionPair(pin.CollisionPair(a, b))
             if ga.parentJoint == 0:
                 continue  # fixed to the world, like the scene
-            for b in range(self._n_robot, gm.ngeoms):
+            for b in range(self._n_robot, n_world):
                 scene_pairs.append(len(gm.collisionPairs))
                 gm.addCollisionPair(pin.CollisionPair(a, b))
+        for c, (_, touching) in carried.items():
+            gc = gm.geometryObjects[c]
+            if gc.parentJoint == 0:
+                continue  # carried by a link fixed to the world: part of the scene
+            for b in range(self._n_robot, n_world):
+                scene_pairs.append(len(gm.collisionPairs))
+                gm.addCollisionPair(pin.CollisionPair(c, b))
+            for a in robot:
+                ga = gm.geometryObjects[a]
+                if ga.parentJoint != gc.parentJoint and self._link_of_obj(ga) not in touching:
+                    gm.addCollisionPair(pin.CollisionPair(a, c))
+            for d in carried:
+                if d > c and gm.geometryObjects[d].parentJoint != gc.parentJoint:
+                    gm.addCollisionPair(pin.CollisionPair(c, d))
+        self._carried = sorted(carried)
         self._geom_model = gm
         self._geom_data = pin.GeometryData(gm)
         self._scene_pairs = scene_pairs
@@ -192,12 +230,15 @@ class CollisionChecker:
         return pairs
 
     def robot_bounds(self, q: np.ndarray) -> list[tuple[np.ndarray, np.ndarray]]:
-        """World-axis-aligned bounds ``(lower, upper)`` of each robot collision geometry at ``q`` (m).
+        """World-axis-aligned bounds ``(lower, upper)`` of each robot collision geometry at ``q`` (m), the
+        shapes of the objects it carries included.
 
         Loose for tilted shapes; meant for filtering the robot out of what its cameras see.
         """
         import pinocchio as pin
 
+        if self.scene.version != self._scene_version:
+            self._build()
         pin.updateGeometryPlacements(
             self.model.pin_model,
             self._data,
@@ -206,7 +247,7 @@ class CollisionChecker:
             self.model.pin_configuration(np.asarray(q, dtype=float)),
         )
         bounds = []
-        for index in range(self._n_robot):
+        for index in [*range(self._n_robot), *self._carried]:
             geometry = self._geom_model.geometryObjects[index].geometry
             geometry.computeLocalAABB()
             box = geometry.aabb_local

@@ -1,10 +1,13 @@
 """The planning scene: collision objects in the world the robot must not touch (table, tray, walls, ...).
 
-Two kinds of objects live in it. The *environment* is what the config's cell is made of (the static geoms
-of its MuJoCo scene); it is always there. *World objects* are what objectives add at run time
-(``AddCollisionBox``, ``AddCollisionObject``), each under an id as in MoveIt, made of one or more
-primitives; :meth:`PlanningScene.reset_world` removes them all and leaves the environment. Planning
-checks both; listeners (the runtime's publisher for ``kinema view``) hear of every change.
+Three kinds of objects live in it. The *environment* is what the config's cell is made of (the static
+geoms of its MuJoCo scene); it is always there. *World objects* are what objectives add at run time
+(``AddCollisionBox``, ``AddCollisionObject``, ``AddURDF``), each under an id as in MoveIt, made of one or
+more primitives. *Attached objects* are world objects bound to a robot link (``AttachURDF``): they move
+with the link, the planner checks them against the world and the robot's other links, and detaching puts
+them back into the world where they are then. An object is in the world or attached, never both.
+:meth:`PlanningScene.reset_world` removes world and attached objects and leaves the environment. Planning
+checks all three; listeners (the runtime's publisher for ``kinema view``) hear of every change.
 """
 
 from __future__ import annotations
@@ -59,22 +62,48 @@ def check_shape(obj: CollisionObject) -> None:
         raise MotionError(f"the pose of {obj.name!r} must be a finite 4x4 transform")
 
 
+@dataclass(frozen=True, eq=False)  # holds numpy arrays
+class AttachedObject:
+    """A world object bound to a robot link (MoveIt's ``AttachedCollisionObject``).
+
+    Attributes:
+        object_id: its id.
+        link: the robot link it moves with.
+        primitives: its shapes; each ``world_T_object`` is the shape's pose in the *link's* frame
+            (``link_T_shape``), and each name is its name in collision reports (the id, or ``id/k``).
+        link_T_object: the object's own pose in the link's frame.
+        touch_links: robot links it may touch (the link itself always may).
+        urdf: it was added from a URDF (``AddURDF``).
+    """
+
+    object_id: str
+    link: str
+    primitives: tuple[CollisionObject, ...]
+    link_T_object: np.ndarray
+    touch_links: frozenset[str] = frozenset()
+    urdf: bool = False
+
+
 @dataclass
 class PlanningScene:
     """The obstacles planning checks against, by name. ``version`` changes whenever the scene does.
 
     Attributes:
-        objects: every primitive the planner checks (environment and world objects), by unique name.
+        objects: every primitive fixed in the world (environment and world objects), by unique name.
         world: the world objects added at run time: id -> names of its primitives in :attr:`objects`.
         version: incremented on every change.
         world_poses: each world object's own pose (MoveIt's ``CollisionObject.pose``), in the world; a
             MOVE carries its primitives along with it.
+        attached: the objects bound to robot links, by id (see :class:`AttachedObject`).
+        urdf_ids: the ids of objects (in the world or attached) added from a URDF.
     """
 
     objects: dict[str, CollisionObject] = field(default_factory=dict)
     version: int = 0
     world: dict[str, tuple[str, ...]] = field(default_factory=dict)
     world_poses: dict[str, np.ndarray] = field(default_factory=dict)
+    attached: dict[str, AttachedObject] = field(default_factory=dict)
+    urdf_ids: set[str] = field(default_factory=set)
     _listeners: list[Callable[[PlanningScene], None]] = field(default_factory=list, repr=False)
     _lock: threading.RLock = field(default_factory=threading.RLock, repr=False)
 
@@ -99,6 +128,7 @@ class PlanningScene:
         *,
         replace: bool = True,
         pose: np.ndarray | None = None,
+        urdf: bool = False,
     ) -> None:
         """Add world object ``object_id`` made of ``primitives`` (their names are ignored).
 
@@ -108,23 +138,37 @@ class PlanningScene:
             replace: replace an object of the same id; when False an existing id is an error.
             pose: the object's own pose in the world (identity by default); :meth:`move_world_object`
                 moves the primitives with it.
+            urdf: the object comes from a URDF (``AddURDF``); replacing it by a plain object clears this.
 
         Raises:
-            MotionError: empty id, no primitive, a bad shape, an id taken by the environment, or an
-                existing id without ``replace``.
+            MotionError: empty id, no primitive, a bad shape, an id taken by the environment, an id
+                attached to the robot, or an existing id without ``replace``.
         """
         if not object_id:
             raise MotionError("a collision object needs a non-empty id")
         if not primitives:
             raise MotionError(f"collision object {object_id!r} has no shape")
         with self._lock:
+            self._refuse_attached(object_id, "replace")
             if object_id in self.world and not replace:
                 raise MotionError(
                     f"collision object {object_id!r} is already in the planning scene "
                     "(overwrite it to replace it)"
                 )
             self._store(object_id, list(primitives), np.eye(4) if pose is None else pose)
+            if urdf:
+                self.urdf_ids.add(object_id)
+            else:
+                self.urdf_ids.discard(object_id)
         self._changed()
+
+    def _refuse_attached(self, object_id: str, what: str) -> None:
+        """Raise when ``object_id`` is attached (the caller holds the lock)."""
+        if object_id in self.attached:
+            raise MotionError(
+                f"collision object {object_id!r} is attached to {self.attached[object_id].link!r}; detach "
+                f"it before you {what} it"
+            )
 
     def append_to_world_object(
         self, object_id: str, primitives: Sequence[CollisionObject], pose: np.ndarray | None = None
@@ -144,6 +188,7 @@ class PlanningScene:
         if not primitives:
             raise MotionError(f"collision object {object_id!r}: APPEND needs at least one shape")
         with self._lock:
+            self._refuse_attached(object_id, "append to")
             before = [self.objects[n] for n in self.world.get(object_id, ())]
             own = self.world_poses.get(object_id, np.eye(4) if pose is None else pose)
             self._store(object_id, [*before, *primitives], own)
@@ -160,6 +205,7 @@ class PlanningScene:
         if target.shape != (4, 4) or not np.all(np.isfinite(target)):
             raise MotionError(f"the new pose of {object_id!r} must be a finite 4x4 transform")
         with self._lock:
+            self._refuse_attached(object_id, "move")
             if object_id not in self.world:
                 raise MotionError(
                     f"no collision object {object_id!r} in the planning scene to move; "
@@ -215,6 +261,7 @@ class PlanningScene:
             MotionError: no such world object (the message lists those there are).
         """
         with self._lock:
+            self._refuse_attached(object_id, "remove")
             if object_id not in self.world:
                 raise MotionError(
                     f"no collision object {object_id!r} in the planning scene; "
@@ -223,6 +270,7 @@ class PlanningScene:
             for name in self.world.pop(object_id):
                 self.objects.pop(name, None)
             self.world_poses.pop(object_id, None)
+            self.urdf_ids.discard(object_id)
             self.version += 1
         self._changed()
 
@@ -237,9 +285,9 @@ class PlanningScene:
             return {oid: [self.objects[n] for n in names] for oid, names in self.world.items()}
 
     def reset_world(self) -> int:
-        """Remove every world object (the environment stays); returns how many were removed."""
+        """Remove every world and attached object (the environment stays); returns how many were removed."""
         with self._lock:
-            count = len(self.world)
+            count = len(self.world) + len(self.attached)
             if not count:
                 return 0
             for names in self.world.values():
@@ -247,9 +295,104 @@ class PlanningScene:
                     self.objects.pop(name, None)
             self.world.clear()
             self.world_poses.clear()
+            self.attached.clear()
+            self.urdf_ids.clear()
             self.version += 1
         self._changed()
         return count
+
+    # -- attached objects --------------------------------------------------------------------------
+
+    def attach(
+        self,
+        object_id: str,
+        link: str,
+        world_T_link: np.ndarray,
+        touch_links: Iterable[str] = (),
+    ) -> AttachedObject:
+        """Bind world object ``object_id`` to robot link ``link``, where it is now (MoveIt's attach).
+
+        Args:
+            object_id: a world object's id.
+            link: the robot link it moves with from now on.
+            world_T_link: the link's pose now (the object keeps its place relative to the link).
+            touch_links: robot links it may touch besides ``link``.
+
+        Raises:
+            MotionError: no such world object (naming those there are), it is attached already, or a
+                non-finite link pose.
+        """
+        world_T_link = np.asarray(world_T_link, dtype=float)
+        if world_T_link.shape != (4, 4) or not np.all(np.isfinite(world_T_link)):
+            raise MotionError(f"the pose of link {link!r} must be a finite 4x4 transform")
+        with self._lock:
+            if object_id in self.attached:
+                raise MotionError(
+                    f"collision object {object_id!r} is already attached to {self.attached[object_id].link!r}"
+                )
+            if object_id not in self.world:
+                raise MotionError(
+                    f"no collision object {object_id!r} in the planning scene to attach; "
+                    f"{did_you_mean(object_id, self.world)}"
+                )
+            link_T_world = np.linalg.inv(world_T_link)
+            names = self.world.pop(object_id)
+            primitives = tuple(
+                CollisionObject(p.name, p.shape, p.size, link_T_world @ p.world_T_object)
+                for p in (self.objects.pop(n) for n in names)
+            )
+            own = self.world_poses.pop(object_id, np.eye(4))
+            attached = AttachedObject(
+                object_id,
+                link,
+                primitives,
+                link_T_world @ own,
+                frozenset(touch_links) - {link},
+                object_id in self.urdf_ids,
+            )
+            self.attached[object_id] = attached
+            self.version += 1
+        self._changed()
+        return attached
+
+    def detach(self, object_id: str, world_T_link: np.ndarray) -> None:
+        """Put attached object ``object_id`` back into the world where it is now (its link at
+        ``world_T_link``).
+
+        Raises:
+            MotionError: no object of that id is attached (naming those that are), or a bad link pose.
+        """
+        world_T_link = np.asarray(world_T_link, dtype=float)
+        if world_T_link.shape != (4, 4) or not np.all(np.isfinite(world_T_link)):
+            raise MotionError("the link's pose must be a finite 4x4 transform")
+        with self._lock:
+            attached = self.attached.get(object_id)
+            if attached is None:
+                raise MotionError(
+                    f"no collision object {object_id!r} is attached to the robot; "
+                    f"{did_you_mean(object_id, self.attached)}"
+                )
+            placed = [
+                CollisionObject(p.name, p.shape, p.size, world_T_link @ p.world_T_object)
+                for p in attached.primitives
+            ]
+            del self.attached[object_id]
+            self._store(object_id, placed, world_T_link @ attached.link_T_object)
+        self._changed()
+
+    def attached_objects(self) -> dict[str, AttachedObject]:
+        """Every attached object, by id (a snapshot)."""
+        with self._lock:
+            return dict(self.attached)
+
+    def shape_names(self, object_id: str) -> tuple[str, ...]:
+        """The names the shapes of object ``object_id`` (in the world or attached) are checked under; ()
+        when there is no such object."""
+        with self._lock:
+            if object_id in self.world:
+                return self.world[object_id]
+            attached = self.attached.get(object_id)
+            return tuple(p.name for p in attached.primitives) if attached is not None else ()
 
     # -- listeners ---------------------------------------------------------------------------------
 
@@ -290,6 +433,7 @@ class PlanningScene:
                     else:
                         del self.world[object_id]
                         self.world_poses.pop(object_id, None)
+                        self.urdf_ids.discard(object_id)
             self.version += 1
         self._changed()
 

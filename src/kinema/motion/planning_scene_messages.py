@@ -14,7 +14,9 @@ box. Cones and planes are refused with the shapes that work. Orientations are re
 
 The scene to messages: its world objects become ``PlanningScene.world.collision_objects`` in ``world``,
 identity object pose, each primitive placed in the world (the environment, the cell itself, is drawn and
-checked but not listed, as MoveIt lists only objects added to the world).
+checked but not listed, as MoveIt lists only objects added to the world). Attached objects become
+``robot_state.attached_collision_objects``: each in its link's frame (``header.frame_id`` is the link),
+with its touch links, as move_group reports them.
 """
 
 from __future__ import annotations
@@ -72,9 +74,16 @@ def component_bits() -> Any:
 
 
 def everything() -> int:
-    """The components this conversion fills: scene settings, robot state, world object names and geometry."""
+    """The components this conversion fills: scene settings, robot state and attached objects, world object
+    names and geometry."""
     c = component_bits()
-    return int(c.SCENE_SETTINGS | c.ROBOT_STATE | c.WORLD_OBJECT_NAMES | c.WORLD_OBJECT_GEOMETRY)
+    return int(
+        c.SCENE_SETTINGS
+        | c.ROBOT_STATE
+        | c.ROBOT_STATE_ATTACHED_OBJECTS
+        | c.WORLD_OBJECT_NAMES
+        | c.WORLD_OBJECT_GEOMETRY
+    )
 
 
 def supported_shapes() -> str:
@@ -203,14 +212,16 @@ def _primitive_dict(obj: CollisionObject) -> dict[str, Any]:
     return {"type": s.CYLINDER, "dimensions": dimensions}
 
 
-def collision_object_dict(object_id: str, primitives: list[CollisionObject]) -> dict[str, Any]:
-    """A ``moveit_msgs/CollisionObject`` dict of a world object, in ``world``."""
+def collision_object_dict(
+    object_id: str, primitives: list[CollisionObject], frame_id: str = "world"
+) -> dict[str, Any]:
+    """A ``moveit_msgs/CollisionObject`` dict of an object whose primitives are placed in ``frame_id``."""
     import numpy as np
 
     from kinema.transforms import pose_dict
 
     return {
-        "header": {"frame_id": "world"},
+        "header": {"frame_id": frame_id},
         "pose": {"orientation": {"w": 1.0}},
         "id": object_id,
         "primitives": [_primitive_dict(p) for p in primitives],
@@ -256,11 +267,23 @@ def planning_scene_dict(
                 {"header": {"frame_id": "world"}, "id": oid, "operation": add} for oid, _ in objects
             ]
         }
-    if joint_state is not None and wanted & bits.ROBOT_STATE:
-        data["robot_state"] = {
-            "joint_state": {
+    if wanted & (bits.ROBOT_STATE | bits.ROBOT_STATE_ATTACHED_OBJECTS):
+        robot_state: dict[str, Any] = {}
+        if joint_state is not None and wanted & bits.ROBOT_STATE:
+            robot_state["joint_state"] = {
                 "name": [str(n) for n in joint_state.name],
                 "position": [float(p) for p in joint_state.position],
             }
-        }
+        attached = sorted(scene.attached_objects().items())
+        if attached:
+            robot_state["attached_collision_objects"] = [
+                {
+                    "link_name": item.link,
+                    "object": collision_object_dict(oid, list(item.primitives), item.link),
+                    "touch_links": sorted({item.link, *item.touch_links}),
+                }
+                for oid, item in attached
+            ]
+        if robot_state:
+            data["robot_state"] = robot_state
     return data

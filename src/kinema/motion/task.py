@@ -55,6 +55,8 @@ if TYPE_CHECKING:
     from kinema.motion.robot_model import RobotModel
 
 JOIN_TOLERANCE = 1e-6  # rad or m: sub-trajectories must meet this closely
+OCTOMAP_NAME = "<octomap>"  # MoveIt's collision name of the octomap
+OCTOMAP_OBJECT = "octomap"  # the world object Kinema's octomap is (UpdatePlanningSceneService)
 
 
 @dataclass
@@ -363,7 +365,8 @@ class _Planner:
                 allowed = allowed | pairs if stage.allow else allowed - pairs
 
     def names(self, index: int, names: Sequence[str]) -> list[str]:
-        """Robot links and scene object names that ``names`` (links, SRDF groups, object ids) stand for."""
+        """Robot links and scene object names that ``names`` (links, SRDF groups, object ids, attached
+        objects, MoveIt's ``<octomap>``) stand for."""
         from kinema.errors import did_you_mean
 
         scene = self.checker.scene
@@ -371,12 +374,22 @@ class _Planner:
         for name in names:
             if name in self.model.link_names or name in scene.objects:
                 out.append(name)
-            elif name in scene.world:
-                out.extend(scene.world[name])
+            elif scene.shape_names(name):
+                out.extend(scene.shape_names(name))
+            elif name == OCTOMAP_NAME:
+                # MoveIt's name of the octomap; Kinema's is the world object UpdatePlanningSceneService
+                # fills. Without one there is nothing to allow or forbid, as in MoveIt.
+                out.extend(scene.shape_names(OCTOMAP_OBJECT))
             elif name in self.model.semantic.groups and self.model.semantic.groups[name].links:
                 out.extend(self.model.semantic.groups[name].links)
             else:
-                known = [*self.model.link_names, *scene.world, *scene.objects, *self.model.semantic.groups]
+                known = [
+                    *self.model.link_names,
+                    *scene.world,
+                    *scene.attached,
+                    *scene.objects,
+                    *self.model.semantic.groups,
+                ]
                 raise _StageFailure(
                     index,
                     f"{name!r} is no robot link, planning group listing its links, or planning-scene "

@@ -10,6 +10,8 @@
 * :func:`register_icp` (``icp.py``) — point-to-point ICP (nearest neighbours with scipy's cKDTree);
 * :func:`load_pcd`, :func:`save_pcd` (``pcd.py``) — PCL's .pcd files;
 * :func:`sample_mesh_surface` (``mesh_sampling.py``) — points spread evenly over an STL's surface;
+* :func:`slice_contour` (``contour.py``) — poses along the outline of a slice of a cloud;
+* :func:`camera_in_base` (``calibration.py``) — a camera's pose from three tags on a calibration tool;
 * ``ros_messages.py`` — the edge: ``sensor_msgs`` PointCloud2 / Image / CameraInfo ↔ the above.
 
 Heavy dependencies (scipy, trimesh) load inside the functions that need them.
@@ -36,6 +38,9 @@ _EXPORTS = {
     "load_pcd": "pcd",
     "save_pcd": "pcd",
     "sample_mesh_surface": "mesh_sampling",
+    "slice_contour": "contour",
+    "camera_in_base": "calibration",
+    "tool_frame_from_tags": "calibration",
 }
 _lazy = LazyExports(__name__, _EXPORTS)
 

@@ -4,7 +4,9 @@ The agent publishes its planning scene (``moveit_msgs/PlanningScene``, latched) 
 ``/monitored_planning_scene`` whenever it changes; each message is the whole scene, so every message
 redraws the layer: translucent green boxes, spheres and cylinders under ``<root>/<object id>/<k>``,
 read by :mod:`kinema.motion.planning_scene_messages` as the planner reads them (a primitive the planner
-cannot check is not drawn).
+cannot check is not drawn). Objects attached to the robot (``robot_state.attached_collision_objects``,
+in their link's frame) are drawn under ``<root>/attached/<object id>``, a node that :meth:`follow` keeps
+at its link's pose as the robot moves.
 """
 
 from __future__ import annotations
@@ -47,6 +49,9 @@ class PlanningSceneLayer:
     def __init__(self, root: str) -> None:
         self.root = root
         self.object_ids: list[str] = []
+        # attached object id -> (its meshcat node, its link); and the link poses last sent
+        self.attached: dict[str, tuple[str, str]] = {}
+        self._sent: dict[str, np.ndarray] = {}
 
     def update(self, scene: Any, frame_pose: Any = None) -> list[Command]:
         """Commands drawing the collision objects of ``scene`` (replacing what was drawn before).
@@ -82,4 +87,41 @@ class PlanningSceneLayer:
                 path = f"{base}/{k}"
                 commands.append(sc.set_object(path, mesh))
                 commands.append(sc.set_transform(path, placed.world_T_object @ correction))
+        self.attached = {}
+        self._sent = {}
+        robot_state = getattr(scene, "robot_state", None)
+        for item in getattr(robot_state, "attached_collision_objects", []) or []:
+            obj = item.object
+            base = f"{self.root}/attached/{safe_name(str(obj.id), 'object')}"
+            self.attached[str(obj.id)] = (base, str(item.link_name))
+            for k, (shape, pose) in enumerate(zip(obj.primitives, obj.primitive_poses, strict=False)):
+                try:
+                    placed = primitive(
+                        int(shape.type), [float(d) for d in shape.dimensions], pose_from_message(pose), ""
+                    )
+                except (ObjectiveError, TransformError):
+                    continue
+                mesh, correction = _shape(placed)
+                commands.append(sc.set_object(f"{base}/{k}", mesh))
+                commands.append(sc.set_transform(f"{base}/{k}", placed.world_T_object @ correction))
+        if frame_pose is not None:
+            commands += self.follow(frame_pose)
+        return commands
+
+    def follow(self, frame_pose: Any) -> list[Command]:
+        """Commands moving each attached object to its link's pose, for the links that moved.
+
+        Args:
+            frame_pose: ``link -> world_T_link (4x4) or None``; an object whose link is unknown to the
+                view is left where it was last placed.
+        """
+        commands: list[Command] = []
+        for base, link in self.attached.values():
+            pose = frame_pose(link)
+            if pose is None:
+                continue
+            last = self._sent.get(base)
+            if last is None or np.abs(pose - last).max() > 1e-5:
+                self._sent[base] = np.array(pose, dtype=float)
+                commands.append(sc.set_transform(base, pose))
         return commands

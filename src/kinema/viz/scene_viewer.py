@@ -28,6 +28,7 @@ import numpy as np
 from kinema import ui_topics as topics
 from kinema.drivers.mujoco import names as driver_names
 from kinema.runtime import names as agent_names
+from kinema.transforms import TransformError, pose_matrix
 from kinema.transport import Node, Session
 from kinema.viz import scene_commands as sc
 from kinema.viz.liveness import RuntimeLiveness
@@ -89,6 +90,8 @@ class SceneViewer:
         self._rate_window: list[float] = []
         self._node: Node | None = None
         self._joint_states: Any = None
+        # frames heard on /tf: child -> (parent, parent_T_child)
+        self._tf: dict[str, tuple[str, np.ndarray]] = {}
         self._started_at = time.monotonic()
         self._last_scene: float | None = None
         # (wall, sim) of the first scene state of the current speed window, and the speed measured.
@@ -119,6 +122,7 @@ class SceneViewer:
         node.create_subscription(
             agent_names.PLANNING_SCENE_TYPE, agent_names.PLANNING_SCENE, self._on_planning_scene, latched=True
         )
+        node.create_subscription(topics.TF_TYPE, topics.TF_TOPIC, self._on_tf)
         self._thread.start()
 
     def stop(self) -> None:
@@ -222,7 +226,7 @@ class SceneViewer:
 
     def _on_marker(self, marker: Any) -> None:
         frame_id = str(marker.header.frame_id)
-        frame = self.scene.frame_pose(frame_id)
+        frame = self.frame_pose(frame_id)
         if frame is None:
             log.warning(
                 "marker %s/%d: unknown frame %r; drawn in the world frame", marker.ns, marker.id, frame_id
@@ -230,8 +234,29 @@ class SceneViewer:
             frame = np.eye(4)
         self.server.send(self.markers.update(marker, frame))
 
+    def _on_tf(self, message: Any) -> None:
+        for transform in message.transforms:
+            t, r = transform.transform.translation, transform.transform.rotation
+            try:
+                pose = pose_matrix([t.x, t.y, t.z], [r.x, r.y, r.z, r.w])
+            except TransformError:
+                continue
+            self._tf[str(transform.child_frame_id)] = (str(transform.header.frame_id), pose)
+
+    def frame_pose(self, frame_id: str, _depth: int = 0) -> np.ndarray | None:
+        """World pose of a frame: a body of the scene, else a frame heard on ``/tf`` (PublishTF's), placed
+        through its parent; None when neither knows it."""
+        pose = self.scene.frame_pose(frame_id)
+        if pose is not None or _depth > 8:
+            return pose
+        heard = self._tf.get(frame_id)
+        if heard is None:
+            return None
+        parent = self.frame_pose(heard[0], _depth + 1)
+        return None if parent is None else parent @ heard[1]
+
     def _on_planning_scene(self, message: Any) -> None:
-        self.server.send(self.planning_scene.update(message, self.scene.frame_pose))
+        self.server.send(self.planning_scene.update(message, self.frame_pose))
 
     def _on_planned_trajectory(self, message: Any) -> None:
         positions = [list(point.positions) for point in message.points]
@@ -284,6 +309,7 @@ class SceneViewer:
             self._follow_joint_states()
         if changed:
             commands += self.scene.body_commands()
+            commands += self.planning_scene.follow(self.frame_pose)
             now = time.monotonic()
             with self._lock:
                 self._rate_window = [t for t in self._rate_window if now - t <= 1.0] + [now]

@@ -62,6 +62,30 @@ RENAMED = [
         "SetupMTCPlanToRobotState",
         ("joint_state", "{goal}"),
     ),
+    (
+        '<Action ID="SetupMTCPlanToJointState" joint_state="{goal}" max_iterations="5000"/>',
+        "SetupMTCPlanToRobotState",
+        ("max_iterations", "5000"),
+    ),
+    (
+        '<Action ID="PublishStaticFrame" child_frame_id="local"/>',
+        "PublishTF",
+        ("child_frame_id", "local"),
+    ),
+    ('<Action ID="CreateJointState" joint_names="a" positions="1"/>', "CreateRobotState", ("positions", "1")),
+    ('<Action ID="GetRobotJointState" joint_state="{js}"/>', "GetJointState", ("joint_state", "{js}")),
+    (
+        '<Action ID="GetTrajectoryStateAtTime" joint_trajectory_msg="{t}"/>',
+        "GetRobotStateFromTrajectory",
+        ("joint_trajectory_msg", "{t}"),
+    ),
+    ('<Action ID="DetectAprilTags" apriltag_size="0.051"/>', "DetectAprilTags", ("tag_size", "0.051")),
+    (
+        '<Action ID="SetupMTCUpdateGroupCollisionRule" group_name="gripper" object_name="&lt;octomap&gt;" '
+        'allow_collision="true" task="{t}"/>',
+        "SetupMTCSetCollisionRule",
+        ("name_b", "<octomap>"),
+    ),
     ('<Action ID="GetImage" timeout_sec="3"/>', "GetImage", ("message_timeout_sec", "3")),
     ('<Action ID="GetPointCloud" timeout_sec="4"/>', "GetPointCloud", ("message_timeout_sec", "4")),
     ('<Action ID="GetCameraInfo" timeout_sec="6"/>', "GetCameraInfo", ("message_timeout_sec", "6")),
@@ -178,3 +202,81 @@ def test_an_objective_file_in_old_spelling_runs_on_the_objective_server(
     with ObjectiveServer(source) as server:
         result = server.submit(ObjectiveRequest("Old")).wait(5)
     assert result is not None and result.succeeded, result
+
+
+def test_the_old_one_stage_pick_is_refused_with_how_to_write_it_today(registry: BehaviorRegistry) -> None:
+    factory = registry.create_factory()
+    with pytest.raises(KinemaError) as raised:
+        factory.create_tree_from_text(
+            _tree('<Action ID="SetupMTCPickObject" grasp_pose="{g}" task="{t}" parameters="{p}"/>'),
+            filename="old.xml",
+        )
+    text = str(raised.value)
+    assert text.startswith("old.xml:3: SetupMTCPickObject is MoveIt Pro's removed behavior")
+    assert "moves no gripper" in text and "SetupMTCBatchPoseIK" in text and "'Close Gripper'" in text
+
+
+def test_retrieve_joint_state_parameter_is_read_as_retrieve_robot_state_parameter(
+    registry: BehaviorRegistry,
+) -> None:
+    factory = registry.create_factory()
+    factory.register_simple_action("RetrieveRobotStateParameter", lambda node: NodeStatus.SUCCESS)
+    tree = factory.create_tree_from_text(
+        _tree('<Action ID="RetrieveJointStateParameter"/>'), filename="old.xml"
+    )
+    assert next(iter(tree.nodes())).registration_id == "RetrieveRobotStateParameter"
+    (note,) = factory.library.spelling_notes
+    assert "RetrieveJointStateParameter is MoveIt Pro's old name of RetrieveRobotStateParameter" in str(note)
+
+
+APRILTAG_PARAMETERS = """DetectAprilTags:
+  apriltag_family_name: 36h11
+  apriltag_size: 0.051
+  max_hamming: 0
+  refine_edges: false
+  z_up: true
+"""
+
+
+def test_load_objective_parameters_gives_each_behavior_its_section_as_ports(
+    registry: BehaviorRegistry, tmp_path: Any
+) -> None:
+    (tmp_path / "apriltag_detection_config.yaml").write_text(APRILTAG_PARAMETERS)
+    objective = tmp_path / "old.xml"
+    objective.write_text(
+        _tree(
+            "<Sequence>"
+            '<Action ID="LoadObjectiveParameters" config_file_name="apriltag_detection_config.yaml" '
+            'parameters="{parameters}"/>'
+            '<Action ID="DetectAprilTags" image="{image}" camera_info="{info}" parameters="{parameters}" '
+            'max_hamming="2"/>'
+            "</Sequence>"
+        )
+    )
+    factory = registry.create_factory()
+    tree = factory.create_tree_from_file(objective)
+    loader, detector = [n for n in tree.nodes() if n.registration_id != "Sequence"]
+    assert loader.registration_id == "AlwaysSuccess"
+    ports = detector.config.input_ports
+    assert (ports["tag_size"], ports["apriltag_family_name"], ports["refine_edges"]) == (
+        "0.051",
+        "36h11",
+        "false",
+    )
+    assert ports["max_hamming"] == "2"  # what the objective sets itself wins
+    assert "parameters" not in ports and "z_up" not in ports
+    notes = [note.message for note in factory.library.spelling_notes]
+    assert any("Kinema reads apriltag_detection_config.yaml when the objective loads" in n for n in notes)
+    assert any("no port for z_up" in n and "tag_size=0.051" in n for n in notes)
+
+
+def test_load_objective_parameters_without_its_file_names_where_it_looked(
+    registry: BehaviorRegistry, tmp_path: Any
+) -> None:
+    objective = tmp_path / "old.xml"
+    objective.write_text(_tree('<Action ID="LoadObjectiveParameters" config_file_name="gone.yaml"/>'))
+    with pytest.raises(KinemaError) as raised:
+        registry.create_factory().create_tree_from_file(objective)
+    assert "no file 'gone.yaml' beside the objective" in str(raised.value) and str(tmp_path) in str(
+        raised.value
+    )

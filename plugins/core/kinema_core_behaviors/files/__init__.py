@@ -6,6 +6,7 @@ Paths resolve as MoveIt Pro resolves them (:mod:`.locations`); every save is ato
 from __future__ import annotations
 
 from .image_file import LoadImageFromFile, SaveImageToFile
+from .save_pose_for_urdf import SavePoseForUrdf
 from .text_file import ReadTextFileAsString
 from .yaml_messages import (
     LoadJointTrajectoryFromYaml,
@@ -30,4 +31,5 @@ BEHAVIORS = (
     ReadTextFileAsString,
     LoadImageFromFile,
     SaveImageToFile,
+    SavePoseForUrdf,
 )

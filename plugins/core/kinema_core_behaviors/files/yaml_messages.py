@@ -208,10 +208,63 @@ class LoadPoseStampedVectorFromYaml(_LoadFromYaml):
 
 
 class SavePoseStampedToYaml(_SaveToYaml):
-    """Writes a ``geometry_msgs/PoseStamped`` to a YAML file, atomically."""
+    """Writes a ``geometry_msgs/PoseStamped`` to a YAML file, atomically.
+
+    With a ``namespace`` the pose is written under that top-level key, and the file's other keys stay: one
+    file collects a pose per run (``namespace="{run_counter}"``). An existing key is replaced when
+    ``overwrite`` is true; otherwise the file is saved beside with a time stamp, as a file is.
+    """
 
     ros_type = POSE_STAMPED
     what = "The pose to save"
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            *super().provided_ports(),
+            input_port(
+                "namespace",
+                None,
+                "",
+                "Top-level key the pose is saved under, beside the file's other keys ('': the file is the "
+                "pose). MoveIt Pro's layout is not public; this is Kinema's.",
+            ),
+        ]
+
+    @fails_on_bad_input
+    def do_work(self) -> bool:
+        namespace = (
+            str(read_input(self, "namespace")).strip() if "namespace" in self.config.input_ports else ""
+        )
+        if not namespace:
+            return bool(super().do_work())
+        from kinema.transport.messages import to_dict
+
+        message = read_message(self, "message", POSE_STAMPED)
+        text = str(read_input(self, "yaml_filename"))
+        overwrite = bool(read_input(self, "overwrite"))
+        path = file_to_write(self, "yaml_filename", text, ".yaml")
+        entries: dict[str, Any] = {}
+        if path.exists():
+            documents = read_documents(self, "yaml_filename", path)
+            held = documents[0] if len(documents) == 1 and isinstance(documents[0], dict) else None
+            if held is not None:
+                entries = {str(key): value for key, value in held.items()}
+            if (held is None or namespace in entries) and not overwrite:
+                stamp = datetime.datetime.now().strftime("%Y%m%d_%H%M%S")
+                kept, path = path, path.with_name(f"{path.stem}_{stamp}{path.suffix}")
+                what = f"holds {namespace!r}" if held is not None else "is not a file of namespaces"
+                self.logger.publish_info(f"{kept} {what} and overwrite is false: saving to {path.name}")
+                entries = {}
+            elif held is None:
+                entries = {}
+        entries[namespace] = to_dict(message)
+        data = yaml.dump(entries, Dumper=_DUMPER, sort_keys=False, default_flow_style=False).encode()
+        try:
+            atomic_write_bytes(path, data)
+        except KinemaError as error:
+            raise port_error(self, "yaml_filename", f"= {text!r}: {error}", "") from None
+        return True
 
 
 class SavePoseStampedVectorToYaml(_SaveToYaml):

@@ -139,6 +139,9 @@ def read_input(node: Any, port: str, type: Any = None) -> Any:
     try:
         return node.get_input(port, type)
     except BTError as error:
+        if port in getattr(node, "kinema_cell_ports", {}):
+            # a port defaulting to the cell's value: the error says which config key to set
+            raise PortValueError(error.message) from None
         raw = node.config.input_ports.get(port)
         key = node.port_blackboard_key(port)
         if raw is None:

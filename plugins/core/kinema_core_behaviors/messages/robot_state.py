@@ -9,7 +9,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
+from kinema.behaviors import FormerSpelling, NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import did_you_mean
 
 from .conversions import ROBOT_STATE_TYPE, robot_state_message
@@ -52,6 +52,7 @@ class CreateRobotState(SyncBehavior):
     """
 
     subcategory = "Messages"
+    former_spellings = (FormerSpelling("CreateJointState"),)
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

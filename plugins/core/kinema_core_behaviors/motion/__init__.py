@@ -5,6 +5,7 @@ from __future__ import annotations
 from .create_stationary_trajectory import CreateStationaryTrajectory
 from .execute_trajectory import ExecuteTrajectory
 from .execute_trajectory_with_admittance import ExecuteTrajectoryWithAdmittance
+from .generate_coverage_path import GenerateCoveragePath
 from .get_joint_state import GetJointState
 from .get_robot_state_from_trajectory import GetRobotStateFromTrajectory
 from .move_gripper_action import MoveGripperAction
@@ -22,4 +23,5 @@ BEHAVIORS = (
     PlanCartesianPath,
     PlanToJointGoal,
     ValidateTrajectory,
+    GenerateCoveragePath,
 )

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
+from kinema.behaviors import AsyncBehavior, FormerSpelling, PortInfo, input_port, output_port
 from kinema.errors import KinemaError, did_you_mean
 
 from ..messages.conversions import joint_state_message
@@ -16,6 +16,7 @@ class GetJointState(AsyncBehavior):
     """
 
     subcategory = "Motion - Planning"
+    former_spellings = (FormerSpelling("GetRobotJointState"),)
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

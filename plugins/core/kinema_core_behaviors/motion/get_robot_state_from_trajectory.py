@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
+from kinema.behaviors import FormerSpelling, NodeStatus, PortInfo, SyncBehavior, input_port
 
 from ..messages.conversions import (
     JOINT_STATE_TYPE,
@@ -22,6 +22,7 @@ class GetRobotStateFromTrajectory(SyncBehavior):
     """
 
     subcategory = "Motion - Planning"
+    former_spellings = (FormerSpelling("GetTrajectoryStateAtTime"),)
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

@@ -43,6 +43,13 @@ class PlanCartesianPath(AsyncBehavior):
                 "group's tip).",
             ),
             input_port(
+                "tip_link",
+                str,
+                "",
+                "One tool frame, as MoveIt Pro's older objectives name it: the same as tip_links with one "
+                "link (give one of the two).",
+            ),
+            input_port(
                 "position_only", bool, False, "Follow the positions only, leave the orientation free."
             ),
             input_port("ik_cartesian_space_density", float, 0.005, "Distance (m) between IK solutions."),
@@ -69,6 +76,13 @@ class PlanCartesianPath(AsyncBehavior):
                 "0;0;0;0;0;0",
                 "Offset x;y;z;roll;pitch;yaw (m, rad) of the point that follows the path, in the tip "
                 "link's frame.",
+            ),
+            input_port(
+                "trajectory_sampling_rate",
+                int,
+                100,
+                "Points per second of the timed trajectory (MoveIt Pro's default is not public; Kinema's: "
+                "100, its planners' rate).",
             ),
             input_port(
                 "trajectory_timing",
@@ -120,8 +134,17 @@ class PlanCartesianPath(AsyncBehavior):
                     f"unknown planning group {group!r}; {did_you_mean(group, list(model.groups))}"
                 )
             tips = [t.strip() for t in self.get_input_or("tip_links", []) if t.strip()]
+            single = str(self.get_input_or("tip_link", "")).strip()
+            if single and tips and tips != [single]:
+                return self._fail(
+                    f"tip_link {single!r} and tip_links {';'.join(tips)!r} disagree; give one of the two"
+                )
+            tips = tips or ([single] if single else [])
             if len(tips) > 1:
                 return self._fail(f"one tip link at a time is supported, got {', '.join(tips)}")
+            rate = float(self.get_input("trajectory_sampling_rate"))
+            if not rate > 0:
+                return self._fail(f"trajectory_sampling_rate must be > 0 points per second, got {rate:g}")
             cell = self.context.cell
             tip = tips[0] if tips else (cell.tool_frame if cell and cell.tool_frame else None)
             tip = tip or model.group(group).tip_link
@@ -170,6 +193,7 @@ class PlanCartesianPath(AsyncBehavior):
                 model,
                 float(self.get_input("velocity_scale_factor")),
                 float(self.get_input("acceleration_scale_factor")),
+                sample_period=1.0 / rate,
             )
         except KinemaError as error:
             return self._fail(str(error))

@@ -10,15 +10,18 @@ from __future__ import annotations
 
 from .apriltags import DetectAprilTags, GetDetectionPose
 from .box_filters import CropPointsInBox, RemovePointsInBox
+from .calibrate_camera_pose import CalibrateCameraPose
 from .camera_topics import GetCameraInfo, GetImage, GetPointCloud
 from .centroid import GetCentroidFromPointCloud
 from .collision_spheres import CreateCollisionSpheresAtClosestPoints
+from .contour_from_slice import GetContourFromPointCloudSlice
 from .find_masked_objects import FindMaskedObjects
 from .load_point_cloud_from_file import LoadPointCloudFromFile
 from .masks import GetMasks3DFromMasks2D, GetPointCloudFromMask3D
 from .merge_point_clouds import MergePointClouds
 from .register_point_clouds import RegisterPointClouds
 from .segmentation import GetMasks2DFromExemplar, GetMasks2DFromPointQuery
+from .synced_image_and_cloud import GetSyncedImageAndPointCloud
 from .transform_point_cloud import TransformPointCloud, TransformPointCloudFrame
 from .tray_place_positions import ComputeTrayPlacePositionsUsingAprilTags
 from .update_planning_scene import UpdatePlanningSceneService
@@ -45,4 +48,7 @@ BEHAVIORS = (
     DetectAprilTags,
     GetDetectionPose,
     ComputeTrayPlacePositionsUsingAprilTags,
+    GetSyncedImageAndPointCloud,
+    GetContourFromPointCloudSlice,
+    CalibrateCameraPose,
 )

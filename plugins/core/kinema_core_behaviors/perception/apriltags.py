@@ -75,10 +75,12 @@ class DetectAprilTags(AsyncBehavior):
     subcategory = "Perception - 2D Image"
     former_spellings = (
         FormerSpelling(
+            # the name its parameter files (LoadObjectiveParameters) gave the tag size
+            ports={"apriltag_size": "tag_size"},
             dropped={
                 "parameters": "the detector's settings are its own ports today (apriltag_family_name, "
                 "tag_size, max_hamming, n_threads, quad_decimate, quad_sigma, refine_edges)"
-            }
+            },
         ),
     )
 

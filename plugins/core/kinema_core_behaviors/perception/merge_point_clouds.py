@@ -14,17 +14,15 @@ from ..messages.ports import (
 )
 from .clouds import POINT_CLOUD, frame_of, write_cloud
 
-# With align_point_clouds, pairs further apart than this many grid cells are not matched by ICP.
-ALIGN_CORRESPONDENCE_CELLS = 5.0
-
 
 class MergePointClouds(SyncBehavior):
     """Merges the clouds of ``point_clouds`` (all in one frame: TransformPointCloudFrame them first) into
     one with a point per occupied cube of side ``grid_resolution_meters`` (the mean of its points).
 
-    With ``align_point_clouds`` each cloud is first aligned to the ones before it by ICP (pairs closer than
-    five grid cells), for views whose poses are a little off. Fails naming the clouds' frames when they
-    differ, and on an empty vector.
+    With ``align_point_clouds`` each cloud is first aligned to the ones before it by point-to-point ICP
+    (pairs closer than ``icp_correspondence_distance``, at most ``icp_max_iterations`` rounds), for views
+    whose poses are a little off; a cloud ICP cannot align is merged as it is, with a warning. Fails naming
+    the clouds' frames when they differ, and on an empty vector.
     """
 
     subcategory = "Perception - 3D Point Cloud"
@@ -39,6 +37,20 @@ class MergePointClouds(SyncBehavior):
             input_port("grid_resolution_meters", float, 0.01, "Side of the voxel grid's cubes (m)."),
             input_port(
                 "align_point_clouds", bool, False, "Align each cloud to the previous ones by ICP first."
+            ),
+            input_port(
+                "icp_correspondence_distance",
+                float,
+                0.05,
+                "With align_point_clouds: points further apart (m) are not paired by ICP (MoveIt Pro's "
+                "default is not public; Kinema's: 0.05, what its objectives give).",
+            ),
+            input_port(
+                "icp_max_iterations",
+                int,
+                20,
+                "With align_point_clouds: most ICP rounds per cloud (MoveIt Pro's default is not public; "
+                "Kinema's: 20, what its objectives give).",
             ),
             message_output("merged_cloud", POINT_CLOUD, "{merged_cloud}", "The merged cloud."),
         ]
@@ -77,12 +89,18 @@ class MergePointClouds(SyncBehavior):
             )
         clouds = [c if c.frame_id else c.transformed(np.eye(4), "world") for c in clouds]
         if bool(read_input(self, "align_point_clouds")) and len(clouds) > 1:
+            distance = float(read_input(self, "icp_correspondence_distance"))
+            if not distance > 0:
+                raise port_error(self, "icp_correspondence_distance", f"= {distance}", "give a length > 0 m")
+            iterations = int(read_input(self, "icp_max_iterations"))
+            if iterations < 1:
+                raise port_error(self, "icp_max_iterations", f"= {iterations}", "give 1 or more")
             aligned = [clouds[0].finite()]
             for cloud in clouds[1:]:
                 reference = merge_clouds(aligned, resolution)
                 try:
                     result = register_icp(
-                        cloud, reference, max_correspondence_distance=ALIGN_CORRESPONDENCE_CELLS * resolution
+                        cloud, reference, max_correspondence_distance=distance, max_iterations=iterations
                     )
                     cloud = cloud.transformed(result.target_T_source)
                 except PerceptionError as error:

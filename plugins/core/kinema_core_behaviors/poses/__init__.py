@@ -1,7 +1,8 @@
-"""Poses: pose maths and frames (transforms between poses and frames, forward kinematics)."""
+"""Poses: pose maths and frames (transforms between poses and frames, forward kinematics, averages)."""
 
 from __future__ import annotations
 
+from .average_pose_stamped import AveragePoseStamped, AveragePoseStampedVector
 from .calculate_pose_offset import CalculatePoseOffset
 from .compute_link_pose_forward_kinematics import ComputeLinkPoseForwardKinematics
 from .transform_pose import TransformPose
@@ -14,4 +15,6 @@ BEHAVIORS = (
     TransformPose,
     TransformPoseFrame,
     TransformPoseWithPose,
+    AveragePoseStamped,
+    AveragePoseStampedVector,
 )

@@ -8,6 +8,7 @@ ExecuteTrajectory) runs it. WaitForMTCSolutionApproval lives with the other appr
 from __future__ import annotations
 
 from .plan_task import ConvertMtcSolutionToJointTrajectory, PlanMTCTask
+from .set_collision_rule import SetupMTCSetCollisionRule
 from .setup_stages import (
     InitializeMTCTask,
     SetupMTCBatchPoseIK,
@@ -30,4 +31,5 @@ BEHAVIORS = (
     SetupMTCMoveAlongFrameAxis,
     SetupMTCPlanToPose,
     SetupMTCPlanToRobotState,
+    SetupMTCSetCollisionRule,
 )

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 from kinema.behaviors import (
@@ -144,24 +145,39 @@ STAGE_PATHS_NAMESPACE = "mtc_solution"
 MAX_STAGE_LINES = 32
 
 
-def publish_stage_paths(behavior: Any, solution: Any, model: Any) -> None:
-    """Draw the tool's path of each stage in ``kinema view`` (one coloured line per moving stage).
+def publish_stage_paths(behavior: Any, solution: Any, model: Any, frames: Sequence[str] = ()) -> None:
+    """Draw the path of ``frames`` during each stage in ``kinema view`` (one coloured line per moving stage
+    and frame).
 
-    The tool is the tip link of the first moving stage's group (``grasp_link`` on lab_sim). Only for
-    display: without a transport node nothing is published.
+    Without ``frames`` the tool is the tip link of the first moving stage's group (``grasp_link`` on
+    lab_sim). Only for display: without a transport node nothing is published.
     """
+    if behavior.context.node is None or not solution.sub_trajectories:
+        return
+    if not frames:
+        first = solution.sub_trajectories[0].trajectory.joint_names
+        group = next((g for g in model.groups.values() if tuple(g.joint_names) == tuple(first)), None)
+        frames = [getattr(group, "tip_link", None) or model.link_names[-1]]
+    paths = [
+        (stage if len(frames) == 1 else f"{stage}: {frame}", points)
+        for frame in frames
+        for stage, points in solution.tool_paths(model, frame)
+    ]
+    publish_paths(behavior, paths)
+
+
+def publish_paths(behavior: Any, paths: Sequence[tuple[str, Any]]) -> None:
+    """Draw ``(label, points (N, 3) in the world)`` lines in ``kinema view`` under the solution namespace,
+    removing the lines of an earlier, longer drawing (the user's own markers stay)."""
     from kinema.transport import from_dict
 
     from ..ui.visualize_pose import MARKER_ARRAY_TYPE, marker_publisher
 
     node = behavior.context.node
-    if node is None or not solution.sub_trajectories:
+    if node is None:
         return
-    first = solution.sub_trajectories[0].trajectory.joint_names
-    group = next((g for g in model.groups.values() if tuple(g.joint_names) == tuple(first)), None)
-    frame = getattr(group, "tip_link", None) or model.link_names[-1]
     markers: list[dict[str, Any]] = []
-    for index, (stage, points) in enumerate(solution.tool_paths(model, frame)):
+    for index, (label, points) in enumerate(paths):
         if len(points) < 2:
             continue
         r, g, b = STAGE_COLORS[index % len(STAGE_COLORS)]
@@ -176,14 +192,13 @@ def publish_stage_paths(behavior: Any, solution: Any, model: Any) -> None:
                 "scale": {"x": 0.005},
                 "color": {"r": r, "g": g, "b": b, "a": 1.0},
                 "points": [{"x": float(x), "y": float(y), "z": float(z)} for x, y, z in points],
-                "text": stage,
+                "text": label,
             }
         )
     drawn = {m["id"] for m in markers}
-    # Remove the lines of an earlier, longer solution (only this namespace: the user's markers stay).
     markers += [
         {"header": {"frame_id": "world"}, "ns": STAGE_PATHS_NAMESPACE, "id": i, "action": 2}
-        for i in range(1, MAX_STAGE_LINES + 1)
+        for i in range(1, max(MAX_STAGE_LINES, len(paths)) + 1)
         if i not in drawn
     ]
     marker_publisher(behavior, node).publish(from_dict(MARKER_ARRAY_TYPE, {"markers": markers}))

@@ -244,12 +244,17 @@ class SetupMTCPlanToPose(_SetupStage):
 class SetupMTCPlanToRobotState(_SetupStage):
     """Adds a stage that moves the planning group to ``joint_state`` (a collision-free motion).
 
-    It is what MoveIt Pro's former SetupMTCInterpolateToJointState reads as: the straight joint-space
-    motion is tried first, and planned around obstacles only when it collides.
+    The straight joint-space motion is tried first, and planned around obstacles (keeping ``link_padding``,
+    drawing at most ``max_iterations`` samples from ``seed``) only when it collides; the motion is timed
+    under the scaled limits and sampled ``trajectory_sampling_rate`` times a second. It is also what
+    MoveIt Pro's former SetupMTCInterpolateToJointState reads as.
     """
 
-    former_spellings = (FormerSpelling("SetupMTCInterpolateToJointState"),)
-    MOTION = MotionPorts(velocity=None, acceleration=None, planning=False)
+    former_spellings = (
+        FormerSpelling("SetupMTCInterpolateToJointState"),
+        FormerSpelling("SetupMTCPlanToJointState"),
+    )
+    MOTION = MotionPorts(seed=True)
 
     @classmethod
     def stage_ports(cls) -> list[PortInfo]:
@@ -321,6 +326,20 @@ class SetupMTCBatchPoseIK(_SetupStage):
     """Adds a stage that solves IK for each of ``target_poses`` and keeps the solutions closest to the
     state before (up to ``max_ik_solutions``); the stages around it plan to or from the closest that works.
     """
+
+    # MoveIt Pro's old one-stage pick (approach, close the gripper, lift, set by LoadObjectiveParameters)
+    # became a few stages and behaviors, this one among them; Kinema plans no gripper motion inside a
+    # task, so the old stage is refused with how to write it today rather than half done.
+    former_spellings = (
+        FormerSpelling(
+            "SetupMTCPickObject",
+            refused="it planned the approach, closed the gripper and lifted in one MTC stage, and Kinema's "
+            "task planner moves no gripper; write it as MoveIt Pro's lab_sim 'Pick from Pose' does today: "
+            "SetupMTCConnectWithProRRT, SetupMTCMoveAlongFrameAxis (the approach), SetupMTCBatchPoseIK "
+            "(the grasp pose), PlanMTCTask and 'Execute MTC Solution', then 'Close Gripper' and a "
+            "PlanCartesianPath + ExecuteTrajectory to lift",
+        ),
+    )
 
     @classmethod
     def stage_ports(cls) -> list[PortInfo]:

@@ -7,6 +7,7 @@ solution (PlanMTCTask) or a ``trajectory_msgs/JointTrajectory`` (PlanCartesianPa
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from typing import Any
 
 from ..messages.conversions import trajectory_message
@@ -75,8 +76,9 @@ def solution_steps(solution: Any, model: Any = None) -> tuple[list[dict[str, Any
     return [], 0.0
 
 
-def show_solution(behavior: Any, solution: Any, model: Any = None) -> None:
-    """Draw ``solution`` in ``kinema view``: its motion, and for an MTC solution each stage's tool path."""
+def show_solution(behavior: Any, solution: Any, model: Any = None, links: Sequence[str] = ()) -> None:
+    """Draw ``solution`` in ``kinema view``: its motion, and the path of each of ``links`` along it (for an
+    MTC solution stage by stage; without ``links``, the tool's path of each stage of an MTC solution)."""
     from kinema.motion.task import TaskSolution
 
     if isinstance(solution, TaskSolution):
@@ -84,9 +86,35 @@ def show_solution(behavior: Any, solution: Any, model: Any = None) -> None:
 
         publish_planned_trajectory(behavior, trajectory_message(solution.joined()))
         if model is not None:
-            publish_stage_paths(behavior, solution, model)
+            publish_stage_paths(behavior, solution, model, links)
     elif getattr(solution, "__msgtype__", None) == JOINT_TRAJECTORY:
         publish_planned_trajectory(behavior, solution)
+        if model is not None and links and solution.points:
+            from .plan_task import publish_paths
+
+            publish_paths(behavior, [(link, trajectory_link_path(model, solution, link)) for link in links])
+
+
+def trajectory_link_path(model: Any, message: Any, link: str, start: Any = None) -> Any:
+    """Where ``link`` goes along a ``trajectory_msgs/JointTrajectory``: positions ``(N, 3)`` in the world.
+
+    Joints the trajectory does not move stay at ``start`` (a configuration over the model's joints; the
+    model's zero configuration by default).
+    """
+    import numpy as np
+
+    from kinema.motion import fk
+
+    q = np.zeros(len(model.joint_names)) if start is None else np.array(start, dtype=float)
+    index = {name: i for i, name in enumerate(model.joint_names)}
+    columns = [(k, index[str(n)]) for k, n in enumerate(message.joint_names) if str(n) in index]
+    data = model.new_data()
+    points = []
+    for point in message.points:
+        for k, i in columns:
+            q[i] = float(point.positions[k])
+        points.append(fk(model, q, link, data)[:3, 3])
+    return np.array(points)
 
 
 def _gripper_joints(model: Any) -> dict[str, str]:

@@ -9,11 +9,13 @@ from .log_message import LogMessage
 from .markers import PublishMarkers, VisualizeMesh
 from .notices import SwitchUIPrimaryView
 from .point_clouds import ClearSnapshot, PublishPointCloud, SendPointCloudToUI
+from .visualize_path import VisualizePath
 from .visualize_pose import VisualizePose
 
 BEHAVIORS = (
     LogMessage,
     VisualizePose,
+    VisualizePath,
     PublishMarkers,
     VisualizeMesh,
     SendPointCloudToUI,

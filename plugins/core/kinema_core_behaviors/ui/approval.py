@@ -56,6 +56,12 @@ class IsUserAvailable(StatefulBehavior):
     """
 
     subcategory = "User Input"
+    # MoveIt Pro renamed RetrieveJointStateParameter (the user sets a joint state in its UI) to
+    # RetrieveRobotStateParameter. The rename is declared here, among the behaviors that ask the user, so an
+    # objective written either way reaches RetrieveRobotStateParameter wherever a plugin provides it.
+    former_spellings = (
+        FormerSpelling("RetrieveJointStateParameter", current_id="RetrieveRobotStateParameter"),
+    )
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
@@ -144,11 +150,32 @@ class WaitForMTCSolutionApproval(_AskUser):
         return [
             input_port(
                 "solution", None, "{solution}", "The planned solution (an MTC solution or trajectory)."
-            )
+            ),
+            input_port(
+                "cartesian_path_links",
+                list[str],
+                "",
+                "Robot links whose paths kinema view draws along the solution ('': for an MTC solution the "
+                "tip of its group, stage by stage); a name that is no link is left out, with a warning.",
+            ),
         ]
 
     def prompt(self) -> str:
         return "Approve the planned motion?"
+
+    def _links(self, model: Any) -> list[str]:
+        wanted = [str(v).strip() for v in self.get_input_or("cartesian_path_links", []) if str(v).strip()]
+        if model is None:
+            return []
+        unknown = [link for link in wanted if link not in model.link_names]
+        if unknown:
+            from kinema.errors import did_you_mean
+
+            self.logger.publish_warn(
+                f"{self.registration_id}: cartesian_path_links names {unknown[0]!r}, which is no link of the "
+                f"robot; its path is not drawn ({did_you_mean(unknown[0], model.link_names)})"
+            )
+        return [link for link in wanted if link in model.link_names]
 
     async def do_work(self) -> bool:
         solution = self.get_input_or("solution", None)
@@ -160,7 +187,7 @@ class WaitForMTCSolutionApproval(_AskUser):
             )
             model = None
         steps, duration = solution_steps(solution, model)
-        show_solution(self, solution, model)
+        show_solution(self, solution, model, self._links(model))
         return await self.ask({"steps": steps, "duration": duration} if steps else None)
 
 

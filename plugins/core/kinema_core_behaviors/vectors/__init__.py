@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from .add_pose_stamped_to_vector import AddPoseStampedToVector
 from .edit_vector import InsertInVector, PushBackVector, RemoveFromVector, ReplaceInVector
 from .for_each import ForEach, ForEachUntilSuccess
 from .read_vector import GetElementOfVector, GetSizeOfVector
@@ -18,4 +19,5 @@ BEHAVIORS = (
     GetSizeOfVector,
     ForEach,
     ForEachUntilSuccess,
+    AddPoseStampedToVector,
 )
