@@ -49,6 +49,7 @@ from kinema.runtime.objective_status import ObjectiveStatus
 from kinema.runtime.overrides import ParameterOverride, apply_overrides, model_defaults
 from kinema.runtime.result import ObjectiveResult
 from kinema.runtime.tick_watchdog import (
+    STALL_REPORT_S,
     WATCHDOG_PERIOD_S,
     Abandoned,
     TickWatchdog,
@@ -319,6 +320,8 @@ class ObjectiveServer:
         watchdog_report_s: behavior code running longer than this in one call is reported.
         abandon_after_s: how long a cancel or newer request waits for a tick thread stuck in behavior
             code before the thread is abandoned.
+        stall_report_s: how long the interpreter must be held (C code keeping the GIL) before the stacks
+            are dumped and the stall reported (see tick_watchdog.STALL_REPORT_S).
     """
 
     def __init__(
@@ -331,6 +334,7 @@ class ObjectiveServer:
         result_hold_s: float = RESULT_HOLD_S,
         watchdog_report_s: float = WATCHDOG_REPORT_S,
         abandon_after_s: float = ABANDON_AFTER_S,
+        stall_report_s: float = STALL_REPORT_S,
     ) -> None:
         if tick_rate_hz <= 0:
             raise KinemaError(f"the tick rate must be positive, got {tick_rate_hz} Hz")
@@ -340,6 +344,7 @@ class ObjectiveServer:
         self._blackboard_period = blackboard_period_s
         self._watchdog_report = watchdog_report_s
         self._abandon_after = abandon_after_s
+        self._stall_report = stall_report_s
         self._ids = itertools.count(1)
         self._inbox: deque[ObjectiveRun | _Cancel | _Call] = deque()
         self._wake = threading.Condition()
@@ -393,6 +398,7 @@ class ObjectiveServer:
             self._stopped,
             report_after_s=self._watchdog_report,
             abandon_after_s=self._abandon_after,
+            stall_after_s=self._stall_report,
         )
         self._watchdog.start()
 

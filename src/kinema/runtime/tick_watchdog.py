@@ -57,6 +57,12 @@ LOOP_BLOCKED = (
 )
 STUCK_ADVICE = "the objective cannot stop until it returns: cancel it (ctrl+x, kinema objective cancel)"
 ABANDONED_ADVICE = "restart the runtime (kinema down, then kinema run) to free it"
+# faulthandler's timer fires when no watchdog re-armed it for this long. Its C thread then reads every
+# thread's stack without the interpreter's lock: safe while C code holds that lock (what the dump is for),
+# but it can crash the process when the threads are running and the watchdog merely was not scheduled,
+# as on a loaded machine that starves threads for a second or more (an agent died of it at load 85).
+# So a stall is reported after 5 s, not after the report threshold of stuck behavior code (1 s).
+STALL_REPORT_S = 5.0
 # faulthandler's timer is re-armed every this many watchdog rounds (arming costs about 0.1 ms).
 STALL_ARM_EVERY = 5
 # A stall report stays in the health warnings this long.
@@ -193,6 +199,7 @@ class TickWatchdog:
         report_after_s: behavior code running longer than this in one call is reported.
         abandon_after_s: how long a request waits for a thread stuck in behavior code before the
             thread is abandoned.
+        stall_after_s: how long the interpreter must be held before faulthandler dumps the stacks.
     """
 
     def __init__(
@@ -202,8 +209,10 @@ class TickWatchdog:
         *,
         report_after_s: float,
         abandon_after_s: float,
+        stall_after_s: float = STALL_REPORT_S,
     ) -> None:
         self._server = server
+        self.stall_after_s = stall_after_s
         self._stopped = stopped
         self.report_after_s = report_after_s
         self.abandon_after_s = abandon_after_s
@@ -216,7 +225,7 @@ class TickWatchdog:
 
     def start(self) -> None:
         STALLS.register()
-        STALLS.arm(self.report_after_s)  # armed before the first tick, not a round later
+        STALLS.arm(self.stall_after_s)  # armed before the first tick, not a round later
         self._thread.start()
 
     def join(self, timeout: float | None = None) -> None:
@@ -232,7 +241,7 @@ class TickWatchdog:
         while not self._stopped.wait(WATCHDOG_PERIOD_S):
             try:
                 if self._rounds % STALL_ARM_EVERY == 0:
-                    STALLS.arm(self.report_after_s)
+                    STALLS.arm(self.stall_after_s)
                 self._rounds += 1
                 self._watch_stalls()
                 self._watch_once()
@@ -251,7 +260,7 @@ class TickWatchdog:
             where = " ← ".join(frames[:STALL_FRAMES])
             thread = worker.name if worker else "?"
             sentence = (
-                f"Kinema stood still for more than {self.report_after_s:g} s: the interpreter was held (C "
+                f"Kinema stood still for more than {self.stall_after_s:g} s: the interpreter was held (C "
                 f"code that does not release Python's lock?) while tick thread {thread} sat in: {where}; "
                 "slow C work belongs in an AsyncBehavior's do_work, off the tick"
             )

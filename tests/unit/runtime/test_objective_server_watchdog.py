@@ -428,7 +428,9 @@ def test_a_cancel_accepted_while_a_tick_holds_the_interpreter_wins_and_the_stack
     """The probe: C code holding the GIL for 15 s lost a cancel, and the objective reported SUCCESS."""
     GO.clear()
     factory = registry_of([HoldsTheInterpreter]).create_factory(BehaviorContext.offline())
-    with ObjectiveServer(FactoryTreeSource(factory), watchdog_report_s=0.2, abandon_after_s=30) as server:
+    with ObjectiveServer(
+        FactoryTreeSource(factory), watchdog_report_s=0.2, abandon_after_s=30, stall_report_s=0.2
+    ) as server:
         run = _xml(server, _tree("<HoldsTheInterpreter/>"))
         _wait(lambda: _running(server), "the objective to run")
         assert run.request_cancel("cancelled by the test")  # what /do_objective's cancel_goal does
