@@ -230,6 +230,9 @@ def main(argv: list[str] | None = None) -> int:
 
     args = _parser().parse_args(argv)
     configure_process_logging(args.log_file, verbose=args.verbose)
+    from kinema.process import memory_probe
+
+    memory_probe.install_from_environment()  # KINEMA_DEBUG_MEMORY: SIGUSR2 logs a memory report
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     signal.signal(signal.SIGINT, lambda *_: stop.set())
