@@ -10,7 +10,7 @@ grows once allocator fragmentation has levelled off), and the agent's RSS after 
 floor measured in the same run (a fresh ``python -c "import mujoco, pinocchio, zenoh"``).
 
 Target: after 500 cycles threads and descriptors within a handful of the start, RSS flat; the agent
-within 2x of the import floor. To see what grows, run with ``KINEMA_DEBUG_MEMORY=1`` (or ``=8`` for
+within 2x of the import floor. To see what grows, run with ``KINEMA_DEBUG_MEMORY=0`` (or ``=8`` for
 tracemalloc with 8 frames) in the environment and send the agent ``SIGUSR2`` now and then: each signal
 writes a memory report to its ``agent.log`` (:mod:`kinema.process.memory_probe`).
 Run: ``python benchmarks/soak.py [--cycles 500] [--every 50] [--smoke]`` (``--smoke``: 6 cycles, as the

@@ -45,7 +45,8 @@ _previous_snapshot: tracemalloc.Snapshot | None = None
 
 
 def install_from_environment() -> bool:
-    """Install the probe when ``KINEMA_DEBUG_MEMORY`` is set (call first thing in ``main``).
+    """Install the probe when ``KINEMA_DEBUG_MEMORY`` is set (call first thing in ``main``): ``0`` or a word
+    reports without tracing Python allocations, ``N`` >= 1 traces them with N frames.
 
     Returns True when installed. A value that is not a number installs the probe without tracemalloc.
     """
