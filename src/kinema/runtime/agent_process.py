@@ -202,6 +202,23 @@ def _add_debugging_doors(agent: Agent, options: AgentOptions) -> None:
         log.info("Groot2 can attach at 127.0.0.1:%d", options.groot2_port)
 
 
+#: zenoh's pool for sending large messages through shared memory (its default is 16 MiB, all of it
+#: resident in the agent once some trajectories went through it). The agent's large messages
+#: (trajectories, node tables, blackboard snapshots) are tens to hundreds of kB; a larger one than the
+#: pool is sent the ordinary way.
+SHARED_MEMORY_POOL_BYTES = 4 << 20
+
+
+def _shared_memory_pool() -> dict[str, Any]:
+    """The agent's zenoh overrides: a smaller shared-memory pool, unless a zenoh config file is used
+    (``KINEMA_ZENOH_CONFIG``: what it says stands)."""
+    from kinema.transport.session import ENV_CONFIG
+
+    if os.environ.get(ENV_CONFIG):
+        return {}
+    return {"transport/shared_memory/transport_optimization/pool_size": SHARED_MEMORY_POOL_BYTES}
+
+
 class _TrimHeapAfterRuns:
     """Gives the heap's free pages back after each objective run (:func:`kinema.transport.heap.trim_soon`).
 
@@ -279,7 +296,11 @@ def main(argv: list[str] | None = None) -> int:
     try:
         from kinema.transport import host_router, open_session
 
-        session = host_router(args.host_router) if args.host_router else open_session(args.connect)
+        session = (
+            host_router(args.host_router)
+            if args.host_router
+            else open_session(args.connect, config_overrides=_shared_memory_pool())
+        )
     except KinemaError as error:
         log.error("%s", error)
         print(f"error: {error}", file=sys.stderr)
