@@ -8,6 +8,7 @@ each ``SIGUSR2`` then writes one report to the process's log (the run folder's `
   anonymous mappings such as glibc's thread arenas and native libraries' own pools, file mappings);
 * glibc's allocator (``mallinfo2``): bytes in use, bytes free inside the heaps (fragmentation), bytes
   in blocks mapped on their own, and the number of arenas;
+* the modules imported, counted by top-level package (what an import costs stays resident);
 * the Python objects by type whose count changed since the previous report;
 * what ``malloc_trim(0)``, run right then, gave back and how long it took (the part of the RSS that
   was free chunks scattered in the heaps);
@@ -30,6 +31,7 @@ import logging
 import os
 import re
 import signal
+import sys
 import threading
 import time
 import tracemalloc
@@ -84,6 +86,9 @@ def report() -> str:
         ),
         key=lambda item: -abs(item[1]),
     )
+    packages = collections.Counter(name.partition(".")[0] for name in list(sys.modules))
+    top = ", ".join(f"{name} {count}" for name, count in packages.most_common(12))
+    lines.append(f"modules: {sum(packages.values())} imported; most from {top}")
     lines.append(f"python objects: {sum(counts.values())} tracked; changed since the previous report:")
     lines += [f"  {delta:+8d}  {name} ({counts[name]})" for name, delta in changed[:15]] or ["  none"]
     _previous_counts.clear()

@@ -47,6 +47,7 @@ def test_sigusr2_writes_a_memory_report_with_what_grew_since_the_previous_one() 
     for report in (first, second):
         assert "VmRSS" in report and "resident by mapping" in report
         assert "python objects" in report and "malloc_trim(0) gave back" in report
+        assert "modules: " in report and "kinema " in report
     # The second report diffs against the first: the 2 MB of bytearrays made between them show, with the
     # line that made them.
     growth = second.split("net since the previous report: ")[1]
