@@ -4,9 +4,15 @@ Starts ``kinema run --headless`` (lab_sim: the agent and the MuJoCo driver) on a
 private user folders, then runs cycles of: start "3 Waypoints Pick and Place" (a moving objective), let
 it run a moment (0.2 to 0.8 s, varying), cancel it, wait for its result. Every ``--every`` cycles it
 prints the agent process's threads, open descriptors and resident memory, each beside its value after the
-first cycles (the peer: the same process before the soak), so a leak shows as a growing difference.
+first cycles (the peer: the same process before the soak), so a leak shows as a growing difference. At
+the end it prints the RSS slope fitted over the second half of the samples (kB per cycle: what still
+grows once allocator fragmentation has levelled off), and the agent's RSS after 20 runs beside the import
+floor measured in the same run (a fresh ``python -c "import mujoco, pinocchio, zenoh"``).
 
-Target: after 500 cycles threads and descriptors within a handful of the start, RSS flat.
+Target: after 500 cycles threads and descriptors within a handful of the start, RSS flat; the agent
+within 2x of the import floor. To see what grows, run with ``KINEMA_DEBUG_MEMORY=0`` (or ``=8`` for
+tracemalloc with 8 frames) in the environment and send the agent ``SIGUSR2`` now and then: each signal
+writes a memory report to its ``agent.log`` (:mod:`kinema.process.memory_probe`).
 Run: ``python benchmarks/soak.py [--cycles 500] [--every 50] [--smoke]`` (``--smoke``: 6 cycles, as the
 test suite does).
 """
@@ -27,6 +33,12 @@ from kinema.transport import free_endpoint
 
 OBJECTIVE = "3 Waypoints Pick and Place"
 READY = "objectives can be started"
+# The runs after which the agent's RSS is compared with the import floor (fewer in a shorter soak).
+FLOOR_RUNS = 20
+FLOOR_SCRIPT = (
+    "import mujoco, pinocchio, zenoh\n"
+    "print(next(l.split()[1] for l in open('/proc/self/status') if l.startswith('VmRSS:')))"
+)
 
 
 def _agent_pid(supervisor: int) -> int:
@@ -44,6 +56,21 @@ def _sample(pid: int) -> tuple[int, int, int]:
     threads = int(fields["Threads"])
     rss = int(fields["VmRSS"].split()[0])
     return threads, len(os.listdir(f"/proc/{pid}/fd")), rss
+
+
+def _import_floor_kb() -> int:
+    """RSS (kB) of a fresh Python that imported mujoco, pinocchio and zenoh: what any agent must hold."""
+    done = subprocess.run([sys.executable, "-c", FLOOR_SCRIPT], capture_output=True, text=True, check=True)
+    return int(done.stdout.strip())
+
+
+def _slope_kb_per_cycle(samples: list[tuple[int, int]]) -> float:
+    """Least-squares slope of RSS (kB) over cycles."""
+    n = len(samples)
+    mean_x = sum(x for x, _ in samples) / n
+    mean_y = sum(y for _, y in samples) / n
+    var = sum((x - mean_x) ** 2 for x, _ in samples)
+    return sum((x - mean_x) * (y - mean_y) for x, y in samples) / var if var else 0.0
 
 
 def _cycle(quick: QuickClient, hold_s: float) -> None:
@@ -102,16 +129,34 @@ def main() -> None:
                     f"{'cycle':>6} {'threads':>8} {'(+)':>5} {'fds':>6} {'(+)':>5} {'RSS MB':>8} {'ratio':>6}"
                 )
                 started = time.monotonic()
+                samples: list[tuple[int, int]] = []
+                floor_runs = min(FLOOR_RUNS, warmup + cycles)
+                at_floor_runs = base[2]
                 for number in range(1, cycles + 1):
                     _cycle(quick, 0.2 + 0.1 * (number % 7))
+                    if warmup + number == floor_runs:
+                        at_floor_runs = _sample(agent)[2]
                     if number % every == 0 or number == cycles:
                         threads, fds, rss = _sample(agent)
+                        samples.append((number, rss))
                         print(
                             f"{number:>6} {threads:>8} {threads - base[0]:>+5} {fds:>6} {fds - base[1]:>+5} "
                             f"{rss / 1024:>8.1f} {rss / base[2]:>6.2f}",
                             flush=True,
                         )
                 print(f"\n{cycles} cycles in {time.monotonic() - started:.0f} s")
+                later = samples[len(samples) // 2 :]
+                if len(later) >= 2:
+                    print(
+                        f"RSS slope over cycles {later[0][0]}-{later[-1][0]}: "
+                        f"{_slope_kb_per_cycle(later):+.2f} kB/cycle"
+                    )
+                floor = _import_floor_kb()
+                print(
+                    f"agent RSS after {floor_runs} runs {at_floor_runs / 1024:.1f} MB; import floor "
+                    f"(mujoco, pinocchio, zenoh) {floor / 1024:.1f} MB; ratio agent / floor "
+                    f"{at_floor_runs / floor:.2f}x"
+                )
         finally:
             supervisor.send_signal(signal.SIGINT)
             try:

@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import importlib
 import itertools
 import logging
+import sys
+import types
+from typing import Any
 
 import numpy as np
 
@@ -17,6 +21,43 @@ log = logging.getLogger(__name__)
 # with chord-length parameterization). The limits are therefore derated and the result verified by sampling.
 _DERATE = 0.9
 _CHECK_DT = 0.002
+
+
+class _DeferredModule(types.ModuleType):
+    """Stands in for a module that is imported only when one of its attributes is first used."""
+
+    def __getattr__(self, name: str) -> Any:
+        if name.startswith("__"):  # __file__, __path__ ... asked by tools walking modules load nothing
+            raise AttributeError(name)
+        return getattr(importlib.import_module(self.__name__), name)
+
+
+def _import_toppra() -> Any:
+    """``toppra``, imported without loading matplotlib.
+
+    toppra imports ``matplotlib.pyplot`` at its top for plotting helpers that timing never calls; that
+    costs a long-running agent about 30 MB (matplotlib, PIL, kiwisolver, fonttools) and 0.3 s. While
+    toppra is imported, placeholders stand for ``matplotlib`` and ``matplotlib.pyplot`` (unless matplotlib
+    is already loaded); they leave ``sys.modules`` right after, so anyone else gets the real one, and
+    toppra's own ``plt`` imports it on first use.
+    """
+    if "toppra" in sys.modules or "matplotlib" in sys.modules:
+        import toppra
+
+        return toppra
+    placeholders = {name: _DeferredModule(name) for name in ("matplotlib", "matplotlib.pyplot")}
+    placeholders["matplotlib"].pyplot = placeholders["matplotlib.pyplot"]  # type: ignore[attr-defined]
+    placeholders["matplotlib"].__path__ = []  # a package, so the submodule import looks no further
+    sys.modules.update(placeholders)
+    try:
+        import toppra
+        import toppra.algorithm
+        import toppra.constraint
+    finally:
+        for name, placeholder in placeholders.items():
+            if sys.modules.get(name) is placeholder:
+                del sys.modules[name]
+    return toppra
 
 
 def _densify(points: np.ndarray, max_step: float) -> np.ndarray:
@@ -101,9 +142,8 @@ def time_parameterize(
             exceeded after derating (when toppra finds no timing at all, the path is timed rest to rest
             at each waypoint).
     """
-    import toppra as ta
-    import toppra.algorithm as algo
-    import toppra.constraint as constraint
+    ta = _import_toppra()
+    algo, constraint = ta.algorithm, ta.constraint
 
     for label, value in (("velocity", velocity_scale), ("acceleration", acceleration_scale)):
         if not 0.0 < value <= 1.0:

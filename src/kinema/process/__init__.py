@@ -2,7 +2,9 @@
 
 * :mod:`kinema.process.lifeline` — a child's lifeline to the ``kinema run`` supervisor (it ends when the
   supervisor dies);
-* :mod:`kinema.process.log_files` — one log format for every process, read back merged and filtered.
+* :mod:`kinema.process.log_files` — one log format for every process, read back merged and filtered;
+* :mod:`kinema.process.memory_probe` — with ``KINEMA_DEBUG_MEMORY`` set, ``SIGUSR2`` logs a memory report
+  (what grew and where it sits), for finding what grows in a long-running process.
 
 A process's presence on the network (agent or driver of a cell) is :mod:`kinema.transport.presence`.
 Importing this package imports nothing else.

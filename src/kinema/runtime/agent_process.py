@@ -202,6 +202,47 @@ def _add_debugging_doors(agent: Agent, options: AgentOptions) -> None:
         log.info("Groot2 can attach at 127.0.0.1:%d", options.groot2_port)
 
 
+#: zenoh's pool for sending large messages through shared memory (its default is 16 MiB, all of it
+#: resident in the agent once some trajectories went through it). The agent's large messages
+#: (trajectories, node tables, blackboard snapshots) are tens to hundreds of kB; a larger one than the
+#: pool is sent the ordinary way.
+SHARED_MEMORY_POOL_BYTES = 4 << 20
+
+
+def _shared_memory_pool() -> dict[str, Any]:
+    """The agent's zenoh overrides: a smaller shared-memory pool, unless a zenoh config file is used
+    (``KINEMA_ZENOH_CONFIG``: what it says stands)."""
+    from kinema.transport.session import ENV_CONFIG
+
+    if os.environ.get(ENV_CONFIG):
+        return {}
+    return {"transport/shared_memory/transport_optimization/pool_size": SHARED_MEMORY_POOL_BYTES}
+
+
+class _TrimHeapAfterRuns:
+    """Gives the heap's free pages back after each objective run (:func:`kinema.transport.heap.trim_soon`).
+
+    A run's behaviors, result waiters and transport queries allocate on many short-lived threads, and
+    glibc spreads them over up to 8 arenas per core; what they free stays resident as scattered free
+    chunks, which grew the agent by about 5-10 kB per start/cancel cycle (``benchmarks/soak.py``). A
+    trim a second after each run (in the background, about a millisecond) returns those pages.
+    """
+
+    def on_status(self, status: Any, objective_name: str) -> None:
+        pass
+
+    def on_node_status(self, objective_name: str, changes: Any) -> None:
+        pass
+
+    def on_blackboard(self, objective_name: str, entries: Any) -> None:
+        pass
+
+    def on_run_finished(self, run: Any, result: Any) -> None:
+        from kinema.transport.heap import trim_soon
+
+        trim_soon()
+
+
 def _parser() -> argparse.ArgumentParser:
     parser = argparse.ArgumentParser(prog="python -m kinema.runtime.agent_process", description=__doc__)
     parser.add_argument("--config", "-c", help="config package to run")
@@ -230,6 +271,9 @@ def main(argv: list[str] | None = None) -> int:
 
     args = _parser().parse_args(argv)
     configure_process_logging(args.log_file, verbose=args.verbose)
+    from kinema.process import memory_probe
+
+    memory_probe.install_from_environment()  # KINEMA_DEBUG_MEMORY: SIGUSR2 logs a memory report
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     signal.signal(signal.SIGINT, lambda *_: stop.set())
@@ -252,7 +296,11 @@ def main(argv: list[str] | None = None) -> int:
     try:
         from kinema.transport import host_router, open_session
 
-        session = host_router(args.host_router) if args.host_router else open_session(args.connect)
+        session = (
+            host_router(args.host_router)
+            if args.host_router
+            else open_session(args.connect, config_overrides=_shared_memory_pool())
+        )
     except KinemaError as error:
         log.error("%s", error)
         print(f"error: {error}", file=sys.stderr)
@@ -266,6 +314,7 @@ def main(argv: list[str] | None = None) -> int:
     )
     try:
         agent = build_agent(options, session)
+        agent.server.add_listener(_TrimHeapAfterRuns())
         agent.start()
     except KinemaError as error:
         log.error("%s", error)

@@ -15,6 +15,10 @@ such requests (refused ones included) grow a long-running agent without bound. T
   stays resident there. :func:`bound_heap_growth` fixes both thresholds (``mallopt``): blocks from
   :data:`MMAP_THRESHOLD_BYTES` on are mapped and unmapped on their own, and a heap's free top is
   returned past :data:`TRIM_THRESHOLD_BYTES`. Long-running processes call it once at start.
+* Free chunks scattered between blocks still in use, in the arenas of the many short-lived threads a
+  unit of work runs on (an objective run's behaviors, result waiters and queries). Neither threshold
+  reaches them; over thousands of runs they grew the agent by 5-10 kB a run. :func:`trim_soon`, called
+  at the end of such a unit (the agent: after each objective run), trims a second later.
 
 Elsewhere than glibc both do nothing.
 """
@@ -36,6 +40,9 @@ LARGE_MESSAGE_BYTES = 1 << 20
 #: Seconds after the large message: once its handler is likely done, once everything settled, and once
 #: more for a handler that a busy machine kept from finishing sooner.
 TRIM_DELAYS_S = (0.5, 3.0, 15.0)
+
+#: Seconds after :func:`trim_soon` that the trim runs (the work's last messages have settled by then).
+TRIM_AFTER_WORK_S = 1.0
 
 #: Blocks from this size on get pages of their own, returned to the system when freed (glibc's default
 #: starts at 128 kB and grows up to 32 MB, which is what lets large messages settle in arena heaps).
@@ -111,7 +118,9 @@ def _trimmer() -> None:
                 continue
             _due.pop(0)
         try:
+            started = time.perf_counter()
             release_free_memory()
+            log.debug("malloc_trim took %.1f ms", 1e3 * (time.perf_counter() - started))
         except Exception:  # housekeeping never disturbs the transport
             log.debug("malloc_trim failed", exc_info=True)
 
@@ -122,13 +131,34 @@ def note_message_size(size: int) -> None:
     Each large message moves the trims after itself (a trim already due sooner stays), so the
     last of a burst is covered too.
     """
-    global _thread
     if size < LARGE_MESSAGE_BYTES or _malloc_trim() is None:
         return
     now = time.monotonic()
     with _cond:
         _due[:] = sorted({*_due[:1], *(now + delay for delay in TRIM_DELAYS_S)})
-        if _thread is None:
-            _thread = threading.Thread(target=_trimmer, name="kinema-heap-trim", daemon=True)
-            _thread.start()
-        _cond.notify()
+        _wake_trimmer()
+
+
+def trim_soon() -> None:
+    """Trim the heap :data:`TRIM_AFTER_WORK_S` from now, in the background (a burst gives one trim).
+
+    For a long-running process at the end of a unit of work (the agent, after each objective run):
+    the free chunks that the work's short-lived threads left in their arenas stay resident otherwise,
+    and over thousands of runs they add up (see the module's docstring).
+    """
+    if _malloc_trim() is None:
+        return
+    due = time.monotonic() + TRIM_AFTER_WORK_S
+    with _cond:
+        if not any(when <= due for when in _due):  # else a trim comes soon enough anyway
+            _due[:] = sorted([*_due, due])
+            _wake_trimmer()
+
+
+def _wake_trimmer() -> None:
+    """Start the trimmer thread, or tell it the schedule changed (call with ``_cond`` held)."""
+    global _thread
+    if _thread is None:
+        _thread = threading.Thread(target=_trimmer, name="kinema-heap-trim", daemon=True)
+        _thread.start()
+    _cond.notify()

@@ -148,3 +148,28 @@ def test_timing_many_paths_adds_no_log_handlers(model, pick_path):
     assert toppra_logger.handlers == before
     assert len(toppra_logger.handlers) <= 1
     assert toppra_logger.level == logging.WARNING
+
+
+def test_timing_a_path_does_not_load_matplotlib() -> None:
+    """toppra imports matplotlib.pyplot for plots timing never draws (about 30 MB in every agent); it is
+    loaded only when something uses it, and then it is the real one."""
+    import subprocess
+    import sys
+
+    script = """
+import sys
+import numpy as np
+from kinema.motion import JointPath, RobotDescription, time_parameterize
+model = RobotDescription.lab_sim().load_model()
+arm = model.group("manipulator").joint_names
+path = JointPath(tuple(arm), np.array([np.zeros(len(arm)), np.full(len(arm), 0.3)]))
+trajectory = time_parameterize(path, model)
+assert trajectory.duration > 0
+print("matplotlib" in sys.modules, "matplotlib.pyplot" in sys.modules)
+import toppra.algorithm.algorithm as algorithm
+import matplotlib.pyplot
+print(algorithm.plt.plot is matplotlib.pyplot.plot)
+"""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["False", "False", "True"]

@@ -60,3 +60,70 @@ def test_blocks_freed_by_another_thread_leave_no_memory_behind_once_the_heap_is_
         f"the process kept {bounded} MB after freeing 10-30 MB blocks on a thread "
         f"(with glibc's default thresholds it kept {default} MB)"
     )
+
+
+# Short-lived threads leave their arenas full of free chunks between a few blocks still in use (as an
+# objective run's behaviors, result waiters and queries do in the agent): nothing of it is at a heap's
+# top, so only a trim gives those pages back. ``trim_soon`` (the agent calls it after each run) must.
+FRAGMENTS = """
+import sys, threading, time
+from kinema.transport import heap
+
+def rss_mb():
+    with open("/proc/self/status") as status:
+        for line in status:
+            if line.startswith("VmRSS:"):
+                return int(line.split()[1]) / 1024
+
+heap.bound_heap_growth()
+kept = []
+
+def run():
+    blocks = [bytearray(1000) for _ in range(40_000)]  # 40 MB of small blocks in this thread's arena
+    kept.extend(blocks[::16])  # one in 16 outlives the run
+
+baseline = rss_mb()
+threads = [threading.Thread(target=run) for _ in range(4)]
+for thread in threads:
+    thread.start()
+for thread in threads:
+    thread.join()
+fragmented = rss_mb()
+if sys.argv[1] == "trim":
+    heap.trim_soon()
+deadline = time.monotonic() + 10 * heap.TRIM_AFTER_WORK_S + 5
+while rss_mb() > fragmented - 50 and time.monotonic() < deadline:
+    time.sleep(0.05)
+print(round(fragmented - baseline), round(rss_mb() - baseline))
+"""
+
+
+def fragments_kept_mb(mode: str) -> tuple[int, int]:
+    done = subprocess.run(
+        [sys.executable, "-c", FRAGMENTS, mode], capture_output=True, text=True, timeout=120, check=False
+    )
+    assert done.returncode == 0, done.stderr
+    fragmented, after = done.stdout.split()
+    return int(fragmented), int(after)
+
+
+@pytest.mark.skipif(not Path("/proc/self/status").exists(), reason="needs Linux /proc to read the RSS")
+@pytest.mark.skipif(_libc() is None, reason="malloc_trim is glibc's")
+def test_trim_soon_gives_back_the_free_chunks_that_finished_threads_left_in_their_arenas() -> None:
+    fragmented, after = fragments_kept_mb("trim")
+    assert fragmented > 100, f"the threads' blocks took only {fragmented} MB: nothing to give back"
+    assert after < fragmented - 50, (
+        f"{fragmented} MB resident after the threads, still {after} MB after trim_soon "
+        f"(without it: {fragments_kept_mb('none')[1]} MB)"
+    )
+
+
+def test_a_burst_of_trim_soon_schedules_one_trim(monkeypatch: pytest.MonkeyPatch) -> None:
+    from kinema.transport import heap
+
+    if heap._malloc_trim() is None:
+        pytest.skip("malloc_trim is glibc's")
+    monkeypatch.setattr(heap, "_due", [])
+    for _ in range(50):
+        heap.trim_soon()
+    assert len(heap._due) <= 1  # one trim (or none left: it ran already on a very slow machine)
