@@ -36,6 +36,8 @@ LIST_TIMEOUT = 2.0
 # enough to ride out a liveliness hiccup, short enough that a crashed driver fails the run within 1 s.
 SERVER_LOST_AFTER = 0.3
 _POLL = 0.01
+# How often a running execution looks for its controller's action server on the graph.
+SERVER_CHECK = 0.05
 # After success, how long to wait for /joint_states to show the arm at the trajectory's end, and how many
 # times the goal tolerance counts as there (the controller's default goal tolerance is 0.01 rad or m).
 SETTLE_TIMEOUT = 2.0
@@ -200,9 +202,19 @@ class ExecuteTrajectory(AsyncBehavior):
         self._handle = handle
         graph = node.session.graph_cache()
         missing_since: float | None = None
+        # The result wakes this coroutine at once (the next behavior starts without waiting out a poll);
+        # in between, every SERVER_CHECK the graph says whether the controller is still there.
+        loop = asyncio.get_running_loop()
+        finished: asyncio.Future[None] = loop.create_future()
+        handle.add_done_callback(lambda _handle: loop.call_soon_threadsafe(_resolve, finished))
         try:
             while not handle.done():
-                await asyncio.sleep(_POLL)
+                try:
+                    await asyncio.wait_for(asyncio.shield(finished), SERVER_CHECK)
+                except TimeoutError:
+                    pass
+                if handle.done():
+                    break
                 if graph.snapshot().action_server_ready(client.name):
                     missing_since = None
                     continue
@@ -386,6 +398,11 @@ def _per_joint(values: list[float], names: list[str], port: str) -> list[float]:
         f"port [{port}] has {len(values)} values but the trajectory moves {len(names)} joints "
         f"({', '.join(names)}); give one value or one per joint"
     )
+
+
+def _resolve(future: Any) -> None:
+    if not future.done():
+        future.set_result(None)
 
 
 def _cancel_when_accepted(sending: Any) -> None:
