@@ -18,6 +18,7 @@ from ..controllers.switch_controller import (
     STRICT,
     SWITCH_TYPE,
     conflicting_active,
+    controller_states,
     switch_request,
 )
 from ..messages.conversions import duration, trajectory_from_message
@@ -290,6 +291,9 @@ class ExecuteTrajectory(AsyncBehavior):
         if len(parts) != 2 or parts[1] != "follow_joint_trajectory":
             return ""
         controller = parts[0]
+        known = controller_states(self.context)
+        if known.active(LIST_CONTROLLERS_SERVICE, [controller]):
+            return ""  # listed active within the last second (SwitchController just before, usually)
         lister = self.context.service_client(node, LIST_TYPE, LIST_CONTROLLERS_SERVICE)
         if not lister.service_is_ready():
             return ""
@@ -298,10 +302,12 @@ class ExecuteTrajectory(AsyncBehavior):
         except TransportError:
             return ""
         controllers = {str(c.name): c for c in listing.controller}
+        known.remember(LIST_CONTROLLERS_SERVICE, controllers)
         if controller not in controllers or controllers[controller].state == "active":
             return ""
         deactivate = conflicting_active(controllers, [controller])
         switcher = self.context.service_client(node, SWITCH_TYPE, SWITCH_CONTROLLERS_SERVICE)
+        known.forget(LIST_CONTROLLERS_SERVICE)
         request = switch_request([controller], deactivate, STRICT, True, 5.0)
         try:
             response = await asyncio.wrap_future(switcher.call_async(request, 10.0))
