@@ -99,20 +99,25 @@ class _NotFlow(Exception):
 def _flow(data: dict[Any, Any] | list[Any]) -> str | None:
     """``data`` as ``yaml.safe_dump(data, default_flow_style=True)`` writes it, without YAML's cost.
 
-    Only for dicts with string keys, lists, short one-line strings, ints, floats, bools and None (what a
-    message's preview holds); None for anything else, which YAML then renders. A trajectory's preview took
+    Only for dicts with non-empty string keys, lists, short one-line strings, ints, floats, bools and None
+    (what a message's preview holds), each collection met once; None for anything else, which YAML then
+    renders. A trajectory's preview took
     YAML about 10 ms per rendering, on the thread that competes with the tick thread and the simulation.
     """
     parts: list[str] = []
     try:
-        _flow_into(data, parts)
+        _flow_into(data, parts, set())
     except _NotFlow:
         return None
     return "".join(parts)
 
 
-def _flow_into(value: Any, parts: list[str]) -> None:
+def _flow_into(value: Any, parts: list[str], seen: set[int]) -> None:
     kind = type(value)
+    if kind is list or kind is dict:
+        if id(value) in seen:
+            raise _NotFlow  # YAML writes a collection met twice as an anchor and aliases
+        seen.add(id(value))
     if kind is str:
         parts.append(_flow_string(value))
     elif kind is float:
@@ -128,7 +133,7 @@ def _flow_into(value: Any, parts: list[str]) -> None:
         for index, item in enumerate(value):
             if index:
                 parts.append(", ")
-            _flow_into(item, parts)
+            _flow_into(item, parts, seen)
         parts.append("]")
     elif kind is dict:
         if not all(type(key) is str and 0 < len(key) < _FLOW_KEY_MOST for key in value):
@@ -139,7 +144,7 @@ def _flow_into(value: Any, parts: list[str]) -> None:
                 parts.append(", ")
             parts.append(_flow_string(key))
             parts.append(": ")
-            _flow_into(value[key], parts)
+            _flow_into(value[key], parts, seen)
         parts.append("}")
     else:
         raise _NotFlow
