@@ -127,8 +127,7 @@ class Cell:
         raise RuntimeError("no cube in the simulation")
 
     def peer(self) -> dict[str, Any]:
-        """What the plain script plans and moves with, made once per cell (a second set of clients and
-        a second /joint_states subscription would load every later round)."""
+        """What the plain script plans and moves with, made once per cell (not a set of clients per round)."""
         if self._peer:
             return self._peer
         from kinema.config import WaypointStore
@@ -143,8 +142,6 @@ class Cell:
             waypoint = store.get(name)
             positions = dict(zip(waypoint.joint_names, waypoint.positions, strict=True))
             goals[name] = {joint: positions[joint] for joint in arm}
-        latest: list[Any] = []
-        self.node.create_subscription("sensor_msgs/msg/JointState", "/joint_states", latest.append)
         self._peer = {
             "checker": CollisionChecker(model, description.load_scene(model), padding=0.01),
             "model": model,
@@ -156,7 +153,6 @@ class Cell:
             "gripper": self.node.create_action_client(
                 "control_msgs/action/GripperCommand", "/robotiq_gripper_controller/gripper_cmd"
             ),
-            "latest": latest,
         }
         return self._peer
 
@@ -207,18 +203,34 @@ def measure_objective_cycles(cell: Cell, cycles: int) -> list[Cycle]:
 
 def measure_script_cycles(cell: Cell, cycles: int) -> list[Cycle]:
     """The peer: the same motions, planned with kinema.motion and sent straight to the driver."""
-    from kinema.motion import plan_joint_goal, time_parameterize
-
     peer = cell.peer()
-    checker, model, goals, follow, gripper, latest = (
+    checker, model, goals, follow, gripper = (
         peer["checker"],
         peer["model"],
         peer["goals"],
         peer["follow"],
         peer["gripper"],
-        peer["latest"],
     )
-    latest.clear()
+    # Subscribed while the script runs only: decoding every /joint_states would load the objective's rounds.
+    latest: list[Any] = []
+    subscription = cell.node.create_subscription("sensor_msgs/msg/JointState", "/joint_states", latest.append)
+    try:
+        return _script_cycles(cell, cycles, checker, model, goals, follow, gripper, latest)
+    finally:
+        subscription.close()
+
+
+def _script_cycles(
+    cell: Cell,
+    cycles: int,
+    checker: Any,
+    model: Any,
+    goals: dict[str, dict[str, float]],
+    follow: Any,
+    gripper: Any,
+    latest: list[Any],
+) -> list[Cycle]:
+    from kinema.motion import plan_joint_goal, time_parameterize
 
     def current() -> np.ndarray:
         while not latest:
