@@ -12,7 +12,10 @@ the planner up, then measures:
 
 It prints wall seconds per cycle, the sim seconds each represents (so the real-time factor), and the
 ratio objective / peer: what the runtime adds on top of planning and simulating. Numbers only, no
-assertions. Run: ``python benchmarks/pick_and_place.py [--cycles N] [--library kinema|moveit_pro] [--smoke]``
+assertions. The objective and the script alternate over ``--rounds`` rounds (each from the start keyframe)
+so that the load of a shared machine weighs on both; the figures are medians over every cycle, and the
+ratio is also given per round. Run:
+``python benchmarks/pick_and_place.py [--cycles N] [--rounds R] [--library kinema|moveit_pro] [--smoke]``
 (``moveit_pro`` runs a copy of ``../shared/compat/moveit_pro/objectives`` when that folder exists).
 
 :func:`measure_objective_cycles` is reusable (``benchmarks/motion.py`` may call it).
@@ -114,6 +117,7 @@ class Cell:
         self.client.wait_for_runtime()
         self.node = Node(client_session, "pick_and_place_bench")
         self._bodies = self.node.create_client("kinema_msgs/srv/GetSimBodies", "/mujoco/bodies")
+        self._peer: dict[str, Any] = {}
 
     def cube(self) -> np.ndarray:
         for body in self._bodies.call({}, timeout=10.0).bodies:
@@ -121,6 +125,36 @@ class Cell:
                 p = body.pose.position
                 return np.array([p.x, p.y, p.z])
         raise RuntimeError("no cube in the simulation")
+
+    def peer(self) -> dict[str, Any]:
+        """What the plain script plans and moves with, made once per cell (not a set of clients per round)."""
+        if self._peer:
+            return self._peer
+        from kinema.config import WaypointStore
+        from kinema.motion import CollisionChecker, RobotDescription
+
+        description = RobotDescription.lab_sim()
+        model = description.load_model()
+        store = WaypointStore(bundled_dir("configs") / "lab_sim" / "waypoints" / "lab_sim_waypoints.yaml")
+        arm = model.group("manipulator").joint_names
+        goals = {}
+        for name in (PICK, PLACE, MID):
+            waypoint = store.get(name)
+            positions = dict(zip(waypoint.joint_names, waypoint.positions, strict=True))
+            goals[name] = {joint: positions[joint] for joint in arm}
+        self._peer = {
+            "checker": CollisionChecker(model, description.load_scene(model), padding=0.01),
+            "model": model,
+            "goals": goals,
+            "follow": self.node.create_action_client(
+                "control_msgs/action/FollowJointTrajectory",
+                "/joint_trajectory_controller/follow_joint_trajectory",
+            ),
+            "gripper": self.node.create_action_client(
+                "control_msgs/action/GripperCommand", "/robotiq_gripper_controller/gripper_cmd"
+            ),
+        }
+        return self._peer
 
     def close(self) -> None:
         for close in reversed(self._closers):
@@ -169,27 +203,34 @@ def measure_objective_cycles(cell: Cell, cycles: int) -> list[Cycle]:
 
 def measure_script_cycles(cell: Cell, cycles: int) -> list[Cycle]:
     """The peer: the same motions, planned with kinema.motion and sent straight to the driver."""
-    from kinema.config import WaypointStore
-    from kinema.motion import CollisionChecker, RobotDescription, plan_joint_goal, time_parameterize
-
-    description = RobotDescription.lab_sim()
-    model = description.load_model()
-    checker = CollisionChecker(model, description.load_scene(model), padding=0.01)
-    store = WaypointStore(bundled_dir("configs") / "lab_sim" / "waypoints" / "lab_sim_waypoints.yaml")
-    arm = model.group("manipulator").joint_names
-    goals = {}
-    for name in (PICK, PLACE, MID):
-        waypoint = store.get(name)
-        positions = dict(zip(waypoint.joint_names, waypoint.positions, strict=True))
-        goals[name] = {joint: positions[joint] for joint in arm}
-    follow = cell.node.create_action_client(
-        "control_msgs/action/FollowJointTrajectory", "/joint_trajectory_controller/follow_joint_trajectory"
+    peer = cell.peer()
+    checker, model, goals, follow, gripper = (
+        peer["checker"],
+        peer["model"],
+        peer["goals"],
+        peer["follow"],
+        peer["gripper"],
     )
-    gripper = cell.node.create_action_client(
-        "control_msgs/action/GripperCommand", "/robotiq_gripper_controller/gripper_cmd"
-    )
+    # Subscribed while the script runs only: decoding every /joint_states would load the objective's rounds.
     latest: list[Any] = []
-    cell.node.create_subscription("sensor_msgs/msg/JointState", "/joint_states", lambda m: latest.append(m))
+    subscription = cell.node.create_subscription("sensor_msgs/msg/JointState", "/joint_states", latest.append)
+    try:
+        return _script_cycles(cell, cycles, checker, model, goals, follow, gripper, latest)
+    finally:
+        subscription.close()
+
+
+def _script_cycles(
+    cell: Cell,
+    cycles: int,
+    checker: Any,
+    model: Any,
+    goals: dict[str, dict[str, float]],
+    follow: Any,
+    gripper: Any,
+    latest: list[Any],
+) -> list[Cycle]:
+    from kinema.motion import plan_joint_goal, time_parameterize
 
     def current() -> np.ndarray:
         while not latest:
@@ -249,9 +290,23 @@ def _report(label: str, cycles: list[Cycle]) -> float:
     return wall
 
 
+def _reset(cell: Cell) -> None:
+    """Back to the start keyframe (arm and cube)."""
+    set_state = cell.node.create_client("kinema_msgs/srv/SetMujocoState", "/mujoco/set_state")
+    if not set_state.call({"keyframe": "default"}, timeout=10.0).success:
+        raise RuntimeError("cannot reset the simulation to keyframe 'default'")
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--cycles", type=int, default=3, help="cycles to time per variant (default 3)")
+    parser.add_argument("--cycles", type=int, default=3, help="cycles per variant and round (default 3)")
+    parser.add_argument(
+        "--rounds",
+        type=int,
+        default=3,
+        help="rounds, each timing the objective then the script, so that a load that changes over the run "
+        "weighs on both alike (default 3)",
+    )
     parser.add_argument("--smoke", action="store_true", help="one cycle of each variant (the test suite)")
     parser.add_argument(
         "--library",
@@ -261,7 +316,7 @@ def main() -> None:
     )
     args = parser.parse_args()
     if args.smoke:
-        args.cycles = 1
+        args.cycles, args.rounds = 1, 1
     with tempfile.TemporaryDirectory() as tmp:
         config, workspace = _workspace(Path(tmp), args.library)
         cell = Cell(config, workspace)
@@ -270,13 +325,27 @@ def main() -> None:
             warm = cell.client.execute("Look at Table")  # loads the model, scene and planner once
             warmup = time.monotonic() - started
             print(f"lab_sim, sim speed max, {args.library} objectives; warm-up {warmup:.2f} s ({warm})")
-            objective = _report(f'objective "{OBJECTIVE}"', measure_objective_cycles(cell, args.cycles))
-            # Back to the start keyframe (arm and cube) for the peer.
-            set_state = cell.node.create_client("kinema_msgs/srv/SetMujocoState", "/mujoco/set_state")
-            if not set_state.call({"keyframe": "default"}, timeout=10.0).success:
-                raise RuntimeError("cannot reset the simulation to keyframe 'default'")
-            script = _report("peer: plain script, same motions", measure_script_cycles(cell, args.cycles))
-            print(f"  objective / plain script: {objective / script:.2f}x")
+            objective_cycles: list[Cycle] = []
+            script_cycles: list[Cycle] = []
+            ratios = []
+            for round_ in range(args.rounds):
+                if round_:
+                    _reset(cell)
+                objective = measure_objective_cycles(cell, args.cycles)
+                _reset(cell)
+                script = measure_script_cycles(cell, args.cycles)
+                objective_cycles += objective
+                script_cycles += script
+                ratios.append(
+                    statistics.median(c.wall for c in objective) / statistics.median(c.wall for c in script)
+                )
+            objective_wall = _report(f'objective "{OBJECTIVE}"', objective_cycles)
+            script_wall = _report("peer: plain script, same motions", script_cycles)
+            rounds = ", ".join(f"{r:.2f}" for r in ratios)
+            print(
+                f"  objective / plain script: {objective_wall / script_wall:.2f}x "
+                f"(per round: {rounds}; median {statistics.median(ratios):.2f}x)"
+            )
         finally:
             cell.close()
 

@@ -160,7 +160,11 @@ def _list(
 
 
 class WaypointStore:
-    """The waypoints of one file, read fresh on every call and changed under the file's lock.
+    """The waypoints of one file, as the file is at every call, and changed under the file's lock.
+
+    A call reads the file again only when it changed (its inode, size or modification time differ from
+    the last read): an edit made by hand is seen at the next call, and a run that looks up a waypoint
+    per motion does not parse the YAML each time.
 
     Args:
         path: the file changes are written to.
@@ -173,6 +177,8 @@ class WaypointStore:
         self.path = Path(path)
         self.seed_from = Path(seed_from) if seed_from is not None else None
         self.notice = notice
+        # (path, inode, size, mtime_ns, ctime_ns) of the last read, and what it parsed to.
+        self._parsed: tuple[tuple[Any, ...], list[Waypoint]] | None = None
 
     @property
     def read_path(self) -> Path:
@@ -286,8 +292,23 @@ class WaypointStore:
 
     def _read(self) -> list[Waypoint]:
         path = self.read_path
-        if not path.exists():
+        try:
+            stat = path.stat()
+        except FileNotFoundError:
             return []
+        except OSError:
+            stat = None  # let the read below report it
+        if stat is not None:
+            key = (path, stat.st_ino, stat.st_size, stat.st_mtime_ns, stat.st_ctime_ns)
+            parsed = self._parsed
+            if parsed is not None and parsed[0] == key:
+                return list(parsed[1])
+        waypoints = self._parse(path)
+        if stat is not None:
+            self._parsed = (key, waypoints)
+        return list(waypoints)
+
+    def _parse(self, path: Path) -> list[Waypoint]:
         document = load_yaml_file(path, max_bytes=MAX_WAYPOINTS_BYTES, track_lines=False)
         if document.data is None:
             return []

@@ -9,6 +9,7 @@ taken.
 from __future__ import annotations
 
 import bisect
+import struct
 import threading
 import time
 from collections import deque
@@ -39,30 +40,52 @@ class JointStateMonitor:
 
     def __init__(self, node: Any, topic: str = JOINT_STATES_TOPIC) -> None:
         self.topic = topic
-        self._latest: Any = None
+        # Messages are kept as received (CDR) and decoded when a behavior reads one: a simulation at full
+        # speed publishes thousands a second, and decoding each took the interpreter from the tick thread,
+        # planning and the simulation for most of a motion. Only the header's stamp is read on arrival.
+        self._registry = node.session.registry
+        self._latest_raw: bytes | None = None
+        self._decoded: tuple[bytes | None, Any] = (None, None)
         self._received_at = 0.0
         self._stamps: deque[float] = deque(maxlen=HISTORY)
-        self._history: deque[Any] = deque(maxlen=HISTORY)
+        self._history: deque[bytes] = deque(maxlen=HISTORY)
         self._changed = threading.Condition()
-        self._subscription = node.create_subscription(JOINT_STATES_TYPE, topic, self._on_message)
+        self._subscription = node.create_subscription(JOINT_STATES_TYPE, topic, self._on_message, raw=True)
 
-    def _on_message(self, message: Any) -> None:
-        stamp = message.header.stamp.sec + message.header.stamp.nanosec * 1e-9
+    def _on_message(self, payload: bytes) -> None:
+        stamp = _header_stamp(payload)
+        if stamp is None:
+            stamp = self._decode(payload).header.stamp
+            stamp = stamp.sec + stamp.nanosec * 1e-9
         with self._changed:
-            self._latest = message
+            self._latest_raw = payload
             self._received_at = time.monotonic()
             if self._stamps and stamp < self._stamps[-1]:
                 # The clock went back (a reset simulation): the old history is another timeline.
                 self._stamps.clear()
                 self._history.clear()
             self._stamps.append(stamp)
-            self._history.append(message)
+            self._history.append(payload)
             self._changed.notify_all()
+
+    def _decode(self, payload: bytes) -> Any:
+        """The message of ``payload`` (the last one decoded is kept: readers ask for the latest)."""
+        decoded = self._decoded
+        if decoded[0] is payload:
+            return decoded[1]
+        message = self._registry.deserialize(payload, JOINT_STATES_TYPE)
+        self._decoded = (payload, message)
+        return message
+
+    @property
+    def _latest(self) -> Any:
+        payload = self._latest_raw
+        return None if payload is None else self._decode(payload)
 
     @property
     def received(self) -> bool:
         """Whether a message has arrived yet."""
-        return self._latest is not None
+        return self._latest_raw is not None
 
     def latest(self, timeout: float = 2.0) -> Any:
         """The latest message; waits up to ``timeout`` s for the first one.
@@ -71,7 +94,9 @@ class JointStateMonitor:
             ObjectiveError: nothing was received within ``timeout`` (no driver running).
         """
         with self._changed:
-            if self._latest is None and not self._changed.wait_for(lambda: self._latest is not None, timeout):
+            if self._latest_raw is None and not self._changed.wait_for(
+                lambda: self._latest_raw is not None, timeout
+            ):
                 raise ObjectiveError(
                     f"no joint state received on {self.topic} within {timeout:g} s; is the robot driver "
                     "running (`kinema run`)?"
@@ -143,11 +168,12 @@ class JointStateMonitor:
             stamps, history = list(self._stamps), list(self._history)
         after = bisect.bisect_left(stamps, stamp)
         if after >= len(stamps):
-            return self._named(history[-1], joint_names)
+            return self._named(self._decode(history[-1]), joint_names)
         if after == 0 or stamps[after] == stamp:
-            return self._named(history[after], joint_names)
+            return self._named(self._decode(history[after]), joint_names)
         t0, t1 = stamps[after - 1], stamps[after]
-        q0, q1 = self._named(history[after - 1], joint_names), self._named(history[after], joint_names)
+        q0 = self._named(self._decode(history[after - 1]), joint_names)
+        q1 = self._named(self._decode(history[after]), joint_names)
         return q0 + (q1 - q0) * ((stamp - t0) / (t1 - t0))
 
     def _named(self, message: Any, joint_names: Sequence[str]) -> np.ndarray:
@@ -163,3 +189,12 @@ class JointStateMonitor:
     def close(self) -> None:
         """Stop listening."""
         self._subscription.close()
+
+
+def _header_stamp(payload: bytes) -> float | None:
+    """The header stamp (s) of a CDR ``sensor_msgs/JointState``: its first field, right after the 4-byte
+    encapsulation header (int32 sec, uint32 nanosec); None for an encoding this does not read."""
+    if len(payload) < 12 or payload[0] != 0 or payload[1] not in (0, 1):
+        return None
+    sec, nanosec = struct.unpack_from("<iI" if payload[1] == 1 else ">iI", payload, 4)
+    return sec + nanosec * 1e-9

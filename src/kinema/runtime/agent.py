@@ -368,7 +368,9 @@ class Agent:
         node.create_service(names.GET_WAYPOINTS_TYPE, names.GET_WAYPOINTS, self._on_get_waypoints)
         node.create_service(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, self._on_edit_waypoints)
         if self.waypoints is not None:
-            node.create_subscription(JOINT_STATES_TYPE, JOINT_STATES_TOPIC, self._on_joint_states)
+            # Kept as received and decoded only when a waypoint is saved: a simulation at full speed
+            # publishes thousands a second, and decoding each cost the tick thread and planning the GIL.
+            node.create_subscription(JOINT_STATES_TYPE, JOINT_STATES_TOPIC, self._on_joint_states, raw=True)
         from kinema.runtime import quick_protocol as quick
 
         domain = self.session.domain_id
@@ -692,8 +694,8 @@ class Agent:
 
     # -- waypoints ---------------------------------------------------------------------------------
 
-    def _on_joint_states(self, message: Any) -> None:
-        self._joint_state = message
+    def _on_joint_states(self, payload: bytes) -> None:
+        self._joint_state = payload
 
     def _on_get_waypoints(self, request: Any) -> dict[str, Any]:
         if self.waypoints is None:
@@ -744,9 +746,10 @@ class Agent:
         from kinema.config import Waypoint
 
         assert self.waypoints is not None
-        state = self._joint_state
-        if state is None:
+        payload = self._joint_state
+        if payload is None:
             raise ObjectiveError(f"cannot save waypoint {name!r}: no /joint_states received yet")
+        state = self.session.registry.deserialize(payload, JOINT_STATES_TYPE)
         waypoint = Waypoint(
             name=name,
             joint_names=[str(n) for n in state.name],

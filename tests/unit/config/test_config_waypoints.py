@@ -266,3 +266,22 @@ def test_rename_erase_and_add_touch_only_their_own_lines(moveit_pro_waypoints: P
     ] + ["Kinema"]
     assert added_text.startswith(COMMENTED_HEAD)
     assert "  name: Home  # where every objective starts\n# the poses below" in added_text
+
+
+def test_a_file_edited_by_hand_between_reads_is_read_again(tmp_path: Path) -> None:
+    path = tmp_path / "waypoints.yaml"
+    store = WaypointStore(path)
+    store.save(_waypoint("above", 0.1, 0.2))
+    assert store.get("above").positions == [0.1, 0.2]
+    # Same length, written in place (same inode): the cache must not hide the change.
+    text = path.read_text()
+    path.write_text(text.replace("0.1", "0.7"))
+    assert store.get("above").positions == [0.7, 0.2]
+    path.write_text(text.replace("above", "below"))
+    assert store.names() == ["below"]
+    path.unlink()
+    assert store.all() == []
+    # A file that turned invalid is reported, not served from what was read before.
+    path.write_text("- name: [broken\n")
+    with pytest.raises(ConfigError):
+        store.all()

@@ -34,17 +34,22 @@ class ControllerManager:
 
     def __init__(self, node: Any, ok: bool = True) -> None:
         self.requests: list[Any] = []
+        self.listings = 0
         self.ok = ok
         node.create_service(
             "controller_manager_msgs/srv/ListControllers",
             "/controller_manager/list_controllers",
-            lambda _r: {"controller": CONTROLLERS},
+            self._list,
         )
         node.create_service(
             "controller_manager_msgs/srv/SwitchController",
             "/controller_manager/switch_controller",
             self._switch,
         )
+
+    def _list(self, _request: Any) -> dict[str, Any]:
+        self.listings += 1
+        return {"controller": CONTROLLERS}
 
     def _switch(self, request: Any) -> dict[str, Any]:
         self.requests.append(request)
@@ -219,3 +224,37 @@ def test_activating_an_active_controller_needs_no_switch(behavior: Any, context:
     )
     assert run.status == NodeStatus.SUCCESS, run.toasts
     assert manager.requests == []
+
+
+def test_a_controller_listed_active_a_moment_ago_is_not_listed_again_until_this_cell_switches(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    manager = ControllerManager(context.node)
+    activate = {"activate_controllers": "/joint_trajectory_controller"}
+    for _ in range(2):  # one motion after another: SwitchController before each
+        run = tick_behavior(behavior("SwitchController"), activate, context=context)
+        assert run.status == NodeStatus.SUCCESS, run.toasts
+    assert (manager.listings, manager.requests) == (1, [])
+    deactivate = {"deactivate_controllers": "joint_trajectory_controller"}
+    run = tick_behavior(behavior("SwitchController"), deactivate, context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    assert len(manager.requests) == 1
+    # This cell switched: what it knew of the states is no longer trusted.
+    run = tick_behavior(behavior("SwitchController"), activate, context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    assert manager.listings == 2
+
+
+def test_a_listing_older_than_a_second_is_not_trusted(
+    behavior: Any, context: BehaviorContext, monkeypatch: Any
+) -> None:
+    import sys
+
+    switching = sys.modules[behavior("SwitchController").__module__]
+    monkeypatch.setattr(switching, "STATES_VALID_FOR", 0.0)
+    manager = ControllerManager(context.node)
+    activate = {"activate_controllers": "joint_trajectory_controller"}
+    for _ in range(2):
+        run = tick_behavior(behavior("SwitchController"), activate, context=context)
+        assert run.status == NodeStatus.SUCCESS, run.toasts
+    assert manager.listings == 2

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import threading
+import time
 from typing import Any
 
 from kinema.behaviors import AsyncBehavior, FormerSpelling, PortInfo, input_port
@@ -45,6 +47,51 @@ def switch_request(
         "activate_asap": activate_asap,
         "timeout": {"sec": int(wait), "nanosec": int((wait % 1.0) * 1e9)},
     }
+
+
+# How long a listing of the controllers is trusted: as MoveIt's trajectory execution manager, which reads
+# the controller states again only when what it knows is older than a second
+# (DEFAULT_CONTROLLER_INFORMATION_VALIDITY_AGE), not before every trajectory.
+STATES_VALID_FOR = 1.0
+
+
+class ControllerStates:
+    """What this cell's behaviors last learned of the controllers' states, per ListControllers service.
+
+    A controller seen active within :data:`STATES_VALID_FOR` is taken as still active: a motion does not
+    ask the controller manager again (SwitchController, then ExecuteTrajectory, asked twice per motion).
+    A switch this cell makes forgets what it knew. A switch made elsewhere within that second shows as the
+    controller's refusal of the trajectory, as with MoveIt.
+    """
+
+    def __init__(self) -> None:
+        self._lock = threading.Lock()
+        self._known: dict[str, tuple[float, dict[str, str]]] = {}
+
+    def remember(self, service: str, controllers: dict[str, Any]) -> None:
+        """Keep the states of a ListControllers response (``controllers`` by name)."""
+        states = {name: str(controller.state) for name, controller in controllers.items()}
+        with self._lock:
+            self._known[service] = (time.monotonic(), states)
+
+    def forget(self, service: str) -> None:
+        """Forget the states (a switch was asked for)."""
+        with self._lock:
+            self._known.pop(service, None)
+
+    def active(self, service: str, names: list[str]) -> bool:
+        """Whether every one of ``names`` was seen active within STATES_VALID_FOR."""
+        with self._lock:
+            known = self._known.get(service)
+        if known is None or time.monotonic() - known[0] > STATES_VALID_FOR:
+            return False
+        return all(known[1].get(name) == "active" for name in names)
+
+
+def controller_states(context: Any) -> ControllerStates:
+    """The cell's :class:`ControllerStates` (one per behavior context)."""
+    states: ControllerStates = context.shared("controller_states", ControllerStates)
+    return states
 
 
 _FOREVER = 1e9  # seconds: "no timeout" for a service call (halting the objective still ends the wait)
@@ -123,8 +170,12 @@ class SwitchController(AsyncBehavior):
             return True
         automatic_deactivation = bool(self.get_input("automatic_deactivation"))
         automatic_activation = bool(self.get_input("automatic_activation"))
+        list_name = str(self.get_input("controller_list_action_name"))
+        known = controller_states(self.context)
+        if automatic_deactivation and activate and not deactivate and known.active(list_name, activate):
+            # Active a moment ago: nothing to switch, and nothing active can share their interfaces.
+            return True
         if (automatic_deactivation and activate) or (automatic_activation and deactivate):
-            list_name = str(self.get_input("controller_list_action_name"))
             client = self.context.service_client(node, LIST_TYPE, list_name)
             try:
                 listing = await asyncio.wrap_future(client.call_async({}, timeout))
@@ -134,6 +185,7 @@ class SwitchController(AsyncBehavior):
                 )
                 return False
             controllers = {str(c.name): c for c in listing.controller}
+            known.remember(list_name, controllers)
             if automatic_deactivation:
                 deactivate += [n for n in conflicting_active(controllers, activate) if n not in deactivate]
             if automatic_activation:
@@ -157,6 +209,7 @@ class SwitchController(AsyncBehavior):
                 return True  # already as asked: skip the switch (a round trip per motion)
         switch_name = str(self.get_input("controller_switch_action_name"))
         client = self.context.service_client(node, SWITCH_TYPE, switch_name)
+        known.forget(list_name)
         request = switch_request(
             activate, deactivate, strictness, bool(self.get_input("activate_asap")), given
         )

@@ -20,6 +20,8 @@ if TYPE_CHECKING:
 JOINT_STATE_TYPE = "sensor_msgs/msg/JointState"
 ROBOT_STATE_TYPE = "moveit_studio_agent_msgs/msg/RobotJointState"
 TRAJECTORY_TYPE = "trajectory_msgs/msg/JointTrajectory"
+POINT_TYPE = "trajectory_msgs/msg/JointTrajectoryPoint"
+DURATION_TYPE = "builtin_interfaces/msg/Duration"
 POSE_STAMPED_TYPE = "geometry_msgs/msg/PoseStamped"
 
 
@@ -83,16 +85,28 @@ def joint_positions(value: Any, what: str) -> dict[str, float]:
 
 def trajectory_message(trajectory: JointTrajectory, frame_id: str = "") -> Any:
     """A ``trajectory_msgs/JointTrajectory`` of a timed trajectory (positions, velocities, accelerations)."""
+    import numpy as np
+
+    from kinema.interfaces import load_interfaces
     from kinema.transport import from_dict
 
+    # The points are built as messages directly, their rows of float64 kept as arrays: converting a few
+    # hundred points from lists, field by field, took longer than planning them.
+    types = load_interfaces().typestore.types
+    point, stamp = types[POINT_TYPE], types[DURATION_TYPE]
+    positions, velocities, accelerations = (
+        np.asarray(values, dtype=np.float64)
+        for values in (trajectory.positions, trajectory.velocities, trajectory.accelerations)
+    )
     points = [
-        {
-            "positions": trajectory.positions[i].tolist(),
-            "velocities": trajectory.velocities[i].tolist(),
-            "accelerations": trajectory.accelerations[i].tolist(),
-            "time_from_start": duration(float(trajectory.times[i])),
-        }
-        for i in range(len(trajectory.times))
+        point(
+            positions=positions[i].copy(),
+            velocities=velocities[i].copy(),
+            accelerations=accelerations[i].copy(),
+            effort=np.zeros(0, dtype=np.float64),
+            time_from_start=stamp(**duration(float(time))),
+        )
+        for i, time in enumerate(trajectory.times)
     ]
     return from_dict(
         TRAJECTORY_TYPE,

@@ -16,6 +16,7 @@ from ..controllers.switch_controller import (
     STRICT,
     SWITCH_TYPE,
     conflicting_active,
+    controller_states,
     switch_request,
 )
 from ..messages.conversions import duration, trajectory_from_message
@@ -34,6 +35,8 @@ LIST_TIMEOUT = 2.0
 # enough to ride out a liveliness hiccup, short enough that a crashed driver fails the run within 1 s.
 SERVER_LOST_AFTER = 0.3
 _POLL = 0.01
+# How often a running execution looks for its controller's action server on the graph.
+SERVER_CHECK = 0.05
 # After success, how long to wait for /joint_states to show the arm at the trajectory's end, and how many
 # times the goal tolerance counts as there (the controller's default goal tolerance is 0.01 rad or m).
 SETTLE_TIMEOUT = 2.0
@@ -198,9 +201,19 @@ class ExecuteTrajectory(AsyncBehavior):
         self._handle = handle
         graph = node.session.graph_cache()
         missing_since: float | None = None
+        # The result wakes this coroutine at once (the next behavior starts without waiting out a poll);
+        # in between, every SERVER_CHECK the graph says whether the controller is still there.
+        loop = asyncio.get_running_loop()
+        finished: asyncio.Future[None] = loop.create_future()
+        handle.add_done_callback(lambda _handle: loop.call_soon_threadsafe(_resolve, finished))
         try:
             while not handle.done():
-                await asyncio.sleep(_POLL)
+                try:
+                    await asyncio.wait_for(asyncio.shield(finished), SERVER_CHECK)
+                except TimeoutError:
+                    pass
+                if handle.done():
+                    break
                 if graph.snapshot().action_server_ready(client.name):
                     missing_since = None
                     continue
@@ -278,6 +291,9 @@ class ExecuteTrajectory(AsyncBehavior):
         if len(parts) != 2 or parts[1] != "follow_joint_trajectory":
             return ""
         controller = parts[0]
+        known = controller_states(self.context)
+        if known.active(LIST_CONTROLLERS_SERVICE, [controller]):
+            return ""  # listed active within the last second (SwitchController just before, usually)
         lister = self.context.service_client(node, LIST_TYPE, LIST_CONTROLLERS_SERVICE)
         if not lister.service_is_ready():
             return ""
@@ -286,10 +302,12 @@ class ExecuteTrajectory(AsyncBehavior):
         except TransportError:
             return ""
         controllers = {str(c.name): c for c in listing.controller}
+        known.remember(LIST_CONTROLLERS_SERVICE, controllers)
         if controller not in controllers or controllers[controller].state == "active":
             return ""
         deactivate = conflicting_active(controllers, [controller])
         switcher = self.context.service_client(node, SWITCH_TYPE, SWITCH_CONTROLLERS_SERVICE)
+        known.forget(LIST_CONTROLLERS_SERVICE)
         request = switch_request([controller], deactivate, STRICT, True, 5.0)
         try:
             response = await asyncio.wrap_future(switcher.call_async(request, 10.0))
@@ -386,6 +404,11 @@ def _per_joint(values: list[float], names: list[str], port: str) -> list[float]:
         f"port [{port}] has {len(values)} values but the trajectory moves {len(names)} joints "
         f"({', '.join(names)}); give one value or one per joint"
     )
+
+
+def _resolve(future: Any) -> None:
+    if not future.done():
+        future.set_result(None)
 
 
 def _cancel_when_accepted(sending: Any) -> None:
