@@ -26,11 +26,10 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Generic
 
-import zenoh
-
 from kinema.errors import TransportError
 from kinema.interfaces import ActionType
 from kinema.interfaces.definition import FeedbackT, GoalT, ResultT
+from kinema.transport.dispatch import inline
 from kinema.transport.goal_status_cdr import (
     CDR_LE_HEADER,
     payload_of_chunks,
@@ -875,7 +874,7 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
             client._send(
                 CDR_LE_HEADER + handle.goal_id,
                 _RESULT_QUERY_TIMEOUT,
-                zenoh.handlers.Callback(on_reply, on_end, indirect=False),
+                inline(on_reply, on_end),
                 sequence=sequence,
             )
         except TransportError:
