@@ -72,6 +72,9 @@ CANCEL_ERROR_GOAL_TERMINATED = 3
 
 # A get_result request is held open until the goal ends; this only bounds a lost request.
 _RESULT_QUERY_TIMEOUT = 7 * 24 * 3600.0
+# The get_result sent with a goal gives up after this long and a thread asks again, watching the graph: a
+# request caught in flight by the server's death may never be ended by zenoh.
+_EARLY_RESULT_QUERY_TIMEOUT = 5.0
 # Closing a server waits this long for its running goals to end as cancelled, so that clients get that
 # result rather than "the server went away".
 CLOSE_GRACE_S = 1.0
@@ -258,10 +261,11 @@ class ServerGoalHandle:
             # to a whole objective's XML) is let go now, so rejected large goals do not pile up.
             self.goal = None
             waiters, self._waiters = self._waiters, []
+        self.server._note_terminated(self)
         # The waiting clients first: the status array is for watchers, the result is what a caller waits for.
         for responder in waiters:
             self._answer(responder)
-        self.server._on_terminated(self)
+        self.server._publish_status()
 
     def _add_waiter(self, responder: Responder) -> None:
         with self._lock:
@@ -530,13 +534,13 @@ class ActionServer:
             "goals_canceling": [g.goal_info for g in canceling],
         }
 
-    def _on_terminated(self, handle: ServerGoalHandle) -> None:
+    def _note_terminated(self, handle: ServerGoalHandle) -> None:
+        """Count ``handle`` among the ended goals (before its clients hear of it)."""
         with self._lock:
             if self._active.pop(handle.goal_id, None) is not None:
                 self._finished[handle.goal_id] = handle
                 if self._finished_chunks is not None:
                     self._finished_chunks += handle._status_chunk()
-        self._publish_status()
 
     def _expire(self, now: float) -> None:
         """Forget ended goals past ``result_timeout``, and the oldest beyond ``max_finished_goals``
@@ -835,8 +839,9 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         """Send the goal's get_result now; its replies finish the handle on the transport's thread.
 
         A Kinema server holds the request until the goal ends. When it ends without the result (a server
-        that answers UNKNOWN for a goal it has not accepted yet, or none reachable), the handle asks
-        again once the goal is accepted (:meth:`_wait_result`).
+        that answers UNKNOWN for a goal it has not accepted yet, none reachable, or no answer within
+        :data:`_EARLY_RESULT_QUERY_TIMEOUT`), the handle asks again once the goal is accepted
+        (:meth:`_wait_result`, which also notices a server that went away).
         """
         client = self._get_result
         sequence = client._next_sequence()
@@ -873,7 +878,7 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         try:
             client._send(
                 CDR_LE_HEADER + handle.goal_id,
-                _RESULT_QUERY_TIMEOUT,
+                _EARLY_RESULT_QUERY_TIMEOUT,
                 inline(on_reply, on_end),
                 sequence=sequence,
             )
