@@ -61,11 +61,7 @@ class TreeBuilder:
         self._subtree_paths: set[str] = set()
         # Registered node classes, which the builder constructs itself (other builders go through
         # factory.instantiate_node, which checks what they return).
-        self._classes: dict[str, type[TreeNode]] = {
-            node_id: builder
-            for node_id, builder in factory._builders.items()
-            if isinstance(builder, type) and issubclass(builder, TreeNode)
-        }
+        self._classes: dict[str, type[TreeNode]] = factory.node_classes()
         # The entries SubTree number literals created (ids, while this tree is built): see _number_fits.
         self._number_literals: set[int] = set()
 

@@ -80,6 +80,7 @@ class BehaviorTreeFactory:
         self.library.spellings = self.former_spellings
         # Bumped by every change of the node types or enums: compiled tree plans depend on them.
         self._generation = 0
+        self._node_classes: tuple[int, dict[str, type[TreeNode]]] | None = None
         self._serial = next(_FACTORY_SERIALS)
         if register_builtins:
             from kinema.bt.builtins import register_builtin_nodes
@@ -189,6 +190,19 @@ class BehaviorTreeFactory:
     def manifests(self) -> dict[str, NodeManifest]:
         """Registered node types: ID -> manifest (category, ports, description, metadata)."""
         return dict(self._manifests)
+
+    def node_classes(self) -> dict[str, type[TreeNode]]:
+        """The registered node types that are TreeNode classes (the tree builder constructs those
+        itself); one dict per registry generation, not to be changed by the caller."""
+        cached = self._node_classes
+        if cached is None or cached[0] != self._generation:
+            classes = {
+                node_id: builder
+                for node_id, builder in self._builders.items()
+                if isinstance(builder, type) and issubclass(builder, TreeNode)
+            }
+            cached = self._node_classes = (self._generation, classes)
+        return cached[1]
 
     def builtin_nodes(self) -> list[str]:
         """IDs of the built-in node types."""

@@ -121,13 +121,23 @@ class _Streams:
         self._node_status = node.create_publisher(names.NODE_STATUS_TYPE, names.NODE_STATUS)
         self._node_table = node.create_publisher(names.NODE_TABLE_TYPE, names.NODE_TABLE, latched=True)
         self._table_id = 0
+        self._node_table_class: Any = None
         self._encoder: NodeStatusCodesEncoder | None = None
         self._blackboard = node.create_publisher(names.BLACKBOARD_TYPE, names.BLACKBOARD, latched=True)
         self._log = node.create_publisher(names.LOG_TYPE, names.LOG)
         self._status: tuple[ObjectiveStatus, str] = (ObjectiveStatus.IDLE, "")
         self._last_blackboard: list[tuple[str, str, str, str]] | None = None
         self._render_cache: dict[int, tuple[Any, str]] = {}
+        # Whether the last snapshot handed to the worker was empty (another empty one would change nothing).
+        self._handed_empty = False
         self._lock = threading.Lock()
+        # Built once: a status change publishes a heartbeat from the tick thread.
+        from kinema.transport.messages import load_interfaces
+
+        registry = load_interfaces()
+        self._heartbeat_class = registry.message_class(names.HEARTBEAT_TYPE)
+        self._health_class = registry.message_class(names.HEALTH_TYPE)
+        self._time_class = registry.message_class("builtin_interfaces/msg/Time")
         # Also tells the clients waiting for a run (set by the Agent).
         self.on_warning: Callable[[str], None] | None = None
         self._work = HandOff("kinema-blackboard")
@@ -136,35 +146,37 @@ class _Streams:
         """Publish what was handed over, then stop the worker thread."""
         self._work.close()
 
-    def publish_heartbeat(self) -> None:
-        from kinema.transport.messages import msg
-
-        health = self._server.health()
+    def publish_heartbeat(self, *, health: bool = True) -> None:
+        """Publish the heartbeat and, with ``health``, the watchdog's report (the periodic beat does; a
+        status change, on the tick thread, sends the heartbeat alone: the latched report stands)."""
+        report = self._server.health() if health else None
         with self._lock:
             # The status is read where it is published, under the lock on_status takes to change it:
             # a beat read before a run ended and sent after it would tell subscribers the run restarted.
             status, name = self._status
             now = time.time()
             clock_now = self._clock.now() if self._clock is not None and not _is_wall(self._clock) else now
-            message = msg(
-                names.HEARTBEAT_TYPE,
-                process_timestamp=_stamp(now),
-                ros_timestamp=_stamp(clock_now),
+            stamp = self._time_class(*time_parts(now))
+            message = self._heartbeat_class(
+                process_timestamp=stamp,
+                ros_timestamp=stamp if clock_now == now else self._time_class(*time_parts(clock_now)),
                 objective_name=name,
                 objective_status=str(status),
             )
-            report = msg(
-                names.HEALTH_TYPE,
-                stamp=_stamp(now),
-                tick_thread_alive=health.tick_thread_alive,
-                tick_thread_replacements=health.replacements,
-                warnings=list(health.warnings),
-            )
             self._heartbeat.publish(message)
-            self._health.publish(report)
+            if report is None:
+                return
+            self._health.publish(
+                self._health_class(
+                    stamp=stamp,
+                    tick_thread_alive=report.tick_thread_alive,
+                    tick_thread_replacements=report.replacements,
+                    warnings=list(report.warnings),
+                )
+            )
             seen = {_topic(old) for old in self._last_warnings}
-            new = [warning for warning in health.warnings if _topic(warning) not in seen]
-            self._last_warnings = health.warnings
+            new = [warning for warning in report.warnings if _topic(warning) not in seen]
+            self._last_warnings = report.warnings
         for warning in new:
             # Once per problem on the log topic too, so `kinema run`'s terminal and the TUI's log show it.
             self.publish_log(LOG_WARN, f"watchdog: {warning}")
@@ -181,24 +193,32 @@ class _Streams:
     def on_status(self, status: ObjectiveStatus, objective_name: str) -> None:
         with self._lock:
             self._status = (status, objective_name)
-        log.info("objective %r: %s", objective_name, status)
-        self.publish_heartbeat()
+        # How a run ends is logged by on_run_finished, once its clients have their answer.
+        log.log(
+            logging.INFO if status is ObjectiveStatus.RUNNING else logging.DEBUG,
+            "objective %r: %s",
+            objective_name,
+            status,
+        )
+        self.publish_heartbeat(health=False)
 
     def on_node_status(self, objective_name: str, changes: NodeStatusBatch) -> None:
-        from kinema.transport.messages import msg
-
         table = changes.table
         if table.id != self._table_id:
             # Once per run, latched, before its first changes: subscribers name nodes with it.
+            table_class = self._node_table_class
+            if table_class is None:
+                from kinema.transport.messages import load_interfaces
+
+                table_class = self._node_table_class = load_interfaces().message_class(names.NODE_TABLE_TYPE)
             self._node_table.publish(
-                msg(
-                    names.NODE_TABLE_TYPE,
+                table_class(
                     objective_name=objective_name,
                     table_id=table.id,
                     uids=table.uid_array,
-                    node_paths=table.paths,
-                    node_ids=table.node_ids,
-                    node_names=table.names,
+                    node_paths=list(table.paths),
+                    node_ids=list(table.node_ids),
+                    node_names=list(table.names),
                 )
             )
             self._table_id = table.id
@@ -221,6 +241,9 @@ class _Streams:
         return encoder
 
     def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
+        if not entries and self._handed_empty:
+            return  # the worker would find nothing changed: do not wake it
+        self._handed_empty = not entries
         self._work.submit(lambda: self._publish_blackboard(objective_name, entries), key="blackboard")
 
     def _publish_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
@@ -355,6 +378,7 @@ class Agent:
             # Ended goals stay in the (latched) status array this long: long enough for a client to
             # fetch a result, short enough that a busy server does not publish thousands of them.
             result_timeout=DO_OBJECTIVE_RESULT_KEEP_S,
+            deferred=True,
         )
         node.create_action_server(
             names.DO_OBJECTIVE_TYPE,
@@ -362,6 +386,7 @@ class Agent:
             self._on_run_objective,
             cancel_callback=self._on_cancel_goal,
             result_timeout=DO_OBJECTIVE_RESULT_KEEP_S,
+            deferred=True,
         )
         node.create_service(names.LIST_OBJECTIVES_TYPE, names.LIST_OBJECTIVES, self._on_list_objectives)
         node.create_service(names.GET_OBJECTIVE_XML_TYPE, names.GET_OBJECTIVE_XML, self._on_get_objective_xml)
@@ -505,32 +530,42 @@ class Agent:
             return {"status": {"success": True, "error_message": ""}}
         return {"status": {"success": False, "error_message": "no objective is running"}}
 
-    def _on_run_objective(self, handle: Any) -> Any:
+    def _on_run_objective(self, handle: Any) -> None:
         goal = handle.goal
         if goal.objective_xml_string:
             refused = ObjectiveResult.failure(NO_XML_HERE.format(door=names.RUN_OBJECTIVE), "<objective XML>")
             handle.abort({"error_code": result_message(refused), "error_message": refused.error_message})
-            return None
-        return self._on_do_objective(handle)
+            return
+        self._on_do_objective(handle)
 
-    def _on_do_objective(self, handle: Any) -> Any:
+    def _on_do_objective(self, handle: Any) -> None:
+        """Queue the goal's objective; its run's end ends the goal (on the tick thread).
+
+        Runs on the thread that accepted the goal (a deferred action server): it never blocks, and no
+        thread waits per goal.
+        """
         goal = handle.goal
         try:
             overrides = overrides_from_messages(goal.parameter_overrides)
         except ObjectiveError as error:
             refused = ObjectiveResult.failure(str(error), goal.objective_name)
             handle.abort({"error_code": result_message(refused), "error_message": refused.error_message})
-            return None
+            return
         request = ObjectiveRequest(goal.objective_name, goal.objective_xml_string, overrides, "do_objective")
-        run = self.server.submit(request)
-        with self._goal_lock:
-            self._goal_runs[handle.goal_id] = run
+
+        def registered(run: ObjectiveRun) -> None:
+            # Before the tick thread sees the run: a cancel of the goal finds it from the start.
+            with self._goal_lock:
+                self._goal_runs[handle.goal_id] = run
+
+        run = self.server.submit(request, before_start=registered)
+        if handle.is_cancel_requested:
+            self.server.cancel(run, reason="goal cancelled", timeout=0)
+        run.add_done_callback(lambda result: self._end_goal(handle, result))
+
+    def _end_goal(self, handle: Any, result: ObjectiveResult) -> None:
+        """Answer a goal's clients with how its run ended (a done callback of the run: the tick thread)."""
         try:
-            if handle.is_cancel_requested:
-                self.server.cancel(run, reason="goal cancelled", timeout=0)
-            outcome = run.wait()
-            assert outcome is not None
-            result = outcome
             payload = {"error_code": result_message(result), "error_message": result.error_message}
             if result.succeeded:
                 handle.succeed(payload)
@@ -538,18 +573,21 @@ class Agent:
                 handle.canceled(payload)
             else:
                 handle.abort(payload)
+        except KinemaError:
+            log.exception("could not end the goal of objective %r", result.objective_name)
         finally:
             # Only once the result is handed over: close() waits for this to answer waiting clients.
             with self._goal_lock:
                 self._goal_runs.pop(handle.goal_id, None)
                 self._goal_lock.notify_all()
-        return None
 
     def _on_cancel_goal(self, handle: Any) -> bool:
         with self._goal_lock:
             run = self._goal_runs.get(handle.goal_id)
-        if run is None:
-            return True  # not started yet: the execute thread sees is_cancel_requested
+            if run is None:
+                # Not queued yet: set under the lock that queuing takes, so _on_do_objective sees it.
+                handle.cancel_requested_event.set()
+                return True
         # Accepted only while the outcome is open: an accepted cancel never ends as SUCCESS.
         accepted = run.request_cancel("goal cancelled")
         if accepted:

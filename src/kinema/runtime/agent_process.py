@@ -28,6 +28,8 @@ if TYPE_CHECKING:
 log = logging.getLogger("kinema.agent")
 
 ClockChoice = Literal["auto", "wall", "sim"]
+# How often the main thread, waiting for SIGTERM/SIGINT, returns to Python code to run a pending handler.
+SIGNAL_POLL_S = 0.25
 
 
 @dataclass
@@ -327,7 +329,11 @@ def main(argv: list[str] | None = None) -> int:
         with os.fdopen(args.ready_fd, "w") as ready:
             ready.write("ready\n")
     try:
-        stop.wait()
+        # Woken now and then: CPython runs a signal's handler on the main thread only, when it next
+        # executes Python code. A SIGTERM the kernel hands to one of the transport's threads would
+        # otherwise wait for a wake-up that never comes, and the agent would outlive its `kinema down`.
+        while not stop.wait(SIGNAL_POLL_S):
+            pass
     finally:
         log.info("agent stopping")
         agent.close()

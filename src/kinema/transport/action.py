@@ -8,6 +8,11 @@
 
 So ``ros2 action send_goal`` against a Kinema action server, and a Kinema client against a ROS 2 action
 server on rmw_zenoh, both work.
+
+A Kinema client asks for the result right after sending the goal, without waiting for the acceptance: one
+round trip instead of two for a goal that ends at once. A Kinema server holds a ``get_result`` that comes
+before its goal until the goal is decided (:data:`EARLY_RESULT_HOLD_S` at most); another server answers it
+UNKNOWN at once, and the client then asks again once the goal is accepted, as rcl does.
 """
 
 from __future__ import annotations
@@ -16,16 +21,21 @@ import logging
 import threading
 import time
 import uuid
+from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Generic
 
-import numpy as np
-
 from kinema.errors import TransportError
 from kinema.interfaces import ActionType
 from kinema.interfaces.definition import FeedbackT, GoalT, ResultT
-from kinema.transport.goal_status_cdr import decode_goal_statuses, encode_goal_statuses
+from kinema.transport.dispatch import inline
+from kinema.transport.goal_status_cdr import (
+    CDR_LE_HEADER,
+    payload_of_chunks,
+    status_chunk,
+    statuses_of,
+)
 from kinema.transport.keys import LATCHED_QOS, QoS, fully_qualified
 from kinema.transport.messages import from_dict, type_of
 from kinema.transport.pubsub import Publisher, Subscription
@@ -62,6 +72,9 @@ CANCEL_ERROR_GOAL_TERMINATED = 3
 
 # A get_result request is held open until the goal ends; this only bounds a lost request.
 _RESULT_QUERY_TIMEOUT = 7 * 24 * 3600.0
+# The get_result sent with a goal gives up after this long and a thread asks again, watching the graph: a
+# request caught in flight by the server's death may never be ended by zenoh.
+_EARLY_RESULT_QUERY_TIMEOUT = 5.0
 # Closing a server waits this long for its running goals to end as cancelled, so that clients get that
 # result rather than "the server went away".
 CLOSE_GRACE_S = 1.0
@@ -71,7 +84,11 @@ CLOSE_FLUSH_S = 0.25
 # Feedback travels on a topic, the result on a service: feedback sent before the result may be
 # dispatched after it. A finished goal's feedback callback still gets such feedback for this long.
 LATE_FEEDBACK_S = 5.0
+# A get_result that comes before its goal (the client asks for both at once, and the two are served on
+# different threads) is held this long for the goal's decision, then answered UNKNOWN.
+EARLY_RESULT_HOLD_S = 2.0
 _ZERO_ID = bytes(16)
+_CHUNK_SIZE = len(status_chunk(_ZERO_ID, 0, 0, 0))
 
 
 def _stamp_now() -> dict[str, int]:
@@ -80,7 +97,16 @@ def _stamp_now() -> dict[str, int]:
 
 
 def _uuid_bytes(message: Any) -> bytes:
-    return bytes(np.asarray(message.uuid, dtype=np.uint8).tobytes())
+    # A numpy uint8 array as deserialised (its buffer), or a list of ints.
+    return bytes(message.uuid)
+
+
+def _uuid_message(registry: Any, goal_id: bytes) -> Any:
+    import numpy as np
+
+    return registry.message_class("unique_identifier_msgs/msg/UUID")(
+        uuid=np.frombuffer(goal_id, dtype=np.uint8).copy()
+    )
 
 
 def _uuid_dict(goal_id: bytes) -> dict[str, Any]:
@@ -130,10 +156,30 @@ class ServerGoalHandle:
         self.cancel_requested_event = threading.Event()
         self._waiters: list[Responder] = []
         self._lock = threading.Lock()
-        # Built once: the status array repeats it for every goal on every status change.
-        self.goal_info = from_dict(
-            "action_msgs/msg/GoalInfo", {"goal_id": _uuid_dict(goal_id), "stamp": self.stamp}
-        )
+        self._goal_info: Any = None
+        # This goal's element of the status array (goal_status_cdr.status_chunk), and the status it shows.
+        self._chunk = b""
+        self._chunk_status = -1
+
+    @property
+    def goal_info(self) -> Any:
+        """The ``action_msgs/msg/GoalInfo`` of this goal (built on first use: feedback, cancel replies)."""
+        info = self._goal_info
+        if info is None:
+            registry = self.server.node.session.registry
+            stamp = registry.message_class("builtin_interfaces/msg/Time")(**self.stamp)
+            info = registry.message_class("action_msgs/msg/GoalInfo")(
+                goal_id=_uuid_message(registry, self.goal_id), stamp=stamp
+            )
+            self._goal_info = info
+        return info
+
+    def _status_chunk(self) -> bytes:
+        status = self.status
+        if status != self._chunk_status:
+            self._chunk = status_chunk(self.goal_id, self.stamp["sec"], self.stamp["nanosec"], status)
+            self._chunk_status = status
+        return self._chunk
 
     @property
     def goal_uuid(self) -> uuid.UUID:
@@ -188,7 +234,7 @@ class ServerGoalHandle:
 
     def _set_status(self, status: int) -> None:
         with self._lock:
-            if self.status in TERMINAL:
+            if self.status in TERMINAL or self.status == status:
                 return
             self.status = status
         self.server._publish_status()
@@ -215,19 +261,11 @@ class ServerGoalHandle:
             # to a whole objective's XML) is let go now, so rejected large goals do not pile up.
             self.goal = None
             waiters, self._waiters = self._waiters, []
-        self.server._publish_status()
+        self.server._note_terminated(self)
+        # The waiting clients first: the status array is for watchers, the result is what a caller waits for.
         for responder in waiters:
             self._answer(responder)
-
-    def _answer(self, responder: Responder) -> None:
-        response = {"status": self.status, "result": self.result}
-        try:
-            if self.error:
-                responder.reply_then_error(response, self.error)
-            else:
-                responder.reply(response)
-        except Exception:
-            log.exception("cannot send the result of goal %s on %s", self.goal_uuid, self.server.name)
+        self.server._publish_status()
 
     def _add_waiter(self, responder: Responder) -> None:
         with self._lock:
@@ -235,6 +273,17 @@ class ServerGoalHandle:
                 self._waiters.append(responder)
                 return
         self._answer(responder)
+
+    def _answer(self, responder: Responder) -> None:
+        server = self.server
+        response = server._get_result_class(status=self.status, result=self.result)
+        try:
+            if self.error:
+                responder.reply_then_error(response, self.error)
+            else:
+                responder.reply(response)
+        except Exception:
+            log.exception("cannot send the result of goal %s on %s", self.goal_uuid, server.name)
 
 
 ExecuteCallback = Callable[[ServerGoalHandle], Any]
@@ -249,6 +298,12 @@ class ActionServer:
     (default: accept all) decides acceptance; ``cancel_callback(goal_handle)`` (default: accept) decides
     whether a cancel request is honoured. An exception in the execute callback aborts the goal; Kinema
     clients then get a TransportError with the message from ``result()``.
+
+    With ``deferred=True`` the execute callback instead runs right after the goal is accepted, on the
+    thread that accepted it: it must not block, and ends the goal later, from any thread, with the
+    handle's :meth:`~ServerGoalHandle.succeed`, :meth:`~ServerGoalHandle.abort` or
+    :meth:`~ServerGoalHandle.canceled` (what it returns is ignored). For work that another thread does
+    anyway (the objective server's tick thread): no thread is started per goal.
     """
 
     def __init__(
@@ -262,6 +317,7 @@ class ActionServer:
         cancel_callback: CancelCallback | None = None,
         result_timeout: float = 900.0,
         max_finished_goals: int = 100,
+        deferred: bool = False,
     ) -> None:
         self.node = node
         registry = node.session.registry
@@ -273,9 +329,23 @@ class ActionServer:
         self._cancel_callback = cancel_callback
         self._result_timeout = result_timeout
         self._max_finished = max_finished_goals
+        self._deferred = deferred
         self._feedback_class = registry.message_class(self.action.feedback_message)
+        self._get_result_class = registry.message_class(self.action.get_result.response)
+        self._send_goal_response_class = registry.message_class(self.action.send_goal.response)
+        self._time_class = registry.message_class("builtin_interfaces/msg/Time")
         self._goals: dict[bytes, ServerGoalHandle] = {}
+        self._active: dict[bytes, ServerGoalHandle] = {}
+        # The ended goals in the order they ended (the status array lists them first, and they expire
+        # from the front), and their status elements joined, kept while no goal ends or expires.
+        self._finished: dict[bytes, ServerGoalHandle] = {}
+        self._finished_chunks: bytes | None = None
+        # get_result requests that came before their goal: goal id -> [(deadline, responder)].
+        self._early: dict[bytes, list[tuple[float, Responder]]] = {}
+        self._early_thread: threading.Thread | None = None
+        self._early_idle = False
         self._lock = threading.RLock()
+        self._early_wake = threading.Condition(self._lock)
         self._closed = False
         base = f"{self.name}/_action"
         action = self.action
@@ -308,25 +378,51 @@ class ActionServer:
         if accepted and self._goal_callback is not None:
             accepted = bool(self._goal_callback(request.goal))
         handle = None
-        if accepted:
-            handle = ServerGoalHandle(self, goal_id, request.goal)
-            with self._lock:
+        early: list[tuple[float, Responder]] = []
+        with self._lock:
+            if not duplicate:
+                early = self._early.pop(goal_id, [])
+            if accepted:
+                handle = ServerGoalHandle(self, goal_id, request.goal)
+                # Result requests that came first wait for this goal's end like any later one.
+                handle._waiters.extend(responder for _deadline, responder in early)
                 self._goals[goal_id] = handle
+                self._active[goal_id] = handle
+        if not accepted:
+            for _deadline, responder in early:
+                _answer_unknown(responder)
         stamp = handle.stamp if handle else _stamp_now()
-        return {"accepted": accepted, "stamp": stamp}
+        return self._send_goal_response_class(accepted=accepted, stamp=self._time_class(**stamp))
 
     def _after_send_goal(self, request: Any, response: Any) -> None:
-        if not response["accepted"]:
+        if not response.accepted:
             return
         with self._lock:
             handle = self._goals.get(_uuid_bytes(request.goal_id))
         if handle is None:
             return
+        # Accepted and executing from here on: one status message says both.
+        with handle._lock:
+            if handle.status == STATUS_ACCEPTED:
+                handle.status = STATUS_EXECUTING
         self._publish_status()
+        if self._deferred:
+            self._start_deferred(handle)
+            return
         thread = threading.Thread(
             target=self._execute, args=(handle,), name=f"kinema-goal{self.name}", daemon=True
         )
         thread.start()
+
+    def _start_deferred(self, handle: ServerGoalHandle) -> None:
+        try:
+            self._execute_callback(handle)
+        except Exception as error:
+            log.exception("execute callback of action %s raised", self.name)
+            if handle.status not in TERMINAL:
+                handle._terminate(
+                    STATUS_ABORTED, None, error=f"action {self.name} failed: {type(error).__name__}: {error}"
+                )
 
     def _execute(self, handle: ServerGoalHandle) -> None:
         handle._set_status(STATUS_EXECUTING)
@@ -350,12 +446,54 @@ class ActionServer:
             handle.succeed(outcome)
 
     def _on_get_result(self, request: Any, responder: Responder) -> None:
+        goal_id = _uuid_bytes(request.goal_id)
         with self._lock:
-            handle = self._goals.get(_uuid_bytes(request.goal_id))
+            handle = self._goals.get(goal_id)
+            if handle is None and not self._closed:
+                # Its goal may be on its way (sent just before, served on another thread): hold it.
+                self._early.setdefault(goal_id, []).append(
+                    (time.monotonic() + EARLY_RESULT_HOLD_S, responder)
+                )
+                if self._early_thread is None:
+                    self._early_thread = threading.Thread(
+                        target=self._expire_early, name=f"kinema-early{self.name}", daemon=True
+                    )
+                    self._early_thread.start()
+                elif self._early_idle:
+                    self._early_wake.notify()
+                return
         if handle is None:
-            responder.reply({"status": STATUS_UNKNOWN})
+            _answer_unknown(responder)
             return
         handle._add_waiter(responder)
+
+    def _expire_early(self) -> None:
+        """Answer UNKNOWN to held result requests whose goal did not come in time.
+
+        One thread, from the first held request until the server closes. It sweeps a few times per hold
+        while requests are held (most are claimed by their goal within microseconds) and sleeps
+        otherwise.
+        """
+        while True:
+            with self._lock:
+                if self._closed:
+                    return  # close() answers the requests still held
+                now = time.monotonic()
+                expired: list[Responder] = []
+                for goal_id, waiting in list(self._early.items()):
+                    expired += [responder for deadline, responder in waiting if deadline <= now]
+                    kept = [(deadline, responder) for deadline, responder in waiting if deadline > now]
+                    if kept:
+                        self._early[goal_id] = kept
+                    else:
+                        del self._early[goal_id]
+                if not expired:
+                    self._early_idle = not self._early
+                    self._early_wake.wait(None if self._early_idle else EARLY_RESULT_HOLD_S / 4)
+                    self._early_idle = False
+                    continue
+            for responder in expired:
+                _answer_unknown(responder)
 
     def _on_cancel(self, request: Any) -> Any:
         goal_id = _uuid_bytes(request.goal_info.goal_id)
@@ -396,29 +534,42 @@ class ActionServer:
             "goals_canceling": [g.goal_info for g in canceling],
         }
 
+    def _note_terminated(self, handle: ServerGoalHandle) -> None:
+        """Count ``handle`` among the ended goals (before its clients hear of it)."""
+        with self._lock:
+            if self._active.pop(handle.goal_id, None) is not None:
+                self._finished[handle.goal_id] = handle
+                if self._finished_chunks is not None:
+                    self._finished_chunks += handle._status_chunk()
+
+    def _expire(self, now: float) -> None:
+        """Forget ended goals past ``result_timeout``, and the oldest beyond ``max_finished_goals``
+        (the lock held), so a burst of goals does not make every status message (and get_result
+        lookup) grow forever."""
+        finished = self._finished
+        while finished:
+            goal_id, oldest = next(iter(finished.items()))
+            ended = oldest.terminated_at if oldest.terminated_at is not None else now
+            if len(finished) <= self._max_finished and now - ended <= self._result_timeout:
+                return
+            del finished[goal_id]
+            self._goals.pop(goal_id, None)
+            if self._finished_chunks is not None:
+                self._finished_chunks = self._finished_chunks[_CHUNK_SIZE:]
+
     def _publish_status(self) -> None:
         if self._closed:
             return
-        now = time.monotonic()
         with self._lock:
-            finished = sorted(
-                ((h.terminated_at, h) for h in self._goals.values() if h.terminated_at is not None),
-                key=lambda pair: pair[0],
-            )
-            # Results stay available for result_timeout, but at most max_finished_goals of them, so a
-            # burst of goals does not make every status message (and get_result lookup) grow forever.
-            surplus = max(0, len(finished) - self._max_finished)
-            expired = [
-                h
-                for index, (ended, h) in enumerate(finished)
-                if index < surplus or now - ended > self._result_timeout
-            ]
-            for handle in expired:
-                del self._goals[handle.goal_id]
-            # Laid out directly: through the generic serializer a full array cost 0.3 ms per change.
-            payload = encode_goal_statuses(
-                (h.goal_id, h.stamp["sec"], h.stamp["nanosec"], h.status) for h in self._goals.values()
-            )
+            self._expire(time.monotonic())
+            # Laid out directly (through the generic serializer a full array cost 0.3 ms per change); the
+            # ended goals' part is kept, and changes by a chunk when one ends or expires.
+            chunks = self._finished_chunks
+            if chunks is None:
+                chunks = self._finished_chunks = b"".join(h._status_chunk() for h in self._finished.values())
+            if self._active:
+                chunks += b"".join(h._status_chunk() for h in self._active.values())
+            payload = payload_of_chunks(len(self._finished) + len(self._active), chunks)
             try:
                 self._status.publish_raw(payload)
             except TransportError:
@@ -436,6 +587,12 @@ class ActionServer:
         deadline = time.monotonic() + CLOSE_GRACE_S
         while any(handle.is_active for handle in active) and time.monotonic() < deadline:
             time.sleep(0.005)
+        with self._lock:
+            early = [responder for waiting in self._early.values() for _deadline, responder in waiting]
+            self._early.clear()
+            self._early_wake.notify_all()
+        for responder in early:
+            _answer_unknown(responder)
         if active:
             # The results just answered are queued, not delivered (zenoh confirms no reply), and closing
             # the queryable and then the session drops them: the client would hear "went away"
@@ -447,6 +604,14 @@ class ActionServer:
 
     def __repr__(self) -> str:
         return f"<ActionServer {self.name} [{self.type_name}]>"
+
+
+def _answer_unknown(responder: Responder) -> None:
+    """Answer a get_result for a goal the server does not know."""
+    try:
+        responder.reply({"status": STATUS_UNKNOWN})
+    except Exception:
+        log.debug("cannot answer a get_result for an unknown goal", exc_info=True)
 
 
 def _ns(stamp: Any) -> int:
@@ -476,6 +641,10 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         self.finished_at: float | None = None
         self._callbacks: list[Callable[[ClientGoalHandle[ResultT, FeedbackT]], Any]] = []
         self._lock = threading.Lock()
+        # The result request sent with the goal: whether the goal's acceptance is known, and whether that
+        # request ended without the result (the server did not know the goal yet).
+        self._decided = False
+        self._unanswered = False
 
     @property
     def goal_uuid(self) -> uuid.UUID:
@@ -492,7 +661,11 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         return self._done.is_set()
 
     def add_done_callback(self, callback: Callable[[ClientGoalHandle[ResultT, FeedbackT]], Any]) -> None:
-        """Call ``callback(handle)`` when the goal ends (at once if it already has)."""
+        """Call ``callback(handle)`` when the goal ends (at once if it already has).
+
+        It runs on the transport's thread that received the result: it must return quickly (hand the
+        work to a loop or an event).
+        """
         with self._lock:
             if not self._done.is_set():
                 self._callbacks.append(callback)
@@ -529,6 +702,23 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         if self._feedback_callback is not None:
             self._feedback_callback(feedback)
 
+    def _decide(self, accepted: bool) -> None:
+        """The server answered the goal; ask for the result again if the first request went unanswered."""
+        with self._lock:
+            self.accepted = accepted
+            self._decided = True
+            ask = accepted and self._unanswered and not self._done.is_set()
+        if ask:
+            self.client._wait_result_on_thread(self)
+
+    def _early_request_unanswered(self) -> None:
+        """The result request sent with the goal ended without the result."""
+        with self._lock:
+            self._unanswered = True
+            ask = self._decided and self.accepted and not self._done.is_set()
+        if ask:
+            self.client._wait_result_on_thread(self)
+
     def _finish(self, outcome: GoalResult[ResultT] | None, error: TransportError | None) -> None:
         with self._lock:
             if self._done.is_set():
@@ -539,6 +729,7 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
                 self.status = outcome.status
             self._done.set()
             callbacks, self._callbacks = self._callbacks, []
+        self.client._ended(self)
         for callback in callbacks:
             try:
                 callback(self)
@@ -555,12 +746,18 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
 
     def __init__(self, node: Node, action_type: str, name: str) -> None:
         self.node = node
-        self.action: ActionType = node.session.registry.action(action_type)
+        registry = node.session.registry
+        self.action: ActionType = registry.action(action_type)
         self.name = _action_names(node, name)
         self.type_name = self.action.name
+        # Goals sent, kept LATE_FEEDBACK_S after they end (late feedback still reaches them); those not
+        # ended yet (status messages update them); and the ended ones in the order they ended.
         self._handles: dict[bytes, ClientGoalHandle[ResultT, FeedbackT]] = {}
+        self._pending: dict[bytes, ClientGoalHandle[ResultT, FeedbackT]] = {}
+        self._ended_order: deque[tuple[float, bytes]] = deque()
         self._lock = threading.Lock()
         self._closed = False
+        self._request_class = registry.message_class(self.action.send_goal.request)
         base = f"{self.name}/_action"
         action = self.action
         self._send_goal: ServiceClient[Any, Any] = ServiceClient(node, action.send_goal, f"{base}/send_goal")
@@ -604,77 +801,141 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         with self._lock:
             self._forget_finished()
             self._handles[goal_id] = handle
-        request = from_dict(action.send_goal.request, {"goal_id": _uuid_dict(goal_id), "goal": goal_msg})
+            self._pending[goal_id] = handle
+        registry = self._send_goal.registry
+        request = self._request_class(goal_id=_uuid_message(registry, goal_id), goal=goal_msg)
+        started = time.monotonic()
         try:
-            response = self._send_goal.call(request, timeout=timeout)
+            payload = registry.serialize(request, action.send_goal.request)
+            sent = self._send_goal._send(payload, timeout)
+            # The result is asked for at once: a goal that ends quickly costs one round trip, not two.
+            self._ask_result_early(handle)
+            # The acceptance is one reply, never followed by an error: taken as it comes.
+            response = self._send_goal._call_payload(payload, timeout, sent, started, first=True)
         except TransportError as error:
-            with self._lock:
-                self._handles.pop(goal_id, None)
+            self._drop(handle)
             if str(error).startswith("no server for service"):
                 raise TransportError(
                     f"no action server {self.name} [{self.type_name}] answered within {timeout:g} s"
                 ) from error
             raise
-        handle.accepted = bool(response.accepted)
         handle.stamp = response.stamp
-        if not handle.accepted:
-            with self._lock:
-                self._handles.pop(goal_id, None)
+        if not response.accepted:
+            self._drop(handle)
             return handle
         if handle.status == STATUS_UNKNOWN:
             handle.status = STATUS_ACCEPTED
+        handle._decide(True)
+        return handle
+
+    def _drop(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
+        """Forget a goal that was not accepted (rejected, or the server never answered)."""
+        handle._decide(False)
+        with self._lock:
+            self._handles.pop(handle.goal_id, None)
+            self._pending.pop(handle.goal_id, None)
+
+    def _ask_result_early(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
+        """Send the goal's get_result now; its replies finish the handle on the transport's thread.
+
+        A Kinema server holds the request until the goal ends. When it ends without the result (a server
+        that answers UNKNOWN for a goal it has not accepted yet, none reachable, or no answer within
+        :data:`_EARLY_RESULT_QUERY_TIMEOUT`), the handle asks again once the goal is accepted
+        (:meth:`_wait_result`, which also notices a server that went away).
+        """
+        client = self._get_result
+        sequence = client._next_sequence()
+        response: list[Any] = []
+        errors: list[str] = []
+
+        def on_reply(reply: Any) -> None:
+            try:
+                if reply.ok is not None:
+                    if response:
+                        return
+                    response.append(client._decode_reply(reply.ok, sequence))
+                    status = int(response[0].status)
+                    if status in (STATUS_SUCCEEDED, STATUS_CANCELED):  # only an abort is followed by an error
+                        handle._finish(GoalResult(status, response[0].result), None)
+                elif reply.err is not None:
+                    errors.append(reply.err.payload.to_string())
+            except Exception:
+                log.exception("%s: the result of goal %s is unreadable", self.name, handle.goal_uuid)
+
+        def on_end() -> None:
+            try:
+                if handle.done():
+                    return
+                if errors and errors[0] != "Timeout":
+                    handle._finish(None, TransportError(errors[0]))
+                elif response and int(response[0].status) != STATUS_UNKNOWN:
+                    handle._finish(GoalResult(int(response[0].status), response[0].result), None)
+                else:
+                    handle._early_request_unanswered()
+            except Exception:
+                log.exception("%s: the result request of goal %s failed", self.name, handle.goal_uuid)
+
+        try:
+            client._send(
+                CDR_LE_HEADER + handle.goal_id,
+                _EARLY_RESULT_QUERY_TIMEOUT,
+                inline(on_reply, on_end),
+                sequence=sequence,
+            )
+        except TransportError:
+            handle._early_request_unanswered()
+
+    def _wait_result_on_thread(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
         threading.Thread(
             target=self._wait_result, args=(handle,), name=f"kinema-result{self.name}", daemon=True
         ).start()
-        return handle
 
     def _wait_result(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
-        request = self._get_result.registry.serialize(
-            from_dict(self.action.get_result.request, {"goal_id": _uuid_dict(handle.goal_id)}),
-            self.action.get_result.request,
-        )
+        request = CDR_LE_HEADER + handle.goal_id  # GetResult_Request: the goal's UUID
         graph = self.node.session.graph_cache()
         missing_since: float | None = None
-        try:
-            while not self._closed:
-                try:
-                    response = self._get_result._call_once(request, _RESULT_QUERY_TIMEOUT)
-                except TransportError as error:
-                    handle._finish(None, error)
+        while not self._closed and not handle.done():
+            try:
+                response = self._get_result._call_once(request, _RESULT_QUERY_TIMEOUT)
+            except TransportError as error:
+                handle._finish(None, error)
+                return
+            if response is not None:
+                handle._finish(GoalResult(int(response.status), response.result), None)
+                return
+            # No server matched: it may not be discovered yet, or it went away.
+            if graph.snapshot().action_server_ready(self.name):
+                missing_since = None
+            else:
+                missing_since = missing_since or time.monotonic()
+                if handle.status == STATUS_CANCELED:
+                    # The server's last status said so before it closed; a cancelled goal's result
+                    # is its empty default.
+                    handle._finish(GoalResult(STATUS_CANCELED, from_dict(self.action.result, None)), None)
                     return
-                if response is not None:
-                    handle._finish(GoalResult(int(response.status), response.result), None)
+                if time.monotonic() - missing_since > 2.0:
+                    handle._finish(
+                        None,
+                        TransportError(
+                            f"action server {self.name} went away before goal {handle.goal_uuid} finished"
+                        ),
+                    )
                     return
-                # No server matched: it may not be discovered yet, or it went away.
-                if graph.snapshot().action_server_ready(self.name):
-                    missing_since = None
-                else:
-                    missing_since = missing_since or time.monotonic()
-                    if handle.status == STATUS_CANCELED:
-                        # The server's last status said so before it closed; a cancelled goal's result
-                        # is its empty default.
-                        handle._finish(GoalResult(STATUS_CANCELED, from_dict(self.action.result, None)), None)
-                        return
-                    if time.monotonic() - missing_since > 2.0:
-                        handle._finish(
-                            None,
-                            TransportError(
-                                f"action server {self.name} went away before goal {handle.goal_uuid} finished"
-                            ),
-                        )
-                        return
-                time.sleep(0.02)
-            handle._finish(None, TransportError(f"action client {self.name} was closed"))
-        finally:
-            with self._lock:
-                self._forget_finished()
+            time.sleep(0.02)
+        handle._finish(None, TransportError(f"action client {self.name} was closed"))
+
+    def _ended(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
+        with self._lock:
+            if self._pending.pop(handle.goal_id, None) is not None and handle.finished_at is not None:
+                self._ended_order.append((handle.finished_at, handle.goal_id))
 
     def _forget_finished(self) -> None:
         """Drop the goals that finished more than LATE_FEEDBACK_S ago (call with the lock held)."""
         now = time.monotonic()
-        for goal_id, handle in list(self._handles.items()):
-            if handle.finished_at is not None and now - handle.finished_at > LATE_FEEDBACK_S:
-                del self._handles[goal_id]
+        ended = self._ended_order
+        while ended and now - ended[0][0] > LATE_FEEDBACK_S:
+            _finished_at, goal_id = ended.popleft()
+            self._handles.pop(goal_id, None)
 
     def _on_feedback(self, message: Any) -> None:
         with self._lock:
@@ -684,18 +945,16 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
 
     def _on_status(self, payload: bytes) -> None:
         with self._lock:
-            if not self._handles:
+            if not self._pending:
                 return
-            handles = dict(self._handles)
+            pending = dict(self._pending)
         try:
-            statuses = decode_goal_statuses(payload)
+            statuses = statuses_of(payload, pending)
             if statuses is None:  # not little-endian CDR: the generic deserializer reads it
                 message = self._status_sub._registry.deserialize(payload, self.action.status)
-                statuses = iter(
-                    [(_uuid_bytes(s.goal_info.goal_id), int(s.status)) for s in message.status_list]
-                )
-            for goal_id, status in statuses:
-                handle = handles.get(goal_id)
+                statuses = {_uuid_bytes(s.goal_info.goal_id): int(s.status) for s in message.status_list}
+            for goal_id, status in statuses.items():
+                handle = pending.get(goal_id)
                 if handle is not None and not handle.done():
                     handle.status = status
         except Exception:

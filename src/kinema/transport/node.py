@@ -180,11 +180,14 @@ class Node:
         cancel_callback: CancelCallback | None = None,
         result_timeout: float = 900.0,
         max_finished_goals: int = 100,
+        deferred: bool = False,
     ) -> ActionServer:
         """Serve the action ``name`` of ``action_type`` (``pkg/action/Name``).
 
         ``execute_callback(goal_handle)`` runs on a thread of its own for each accepted goal. Results of
         finished goals stay available for ``result_timeout`` seconds (at most ``max_finished_goals``).
+        With ``deferred=True`` it runs on the accepting thread instead, must not block, and ends the goal
+        later through the handle (see :class:`~kinema.transport.action.ActionServer`).
         """
         self._check_open()
         return ActionServer(
@@ -196,6 +199,7 @@ class Node:
             cancel_callback=cancel_callback,
             result_timeout=result_timeout,
             max_finished_goals=max_finished_goals,
+            deferred=deferred,
         )
 
     @overload

@@ -274,11 +274,27 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
             request = {}
         message = _as_message(request, self.service.request, f"request of {self.name}")
         payload = self.registry.serialize(message, self.service.request)
-        deadline = time.monotonic() + timeout
+        return self._call_payload(payload, timeout)  # type: ignore[no-any-return]
+
+    def _call_payload(
+        self,
+        payload: bytes,
+        timeout: float,
+        sent: tuple[int, Any] | None = None,
+        started: float | None = None,
+        *,
+        first: bool = False,
+    ) -> Any:
+        """:meth:`call` with a serialised request; ``sent`` is a first attempt already on its way
+        (``_send``'s result, sent at ``started``). ``first``: see :meth:`_collect`."""
+        deadline = (time.monotonic() if started is None else started) + timeout
         while True:
             remaining = deadline - time.monotonic()
             try:
-                outcome = self._call_once(payload, max(remaining, 0.001))
+                if sent is None:
+                    sent = self._send(payload, max(remaining, 0.001))
+                outcome = self._collect(*sent, first=first)
+                sent = None
             except _QueryTimedOut:
                 # A server took the request but did not reply in time (or the last slice was too short
                 # for a reply to come back): say which.
@@ -286,7 +302,7 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
                     raise TransportError(f"service {self.name} did not answer within {timeout:g} s") from None
                 outcome = None
             if outcome is not None:
-                return outcome  # type: ignore[no-any-return]  # deserialized as service.response
+                return outcome
             if time.monotonic() + _RETRY_PAUSE >= deadline:
                 raise TransportError(
                     f"no server for service {self.name} [{self.type_name}] answered within {timeout:g} s"
@@ -310,19 +326,41 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
         )
 
     def _call_once(self, payload: bytes, timeout: float) -> Any | None:
+        sequence, replies = self._send(payload, timeout)
+        return self._collect(sequence, replies)
+
+    def _next_sequence(self) -> int:
+        with self._lock:
+            return next(self._sequence)
+
+    def _send(
+        self, payload: bytes, timeout: float, handler: Any = None, *, sequence: int | None = None
+    ) -> tuple[int, Any]:
+        """Send one request; returns its sequence number and zenoh's reply handler (``handler`` if given:
+        a ``zenoh.handlers.Callback``), without waiting for a reply."""
         if self._closed:
             raise TransportError(f"client of {self.name} is closed")
-        with self._lock:
-            sequence = next(self._sequence)
+        if sequence is None:
+            sequence = self._next_sequence()
         attachment = Attachment(sequence, gid=self.gid).encode()
         replies = self.node.session.zenoh.get(
             self.key,
+            handler,
             target=zenoh.QueryTarget.ALL_COMPLETE,
             consolidation=zenoh.ConsolidationMode.NONE,
             payload=payload,
             attachment=attachment,
             timeout=timeout,
         )
+        return sequence, replies
+
+    def _collect(self, sequence: int, replies: Any, *, first: bool = False) -> Any | None:
+        """The response among ``replies`` (None when no server answered); raises an error reply.
+
+        With ``first``, the first response is returned as it comes, without waiting for the query to
+        end: for a service whose server never follows a response with an error
+        (:meth:`Responder.reply_then_error`), such as an action's ``send_goal``.
+        """
         response: Any = None
         answered = False
         errors: list[str] = []
@@ -330,18 +368,10 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
             if reply.ok is not None:
                 if answered:
                     continue
-                sample = reply.ok
-                if sample.attachment is not None:
-                    echoed = Attachment.decode(sample.attachment.to_bytes())
-                    if echoed.sequence_number != sequence:
-                        log.warning(
-                            "reply on %s echoes sequence %d, expected %d",
-                            self.name,
-                            echoed.sequence_number,
-                            sequence,
-                        )
-                response = self.registry.deserialize(sample.payload.to_bytes(), self.service.response)
+                response = self._decode_reply(reply.ok, sequence)
                 answered = True
+                if first and not errors:
+                    return response
             elif reply.err is not None:
                 errors.append(reply.err.payload.to_string())
         if errors:
@@ -350,6 +380,16 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
                 raise _QueryTimedOut(message)
             raise TransportError(message)
         return response if answered else None
+
+    def _decode_reply(self, sample: Any, sequence: int) -> Any:
+        """The response in a reply's sample (a reply echoing another sequence number is logged)."""
+        if sample.attachment is not None:
+            echoed = Attachment.decode(sample.attachment.to_bytes())
+            if echoed.sequence_number != sequence:
+                log.warning(
+                    "reply on %s echoes sequence %d, expected %d", self.name, echoed.sequence_number, sequence
+                )
+        return self.registry.deserialize(sample.payload.to_bytes(), self.service.response)
 
     def call_async(
         self, request: RequestT | dict[str, Any] | None = None, timeout: float = 5.0

@@ -7,6 +7,7 @@ import subprocess
 import sys
 import threading
 import time
+import uuid
 from collections.abc import Callable
 from typing import Any
 
@@ -21,6 +22,9 @@ from kinema.transport import (
     ServerGoalHandle,
     Session,
 )
+from kinema.transport import action as action_module
+from kinema.transport.action import STATUS_UNKNOWN
+from kinema.transport.goal_status_cdr import CDR_LE_HEADER
 
 FIB = "example_interfaces/action/Fibonacci"
 
@@ -230,3 +234,78 @@ def test_finished_goals_are_kept_up_to_the_limit(connect: Callable[[], Session])
     server._publish_status()  # pruning happens on each status change
     kept = {goal.goal_id for goal in server.goals()}
     assert kept == {handle.goal_id for handle in handles[-3:]}
+
+
+def _hand_made_goal(client: Any, goal_id: bytes, order: int) -> Any:
+    return client._send_goal.call({"goal_id": {"uuid": list(goal_id)}, "goal": {"order": order}}, timeout=5)
+
+
+def _result_request(client: Any, goal_id: bytes) -> tuple[int, Any]:
+    """A get_result for ``goal_id`` on its way (its replies are read with ``client._get_result._collect``)."""
+    return client._get_result._send(CDR_LE_HEADER + goal_id, 10)
+
+
+def test_a_result_request_that_comes_before_its_goal_gets_the_result(connect: Callable[[], Session]) -> None:
+    # A Kinema client asks for the result together with the goal: the server holds the request that
+    # arrives first until the goal it names ends.
+    Node(connect(), "server").create_action_server(FIB, "/early", _fibonacci)
+    client = _client(connect, "/early")
+    goal_id = uuid.uuid4().bytes
+    early = _result_request(client, goal_id)
+    assert _hand_made_goal(client, goal_id, 4).accepted
+    response = client._get_result._collect(*early)
+    assert response.status == STATUS_SUCCEEDED
+    assert response.result.sequence.tolist() == [0, 1, 1, 2]
+
+
+def test_a_held_result_request_is_answered_unknown_when_its_goal_is_rejected(
+    connect: Callable[[], Session],
+) -> None:
+    Node(connect(), "server").create_action_server(
+        FIB, "/refusing", _fibonacci, goal_callback=lambda goal: False
+    )
+    client = _client(connect, "/refusing")
+    goal_id = uuid.uuid4().bytes
+    early = _result_request(client, goal_id)
+    assert not _hand_made_goal(client, goal_id, 4).accepted
+    assert client._get_result._collect(*early).status == STATUS_UNKNOWN
+
+
+def test_a_result_request_for_a_goal_that_never_comes_is_answered_unknown(
+    connect: Callable[[], Session], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.setattr(action_module, "EARLY_RESULT_HOLD_S", 0.2)
+    Node(connect(), "server").create_action_server(FIB, "/forgotten", _fibonacci)
+    client = _client(connect, "/forgotten")
+    for _ in range(2):  # the second request finds the expiring thread asleep and wakes it
+        response = client._get_result._collect(*_result_request(client, uuid.uuid4().bytes))
+        assert response.status == STATUS_UNKNOWN
+
+
+def test_a_server_that_does_not_hold_early_result_requests_still_delivers_results(
+    connect: Callable[[], Session], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # rclcpp answers a get_result for a goal it has not accepted yet with UNKNOWN at once: the client then
+    # asks again once its goal is accepted.
+    answered_unknown = threading.Event()
+
+    def answer_unknown_at_once(self: Any, request: Any, responder: Any) -> None:
+        handle = self._goals.get(bytes(request.goal_id.uuid))
+        if handle is None:
+            responder.reply({"status": STATUS_UNKNOWN})
+            answered_unknown.set()
+        else:
+            handle._add_waiter(responder)
+
+    monkeypatch.setattr(action_module.ActionServer, "_on_get_result", answer_unknown_at_once)
+    Node(connect(), "server").create_action_server(
+        # The goal is accepted only once the result request that came with it was turned away.
+        FIB,
+        "/rcl_like",
+        _fibonacci,
+        goal_callback=lambda goal: answered_unknown.wait(5),
+    )
+    handle = _client(connect, "/rcl_like").send_goal({"order": 5})
+    assert handle.accepted and answered_unknown.is_set()
+    outcome = handle.result(timeout=10)
+    assert outcome.succeeded and outcome.result.sequence.tolist() == [0, 1, 1, 2, 3]

@@ -7,7 +7,13 @@ import struct
 import pytest
 
 from kinema.interfaces import load_interfaces
-from kinema.transport.goal_status_cdr import decode_goal_statuses, encode_goal_statuses
+from kinema.transport.goal_status_cdr import (
+    decode_goal_statuses,
+    encode_goal_statuses,
+    payload_of_chunks,
+    status_chunk,
+    statuses_of,
+)
 from kinema.transport.messages import from_dict
 
 TYPE = "action_msgs/msg/GoalStatusArray"
@@ -53,3 +59,27 @@ def test_a_payload_cut_short_raises() -> None:
     assert statuses is not None
     with pytest.raises(struct.error):
         list(statuses)
+
+
+@pytest.mark.parametrize("count", range(len(GOALS) + 1))
+def test_payloads_joined_from_chunks_are_the_generic_serializers(count: int) -> None:
+    goals = GOALS[:count]
+    chunks = b"".join(status_chunk(*goal) for goal in goals)
+    assert payload_of_chunks(count, chunks) == _generic(goals)
+
+
+def test_the_statuses_of_given_goals_are_found_without_reading_the_others() -> None:
+    payload = encode_goal_statuses(GOALS)
+    wanted = [GOALS[0][0], GOALS[2][0], GOALS[3][0], b"\x42" * 16]
+    assert statuses_of(payload, wanted) == {GOALS[0][0]: 1, GOALS[2][0]: 6, GOALS[3][0]: 0}
+    assert statuses_of(b"\x00\x00\x00\x00" + payload[4:], wanted) is None
+
+
+def test_a_goal_id_that_appears_inside_another_element_is_not_mistaken_for_it() -> None:
+    first = bytes(range(1, 17))
+    alone = encode_goal_statuses([(first, 7, 9, 2)])
+    straddling = alone[14:30]  # the end of the first id, its stamp and status: no element starts there
+    assert statuses_of(alone, [straddling]) == {}
+    both = encode_goal_statuses([(first, 7, 9, 2), (straddling, 0, 0, 5)])
+    assert both.find(straddling) < both.rfind(straddling)  # it appears twice; only its own element counts
+    assert statuses_of(both, [straddling, first]) == {straddling: 5, first: 2}
