@@ -248,9 +248,10 @@ def check(
 
     With --run, a headless runtime of the config starts (simulation at --sim-speed, approvals granted as
     with `kinema run --auto-approve`) and runs each runnable objective in turn, after putting the cell
-    back as it started (simulation keyframe, startup controllers, planning scene). One still running
-    without failure after --time-limit simulated seconds (and at least 30 wall seconds), a loop such as
-    "3 Waypoints Pick and Place", is cancelled and counts as succeeding ("kept running").
+    back as it started: the folder's files as shipped, the simulation's keyframe, the startup
+    controllers, an empty planning scene. One still running without failure after --time-limit
+    simulated seconds (and at least 30 wall seconds), a loop such as "3 Waypoints Pick and Place", is
+    cancelled and counts as succeeding ("kept running").
 
     Prints a line per file that does not validate and per objective run, then the counts. Exits 0 only
     when every file validates and, with --run, every runnable objective succeeds.

@@ -11,11 +11,11 @@ What ``kinema objective check`` does, usable from a test or a program:
    against the config's behaviors (what ``kinema objective list`` reports), one verdict per file.
 3. :class:`CheckCell` starts the config's simulation and the agent headless at maximum sim speed, with
    approvals granted automatically (as ``kinema run --auto-approve``); :meth:`CheckCell.run` resets the
-   cell (the simulation to its start keyframe, the controllers to those active at startup, the
-   objects objectives added to the planning scene removed) and runs one objective until it ends or has
-   run ``time_limit`` seconds of simulated time (and at least :data:`MIN_WALL_S` wall seconds). An
-   objective still running then without having failed (a loop such as "3 Waypoints Pick and Place") is
-   cancelled and counts as running correctly: "kept running".
+   cell (the folder's files as shipped, the simulation to its start keyframe, the controllers to those
+   active at startup, the objects objectives added to the planning scene removed) and runs one
+   objective until it ends or has run ``time_limit`` seconds of simulated time (and at least
+   :data:`MIN_WALL_S` wall seconds). An objective still running then without having failed (a loop such
+   as "3 Waypoints Pick and Place") is cancelled and counts as running correctly: "kept running".
 
 Runnable objectives that do not validate count as not succeeding, with their validation problem.
 """
@@ -45,6 +45,8 @@ log = logging.getLogger(__name__)
 
 #: The package the checked folder is copied into (based on the config checked against).
 CHECK_PACKAGE = "kinema_objective_check"
+#: The package the folders its SubTrees reach are copied into (between the config and the check package).
+SUBTREES_PACKAGE = "kinema_objective_check_subtrees"
 #: Simulated seconds an objective may run before it is cancelled (and counts as "kept running").
 DEFAULT_TIME_LIMIT_S = 120.0
 #: Wall-clock seconds an objective runs at least before the time limit cancels it: at maximum sim speed
@@ -240,28 +242,30 @@ class CheckWorkspace:
         if workspace is not None:
             user_src = find_workspace_root(workspace) / "src"
             for entry in sorted(user_src.iterdir()):
-                if not entry.name.startswith(".") and entry.name != CHECK_PACKAGE:
+                if not entry.name.startswith(".") and entry.name not in (CHECK_PACKAGE, SUBTREES_PACKAGE):
                     (src / entry.name).symlink_to(entry.resolve(), target_is_directory=entry.is_dir())
+        copies: dict[Path, Path] = {}
+        parent = config
+        if subtree_folders:
+            # The folders SubTrees reach form a package between the config and the checked folder, so the
+            # checked folder's objectives win over theirs and the config's, and saves go to the folder.
+            helpers = src / SUBTREES_PACKAGE
+            libraries: dict[str, Any] = {}
+            for index, extra in enumerate(subtree_folders):
+                name = f"subtrees_{index}"
+                copies[helpers / name] = objective_folder(extra)
+                shutil.copytree(copies[helpers / name], helpers / name)
+                libraries[f"checked_{name}"] = {"package_name": SUBTREES_PACKAGE, "relative_path": name}
+            _write_package(helpers, SUBTREES_PACKAGE, config, libraries, f"Subtrees reached from {source}")
+            parent = SUBTREES_PACKAGE
         package = src / CHECK_PACKAGE
-        (package / "config").mkdir(parents=True)
         objectives = package / "objectives"
         shutil.copytree(source, objectives)
-        copies = {objectives: source}
-        libraries: dict[str, Any] = {}
-        for index, extra in enumerate(subtree_folders):
-            name = f"subtrees_{index}"
-            copies[package / name] = objective_folder(extra)
-            shutil.copytree(copies[package / name], package / name)
-            libraries[f"checked_{name}"] = {"package_name": CHECK_PACKAGE, "relative_path": name}
-        # Declared last, so the checked folder's objectives win over the subtree folders' of the same ID.
-        libraries["checked_objectives"] = {"package_name": CHECK_PACKAGE, "relative_path": "objectives"}
-        (package / "package.xml").write_text(
-            f'<?xml version="1.0"?>\n<package format="3"><name>{CHECK_PACKAGE}</name><version>0.0.0</version>'
-            f"<description>Objectives of {source}, checked against {config}</description>"
-            "<maintainer email='kinema@example.com'>kinema</maintainer><license>none</license></package>\n"
+        copies = {objectives: source, **copies}
+        libraries = {"checked_objectives": {"package_name": CHECK_PACKAGE, "relative_path": "objectives"}}
+        _write_package(
+            package, CHECK_PACKAGE, parent, libraries, f"Objectives of {source}, checked against {config}"
         )
-        settings = {"based_on_package": config, "objectives": {"objective_library_paths": libraries}}
-        (package / "config" / "config.yaml").write_text(yaml.safe_dump(settings, sort_keys=False))
         checked = cls(root=root, config=config, source=source, objectives=objectives, copies=copies)
         resolve_config(CHECK_PACKAGE, Workspace.discover(root))  # a bad config name fails here, once
         return checked
@@ -271,6 +275,26 @@ class CheckWorkspace:
         for copy, original in self.copies.items():
             text = text.replace(str(copy), str(original))
         return text
+
+    def restore(self) -> list[Path]:
+        """Put the copies back as the folders they copy are (files objectives saved are undone), so each
+        run starts from the library as shipped; returns the files changed."""
+        changed: list[Path] = []
+        for copy, original in self.copies.items():
+            for path in sorted(copy.rglob("*"), reverse=True):
+                source = original / path.relative_to(copy)
+                if path.is_file() and not source.exists():
+                    path.unlink()
+                    changed.append(path)
+            for source in original.rglob("*"):
+                if not source.is_file():
+                    continue
+                path = copy / source.relative_to(original)
+                if not path.is_file() or path.read_bytes() != source.read_bytes():
+                    path.parent.mkdir(parents=True, exist_ok=True)
+                    shutil.copy2(source, path)
+                    changed.append(path)
+        return changed
 
     def resolved(self) -> ResolvedConfig:
         """The check package resolved with its inheritance chain."""
@@ -316,6 +340,22 @@ class CheckWorkspace:
                 )
             )
         return verdicts
+
+
+def _write_package(
+    folder: Path, name: str, based_on: str, libraries: dict[str, Any], description: str
+) -> None:
+    """A config package ``name`` in ``folder``, based on ``based_on``, with these objective libraries."""
+    from xml.sax.saxutils import escape
+
+    (folder / "config").mkdir(parents=True, exist_ok=True)
+    (folder / "package.xml").write_text(
+        f'<?xml version="1.0"?>\n<package format="3"><name>{name}</name><version>0.0.0</version>'
+        f"<description>{escape(description)}</description>"
+        "<maintainer email='kinema@example.com'>kinema</maintainer><license>none</license></package>\n"
+    )
+    settings = {"based_on_package": based_on, "objectives": {"objective_library_paths": libraries}}
+    (folder / "config" / "config.yaml").write_text(yaml.safe_dump(settings, sort_keys=False))
 
 
 def _hidden(path: Path, folder: Path) -> bool:
@@ -453,14 +493,16 @@ class CheckCell:
         return {str(c.name) for c in states if str(c.state) == "active"}, {str(c.name) for c in states}
 
     def reset(self) -> None:
-        """Put the cell back as it started: simulation at its start keyframe, startup controllers active,
-        no collision objects added by objectives.
+        """Put the cell back as it started: the checked folder as shipped (files objectives saved are
+        undone), simulation at its start keyframe, startup controllers active, no collision objects added
+        by objectives.
 
         Raises:
             KinemaError: the simulator or the controller manager refused.
         """
         assert self.client is not None and self.node is not None
         self.client.cancel()  # a run a caller left going (run() waits for its own)
+        self.checked.restore()
         if self.sim is not None and self.keyframe:
             self.sim.set_state(keyframe=self.keyframe)
         if self._known_controllers:
