@@ -703,9 +703,9 @@ def _flask_and_burner_bodies() -> list[str]:
             f'    <body name="{name}" pos="{_f(x)} {_f(y)} {_f(TABLE_TOP)}">',
             f'      <geom name="{name}" type="cylinder" size="{_f(BURNER_RADIUS)} {_f(BURNER_HEIGHT / 2)}" '
             f'pos="0 0 {_f(BURNER_HEIGHT / 2)}" rgba="0.25 0.25 0.27 1"/>',
-            # The heating ring on top: drawn only.
+            # The hot plate on top: drawn only, steel grey (red in a camera image is the cube alone).
             f'      <geom name="{name}_ring" type="cylinder" size="{_f(BURNER_RADIUS - 0.01)} 0.001" '
-            f'pos="0 0 {_f(BURNER_HEIGHT + 0.001)}" rgba="0.8 0.25 0.1 1" contype="0" conaffinity="0"/>',
+            f'pos="0 0 {_f(BURNER_HEIGHT + 0.001)}" rgba="0.6 0.6 0.63 1" contype="0" conaffinity="0"/>',
             "    </body>",
         ]
     return lines
