@@ -31,3 +31,13 @@ TASK_PLANNING_TYPE = "kinema_msgs/msg/TaskPlanningStatus"
 # calls it, and fails over to its headless rule when nobody serves it.
 APPROVAL_SERVICE = "/kinema/user_approval"
 APPROVAL_TYPE = "kinema_msgs/srv/RequestApproval"
+
+# Served by the terminal UI too: a behavior asking the operator for a value (RetrievePoseParameter: a pose;
+# GetPointsFromUser: points on an image; DoTeleoperateAction: a teleoperation session) calls it, and follows
+# the same headless rule as the approvals when nobody serves it.
+USER_INPUT_SERVICE = "/kinema/user_input"
+USER_INPUT_TYPE = "kinema_msgs/srv/RequestUserInput"
+# While a teleoperation session is open the UI publishes the mode the user picks (std_msgs/UInt8, the values
+# of moveit_studio_sdk_msgs/TeleoperationMode); DoTeleoperateAction writes it to its current_teleop_mode.
+TELEOPERATION_MODE_TOPIC = "/kinema/teleoperation_mode"
+TELEOPERATION_MODE_TYPE = "std_msgs/msg/UInt8"

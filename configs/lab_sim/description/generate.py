@@ -61,6 +61,23 @@ TRAY_FLOOR = 0.004  # thickness of the tray bottom: thin, so placing and re-pick
 TRAY_INNER_HALF = (0.14, 0.17)
 TRAY_WALL = 0.005  # half thickness
 
+# MoveIt Pro's "Move Flasks to Burners" picks two flasks by their necks at its waypoints "Flask 1 - Pick" and
+# "Flask 2 - Pick" and lowers each onto a burner below "Flask 1 - Place" / "Flask 2 - Place" until it touches.
+# Each flask stands where its pick waypoint holds grasp_link (MoveIt Pro's world poses: the waypoints'
+# joint values through MoveIt Pro's lab_sim URDF), each burner under its place waypoint. (MoveIt Pro's
+# own desk.xml has moved its flasks since those waypoints were saved; the waypoints are what the objective
+# uses.) The flasks are 250 ml Erlenmeyers made of three cylinders (base, shoulder, neck; MoveIt Pro's
+# collision neck is 14 mm in radius), free to be picked; the burners are fixed hot plates.
+FLASK_PARTS = (  # name, radius, z from, z to (m above the flask's base), mass (kg)
+    ("base", 0.035, 0.0, 0.035, 0.08),
+    ("shoulder", 0.025, 0.035, 0.055, 0.025),
+    ("neck", 0.014, 0.04, 0.12, 0.015),
+)
+FLASKS = (("flask_1", (-0.357, 0.40)), ("flask_2", (-0.502, 0.474)))
+BURNER_RADIUS = 0.045
+BURNER_HEIGHT = 0.06
+BURNERS = (("burner_1", (0.555, 0.56)), ("burner_2", (0.66, 0.56)))
+
 # Cameras, named as MoveIt Pro's lab_sim names them (topics /<name>/color, depth, camera_info, points).
 # Each sits in a link of its own whose frame follows the ROS optical convention (z forward, x right,
 # y down), so that link is the frame_id of the camera's images and clouds and the frame tree knows it.
@@ -665,8 +682,38 @@ def render_apriltags() -> str:
 def _keyframe_qpos(arm: tuple[float, ...], knuckle: float) -> str:
     finger = knuckle * FINGER_PER_KNUCKLE
     cube = (*CUBE_START, 1.0, 0.0, 0.0, 0.0)
+    flasks = [v for _name, (x, y) in FLASKS for v in (x, y, TABLE_TOP, 1.0, 0.0, 0.0, 0.0)]
     tagged = [v for o in TAGGED_OBJECTS for v in (*o.start, *_yaw_quat(o.yaw))]
-    return _vec([*arm, knuckle, finger, finger, *cube, *tagged])
+    return _vec([*arm, knuckle, finger, finger, *cube, *flasks, *tagged])
+
+
+def _flask_and_burner_bodies() -> list[str]:
+    """The flasks (free, origin at the centre of the base) and the burners (fixed) on the table."""
+    lines = []
+    for name, (x, y) in FLASKS:
+        lines += [
+            f'    <body name="{name}" pos="{_f(x)} {_f(y)} {_f(TABLE_TOP)}">',
+            f'      <freejoint name="{name}_joint"/>',
+        ]
+        for part, radius, low, high, mass in FLASK_PARTS:
+            size = f"{_f(radius)} {_f((high - low) / 2)}"
+            lines.append(
+                f'      <geom name="{name}_{part}" type="cylinder" size="{size}" '
+                f'pos="0 0 {_f((low + high) / 2)}" mass="{_f(mass)}" friction="1 0.01 0.0001" condim="4" '
+                'rgba="0.75 0.88 0.92 0.6"/>'
+            )
+        lines.append("    </body>")
+    for name, (x, y) in BURNERS:
+        lines += [
+            f'    <body name="{name}" pos="{_f(x)} {_f(y)} {_f(TABLE_TOP)}">',
+            f'      <geom name="{name}" type="cylinder" size="{_f(BURNER_RADIUS)} {_f(BURNER_HEIGHT / 2)}" '
+            f'pos="0 0 {_f(BURNER_HEIGHT / 2)}" rgba="0.25 0.25 0.27 1"/>',
+            # The hot plate on top: drawn only, steel grey (red in a camera image is the cube alone).
+            f'      <geom name="{name}_ring" type="cylinder" size="{_f(BURNER_RADIUS - 0.01)} 0.001" '
+            f'pos="0 0 {_f(BURNER_HEIGHT + 0.001)}" rgba="0.6 0.6 0.63 1" contype="0" conaffinity="0"/>',
+            "    </body>",
+        ]
+    return lines
 
 
 def render_scene() -> str:
@@ -728,6 +775,7 @@ def render_scene() -> str:
         f'      <geom name="cube" type="box" size="{_vec([CUBE_HALF] * 3)}" mass="0.08" '
         'friction="1 0.01 0.0001" condim="4" rgba="0.85 0.2 0.2 1"/>',
         "    </body>",
+        *_flask_and_burner_bodies(),
         # The bottles and microscope the point-cloud objectives look at (perception_objects.py).
         '    <include file="lab_sim_perception_objects.xml"/>',
         "  </worldbody>",

@@ -82,12 +82,12 @@ class Placed:
 # (-1.32, 0.48) on the table plane and "Register CAD Part" guesses the microscope at (-1.0, 0.5); its
 # "Look at Objects" waypoints look around (-0.37, 0.67) and "Register CAD Part Subtree" guesses a bottle
 # at (-0.15, 0.5). The cube (-0.30, 0.62), where the pick-and-place tests set it down, its way to the
-# tray and the AprilTag block (0.0, 0.52) stay clear.
+# tray, the AprilTag block (0.0, 0.52) and the flasks (generate.py's FLASKS) stay clear.
 PLACED = (
     Placed("microscope", MICROSCOPE, (-1.05, 0.5), 90.0),
     Placed("bottle_1", BOTTLE, (-0.1, 0.4)),
     Placed("bottle_2", BOTTLE, (-0.48, 0.74)),
-    Placed("bottle_3", BOTTLE, (-0.5, 0.52)),
+    Placed("bottle_3", BOTTLE, (-0.58, 0.6)),
 )
 
 

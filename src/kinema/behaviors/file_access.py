@@ -8,7 +8,10 @@ Whatever role asked, and whichever port carries the path:
   router's key, the client configs) is read or written, wherever that folder is;
 - **the file rule**: once ``..`` and symlinks are resolved, the file is inside the workspace, one of the
   config packages the workspace sees, or Kinema's data folder (``$XDG_DATA_HOME/kinema``); without a
-  config (``kinema tree run``, tests) the working directory stands for the workspace.
+  config (``kinema tree run``, tests) the working directory stands for the workspace. A file *written*
+  may also lie directly in the system's temporary folder (``/tmp/inspection_image.png``, where MoveIt
+  Pro's objectives save scratch images): not in a folder below it, and never read from there, so an
+  objective can neither reach another program's temporary files nor read back what others left.
 
 :func:`check_file_access` is what :mod:`kinema_core_behaviors.files.locations` calls for every file
 behavior; a third-party behavior that opens a file named by a port should call it too.
@@ -26,7 +29,7 @@ from kinema.errors import KinemaError
 SECURITY_RULE = "security rule: objectives never read or write the security folder"
 FILE_RULE = (
     "file rule: objectives read and write only inside the workspace, the config packages and Kinema's "
-    "data folder"
+    "data folder, and also write files directly in the system's temporary folder"
 )
 
 
@@ -60,19 +63,28 @@ def allowed_folders(config: Any) -> list[Path]:
     return _unique(folders)
 
 
-def check_file_access(path: Path, config: Any) -> Path:
+def check_file_access(path: Path, config: Any, *, writing: bool = False) -> Path:
     """``path`` resolved (``..`` and symlinks followed) when the rules allow it.
+
+    Args:
+        path: the file.
+        config: the running config (a ResolvedConfig, or None offline).
+        writing: the file is to be written (a file directly in the system's temporary folder is allowed).
 
     Raises:
         FileAccessError: inside a security folder, or outside every allowed folder; the message names
             the rule and the folders allowed.
     """
+    import tempfile
+
     resolved = Path(path).expanduser().resolve()
     for folder in security_folders():
         if resolved.is_relative_to(folder.resolve()):
             raise FileAccessError(f"{path} is refused by the {SECURITY_RULE} ({folder})")
     allowed = allowed_folders(config)
     if any(resolved.is_relative_to(folder.resolve()) for folder in allowed):
+        return resolved
+    if writing and resolved.parent == Path(tempfile.gettempdir()).resolve():
         return resolved
     where = f" (it resolves to {resolved})" if resolved != Path(path) else ""
     raise FileAccessError(

@@ -192,6 +192,121 @@ def _behavior_factory(library: ObjectiveLibrary, verbose: bool) -> object:
     return factory
 
 
+@objective.command("check")
+@click.argument("folder", type=click.Path(exists=True, file_okay=False, path_type=Path))
+@selection_options
+@click.option(
+    "--run",
+    "run_them",
+    is_flag=True,
+    help="Also run each runnable objective on the config's simulation, headless, one at a time.",
+)
+@click.option(
+    "--subtrees",
+    "subtree_folders",
+    multiple=True,
+    type=click.Path(exists=True, file_okay=False, path_type=Path),
+    metavar="DIR",
+    help="A folder of objectives the checked ones reach through SubTrees (not counted); repeatable.",
+)
+@click.option(
+    "--only", multiple=True, metavar="NAME", help="Run only this runnable objective (repeatable; with --run)."
+)
+@click.option(
+    "--time-limit",
+    type=click.FloatRange(min=1.0),
+    default=120.0,
+    show_default=True,
+    metavar="SECONDS",
+    help="Simulated seconds an objective may run before it is cancelled (and counts as kept running).",
+)
+@click.option(
+    "--sim-speed",
+    default="max",
+    show_default=True,
+    metavar="FACTOR|max",
+    help="Simulated seconds per wall second while the objectives run.",
+)
+@click.option("--json", "as_json", is_flag=True, help="Print the report as JSON (counts, files, runs).")
+def check(
+    folder: Path,
+    workspace: Path | None,
+    config: str | None,
+    run_them: bool,
+    subtree_folders: tuple[Path, ...],
+    only: tuple[str, ...],
+    time_limit: float,
+    sim_speed: str,
+    as_json: bool,
+) -> None:
+    """Count how many objective files of FOLDER validate and, with --run, how many runnable ones succeed.
+
+    FOLDER holds objective XML files (or is a package with an objectives/ folder, as MoveIt Pro's
+    config packages are). They are checked against a config package (-c; default the selected one,
+    else lab_sim): its behaviors, core subtrees, waypoints, robot and simulation. A copy of FOLDER is
+    checked, so files the objectives save never land in it.
+
+    With --run, a headless runtime of the config starts (simulation at --sim-speed, approvals granted as
+    with `kinema run --auto-approve`) and runs each runnable objective in turn, after putting the cell
+    back as it started: the folder's files as shipped, the simulation's keyframe, the startup
+    controllers, an empty planning scene. One still running without failure after --time-limit
+    simulated seconds (and at least 30 wall seconds), a loop such as "3 Waypoints Pick and Place", is
+    cancelled and counts as succeeding ("kept running").
+
+    Prints a line per file that does not validate and per objective run, then the counts. Exits 0 only
+    when every file validates and, with --run, every runnable objective succeeds.
+    """
+    import json
+
+    from kinema.cli.options import resolve_selection
+    from kinema.drivers.mujoco.sim_speed import parse_sim_speed
+    from kinema.runtime.objective_check import FileVerdict, RunVerdict, check_folder
+
+    if only and not run_them:
+        raise click.UsageError("--only names objectives to run: give --run too")
+    parse_sim_speed(sim_speed)
+    found, name = resolve_selection(workspace, config, need_config=False)
+    name = name or "lab_sim"
+    root = getattr(found, "root", None)
+
+    def on_file(verdict: FileVerdict) -> None:
+        if verdict.problem is not None and not as_json:
+            click.echo(f"cannot load  {verdict.path}: {verdict.problem.splitlines()[0]}")
+
+    def on_run(verdict: RunVerdict) -> None:
+        if as_json:
+            return
+        seconds = f"{verdict.sim_seconds:.0f} s sim, {verdict.wall_seconds:.0f} s wall"
+        if verdict.outcome == "cannot load":
+            return  # said above, with its file
+        if verdict.ok:
+            click.echo(f"{verdict.outcome:<12} {verdict.objective} ({seconds})")
+        else:
+            message = verdict.message.splitlines()[0] if verdict.message else ""
+            click.secho(f"{'failed':<12} {verdict.objective} ({seconds}): {message}", fg="red")
+
+    report = check_folder(
+        folder,
+        name,
+        workspace=Path(root) if root is not None else None,
+        subtree_folders=subtree_folders,
+        run=run_them,
+        time_limit=time_limit,
+        only=only,
+        sim_speed=sim_speed,
+        on_file=on_file,
+        on_run=on_run,
+        echo=None if as_json else (lambda text: click.echo(text, err=True)),
+    )
+    counts = report.counts()
+    if as_json:
+        click.echo(json.dumps(report.to_json(), indent=2))
+    else:
+        click.echo(report.summary())
+    if counts["valid"] < counts["files"] or any(not run.ok for run in report.runs or ()):
+        raise click.exceptions.Exit(1)
+
+
 # -- running objectives on a live runtime (run, cancel, do, status) ------------------------------------
 
 connect_option = click.option(

@@ -26,6 +26,7 @@ if TYPE_CHECKING:
     from rosbags.typesys.stores.ros2_jazzy import (
         builtin_interfaces__msg__Duration,
         builtin_interfaces__msg__Time,
+        geometry_msgs__msg__Point,
         geometry_msgs__msg__Pose,
         geometry_msgs__msg__PoseStamped,
         geometry_msgs__msg__PoseWithCovariance,
@@ -652,6 +653,34 @@ if TYPE_CHECKING:
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/RequestApproval_Response"
 
     @dataclass
+    class kinema_msgs__srv__RequestUserInput_Request:
+        """kinema_msgs/srv/RequestUserInput_Request."""
+
+        behavior: str
+        node_path: str
+        prompt: str
+        kind: str
+        initial_pose: geometry_msgs__msg__PoseStamped
+        image_topic: str
+        point_prompts: list[str]
+        point_names: list[str]
+        initial_teleop_mode: int
+        KIND_POSE: ClassVar[str] = "pose"
+        KIND_POINTS: ClassVar[str] = "points"
+        KIND_TELEOPERATE: ClassVar[str] = "teleoperate"
+        __msgtype__: ClassVar[str] = "kinema_msgs/srv/RequestUserInput_Request"
+
+    @dataclass
+    class kinema_msgs__srv__RequestUserInput_Response:
+        """kinema_msgs/srv/RequestUserInput_Response."""
+
+        accepted: bool
+        message: str
+        pose: geometry_msgs__msg__PoseStamped
+        points: list[geometry_msgs__msg__Point]
+        __msgtype__: ClassVar[str] = "kinema_msgs/srv/RequestUserInput_Response"
+
+    @dataclass
     class kinema_msgs__srv__SetMujocoState_Request:
         """kinema_msgs/srv/SetMujocoState_Request."""
 
@@ -1249,6 +1278,15 @@ if TYPE_CHECKING:
         __msgtype__: ClassVar[str] = "std_srvs/srv/Trigger_Response"
 
     @dataclass
+    class vision_msgs__msg__BoundingBox2D:
+        """vision_msgs/msg/BoundingBox2D."""
+
+        center: vision_msgs__msg__Pose2D
+        size_x: float
+        size_y: float
+        __msgtype__: ClassVar[str] = "vision_msgs/msg/BoundingBox2D"
+
+    @dataclass
     class vision_msgs__msg__BoundingBox3D:
         """vision_msgs/msg/BoundingBox3D."""
 
@@ -1289,6 +1327,22 @@ if TYPE_CHECKING:
         hypothesis: vision_msgs__msg__ObjectHypothesis
         pose: geometry_msgs__msg__PoseWithCovariance
         __msgtype__: ClassVar[str] = "vision_msgs/msg/ObjectHypothesisWithPose"
+
+    @dataclass
+    class vision_msgs__msg__Point2D:
+        """vision_msgs/msg/Point2D."""
+
+        x: float
+        y: float
+        __msgtype__: ClassVar[str] = "vision_msgs/msg/Point2D"
+
+    @dataclass
+    class vision_msgs__msg__Pose2D:
+        """vision_msgs/msg/Pose2D."""
+
+        position: vision_msgs__msg__Point2D
+        theta: float
+        __msgtype__: ClassVar[str] = "vision_msgs/msg/Pose2D"
 
     class CancelGoal(
         ServiceDefinition[
@@ -1397,6 +1451,18 @@ if TYPE_CHECKING:
         type_name: ClassVar[str] = "kinema_msgs/srv/RequestApproval"
         Request: TypeAlias = kinema_msgs__srv__RequestApproval_Request
         Response: TypeAlias = kinema_msgs__srv__RequestApproval_Response
+
+    class RequestUserInput(
+        ServiceDefinition[
+            kinema_msgs__srv__RequestUserInput_Request,
+            kinema_msgs__srv__RequestUserInput_Response,
+        ]
+    ):
+        """kinema_msgs/srv/RequestUserInput."""
+
+        type_name: ClassVar[str] = "kinema_msgs/srv/RequestUserInput"
+        Request: TypeAlias = kinema_msgs__srv__RequestUserInput_Request
+        Response: TypeAlias = kinema_msgs__srv__RequestUserInput_Response
 
     class SetMujocoState(
         ServiceDefinition[
@@ -1663,6 +1729,8 @@ _MESSAGES = frozenset(
         "kinema_msgs__srv__ListObjectives_Response",
         "kinema_msgs__srv__RequestApproval_Request",
         "kinema_msgs__srv__RequestApproval_Response",
+        "kinema_msgs__srv__RequestUserInput_Request",
+        "kinema_msgs__srv__RequestUserInput_Response",
         "kinema_msgs__srv__SetMujocoState_Request",
         "kinema_msgs__srv__SetMujocoState_Response",
         "moveit_msgs__msg__AllowedCollisionEntry",
@@ -1721,11 +1789,14 @@ _MESSAGES = frozenset(
         "octomap_msgs__msg__OctomapWithPose",
         "std_srvs__srv__Trigger_Request",
         "std_srvs__srv__Trigger_Response",
+        "vision_msgs__msg__BoundingBox2D",
         "vision_msgs__msg__BoundingBox3D",
         "vision_msgs__msg__Detection3D",
         "vision_msgs__msg__Detection3DArray",
         "vision_msgs__msg__ObjectHypothesis",
         "vision_msgs__msg__ObjectHypothesisWithPose",
+        "vision_msgs__msg__Point2D",
+        "vision_msgs__msg__Pose2D",
     }
 )
 
@@ -1739,6 +1810,7 @@ _SERVICES: dict[str, str] = {
     "ListKeyframes": "kinema_msgs/srv/ListKeyframes",
     "ListObjectives": "kinema_msgs/srv/ListObjectives",
     "RequestApproval": "kinema_msgs/srv/RequestApproval",
+    "RequestUserInput": "kinema_msgs/srv/RequestUserInput",
     "SetMujocoState": "kinema_msgs/srv/SetMujocoState",
     "GetPlanningScene": "moveit_msgs/srv/GetPlanningScene",
     "EditWaypoints": "moveit_studio_agent_msgs/srv/EditWaypoints",

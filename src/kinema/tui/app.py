@@ -42,6 +42,7 @@ from kinema.tui.connection import (
     RuntimeConnection,
     RuntimeEvent,
     TaskPlanning,
+    UserInputRequested,
 )
 from kinema.tui.dialogs.confirm import ConfirmDialog, MotionQuestionDialog
 from kinema.tui.messages import (
@@ -203,6 +204,8 @@ class KinemaApp(App[None]):
     ) -> None:
         super().__init__()
         self.camera_topic = camera
+        # True while a teleoperation session (DoTeleoperateAction) is open in a dialog.
+        self.teleoperating = False
         self.connection = connection
         self.owns_runtime = owns_runtime
         self.initial_mode = initial_mode
@@ -376,6 +379,8 @@ class KinemaApp(App[None]):
                 self._views_call(lambda view: view.runtime_objectives_changed())
             elif isinstance(event, ApprovalRequested):
                 self.ask_approval(event)
+            elif isinstance(event, UserInputRequested):
+                self.ask_user_input(event)
             elif isinstance(event, TaskPlanning):
                 self.task_planning = event
                 self._views_call(lambda view: view.runtime_task_planning(event))  # noqa: B023 - called now
@@ -399,6 +404,49 @@ class KinemaApp(App[None]):
             self.push_screen(ApprovalDialog(question, request.steps, request.duration), answered)
             return
         self.push_screen(MotionQuestionDialog(question), answered)
+
+    def ask_user_input(self, request: UserInputRequested) -> None:
+        """Ask the user for what a behavior needs (a pose, points on an image, a teleoperation session);
+        the answer goes back to it. A pose the user declines during teleoperation also ends the "move to a
+        pose" mode, so the objective does not ask again at once."""
+        from kinema.tui.connection import TELEOP_NONE, UserInputAnswer
+        from kinema.tui.dialogs.user_input import PointsDialog, PoseDialog, TeleoperateDialog
+
+        def answered(answer: UserInputAnswer | None) -> None:
+            answer = answer or UserInputAnswer(False, "cancelled in the TUI")
+            request.answer(answer)
+            if request.kind == "teleoperate":
+                self.teleoperating = False
+            elif request.kind == "pose" and not answer.accepted and self.teleoperating:
+                self.pick_teleoperation_mode(TELEOP_NONE)
+
+        if request.kind == "pose":
+            self.push_screen(PoseDialog(request), answered)
+        elif request.kind == "points":
+            from kinema.tui.screens.camera import image_widget_class
+
+            try:
+                widget_class = image_widget_class()
+            except ValueError as error:  # a bad KINEMA_TUI_IMAGE: typed points still work
+                self.notify(str(error), severity="warning")
+                widget_class = None
+            self.push_screen(PointsDialog(request, self.connection.watch_images, widget_class), answered)
+        elif request.kind == "teleoperate":
+            self.teleoperating = True
+            self.push_screen(TeleoperateDialog(request, self.pick_teleoperation_mode), answered)
+        else:
+            request.answer(UserInputAnswer(False, f"this TUI cannot answer a {request.kind!r} question"))
+
+    def pick_teleoperation_mode(self, mode: int) -> None:
+        """Tell the running teleoperation session the mode the user picked (off the UI thread)."""
+
+        def send() -> None:
+            try:
+                self.connection.set_teleoperation_mode(mode)
+            except Exception as error:  # shown, never raised: the runtime may be gone
+                self.call_from_thread(self.notify, str(error), title="Teleoperation", severity="error")
+
+        self.run_worker(send, thread=True, group="teleoperation-mode")
 
     def _connection_message(self, text: str, title: str, level: LogLevel) -> None:
         """A lost or found connection: a toast and a log line, at most one of each kind per period."""

@@ -295,6 +295,65 @@ class ApprovalRequested:
 
 
 @dataclass(frozen=True)
+class UserInputAnswer:
+    """The user's answer to a :class:`UserInputRequested`.
+
+    Attributes:
+        accepted: False when the user cancelled.
+        message: what the user said, if anything.
+        frame_id: the pose's frame (a pose answer).
+        position: the pose's position, m (a pose answer).
+        orientation: the pose's orientation quaternion, x y z w (a pose answer).
+        points: one pixel (column, row) per point prompt (a points answer).
+    """
+
+    accepted: bool
+    message: str = ""
+    frame_id: str = "world"
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    orientation: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
+    points: tuple[tuple[float, float], ...] = ()
+
+
+@dataclass(frozen=True)
+class UserInputRequested:
+    """A behavior asks the user for a value and waits (``kinema_msgs/srv/RequestUserInput``).
+
+    ``kind`` is ``pose`` (RetrievePoseParameter: a target pose; ``frame_id``, ``position`` and
+    ``orientation`` are where the tool is now), ``points`` (GetPointsFromUser: one pixel per entry of
+    ``point_prompts`` on ``image_topic``) or ``teleoperate`` (DoTeleoperateAction: a session the user ends;
+    the modes they pick go to :meth:`RuntimeConnection.set_teleoperation_mode`).
+
+    Attributes:
+        kind: what is asked.
+        prompt: the question.
+        behavior: the behavior ID that asks.
+        node_path: its node in the running tree.
+        answer: call once with a :class:`UserInputAnswer`; any thread.
+    """
+
+    kind: str
+    prompt: str
+    behavior: str
+    node_path: str
+    answer: Callable[[UserInputAnswer], None] = field(compare=False, repr=False)
+    frame_id: str = "world"
+    position: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    orientation: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
+    image_topic: str = ""
+    point_prompts: tuple[str, ...] = ()
+    point_names: tuple[str, ...] = ()
+    initial_teleop_mode: int = 0
+
+
+# moveit_studio_sdk_msgs/TeleoperationMode values the TUI offers.
+TELEOP_TARGET_POSE = 4
+TELEOP_OPEN_GRIPPER = 6
+TELEOP_CLOSE_GRIPPER = 7
+TELEOP_NONE = 0
+
+
+@dataclass(frozen=True)
 class CameraImage:
     """One picture of an image topic, ready to show.
 
@@ -326,6 +385,7 @@ RuntimeEvent = (
     | ReloadNotice
     | ObjectivesChanged
     | ApprovalRequested
+    | UserInputRequested
     | TaskPlanning
 )
 EventListener = Callable[[RuntimeEvent], None]
@@ -397,3 +457,6 @@ class RuntimeConnection(Protocol):
 
         Returns the function that stops watching. A simulated camera renders only while watched.
         """
+
+    def set_teleoperation_mode(self, mode: int) -> None:
+        """Tell the running teleoperation session (DoTeleoperateAction) the mode the user picked."""

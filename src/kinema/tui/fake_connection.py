@@ -163,6 +163,9 @@ class FakeConnection:
 
         return stop
 
+    def set_teleoperation_mode(self, mode: int) -> None:
+        self._record("set_teleoperation_mode", mode)
+
     # -- driving it -----------------------------------------------------------------------------
 
     def _require_connected(self) -> None:

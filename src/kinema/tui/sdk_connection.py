@@ -43,9 +43,20 @@ from kinema.tui.connection import (
     SolutionStep,
     TaskPlanning,
     TaskStage,
+    UserInputAnswer,
+    UserInputRequested,
     WaypointSummary,
 )
-from kinema.ui_topics import APPROVAL_SERVICE, APPROVAL_TYPE, TASK_PLANNING_TOPIC, TASK_PLANNING_TYPE
+from kinema.ui_topics import (
+    APPROVAL_SERVICE,
+    APPROVAL_TYPE,
+    TASK_PLANNING_TOPIC,
+    TASK_PLANNING_TYPE,
+    TELEOPERATION_MODE_TOPIC,
+    TELEOPERATION_MODE_TYPE,
+    USER_INPUT_SERVICE,
+    USER_INPUT_TYPE,
+)
 
 if TYPE_CHECKING:
     from kinema.config import ResolvedConfig, Workspace
@@ -130,6 +141,8 @@ class SdkConnection:
         self._clock_window: deque[tuple[float, float]] = deque(maxlen=50)
         self._last_clock_event = 0.0
         self._selection_cache: tuple[Workspace, str | None] | None = None
+        self._teleoperation_publisher: Any = None
+        self._teleoperation_node: Any = None
 
     # -- identity -------------------------------------------------------------------------------
 
@@ -239,6 +252,10 @@ class SdkConnection:
             node.create_service(
                 APPROVAL_TYPE, APPROVAL_SERVICE, self._on_approval, deferred=True, max_concurrent=4
             )
+            # ... and the one the user-input behaviors ask (ui/user_input.py of the core behaviors).
+            node.create_service(
+                USER_INPUT_TYPE, USER_INPUT_SERVICE, self._on_user_input, deferred=True, max_concurrent=4
+            )
         except Exception:
             self._drop_client()
             raise
@@ -283,6 +300,61 @@ class SdkConnection:
                 float(request.duration),
             )
         )
+
+    def _on_user_input(self, request: Any, responder: Any) -> None:
+        def answer(reply: UserInputAnswer) -> None:
+            if responder.done:
+                return
+            x, y, z = reply.position
+            qx, qy, qz, qw = reply.orientation
+            responder.reply(
+                {
+                    "accepted": reply.accepted,
+                    "message": reply.message,
+                    "pose": {
+                        "header": {"frame_id": reply.frame_id},
+                        "pose": {
+                            "position": {"x": x, "y": y, "z": z},
+                            "orientation": {"x": qx, "y": qy, "z": qz, "w": qw},
+                        },
+                    },
+                    "points": [{"x": column, "y": row, "z": 0.0} for column, row in reply.points],
+                }
+            )
+
+        pose = request.initial_pose
+        p, q = pose.pose.position, pose.pose.orientation
+        self._emit(
+            UserInputRequested(
+                str(request.kind),
+                str(request.prompt),
+                str(request.behavior),
+                str(request.node_path),
+                answer,
+                str(pose.header.frame_id) or "world",
+                (float(p.x), float(p.y), float(p.z)),
+                (float(q.x), float(q.y), float(q.z), float(q.w)),
+                str(request.image_topic),
+                tuple(str(text) for text in request.point_prompts),
+                tuple(str(text) for text in request.point_names),
+                int(request.initial_teleop_mode),
+            )
+        )
+
+    def set_teleoperation_mode(self, mode: int) -> None:
+        from kinema.transport import from_dict
+
+        # The session that asked is on this connection's node, heartbeat or not (a behavior asked it).
+        client = self._client
+        if client is None:
+            raise TransportError(f"not connected to a runtime at {self.endpoint} (is `kinema run` running?)")
+        with self._lock:
+            publisher = self._teleoperation_publisher
+            if publisher is None or self._teleoperation_node is not client.node:
+                publisher = client.node.create_publisher(TELEOPERATION_MODE_TYPE, TELEOPERATION_MODE_TOPIC)
+                self._teleoperation_publisher = publisher
+                self._teleoperation_node = client.node
+        publisher.publish(from_dict(TELEOPERATION_MODE_TYPE, {"data": int(mode)}))
 
     def _on_task_planning(self, message: Any) -> None:
         stages = tuple(

@@ -129,15 +129,21 @@ def test_scene_is_ready_for_a_driver(cell):
 
 
 def test_robot_holds_the_default_keyframe(cell):
-    """With ctrl from the keyframe the servos hold the arm still and the cube rests on the table."""
+    """With ctrl from the keyframe the servos hold the arm still and the free objects rest on the table."""
+    import mujoco
+
+    m, d = cell.m, cell.d
+    free = [
+        m.body(m.jnt_bodyid[j]).name for j in range(m.njnt) if m.jnt_type[j] == mujoco.mjtJoint.mjJNT_FREE
+    ]
+    assert {"cube", "tag_block", "flask_1", "flask_2"} <= set(free), free
     q0 = cell.arm_q()
-    cube0, block0 = cell.body_pos("cube"), cell.body_pos("tag_block")
+    start = {name: cell.body_pos(name) for name in free}
     cell.step(2.0)
     assert np.abs(cell.arm_q() - q0).max() < 1e-3
-    assert np.linalg.norm(cell.body_pos("cube") - cube0) < 1e-3
-    assert np.linalg.norm(cell.body_pos("tag_block") - block0) < 1e-3
-    m, d = cell.m, cell.d
-    objects = {m.body(name).id for name in ("cube", "tag_block")}
+    for name, position in start.items():
+        assert np.linalg.norm(cell.body_pos(name) - position) < 1e-3, name
+    objects = {m.body(name).id for name in free}
     touching = {
         m.body(m.geom_bodyid[g]).name
         for c in d.contact[: d.ncon]

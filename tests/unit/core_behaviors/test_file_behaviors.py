@@ -288,6 +288,32 @@ def test_writes_outside_the_allowed_folders_are_refused(
     assert list(outside.iterdir()) == []
 
 
+def test_a_file_directly_in_the_temporary_folder_may_be_written_not_read(
+    behavior: Any, offline: BehaviorContext
+) -> None:
+    """MoveIt Pro's objectives save scratch images as /tmp/NAME: allowed; a folder below it, or reading
+    anything there back, is not."""
+    import tempfile
+    import uuid
+
+    pose = tick_behavior(behavior("CreatePoseStamped"), {}, context=offline).outputs["pose_stamped"]
+    name = Path(tempfile.gettempdir()) / f"kinema-test-{uuid.uuid4().hex}"
+    try:
+        written = tick_behavior(
+            behavior("SavePoseStampedToYaml"), {"message": pose, "yaml_filename": str(name)}, context=offline
+        )
+        assert written.status == NodeStatus.SUCCESS, written.toasts
+        assert name.with_suffix(".yaml").is_file()
+        read = tick_behavior(
+            behavior("ReadTextFileAsString"),
+            {"text_filename": str(name.with_suffix(".yaml"))},
+            context=offline,
+        )
+        assert read.status == NodeStatus.FAILURE and "refused by the file rule" in read.toasts[-1]
+    finally:
+        name.with_suffix(".yaml").unlink(missing_ok=True)
+
+
 def test_the_security_folder_is_never_read_or_written_even_inside_the_workspace(
     behavior: Any, offline: BehaviorContext, folder: Path, monkeypatch: pytest.MonkeyPatch
 ) -> None:

@@ -12,8 +12,9 @@
 - Any other absolute path (``~/file``, a folder of the workspace) is used as written.
 
 Whatever form, the file must then pass :func:`kinema.behaviors.file_access.check_file_access`: inside the
-workspace, the config packages or Kinema's data folder, never the security folder (``..`` and symlinks
-resolved first). A refusal names the rule.
+workspace, the config packages or Kinema's data folder (a file written: also directly in the system's
+temporary folder), never the security folder (``..`` and symlinks resolved first). A refusal names the
+rule.
 Saves need a library folder of the config's own package; without a config (offline runs, ``kinema tree
 run``) relative paths resolve against the working directory.
 """
@@ -133,10 +134,10 @@ def _inside(folder: Path, relative: str, node: Any, port: str) -> Path:
     return path
 
 
-def _allowed(node: Any, port: str, text: str, path: Path) -> Path:
+def _allowed(node: Any, port: str, text: str, path: Path, *, writing: bool = False) -> Path:
     """``path`` resolved, or a PortValueError naming the rule that refuses it."""
     try:
-        return check_file_access(path, node.context.config)
+        return check_file_access(path, node.context.config, writing=writing)
     except FileAccessError as error:
         raise port_error(node, port, f"= {text!r}: {error}") from None
 
@@ -186,7 +187,7 @@ def file_to_write(node: Any, port: str, text: str, suffix: str = "") -> Path:
     text = with_suffix(text, suffix) if suffix else text
     explicit = _explicit(node, port, text)
     path = explicit if explicit is not None else _inside(save_folder(node, port), _relative(text), node, port)
-    path = _allowed(node, port, text, path)
+    path = _allowed(node, port, text, path, writing=True)
     if not path.parent.is_dir():
         raise port_error(node, port, f"= {text!r}: the folder {path.parent} does not exist", "")
     return path

@@ -5,7 +5,10 @@ is called, every joint state of ``planning_group_name`` that moved at least ``jo
 m, largest joint change) from the last kept one becomes a trajectory point, timed from the joint state
 stamps (sim time in simulation). ``stop_recording_service`` ends the recording: the trajectory goes to
 ``joint_trajectory_message`` and the behavior succeeds. Without a start call within ``timeout_sec`` it
-fails; halting it stops recording and closes the services.
+fails; halting it stops recording and closes the services. The timeout passes only once it has passed in
+sim time and in wall time (:class:`~kinema.behaviors.wait_deadline.WaitDeadline`): at maximum sim speed
+the five seconds MoveIt Pro's "Record Square Trajectory" gives the other branch to plan and make its move
+pass in sim time during the planning alone.
 """
 
 from __future__ import annotations
@@ -19,6 +22,7 @@ if TYPE_CHECKING:
 
 from kinema.behaviors import NodeStatus, PortInfo, StatefulBehavior, input_port
 from kinema.behaviors.cell_ports import cell_input_port
+from kinema.behaviors.wait_deadline import WaitDeadline
 
 from ..messages.conversions import duration, seconds
 from ..messages.ports import PortValueError, message_output, port_error, read_input
@@ -97,7 +101,12 @@ class RecordJointTrajectory(StatefulBehavior):
             input_port(
                 "stop_recording_service", str, "/stop_recording_joint_trajectory", "Trigger that stops."
             ),
-            input_port("timeout_sec", float, -1.0, "Seconds to wait for the start call (negative: forever)."),
+            input_port(
+                "timeout_sec",
+                float,
+                -1.0,
+                "Seconds to wait for the start call, in sim time and in wall time (negative: forever).",
+            ),
             input_port(
                 "joint_space_step",
                 float,
@@ -117,7 +126,7 @@ class RecordJointTrajectory(StatefulBehavior):
         super().__init__(name, config)
         self._recording: _Recording | None = None
         self._entities: list[Any] = []
-        self._deadline = 0.0
+        self._deadline: WaitDeadline | None = None
 
     def _joints(self, group: str) -> list[str] | None:
         model = self.context.robot_model
@@ -157,7 +166,7 @@ class RecordJointTrajectory(StatefulBehavior):
             self.logger.publish_failure(error.message)
             return NodeStatus.FAILURE
         self._recording = recording
-        self._deadline = self.context.clock.now() + timeout if timeout >= 0 else float("inf")
+        self._deadline = WaitDeadline(self.context.clock, timeout)
         return NodeStatus.RUNNING
 
     def on_running(self) -> NodeStatus:
@@ -166,7 +175,7 @@ class RecordJointTrajectory(StatefulBehavior):
         with recording.lock:
             started, stopped = recording.started, recording.stopped
         if not started:
-            if self.context.clock.now() > self._deadline:
+            if self._deadline is not None and self._deadline.passed():
                 self._close()
                 self.logger.publish_failure("RecordJointTrajectory: the start service was not called in time")
                 return NodeStatus.FAILURE

@@ -9,6 +9,7 @@ Ports hold ``sensor_msgs`` messages as MoveIt Pro's do; the work is done on nump
 from __future__ import annotations
 
 from .apriltags import DetectAprilTags, GetDetectionPose
+from .bounding_boxes import CreateBoundingBoxFromOffset
 from .box_filters import CropPointsInBox, RemovePointsInBox
 from .calibrate_camera_pose import CalibrateCameraPose
 from .camera_topics import GetCameraInfo, GetImage, GetPointCloud
@@ -41,6 +42,7 @@ BEHAVIORS = (
     UpdatePlanningSceneService,
     GetMasks2DFromExemplar,
     GetMasks2DFromPointQuery,
+    CreateBoundingBoxFromOffset,
     GetMasks3DFromMasks2D,
     GetPointCloudFromMask3D,
     FindMaskedObjects,

@@ -36,15 +36,49 @@ def _stage_summary(reports: Any) -> str:
 START_TOLERANCE = 0.01  # rad or m: how far the robot may be from a replayed solution's start
 
 
-def _away_from(model: Any, q: Any, solution: Any) -> str:
-    """The joints a replayed solution moves that are not where it starts ('' when all are)."""
+def _away_joints(model: Any, q: Any, solution: Any) -> list[str]:
+    """The joints a replayed solution moves that are not where it starts."""
     moved = {n for sub in solution.sub_trajectories for n in sub.trajectory.joint_names}
-    off = [
-        f"{n} at {q[i]:.3f}, not {solution.start[i]:.3f}"
+    return [
+        n
         for i, n in enumerate(model.joint_names)
         if n in moved and abs(q[i] - solution.start[i]) > START_TOLERANCE
     ]
+
+
+def _away_from(model: Any, q: Any, solution: Any) -> str:
+    """The joints a replayed solution moves that are not where it starts ('' when all are)."""
+    index = {n: i for i, n in enumerate(model.joint_names)}
+    off = [
+        f"{n} at {q[index[n]]:.3f}, not {solution.start[index[n]]:.3f}"
+        for n in _away_joints(model, q, solution)
+    ]
     return ", ".join(off[:3]) + (f" and {len(off) - 3} more" if len(off) > 3 else "")
+
+
+def _group_moving(behavior: Any, model: Any, q: Any, solution: Any) -> str:
+    """The planning group that moves every joint not yet where ``solution`` starts: the config's own when
+    it does, else the smallest such group.
+
+    Raises:
+        KinemaError: no group holds them all.
+    """
+    moved = set(_away_joints(model, q, solution))
+    cell = behavior.context.cell
+    preferred = cell.planning_group if cell is not None else None
+    fitting = sorted(
+        (len(group.joint_names), name)
+        for name, group in model.groups.items()
+        if moved <= set(group.joint_names)
+    )
+    if preferred and any(name == preferred for _size, name in fitting):
+        return str(preferred)
+    if not fitting:
+        raise KinemaError(
+            f"the robot is not where the replayed solution starts, and no planning group moves every joint "
+            f"that is elsewhere ({', '.join(sorted(moved))}) to get there"
+        )
+    return fitting[0][1]
 
 
 class PlanMTCTask(AsyncBehavior):
@@ -84,7 +118,7 @@ class PlanMTCTask(AsyncBehavior):
 
     def _plan(self, mtc: Any, progress: TaskProgress) -> bool:
         from kinema.motion.task import Task, TaskPlanningError, plan_task
-        from kinema.motion.task_stages import CurrentState, FromSolution
+        from kinema.motion.task_stages import Connect, CurrentState, FromSolution, MotionSettings
 
         try:
             if int(self.get_input("max_solutions")) < 1:
@@ -102,12 +136,18 @@ class PlanMTCTask(AsyncBehavior):
             if stages and isinstance(stages[0], FromSolution):
                 away = _away_from(model, q, stages[0].solution)
                 if away:
-                    return self._fail(
-                        f"the task starts with the solution of {stages[0].name!r}, but the robot is not "
-                        f"where that solution starts ({away}); executing it would jump. Start the task with "
-                        "SetupMTCCurrentState and SetupMTCConnectWithProRRT to move there first",
-                        progress,
+                    # Replaying a stored solution from elsewhere (MoveIt Pro's "Stitch Multiple Point
+                    # Clouds Together" replays its first plan after visiting every viewpoint): move to its
+                    # start first, collision-free, rather than jump there.
+                    self.logger.publish_info(
+                        f"PlanMTCTask: the robot is not where the solution of {stages[0].name!r} starts "
+                        f"({away}); a collision-free move there comes first"
                     )
+                    connect = Connect(
+                        MotionSettings(group=_group_moving(self, model, q, stages[0].solution)),
+                        name="move to the solution's start",
+                    )
+                    stages = [CurrentState(q), connect, *stages]
             checker = collision_checker(self.context, "PlanMTCTask", DEFAULT_PADDING)
             solution = plan_task(
                 Task(mtc.task_id, stages),

@@ -388,7 +388,12 @@ class SetupMTCBatchPoseIK(_SetupStage):
 
 
 class SetupMTCFromSolution(_SetupStage):
-    """Adds an earlier ``solution``'s motions; the task goes on from where it ended."""
+    """Adds an earlier ``solution``'s motions; the task goes on from where it ended.
+
+    A task that starts with it replays the solution; when the robot is no longer where the solution
+    starts, PlanMTCTask plans a collision-free move there first (Kinema's rule; MoveIt Pro's is not
+    public), instead of a jump.
+    """
 
     @classmethod
     def stage_ports(cls) -> list[PortInfo]:

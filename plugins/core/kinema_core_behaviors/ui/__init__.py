@@ -1,5 +1,5 @@
 """UI: behaviors that show things to the user and ask them (toasts and TUI notices, ``kinema view`` markers,
-point cloud snapshots, 2D detection images, approvals and breakpoints)."""
+point cloud snapshots, 2D detection images, approvals and breakpoints, values only the user can give)."""
 
 from __future__ import annotations
 
@@ -9,6 +9,7 @@ from .log_message import LogMessage
 from .markers import PublishMarkers, VisualizeMesh
 from .notices import SwitchUIPrimaryView
 from .point_clouds import ClearSnapshot, PublishPointCloud, SendPointCloudToUI
+from .user_input import DoTeleoperateAction, GetPointsFromUser, RetrievePoseParameter
 from .visualize_path import VisualizePath
 from .visualize_pose import VisualizePose
 
@@ -27,4 +28,7 @@ BEHAVIORS = (
     IsUserAvailable,
     WaitForMTCSolutionApproval,
     BreakpointSubscriber,
+    RetrievePoseParameter,
+    GetPointsFromUser,
+    DoTeleoperateAction,
 )
