@@ -258,3 +258,70 @@ def test_a_listing_older_than_a_second_is_not_trusted(
         run = tick_behavior(behavior("SwitchController"), activate, context=context)
         assert run.status == NodeStatus.SUCCESS, run.toasts
     assert manager.listings == 2
+
+
+class StatefulManager(ControllerManager):
+    """A fake controller manager whose switches change what it lists."""
+
+    def __init__(self, node: Any) -> None:
+        import copy
+
+        self.states = copy.deepcopy(CONTROLLERS)
+        super().__init__(node)
+
+    def state(self, name: str) -> dict[str, Any]:
+        return next(c for c in self.states if c["name"] == name.strip("/"))
+
+    def _list(self, _request: Any) -> dict[str, Any]:
+        self.listings += 1
+        return {"controller": self.states}
+
+    def _switch(self, request: Any) -> dict[str, Any]:
+        for name in request.deactivate_controllers:
+            self.state(name)["state"] = "inactive"
+        for name in request.activate_controllers:
+            self.state(name)["state"] = "active"
+        return super()._switch(request)
+
+
+def test_a_controller_switched_elsewhere_since_its_listing_is_activated_and_the_trajectory_sent_again(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    """The trusted listing is stale (a reset of the simulation went back to the startup controllers): the
+    controller turns the goal down as inactive, and ExecuteTrajectory asks the controller manager again,
+    activates it and sends the trajectory once more, instead of failing the objective."""
+    from kinema.transport import from_dict
+
+    manager = StatefulManager(context.node)
+    jtc = manager.state("joint_trajectory_controller")
+    goals: list[str] = []
+
+    def execute(handle: Any) -> Any:
+        if jtc["state"] != "active":
+            goals.append("turned down")
+            handle.abort({"error_code": -1, "error_string": "joint_trajectory_controller is inactive"})
+            return None
+        goals.append("executed")
+        return {"error_code": 0, "error_string": ""}
+
+    context.node.create_action_server(
+        "control_msgs/action/FollowJointTrajectory",
+        "/joint_trajectory_controller/follow_joint_trajectory",
+        execute,
+    )
+    run = tick_behavior(
+        behavior("SwitchController"), {"activate_controllers": "joint_trajectory_controller"}, context=context
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    jtc["state"] = "inactive"  # switched by someone else within the second the listing is trusted
+    trajectory = from_dict(
+        "trajectory_msgs/msg/JointTrajectory",
+        {
+            "joint_names": ["elbow_joint"],
+            "points": [{"positions": [0.1], "time_from_start": {"sec": 1, "nanosec": 0}}],
+        },
+    )
+    run = tick_behavior(behavior("ExecuteTrajectory"), {"joint_trajectory_msg": trajectory}, context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    assert goals == ["turned down", "executed"]
+    assert [list(r.activate_controllers) for r in manager.requests] == [["joint_trajectory_controller"]]

@@ -162,6 +162,16 @@ class ExecuteTrajectory(AsyncBehavior):
         return goal
 
     async def do_work(self) -> bool:
+        outcome = await self._execute(trust_states=True)
+        if outcome is None:  # the controller was not active after all: ask the controller manager
+            controller_states(self.context).forget(LIST_CONTROLLERS_SERVICE)
+            outcome = await self._execute(trust_states=False)
+        return bool(outcome)
+
+    async def _execute(self, *, trust_states: bool) -> bool | None:
+        """Send the trajectory and wait for its end. None: the controller, taken as active from a listing
+        under a second old (controller_states), turned the goal down as inactive (switched by someone
+        else since, e.g. a reset of the simulation); the caller lists the controllers again."""
         import asyncio
 
         node = self.context.require_node(self.registration_id)
@@ -184,7 +194,7 @@ class ExecuteTrajectory(AsyncBehavior):
             return self._fail(str(error))
         publish_planned_trajectory(self, goal["trajectory"])
         joint_state_monitor(self.context, "ExecuteTrajectory")  # listening before the arm moves
-        refused = await self._activate(node, name)
+        refused, trusted = await self._activate(node, name, trust_states)
         if refused:
             return self._fail(refused)
         client = self.context.action_client(node, action_type, name)
@@ -197,6 +207,8 @@ class ExecuteTrajectory(AsyncBehavior):
         except TransportError as error:
             return self._fail(f"cannot send the trajectory to {name}: {error}")
         if not handle.accepted:
+            if trusted:
+                return None
             return self._fail(f"the controller {name} rejected the trajectory")
         self._handle = handle
         graph = node.session.graph_cache()
@@ -238,6 +250,8 @@ class ExecuteTrajectory(AsyncBehavior):
                 await self._until_reported(goal)
             return True
         detail = str(result.error_string) or f"error code {int(result.error_code)}"
+        if trusted and "inactive" in detail:
+            return None
         return self._fail(f"the controller {name} ended the trajectory {outcome.status_name}: {detail}")
 
     async def _until_reported(self, goal: dict[str, Any]) -> None:
@@ -280,31 +294,38 @@ class ExecuteTrajectory(AsyncBehavior):
                 return
             await asyncio.sleep(_POLL)
 
-    async def _activate(self, node: Any, action: str) -> str:
+    async def _activate(self, node: Any, action: str, trust_states: bool = True) -> tuple[str, bool]:
         """Activate the controller behind ``action`` when the controller manager has it inactive.
 
-        Returns why that failed, or '' (also when there is no controller manager to ask).
+        Returns why that failed, or '' (also when there is no controller manager to ask), and whether the
+        controller was taken as active from a recent listing without asking (``trust_states``).
         """
         import asyncio
 
         parts = action.strip("/").split("/")
         if len(parts) != 2 or parts[1] != "follow_joint_trajectory":
-            return ""
+            return "", False
         controller = parts[0]
         known = controller_states(self.context)
-        if known.active(LIST_CONTROLLERS_SERVICE, [controller]):
-            return ""  # listed active within the last second (SwitchController just before, usually)
+        if trust_states and known.active(LIST_CONTROLLERS_SERVICE, [controller]):
+            return "", True  # listed active within the last second (SwitchController just before, usually)
         lister = self.context.service_client(node, LIST_TYPE, LIST_CONTROLLERS_SERVICE)
         if not lister.service_is_ready():
-            return ""
+            if trust_states:
+                return "", False  # no controller manager on the graph (another robot's driver)
+            # Asked again after the controller turned a goal down as inactive: a controller manager was
+            # listed a moment ago, so wait for this client to see it on the graph.
+            waiting = RUNNER.run_function(lambda: lister.wait_for_service(LIST_TIMEOUT))
+            if not await asyncio.wrap_future(waiting):
+                return "", False
         try:
             listing = await asyncio.wrap_future(lister.call_async({}, LIST_TIMEOUT))
         except TransportError:
-            return ""
+            return "", False
         controllers = {str(c.name): c for c in listing.controller}
         known.remember(LIST_CONTROLLERS_SERVICE, controllers)
         if controller not in controllers or controllers[controller].state == "active":
-            return ""
+            return "", False
         deactivate = conflicting_active(controllers, [controller])
         switcher = self.context.service_client(node, SWITCH_TYPE, SWITCH_CONTROLLERS_SERVICE)
         known.forget(LIST_CONTROLLERS_SERVICE)
@@ -312,12 +333,12 @@ class ExecuteTrajectory(AsyncBehavior):
         try:
             response = await asyncio.wrap_future(switcher.call_async(request, 10.0))
         except TransportError as error:
-            return f"{controller} is inactive and the controller manager cannot be reached: {error}"
+            return f"{controller} is inactive and the controller manager cannot be reached: {error}", False
         if not response.ok:
-            return f"{controller} is inactive and activating it was refused: {response.message}"
+            return f"{controller} is inactive and activating it was refused: {response.message}", False
         replaced = f" instead of {', '.join(deactivate)}" if deactivate else ""
         self.logger.publish_info(f"ExecuteTrajectory: activated {controller}{replaced} to execute")
-        return ""
+        return "", False
 
     def do_halt(self) -> None:
         handle, self._handle = self._handle, None
