@@ -3,10 +3,11 @@ validated, every runnable objective run on a fresh cell (keyframe, startup contr
 scene), and where an objective moves something, the simulator asked whether it did (the object moved,
 the joints reached, the file written).
 
-Issue 30's measure: 27 of the 50 runnable objectives succeeded before it. Of the others, the nine that
-need a segmentation model (SAM2/SAM3; Kinema runs none) cannot succeed; MPC and admittance come with
-their own branches. ``SUCCEED`` lists what runs here; the test fails naming any that stopped succeeding
-or did not do its job.
+Issue 30's measure: 27 of the 50 runnable objectives succeeded before it, and at least 41 must after it.
+The nine others need a segmentation model (SAM2/SAM3; Kinema runs none) or an image the compat copy holds
+as a Git LFS pointer, and fail saying so. ``SUCCEED`` lists what runs here (41); the test fails naming any
+that stopped succeeding or did not do its job. The MPC and admittance objectives' own tests
+(test_lab_sim_mpc.py, test_lab_sim_admittance.py) measure what they do.
 """
 
 from __future__ import annotations
@@ -46,6 +47,11 @@ SUCCEED = {
     "Load MuJoCo Robot State",
     "Load and Execute Joint Trajectory",
     "Look at Table",
+    "MPC Pose Tracking",
+    "MPC Pose Tracking Dynamic Point Cloud Avoidance with Sphere Down Sample",
+    "MPC Pose Tracking Static Point Cloud Avoidance with Sphere Down Sample",
+    "MPC Pose Tracking With Point Cloud Avoidance",
+    "MPC Pose Tracking With Static Sphere Point Cloud Avoidance",
     "Move Flasks to Burners",
     "Octomap Example",
     "Open Gripper",
@@ -57,12 +63,14 @@ SUCCEED = {
     "Plan and Save Trajectory",
     "Playback Square Trajectory",
     "Push Button",
+    "Push Button With a Trajectory",
     "Record Square Trajectory",
     "Record and Replay Scanning Motion",
     "Register CAD Part",
     "Reset MuJoCo Robot",
     "Save Robot Joint State",
     "Scan Scene - Multiple Point Clouds",
+    "Stationary Admittance",
     "Stitch Multiple Point Clouds Together",
     "Take Scene Camera Snapshot",
     "Take Wrist Camera Snapshot",
@@ -363,6 +371,6 @@ def test_moveit_pros_lab_sim_library_runs_unchanged(tmp_path: Path) -> None:
     print(f"\n{len(ok)} of {len(runnable)} runnable objectives succeed; the others:\n{report}")
     assert not (SUCCEED - ok), f"these stopped succeeding: {sorted(SUCCEED - ok)}\n{report}"
     assert not jobs_undone, f"these succeeded without doing their job: {jobs_undone}"
-    assert len(ok) >= len(SUCCEED)
+    assert len(ok) >= len(SUCCEED) >= 41
     failing_with_a_model = {name for name in NEEDS_A_MODEL if name in outcomes and name not in ok}
     assert failing_with_a_model == NEEDS_A_MODEL - ok
