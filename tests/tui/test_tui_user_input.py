@@ -154,7 +154,9 @@ def test_an_attached_tui_is_the_user_the_input_behaviors_ask(monkeypatch: Any, k
         assert client.wait_for_service(20.0), "the TUI connection did not serve /kinema/user_input"
         host = BehaviorHost(["kinema::CoreBehaviorsLoader"])
         host.load().raise_for_errors()
-        context = BehaviorContext(node)
+        from kinema.config import resolve_config
+
+        context = BehaviorContext(node, config=resolve_config("lab_sim"))  # names the camera to click on
         if kind == "teleoperate":
             run = tick_behavior(
                 host.registry["DoTeleoperateAction"].cls, {"initial_teleop_mode": 4}, context=context

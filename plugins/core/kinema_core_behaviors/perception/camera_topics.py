@@ -71,7 +71,7 @@ class _GetCameraMessage(AsyncBehavior):
         topic = str(read_input(self, "topic_name")).strip()
         if not topic.startswith("/"):
             raise port_error(
-                self, "topic_name", f"= {topic!r}", "give an absolute topic, e.g. /wrist_camera/points"
+                self, "topic_name", f"= {topic!r}", "give an absolute topic, e.g. /<camera>/points"
             )
         message_timeout = float(read_input(self, "message_timeout_sec"))
         publisher_timeout = float(read_input(self, "publisher_timeout_sec"))

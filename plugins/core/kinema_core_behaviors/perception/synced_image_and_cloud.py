@@ -60,7 +60,7 @@ class GetSyncedImageAndPointCloud(AsyncBehavior):
             topic = str(read_input(self, port)).strip()
             if not topic.startswith("/"):
                 raise port_error(
-                    self, port, f"= {topic!r}", "give an absolute topic, e.g. /wrist_camera/points"
+                    self, port, f"= {topic!r}", "give an absolute topic, e.g. /<camera>/points"
                 )
             topics[port] = topic
         timeout = float(read_input(self, "message_timeout_sec"))

@@ -21,6 +21,7 @@ import time
 from typing import Any
 
 from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, StatefulBehavior, input_port, output_port
+from kinema.behaviors.cell_ports import cell_input_port
 from kinema.config.cell import JOINT_TRAJECTORY_CONTROLLER
 from kinema.errors import KinemaError, TransportError
 from kinema.ui_topics import (
@@ -162,7 +163,7 @@ class GetPointsFromUser(AsyncBehavior):
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
         return [
-            input_port("view_name", str, "/wrist_camera/color", "The image topic the user clicks on."),
+            cell_input_port("view_name", str, "camera_color_topic", "The image topic the user clicks on."),
             input_port("point_prompts", None, "", "What to click, one prompt per point (a;b;c)."),
             input_port("point_names", None, "", "A name per point (a;b;c), each point's frame_id."),
             output_port(
