@@ -9,10 +9,7 @@ validates cached bytecode by whole-second mtime and size, so two saves within on
 (``1`` → ``2``) would otherwise load stale code.
 
 Packages that never reload (Kinema's bundled plugins) keep their compiled code in the user's cache folder
-(``<user cache>/kinema/bytecode``), checked against the source's nanosecond mtime and size. It works in
-every install mode: an editable checkout that cannot be written, or ``PYTHONDONTWRITEBYTECODE`` (which
-keeps ``__pycache__`` folders out of source trees, and so also kept them out of the bundled plugins, which
-then compiled at every start).
+(:mod:`kinema.bytecode`), checked against the source's nanosecond mtime and size, in every install mode.
 """
 
 from __future__ import annotations
@@ -22,8 +19,6 @@ import importlib.abc
 import importlib.machinery
 import importlib.util
 import itertools
-import marshal
-import os
 import re
 import sys
 import threading
@@ -32,8 +27,8 @@ from collections.abc import Sequence
 from importlib.machinery import ModuleSpec
 from pathlib import Path
 from types import ModuleType
-from typing import Any
 
+from kinema.bytecode import UserCacheSourceLoader
 from kinema.errors import PluginError, SourceLocation
 
 _PREFIX = "_kinema_plugin_"
@@ -56,52 +51,10 @@ class _FreshSourceLoader(importlib.abc.SourceLoader):
         return Path(path).read_bytes()
 
 
-class _UserCacheSourceLoader(importlib.machinery.SourceFileLoader):
-    """Loads Python source through a bytecode cache in the user's cache folder (see the module docstring)."""
-
-    def get_code(self, fullname: str) -> Any:
-        source_path = self.get_filename(fullname)
-        stat = os.stat(source_path)
-        # the interpreter's magic number, then the source's identity: any change makes a miss
-        header = importlib.util.MAGIC_NUMBER + f"{stat.st_mtime_ns}:{stat.st_size}\n".encode()
-        cached = bytecode_cache_path(source_path)
-        try:
-            data = cached.read_bytes()
-        except OSError:
-            data = b""
-        if data.startswith(header):
-            try:
-                return marshal.loads(data[len(header) :])
-            except (EOFError, ValueError, TypeError):
-                pass  # a damaged file: compile again and replace it
-        code = self.source_to_code(self.get_data(source_path), source_path)
-        try:
-            cached.parent.mkdir(parents=True, exist_ok=True)
-            partial = cached.with_name(f"{cached.name}.{os.getpid()}.tmp")
-            partial.write_bytes(header + marshal.dumps(code))
-            os.replace(partial, cached)
-        except OSError:
-            pass  # no writable cache folder: the module still loads, compiled as before
-        return code
-
-
-def bytecode_cache_path(source_path: str) -> Path:
-    """Where the compiled code of the never-reloaded plugin source ``source_path`` is kept.
-
-    The source's absolute path is mirrored under the cache folder, as ``sys.pycache_prefix`` does.
-    """
-    import platformdirs
-
-    source = Path(os.path.abspath(source_path))
-    tag = sys.implementation.cache_tag or "python"
-    mirrored = source.relative_to(source.anchor).with_name(f"{source.stem}.{tag}.pyc")
-    return platformdirs.user_cache_path("kinema") / "bytecode" / mirrored
-
-
 def _loader(fullname: str, path: str) -> importlib.abc.Loader:
     """The fresh loader, or the user-cache one for packages that never reload (bundled plugins)."""
     if fullname.split(".")[0] in _BYTECODE_OK:
-        return _UserCacheSourceLoader(fullname, path)
+        return UserCacheSourceLoader(fullname, path)
     return _FreshSourceLoader(fullname, path)
 
 
