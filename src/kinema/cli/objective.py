@@ -99,17 +99,30 @@ def list_(workspace: Path | None, config: str | None, as_json: bool, no_check: b
 
 
 def _load_problems(library: ObjectiveLibrary) -> dict[str, str]:
-    """Objective ID -> why it cannot load, against the behaviors the config loads."""
+    """Objective ID -> why it cannot load, against the behaviors the config loads.
+
+    The answer of the last check is reused while nothing it depends on changed (see
+    :mod:`kinema.runtime.library_check`).
+    """
     from kinema.plugins import BehaviorHost
-    from kinema.runtime.library_check import library_problems
+    from kinema.runtime.library_check import LibraryCheckCache, check_fingerprint, library_problems
 
     if library.resolved is None:
         return {}
     host = BehaviorHost.for_config(library.resolved)
-    report = host.load()
+    specs, report = host.select()
+    cache = LibraryCheckCache(library.resolved.name, host.workspace)
+    fingerprint = check_fingerprint(library, specs)
+    problems = None if report.errors else cache.get(fingerprint)
+    if problems is None:
+        loaded = host.load_specs(specs)
+        report.errors.extend(loaded.errors)
+        problems = library_problems(library, host.registry.create_factory())
+        if not report.errors:
+            cache.put(fingerprint, problems)
     for error in report.errors:
         click.secho(f"warning: {error}", err=True, fg="yellow")
-    return library_problems(library, host.registry.create_factory())
+    return problems
 
 
 @objective.command()

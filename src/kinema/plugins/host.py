@@ -99,12 +99,19 @@ class BehaviorHost:
 
     def load(self) -> LoadReport:
         """Discover and load every active plugin; a failing plugin is recorded and the others still load."""
+        specs, found = self.select()
+        report = self.load_specs(specs)
+        report.warnings[:0] = found.warnings
+        report.errors[:0] = found.errors
+        return report
+
+    def select(self) -> tuple[tuple[PluginSpec, ...], LoadReport]:
+        """The plugins the config's loader names activate, without importing them (what :meth:`load`
+        loads), and the discovery's warnings and errors."""
         catalog, discovery_errors = available_plugins(self.workspace)
         selection = select_loaders(self.loader_names, catalog)
-        report = self.load_specs(selection.plugins)
-        report.warnings[:0] = selection.warnings
-        report.errors[:0] = [*discovery_errors, *selection.errors]
-        return report
+        found = LoadReport(list(selection.warnings), [*discovery_errors, *selection.errors])
+        return selection.plugins, found
 
     def load_specs(self, specs: Iterable[PluginSpec]) -> LoadReport:
         """Load the given plugins (already discovered and selected) into the registry."""

@@ -4,10 +4,23 @@ An objective loads when its file and the files of every SubTree it reaches (its 
 through the library's objective IDs) validate against the registered behaviors. The check reports the
 first problem of each objective that does not, as ``file:line: message``, so ``kinema objective list``
 can say in one line why an objective will not run.
+
+Loading every behavior of a config to check its library takes most of a ``kinema objective list``, so the
+answer is kept (:class:`LibraryCheckCache`) under a fingerprint of everything it depends on: the library's
+objective files (their content), the source files of the plugins the config activates and of Kinema itself (path, nanosecond
+mtime and size of each), and the interpreter. Any change to one of them checks again. Only a check in
+which every plugin loaded is kept, so a plugin that failed for a passing reason (its import ran out of time
+on a busy machine) is tried again next time.
 """
 
 from __future__ import annotations
 
+import hashlib
+import importlib.util
+import json
+import os
+import sys
+from collections.abc import Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -16,6 +29,10 @@ from lxml import etree
 if TYPE_CHECKING:
     from kinema.bt import BehaviorTreeFactory
     from kinema.config import ObjectiveLibrary
+    from kinema.plugins.discovery import PluginSpec
+
+# Bump when what the check reports, or how it is stored, changes in a way a source stamp would not show.
+_CACHE_FORMAT = 1
 
 
 def _subtree_ids(path: Path) -> set[str]:
@@ -66,3 +83,79 @@ def library_problems(library: ObjectiveLibrary, factory: BehaviorTreeFactory) ->
         if problem is not None:
             problems[info.id] = problem
     return problems
+
+
+def _stamp_tree(digest: hashlib._Hash, folder: Path, suffixes: tuple[str, ...]) -> None:
+    """Feed path, nanosecond mtime and size of every file under ``folder`` ending in ``suffixes``."""
+    if folder.is_file():
+        stat = folder.stat()
+        digest.update(f"{folder}:{stat.st_mtime_ns}:{stat.st_size}\n".encode())
+        return
+    for current, folders, files in os.walk(folder):
+        folders[:] = sorted(name for name in folders if name != "__pycache__" and not name.startswith("."))
+        for name in sorted(files):
+            if name.endswith(suffixes):
+                stat = os.stat(os.path.join(current, name))
+                digest.update(f"{current}/{name}:{stat.st_mtime_ns}:{stat.st_size}\n".encode())
+
+
+def _plugin_sources(spec: PluginSpec) -> list[Path]:
+    """The folder (or file) holding a plugin's code: its package folder, or its entry point's top module."""
+    if spec.root is not None:
+        return [spec.root]
+    found = importlib.util.find_spec(spec.module.split(".")[0])  # a top-level name: nothing is imported
+    if found is None:
+        return []
+    if found.submodule_search_locations:
+        return [Path(location) for location in found.submodule_search_locations]
+    return [Path(found.origin)] if found.origin else []
+
+
+def check_fingerprint(library: ObjectiveLibrary, specs: Iterable[PluginSpec]) -> str:
+    """A digest of everything :func:`library_problems` depends on, for :class:`LibraryCheckCache`."""
+    import kinema
+
+    digest = hashlib.sha256(f"{_CACHE_FORMAT}\n{sys.version}\n{kinema.__version__}\n".encode())
+    _stamp_tree(digest, Path(kinema.__file__).parent, (".py",))
+    for spec in sorted(specs, key=lambda one: one.name):
+        digest.update(f"{spec.name}|{spec.module}|{spec.package}|{spec.root}|{spec.attribute}\n".encode())
+        for folder in _plugin_sources(spec):
+            _stamp_tree(digest, folder, (".py", ".xml", ".yaml", ".toml"))
+    # objective files by content: they are small, and an edit that keeps the size within one tick of the
+    # file system's clock keeps the mtime too
+    for info in library.sorted():
+        digest.update(f"{info.id}|{info.file}|".encode() + hashlib.sha256(info.file.read_bytes()).digest())
+    return digest.hexdigest()
+
+
+class LibraryCheckCache:
+    """The last check of one config's library, in the user's cache folder, under its fingerprint."""
+
+    def __init__(self, config: str, workspace: Path | None) -> None:
+        import platformdirs
+
+        identity = hashlib.sha256(f"{config}|{workspace}".encode()).hexdigest()[:16]
+        self.path = platformdirs.user_cache_path("kinema") / "objective-check" / f"{config}-{identity}.json"
+
+    def get(self, fingerprint: str) -> dict[str, str] | None:
+        """The problems stored under ``fingerprint``, else None (none, another fingerprint, damaged)."""
+        try:
+            stored = json.loads(self.path.read_text())
+        except (OSError, ValueError):
+            return None
+        if not isinstance(stored, dict) or stored.get("fingerprint") != fingerprint:
+            return None
+        problems = stored.get("problems")
+        if not isinstance(problems, dict) or not all(isinstance(v, str) for v in problems.values()):
+            return None
+        return {str(key): value for key, value in problems.items()}
+
+    def put(self, fingerprint: str, problems: dict[str, str]) -> None:
+        """Store ``problems`` under ``fingerprint`` (atomically; an unwritable cache is skipped)."""
+        try:
+            self.path.parent.mkdir(parents=True, exist_ok=True)
+            partial = self.path.with_name(f"{self.path.name}.{os.getpid()}.tmp")
+            partial.write_text(json.dumps({"fingerprint": fingerprint, "problems": problems}))
+            os.replace(partial, self.path)
+        except OSError:
+            pass

@@ -24,6 +24,7 @@ BENCHMARKS = Path(__file__).resolve().parents[3] / "benchmarks"
 RATIO_LINES = {
     "bt_tick.py": "ratio = BT.CPP rate / Kinema rate",
     "cancel_latency.py": "vs peer",
+    "cli_start.py": "ratio to python -c pass",
     "config_resolve.py": "ratio kinema / peer",
     "hot_reload.py": "restart / hot reload",
     "large_values.py": "cancel vs peer",
