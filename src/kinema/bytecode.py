@@ -28,20 +28,22 @@ from pathlib import Path
 from types import ModuleType
 from typing import Any
 
-_cache_root: Path | None = None
+
+def _cache_root() -> Path:
+    if sys.platform.startswith("linux"):  # platformdirs' answer, without importing it into every command
+        base = os.environ.get("XDG_CACHE_HOME", "").strip() or os.path.expanduser("~/.cache")
+        return Path(base) / "kinema" / "bytecode"
+    import platformdirs
+
+    return platformdirs.user_cache_path("kinema") / "bytecode"
 
 
 def bytecode_cache_path(source_path: str) -> Path:
     """Where the compiled code of the source file ``source_path`` is kept (see the module docstring)."""
-    global _cache_root
-    if _cache_root is None:
-        import platformdirs
-
-        _cache_root = platformdirs.user_cache_path("kinema") / "bytecode"
     source = Path(os.path.abspath(source_path))
     tag = sys.implementation.cache_tag or "python"
     mirrored = source.relative_to(source.anchor).with_name(f"{source.stem}.{tag}.pyc")
-    return _cache_root / mirrored
+    return _cache_root() / mirrored
 
 
 class UserCacheSourceLoader(importlib.machinery.SourceFileLoader):
