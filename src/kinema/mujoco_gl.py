@@ -11,6 +11,8 @@ from __future__ import annotations
 import os
 import sys
 
+# Set beside MUJOCO_GL when Kinema chose the backend, so a child process can tell it from the user's choice.
+CHOSEN_BY_KINEMA = "KINEMA_MUJOCO_GL_CHOSEN"
 # True when mujoco was already loaded (with its default backend) by the time Kinema chose one.
 imported_too_early = False
 
@@ -41,7 +43,18 @@ def choose_gl_backend() -> None:
         return False
 
     usable = loads("libEGL.so.1", "libEGL.so") and loads("libOpenGL.so.0", "libGL.so.1", "libGL.so")
-    os.environ["MUJOCO_GL"] = "egl" if usable else "disable"
+    os.environ["MUJOCO_GL"] = os.environ[CHOSEN_BY_KINEMA] = "egl" if usable else "disable"
+
+
+def no_rendering() -> None:
+    """For a process that reads MuJoCo models but never renders (the agent; the driver renders): no OpenGL
+    backend, so ``import mujoco`` loads no PyOpenGL, EGL or Mesa (about 5 MB resident). Call it before
+    mujoco is imported. A backend the user chose is left alone; one Kinema chose for a parent process
+    (the supervisor's, inherited through the environment) is not the user's.
+    """
+    chosen = os.environ.get("MUJOCO_GL")
+    if chosen is None or chosen == os.environ.get(CHOSEN_BY_KINEMA):
+        os.environ["MUJOCO_GL"] = os.environ[CHOSEN_BY_KINEMA] = "disable"
 
 
 choose_gl_backend()

@@ -276,6 +276,9 @@ def main(argv: list[str] | None = None) -> int:
     from kinema.process import memory_probe
 
     memory_probe.install_from_environment()  # KINEMA_DEBUG_MEMORY: SIGUSR2 logs a memory report
+    from kinema.mujoco_gl import no_rendering
+
+    no_rendering()  # it reads MuJoCo scenes (planning scene, camera frames) but never renders
     stop = threading.Event()
     signal.signal(signal.SIGTERM, lambda *_: stop.set())
     signal.signal(signal.SIGINT, lambda *_: stop.set())

@@ -126,6 +126,15 @@ def resolve_domain_id(domain_id: int | None) -> int:
     return resolved
 
 
+#: Messages at least this large go through zenoh's shared memory (zenoh's default is 3 kB). Below it a copy
+#: over loopback costs microseconds; above 3 kB the cell's frequent messages (transforms, joint states of
+#: larger robots, node tables) went through the sender's 16 MiB pool at advancing offsets, so every process
+#: reading them came to hold the whole pool resident: 16 MB of the agent's memory for what fits in a few
+#: pages. Camera images and point clouds, where shared memory pays, are far larger.
+SHARED_MEMORY_THRESHOLD_BYTES = 64 << 10
+SHARED_MEMORY_THRESHOLD_KEY = "transport/shared_memory/transport_optimization/message_size_threshold"
+
+
 def build_config(
     mode: Mode,
     *,
@@ -154,6 +163,8 @@ def build_config(
         "scouting/delay": 0,
         "timestamping/enabled": True,
     }
+    if not config_file:
+        settings[SHARED_MEMORY_THRESHOLD_KEY] = SHARED_MEMORY_THRESHOLD_BYTES
     listen = list(listen)
     connect = list(connect)
     if listen or not config_file:

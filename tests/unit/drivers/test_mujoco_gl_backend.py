@@ -52,3 +52,42 @@ print(cameras.unavailable)
     run = _run(code)
     assert run.returncode == 0, run.stderr[-2000:]
     assert "mujoco was imported before Kinema chose its OpenGL backend" in run.stdout, run.stdout
+
+
+NO_RENDERING = """
+import os, sys
+from kinema.mujoco_gl import no_rendering
+no_rendering()
+import mujoco
+print(os.environ.get("MUJOCO_GL"), any(name.startswith("OpenGL") for name in sys.modules))
+"""
+
+
+def test_the_agent_loads_no_opengl_even_when_its_parent_chose_egl() -> None:
+    _egl_or_skip()
+    # `kinema run` chose EGL for itself (the driver renders); the agent inherits it, and never renders
+    child = f"subprocess.run([sys.executable, '-c', {NO_RENDERING!r}])"
+    inherited = _run(f"import kinema.mujoco_gl\nimport subprocess, sys\n{child}")
+    assert inherited.returncode == 0, inherited.stderr[-2000:]
+    assert inherited.stdout.split() == ["disable", "False"]
+
+
+@pytest.mark.parametrize("chosen", ["egl", "osmesa"])
+def test_a_backend_the_user_chose_is_kept_by_a_process_that_never_renders(chosen: str) -> None:
+    env = {
+        k: v
+        for k, v in os.environ.items()
+        if not k.endswith("MUJOCO_GL") and not k.startswith("KINEMA_MUJOCO")
+    }
+    code = (
+        "import os\nfrom kinema.mujoco_gl import no_rendering\nno_rendering()\nprint(os.environ['MUJOCO_GL'])"
+    )
+    run = subprocess.run(
+        [sys.executable, "-c", code],
+        capture_output=True,
+        text=True,
+        timeout=60,
+        env={**env, "MUJOCO_GL": chosen},
+    )
+    assert run.returncode == 0, run.stderr[-2000:]
+    assert run.stdout.strip() == chosen
