@@ -32,15 +32,47 @@ class _DeferredModule(types.ModuleType):
         return getattr(importlib.import_module(self.__name__), name)
 
 
+# numpy's submodules that scipy's array API layer (``scipy._lib.array_api_compat.numpy``, imported by
+# toppra's scipy.interpolate) imports with ``from numpy import *`` and never uses: about 8 MB resident
+# (f2py alone brings charset_normalizer and unittest).
+_UNUSED_NUMPY_PARTS = ("f2py", "testing", "ma", "polynomial", "ctypeslib", "char", "rec")
+
+
+def _defer_unused_numpy_parts() -> None:
+    """Make the numpy submodules in ``_UNUSED_NUMPY_PARTS`` load on their first attribute use.
+
+    Each not yet imported is put in ``sys.modules`` (and on ``numpy``) through the standard library's
+    ``importlib.util.LazyLoader``: importing it, or ``from numpy import *``, gives the module without
+    running it; the first attribute read runs it, so code that uses it sees no difference.
+    """
+    import importlib.util
+
+    for part in _UNUSED_NUMPY_PARTS:
+        name = f"numpy.{part}"
+        if name in sys.modules:
+            continue
+        spec = importlib.util.find_spec(name)
+        if spec is None or spec.loader is None:
+            continue
+        spec.loader = importlib.util.LazyLoader(spec.loader)
+        module = importlib.util.module_from_spec(spec)
+        sys.modules[name] = module
+        spec.loader.exec_module(module)
+        setattr(np, part, module)  # as the import system does; numpy's own __getattr__ would import again
+
+
 def _import_toppra() -> Any:
-    """``toppra``, imported without loading matplotlib.
+    """``toppra``, imported without loading matplotlib or numpy's parts nothing here uses.
 
     toppra imports ``matplotlib.pyplot`` at its top for plotting helpers that timing never calls; that
     costs a long-running agent about 30 MB (matplotlib, PIL, kiwisolver, fonttools) and 0.3 s. While
     toppra is imported, placeholders stand for ``matplotlib`` and ``matplotlib.pyplot`` (unless matplotlib
     is already loaded); they leave ``sys.modules`` right after, so anyone else gets the real one, and
-    toppra's own ``plt`` imports it on first use.
+    toppra's own ``plt`` imports it on first use. When toppra is what brings scipy in, numpy's unused
+    submodules that scipy imports are deferred first (:func:`_defer_unused_numpy_parts`).
     """
+    if "scipy" not in sys.modules:
+        _defer_unused_numpy_parts()
     if "toppra" in sys.modules or "matplotlib" in sys.modules:
         import toppra
 

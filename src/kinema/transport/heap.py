@@ -28,6 +28,7 @@ from __future__ import annotations
 import ctypes
 import ctypes.util
 import logging
+import os
 import threading
 import time
 from collections.abc import Callable
@@ -55,6 +56,11 @@ TRIM_THRESHOLD_BYTES = 2 * LARGE_MESSAGE_BYTES
 # glibc's mallopt parameters (malloc.h).
 _M_TRIM_THRESHOLD = -1
 _M_MMAP_THRESHOLD = -3
+_M_ARENA_MAX = -8
+#: At most this many glibc arenas (its default is 8 per core). The agent's threads mostly run Python under
+#: one lock, so arenas per thread buy no parallelism, while each keeps its own free chunks: after 20
+#: pick-and-place runs the agent held 16 arenas with 35 MB free inside them.
+ARENA_MAX = 2
 
 _cond = threading.Condition()
 _due: list[float] = []  # monotonic times of the trims still to run
@@ -84,7 +90,8 @@ def _malloc_trim() -> Callable[[int], int] | None:
 
 
 def bound_heap_growth() -> bool:
-    """Fix glibc's mmap and trim thresholds so large blocks never stay resident once freed.
+    """Fix glibc's mmap and trim thresholds so large blocks never stay resident once freed, and cap its
+    arenas (:data:`ARENA_MAX`).
 
     Call once, early, in a long-running process that receives large messages (the agent, the
     router); it changes how every later allocation of the process is placed. Returns False where
@@ -95,6 +102,8 @@ def bound_heap_growth() -> bool:
         return False
     mmap_ok = libc.mallopt(_M_MMAP_THRESHOLD, MMAP_THRESHOLD_BYTES) == 1
     trim_ok = libc.mallopt(_M_TRIM_THRESHOLD, TRIM_THRESHOLD_BYTES) == 1
+    if "MALLOC_ARENA_MAX" not in os.environ:  # what the user set stands
+        libc.mallopt(_M_ARENA_MAX, ARENA_MAX)
     if not (mmap_ok and trim_ok):
         log.warning("glibc refused the heap thresholds (mallopt); large messages may stay resident")
     return mmap_ok and trim_ok

@@ -173,3 +173,27 @@ print(algorithm.plt.plot is matplotlib.pyplot.plot)
     done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
     assert done.returncode == 0, done.stderr
     assert done.stdout.split() == ["False", "False", "True"]
+
+
+def test_timing_a_path_runs_none_of_the_numpy_parts_scipy_imports_unused_and_they_still_work() -> None:
+    """scipy's array API layer imports all of numpy's submodules (f2py, testing, ma, ...: about 8 MB in every
+    agent); they run only when something reads them, and then work as usual."""
+    import subprocess
+    import sys
+
+    script = """
+import sys
+import numpy as np
+from kinema.motion import JointPath, RobotDescription, time_parameterize
+model = RobotDescription.lab_sim().load_model()
+arm = model.group("manipulator").joint_names
+path = JointPath(tuple(arm), np.array([np.zeros(len(arm)), np.full(len(arm), 0.3)]))
+assert time_parameterize(path, model).duration > 0
+print("scipy.interpolate" in sys.modules, "charset_normalizer" in sys.modules, "unittest" in sys.modules)
+import numpy.testing
+numpy.testing.assert_allclose(np.polynomial.Polynomial([1, 2])(2.0), 5.0)
+print(float(np.ma.masked_array([1.0, 2.0], [0, 1]).sum()), "unittest" in sys.modules)
+"""
+    done = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=120)
+    assert done.returncode == 0, done.stderr
+    assert done.stdout.split() == ["True", "False", "False", "1.0", "True"]
