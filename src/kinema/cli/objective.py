@@ -65,6 +65,8 @@ def list_(workspace: Path | None, config: str | None, as_json: bool, no_check: b
     that cannot load (its file or a SubTree it reaches does not validate against the config's behaviors)
     is listed after the table, one line each, with the first problem as file:line: message. Files that
     cannot be read are reported as file:line: message on stderr; the other objectives are still listed.
+    The check's answer is kept in the user cache folder and reused until an objective file, a behavior
+    package's source or Kinema itself changes.
     """
     import json
 
