@@ -69,3 +69,51 @@ def test_reset_mujoco_robot_puts_the_arm_upright(cell: Cell) -> None:
 
 def test_pick_and_place_moves_the_cube_to_the_tray_and_back_and_loops(cell: Cell) -> None:
     run_pick_and_place_two_placements(cell)
+
+
+# A pick as Kinema's lab_sim writes one: down to the waypoint, close with the grasp check, lift.
+PICK_AT = """<root BTCPP_format="4" main_tree_to_execute="Pick Test">
+  <BehaviorTree ID="Pick Test">
+    {body}
+  </BehaviorTree>
+  <BehaviorTree ID="Pick at Waypoint">
+    <Control ID="Sequence">
+      <SubTree ID="Move to Waypoint" waypoint_name="{{waypoint}}" />
+      <SubTree ID="Close Gripper" require_grasp="true" />
+      <SubTree ID="Move to Waypoint" waypoint_name="3 Waypoint Mid Point" />
+    </Control>
+  </BehaviorTree>
+</root>"""
+
+
+def _pick(waypoint: str, *, forced: bool = False) -> str:
+    pick = f'<SubTree ID="Pick at Waypoint" waypoint="{waypoint}" />'
+    if forced:
+        pick = f'<Decorator ID="ForceSuccess">{pick}</Decorator>'
+    body = (
+        '<Control ID="Sequence"><SubTree ID="Move to Waypoint" waypoint_name="3 Waypoint Mid Point" />'
+        f'<SubTree ID="Open Gripper" />{pick}</Control>'
+    )
+    return PICK_AT.format(body=body)
+
+
+def test_a_pick_that_closes_on_nothing_fails_unless_the_objective_forces_success(cell: Cell) -> None:
+    # The cube back on the table and the tray empty, whatever an earlier test left.
+    run_and_expect_success(cell, "Reset MuJoCo Scene")
+    try:
+        # The tray ("3 Waypoint Place Pose") is empty: the fingers meet nothing.
+        air = cell.client.do_xml(_pick("3 Waypoint Place Pose"), timeout=300)
+        assert air.failed, air
+        assert "the gripper closed on nothing" in air.error_message, air
+        assert joint_positions(cell)["robotiq_85_left_knuckle_joint"] > 0.75
+        forced = cell.client.do_xml(_pick("3 Waypoint Place Pose", forced=True), timeout=300)
+        assert forced.succeeded, forced
+        # Closing an empty gripper on purpose still succeeds (MoveIt Pro's Close Gripper, Push Button).
+        run_and_expect_success(cell, "Close Gripper")
+        # The cube at "3 Waypoint Pick Pose" stops the fingers: the same pick succeeds and lifts it.
+        before = cell.cube()
+        cube = cell.client.do_xml(_pick("3 Waypoint Pick Pose"), timeout=300)
+        assert cube.succeeded, cube
+        assert cell.cube()[2] - before[2] > 0.05, f"the cube went from {before} to {cell.cube()}"
+    finally:
+        run_and_expect_success(cell, "Reset MuJoCo Scene")
