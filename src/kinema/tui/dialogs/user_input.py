@@ -1,7 +1,8 @@
-"""What only the user can give a running objective: a pose, points on a camera image, a teleoperation session.
+"""What only the user can give a running objective: a pose, joint values, points on a camera image, a
+teleoperation session.
 
 Each dialog answers one :class:`~kinema.tui.connection.UserInputRequested` (RetrievePoseParameter,
-GetPointsFromUser, DoTeleoperateAction of the core behaviors) and returns a
+RetrieveRobotStateParameter, GetPointsFromUser, DoTeleoperateAction of the core behaviors) and returns a
 :class:`~kinema.tui.connection.UserInputAnswer`; Escape cancels (the behavior then fails).
 """
 
@@ -112,6 +113,53 @@ class PoseDialog(_UserInputDialog):
         self.dismiss(
             UserInputAnswer(True, "", frame, position, orientation)  # type: ignore[arg-type]
         )
+
+
+class JointStateDialog(_UserInputDialog):
+    """A value per joint (rad, or m for a prismatic joint), each prefilled with where the joint is now.
+    Enter in the last field or OK gives them."""
+
+    def compose(self) -> ComposeResult:
+        request = self.request
+        with Vertical(classes="dialog wide"):
+            yield from self.compose_title()
+            for index, (name, value) in enumerate(
+                zip(request.joint_names, request.joint_positions, strict=False)
+            ):
+                yield Label(name)
+                yield Input(_text((value,)), id=f"joint-{index}")
+            with Horizontal(classes="dialog-buttons"):
+                yield Button("OK", variant="primary", id="ok")
+                yield Button("Cancel (Esc)", id="cancel")
+
+    def on_mount(self) -> None:
+        if self.request.joint_names:
+            self.set_focus(self.query_one("#joint-0", Input))
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        event.stop()
+        if event.input.id == f"joint-{len(self.request.joint_names) - 1}":
+            self._give()
+        else:
+            self.focus_next()
+
+    def on_button_pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        if event.button.id == "ok":
+            self._give()
+        else:
+            self.action_cancel()
+
+    def _give(self) -> None:
+        values: list[float] = []
+        for index, name in enumerate(self.request.joint_names):
+            try:
+                (value,) = _numbers(self.query_one(f"#joint-{index}", Input).value, 1, name)
+            except ValueError as error:
+                self.notify(str(error), severity="warning")
+                return
+            values.append(value)
+        self.dismiss(UserInputAnswer(True, "", joint_positions=tuple(values)))
 
 
 class PointsDialog(_UserInputDialog):
