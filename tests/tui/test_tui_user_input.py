@@ -143,6 +143,17 @@ def test_a_teleoperation_session_sends_the_modes_the_user_picks_until_done(fake:
         await pilot.pause(0.2)
         assert fake.called("set_teleoperation_mode") == [(7,), (4,), (0,)]
         assert isinstance(app.screen, TeleoperateDialog)
+        # Moving to joint values: the same, with the joint values form.
+        await pilot.click("#teleop-joints")
+        await settle(pilot)
+        fake.emit(_request("joint_state", answers, joint_names=("elbow_joint",), joint_positions=(1.9,)))
+        await settle(pilot)
+        assert isinstance(app.screen, JointStateDialog)
+        await pilot.press("escape")
+        await settle(pilot)
+        await pilot.pause(0.2)
+        assert fake.called("set_teleoperation_mode") == [(7,), (4,), (0,), (5,), (0,)]
+        assert isinstance(app.screen, TeleoperateDialog)
         await pilot.press("ctrl+d")
         await settle(pilot)
         assert answers[-1].accepted and not app.teleoperating

@@ -354,6 +354,7 @@ class UserInputRequested:
 
 # moveit_studio_sdk_msgs/TeleoperationMode values the TUI offers.
 TELEOP_TARGET_POSE = 4
+TELEOP_JOINT_VALUES = 5  # MoveIt Pro's joint sliders
 TELEOP_OPEN_GRIPPER = 6
 TELEOP_CLOSE_GRIPPER = 7
 TELEOP_NONE = 0

@@ -21,6 +21,7 @@ from textual.widgets import Button, Input, Label, Static
 
 from kinema.tui.connection import (
     TELEOP_CLOSE_GRIPPER,
+    TELEOP_JOINT_VALUES,
     TELEOP_OPEN_GRIPPER,
     TELEOP_TARGET_POSE,
     CameraImage,
@@ -286,7 +287,8 @@ class PointsDialog(_UserInputDialog):
 
 class TeleoperateDialog(_UserInputDialog):
     """A teleoperation session: each button tells the running objective a mode (open or close the gripper,
-    move to a target pose, which then asks for the pose); Done ends the session, Cancel fails it."""
+    move to a target pose or to joint values, which then ask for them); Done ends the session, Cancel fails
+    it."""
 
     BINDINGS = [
         Binding("ctrl+d", "done", "Done", id="dialog.done", tooltip="End it; the objective goes on"),
@@ -294,6 +296,7 @@ class TeleoperateDialog(_UserInputDialog):
     ]
     MODES = (
         (TELEOP_TARGET_POSE, "Move to a pose", "teleop-pose"),
+        (TELEOP_JOINT_VALUES, "Move to joint values", "teleop-joints"),
         (TELEOP_OPEN_GRIPPER, "Open gripper", "teleop-open"),
         (TELEOP_CLOSE_GRIPPER, "Close gripper", "teleop-close"),
     )
@@ -330,7 +333,7 @@ class TeleoperateDialog(_UserInputDialog):
             self.choose(mode)
 
     def choose(self, mode: int) -> None:
-        """Pick ``mode``: the objective acts on it (a pose question follows for a target pose)."""
+        """Pick ``mode``: the objective acts on it (a pose or joint values question follows for a move)."""
         self.mode = mode
         self.query_one("#teleop-mode", Label).update(self._mode_text())
         self._pick_mode(mode)
