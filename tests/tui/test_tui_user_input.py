@@ -1,5 +1,5 @@
-"""What only the user can give a running objective, asked in the TUI: a pose, points on a camera image, a
-teleoperation session; the answer goes back to the behavior that asked."""
+"""What only the user can give a running objective, asked in the TUI: a pose, joint values, points on a
+camera image, a teleoperation session; the answer goes back to the behavior that asked."""
 
 from __future__ import annotations
 
@@ -11,7 +11,7 @@ import pytest
 from tui_pilot_harness import drive, settle
 
 from kinema.tui.connection import UserInputAnswer, UserInputRequested
-from kinema.tui.dialogs.user_input import PointsDialog, PoseDialog, TeleoperateDialog
+from kinema.tui.dialogs.user_input import JointStateDialog, PointsDialog, PoseDialog, TeleoperateDialog
 from kinema.tui.fake_connection import FakeConnection
 
 
@@ -49,6 +49,35 @@ def test_a_pose_is_given_in_a_form_that_starts_at_the_tool(fake: FakeConnection)
         await pilot.press("escape")
         await settle(pilot)
         assert not answers[-1].accepted and not isinstance(app.screen, PoseDialog)
+
+    drive(fake, scenario)
+
+
+def test_joint_values_are_given_in_a_form_that_starts_where_the_joints_are(fake: FakeConnection) -> None:
+    answers: list[UserInputAnswer] = []
+    joints = {"joint_names": ("elbow_joint", "wrist_1_joint"), "joint_positions": (1.9, -1.57)}
+
+    async def scenario(app: Any, pilot: Any) -> None:
+        fake.emit(_request("joint_state", answers, **joints))
+        await settle(pilot)
+        assert isinstance(app.screen, JointStateDialog)
+        elbow, wrist = app.screen.query_one("#joint-0"), app.screen.query_one("#joint-1")
+        assert (elbow.value, wrist.value) == ("1.9", "-1.57")
+        wrist.value = "a lot"
+        await pilot.click("#ok")
+        await settle(pilot)
+        assert answers == [] and isinstance(app.screen, JointStateDialog), "a bad value is refused, not sent"
+        wrist.value = "-1.2"
+        app.screen.set_focus(wrist)
+        await pilot.press("enter")
+        await settle(pilot)
+        (answer,) = answers
+        assert answer.accepted and answer.joint_positions == (1.9, -1.2)
+        fake.emit(_request("joint_state", answers, **joints))
+        await settle(pilot)
+        await pilot.press("escape")
+        await settle(pilot)
+        assert not answers[-1].accepted and not isinstance(app.screen, JointStateDialog)
 
     drive(fake, scenario)
 
@@ -114,6 +143,17 @@ def test_a_teleoperation_session_sends_the_modes_the_user_picks_until_done(fake:
         await pilot.pause(0.2)
         assert fake.called("set_teleoperation_mode") == [(7,), (4,), (0,)]
         assert isinstance(app.screen, TeleoperateDialog)
+        # Moving to joint values: the same, with the joint values form.
+        await pilot.click("#teleop-joints")
+        await settle(pilot)
+        fake.emit(_request("joint_state", answers, joint_names=("elbow_joint",), joint_positions=(1.9,)))
+        await settle(pilot)
+        assert isinstance(app.screen, JointStateDialog)
+        await pilot.press("escape")
+        await settle(pilot)
+        await pilot.pause(0.2)
+        assert fake.called("set_teleoperation_mode") == [(7,), (4,), (0,), (5,), (0,)]
+        assert isinstance(app.screen, TeleoperateDialog)
         await pilot.press("ctrl+d")
         await settle(pilot)
         assert answers[-1].accepted and not app.teleoperating
@@ -122,7 +162,7 @@ def test_a_teleoperation_session_sends_the_modes_the_user_picks_until_done(fake:
     drive(fake, scenario)
 
 
-@pytest.mark.parametrize("kind", ["points", "teleoperate"])
+@pytest.mark.parametrize("kind", ["points", "teleoperate", "joint_state"])
 def test_an_attached_tui_is_the_user_the_input_behaviors_ask(monkeypatch: Any, kind: str) -> None:
     """End to end over a router: the TUI's connection serves /kinema/user_input; a behavior asks it."""
     from kinema.behaviors import BehaviorContext
@@ -144,6 +184,11 @@ def test_an_attached_tui_is_the_user_the_input_behaviors_ask(monkeypatch: Any, k
             if event.kind == "teleoperate":
                 connection.set_teleoperation_mode(6)
                 time.sleep(0.5)  # the mode reaches the behavior before the session ends
+            if event.kind == "joint_state":
+                assert event.joint_names == ("elbow_joint", "wrist_1_joint")
+                assert event.joint_positions == (1.9, -1.57)
+                event.answer(UserInputAnswer(True, joint_positions=(1.5, -1.2)))
+                return
             event.answer(UserInputAnswer(True, points=((12.0, 34.0),)))
 
     session = open_session(endpoint)
@@ -163,6 +208,19 @@ def test_an_attached_tui_is_the_user_the_input_behaviors_ask(monkeypatch: Any, k
             )
             assert run.status == NodeStatus.SUCCESS, run.toasts
             assert run.outputs["current_teleop_mode"] == 6
+        elif kind == "joint_state":
+            from kinema.testing import publish_repeatedly
+
+            # Without a robot model the question covers every joint /joint_states names.
+            state = {"name": ["elbow_joint", "wrist_1_joint"], "position": [1.9, -1.57]}
+            with publish_repeatedly(node, "sensor_msgs/msg/JointState", "/joint_states", state):
+                run = tick_behavior(host.registry["RetrieveRobotStateParameter"].cls, {}, context=context)
+            assert run.status == NodeStatus.SUCCESS, run.toasts
+            answer = run.outputs["joint_state"]
+            assert list(answer.name) == ["elbow_joint", "wrist_1_joint"] and list(answer.position) == [
+                1.5,
+                -1.2,
+            ]
         else:
             run = tick_behavior(
                 host.registry["GetPointsFromUser"].cls, {"point_prompts": "here"}, context=context

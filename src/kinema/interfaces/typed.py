@@ -661,11 +661,13 @@ if TYPE_CHECKING:
         prompt: str
         kind: str
         initial_pose: geometry_msgs__msg__PoseStamped
+        initial_joint_state: sensor_msgs__msg__JointState
         image_topic: str
         point_prompts: list[str]
         point_names: list[str]
         initial_teleop_mode: int
         KIND_POSE: ClassVar[str] = "pose"
+        KIND_JOINT_STATE: ClassVar[str] = "joint_state"
         KIND_POINTS: ClassVar[str] = "points"
         KIND_TELEOPERATE: ClassVar[str] = "teleoperate"
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/RequestUserInput_Request"
@@ -677,6 +679,7 @@ if TYPE_CHECKING:
         accepted: bool
         message: str
         pose: geometry_msgs__msg__PoseStamped
+        joint_state: sensor_msgs__msg__JointState
         points: list[geometry_msgs__msg__Point]
         __msgtype__: ClassVar[str] = "kinema_msgs/srv/RequestUserInput_Response"
 

@@ -343,15 +343,24 @@ def _waypoints_yaml(plan: RobotPlan) -> str:
     return "\n".join(lines) + "\n"
 
 
-def _gripper_objective(plan: RobotPlan, objective: str, position: float) -> str:
+def _gripper_objective(plan: RobotPlan, objective: str, position: float, *, grasp_check: bool = False) -> str:
+    """Open Gripper / Close Gripper; Close Gripper takes ``require_grasp`` for picks (as lab_sim's does)."""
+    action = f'<Action ID="MoveGripperAction" position="{position:g}"/>'
+    port = ""
+    if grasp_check:
+        action = f'<Action ID="MoveGripperAction" position="{position:g}" require_grasp="{{require_grasp}}"/>'
+        port = (
+            '\n      <input_port name="require_grasp" default="false">true for a pick: the gripper closing '
+            "all the way (on nothing) fails instead of succeeding.</input_port>"
+        )
     return f"""<?xml version="1.0" encoding="UTF-8"?>
 <root BTCPP_format="4" main_tree_to_execute="{objective}">
   <!-- Made by kinema new config (from the URDF): {plan.gripper_joint} to {position:g}. -->
   <BehaviorTree ID="{objective}" _description="{objective.split()[0]} the gripper" _favorite="true">
-    <Action ID="MoveGripperAction" position="{position:g}"/>
+    {action}
   </BehaviorTree>
   <TreeNodesModel>
-    <SubTree ID="{objective}">
+    <SubTree ID="{objective}">{port}
       <MetadataFields>
         <Metadata subcategory="Grasping"/>
         <Metadata runnable="true"/>
@@ -528,7 +537,7 @@ def new_robot_package(
                 _gripper_objective(plan, "Open Gripper", plan.gripper_open)
             )
             (staging / "objectives" / "close_gripper.xml").write_text(
-                _gripper_objective(plan, "Close Gripper", plan.gripper_closed)
+                _gripper_objective(plan, "Close Gripper", plan.gripper_closed, grasp_check=True)
             )
         (staging / "config").mkdir()
         (staging / "config" / "config.yaml").write_text(_config_yaml(plan, scene, str(urdf)))

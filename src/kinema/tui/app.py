@@ -406,22 +406,29 @@ class KinemaApp(App[None]):
         self.push_screen(MotionQuestionDialog(question), answered)
 
     def ask_user_input(self, request: UserInputRequested) -> None:
-        """Ask the user for what a behavior needs (a pose, points on an image, a teleoperation session);
-        the answer goes back to it. A pose the user declines during teleoperation also ends the "move to a
-        pose" mode, so the objective does not ask again at once."""
+        """Ask the user for what a behavior needs (a pose, joint values, points on an image, a teleoperation
+        session); the answer goes back to it. A pose or joint values the user declines during teleoperation
+        also end the "move to" mode, so the objective does not ask again at once."""
         from kinema.tui.connection import TELEOP_NONE, UserInputAnswer
-        from kinema.tui.dialogs.user_input import PointsDialog, PoseDialog, TeleoperateDialog
+        from kinema.tui.dialogs.user_input import (
+            JointStateDialog,
+            PointsDialog,
+            PoseDialog,
+            TeleoperateDialog,
+        )
 
         def answered(answer: UserInputAnswer | None) -> None:
             answer = answer or UserInputAnswer(False, "cancelled in the TUI")
             request.answer(answer)
             if request.kind == "teleoperate":
                 self.teleoperating = False
-            elif request.kind == "pose" and not answer.accepted and self.teleoperating:
+            elif request.kind in ("pose", "joint_state") and not answer.accepted and self.teleoperating:
                 self.pick_teleoperation_mode(TELEOP_NONE)
 
         if request.kind == "pose":
             self.push_screen(PoseDialog(request), answered)
+        elif request.kind == "joint_state":
+            self.push_screen(JointStateDialog(request), answered)
         elif request.kind == "points":
             from kinema.tui.screens.camera import image_widget_class
 

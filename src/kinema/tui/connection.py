@@ -305,6 +305,8 @@ class UserInputAnswer:
         position: the pose's position, m (a pose answer).
         orientation: the pose's orientation quaternion, x y z w (a pose answer).
         points: one pixel (column, row) per point prompt (a points answer).
+        joint_positions: a value per joint of the request's ``joint_names``, in order (a joint state
+            answer).
     """
 
     accepted: bool
@@ -313,6 +315,7 @@ class UserInputAnswer:
     position: tuple[float, float, float] = (0.0, 0.0, 0.0)
     orientation: tuple[float, float, float, float] = (0.0, 0.0, 0.0, 1.0)
     points: tuple[tuple[float, float], ...] = ()
+    joint_positions: tuple[float, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -320,9 +323,10 @@ class UserInputRequested:
     """A behavior asks the user for a value and waits (``kinema_msgs/srv/RequestUserInput``).
 
     ``kind`` is ``pose`` (RetrievePoseParameter: a target pose; ``frame_id``, ``position`` and
-    ``orientation`` are where the tool is now), ``points`` (GetPointsFromUser: one pixel per entry of
-    ``point_prompts`` on ``image_topic``) or ``teleoperate`` (DoTeleoperateAction: a session the user ends;
-    the modes they pick go to :meth:`RuntimeConnection.set_teleoperation_mode`).
+    ``orientation`` are where the tool is now), ``joint_state`` (RetrieveRobotStateParameter: a value per
+    joint of ``joint_names``; ``joint_positions`` are where they are now), ``points`` (GetPointsFromUser: one
+    pixel per entry of ``point_prompts`` on ``image_topic``) or ``teleoperate`` (DoTeleoperateAction: a
+    session the user ends; the modes they pick go to :meth:`RuntimeConnection.set_teleoperation_mode`).
 
     Attributes:
         kind: what is asked.
@@ -344,10 +348,13 @@ class UserInputRequested:
     point_prompts: tuple[str, ...] = ()
     point_names: tuple[str, ...] = ()
     initial_teleop_mode: int = 0
+    joint_names: tuple[str, ...] = ()
+    joint_positions: tuple[float, ...] = ()
 
 
 # moveit_studio_sdk_msgs/TeleoperationMode values the TUI offers.
 TELEOP_TARGET_POSE = 4
+TELEOP_JOINT_VALUES = 5  # MoveIt Pro's joint sliders
 TELEOP_OPEN_GRIPPER = 6
 TELEOP_CLOSE_GRIPPER = 7
 TELEOP_NONE = 0

@@ -319,11 +319,17 @@ class SdkConnection:
                         },
                     },
                     "points": [{"x": column, "y": row, "z": 0.0} for column, row in reply.points],
+                    "joint_state": {
+                        "name": list(joint_names) if reply.joint_positions else [],
+                        "position": list(reply.joint_positions),
+                    },
                 }
             )
 
         pose = request.initial_pose
         p, q = pose.pose.position, pose.pose.orientation
+        joints = request.initial_joint_state
+        joint_names = tuple(str(name) for name in joints.name)
         self._emit(
             UserInputRequested(
                 str(request.kind),
@@ -338,6 +344,8 @@ class SdkConnection:
                 tuple(str(text) for text in request.point_prompts),
                 tuple(str(text) for text in request.point_names),
                 int(request.initial_teleop_mode),
+                joint_names,
+                tuple(float(value) for value in joints.position),
             )
         )
 

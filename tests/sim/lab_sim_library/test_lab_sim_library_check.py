@@ -280,6 +280,11 @@ def gripper_at(position: float) -> Check:
     return check
 
 
+# "Pick up Object" has no check: it closes the gripper at a fixed pose where MoveIt Pro's scene has its blue
+# pill bottle and Kinema's has nothing, and MoveIt Pro's pick sets no grasp check (its "Close Gripper" is a
+# plain MoveGripperAction, which succeeds on air as MoveIt Pro's allow_stalling controller does), so it
+# succeeds holding nothing. A bottle on that spot (tried: 42 mm wide, 12 cm tall, so the fingers reach it)
+# is lifted, but it pulls "Register CAD Part Subtree"'s ICP (max_correspondence_distance 1.0) off bottle_1.
 CHECKS: dict[str, Check] = {
     "3 Waypoints Pick and Place": lifted("cube"),
     "Cycle Between Waypoints": visited("Above Pick Object", "Look at Table"),

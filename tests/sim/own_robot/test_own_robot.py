@@ -187,6 +187,9 @@ def test_the_panda_with_its_hand_from_its_urdf(start_cell: Callable[..., RobotCe
     assert closed.succeeded, closed
     # The gripper controller reports success within its goal tolerance (1 cm); the empty hand goes on to 0.
     assert _finger_settles(cell, lambda q: q < 0.005), "the empty hand did not close"
+    # The generated Close Gripper has the grasp check a pick sets: this hand holds nothing.
+    empty = cell.client.execute("Close Gripper", {"require_grasp": True}, timeout=60)
+    assert empty.failed and "the gripper closed on nothing" in empty.error_message, empty
     opened = cell.client.execute("Open Gripper", timeout=60)
     assert opened.succeeded, opened
     assert _finger_settles(cell, lambda q: q > 0.035), "the hand did not open"

@@ -5,6 +5,8 @@ from __future__ import annotations
 import threading
 from typing import Any
 
+import pytest
+
 from kinema.behaviors import BehaviorContext
 from kinema.bt import NodeStatus
 from kinema.testing import build_tree, tick_behavior
@@ -176,6 +178,54 @@ def test_a_gripper_that_neither_reaches_nor_stalls_fails(behavior: Any, context:
     run = tick_behavior(behavior("MoveGripperAction"), {"position": 0.7929}, context=context)
     assert run.status == NodeStatus.FAILURE
     assert "without reaching 0.7929" in run.toasts[-1]
+
+
+@pytest.mark.parametrize(
+    ("require_grasp", "reached", "stalled", "expected"),
+    [
+        # Closing an empty gripper on purpose (MoveIt Pro's Close Gripper, Push Button) succeeds.
+        (False, True, False, NodeStatus.SUCCESS),
+        (False, False, True, NodeStatus.SUCCESS),
+        # A pick that must hold something: the fingers reaching closed means they met nothing.
+        (True, True, False, NodeStatus.FAILURE),
+        (True, False, True, NodeStatus.SUCCESS),
+    ],
+)
+def test_the_grasp_check_fails_a_close_on_nothing_only_when_asked(
+    behavior: Any,
+    context: BehaviorContext,
+    require_grasp: bool,
+    reached: bool,
+    stalled: bool,
+    expected: NodeStatus,
+) -> None:
+    Gripper(context.node, reached=reached, stalled=stalled)
+    run = tick_behavior(
+        behavior("MoveGripperAction"), {"position": 0.7929, "require_grasp": require_grasp}, context=context
+    )
+    assert run.status == expected, run.toasts
+    if expected == NodeStatus.FAILURE:
+        assert "the gripper closed on nothing" in run.toasts[-1]
+        assert "ForceSuccess" in run.toasts[-1]
+
+
+def test_forcesuccess_lets_a_pick_that_closed_on_nothing_go_on(
+    registry: Any, context: BehaviorContext
+) -> None:
+    from kinema.testing import run_objective
+
+    Gripper(context.node, reached=True, stalled=False)
+    close = (
+        '<Action ID="MoveGripperAction" position="0.7929" require_grasp="true" '
+        'gripper_command_action_name="/robotiq_gripper_controller/gripper_cmd"/>'
+    )
+    tree = '<root BTCPP_format="4"><BehaviorTree ID="T">{}</BehaviorTree></root>'
+    plain = run_objective(tree.format(close), registry=registry, context=context)
+    assert plain.status == NodeStatus.FAILURE
+    forced = run_objective(
+        tree.format(f'<Decorator ID="ForceSuccess">{close}</Decorator>'), registry=registry, context=context
+    )
+    assert forced.status == NodeStatus.SUCCESS
 
 
 def test_a_slow_gripper_times_out_and_halting_cancels(behavior: Any, context: BehaviorContext) -> None:

@@ -220,9 +220,9 @@ def test_retrieve_joint_state_parameter_is_read_as_retrieve_robot_state_paramete
     registry: BehaviorRegistry,
 ) -> None:
     factory = registry.create_factory()
-    factory.register_simple_action("RetrieveRobotStateParameter", lambda node: NodeStatus.SUCCESS)
     tree = factory.create_tree_from_text(
-        _tree('<Action ID="RetrieveJointStateParameter"/>'), filename="old.xml"
+        _tree('<Action ID="RetrieveJointStateParameter" timeout_sec="2" joint_state="{j}"/>'),
+        filename="old.xml",
     )
     assert next(iter(tree.nodes())).registration_id == "RetrieveRobotStateParameter"
     (note,) = factory.library.spelling_notes

@@ -1,6 +1,7 @@
-"""RetrievePoseParameter, GetPointsFromUser and DoTeleoperateAction: a UI serving /kinema/user_input answers
-them; headless they follow the approvals' rule (fail, or answer as a user who changes nothing when
-approvals are granted automatically). CreateBoundingBoxFromOffset: the exemplar image's box."""
+"""RetrievePoseParameter, RetrieveRobotStateParameter, GetPointsFromUser and DoTeleoperateAction: a UI
+serving /kinema/user_input answers them; headless they follow the approvals' rule (fail, or answer as a
+user who changes nothing when approvals are granted automatically). CreateBoundingBoxFromOffset: the
+exemplar image's box."""
 
 from __future__ import annotations
 
@@ -106,6 +107,86 @@ def test_retrieve_pose_parameter_headless(
     granted = tick_behavior(behavior("RetrievePoseParameter"), {}, context=context)
     assert granted.status == NodeStatus.SUCCESS and "answered automatically" in granted.toasts[-1]
     assert granted.outputs["pose"].header.frame_id == "world"
+
+
+# -- RetrieveRobotStateParameter -------------------------------------------------------------------------
+
+TARGET = [0.2, 0.1, -1.8, 1.7, -1.4, -1.5708, 0.3]
+
+
+def _joint_answer(names: list[str], positions: list[float]) -> dict[str, Any]:
+    return {"accepted": True, "joint_state": {"name": names, "position": positions}}
+
+
+def test_retrieve_robot_state_parameter_takes_the_users_joint_values(
+    behavior: Any, context: BehaviorContext, at_home: None, headless: None
+) -> None:
+    ui = FakeUi(context, lambda request: _joint_answer(ARM, TARGET))
+    run = tick_behavior(
+        behavior("RetrieveRobotStateParameter"), {"command_type": "joint_slider"}, context=context
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    state = run.outputs["joint_state"]
+    assert list(state.name) == ARM and list(state.position) == pytest.approx(TARGET)
+    (request,) = ui.requests
+    assert request.kind == "joint_state" and request.behavior == "RetrieveRobotStateParameter"
+    assert "joint slider" in request.prompt
+    # The form starts at the planning group's joints (lab_sim: manipulator, no gripper) where they are now.
+    assert list(request.initial_joint_state.name) == ARM
+    assert list(request.initial_joint_state.position) == pytest.approx(HOME)
+
+
+@pytest.mark.parametrize(
+    ("answer", "said"),
+    [
+        ({"accepted": False, "message": "not now"}, "the user gave no joint values: not now"),
+        (_joint_answer([*ARM[:6], "wrist_3_jiont"], TARGET), "joints that were not asked: wrist_3_jiont"),
+        (_joint_answer(ARM, TARGET[:3]), "7 names and 3 positions"),
+    ],
+)
+def test_retrieve_robot_state_parameter_fails_on_a_cancel_or_a_wrong_answer(
+    behavior: Any, context: BehaviorContext, at_home: None, headless: None, answer: dict[str, Any], said: str
+) -> None:
+    FakeUi(context, lambda request: answer)
+    run = tick_behavior(behavior("RetrieveRobotStateParameter"), {}, context=context)
+    assert run.status == NodeStatus.FAILURE and said in run.toasts[-1], run.toasts
+
+
+def test_retrieve_robot_state_parameter_names_the_valid_command_types(
+    behavior: Any, context: BehaviorContext, at_home: None, headless: None
+) -> None:
+    run = tick_behavior(behavior("RetrieveRobotStateParameter"), {"command_type": "slider"}, context=context)
+    assert run.status == NodeStatus.FAILURE
+    assert "'slider'" in run.toasts[-1] and "waypoint, joint_slider, interactive_marker" in run.toasts[-1]
+
+
+def test_retrieve_robot_state_parameter_headless(
+    behavior: Any, context: BehaviorContext, at_home: None, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    monkeypatch.delenv("KINEMA_AUTO_APPROVE", raising=False)
+    refused = tick_behavior(behavior("RetrieveRobotStateParameter"), {}, context=context)
+    assert refused.status == NodeStatus.FAILURE
+    assert "no user interface is attached to give joint values" in refused.toasts[-1]
+    assert "--auto-approve" in refused.toasts[-1]
+    monkeypatch.setenv("KINEMA_AUTO_APPROVE", "1")
+    granted = tick_behavior(behavior("RetrieveRobotStateParameter"), {}, context=context)
+    assert granted.status == NodeStatus.SUCCESS and "answered automatically" in granted.toasts[-1]
+    # A user who changes nothing: the joints where they are.
+    state = granted.outputs["joint_state"]
+    assert list(state.name) == ARM and list(state.position) == pytest.approx(HOME)
+
+
+def test_the_former_name_retrieve_joint_state_parameter_runs_with_its_ports(
+    registry: Any, context: BehaviorContext, at_home: None, auto_approve: None
+) -> None:
+    from kinema.testing import run_objective
+
+    xml = """<root BTCPP_format="4"><BehaviorTree ID="T">
+        <Action ID="RetrieveJointStateParameter" timeout_sec="-1" joint_state="{target_joint_state}"/>
+        </BehaviorTree></root>"""
+    run = run_objective(xml, registry=registry, context=context)
+    assert run.status == NodeStatus.SUCCESS
+    assert list(run.blackboard["target_joint_state"].position) == pytest.approx(HOME)
 
 
 # -- GetPointsFromUser ------------------------------------------------------------------------------------

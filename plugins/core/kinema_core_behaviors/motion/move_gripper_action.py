@@ -11,8 +11,12 @@ from kinema.behaviors.cell_ports import cell_input_port
 class MoveGripperAction(ActionClientBehavior["control_msgs/action/GripperCommand"]):
     """Sends the gripper to ``position`` and waits until it gets there or stalls on an object.
 
-    A stall counts as success: closing on an object stops short of the commanded position, and that
-    is a grasp. The gripper controller aborting, or no result within ``timeout`` seconds, fails.
+    As MoveIt Pro's gripper controllers are set up (``allow_stalling: true``), both endings succeed: the
+    fingers reaching ``position`` (``reached_goal``) and the fingers stopping short of it on an object
+    (``stalled``). A pick that must hold something sets ``require_grasp``: then reaching ``position``
+    means the gripper closed on nothing, and the behavior fails saying so (a ``ForceSuccess`` around the
+    pick lets it go on anyway). The gripper controller aborting, or no result within ``timeout`` seconds,
+    fails.
     """
 
     subcategory = "Motion - Execute"
@@ -35,6 +39,16 @@ class MoveGripperAction(ActionClientBehavior["control_msgs/action/GripperCommand
             ),
             input_port("max_effort", float, 0.0, "Effort limit (0: the controller's default)."),
             input_port("timeout", float, 10.0, "Seconds to wait for the gripper to finish."),
+            input_port(
+                "require_grasp",
+                bool,
+                False,
+                "Kinema's grasp check (MoveIt Pro's MoveGripperAction has no such port: its controller "
+                "succeeds either way). True: the goal must end stalled on an object; a gripper that reaches "
+                "`position` (the controller's reached_goal: nothing between the fingers) fails with 'the "
+                "gripper closed on nothing'. Set it on the close of a pick; False (default): reaching "
+                "`position` succeeds, as closing an empty gripper on purpose should.",
+            ),
         ]
 
     def get_action_name(self) -> str:
@@ -50,16 +64,25 @@ class MoveGripperAction(ActionClientBehavior["control_msgs/action/GripperCommand
 
     def process_result(self, result: Any) -> bool:
         outcome = result.result
+        target = float(self.get_input("position"))
         if not result.succeeded:
             self.logger.publish_failure(
                 f"MoveGripperAction: the gripper goal ended {result.status_name} at position "
-                f"{outcome.position:.4f} (target {float(self.get_input('position')):.4f})"
+                f"{outcome.position:.4f} (target {target:.4f})"
+            )
+            return False
+        if outcome.reached_goal and bool(self.get_input("require_grasp")):
+            self.logger.publish_failure(
+                f"MoveGripperAction: the gripper closed on nothing: it reached {outcome.position:.4f} "
+                f"(target {target:.4f}) without stopping on an object, and require_grasp is true. Check "
+                "that the object is where the gripper closed, or wrap the pick in ForceSuccess to go on "
+                "without it."
             )
             return False
         if outcome.reached_goal or outcome.stalled:
             return True
         self.logger.publish_failure(
             f"MoveGripperAction: the gripper stopped at {outcome.position:.4f} without reaching "
-            f"{float(self.get_input('position')):.4f} or grasping an object"
+            f"{target:.4f} or grasping an object"
         )
         return False

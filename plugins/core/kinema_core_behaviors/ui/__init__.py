@@ -9,7 +9,12 @@ from .log_message import LogMessage
 from .markers import PublishMarkers, VisualizeMesh
 from .notices import SwitchUIPrimaryView
 from .point_clouds import ClearSnapshot, PublishPointCloud, SendPointCloudToUI
-from .user_input import DoTeleoperateAction, GetPointsFromUser, RetrievePoseParameter
+from .user_input import (
+    DoTeleoperateAction,
+    GetPointsFromUser,
+    RetrievePoseParameter,
+    RetrieveRobotStateParameter,
+)
 from .visualize_path import VisualizePath
 from .visualize_pose import VisualizePose
 
@@ -29,6 +34,7 @@ BEHAVIORS = (
     WaitForMTCSolutionApproval,
     BreakpointSubscriber,
     RetrievePoseParameter,
+    RetrieveRobotStateParameter,
     GetPointsFromUser,
     DoTeleoperateAction,
 )

@@ -56,12 +56,6 @@ class IsUserAvailable(StatefulBehavior):
     """
 
     subcategory = "User Input"
-    # MoveIt Pro renamed RetrieveJointStateParameter (the user sets a joint state in its UI) to
-    # RetrieveRobotStateParameter. The rename is declared here, among the behaviors that ask the user, so an
-    # objective written either way reaches RetrieveRobotStateParameter wherever a plugin provides it.
-    former_spellings = (
-        FormerSpelling("RetrieveJointStateParameter", current_id="RetrieveRobotStateParameter"),
-    )
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:

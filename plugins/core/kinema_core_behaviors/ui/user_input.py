@@ -1,5 +1,6 @@
-"""Asking the user for values: a pose (RetrievePoseParameter), points on an image (GetPointsFromUser), and a
-teleoperation session (DoTeleoperateAction), in the TUI when one is attached.
+"""Asking the user for values: a pose (RetrievePoseParameter), joint values (RetrieveRobotStateParameter),
+points on an image (GetPointsFromUser), and a teleoperation session (DoTeleoperateAction), in the TUI when
+one is attached.
 
 A UI that can ask the user serves ``/kinema/user_input`` (``kinema_msgs/srv/RequestUserInput``); the TUI
 does while it is open, as it serves the approvals (:mod:`.approval`). MoveIt Pro's web UI answers these
@@ -10,6 +11,7 @@ saying no user is attached; with ``KINEMA_AUTO_APPROVE=1`` (``kinema run --auto-
 answered at once the way a user who changes nothing would, with a warning toast saying so:
 
 - RetrievePoseParameter: the tool frame (``robot.tool_frame``) where it is now, in the world frame;
+- RetrieveRobotStateParameter: the planning group's joints where they are now;
 - GetPointsFromUser: the centre of the latest image of ``view_name``, once per point;
 - DoTeleoperateAction: the session ends at once, the robot where it is.
 """
@@ -20,7 +22,15 @@ import threading
 import time
 from typing import Any
 
-from kinema.behaviors import AsyncBehavior, NodeStatus, PortInfo, StatefulBehavior, input_port, output_port
+from kinema.behaviors import (
+    AsyncBehavior,
+    FormerSpelling,
+    NodeStatus,
+    PortInfo,
+    StatefulBehavior,
+    input_port,
+    output_port,
+)
 from kinema.behaviors.cell_ports import cell_input_port
 from kinema.config.cell import JOINT_TRAJECTORY_CONTROLLER
 from kinema.errors import KinemaError, TransportError
@@ -31,12 +41,17 @@ from kinema.ui_topics import (
     USER_INPUT_TYPE,
 )
 
-from ..messages.conversions import pose_stamped_message
+from ..messages.conversions import joint_state_message, pose_stamped_message
 from ..messages.ports import PortValueError, fails_on_bad_input, message_output, port_error, read_input
+from ..motion.joint_states import joint_state_monitor
 from .approval import AUTO_APPROVE_ENV, DISCOVERY_SECONDS, auto_approve
 
 # How long the user may take (an hour at most; halting the node stops waiting for them).
 ANSWER_SECONDS = 3600.0
+# How long RetrieveRobotStateParameter waits for the robot's joint state to start the form from.
+JOINT_STATE_SECONDS = 5.0
+# MoveIt Pro 10's teleoperation slots a retrieval reads (its ``command_type``).
+COMMAND_TYPES = ("waypoint", "joint_slider", "interactive_marker")
 # How long an automatic answer waits for an image to learn its size.
 IMAGE_SECONDS = 10.0
 IMAGE_TYPE = "sensor_msgs/msg/Image"
@@ -149,6 +164,128 @@ class RetrievePoseParameter(AsyncBehavior):
             return False
         self.set_output("pose", response.pose)
         return True
+
+
+class RetrieveRobotStateParameter(AsyncBehavior):
+    """Asks the user for joint values and writes them to ``joint_state`` (MoveIt Pro: the robot state its
+    UI's joint sliders or waypoint buttons store; formerly RetrieveJointStateParameter). The question covers
+    the config's planning group (``moveit_params.joint_group_name``; every joint of ``/joint_states``
+    without one), and the TUI asks with a form prefilled with where those joints are now; see the module
+    for the headless rule. Fails when the user cancels, answers joints that were not asked, or no answer
+    comes within ``timeout_sec``.
+    """
+
+    subcategory = "User Input"
+    former_spellings = (FormerSpelling("RetrieveJointStateParameter"),)
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [
+            input_port(
+                "timeout_sec",
+                float,
+                -1.0,
+                "Seconds to wait for the user's joint values (negative: as long as it takes, up to an hour).",
+            ),
+            input_port(
+                "command_type",
+                str,
+                "",
+                "MoveIt Pro 10's teleoperation slot the target is read from (waypoint, joint_slider or "
+                "interactive_marker). Kinema's UIs answer the question directly, so the slot only names the "
+                "question; '' (files older than MoveIt Pro 10) asks the same way.",
+            ),
+            message_output(
+                "joint_state",
+                "sensor_msgs/msg/JointState",
+                "{joint_state}",
+                "The joint values the user gave (what Move to Joint State and Interpolate to Joint State "
+                "take as target_joint_state).",
+            ),
+        ]
+
+    @fails_on_bad_input
+    async def do_work(self) -> bool:
+        import asyncio
+
+        timeout = float(read_input(self, "timeout_sec"))
+        slot = str(self.get_input_or("command_type", "") or "").strip()
+        if slot and slot not in COMMAND_TYPES:
+            raise port_error(
+                self, "command_type", f"= {slot!r} is no teleoperation slot", _one_of(COMMAND_TYPES)
+            )
+        try:
+            start = await asyncio.to_thread(self._current_joints)
+        except KinemaError as error:
+            self.logger.publish_failure(f"RetrieveRobotStateParameter: {error}")
+            return False
+        prompt = "Give the target joint values" + (f" ({slot.replace('_', ' ')})" if slot else "")
+        try:
+            response = await ask_user(
+                self,
+                _request(self, "joint_state", prompt, initial_joint_state=start),
+                ANSWER_SECONDS if timeout < 0 else timeout,
+            )
+        except TransportError as error:
+            self.logger.publish_failure(
+                f"RetrieveRobotStateParameter: no joint values from the user: {error.message}"
+            )
+            return False
+        if response is None:
+            if not auto_approve():
+                self.logger.publish_failure(no_user_message(self, "give joint values"))
+                return False
+            self.logger.publish_warn(
+                f"{prompt} — answered automatically with the joints where they are ({AUTO_APPROVE_ENV}=1)"
+            )
+            self.set_output("joint_state", start)
+            return True
+        if not response.accepted:
+            said = f": {response.message}" if str(response.message) else ""
+            self.logger.publish_failure(f"RetrieveRobotStateParameter: the user gave no joint values{said}")
+            return False
+        answer = response.joint_state
+        asked = [str(name) for name in start.name]
+        names, positions = [str(name) for name in answer.name], [float(p) for p in answer.position]
+        unknown = [name for name in names if name not in asked]
+        if not names or unknown or len(positions) != len(names):
+            problem = (
+                f"joints that were not asked: {', '.join(unknown)}"
+                if unknown
+                else f"{len(names)} names and {len(positions)} positions"
+            )
+            self.logger.publish_failure(
+                f"RetrieveRobotStateParameter: the UI answered {problem}; the question was about "
+                f"{', '.join(asked)}"
+            )
+            return False
+        self.set_output("joint_state", joint_state_message(names, positions))
+        return True
+
+    def _current_joints(self) -> Any:
+        """The config's planning group's joints (or all of ``/joint_states``) where they are now."""
+        message = joint_state_monitor(self.context, self.registration_id).fresh(JOINT_STATE_SECONDS)
+        current = dict(
+            zip((str(n) for n in message.name), (float(p) for p in message.position), strict=False)
+        )
+        cell, model = self.context.cell, self.context.robot_model
+        group = cell.planning_group if cell is not None else None
+        if not group or model is None:
+            return joint_state_message(list(current), list(current.values()))
+        if group not in model.groups:
+            raise KinemaError(
+                f"the config's planning group {group!r} (moveit_params.joint_group_name) is not in the "
+                f"robot's SRDF; groups: {', '.join(model.groups)}"
+            )
+        joints = list(model.group(group).joint_names)
+        missing = [name for name in joints if name not in current]
+        if missing:
+            raise KinemaError(f"/joint_states lacks {', '.join(missing)} of planning group {group!r}")
+        return joint_state_message(joints, [current[name] for name in joints])
+
+
+def _one_of(values: tuple[str, ...]) -> str:
+    return "give one of " + ", ".join(values) + ", or leave it empty"
 
 
 class GetPointsFromUser(AsyncBehavior):

@@ -1,7 +1,8 @@
-"""What only the user can give a running objective: a pose, points on a camera image, a teleoperation session.
+"""What only the user can give a running objective: a pose, joint values, points on a camera image, a
+teleoperation session.
 
 Each dialog answers one :class:`~kinema.tui.connection.UserInputRequested` (RetrievePoseParameter,
-GetPointsFromUser, DoTeleoperateAction of the core behaviors) and returns a
+RetrieveRobotStateParameter, GetPointsFromUser, DoTeleoperateAction of the core behaviors) and returns a
 :class:`~kinema.tui.connection.UserInputAnswer`; Escape cancels (the behavior then fails).
 """
 
@@ -20,6 +21,7 @@ from textual.widgets import Button, Input, Label, Static
 
 from kinema.tui.connection import (
     TELEOP_CLOSE_GRIPPER,
+    TELEOP_JOINT_VALUES,
     TELEOP_OPEN_GRIPPER,
     TELEOP_TARGET_POSE,
     CameraImage,
@@ -112,6 +114,53 @@ class PoseDialog(_UserInputDialog):
         self.dismiss(
             UserInputAnswer(True, "", frame, position, orientation)  # type: ignore[arg-type]
         )
+
+
+class JointStateDialog(_UserInputDialog):
+    """A value per joint (rad, or m for a prismatic joint), each prefilled with where the joint is now.
+    Enter in the last field or OK gives them."""
+
+    def compose(self) -> ComposeResult:
+        request = self.request
+        with Vertical(classes="dialog wide"):
+            yield from self.compose_title()
+            for index, (name, value) in enumerate(
+                zip(request.joint_names, request.joint_positions, strict=False)
+            ):
+                yield Label(name)
+                yield Input(_text((value,)), id=f"joint-{index}")
+            with Horizontal(classes="dialog-buttons"):
+                yield Button("OK", variant="primary", id="ok")
+                yield Button("Cancel (Esc)", id="cancel")
+
+    def on_mount(self) -> None:
+        if self.request.joint_names:
+            self.set_focus(self.query_one("#joint-0", Input))
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        event.stop()
+        if event.input.id == f"joint-{len(self.request.joint_names) - 1}":
+            self._give()
+        else:
+            self.focus_next()
+
+    def on_button_pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        if event.button.id == "ok":
+            self._give()
+        else:
+            self.action_cancel()
+
+    def _give(self) -> None:
+        values: list[float] = []
+        for index, name in enumerate(self.request.joint_names):
+            try:
+                (value,) = _numbers(self.query_one(f"#joint-{index}", Input).value, 1, name)
+            except ValueError as error:
+                self.notify(str(error), severity="warning")
+                return
+            values.append(value)
+        self.dismiss(UserInputAnswer(True, "", joint_positions=tuple(values)))
 
 
 class PointsDialog(_UserInputDialog):
@@ -238,7 +287,8 @@ class PointsDialog(_UserInputDialog):
 
 class TeleoperateDialog(_UserInputDialog):
     """A teleoperation session: each button tells the running objective a mode (open or close the gripper,
-    move to a target pose, which then asks for the pose); Done ends the session, Cancel fails it."""
+    move to a target pose or to joint values, which then ask for them); Done ends the session, Cancel fails
+    it."""
 
     BINDINGS = [
         Binding("ctrl+d", "done", "Done", id="dialog.done", tooltip="End it; the objective goes on"),
@@ -246,6 +296,7 @@ class TeleoperateDialog(_UserInputDialog):
     ]
     MODES = (
         (TELEOP_TARGET_POSE, "Move to a pose", "teleop-pose"),
+        (TELEOP_JOINT_VALUES, "Move to joint values", "teleop-joints"),
         (TELEOP_OPEN_GRIPPER, "Open gripper", "teleop-open"),
         (TELEOP_CLOSE_GRIPPER, "Close gripper", "teleop-close"),
     )
@@ -282,7 +333,7 @@ class TeleoperateDialog(_UserInputDialog):
             self.choose(mode)
 
     def choose(self, mode: int) -> None:
-        """Pick ``mode``: the objective acts on it (a pose question follows for a target pose)."""
+        """Pick ``mode``: the objective acts on it (a pose or joint values question follows for a move)."""
         self.mode = mode
         self.query_one("#teleop-mode", Label).update(self._mode_text())
         self._pick_mode(mode)
