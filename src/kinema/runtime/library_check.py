@@ -6,11 +6,11 @@ first problem of each objective that does not, as ``file:line: message``, so ``k
 can say in one line why an objective will not run.
 
 Loading every behavior of a config to check its library takes most of a ``kinema objective list``, so the
-answer is kept (:class:`LibraryCheckCache`) under a fingerprint of everything it depends on: the library's
-objective files (their content), the source files of the plugins the config activates and of Kinema itself (path, nanosecond
-mtime and size of each), and the interpreter. Any change to one of them checks again. Only a check in
-which every plugin loaded is kept, so a plugin that failed for a passing reason (its import ran out of time
-on a busy machine) is tried again next time.
+answer is kept (:class:`LibraryCheckCache`) under a fingerprint of everything it depends on: the content of
+the library's objective files, the source files of the plugins the config activates and of Kinema itself
+(path, nanosecond mtime and size of each), and the interpreter. Any change to one of them checks again.
+Only a check in which every plugin loaded is kept, so a plugin that failed for a passing reason (its import
+ran out of time on a busy machine) is tried again next time.
 """
 
 from __future__ import annotations
