@@ -405,10 +405,14 @@ class ActionServer:
         with handle._lock:
             if handle.status == STATUS_ACCEPTED:
                 handle.status = STATUS_EXECUTING
-        self._publish_status()
         if self._deferred:
             self._start_deferred(handle)
+            # Published once the goal is under way (its result waits for nothing here); a goal that
+            # ended meanwhile was published as it ended.
+            if handle.is_active:
+                self._publish_status()
             return
+        self._publish_status()
         thread = threading.Thread(
             target=self._execute, args=(handle,), name=f"kinema-goal{self.name}", daemon=True
         )
