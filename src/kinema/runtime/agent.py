@@ -126,6 +126,8 @@ class _Streams:
         self._blackboard = node.create_publisher(names.BLACKBOARD_TYPE, names.BLACKBOARD, latched=True)
         self._log = node.create_publisher(names.LOG_TYPE, names.LOG)
         self._status: tuple[ObjectiveStatus, str] = (ObjectiveStatus.IDLE, "")
+        # Status changes whose heartbeat is not out yet (see on_status), oldest first.
+        self._owed: list[tuple[ObjectiveStatus, str]] = []
         self._last_blackboard: list[tuple[str, str, str, str]] | None = None
         self._render_cache: dict[int, tuple[Any, str]] = {}
         # Whether the last snapshot handed to the worker was empty (another empty one would change nothing).
@@ -150,22 +152,16 @@ class _Streams:
         """Publish the heartbeat and, with ``health``, the watchdog's report (the periodic beat does; a
         status change, on the tick thread, sends the heartbeat alone: the latched report stands)."""
         report = self._server.health() if health else None
+        # The status is read where it is published, under the lock on_status takes to change it: a beat
+        # read before a run ended and sent after it would tell subscribers the run restarted. Changes
+        # not yet published go out in order, the last of them being the current status.
+        if not self._pay_owed():
+            with self._lock:
+                self._publish_beat(*self._status)
+        if report is None:
+            return
         with self._lock:
-            # The status is read where it is published, under the lock on_status takes to change it:
-            # a beat read before a run ended and sent after it would tell subscribers the run restarted.
-            status, name = self._status
-            now = time.time()
-            clock_now = self._clock.now() if self._clock is not None and not _is_wall(self._clock) else now
-            stamp = self._time_class(*time_parts(now))
-            message = self._heartbeat_class(
-                process_timestamp=stamp,
-                ros_timestamp=stamp if clock_now == now else self._time_class(*time_parts(clock_now)),
-                objective_name=name,
-                objective_status=str(status),
-            )
-            self._heartbeat.publish(message)
-            if report is None:
-                return
+            stamp = self._time_class(*time_parts(time.time()))
             self._health.publish(
                 self._health_class(
                     stamp=stamp,
@@ -181,6 +177,36 @@ class _Streams:
             # Once per problem on the log topic too, so `kinema run`'s terminal and the TUI's log show it.
             self.publish_log(LOG_WARN, f"watchdog: {warning}")
 
+    def _publish_beat(self, status: ObjectiveStatus, name: str) -> None:
+        """Publish one heartbeat saying ``status`` (the lock held)."""
+        now = time.time()
+        clock_now = self._clock.now() if self._clock is not None and not _is_wall(self._clock) else now
+        stamp = self._time_class(*time_parts(now))
+        message = self._heartbeat_class(
+            process_timestamp=stamp,
+            ros_timestamp=stamp if clock_now == now else self._time_class(*time_parts(clock_now)),
+            objective_name=name,
+            objective_status=str(status),
+        )
+        self._heartbeat.publish(message)
+
+    def _pay_owed(self) -> bool:
+        """Publish the heartbeats of the status changes that wait, in order, and log them; False when
+        none waited."""
+        with self._lock:
+            owed, self._owed = self._owed, []
+            for status, name in owed:
+                self._publish_beat(status, name)
+        for status, name in owed:
+            # How a run ends is logged by on_run_finished, once its clients have their answer.
+            log.log(
+                logging.INFO if status is ObjectiveStatus.RUNNING else logging.DEBUG,
+                "objective %r: %s",
+                name,
+                status,
+            )
+        return bool(owed)
+
     def publish_log(self, level: int, text: str) -> None:
         from kinema.transport.messages import msg
 
@@ -193,16 +219,17 @@ class _Streams:
     def on_status(self, status: ObjectiveStatus, objective_name: str) -> None:
         with self._lock:
             self._status = (status, objective_name)
-        # How a run ends is logged by on_run_finished, once its clients have their answer.
-        log.log(
-            logging.INFO if status is ObjectiveStatus.RUNNING else logging.DEBUG,
-            "objective %r: %s",
-            objective_name,
-            status,
-        )
-        self.publish_heartbeat(health=False)
+            self._owed.append((status, objective_name))
+        if status in (ObjectiveStatus.LOADING, ObjectiveStatus.RUNNING):
+            # Published with the run's first node changes or its end, whichever comes first (a run that
+            # ends in its first tick has answered its client by then), or by the next periodic beat: a
+            # long build or first tick still shows within a heartbeat period.
+            return
+        self._pay_owed()
 
     def on_node_status(self, objective_name: str, changes: NodeStatusBatch) -> None:
+        if self._owed:
+            self._pay_owed()
         table = changes.table
         if table.id != self._table_id:
             # Once per run, latched, before its first changes: subscribers name nodes with it.

@@ -173,3 +173,37 @@ def test_a_large_tick_is_published_as_several_node_status_messages_in_order() ->
     tree.tick_once()
     streams.on_node_status("Big", recorder.take())  # type: ignore[arg-type]
     assert [topic for topic, _ in sent] == ["/objective_server/node_status"] * 3
+
+
+def test_loading_and_running_beats_wait_for_the_first_node_changes_the_end_or_the_periodic_beat() -> None:
+    """A run that ends in its first tick answers its client before any heartbeat of it is published;
+    every status change still gets its heartbeat, in order, and a long build shows within a beat."""
+    from kinema.runtime.agent import _Streams
+    from kinema.runtime.objective_status import ObjectiveStatus
+
+    beats: list[str] = []
+
+    class Publisher:
+        def __init__(self, topic: str) -> None:
+            self.topic = topic
+
+        def publish(self, message: Any) -> None:
+            if "heartbeat" in self.topic:
+                beats.append(str(message.objective_status))
+
+    node = SimpleNamespace(create_publisher=lambda _type, topic, **_: Publisher(topic))
+    report = SimpleNamespace(tick_thread_alive=True, replacements=0, warnings=())
+    server = SimpleNamespace(health=lambda: report)
+    streams = _Streams(node, None, server)  # type: ignore[arg-type]
+    streams.on_status(ObjectiveStatus.LOADING, "Quick")
+    streams.on_status(ObjectiveStatus.RUNNING, "Quick")
+    assert beats == []
+    streams.on_status(ObjectiveStatus.SUCCESS, "Quick")
+    assert beats == ["Loading", "Running", "Success"]
+
+    beats.clear()
+    streams.on_status(ObjectiveStatus.LOADING, "Slow to build")
+    streams.publish_heartbeat()  # the periodic beat, 10 Hz
+    assert beats == ["Loading"]
+    streams.publish_heartbeat()
+    assert beats == ["Loading", "Loading"]
