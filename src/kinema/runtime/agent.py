@@ -28,6 +28,8 @@ from kinema.runtime import names
 from kinema.runtime.background_work import HandOff
 from kinema.runtime.blackboard_text import render_value
 from kinema.runtime.error_codes import MoveItErrorCode
+from kinema.runtime.heartbeat_cdr import HeartbeatEncoder
+from kinema.runtime.heartbeat_cdr import generic_serializer as heartbeat_serializer
 from kinema.runtime.node_status_cdr import NodeStatusCodesEncoder, generic_serializer, time_parts
 from kinema.runtime.objective_server import (
     ObjectiveRequest,
@@ -137,7 +139,7 @@ class _Streams:
         from kinema.transport.messages import load_interfaces
 
         registry = load_interfaces()
-        self._heartbeat_class = registry.message_class(names.HEARTBEAT_TYPE)
+        self._heartbeat_encoder = HeartbeatEncoder(heartbeat_serializer(registry, names.HEARTBEAT_TYPE))
         self._health_class = registry.message_class(names.HEALTH_TYPE)
         self._time_class = registry.message_class("builtin_interfaces/msg/Time")
         # Also tells the clients waiting for a run (set by the Agent).
@@ -181,14 +183,9 @@ class _Streams:
         """Publish one heartbeat saying ``status`` (the lock held)."""
         now = time.time()
         clock_now = self._clock.now() if self._clock is not None and not _is_wall(self._clock) else now
-        stamp = self._time_class(*time_parts(now))
-        message = self._heartbeat_class(
-            process_timestamp=stamp,
-            ros_timestamp=stamp if clock_now == now else self._time_class(*time_parts(clock_now)),
-            objective_name=name,
-            objective_status=str(status),
-        )
-        self._heartbeat.publish(message)
+        stamp = time_parts(now)
+        ros_stamp = stamp if clock_now == now else time_parts(clock_now)
+        self._heartbeat.publish_raw(self._heartbeat_encoder.encode(stamp, ros_stamp, name, str(status)))
 
     def _pay_owed(self) -> bool:
         """Publish the heartbeats of the status changes that wait, in order, and log them; False when

@@ -8,9 +8,11 @@ from typing import Any
 import pytest
 
 from kinema.errors import ObjectiveError
+from kinema.runtime import names
 from kinema.runtime.agent import overrides_from_messages, render_value, result_message
 from kinema.runtime.overrides import ParameterOverride
 from kinema.runtime.result import ObjectiveResult
+from kinema.transport.messages import load_interfaces
 
 
 def _parameter(name: str, kind: int, **values: Any) -> SimpleNamespace:
@@ -95,6 +97,9 @@ def test_a_heartbeat_never_reports_a_status_older_than_the_one_published_before_
         def publish(self, message: Any) -> None:
             if "heartbeat" in self.topic:
                 beats.append(str(message.objective_status))
+
+        def publish_raw(self, payload: bytes) -> None:
+            self.publish(load_interfaces().deserialize(payload, names.HEARTBEAT_TYPE))
 
     node = SimpleNamespace(create_publisher=lambda _type, topic, **_: Publisher(topic))
     in_health, release = threading.Event(), threading.Event()
@@ -191,6 +196,9 @@ def test_loading_and_running_beats_wait_for_the_first_node_changes_the_end_or_th
             if "heartbeat" in self.topic:
                 beats.append(str(message.objective_status))
 
+        def publish_raw(self, payload: bytes) -> None:
+            self.publish(load_interfaces().deserialize(payload, names.HEARTBEAT_TYPE))
+
     node = SimpleNamespace(create_publisher=lambda _type, topic, **_: Publisher(topic))
     report = SimpleNamespace(tick_thread_alive=True, replacements=0, warnings=())
     server = SimpleNamespace(health=lambda: report)
@@ -207,3 +215,16 @@ def test_loading_and_running_beats_wait_for_the_first_node_changes_the_end_or_th
     assert beats == ["Loading"]
     streams.publish_heartbeat()
     assert beats == ["Loading", "Loading"]
+
+
+@pytest.mark.parametrize("name", ["", "a", "ab", "abc", "Pick \u00e9 and place", "x" * 257])
+@pytest.mark.parametrize("status", ["Idle", "Running", "Cancelled", ""])
+def test_the_heartbeat_laid_out_directly_is_what_the_generic_serializer_writes(
+    name: str, status: str
+) -> None:
+    from kinema.runtime.heartbeat_cdr import HeartbeatEncoder, generic_serializer
+
+    generic = generic_serializer(load_interfaces(), names.HEARTBEAT_TYPE)
+    encoder = HeartbeatEncoder(generic)
+    stamps = ((1_700_000_000, 999_999_999), (42, 7))
+    assert encoder.encode(*stamps, name, status) == generic(*stamps, name, status)
