@@ -10,9 +10,11 @@ So ``ros2 action send_goal`` against a Kinema action server, and a Kinema client
 server on rmw_zenoh, both work.
 
 A Kinema client asks for the result right after sending the goal, without waiting for the acceptance: one
-round trip instead of two for a goal that ends at once. A Kinema server holds a ``get_result`` that comes
-before its goal until the goal is decided (:data:`EARLY_RESULT_HOLD_S` at most); another server answers it
-UNKNOWN at once, and the client then asks again once the goal is accepted, as rcl does.
+round trip instead of two for a goal that ends at once. The replies of that request wait in a channel that
+the thread which needs the result reads itself (``result()``), so no other thread is woken for them. A
+Kinema server holds a ``get_result`` that comes before its goal until the goal is decided
+(:data:`EARLY_RESULT_HOLD_S` at most); another server answers it UNKNOWN at once, and the client then asks
+again once the goal is accepted, as rcl does.
 """
 
 from __future__ import annotations
@@ -26,10 +28,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Generic
 
+import zenoh
+
 from kinema.errors import TransportError
 from kinema.interfaces import ActionType
 from kinema.interfaces.definition import FeedbackT, GoalT, ResultT
-from kinema.transport.dispatch import inline
 from kinema.transport.goal_status_cdr import (
     CDR_LE_HEADER,
     payload_of_chunks,
@@ -649,6 +652,12 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         # request ended without the result (the server did not know the goal yet).
         self._decided = False
         self._unanswered = False
+        # That request's replies (a zenoh channel and the request's sequence number) until they are read,
+        # whether a thread reads them now, and what they said so far.
+        self._early: tuple[Any, int] | None = None
+        self._early_reader = False
+        self._early_response: Any = None
+        self._early_errors: list[str] = []
 
     @property
     def goal_uuid(self) -> uuid.UUID:
@@ -662,18 +671,25 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
 
     def done(self) -> bool:
         """True once the result (or a failure to get it) arrived."""
+        if not self._done.is_set():
+            self._read_early(block=False)
         return self._done.is_set()
 
     def add_done_callback(self, callback: Callable[[ClientGoalHandle[ResultT, FeedbackT]], Any]) -> None:
         """Call ``callback(handle)`` when the goal ends (at once if it already has).
 
-        It runs on the transport's thread that received the result: it must return quickly (hand the
+        It runs on a transport thread that received the result: it must return quickly (hand the
         work to a loop or an event).
         """
         with self._lock:
             if not self._done.is_set():
                 self._callbacks.append(callback)
-                return
+                waiting = True
+            else:
+                waiting = False
+        if waiting:
+            self._read_early_on_thread()
+            return
         callback(self)
 
     def cancel(self, timeout: float = 5.0) -> bool:
@@ -692,6 +708,13 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         """
         if not self.accepted:
             raise TransportError(f"goal {self.goal_uuid} was rejected by {self.client.name}")
+        if not self._done.is_set():
+            # The result request sent with the goal ends within _EARLY_RESULT_QUERY_TIMEOUT: a wait at least
+            # that long reads its replies here; a shorter one leaves that to a thread.
+            if timeout is None or timeout >= _EARLY_RESULT_QUERY_TIMEOUT:
+                self._read_early(block=True)
+            else:
+                self._read_early_on_thread()
         if not self._done.wait(timeout):
             raise TransportError(
                 f"goal {self.goal_uuid} on {self.client.name} did not finish within {timeout:g} s "
@@ -714,6 +737,76 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
             ask = accepted and self._unanswered and not self._done.is_set()
         if ask:
             self.client._wait_result_on_thread(self)
+
+    def _read_early(self, *, block: bool) -> None:
+        """Read the replies of the result request sent with the goal on this thread: until the goal ends
+        or the request does (``block``), or only those already there. One thread reads at a time; the
+        others return at once."""
+        with self._lock:
+            if self._early is None or self._early_reader:
+                return
+            self._early_reader = True
+            replies, sequence = self._early
+        ended = False
+        try:
+            while not self._done.is_set():
+                try:
+                    reply = replies.recv() if block else replies.try_recv()
+                except zenoh.ZError:  # the request ended: its channel is closed and empty
+                    ended = True
+                    break
+                if reply is None:
+                    break
+                self._take_early_reply(reply, sequence)
+        finally:
+            with self._lock:
+                self._early_reader = False
+                if ended or self._done.is_set():
+                    self._early = None
+        if ended:
+            self._early_request_ended()
+
+    def _read_early_on_thread(self) -> None:
+        """Read the result request's replies on a thread of their own (for done callbacks and short waits)."""
+        with self._lock:
+            if self._early is None or self._early_reader:
+                return
+        threading.Thread(
+            target=self._read_early,
+            kwargs={"block": True},
+            name=f"kinema-result{self.client.name}",
+            daemon=True,
+        ).start()
+
+    def _take_early_reply(self, reply: Any, sequence: int) -> None:
+        try:
+            if reply.ok is not None:
+                if self._early_response is not None:
+                    return
+                response = self.client._get_result._decode_reply(reply.ok, sequence)
+                self._early_response = response
+                status = int(response.status)
+                if status in (STATUS_SUCCEEDED, STATUS_CANCELED):  # only an abort is followed by an error
+                    self._finish(GoalResult(status, response.result), None)
+            elif reply.err is not None:
+                self._early_errors.append(reply.err.payload.to_string())
+        except Exception:
+            log.exception("%s: the result of goal %s is unreadable", self.client.name, self.goal_uuid)
+
+    def _early_request_ended(self) -> None:
+        """The result request sent with the goal ended: finish with what it said, or ask again."""
+        try:
+            if self._done.is_set():
+                return
+            errors, response = self._early_errors, self._early_response
+            if errors and errors[0] != "Timeout":
+                self._finish(None, TransportError(errors[0]))
+            elif response is not None and int(response.status) != STATUS_UNKNOWN:
+                self._finish(GoalResult(int(response.status), response.result), None)
+            else:
+                self._early_request_unanswered()
+        except Exception:
+            log.exception("%s: the result request of goal %s failed", self.client.name, self.goal_uuid)
 
     def _early_request_unanswered(self) -> None:
         """The result request sent with the goal ended without the result."""
@@ -840,7 +933,8 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
             self._pending.pop(handle.goal_id, None)
 
     def _ask_result_early(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
-        """Send the goal's get_result now; its replies finish the handle on the transport's thread.
+        """Send the goal's get_result now; its replies wait in a channel for whoever needs the result
+        (:meth:`ClientGoalHandle._read_early`).
 
         A Kinema server holds the request until the goal ends. When it ends without the result (a server
         that answers UNKNOWN for a goal it has not accepted yet, none reachable, or no answer within
@@ -849,45 +943,14 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         """
         client = self._get_result
         sequence = client._next_sequence()
-        response: list[Any] = []
-        errors: list[str] = []
-
-        def on_reply(reply: Any) -> None:
-            try:
-                if reply.ok is not None:
-                    if response:
-                        return
-                    response.append(client._decode_reply(reply.ok, sequence))
-                    status = int(response[0].status)
-                    if status in (STATUS_SUCCEEDED, STATUS_CANCELED):  # only an abort is followed by an error
-                        handle._finish(GoalResult(status, response[0].result), None)
-                elif reply.err is not None:
-                    errors.append(reply.err.payload.to_string())
-            except Exception:
-                log.exception("%s: the result of goal %s is unreadable", self.name, handle.goal_uuid)
-
-        def on_end() -> None:
-            try:
-                if handle.done():
-                    return
-                if errors and errors[0] != "Timeout":
-                    handle._finish(None, TransportError(errors[0]))
-                elif response and int(response[0].status) != STATUS_UNKNOWN:
-                    handle._finish(GoalResult(int(response[0].status), response[0].result), None)
-                else:
-                    handle._early_request_unanswered()
-            except Exception:
-                log.exception("%s: the result request of goal %s failed", self.name, handle.goal_uuid)
-
         try:
-            client._send(
-                CDR_LE_HEADER + handle.goal_id,
-                _EARLY_RESULT_QUERY_TIMEOUT,
-                inline(on_reply, on_end),
-                sequence=sequence,
+            _sequence, replies = client._send(
+                CDR_LE_HEADER + handle.goal_id, _EARLY_RESULT_QUERY_TIMEOUT, sequence=sequence
             )
         except TransportError:
             handle._early_request_unanswered()
+            return
+        handle._early = (replies, sequence)
 
     def _wait_result_on_thread(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
         threading.Thread(
@@ -959,6 +1022,7 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
                 statuses = {_uuid_bytes(s.goal_info.goal_id): int(s.status) for s in message.status_list}
             for goal_id, status in statuses.items():
                 handle = pending.get(goal_id)
+                # done() also takes a result that arrived for a goal whose caller has not asked yet.
                 if handle is not None and not handle.done():
                     handle.status = status
         except Exception:

@@ -309,3 +309,41 @@ def test_a_server_that_does_not_hold_early_result_requests_still_delivers_result
     assert handle.accepted and answered_unknown.is_set()
     outcome = handle.result(timeout=10)
     assert outcome.succeeded and outcome.result.sequence.tolist() == [0, 1, 1, 2, 3]
+
+
+def test_the_result_is_read_by_the_thread_that_waits_for_it(
+    connect: Callable[[], Session], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # No transport thread is woken to hand the result over: the caller of result() reads its reply.
+    finished_on: list[str] = []
+    finish = action_module.ClientGoalHandle._finish
+
+    def recording_finish(self: Any, outcome: Any, error: Any) -> None:
+        finished_on.append(threading.current_thread().name)
+        finish(self, outcome, error)
+
+    monkeypatch.setattr(action_module.ClientGoalHandle, "_finish", recording_finish)
+    Node(connect(), "server").create_action_server(FIB, "/waited", _fibonacci)
+    client = _client(connect, "/waited")
+    waiter = threading.Thread(
+        target=lambda: client.send_goal({"order": 4}).result(), name="the waiting thread"
+    )
+    waiter.start()
+    waiter.join(10)
+    assert finished_on == ["the waiting thread"]
+
+
+def test_a_result_nobody_waits_for_still_ends_the_goal(connect: Callable[[], Session]) -> None:
+    Node(connect(), "server").create_action_server(FIB, "/unwatched", _fibonacci)
+    client = _client(connect, "/unwatched")
+    polled = client.send_goal({"order": 3})
+    deadline = time.monotonic() + 10
+    while not polled.done():
+        assert time.monotonic() < deadline, "done() never turned true"
+        time.sleep(0.01)
+    assert polled.status == STATUS_SUCCEEDED
+    called = threading.Event()
+    with_callback = client.send_goal({"order": 3})
+    with_callback.add_done_callback(lambda _handle: called.set())
+    assert called.wait(10)
+    assert with_callback.result(timeout=0.1).result.sequence.tolist() == [0, 1, 1]
