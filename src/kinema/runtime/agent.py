@@ -130,6 +130,8 @@ class _Streams:
         self._status: tuple[ObjectiveStatus, str] = (ObjectiveStatus.IDLE, "")
         # Status changes whose heartbeat is not out yet (see on_status), oldest first.
         self._owed: list[tuple[ObjectiveStatus, str]] = []
+        # The objective whose "Running" line is not logged yet (see _pay_owed).
+        self._running_unlogged: str | None = None
         self._last_blackboard: list[tuple[str, str, str, str]] | None = None
         self._render_cache: dict[int, tuple[Any, str]] = {}
         # Whether the last snapshot handed to the worker was empty (another empty one would change nothing).
@@ -162,6 +164,7 @@ class _Streams:
                 self._publish_beat(*self._status)
         if report is None:
             return
+        self._log_running()
         with self._lock:
             stamp = self._time_class(*time_parts(time.time()))
             self._health.publish(
@@ -194,15 +197,20 @@ class _Streams:
             owed, self._owed = self._owed, []
             for status, name in owed:
                 self._publish_beat(status, name)
+                if status is ObjectiveStatus.RUNNING:
+                    # Logged once the run still runs a heartbeat period or a tick later (_log_running): a
+                    # run that ends sooner gets only its result's line, a file write less per run.
+                    self._running_unlogged = name
         for status, name in owed:
-            # How a run ends is logged by on_run_finished, once its clients have their answer.
-            log.log(
-                logging.INFO if status is ObjectiveStatus.RUNNING else logging.DEBUG,
-                "objective %r: %s",
-                name,
-                status,
-            )
+            if status is not ObjectiveStatus.RUNNING:
+                log.debug("objective %r: %s", name, status)
         return bool(owed)
+
+    def _log_running(self) -> None:
+        with self._lock:
+            name, self._running_unlogged = self._running_unlogged, None
+        if name is not None:
+            log.info("objective %r: %s", name, ObjectiveStatus.RUNNING)
 
     def publish_log(self, level: int, text: str) -> None:
         from kinema.transport.messages import msg
@@ -228,7 +236,9 @@ class _Streams:
         if self._owed:
             self._pay_owed()
         table = changes.table
-        if table.id != self._table_id:
+        if table.id == self._table_id:
+            self._log_running()  # a later tick of the run
+        else:
             # Once per run, latched, before its first changes: subscribers name nodes with it.
             table_class = self._node_table_class
             if table_class is None:
@@ -309,6 +319,8 @@ class _Streams:
             self.on_warning(text)
 
     def on_run_finished(self, run: ObjectiveRun, result: ObjectiveResult) -> None:
+        with self._lock:
+            self._running_unlogged = None
         if result.succeeded:
             log.info("%s", result)
         elif result.cancelled:
@@ -364,6 +376,9 @@ class Agent:
         self.waypoints = waypoints
         self.clock = clock
         self.node = node if node is not None else Node(session, names.NODE_NAME)
+        registry = session.registry
+        self._goal_result_class = registry.message_class(registry.action(names.DO_OBJECTIVE_TYPE).result)
+        self._error_codes_class = registry.message_class("moveit_msgs/msg/MoveItErrorCodes")
         self._streams = _Streams(self.node, clock, server)
         self._streams.on_warning = lambda text: self._tell_quick_clients("warn", text)
         server.add_listener(self._streams)
@@ -590,7 +605,14 @@ class Agent:
     def _end_goal(self, handle: Any, result: ObjectiveResult) -> None:
         """Answer a goal's clients with how its run ended (a done callback of the run: the tick thread)."""
         try:
-            payload = {"error_code": result_message(result), "error_message": result.error_message}
+            # Built from the classes: from_dict's checks of each field cost more than the rest of the
+            # answer, on the tick thread, once per goal.
+            payload = self._goal_result_class(
+                error_code=self._error_codes_class(
+                    val=int(result.error_code), message=result.error_message, source=names.NODE_NAME
+                ),
+                error_message=result.error_message,
+            )
             if result.succeeded:
                 handle.succeed(payload)
             elif result.cancelled:

@@ -228,3 +228,35 @@ def test_the_heartbeat_laid_out_directly_is_what_the_generic_serializer_writes(
     encoder = HeartbeatEncoder(generic)
     stamps = ((1_700_000_000, 999_999_999), (42, 7))
     assert encoder.encode(*stamps, name, status) == generic(*stamps, name, status)
+
+
+def test_only_a_run_still_running_a_beat_later_gets_a_running_line(caplog: pytest.LogCaptureFixture) -> None:
+    """One line per quick run (its result), not two: the "Running" line is a file write on the tick
+    thread per run; a run that lasts gets it from the periodic beat (or its next tick)."""
+    import logging
+
+    from kinema.runtime.agent import _Streams
+    from kinema.runtime.objective_status import ObjectiveStatus
+
+    class Publisher:
+        def publish(self, message: Any) -> None: ...
+
+        def publish_raw(self, payload: bytes) -> None: ...
+
+    node = SimpleNamespace(create_publisher=lambda *_args, **_kwargs: Publisher())
+    report = SimpleNamespace(tick_thread_alive=True, replacements=0, warnings=())
+    streams = _Streams(node, None, SimpleNamespace(health=lambda: report))  # type: ignore[arg-type]
+    caplog.set_level(logging.INFO, logger="kinema.agent")
+    for status in (ObjectiveStatus.LOADING, ObjectiveStatus.RUNNING, ObjectiveStatus.SUCCESS):
+        streams.on_status(status, "Quick")
+    streams.on_run_finished(None, ObjectiveResult.success("Quick"))  # type: ignore[arg-type]
+    streams.publish_heartbeat()
+    assert [r.getMessage() for r in caplog.records if "Running" in r.getMessage()] == []
+
+    streams.on_status(ObjectiveStatus.LOADING, "Slow")
+    streams.on_status(ObjectiveStatus.RUNNING, "Slow")
+    streams.publish_heartbeat()
+    streams.publish_heartbeat()
+    assert [r.getMessage() for r in caplog.records if "Running" in r.getMessage()] == [
+        "objective 'Slow': Running"
+    ]
