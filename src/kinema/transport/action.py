@@ -42,6 +42,7 @@ from kinema.transport.goal_status_cdr import (
 from kinema.transport.keys import LATCHED_QOS, QoS, fully_qualified
 from kinema.transport.messages import from_dict, type_of
 from kinema.transport.pubsub import Publisher, Subscription
+from kinema.transport.send_goal_cdr import response_reader, send_goal_request
 from kinema.transport.service import Responder, ServiceClient, ServiceServer
 
 if TYPE_CHECKING:
@@ -854,7 +855,7 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         self._ended_order: deque[tuple[float, bytes]] = deque()
         self._lock = threading.Lock()
         self._closed = False
-        self._request_class = registry.message_class(self.action.send_goal.request)
+        self._read_acceptance = response_reader(registry, self.action.send_goal.response)
         base = f"{self.name}/_action"
         action = self.action
         self._send_goal: ServiceClient[Any, Any] = ServiceClient(node, action.send_goal, f"{base}/send_goal")
@@ -899,16 +900,16 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
             self._forget_finished()
             self._handles[goal_id] = handle
             self._pending[goal_id] = handle
-        registry = self._send_goal.registry
-        request = self._request_class(goal_id=_uuid_message(registry, goal_id), goal=goal_msg)
         started = time.monotonic()
         try:
-            payload = registry.serialize(request, action.send_goal.request)
+            payload = send_goal_request(goal_id, self._send_goal.registry.serialize(goal_msg, action.goal))
             sent = self._send_goal._send(payload, timeout)
             # The result is asked for at once: a goal that ends quickly costs one round trip, not two.
             self._ask_result_early(handle)
             # The acceptance is one reply, never followed by an error: taken as it comes.
-            response = self._send_goal._call_payload(payload, timeout, sent, started, first=True)
+            response = self._send_goal._call_payload(
+                payload, timeout, sent, started, first=True, decode=self._read_acceptance
+            )
         except TransportError as error:
             self._drop(handle)
             if str(error).startswith("no server for service"):

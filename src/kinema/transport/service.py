@@ -284,16 +284,17 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
         started: float | None = None,
         *,
         first: bool = False,
+        decode: Callable[[bytes], Any] | None = None,
     ) -> Any:
         """:meth:`call` with a serialised request; ``sent`` is a first attempt already on its way
-        (``_send``'s result, sent at ``started``). ``first``: see :meth:`_collect`."""
+        (``_send``'s result, sent at ``started``). ``first``, ``decode``: see :meth:`_collect`."""
         deadline = (time.monotonic() if started is None else started) + timeout
         while True:
             remaining = deadline - time.monotonic()
             try:
                 if sent is None:
                     sent = self._send(payload, max(remaining, 0.001))
-                outcome = self._collect(*sent, first=first)
+                outcome = self._collect(*sent, first=first, decode=decode)
                 sent = None
             except _QueryTimedOut:
                 # A server took the request but did not reply in time (or the last slice was too short
@@ -354,12 +355,20 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
         )
         return sequence, replies
 
-    def _collect(self, sequence: int, replies: Any, *, first: bool = False) -> Any | None:
+    def _collect(
+        self,
+        sequence: int,
+        replies: Any,
+        *,
+        first: bool = False,
+        decode: Callable[[bytes], Any] | None = None,
+    ) -> Any | None:
         """The response among ``replies`` (None when no server answered); raises an error reply.
 
         With ``first``, the first response is returned as it comes, without waiting for the query to
         end: for a service whose server never follows a response with an error
-        (:meth:`Responder.reply_then_error`), such as an action's ``send_goal``.
+        (:meth:`Responder.reply_then_error`), such as an action's ``send_goal``. ``decode(payload)``
+        reads the response instead of the generic deserializer.
         """
         response: Any = None
         answered = False
@@ -368,7 +377,7 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
             if reply.ok is not None:
                 if answered:
                     continue
-                response = self._decode_reply(reply.ok, sequence)
+                response = self._decode_reply(reply.ok, sequence, decode)
                 answered = True
                 if first and not errors:
                     return response
@@ -381,7 +390,7 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
             raise TransportError(message)
         return response if answered else None
 
-    def _decode_reply(self, sample: Any, sequence: int) -> Any:
+    def _decode_reply(self, sample: Any, sequence: int, decode: Callable[[bytes], Any] | None = None) -> Any:
         """The response in a reply's sample (a reply echoing another sequence number is logged)."""
         if sample.attachment is not None:
             echoed = Attachment.decode(sample.attachment.to_bytes())
@@ -389,7 +398,10 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
                 log.warning(
                     "reply on %s echoes sequence %d, expected %d", self.name, echoed.sequence_number, sequence
                 )
-        return self.registry.deserialize(sample.payload.to_bytes(), self.service.response)
+        payload = sample.payload.to_bytes()
+        if decode is not None:
+            return decode(payload)
+        return self.registry.deserialize(payload, self.service.response)
 
     def call_async(
         self, request: RequestT | dict[str, Any] | None = None, timeout: float = 5.0
