@@ -596,6 +596,8 @@ class Agent:
             # Before the tick thread sees the run: a cancel of the goal finds it from the start.
             with self._goal_lock:
                 self._goal_runs[handle.goal_id] = run
+            # EXECUTING once the run ticks on (a run that ends in its first tick is published once, ended).
+            run.add_running_callback(handle.execute)
 
         run = self.server.submit(request, before_start=registered)
         if handle.is_cancel_requested:

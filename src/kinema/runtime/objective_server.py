@@ -151,6 +151,9 @@ class ObjectiveRun:
         self._done = threading.Event()
         self._result: ObjectiveResult | None = None
         self._callbacks: list[Callable[[ObjectiveResult], None]] = []
+        # Called once its first tick returned without ending it (add_running_callback).
+        self._running_callbacks: list[Callable[[], None]] = []
+        self._ticked = False
         self._lock = threading.Lock()
         # Set when a cancel of this run was accepted: from then on it can no longer end as SUCCESS (a
         # tick stuck in C code that holds the interpreter may still complete after the cancel came).
@@ -217,6 +220,33 @@ class ObjectiveRun:
                 return
             result = self._result
         callback(result)
+
+    def add_running_callback(self, callback: Callable[[], None]) -> None:
+        """Call ``callback()`` once the run's first tick returned without ending it (at once if that
+        happened already); never for a run that ends before or in its first tick.
+
+        The callback runs on the tick thread and must not block.
+        """
+        with self._lock:
+            if not self._ticked:
+                self._running_callbacks.append(callback)
+                return
+            if self._result is not None:
+                return
+        callback()
+
+    def _first_tick_returned(self) -> None:
+        """The run's first tick returned RUNNING (the tick thread)."""
+        with self._lock:
+            if self._ticked:
+                return
+            self._ticked = True
+            callbacks, self._running_callbacks = self._running_callbacks, []
+        for callback in callbacks:
+            try:
+                callback()
+            except Exception:
+                log.exception("a running callback of objective run %d raised", self.id)
 
     def release_xml(self) -> None:
         """Let go of the request's objective XML (up to MAX_OBJECTIVE_XML_BYTES, or a larger refused
@@ -961,6 +991,7 @@ class ObjectiveServer:
             failure = ObjectiveResult.failure(self._failure_message(run), run.objective_name)
             self._end(run, failure, ObjectiveStatus.FAILURE, tree)
         else:
+            run._first_tick_returned()
             self._flush_node_changes(run)
             self._maybe_snapshot(run, tree, force=False)
 

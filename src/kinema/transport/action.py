@@ -213,6 +213,19 @@ class ServerGoalHandle:
         self._set_status(STATUS_CANCELING)
         return True
 
+    def execute(self) -> None:
+        """Mark the goal EXECUTING and publish its status, as rclcpp's ``execute()``.
+
+        A deferred server's goals stay ACCEPTED, unpublished, until the code that runs them calls this:
+        a goal that ends first is published once, as it ends (one status message instead of two for a
+        goal that ends at once). Does nothing once the goal executes, is being cancelled or ended.
+        """
+        with self._lock:
+            if self.status != STATUS_ACCEPTED:
+                return
+            self.status = STATUS_EXECUTING
+        self.server._publish_status()
+
     def publish_feedback(self, feedback: Any) -> None:
         """Send feedback (a message or a dict of its fields) to the clients."""
         action = self.server.action
@@ -307,7 +320,8 @@ class ActionServer:
     thread that accepted it: it must not block, and ends the goal later, from any thread, with the
     handle's :meth:`~ServerGoalHandle.succeed`, :meth:`~ServerGoalHandle.abort` or
     :meth:`~ServerGoalHandle.canceled` (what it returns is ignored). For work that another thread does
-    anyway (the objective server's tick thread): no thread is started per goal.
+    anyway (the objective server's tick thread): no thread is started per goal. The goal stays ACCEPTED
+    until that work calls :meth:`~ServerGoalHandle.execute`.
     """
 
     def __init__(
@@ -405,17 +419,14 @@ class ActionServer:
             handle = self._goals.get(_uuid_bytes(request.goal_id))
         if handle is None:
             return
+        if self._deferred:
+            # Its status is published when its work calls execute(), or as it ends.
+            self._start_deferred(handle)
+            return
         # Accepted and executing from here on: one status message says both.
         with handle._lock:
             if handle.status == STATUS_ACCEPTED:
                 handle.status = STATUS_EXECUTING
-        if self._deferred:
-            self._start_deferred(handle)
-            # Published once the goal is under way (its result waits for nothing here); a goal that
-            # ended meanwhile was published as it ended.
-            if handle.is_active:
-                self._publish_status()
-            return
         self._publish_status()
         thread = threading.Thread(
             target=self._execute, args=(handle,), name=f"kinema-goal{self.name}", daemon=True
@@ -709,6 +720,7 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         """
         if not self.accepted:
             raise TransportError(f"goal {self.goal_uuid} was rejected by {self.client.name}")
+        deadline = None if timeout is None else time.monotonic() + timeout
         if not self._done.is_set():
             # The result request sent with the goal ends within _EARLY_RESULT_QUERY_TIMEOUT: a wait at least
             # that long reads its replies here; a shorter one leaves that to a thread.
@@ -716,7 +728,8 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
                 self._read_early(block=True)
             else:
                 self._read_early_on_thread()
-        if not self._done.wait(timeout):
+        remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
+        if not self._done.wait(remaining):
             raise TransportError(
                 f"goal {self.goal_uuid} on {self.client.name} did not finish within {timeout:g} s "
                 f"(last status {self.status_name})"

@@ -17,6 +17,7 @@ from kinema.errors import TransportError
 from kinema.transport import (
     STATUS_ABORTED,
     STATUS_CANCELED,
+    STATUS_EXECUTING,
     STATUS_SUCCEEDED,
     Node,
     ServerGoalHandle,
@@ -347,3 +348,47 @@ def test_a_result_nobody_waits_for_still_ends_the_goal(connect: Callable[[], Ses
     with_callback.add_done_callback(lambda _handle: called.set())
     assert called.wait(10)
     assert with_callback.result(timeout=0.1).result.sequence.tolist() == [0, 1, 1]
+
+
+def test_a_deferred_goal_is_published_executing_when_its_work_says_so(connect: Callable[[], Session]) -> None:
+    # As rclcpp's execute(): a goal that ends at once is published once, ended; one that runs on shows
+    # EXECUTING from the moment its work calls execute().
+    statuses: list[list[int]] = []
+    held: list[ServerGoalHandle] = []
+
+    def hold_or_end(handle: ServerGoalHandle) -> None:
+        if handle.goal.order == 0:
+            handle.succeed({"sequence": []})
+        else:
+            held.append(handle)
+
+    Node(connect(), "server").create_action_server(FIB, "/deferred", hold_or_end, deferred=True)
+    watcher = Node(connect(), "watcher")
+    watcher.create_subscription(
+        "action_msgs/msg/GoalStatusArray",
+        "/deferred/_action/status",
+        lambda m: statuses.append([s.status for s in m.status_list]),
+        latched=True,
+    )
+    client = _client(connect, "/deferred")
+    assert client.send_goal({"order": 0}).result(timeout=5).succeeded
+    _until(lambda: [4] in statuses, "the ended goal's status")
+    assert statuses[-1] == [4] and [2] not in statuses and [1] not in statuses, statuses
+
+    running = client.send_goal({"order": 1})
+    _until(lambda: bool(held), "the second goal to reach its work")
+    time.sleep(0.2)
+    assert statuses[-1] == [4], statuses  # accepted, not yet executing: nothing published
+    held[0].execute()
+    _until(lambda: statuses[-1] == [4, 2], "EXECUTING")
+    _until(lambda: running.status == STATUS_EXECUTING, "the client to see EXECUTING")
+    held[0].succeed({"sequence": [0]})
+    assert running.result(timeout=5).succeeded
+    _until(lambda: statuses[-1] == [4, 4], "SUCCEEDED")
+
+
+def _until(condition: Callable[[], bool], what: str, timeout: float = 5.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, f"timed out waiting for {what}"
+        time.sleep(0.01)

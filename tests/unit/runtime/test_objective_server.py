@@ -151,6 +151,26 @@ def test_a_run_answers_its_clients_before_the_listeners_hear_how_it_ended() -> N
         ]
 
 
+def test_running_callbacks_come_after_a_first_tick_that_did_not_end_the_run(server: ObjectiveServer) -> None:
+    called: list[str] = []
+    quick = server.submit(
+        ObjectiveRequest("Quick"),
+        before_start=lambda r: r.add_running_callback(lambda: called.append("Quick")),
+    )
+    assert quick.wait(5) == ObjectiveResult.success("Quick")
+    forever = server.submit(
+        ObjectiveRequest("Forever"),
+        before_start=lambda r: r.add_running_callback(lambda: called.append("Forever")),
+    )
+    _wait_status(server, ObjectiveStatus.RUNNING)
+    deadline = time.monotonic() + 5
+    while not called and time.monotonic() < deadline:
+        time.sleep(0.002)
+    forever.add_running_callback(lambda: called.append("late"))  # registered after: called at once
+    assert called == ["Forever", "late"]
+    assert server.cancel()
+
+
 def test_cancel_halts_a_looping_objective_within_a_tick(server: ObjectiveServer) -> None:
     run = server.submit(ObjectiveRequest("Forever"))
     _wait_status(server, ObjectiveStatus.RUNNING)
