@@ -22,7 +22,7 @@ import zenoh
 from kinema.errors import TransportError
 from kinema.interfaces import ServiceType
 from kinema.interfaces.definition import RequestT, ResponseT
-from kinema.transport.attachment import Attachment
+from kinema.transport.attachment import GID_SIZE, Attachment, encode_attachment
 from kinema.transport.dispatch import channel, dispatch
 from kinema.transport.heap import note_message_size
 from kinema.transport.keys import SERVICE_QOS, EntityKind
@@ -102,9 +102,12 @@ class Responder:
             return self._query
 
     def _reply_attachment(self) -> bytes | None:
-        if self._attachment is None:
+        request = self._attachment
+        if request is None:
             return None
-        return Attachment(self._attachment.sequence_number, gid=self._attachment.gid).encode()
+        if len(request.gid) == GID_SIZE:
+            return encode_attachment(request.sequence_number, request.gid)
+        return Attachment(request.sequence_number, gid=request.gid).encode()  # raises, naming the size
 
     def reply(self, response: Any) -> None:
         """Send the response (a message object or a dict of its fields)."""
