@@ -668,6 +668,7 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         # whether a thread reads them now, and what they said so far.
         self._early: tuple[Any, int] | None = None
         self._early_reader = False
+        self._early_thread = False
         self._early_response: Any = None
         self._early_errors: list[str] = []
 
@@ -690,8 +691,8 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
     def add_done_callback(self, callback: Callable[[ClientGoalHandle[ResultT, FeedbackT]], Any]) -> None:
         """Call ``callback(handle)`` when the goal ends (at once if it already has).
 
-        It runs on a transport thread that received the result: it must return quickly (hand the
-        work to a loop or an event).
+        It runs on the thread that received the result (a transport thread, or one waiting in
+        :meth:`result`): it must return quickly (hand the work to a loop or an event).
         """
         with self._lock:
             if not self._done.is_set():
@@ -725,7 +726,7 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
             # The result request sent with the goal ends within _EARLY_RESULT_QUERY_TIMEOUT: a wait at least
             # that long reads its replies here; a shorter one leaves that to a thread.
             if timeout is None or timeout >= _EARLY_RESULT_QUERY_TIMEOUT:
-                self._read_early(block=True)
+                self._await_early()
             else:
                 self._read_early_on_thread()
         remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
@@ -752,13 +753,15 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         if ask:
             self.client._wait_result_on_thread(self)
 
-    def _read_early(self, *, block: bool) -> None:
+    def _read_early(self, *, block: bool) -> bool:
         """Read the replies of the result request sent with the goal on this thread: until the goal ends
-        or the request does (``block``), or only those already there. One thread reads at a time; the
-        others return at once."""
+        or the request does (``block``), or only those already there. One thread reads at a time: False
+        when another one reads them now (True when read, or nothing is left to read)."""
         with self._lock:
-            if self._early is None or self._early_reader:
-                return
+            if self._early is None:
+                return True
+            if self._early_reader:
+                return False
             self._early_reader = True
             replies, sequence = self._early
         ended = False
@@ -779,17 +782,23 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
                     self._early = None
         if ended:
             self._early_request_ended()
+        return True
+
+    def _await_early(self) -> None:
+        """Read the result request's replies on this thread until the goal or the request ends, taking
+        over from another reader that stops (done() only looks at what arrived)."""
+        while not self._done.is_set() and not self._read_early(block=True):
+            self._done.wait(0.005)
 
     def _read_early_on_thread(self) -> None:
-        """Read the result request's replies on a thread of their own (for done callbacks and short waits)."""
+        """Read the result request's replies on a thread of their own (for done callbacks and short
+        waits); one such thread per goal."""
         with self._lock:
-            if self._early is None or self._early_reader:
+            if self._early is None or self._early_thread:
                 return
+            self._early_thread = True
         threading.Thread(
-            target=self._read_early,
-            kwargs={"block": True},
-            name=f"kinema-result{self.client.name}",
-            daemon=True,
+            target=self._await_early, name=f"kinema-result{self.client.name}", daemon=True
         ).start()
 
     def _take_early_reply(self, reply: Any, sequence: int) -> None:

@@ -392,3 +392,30 @@ def _until(condition: Callable[[], bool], what: str, timeout: float = 5.0) -> No
     while not condition():
         assert time.monotonic() < deadline, f"timed out waiting for {what}"
         time.sleep(0.01)
+
+
+def test_a_waiting_caller_takes_over_reading_the_result_from_a_look_that_stops(
+    connect: Callable[[], Session], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # done() (the status topic's thread calls it too) only looks at the replies that arrived; a caller
+    # blocked in result() while such a look held the replies must read them once it stops.
+    monkeypatch.setattr(action_module.ActionClient, "_on_status", lambda self, payload: None)
+    release = threading.Event()
+
+    def waits(handle: ServerGoalHandle) -> dict[str, list[int]]:
+        release.wait(5)
+        return {"sequence": [0, 1]}
+
+    Node(connect(), "server").create_action_server(FIB, "/looked_at", waits)
+    handle = _client(connect, "/looked_at").send_goal({"order": 2})
+    with handle._lock:
+        handle._early_reader = True  # another thread looks at the replies now
+    outcome: list[Any] = []
+    waiter = threading.Thread(target=lambda: outcome.append(handle.result(timeout=30)))
+    waiter.start()
+    time.sleep(0.1)
+    with handle._lock:
+        handle._early_reader = False  # ...and stops without the result
+    release.set()
+    waiter.join(10)
+    assert outcome and outcome[0].result.sequence.tolist() == [0, 1]
