@@ -9,12 +9,13 @@
 So ``ros2 action send_goal`` against a Kinema action server, and a Kinema client against a ROS 2 action
 server on rmw_zenoh, both work.
 
-A Kinema client asks for the result right after sending the goal, without waiting for the acceptance: one
-round trip instead of two for a goal that ends at once. The replies of that request wait in a channel that
-the thread which needs the result reads itself (``result()``), so no other thread is woken for them. A
-Kinema server holds a ``get_result`` that comes before its goal until the goal is decided
-(:data:`EARLY_RESULT_HOLD_S` at most); another server answers it UNKNOWN at once, and the client then asks
-again once the goal is accepted, as rcl does.
+A Kinema client asks for the result with the goal: its ``send_goal`` request carries the selector parameter
+:data:`RESULT_WITH_GOAL`, and a Kinema server answers it twice, the acceptance and then, once the goal ended,
+the ``get_result`` response (one request and one round trip for a goal that ends at once). Servers that do
+not know the parameter ignore it and answer once (rmw_zenoh); the client then asks ``get_result`` as rcl
+does. The replies wait in a channel that the thread which needs the result reads itself (``result()``), so
+no other thread is woken for them. A Kinema server also holds a ``get_result`` that comes before its goal
+until the goal is decided (:data:`EARLY_RESULT_HOLD_S` at most): what earlier Kinema clients sent.
 """
 
 from __future__ import annotations
@@ -76,9 +77,6 @@ CANCEL_ERROR_GOAL_TERMINATED = 3
 
 # A get_result request is held open until the goal ends; this only bounds a lost request.
 _RESULT_QUERY_TIMEOUT = 7 * 24 * 3600.0
-# The get_result sent with a goal gives up after this long and a thread asks again, watching the graph: a
-# request caught in flight by the server's death may never be ended by zenoh.
-_EARLY_RESULT_QUERY_TIMEOUT = 5.0
 # Closing a server waits this long for its running goals to end as cancelled, so that clients get that
 # result rather than "the server went away".
 CLOSE_GRACE_S = 1.0
@@ -91,6 +89,8 @@ LATE_FEEDBACK_S = 5.0
 # A get_result that comes before its goal (the client asks for both at once, and the two are served on
 # different threads) is held this long for the goal's decision, then answered UNKNOWN.
 EARLY_RESULT_HOLD_S = 2.0
+# The selector parameter of a send_goal request whose client wants the result as a second reply.
+RESULT_WITH_GOAL = "kinema_result"
 _ZERO_ID = bytes(16)
 _CHUNK_SIZE = len(status_chunk(_ZERO_ID, 0, 0, 0))
 
@@ -164,6 +164,8 @@ class ServerGoalHandle:
         # This goal's element of the status array (goal_status_cdr.status_chunk), and the status it shows.
         self._chunk = b""
         self._chunk_status = -1
+        # The get_result response once the goal ended (see _answer).
+        self._result_payload: bytes | None = None
 
     @property
     def goal_info(self) -> Any:
@@ -293,12 +295,15 @@ class ServerGoalHandle:
 
     def _answer(self, responder: Responder) -> None:
         server = self.server
-        response = server._get_result_class(status=self.status, result=self.result)
         try:
-            if self.error:
-                responder.reply_then_error(response, self.error)
-            else:
-                responder.reply(response)
+            payload = self._result_payload
+            if payload is None:
+                # Once per goal, whoever waits (get_result requests, the send_goal that asked for it).
+                response = server._get_result_class(status=self.status, result=self.result)
+                payload = self._result_payload = server.node.session.registry.serialize(
+                    response, server.action.get_result.response
+                )
+            responder.reply_payload(payload, self.error)
         except Exception:
             log.exception("cannot send the result of goal %s on %s", self.goal_uuid, server.name)
 
@@ -374,7 +379,15 @@ class ActionServer:
         )
         self._cancel = ServiceServer(node, action.cancel_goal, f"{base}/cancel_goal", self._on_cancel)
         self._send_goal = ServiceServer(
-            node, action.send_goal, f"{base}/send_goal", self._on_send_goal, after_reply=self._after_send_goal
+            node,
+            action.send_goal,
+            f"{base}/send_goal",
+            self._on_send_goal,
+            after_reply=self._after_send_goal,
+            keep_open=_asks_result,
+        )
+        self._unknown_payload = registry.serialize(
+            from_dict(action.get_result.response, {"status": STATUS_UNKNOWN}), action.get_result.response
         )
         node._adopt(self)
         self._publish_status()
@@ -408,17 +421,22 @@ class ActionServer:
                 self._active[goal_id] = handle
         if not accepted:
             for _deadline, responder in early:
-                _answer_unknown(responder)
+                _answer_unknown(responder, self._unknown_payload)
         stamp = handle.stamp if handle else _stamp_now()
         return self._send_goal_response_class(accepted=accepted, stamp=self._time_class(**stamp))
 
-    def _after_send_goal(self, request: Any, response: Any) -> None:
+    def _after_send_goal(self, request: Any, response: Any, result_responder: Responder | None) -> None:
         if not response.accepted:
             return
         with self._lock:
             handle = self._goals.get(_uuid_bytes(request.goal_id))
         if handle is None:
+            if result_responder is not None:
+                _answer_unknown(result_responder, self._unknown_payload)
             return
+        if result_responder is not None:
+            # Its client asked for the result with the goal: answered as it ends, like a get_result.
+            handle._add_waiter(result_responder)
         if self._deferred:
             # Its status is published when its work calls execute(), or as it ends.
             self._start_deferred(handle)
@@ -482,7 +500,7 @@ class ActionServer:
                     self._early_wake.notify()
                 return
         if handle is None:
-            _answer_unknown(responder)
+            _answer_unknown(responder, self._unknown_payload)
             return
         handle._add_waiter(responder)
 
@@ -512,7 +530,7 @@ class ActionServer:
                     self._early_idle = False
                     continue
             for responder in expired:
-                _answer_unknown(responder)
+                _answer_unknown(responder, self._unknown_payload)
 
     def _on_cancel(self, request: Any) -> Any:
         goal_id = _uuid_bytes(request.goal_info.goal_id)
@@ -611,7 +629,7 @@ class ActionServer:
             self._early.clear()
             self._early_wake.notify_all()
         for responder in early:
-            _answer_unknown(responder)
+            _answer_unknown(responder, self._unknown_payload)
         if active:
             # The results just answered are queued, not delivered (zenoh confirms no reply), and closing
             # the queryable and then the session drops them: the client would hear "went away"
@@ -625,10 +643,15 @@ class ActionServer:
         return f"<ActionServer {self.name} [{self.type_name}]>"
 
 
-def _answer_unknown(responder: Responder) -> None:
-    """Answer a get_result for a goal the server does not know."""
+def _asks_result(query: Any, response: Any) -> bool:
+    """Whether a send_goal request wants the goal's result as a second reply (and its goal was accepted)."""
+    return bool(response.accepted) and RESULT_WITH_GOAL in str(query.parameters).split(";")
+
+
+def _answer_unknown(responder: Responder, payload: bytes) -> None:
+    """Answer a get_result for a goal the server does not know (``payload``: that response)."""
     try:
-        responder.reply({"status": STATUS_UNKNOWN})
+        responder.reply_payload(payload)
     except Exception:
         log.debug("cannot answer a get_result for an unknown goal", exc_info=True)
 
@@ -664,11 +687,13 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         # request ended without the result (the server did not know the goal yet).
         self._decided = False
         self._unanswered = False
-        # That request's replies (a zenoh channel and the request's sequence number) until they are read,
-        # whether a thread reads them now, and what they said so far.
-        self._early: tuple[Any, int] | None = None
+        # The replies of the send_goal request after the acceptance (a zenoh channel, the request's
+        # sequence number, and when it times out) until they are read, whether a thread reads them now,
+        # and what they said so far.
+        self._early: tuple[Any, int, float] | None = None
         self._early_reader = False
         self._early_thread = False
+        self._early_cancel: Any = None  # a zenoh.CancellationToken: ends the wait (the server went away)
         self._early_response: Any = None
         self._early_errors: list[str] = []
 
@@ -723,9 +748,10 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
             raise TransportError(f"goal {self.goal_uuid} was rejected by {self.client.name}")
         deadline = None if timeout is None else time.monotonic() + timeout
         if not self._done.is_set():
-            # The result request sent with the goal ends within _EARLY_RESULT_QUERY_TIMEOUT: a wait at least
-            # that long reads its replies here; a shorter one leaves that to a thread.
-            if timeout is None or timeout >= _EARLY_RESULT_QUERY_TIMEOUT:
+            # The request that asked for the result ends by its timeout: a wait at least that long reads
+            # its replies here; a shorter one leaves that to a thread.
+            early = self._early
+            if early is not None and (deadline is None or deadline >= early[2]):
                 self._await_early()
             else:
                 self._read_early_on_thread()
@@ -763,7 +789,7 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
             if self._early_reader:
                 return False
             self._early_reader = True
-            replies, sequence = self._early
+            replies, sequence, _ends = self._early
         ended = False
         try:
             while not self._done.is_set():
@@ -891,6 +917,9 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         self._status_sub = Subscription(
             node, action.status, f"{base}/status", self._on_status, LATCHED_QOS, raw=True
         )
+        # A server that dies may never end the request that waits for a goal's result: its endpoints
+        # leaving the graph end that wait, and the goal's handle then asks the graph (_wait_result).
+        node.session.graph_cache().add_removal_listener(self._on_endpoint_removed)
         node._adopt(self)
 
     def wait_for_server(self, timeout: float = 5.0) -> bool:
@@ -923,14 +952,20 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
             self._handles[goal_id] = handle
             self._pending[goal_id] = handle
         started = time.monotonic()
+        answered_by: list[tuple[int, Any, Any]] = []
         try:
             payload = send_goal_request(goal_id, self._send_goal.registry.serialize(goal_msg, action.goal))
-            sent = self._send_goal._send(payload, timeout)
-            # The result is asked for at once: a goal that ends quickly costs one round trip, not two.
-            self._ask_result_early(handle)
-            # The acceptance is one reply, never followed by an error: taken as it comes.
+            # The result is asked for with the goal: a goal that ends quickly costs one round trip.
+            # The acceptance is the first reply, taken as it comes; the result follows on a Kinema server.
             response = self._send_goal._call_payload(
-                payload, timeout, sent, started, first=True, decode=self._read_acceptance
+                payload,
+                timeout,
+                None,
+                started,
+                first=True,
+                decode=self._read_acceptance,
+                parameters=RESULT_WITH_GOAL,
+                answered_by=answered_by,
             )
         except TransportError as error:
             self._drop(handle)
@@ -943,6 +978,9 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         if not response.accepted:
             self._drop(handle)
             return handle
+        sequence, replies, cancel = answered_by[0]
+        handle._early = (replies, sequence, started + timeout)
+        handle._early_cancel = cancel
         if handle.status == STATUS_UNKNOWN:
             handle.status = STATUS_ACCEPTED
         handle._decide(True)
@@ -954,26 +992,6 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         with self._lock:
             self._handles.pop(handle.goal_id, None)
             self._pending.pop(handle.goal_id, None)
-
-    def _ask_result_early(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
-        """Send the goal's get_result now; its replies wait in a channel for whoever needs the result
-        (:meth:`ClientGoalHandle._read_early`).
-
-        A Kinema server holds the request until the goal ends. When it ends without the result (a server
-        that answers UNKNOWN for a goal it has not accepted yet, none reachable, or no answer within
-        :data:`_EARLY_RESULT_QUERY_TIMEOUT`), the handle asks again once the goal is accepted
-        (:meth:`_wait_result`, which also notices a server that went away).
-        """
-        client = self._get_result
-        sequence = client._next_sequence()
-        try:
-            _sequence, replies = client._send(
-                CDR_LE_HEADER + handle.goal_id, _EARLY_RESULT_QUERY_TIMEOUT, sequence=sequence
-            )
-        except TransportError:
-            handle._early_request_unanswered()
-            return
-        handle._early = (replies, sequence)
 
     def _wait_result_on_thread(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
         threading.Thread(
@@ -1013,6 +1031,15 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
                     return
             time.sleep(0.02)
         handle._finish(None, TransportError(f"action client {self.name} was closed"))
+
+    def _on_endpoint_removed(self, entity: Any) -> None:
+        if not entity.name.startswith(f"{self.name}/_action/"):
+            return
+        with self._lock:
+            waiting = [handle._early_cancel for handle in self._pending.values() if handle._early_cancel]
+        if waiting and not self.node.session.graph_cache().snapshot().action_server_ready(self.name):
+            for cancel in waiting:
+                cancel.cancel()
 
     def _ended(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
         with self._lock:
@@ -1056,6 +1083,7 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         if self._closed:
             return
         self._closed = True
+        self.node.session.graph_cache().remove_removal_listener(self._on_endpoint_removed)
         for entity in (self._send_goal, self._cancel, self._get_result, self._feedback_sub, self._status_sub):
             entity.close()
         with self._lock:
