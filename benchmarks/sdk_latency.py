@@ -5,8 +5,9 @@ and serves one objective, ``Trivial`` (a single AlwaysSuccess). An echo process 
 with a raw zenoh queryable. This process then times, one after the other:
 
 * the raw zenoh query round trip to the echo process (64-byte payload): the floor;
-* ``ObjectiveClient.execute("Trivial")`` (the ``/kinema/run_objective`` action: the goal and its result
-  request go out together; the agent builds, ticks and answers);
+* ``ObjectiveClient.execute("Trivial")`` (the ``/kinema/run_objective`` action: one send_goal request
+  that asks for the result too, answered with the acceptance and then the result; the agent builds, ticks
+  and answers);
 * ``ObjectiveClient.do_xml(...)`` (the ``/do_objective`` action, the same way with the tree as XML);
 * the wall time of a cold ``kinema objective do FILE`` (a new interpreter each time), next to a cold
   ``python -c pass`` measured in the same run.

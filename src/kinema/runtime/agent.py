@@ -28,6 +28,8 @@ from kinema.runtime import names
 from kinema.runtime.background_work import HandOff
 from kinema.runtime.blackboard_text import render_value
 from kinema.runtime.error_codes import MoveItErrorCode
+from kinema.runtime.heartbeat_cdr import HeartbeatEncoder
+from kinema.runtime.heartbeat_cdr import generic_serializer as heartbeat_serializer
 from kinema.runtime.node_status_cdr import NodeStatusCodesEncoder, generic_serializer, time_parts
 from kinema.runtime.objective_server import (
     ObjectiveRequest,
@@ -126,6 +128,10 @@ class _Streams:
         self._blackboard = node.create_publisher(names.BLACKBOARD_TYPE, names.BLACKBOARD, latched=True)
         self._log = node.create_publisher(names.LOG_TYPE, names.LOG)
         self._status: tuple[ObjectiveStatus, str] = (ObjectiveStatus.IDLE, "")
+        # Status changes whose heartbeat is not out yet (see on_status), oldest first.
+        self._owed: list[tuple[ObjectiveStatus, str]] = []
+        # The objective whose "Running" line is not logged yet (see _pay_owed).
+        self._running_unlogged: str | None = None
         self._last_blackboard: list[tuple[str, str, str, str]] | None = None
         self._render_cache: dict[int, tuple[Any, str]] = {}
         # Whether the last snapshot handed to the worker was empty (another empty one would change nothing).
@@ -135,7 +141,7 @@ class _Streams:
         from kinema.transport.messages import load_interfaces
 
         registry = load_interfaces()
-        self._heartbeat_class = registry.message_class(names.HEARTBEAT_TYPE)
+        self._heartbeat_encoder = HeartbeatEncoder(heartbeat_serializer(registry, names.HEARTBEAT_TYPE))
         self._health_class = registry.message_class(names.HEALTH_TYPE)
         self._time_class = registry.message_class("builtin_interfaces/msg/Time")
         # Also tells the clients waiting for a run (set by the Agent).
@@ -150,22 +156,17 @@ class _Streams:
         """Publish the heartbeat and, with ``health``, the watchdog's report (the periodic beat does; a
         status change, on the tick thread, sends the heartbeat alone: the latched report stands)."""
         report = self._server.health() if health else None
+        # The status is read where it is published, under the lock on_status takes to change it: a beat
+        # read before a run ended and sent after it would tell subscribers the run restarted. Changes
+        # not yet published go out in order, the last of them being the current status.
+        if not self._pay_owed():
+            with self._lock:
+                self._publish_beat(*self._status)
+        if report is None:
+            return
+        self._log_running()
         with self._lock:
-            # The status is read where it is published, under the lock on_status takes to change it:
-            # a beat read before a run ended and sent after it would tell subscribers the run restarted.
-            status, name = self._status
-            now = time.time()
-            clock_now = self._clock.now() if self._clock is not None and not _is_wall(self._clock) else now
-            stamp = self._time_class(*time_parts(now))
-            message = self._heartbeat_class(
-                process_timestamp=stamp,
-                ros_timestamp=stamp if clock_now == now else self._time_class(*time_parts(clock_now)),
-                objective_name=name,
-                objective_status=str(status),
-            )
-            self._heartbeat.publish(message)
-            if report is None:
-                return
+            stamp = self._time_class(*time_parts(time.time()))
             self._health.publish(
                 self._health_class(
                     stamp=stamp,
@@ -181,6 +182,36 @@ class _Streams:
             # Once per problem on the log topic too, so `kinema run`'s terminal and the TUI's log show it.
             self.publish_log(LOG_WARN, f"watchdog: {warning}")
 
+    def _publish_beat(self, status: ObjectiveStatus, name: str) -> None:
+        """Publish one heartbeat saying ``status`` (the lock held)."""
+        now = time.time()
+        clock_now = self._clock.now() if self._clock is not None and not _is_wall(self._clock) else now
+        stamp = time_parts(now)
+        ros_stamp = stamp if clock_now == now else time_parts(clock_now)
+        self._heartbeat.publish_raw(self._heartbeat_encoder.encode(stamp, ros_stamp, name, str(status)))
+
+    def _pay_owed(self) -> bool:
+        """Publish the heartbeats of the status changes that wait, in order, and log them; False when
+        none waited."""
+        with self._lock:
+            owed, self._owed = self._owed, []
+            for status, name in owed:
+                self._publish_beat(status, name)
+                if status is ObjectiveStatus.RUNNING:
+                    # Logged once the run still runs a heartbeat period or a tick later (_log_running): a
+                    # run that ends sooner gets only its result's line, a file write less per run.
+                    self._running_unlogged = name
+        for status, name in owed:
+            if status is not ObjectiveStatus.RUNNING:
+                log.debug("objective %r: %s", name, status)
+        return bool(owed)
+
+    def _log_running(self) -> None:
+        with self._lock:
+            name, self._running_unlogged = self._running_unlogged, None
+        if name is not None:
+            log.info("objective %r: %s", name, ObjectiveStatus.RUNNING)
+
     def publish_log(self, level: int, text: str) -> None:
         from kinema.transport.messages import msg
 
@@ -193,18 +224,21 @@ class _Streams:
     def on_status(self, status: ObjectiveStatus, objective_name: str) -> None:
         with self._lock:
             self._status = (status, objective_name)
-        # How a run ends is logged by on_run_finished, once its clients have their answer.
-        log.log(
-            logging.INFO if status is ObjectiveStatus.RUNNING else logging.DEBUG,
-            "objective %r: %s",
-            objective_name,
-            status,
-        )
-        self.publish_heartbeat(health=False)
+            self._owed.append((status, objective_name))
+        if status in (ObjectiveStatus.LOADING, ObjectiveStatus.RUNNING):
+            # Published with the run's first node changes or its end, whichever comes first (a run that
+            # ends in its first tick has answered its client by then), or by the next periodic beat: a
+            # long build or first tick still shows within a heartbeat period.
+            return
+        self._pay_owed()
 
     def on_node_status(self, objective_name: str, changes: NodeStatusBatch) -> None:
+        if self._owed:
+            self._pay_owed()
         table = changes.table
-        if table.id != self._table_id:
+        if table.id == self._table_id:
+            self._log_running()  # a later tick of the run
+        else:
             # Once per run, latched, before its first changes: subscribers name nodes with it.
             table_class = self._node_table_class
             if table_class is None:
@@ -285,6 +319,8 @@ class _Streams:
             self.on_warning(text)
 
     def on_run_finished(self, run: ObjectiveRun, result: ObjectiveResult) -> None:
+        with self._lock:
+            self._running_unlogged = None
         if result.succeeded:
             log.info("%s", result)
         elif result.cancelled:
@@ -340,6 +376,9 @@ class Agent:
         self.waypoints = waypoints
         self.clock = clock
         self.node = node if node is not None else Node(session, names.NODE_NAME)
+        registry = session.registry
+        self._goal_result_class = registry.message_class(registry.action(names.DO_OBJECTIVE_TYPE).result)
+        self._error_codes_class = registry.message_class("moveit_msgs/msg/MoveItErrorCodes")
         self._streams = _Streams(self.node, clock, server)
         self._streams.on_warning = lambda text: self._tell_quick_clients("warn", text)
         server.add_listener(self._streams)
@@ -557,6 +596,8 @@ class Agent:
             # Before the tick thread sees the run: a cancel of the goal finds it from the start.
             with self._goal_lock:
                 self._goal_runs[handle.goal_id] = run
+            # EXECUTING once the run ticks on (a run that ends in its first tick is published once, ended).
+            run.add_running_callback(handle.execute)
 
         run = self.server.submit(request, before_start=registered)
         if handle.is_cancel_requested:
@@ -566,7 +607,14 @@ class Agent:
     def _end_goal(self, handle: Any, result: ObjectiveResult) -> None:
         """Answer a goal's clients with how its run ended (a done callback of the run: the tick thread)."""
         try:
-            payload = {"error_code": result_message(result), "error_message": result.error_message}
+            # Built from the classes: from_dict's checks of each field cost more than the rest of the
+            # answer, on the tick thread, once per goal.
+            payload = self._goal_result_class(
+                error_code=self._error_codes_class(
+                    val=int(result.error_code), message=result.error_message, source=names.NODE_NAME
+                ),
+                error_message=result.error_message,
+            )
             if result.succeeded:
                 handle.succeed(payload)
             elif result.cancelled:

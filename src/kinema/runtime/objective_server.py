@@ -151,6 +151,9 @@ class ObjectiveRun:
         self._done = threading.Event()
         self._result: ObjectiveResult | None = None
         self._callbacks: list[Callable[[ObjectiveResult], None]] = []
+        # Called once its first tick returned without ending it (add_running_callback).
+        self._running_callbacks: list[Callable[[], None]] = []
+        self._ticked = False
         self._lock = threading.Lock()
         # Set when a cancel of this run was accepted: from then on it can no longer end as SUCCESS (a
         # tick stuck in C code that holds the interpreter may still complete after the cancel came).
@@ -159,8 +162,8 @@ class ObjectiveRun:
 
     @property
     def done(self) -> bool:
-        """True once the run ended."""
-        return self._done.is_set()
+        """True once the run ended (its result is known)."""
+        return self._result is not None
 
     @property
     def result(self) -> ObjectiveResult | None:
@@ -218,6 +221,33 @@ class ObjectiveRun:
             result = self._result
         callback(result)
 
+    def add_running_callback(self, callback: Callable[[], None]) -> None:
+        """Call ``callback()`` once the run's first tick returned without ending it (at once if that
+        happened already); never for a run that ends before or in its first tick.
+
+        The callback runs on the tick thread and must not block.
+        """
+        with self._lock:
+            if not self._ticked:
+                self._running_callbacks.append(callback)
+                return
+            if self._result is not None:
+                return
+        callback()
+
+    def _first_tick_returned(self) -> None:
+        """The run's first tick returned RUNNING (the tick thread)."""
+        with self._lock:
+            if self._ticked:
+                return
+            self._ticked = True
+            callbacks, self._running_callbacks = self._running_callbacks, []
+        for callback in callbacks:
+            try:
+                callback()
+            except Exception:
+                log.exception("a running callback of objective run %d raised", self.id)
+
     def release_xml(self) -> None:
         """Let go of the request's objective XML (up to MAX_OBJECTIVE_XML_BYTES, or a larger refused
         one): it is not needed once the tree is built or the run ended, and the tick thread may keep
@@ -226,19 +256,29 @@ class ObjectiveRun:
             self.request = replace(self.request, objective_xml="")
 
     def _finish(self, result: ObjectiveResult) -> bool:
+        answered = self._answer(result)
+        self._release()
+        return answered
+
+    def _answer(self, result: ObjectiveResult) -> bool:
+        """Fix the result and call the done callbacks (they answer the run's clients); False when the run
+        already had a result. :meth:`wait` returns only after :meth:`_release`."""
         self.release_xml()
         with self._lock:
             if self._result is not None:
                 return False
             self._result = result
             callbacks, self._callbacks = self._callbacks, []
-        self._done.set()
         for callback in callbacks:
             try:
                 callback(result)
             except Exception:
                 log.exception("a done callback of objective run %d raised", self.id)
         return True
+
+    def _release(self) -> None:
+        """Let :meth:`wait` return: the listeners have been told how the run ended."""
+        self._done.set()
 
     def __repr__(self) -> str:
         return f"ObjectiveRun({self.id}, {self.objective_name!r}, result={self._result})"
@@ -804,6 +844,9 @@ class ObjectiveServer:
         if self._status == (status, name):
             return
         self._status = (status, name)
+        self._tell_status(status, name)
+
+    def _tell_status(self, status: ObjectiveStatus, name: str) -> None:
         for listener in self._listeners:
             try:
                 listener.on_status(status, name)
@@ -942,16 +985,15 @@ class ObjectiveServer:
             message = f"objective {run.objective_name!r} raised {type(error).__name__}: {error}{where}"
             self._end(run, ObjectiveResult.failure(message, run.objective_name), ObjectiveStatus.FAILURE)
             return
-        self._flush_node_changes(run)
-        self._maybe_snapshot(run, force=status.is_completed)
         if status is NodeStatus.SUCCESS:
-            self._end(run, ObjectiveResult.success(run.objective_name), ObjectiveStatus.SUCCESS)
+            self._end(run, ObjectiveResult.success(run.objective_name), ObjectiveStatus.SUCCESS, tree)
         elif status is NodeStatus.FAILURE:
-            self._end(
-                run,
-                ObjectiveResult.failure(self._failure_message(run), run.objective_name),
-                ObjectiveStatus.FAILURE,
-            )
+            failure = ObjectiveResult.failure(self._failure_message(run), run.objective_name)
+            self._end(run, failure, ObjectiveStatus.FAILURE, tree)
+        else:
+            run._first_tick_returned()
+            self._flush_node_changes(run)
+            self._maybe_snapshot(run, tree, force=False)
 
     def _halt_quietly(self, worker: TickWorker, tree: Tree) -> None:
         try:
@@ -989,7 +1031,16 @@ class ObjectiveServer:
         result = make(reason, run.objective_name)
         self._end(run, result, ObjectiveStatus.CANCELLED if result.cancelled else ObjectiveStatus.FAILURE)
 
-    def _end(self, run: ObjectiveRun, result: ObjectiveResult, status: ObjectiveStatus) -> None:
+    def _end(
+        self,
+        run: ObjectiveRun,
+        result: ObjectiveResult,
+        status: ObjectiveStatus,
+        completed: Tree | None = None,
+    ) -> None:
+        """End ``run``: its clients get the result first (its done callbacks), then the listeners hear
+        the status changes, the last tick's node changes and blackboard (of ``completed``, the tree that
+        returned SUCCESS or FAILURE) and the result; :meth:`ObjectiveRun.wait` returns after them."""
         result = run._settle(result)
         if result.cancelled and status is ObjectiveStatus.SUCCESS:
             status = ObjectiveStatus.CANCELLED
@@ -1000,13 +1051,23 @@ class ObjectiveServer:
         self._run_stuck = None
         self._run = None
         self._ended_at = time.monotonic()
-        self._set_status(status, run.objective_name)
-        if run._finish(result):
-            for listener in self._listeners:
-                try:
-                    listener.on_run_finished(run, result)
-                except Exception:
-                    log.exception("a run listener raised")
+        told = self._status == (status, run.objective_name)
+        self._status = (status, run.objective_name)
+        answered = run._answer(result)
+        try:
+            if completed is not None:
+                self._flush_node_changes(run)
+                self._maybe_snapshot(run, completed, force=True)
+            if not told:
+                self._tell_status(status, run.objective_name)
+            if answered:
+                for listener in self._listeners:
+                    try:
+                        listener.on_run_finished(run, result)
+                    except Exception:
+                        log.exception("a run listener raised")
+        finally:
+            run._release()
 
     # -- observation (tick thread) --------------------------------------------------------------
 
@@ -1020,14 +1081,14 @@ class ObjectiveServer:
             except Exception:
                 log.exception("a node status listener raised")
 
-    def _maybe_snapshot(self, run: ObjectiveRun, *, force: bool) -> None:
-        if self._blackboard_period <= 0 or self._tree is None:
+    def _maybe_snapshot(self, run: ObjectiveRun, tree: Tree, *, force: bool) -> None:
+        if self._blackboard_period <= 0:
             return
         now = time.monotonic()
         if not force and now - self._last_snapshot < self._blackboard_period:
             return
         self._last_snapshot = now
-        entries = blackboard_entries(self._tree)
+        entries = blackboard_entries(tree)
         for listener in self._listeners:
             try:
                 listener.on_blackboard(run.objective_name, entries)

@@ -9,10 +9,13 @@
 So ``ros2 action send_goal`` against a Kinema action server, and a Kinema client against a ROS 2 action
 server on rmw_zenoh, both work.
 
-A Kinema client asks for the result right after sending the goal, without waiting for the acceptance: one
-round trip instead of two for a goal that ends at once. A Kinema server holds a ``get_result`` that comes
-before its goal until the goal is decided (:data:`EARLY_RESULT_HOLD_S` at most); another server answers it
-UNKNOWN at once, and the client then asks again once the goal is accepted, as rcl does.
+A Kinema client asks for the result with the goal: its ``send_goal`` request carries the selector parameter
+:data:`RESULT_WITH_GOAL`, and a Kinema server answers it twice, the acceptance and then, once the goal ended,
+the ``get_result`` response (one request and one round trip for a goal that ends at once). Servers that do
+not know the parameter ignore it and answer once (rmw_zenoh); the client then asks ``get_result`` as rcl
+does. The replies wait in a channel that the thread which needs the result reads itself (``result()``), so
+no other thread is woken for them. A Kinema server also holds a ``get_result`` that comes before its goal
+until the goal is decided (:data:`EARLY_RESULT_HOLD_S` at most): what earlier Kinema clients sent.
 """
 
 from __future__ import annotations
@@ -26,10 +29,11 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Generic
 
+import zenoh
+
 from kinema.errors import TransportError
 from kinema.interfaces import ActionType
 from kinema.interfaces.definition import FeedbackT, GoalT, ResultT
-from kinema.transport.dispatch import inline
 from kinema.transport.goal_status_cdr import (
     CDR_LE_HEADER,
     payload_of_chunks,
@@ -39,6 +43,7 @@ from kinema.transport.goal_status_cdr import (
 from kinema.transport.keys import LATCHED_QOS, QoS, fully_qualified
 from kinema.transport.messages import from_dict, type_of
 from kinema.transport.pubsub import Publisher, Subscription
+from kinema.transport.send_goal_cdr import response_reader, send_goal_request
 from kinema.transport.service import Responder, ServiceClient, ServiceServer
 
 if TYPE_CHECKING:
@@ -72,9 +77,6 @@ CANCEL_ERROR_GOAL_TERMINATED = 3
 
 # A get_result request is held open until the goal ends; this only bounds a lost request.
 _RESULT_QUERY_TIMEOUT = 7 * 24 * 3600.0
-# The get_result sent with a goal gives up after this long and a thread asks again, watching the graph: a
-# request caught in flight by the server's death may never be ended by zenoh.
-_EARLY_RESULT_QUERY_TIMEOUT = 5.0
 # Closing a server waits this long for its running goals to end as cancelled, so that clients get that
 # result rather than "the server went away".
 CLOSE_GRACE_S = 1.0
@@ -87,6 +89,8 @@ LATE_FEEDBACK_S = 5.0
 # A get_result that comes before its goal (the client asks for both at once, and the two are served on
 # different threads) is held this long for the goal's decision, then answered UNKNOWN.
 EARLY_RESULT_HOLD_S = 2.0
+# The selector parameter of a send_goal request whose client wants the result as a second reply.
+RESULT_WITH_GOAL = "kinema_result"
 _ZERO_ID = bytes(16)
 _CHUNK_SIZE = len(status_chunk(_ZERO_ID, 0, 0, 0))
 
@@ -160,6 +164,8 @@ class ServerGoalHandle:
         # This goal's element of the status array (goal_status_cdr.status_chunk), and the status it shows.
         self._chunk = b""
         self._chunk_status = -1
+        # The get_result response once the goal ended (see _answer).
+        self._result_payload: bytes | None = None
 
     @property
     def goal_info(self) -> Any:
@@ -208,6 +214,19 @@ class ServerGoalHandle:
         self.cancel_requested_event.set()
         self._set_status(STATUS_CANCELING)
         return True
+
+    def execute(self) -> None:
+        """Mark the goal EXECUTING and publish its status, as rclcpp's ``execute()``.
+
+        A deferred server's goals stay ACCEPTED, unpublished, until the code that runs them calls this:
+        a goal that ends first is published once, as it ends (one status message instead of two for a
+        goal that ends at once). Does nothing once the goal executes, is being cancelled or ended.
+        """
+        with self._lock:
+            if self.status != STATUS_ACCEPTED:
+                return
+            self.status = STATUS_EXECUTING
+        self.server._publish_status()
 
     def publish_feedback(self, feedback: Any) -> None:
         """Send feedback (a message or a dict of its fields) to the clients."""
@@ -276,12 +295,15 @@ class ServerGoalHandle:
 
     def _answer(self, responder: Responder) -> None:
         server = self.server
-        response = server._get_result_class(status=self.status, result=self.result)
         try:
-            if self.error:
-                responder.reply_then_error(response, self.error)
-            else:
-                responder.reply(response)
+            payload = self._result_payload
+            if payload is None:
+                # Once per goal, whoever waits (get_result requests, the send_goal that asked for it).
+                response = server._get_result_class(status=self.status, result=self.result)
+                payload = self._result_payload = server.node.session.registry.serialize(
+                    response, server.action.get_result.response
+                )
+            responder.reply_payload(payload, self.error)
         except Exception:
             log.exception("cannot send the result of goal %s on %s", self.goal_uuid, server.name)
 
@@ -303,7 +325,8 @@ class ActionServer:
     thread that accepted it: it must not block, and ends the goal later, from any thread, with the
     handle's :meth:`~ServerGoalHandle.succeed`, :meth:`~ServerGoalHandle.abort` or
     :meth:`~ServerGoalHandle.canceled` (what it returns is ignored). For work that another thread does
-    anyway (the objective server's tick thread): no thread is started per goal.
+    anyway (the objective server's tick thread): no thread is started per goal. The goal stays ACCEPTED
+    until that work calls :meth:`~ServerGoalHandle.execute`.
     """
 
     def __init__(
@@ -356,7 +379,15 @@ class ActionServer:
         )
         self._cancel = ServiceServer(node, action.cancel_goal, f"{base}/cancel_goal", self._on_cancel)
         self._send_goal = ServiceServer(
-            node, action.send_goal, f"{base}/send_goal", self._on_send_goal, after_reply=self._after_send_goal
+            node,
+            action.send_goal,
+            f"{base}/send_goal",
+            self._on_send_goal,
+            after_reply=self._after_send_goal,
+            keep_open=_asks_result,
+        )
+        self._unknown_payload = registry.serialize(
+            from_dict(action.get_result.response, {"status": STATUS_UNKNOWN}), action.get_result.response
         )
         node._adopt(self)
         self._publish_status()
@@ -390,25 +421,31 @@ class ActionServer:
                 self._active[goal_id] = handle
         if not accepted:
             for _deadline, responder in early:
-                _answer_unknown(responder)
+                _answer_unknown(responder, self._unknown_payload)
         stamp = handle.stamp if handle else _stamp_now()
         return self._send_goal_response_class(accepted=accepted, stamp=self._time_class(**stamp))
 
-    def _after_send_goal(self, request: Any, response: Any) -> None:
+    def _after_send_goal(self, request: Any, response: Any, result_responder: Responder | None) -> None:
         if not response.accepted:
             return
         with self._lock:
             handle = self._goals.get(_uuid_bytes(request.goal_id))
         if handle is None:
+            if result_responder is not None:
+                _answer_unknown(result_responder, self._unknown_payload)
+            return
+        if result_responder is not None:
+            # Its client asked for the result with the goal: answered as it ends, like a get_result.
+            handle._add_waiter(result_responder)
+        if self._deferred:
+            # Its status is published when its work calls execute(), or as it ends.
+            self._start_deferred(handle)
             return
         # Accepted and executing from here on: one status message says both.
         with handle._lock:
             if handle.status == STATUS_ACCEPTED:
                 handle.status = STATUS_EXECUTING
         self._publish_status()
-        if self._deferred:
-            self._start_deferred(handle)
-            return
         thread = threading.Thread(
             target=self._execute, args=(handle,), name=f"kinema-goal{self.name}", daemon=True
         )
@@ -463,7 +500,7 @@ class ActionServer:
                     self._early_wake.notify()
                 return
         if handle is None:
-            _answer_unknown(responder)
+            _answer_unknown(responder, self._unknown_payload)
             return
         handle._add_waiter(responder)
 
@@ -493,7 +530,7 @@ class ActionServer:
                     self._early_idle = False
                     continue
             for responder in expired:
-                _answer_unknown(responder)
+                _answer_unknown(responder, self._unknown_payload)
 
     def _on_cancel(self, request: Any) -> Any:
         goal_id = _uuid_bytes(request.goal_info.goal_id)
@@ -592,7 +629,7 @@ class ActionServer:
             self._early.clear()
             self._early_wake.notify_all()
         for responder in early:
-            _answer_unknown(responder)
+            _answer_unknown(responder, self._unknown_payload)
         if active:
             # The results just answered are queued, not delivered (zenoh confirms no reply), and closing
             # the queryable and then the session drops them: the client would hear "went away"
@@ -606,10 +643,15 @@ class ActionServer:
         return f"<ActionServer {self.name} [{self.type_name}]>"
 
 
-def _answer_unknown(responder: Responder) -> None:
-    """Answer a get_result for a goal the server does not know."""
+def _asks_result(query: Any, response: Any) -> bool:
+    """Whether a send_goal request wants the goal's result as a second reply (and its goal was accepted)."""
+    return bool(response.accepted) and RESULT_WITH_GOAL in str(query.parameters).split(";")
+
+
+def _answer_unknown(responder: Responder, payload: bytes) -> None:
+    """Answer a get_result for a goal the server does not know (``payload``: that response)."""
     try:
-        responder.reply({"status": STATUS_UNKNOWN})
+        responder.reply_payload(payload)
     except Exception:
         log.debug("cannot answer a get_result for an unknown goal", exc_info=True)
 
@@ -645,6 +687,15 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         # request ended without the result (the server did not know the goal yet).
         self._decided = False
         self._unanswered = False
+        # The replies of the send_goal request after the acceptance (a zenoh channel, the request's
+        # sequence number, and when it times out) until they are read, whether a thread reads them now,
+        # and what they said so far.
+        self._early: tuple[Any, int, float] | None = None
+        self._early_reader = False
+        self._early_thread = False
+        self._early_cancel: Any = None  # a zenoh.CancellationToken: ends the wait (the server went away)
+        self._early_response: Any = None
+        self._early_errors: list[str] = []
 
     @property
     def goal_uuid(self) -> uuid.UUID:
@@ -658,18 +709,25 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
 
     def done(self) -> bool:
         """True once the result (or a failure to get it) arrived."""
+        if not self._done.is_set():
+            self._read_early(block=False)
         return self._done.is_set()
 
     def add_done_callback(self, callback: Callable[[ClientGoalHandle[ResultT, FeedbackT]], Any]) -> None:
         """Call ``callback(handle)`` when the goal ends (at once if it already has).
 
-        It runs on the transport's thread that received the result: it must return quickly (hand the
-        work to a loop or an event).
+        It runs on the thread that received the result (a transport thread, or one waiting in
+        :meth:`result`): it must return quickly (hand the work to a loop or an event).
         """
         with self._lock:
             if not self._done.is_set():
                 self._callbacks.append(callback)
-                return
+                waiting = True
+            else:
+                waiting = False
+        if waiting:
+            self._read_early_on_thread()
+            return
         callback(self)
 
     def cancel(self, timeout: float = 5.0) -> bool:
@@ -688,7 +746,17 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         """
         if not self.accepted:
             raise TransportError(f"goal {self.goal_uuid} was rejected by {self.client.name}")
-        if not self._done.wait(timeout):
+        deadline = None if timeout is None else time.monotonic() + timeout
+        if not self._done.is_set():
+            # The request that asked for the result ends by its timeout: a wait at least that long reads
+            # its replies here; a shorter one leaves that to a thread.
+            early = self._early
+            if early is not None and (deadline is None or deadline >= early[2]):
+                self._await_early()
+            else:
+                self._read_early_on_thread()
+        remaining = None if deadline is None else max(0.0, deadline - time.monotonic())
+        if not self._done.wait(remaining):
             raise TransportError(
                 f"goal {self.goal_uuid} on {self.client.name} did not finish within {timeout:g} s "
                 f"(last status {self.status_name})"
@@ -710,6 +778,84 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
             ask = accepted and self._unanswered and not self._done.is_set()
         if ask:
             self.client._wait_result_on_thread(self)
+
+    def _read_early(self, *, block: bool) -> bool:
+        """Read the replies of the result request sent with the goal on this thread: until the goal ends
+        or the request does (``block``), or only those already there. One thread reads at a time: False
+        when another one reads them now (True when read, or nothing is left to read)."""
+        with self._lock:
+            if self._early is None:
+                return True
+            if self._early_reader:
+                return False
+            self._early_reader = True
+            replies, sequence, _ends = self._early
+        ended = False
+        try:
+            while not self._done.is_set():
+                try:
+                    reply = replies.recv() if block else replies.try_recv()
+                except zenoh.ZError:  # the request ended: its channel is closed and empty
+                    ended = True
+                    break
+                if reply is None:
+                    break
+                self._take_early_reply(reply, sequence)
+        finally:
+            with self._lock:
+                self._early_reader = False
+                if ended or self._done.is_set():
+                    self._early = None
+        if ended:
+            self._early_request_ended()
+        return True
+
+    def _await_early(self) -> None:
+        """Read the result request's replies on this thread until the goal or the request ends, taking
+        over from another reader that stops (done() only looks at what arrived)."""
+        while not self._done.is_set() and not self._read_early(block=True):
+            self._done.wait(0.005)
+
+    def _read_early_on_thread(self) -> None:
+        """Read the result request's replies on a thread of their own (for done callbacks and short
+        waits); one such thread per goal."""
+        with self._lock:
+            if self._early is None or self._early_thread:
+                return
+            self._early_thread = True
+        threading.Thread(
+            target=self._await_early, name=f"kinema-result{self.client.name}", daemon=True
+        ).start()
+
+    def _take_early_reply(self, reply: Any, sequence: int) -> None:
+        try:
+            if reply.ok is not None:
+                if self._early_response is not None:
+                    return
+                response = self.client._get_result._decode_reply(reply.ok, sequence)
+                self._early_response = response
+                status = int(response.status)
+                if status in (STATUS_SUCCEEDED, STATUS_CANCELED):  # only an abort is followed by an error
+                    self._finish(GoalResult(status, response.result), None)
+            elif reply.err is not None:
+                self._early_errors.append(reply.err.payload.to_string())
+        except Exception:
+            log.exception("%s: the result of goal %s is unreadable", self.client.name, self.goal_uuid)
+
+    def _early_request_ended(self) -> None:
+        """The result request sent with the goal ended: finish with what it said, or ask again."""
+        try:
+            if self._done.is_set():
+                return
+            errors, response = self._early_errors, self._early_response
+            if errors and errors[0] != "Timeout":
+                self._finish(None, TransportError(errors[0]))
+            elif response is not None and int(response.status) != STATUS_UNKNOWN:
+                self._finish(GoalResult(int(response.status), response.result), None)
+            else:
+                self._early_request_unanswered()
+        except Exception:
+            log.exception("%s: the result request of goal %s failed", self.client.name, self.goal_uuid)
 
     def _early_request_unanswered(self) -> None:
         """The result request sent with the goal ended without the result."""
@@ -757,7 +903,7 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         self._ended_order: deque[tuple[float, bytes]] = deque()
         self._lock = threading.Lock()
         self._closed = False
-        self._request_class = registry.message_class(self.action.send_goal.request)
+        self._read_acceptance = response_reader(registry, self.action.send_goal.response)
         base = f"{self.name}/_action"
         action = self.action
         self._send_goal: ServiceClient[Any, Any] = ServiceClient(node, action.send_goal, f"{base}/send_goal")
@@ -771,6 +917,9 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         self._status_sub = Subscription(
             node, action.status, f"{base}/status", self._on_status, LATCHED_QOS, raw=True
         )
+        # A server that dies may never end the request that waits for a goal's result: its endpoints
+        # leaving the graph end that wait, and the goal's handle then asks the graph (_wait_result).
+        node.session.graph_cache().add_removal_listener(self._on_endpoint_removed)
         node._adopt(self)
 
     def wait_for_server(self, timeout: float = 5.0) -> bool:
@@ -802,16 +951,22 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
             self._forget_finished()
             self._handles[goal_id] = handle
             self._pending[goal_id] = handle
-        registry = self._send_goal.registry
-        request = self._request_class(goal_id=_uuid_message(registry, goal_id), goal=goal_msg)
         started = time.monotonic()
+        answered_by: list[tuple[int, Any, Any]] = []
         try:
-            payload = registry.serialize(request, action.send_goal.request)
-            sent = self._send_goal._send(payload, timeout)
-            # The result is asked for at once: a goal that ends quickly costs one round trip, not two.
-            self._ask_result_early(handle)
-            # The acceptance is one reply, never followed by an error: taken as it comes.
-            response = self._send_goal._call_payload(payload, timeout, sent, started, first=True)
+            payload = send_goal_request(goal_id, self._send_goal.registry.serialize(goal_msg, action.goal))
+            # The result is asked for with the goal: a goal that ends quickly costs one round trip.
+            # The acceptance is the first reply, taken as it comes; the result follows on a Kinema server.
+            response = self._send_goal._call_payload(
+                payload,
+                timeout,
+                None,
+                started,
+                first=True,
+                decode=self._read_acceptance,
+                parameters=RESULT_WITH_GOAL,
+                answered_by=answered_by,
+            )
         except TransportError as error:
             self._drop(handle)
             if str(error).startswith("no server for service"):
@@ -823,6 +978,9 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         if not response.accepted:
             self._drop(handle)
             return handle
+        sequence, replies, cancel = answered_by[0]
+        handle._early = (replies, sequence, started + timeout)
+        handle._early_cancel = cancel
         if handle.status == STATUS_UNKNOWN:
             handle.status = STATUS_ACCEPTED
         handle._decide(True)
@@ -834,56 +992,6 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         with self._lock:
             self._handles.pop(handle.goal_id, None)
             self._pending.pop(handle.goal_id, None)
-
-    def _ask_result_early(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
-        """Send the goal's get_result now; its replies finish the handle on the transport's thread.
-
-        A Kinema server holds the request until the goal ends. When it ends without the result (a server
-        that answers UNKNOWN for a goal it has not accepted yet, none reachable, or no answer within
-        :data:`_EARLY_RESULT_QUERY_TIMEOUT`), the handle asks again once the goal is accepted
-        (:meth:`_wait_result`, which also notices a server that went away).
-        """
-        client = self._get_result
-        sequence = client._next_sequence()
-        response: list[Any] = []
-        errors: list[str] = []
-
-        def on_reply(reply: Any) -> None:
-            try:
-                if reply.ok is not None:
-                    if response:
-                        return
-                    response.append(client._decode_reply(reply.ok, sequence))
-                    status = int(response[0].status)
-                    if status in (STATUS_SUCCEEDED, STATUS_CANCELED):  # only an abort is followed by an error
-                        handle._finish(GoalResult(status, response[0].result), None)
-                elif reply.err is not None:
-                    errors.append(reply.err.payload.to_string())
-            except Exception:
-                log.exception("%s: the result of goal %s is unreadable", self.name, handle.goal_uuid)
-
-        def on_end() -> None:
-            try:
-                if handle.done():
-                    return
-                if errors and errors[0] != "Timeout":
-                    handle._finish(None, TransportError(errors[0]))
-                elif response and int(response[0].status) != STATUS_UNKNOWN:
-                    handle._finish(GoalResult(int(response[0].status), response[0].result), None)
-                else:
-                    handle._early_request_unanswered()
-            except Exception:
-                log.exception("%s: the result request of goal %s failed", self.name, handle.goal_uuid)
-
-        try:
-            client._send(
-                CDR_LE_HEADER + handle.goal_id,
-                _EARLY_RESULT_QUERY_TIMEOUT,
-                inline(on_reply, on_end),
-                sequence=sequence,
-            )
-        except TransportError:
-            handle._early_request_unanswered()
 
     def _wait_result_on_thread(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
         threading.Thread(
@@ -924,6 +1032,15 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
             time.sleep(0.02)
         handle._finish(None, TransportError(f"action client {self.name} was closed"))
 
+    def _on_endpoint_removed(self, entity: Any) -> None:
+        if not entity.name.startswith(f"{self.name}/_action/"):
+            return
+        with self._lock:
+            waiting = [handle._early_cancel for handle in self._pending.values() if handle._early_cancel]
+        if waiting and not self.node.session.graph_cache().snapshot().action_server_ready(self.name):
+            for cancel in waiting:
+                cancel.cancel()
+
     def _ended(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
         with self._lock:
             if self._pending.pop(handle.goal_id, None) is not None and handle.finished_at is not None:
@@ -955,6 +1072,7 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
                 statuses = {_uuid_bytes(s.goal_info.goal_id): int(s.status) for s in message.status_list}
             for goal_id, status in statuses.items():
                 handle = pending.get(goal_id)
+                # done() also takes a result that arrived for a goal whose caller has not asked yet.
                 if handle is not None and not handle.done():
                     handle.status = status
         except Exception:
@@ -965,6 +1083,7 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         if self._closed:
             return
         self._closed = True
+        self.node.session.graph_cache().remove_removal_listener(self._on_endpoint_removed)
         for entity in (self._send_goal, self._cancel, self._get_result, self._feedback_sub, self._status_sub):
             entity.close()
         with self._lock:

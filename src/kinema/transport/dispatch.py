@@ -27,19 +27,6 @@ def channel() -> zenoh.handlers.FifoChannel:
     return zenoh.handlers.FifoChannel(CHANNEL_CAPACITY)
 
 
-def inline(callback: Callable[[Any], None], drop: Callable[[], None]) -> zenoh.handlers.Callback[Any]:
-    """A handler that runs ``callback(item)`` and, at the end, ``drop()`` on zenoh's own thread.
-
-    Only for short code that never blocks (decode a reply, set an event): it holds up the link's other
-    messages while it runs. Saves the thread a channel would wake; zenoh versions without ``indirect``
-    start a thread of their own per handler instead.
-    """
-    try:
-        return zenoh.handlers.Callback(callback, drop, indirect=False)
-    except TypeError:
-        return zenoh.handlers.Callback(callback, drop)
-
-
 def dispatch(entity: Any, callback: Callable[[Any], None], name: str) -> threading.Thread:
     """Call ``callback(item)`` for each item of ``entity``'s channel until the entity is undeclared.
 

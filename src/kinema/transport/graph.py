@@ -106,6 +106,7 @@ class GraphCache:
         self._session = session
         self._tokens: dict[str, GraphEntity] = {}
         self._changed = threading.Condition()
+        self._on_removed: list[Callable[[GraphEntity], None]] = []
         self._subscriber = session.zenoh.liveliness().declare_subscriber(
             f"{LIVELINESS_PREFIX}/{session.domain_id}/**", channel(), history=True
         )
@@ -118,12 +119,30 @@ class GraphCache:
         entity = parse_token(key)
         if entity is None:
             return
+        removed = sample.kind == zenoh.SampleKind.DELETE  # type: ignore[attr-defined]
         with self._changed:
-            if sample.kind == zenoh.SampleKind.DELETE:  # type: ignore[attr-defined]
+            if removed:
                 self._tokens.pop(key, None)
             else:
                 self._tokens[key] = entity
             self._changed.notify_all()
+            listeners = list(self._on_removed) if removed else []
+        for listener in listeners:
+            try:
+                listener(entity)
+            except Exception:
+                log.exception("a graph listener raised")
+
+    def add_removal_listener(self, listener: Callable[[GraphEntity], None]) -> None:
+        """Call ``listener(entity)`` (on the graph's thread: it must not block) when an entity leaves."""
+        with self._changed:
+            self._on_removed.append(listener)
+
+    def remove_removal_listener(self, listener: Callable[[GraphEntity], None]) -> None:
+        """Stop calling ``listener``."""
+        with self._changed:
+            if listener in self._on_removed:
+                self._on_removed.remove(listener)
 
     def snapshot(self) -> Graph:
         """The graph as known now."""

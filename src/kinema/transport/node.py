@@ -187,7 +187,8 @@ class Node:
         ``execute_callback(goal_handle)`` runs on a thread of its own for each accepted goal. Results of
         finished goals stay available for ``result_timeout`` seconds (at most ``max_finished_goals``).
         With ``deferred=True`` it runs on the accepting thread instead, must not block, and ends the goal
-        later through the handle (see :class:`~kinema.transport.action.ActionServer`).
+        later through the handle, which stays ACCEPTED until ``execute()`` is called on it (see
+        :class:`~kinema.transport.action.ActionServer`).
         """
         self._check_open()
         return ActionServer(

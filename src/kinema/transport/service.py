@@ -22,7 +22,7 @@ import zenoh
 from kinema.errors import TransportError
 from kinema.interfaces import ServiceType
 from kinema.interfaces.definition import RequestT, ResponseT
-from kinema.transport.attachment import Attachment
+from kinema.transport.attachment import GID_SIZE, Attachment, encode_attachment
 from kinema.transport.dispatch import channel, dispatch
 from kinema.transport.heap import note_message_size
 from kinema.transport.keys import SERVICE_QOS, EntityKind
@@ -102,12 +102,19 @@ class Responder:
             return self._query
 
     def _reply_attachment(self) -> bytes | None:
-        if self._attachment is None:
+        request = self._attachment
+        if request is None:
             return None
-        return Attachment(self._attachment.sequence_number, gid=self._attachment.gid).encode()
+        if len(request.gid) == GID_SIZE:
+            return encode_attachment(request.sequence_number, request.gid)
+        return Attachment(request.sequence_number, gid=request.gid).encode()  # raises, naming the size
 
-    def reply(self, response: Any) -> None:
-        """Send the response (a message object or a dict of its fields)."""
+    def reply(self, response: Any, *, more: bool = False) -> None:
+        """Send the response (a message object or a dict of its fields).
+
+        With ``more`` the request stays open for a later :meth:`reply_payload` (an action goal whose
+        client asked for the result with it).
+        """
         server = self._server
         try:
             message = _as_message(response, server.service.response, f"response of {server.name}")
@@ -115,23 +122,26 @@ class Responder:
         except TransportError as error:
             self.error(str(error))
             return
+        if more:
+            with self._lock:
+                if self.done:
+                    raise TransportError(f"request to {server.name} was already answered")
+                query = self._query
+            query.reply(server.key, payload, attachment=self._reply_attachment())
+            return
         query = self._finish()
         try:
             query.reply(server.key, payload, attachment=self._reply_attachment())
         finally:
             query.drop()
 
-    def reply_then_error(self, response: Any, message: str) -> None:
-        """Send a response and then an error reply: ROS clients take the response, Kinema clients raise."""
-        server = self._server
-        payload = server.registry.serialize(
-            _as_message(response, server.service.response, f"response of {server.name}"),
-            server.service.response,
-        )
+    def reply_payload(self, payload: bytes, error: str | None = None) -> None:
+        """Send an already serialised reply (then ``error`` as an error reply) and end the request."""
         query = self._finish()
         try:
-            query.reply(server.key, payload, attachment=self._reply_attachment())
-            query.reply_err(message.encode())
+            query.reply(self._server.key, payload, attachment=self._reply_attachment())
+            if error:
+                query.reply_err(error.encode())
         finally:
             query.drop()
 
@@ -155,6 +165,8 @@ class ServiceServer(Entity):
     time) unless ``max_concurrent > 1``, in which case up to that many run at once on worker threads.
     With ``deferred=True`` the handler is ``handler(request, responder)`` and answers later through
     ``responder.reply(...)`` from any thread (used by action servers for ``get_result``).
+    ``after_reply(request, response, responder)`` runs once the response is sent; ``responder`` is the
+    request's, still open, when ``keep_open(query, response)`` said so (else None).
     """
 
     kind = EntityKind.SERVICE_SERVER
@@ -168,7 +180,8 @@ class ServiceServer(Entity):
         *,
         max_concurrent: int = 1,
         deferred: bool = False,
-        after_reply: Callable[[Any, Any], None] | None = None,
+        after_reply: Callable[[Any, Any, Responder | None], None] | None = None,
+        keep_open: Callable[[Any, Any], bool] | None = None,
     ) -> None:
         super().__init__(node, name, service.name, service.dds_name, service.type_hash, SERVICE_QOS)
         self.service = service
@@ -176,6 +189,7 @@ class ServiceServer(Entity):
         self._handler = handler
         self._deferred = deferred
         self._after_reply = after_reply
+        self._keep_open = keep_open
         self._pool = _HandlerPool(max_concurrent, f"kinema-srv{name}") if max_concurrent > 1 else None
         self._queryable = node.session.zenoh.declare_queryable(self.key, channel(), complete=True)
         node.session._track_dispatcher(dispatch(self._queryable, self._on_query, f"-srv{name}"))
@@ -218,10 +232,11 @@ class ServiceServer(Entity):
         if response is None:
             responder.error(f"service {self.name} failed: its handler returned no response")
             return
-        responder.reply(response)
+        keep = self._keep_open is not None and self._keep_open(query, response)
+        responder.reply(response, more=keep)
         if self._after_reply is not None:
             try:
-                self._after_reply(request, response)
+                self._after_reply(request, response, responder if keep else None)
             except Exception:
                 log.exception("post-reply step of service %s raised", self.name)
 
@@ -284,16 +299,28 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
         started: float | None = None,
         *,
         first: bool = False,
+        decode: Callable[[bytes], Any] | None = None,
+        parameters: str = "",
+        answered_by: list[tuple[int, Any, Any]] | None = None,
     ) -> Any:
         """:meth:`call` with a serialised request; ``sent`` is a first attempt already on its way
-        (``_send``'s result, sent at ``started``). ``first``: see :meth:`_collect`."""
+        (``_send``'s result, sent at ``started``). ``first``, ``decode``: see :meth:`_collect`;
+        ``parameters``: see :meth:`_send`. The attempt that got the response is appended to
+        ``answered_by`` as its sequence number, replies and the ``zenoh.CancellationToken`` that ends its
+        wait (its replies may go on)."""
         deadline = (time.monotonic() if started is None else started) + timeout
+        cancel: Any = None
         while True:
             remaining = deadline - time.monotonic()
             try:
                 if sent is None:
-                    sent = self._send(payload, max(remaining, 0.001))
-                outcome = self._collect(*sent, first=first)
+                    token = zenoh.CancellationToken() if answered_by is not None else None
+                    sent = self._send(
+                        payload, max(remaining, 0.001), parameters=parameters, cancellation_token=token
+                    )
+                    cancel = token
+                attempt = sent
+                outcome = self._collect(*sent, first=first, decode=decode)
                 sent = None
             except _QueryTimedOut:
                 # A server took the request but did not reply in time (or the last slice was too short
@@ -302,6 +329,8 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
                     raise TransportError(f"service {self.name} did not answer within {timeout:g} s") from None
                 outcome = None
             if outcome is not None:
+                if answered_by is not None:
+                    answered_by.append((*attempt, cancel))
                 return outcome
             if time.monotonic() + _RETRY_PAUSE >= deadline:
                 raise TransportError(
@@ -334,32 +363,50 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
             return next(self._sequence)
 
     def _send(
-        self, payload: bytes, timeout: float, handler: Any = None, *, sequence: int | None = None
+        self,
+        payload: bytes,
+        timeout: float,
+        handler: Any = None,
+        *,
+        sequence: int | None = None,
+        parameters: str = "",
+        cancellation_token: Any = None,
     ) -> tuple[int, Any]:
         """Send one request; returns its sequence number and zenoh's reply handler (``handler`` if given:
-        a ``zenoh.handlers.Callback``), without waiting for a reply."""
+        a ``zenoh.handlers.Callback``), without waiting for a reply. ``parameters`` go in the selector
+        (``key?parameters``): servers that do not know them ignore them. Cancelling
+        ``cancellation_token`` ends the wait for replies (the server is not told)."""
         if self._closed:
             raise TransportError(f"client of {self.name} is closed")
         if sequence is None:
             sequence = self._next_sequence()
         attachment = Attachment(sequence, gid=self.gid).encode()
         replies = self.node.session.zenoh.get(
-            self.key,
+            f"{self.key}?{parameters}" if parameters else self.key,
             handler,
             target=zenoh.QueryTarget.ALL_COMPLETE,
             consolidation=zenoh.ConsolidationMode.NONE,
             payload=payload,
             attachment=attachment,
             timeout=timeout,
+            **({} if cancellation_token is None else {"cancellation_token": cancellation_token}),
         )
         return sequence, replies
 
-    def _collect(self, sequence: int, replies: Any, *, first: bool = False) -> Any | None:
+    def _collect(
+        self,
+        sequence: int,
+        replies: Any,
+        *,
+        first: bool = False,
+        decode: Callable[[bytes], Any] | None = None,
+    ) -> Any | None:
         """The response among ``replies`` (None when no server answered); raises an error reply.
 
         With ``first``, the first response is returned as it comes, without waiting for the query to
         end: for a service whose server never follows a response with an error
-        (:meth:`Responder.reply_then_error`), such as an action's ``send_goal``.
+        (:meth:`Responder.reply_payload`'s ``error``), such as an action's ``send_goal``. ``decode(payload)``
+        reads the response instead of the generic deserializer.
         """
         response: Any = None
         answered = False
@@ -368,7 +415,7 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
             if reply.ok is not None:
                 if answered:
                     continue
-                response = self._decode_reply(reply.ok, sequence)
+                response = self._decode_reply(reply.ok, sequence, decode)
                 answered = True
                 if first and not errors:
                     return response
@@ -381,7 +428,7 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
             raise TransportError(message)
         return response if answered else None
 
-    def _decode_reply(self, sample: Any, sequence: int) -> Any:
+    def _decode_reply(self, sample: Any, sequence: int, decode: Callable[[bytes], Any] | None = None) -> Any:
         """The response in a reply's sample (a reply echoing another sequence number is logged)."""
         if sample.attachment is not None:
             echoed = Attachment.decode(sample.attachment.to_bytes())
@@ -389,7 +436,10 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
                 log.warning(
                     "reply on %s echoes sequence %d, expected %d", self.name, echoed.sequence_number, sequence
                 )
-        return self.registry.deserialize(sample.payload.to_bytes(), self.service.response)
+        payload = sample.payload.to_bytes()
+        if decode is not None:
+            return decode(payload)
+        return self.registry.deserialize(payload, self.service.response)
 
     def call_async(
         self, request: RequestT | dict[str, Any] | None = None, timeout: float = 5.0

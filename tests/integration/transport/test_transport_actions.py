@@ -17,6 +17,7 @@ from kinema.errors import TransportError
 from kinema.transport import (
     STATUS_ABORTED,
     STATUS_CANCELED,
+    STATUS_EXECUTING,
     STATUS_SUCCEEDED,
     Node,
     ServerGoalHandle,
@@ -162,11 +163,12 @@ def test_killed_server_fails_the_pending_result(connect: Callable[[], Session], 
     )
     try:
         assert server.stdout is not None and server.stdout.readline().strip() == "ready"
-        handle = _client(connect, "/vanishing").send_goal({"order": 1})
+        # A long request timeout: the server's endpoints leaving the graph end the wait, not the timeout.
+        handle = _client(connect, "/vanishing").send_goal({"order": 1}, timeout=120)
         assert handle.accepted
         server.send_signal(signal.SIGKILL)
         with pytest.raises(TransportError, match="went away"):
-            handle.result(timeout=15)
+            handle.result(timeout=30)
     finally:
         server.kill()
         server.wait(10)
@@ -282,30 +284,145 @@ def test_a_result_request_for_a_goal_that_never_comes_is_answered_unknown(
         assert response.status == STATUS_UNKNOWN
 
 
-def test_a_server_that_does_not_hold_early_result_requests_still_delivers_results(
+def test_a_server_that_answers_a_goal_once_still_delivers_its_result(
     connect: Callable[[], Session], monkeypatch: pytest.MonkeyPatch
 ) -> None:
-    # rclcpp answers a get_result for a goal it has not accepted yet with UNKNOWN at once: the client then
-    # asks again once its goal is accepted.
-    answered_unknown = threading.Event()
+    # rmw_zenoh ignores the send_goal request's result parameter and answers with the acceptance alone:
+    # the client then asks get_result, as rcl does.
+    monkeypatch.setattr(action_module, "_asks_result", lambda query, response: False)
+    asked: list[bytes] = []
+    on_get_result = action_module.ActionServer._on_get_result
 
-    def answer_unknown_at_once(self: Any, request: Any, responder: Any) -> None:
-        handle = self._goals.get(bytes(request.goal_id.uuid))
-        if handle is None:
-            responder.reply({"status": STATUS_UNKNOWN})
-            answered_unknown.set()
-        else:
-            handle._add_waiter(responder)
+    def recording(self: Any, request: Any, responder: Any) -> None:
+        asked.append(bytes(request.goal_id.uuid))
+        on_get_result(self, request, responder)
 
-    monkeypatch.setattr(action_module.ActionServer, "_on_get_result", answer_unknown_at_once)
-    Node(connect(), "server").create_action_server(
-        # The goal is accepted only once the result request that came with it was turned away.
-        FIB,
-        "/rcl_like",
-        _fibonacci,
-        goal_callback=lambda goal: answered_unknown.wait(5),
-    )
+    monkeypatch.setattr(action_module.ActionServer, "_on_get_result", recording)
+    Node(connect(), "server").create_action_server(FIB, "/rcl_like", _fibonacci)
     handle = _client(connect, "/rcl_like").send_goal({"order": 5})
-    assert handle.accepted and answered_unknown.is_set()
+    assert handle.accepted
     outcome = handle.result(timeout=10)
     assert outcome.succeeded and outcome.result.sequence.tolist() == [0, 1, 1, 2, 3]
+    assert asked == [handle.goal_id]
+
+
+def test_a_kinema_server_answers_the_result_on_the_goal_request(
+    connect: Callable[[], Session], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    asked: list[bytes] = []
+    monkeypatch.setattr(
+        action_module.ActionServer, "_on_get_result", lambda self, request, responder: asked.append(b"")
+    )
+    Node(connect(), "server").create_action_server(FIB, "/one_request", _fibonacci)
+    outcome = _client(connect, "/one_request").send_goal({"order": 4}).result(timeout=10)
+    assert outcome.succeeded and outcome.result.sequence.tolist() == [0, 1, 1, 2]
+    assert asked == []  # no get_result request
+
+
+def test_the_result_is_read_by_the_thread_that_waits_for_it(
+    connect: Callable[[], Session], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # No transport thread is woken to hand the result over: the caller of result() reads its reply.
+    finished_on: list[str] = []
+    finish = action_module.ClientGoalHandle._finish
+
+    def recording_finish(self: Any, outcome: Any, error: Any) -> None:
+        finished_on.append(threading.current_thread().name)
+        finish(self, outcome, error)
+
+    monkeypatch.setattr(action_module.ClientGoalHandle, "_finish", recording_finish)
+    Node(connect(), "server").create_action_server(FIB, "/waited", _fibonacci)
+    client = _client(connect, "/waited")
+    waiter = threading.Thread(
+        target=lambda: client.send_goal({"order": 4}).result(), name="the waiting thread"
+    )
+    waiter.start()
+    waiter.join(10)
+    assert finished_on == ["the waiting thread"]
+
+
+def test_a_result_nobody_waits_for_still_ends_the_goal(connect: Callable[[], Session]) -> None:
+    Node(connect(), "server").create_action_server(FIB, "/unwatched", _fibonacci)
+    client = _client(connect, "/unwatched")
+    polled = client.send_goal({"order": 3})
+    deadline = time.monotonic() + 10
+    while not polled.done():
+        assert time.monotonic() < deadline, "done() never turned true"
+        time.sleep(0.01)
+    assert polled.status == STATUS_SUCCEEDED
+    called = threading.Event()
+    with_callback = client.send_goal({"order": 3})
+    with_callback.add_done_callback(lambda _handle: called.set())
+    assert called.wait(10)
+    assert with_callback.result(timeout=0.1).result.sequence.tolist() == [0, 1, 1]
+
+
+def test_a_deferred_goal_is_published_executing_when_its_work_says_so(connect: Callable[[], Session]) -> None:
+    # As rclcpp's execute(): a goal that ends at once is published once, ended; one that runs on shows
+    # EXECUTING from the moment its work calls execute().
+    statuses: list[list[int]] = []
+    held: list[ServerGoalHandle] = []
+
+    def hold_or_end(handle: ServerGoalHandle) -> None:
+        if handle.goal.order == 0:
+            handle.succeed({"sequence": []})
+        else:
+            held.append(handle)
+
+    Node(connect(), "server").create_action_server(FIB, "/deferred", hold_or_end, deferred=True)
+    watcher = Node(connect(), "watcher")
+    watcher.create_subscription(
+        "action_msgs/msg/GoalStatusArray",
+        "/deferred/_action/status",
+        lambda m: statuses.append([s.status for s in m.status_list]),
+        latched=True,
+    )
+    client = _client(connect, "/deferred")
+    assert client.send_goal({"order": 0}).result(timeout=5).succeeded
+    _until(lambda: [4] in statuses, "the ended goal's status")
+    assert statuses[-1] == [4] and [2] not in statuses and [1] not in statuses, statuses
+
+    running = client.send_goal({"order": 1})
+    _until(lambda: bool(held), "the second goal to reach its work")
+    time.sleep(0.2)
+    assert statuses[-1] == [4], statuses  # accepted, not yet executing: nothing published
+    held[0].execute()
+    _until(lambda: statuses[-1] == [4, 2], "EXECUTING")
+    _until(lambda: running.status == STATUS_EXECUTING, "the client to see EXECUTING")
+    held[0].succeed({"sequence": [0]})
+    assert running.result(timeout=5).succeeded
+    _until(lambda: statuses[-1] == [4, 4], "SUCCEEDED")
+
+
+def _until(condition: Callable[[], bool], what: str, timeout: float = 5.0) -> None:
+    deadline = time.monotonic() + timeout
+    while not condition():
+        assert time.monotonic() < deadline, f"timed out waiting for {what}"
+        time.sleep(0.01)
+
+
+def test_a_waiting_caller_takes_over_reading_the_result_from_a_look_that_stops(
+    connect: Callable[[], Session], monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # done() (the status topic's thread calls it too) only looks at the replies that arrived; a caller
+    # blocked in result() while such a look held the replies must read them once it stops.
+    monkeypatch.setattr(action_module.ActionClient, "_on_status", lambda self, payload: None)
+    release = threading.Event()
+
+    def waits(handle: ServerGoalHandle) -> dict[str, list[int]]:
+        release.wait(5)
+        return {"sequence": [0, 1]}
+
+    Node(connect(), "server").create_action_server(FIB, "/looked_at", waits)
+    handle = _client(connect, "/looked_at").send_goal({"order": 2})
+    with handle._lock:
+        handle._early_reader = True  # another thread looks at the replies now
+    outcome: list[Any] = []
+    waiter = threading.Thread(target=lambda: outcome.append(handle.result(timeout=30)))
+    waiter.start()
+    time.sleep(0.1)
+    with handle._lock:
+        handle._early_reader = False  # ...and stops without the result
+    release.set()
+    waiter.join(10)
+    assert outcome and outcome[0].result.sequence.tolist() == [0, 1]

@@ -8,9 +8,11 @@ from typing import Any
 import pytest
 
 from kinema.errors import ObjectiveError
+from kinema.runtime import names
 from kinema.runtime.agent import overrides_from_messages, render_value, result_message
 from kinema.runtime.overrides import ParameterOverride
 from kinema.runtime.result import ObjectiveResult
+from kinema.transport.messages import load_interfaces
 
 
 def _parameter(name: str, kind: int, **values: Any) -> SimpleNamespace:
@@ -96,6 +98,9 @@ def test_a_heartbeat_never_reports_a_status_older_than_the_one_published_before_
             if "heartbeat" in self.topic:
                 beats.append(str(message.objective_status))
 
+        def publish_raw(self, payload: bytes) -> None:
+            self.publish(load_interfaces().deserialize(payload, names.HEARTBEAT_TYPE))
+
     node = SimpleNamespace(create_publisher=lambda _type, topic, **_: Publisher(topic))
     in_health, release = threading.Event(), threading.Event()
 
@@ -173,3 +178,85 @@ def test_a_large_tick_is_published_as_several_node_status_messages_in_order() ->
     tree.tick_once()
     streams.on_node_status("Big", recorder.take())  # type: ignore[arg-type]
     assert [topic for topic, _ in sent] == ["/objective_server/node_status"] * 3
+
+
+def test_loading_and_running_beats_wait_for_the_first_node_changes_the_end_or_the_periodic_beat() -> None:
+    """A run that ends in its first tick answers its client before any heartbeat of it is published;
+    every status change still gets its heartbeat, in order, and a long build shows within a beat."""
+    from kinema.runtime.agent import _Streams
+    from kinema.runtime.objective_status import ObjectiveStatus
+
+    beats: list[str] = []
+
+    class Publisher:
+        def __init__(self, topic: str) -> None:
+            self.topic = topic
+
+        def publish(self, message: Any) -> None:
+            if "heartbeat" in self.topic:
+                beats.append(str(message.objective_status))
+
+        def publish_raw(self, payload: bytes) -> None:
+            self.publish(load_interfaces().deserialize(payload, names.HEARTBEAT_TYPE))
+
+    node = SimpleNamespace(create_publisher=lambda _type, topic, **_: Publisher(topic))
+    report = SimpleNamespace(tick_thread_alive=True, replacements=0, warnings=())
+    server = SimpleNamespace(health=lambda: report)
+    streams = _Streams(node, None, server)  # type: ignore[arg-type]
+    streams.on_status(ObjectiveStatus.LOADING, "Quick")
+    streams.on_status(ObjectiveStatus.RUNNING, "Quick")
+    assert beats == []
+    streams.on_status(ObjectiveStatus.SUCCESS, "Quick")
+    assert beats == ["Loading", "Running", "Success"]
+
+    beats.clear()
+    streams.on_status(ObjectiveStatus.LOADING, "Slow to build")
+    streams.publish_heartbeat()  # the periodic beat, 10 Hz
+    assert beats == ["Loading"]
+    streams.publish_heartbeat()
+    assert beats == ["Loading", "Loading"]
+
+
+@pytest.mark.parametrize("name", ["", "a", "ab", "abc", "Pick \u00e9 and place", "x" * 257])
+@pytest.mark.parametrize("status", ["Idle", "Running", "Cancelled", ""])
+def test_the_heartbeat_laid_out_directly_is_what_the_generic_serializer_writes(
+    name: str, status: str
+) -> None:
+    from kinema.runtime.heartbeat_cdr import HeartbeatEncoder, generic_serializer
+
+    generic = generic_serializer(load_interfaces(), names.HEARTBEAT_TYPE)
+    encoder = HeartbeatEncoder(generic)
+    stamps = ((1_700_000_000, 999_999_999), (42, 7))
+    assert encoder.encode(*stamps, name, status) == generic(*stamps, name, status)
+
+
+def test_only_a_run_still_running_a_beat_later_gets_a_running_line(caplog: pytest.LogCaptureFixture) -> None:
+    """One line per quick run (its result), not two: the "Running" line is a file write on the tick
+    thread per run; a run that lasts gets it from the periodic beat (or its next tick)."""
+    import logging
+
+    from kinema.runtime.agent import _Streams
+    from kinema.runtime.objective_status import ObjectiveStatus
+
+    class Publisher:
+        def publish(self, message: Any) -> None: ...
+
+        def publish_raw(self, payload: bytes) -> None: ...
+
+    node = SimpleNamespace(create_publisher=lambda *_args, **_kwargs: Publisher())
+    report = SimpleNamespace(tick_thread_alive=True, replacements=0, warnings=())
+    streams = _Streams(node, None, SimpleNamespace(health=lambda: report))  # type: ignore[arg-type]
+    caplog.set_level(logging.INFO, logger="kinema.agent")
+    for status in (ObjectiveStatus.LOADING, ObjectiveStatus.RUNNING, ObjectiveStatus.SUCCESS):
+        streams.on_status(status, "Quick")
+    streams.on_run_finished(None, ObjectiveResult.success("Quick"))  # type: ignore[arg-type]
+    streams.publish_heartbeat()
+    assert [r.getMessage() for r in caplog.records if "Running" in r.getMessage()] == []
+
+    streams.on_status(ObjectiveStatus.LOADING, "Slow")
+    streams.on_status(ObjectiveStatus.RUNNING, "Slow")
+    streams.publish_heartbeat()
+    streams.publish_heartbeat()
+    assert [r.getMessage() for r in caplog.records if "Running" in r.getMessage()] == [
+        "objective 'Slow': Running"
+    ]

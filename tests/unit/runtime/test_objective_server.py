@@ -118,6 +118,59 @@ def test_a_quick_objective_succeeds_and_reports_each_state(
     assert ("Quick", "done", "double", 1.0) in recorder.snapshots[-1]
 
 
+def test_a_run_answers_its_clients_before_the_listeners_hear_how_it_ended() -> None:
+    """A goal's result (a done callback) leaves before the heartbeat, node status and log publications
+    of the run's end; ``wait`` returns only once the listeners have heard everything."""
+    events: list[object] = []
+
+    class Watcher(Recorder):
+        def on_status(self, status: ObjectiveStatus, objective_name: str) -> None:
+            events.append(status)
+
+        def on_node_status(self, objective_name: str, changes: NodeStatusBatch) -> None:
+            events.append("node changes")
+
+        def on_run_finished(self, run: ObjectiveRun, result: ObjectiveResult) -> None:
+            events.append("finished")
+
+    factory = BehaviorTreeFactory()
+    factory.register_behavior_tree_from_text(LIBRARY)
+    with ObjectiveServer(FactoryTreeSource(factory), listeners=[Watcher()]) as server:
+        run = server.submit(
+            ObjectiveRequest("Quick"),
+            before_start=lambda r: r.add_done_callback(lambda _: events.append("answered")),
+        )
+        assert run.wait(5) == ObjectiveResult.success("Quick")
+        assert events == [
+            ObjectiveStatus.LOADING,
+            ObjectiveStatus.RUNNING,
+            "answered",
+            "node changes",
+            ObjectiveStatus.SUCCESS,
+            "finished",
+        ]
+
+
+def test_running_callbacks_come_after_a_first_tick_that_did_not_end_the_run(server: ObjectiveServer) -> None:
+    called: list[str] = []
+    quick = server.submit(
+        ObjectiveRequest("Quick"),
+        before_start=lambda r: r.add_running_callback(lambda: called.append("Quick")),
+    )
+    assert quick.wait(5) == ObjectiveResult.success("Quick")
+    forever = server.submit(
+        ObjectiveRequest("Forever"),
+        before_start=lambda r: r.add_running_callback(lambda: called.append("Forever")),
+    )
+    _wait_status(server, ObjectiveStatus.RUNNING)
+    deadline = time.monotonic() + 5
+    while not called and time.monotonic() < deadline:
+        time.sleep(0.002)
+    forever.add_running_callback(lambda: called.append("late"))  # registered after: called at once
+    assert called == ["Forever", "late"]
+    assert server.cancel()
+
+
 def test_cancel_halts_a_looping_objective_within_a_tick(server: ObjectiveServer) -> None:
     run = server.submit(ObjectiveRequest("Forever"))
     _wait_status(server, ObjectiveStatus.RUNNING)
