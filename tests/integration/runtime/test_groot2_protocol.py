@@ -242,10 +242,15 @@ def test_the_agent_process_serves_groot2_and_records_runs(tmp_path: Path, reques
         assert result.failed, result
         tree = client.request("T")[1].decode()
         assert 'BehaviorTree ID="Fails"' in tree and 'name="broken"' in tree
-        status = client.request("S")[1]
         broken_uid = int(tree.split('name="broken" _uid="')[1].split('"')[0])
-        assert struct.pack("<HB", broken_uid, 13) in status, "the failed node reads IDLE-after-FAILURE"
-        files = list_recordings(recordings)
+        # The client has its result first; Groot2 and the recorder hear of the end right after.
+        deadline = time.monotonic() + 10
+        while struct.pack("<HB", broken_uid, 13) not in client.request("S")[1]:
+            assert time.monotonic() < deadline, "the failed node never read IDLE-after-FAILURE"
+            time.sleep(0.02)
+        while not (files := list_recordings(recordings)):
+            assert time.monotonic() < deadline, "the run was never recorded"
+            time.sleep(0.02)
         assert [f.objective_name for f in files] == ["Fails"], files
         recording = read_btlog(files[0].path)
         assert (broken_uid, 3) in [(t.uid, int(t.status)) for t in recording.transitions]
