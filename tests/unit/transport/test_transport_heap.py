@@ -138,9 +138,13 @@ from kinema.process.memory_probe import _arena_count, _glibc
 if sys.argv[1] == "bounded":
     assert bound_heap_growth()
 
+all_allocated = threading.Barrier(12)
+
 def work():
     blocks = [bytearray(200) for _ in range(20_000)]  # small blocks, from this thread's arena
     del blocks[::2]
+    # all alive at once, as the agent's threads are: an exited thread's arena is handed to the next one
+    all_allocated.wait(60)
 
 threads = [threading.Thread(target=work) for _ in range(12)]
 for thread in threads:
