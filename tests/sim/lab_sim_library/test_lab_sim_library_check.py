@@ -130,15 +130,20 @@ class Recorder:
         self._current: Recording | None = None
         self._lock = threading.Lock()
         self._last = 0.0
+        self._final, self._final_taken = threading.Event(), threading.Event()
         cell.node.create_subscription("sensor_msgs/msg/JointState", "/joint_states", self._on_joints)
 
     def _on_joints(self, message: Any) -> None:
         now = time.monotonic()
         with self._lock:
-            if self._current is None or now - self._last < 0.02:
+            if self._current is None or (now - self._last < 0.02 and not self._final.is_set()):
                 return
             self._last = now
             self._current.joints.append(dict(zip(message.name, message.position, strict=False)))
+            if self._final.is_set():
+                self._current = None  # the state after the run: the last sample
+                self._final.clear()
+                self._final_taken.set()
 
     @contextmanager
     def recording(self) -> Iterator[Recording]:
@@ -164,7 +169,13 @@ class Recorder:
             thread.join(5.0)
             _sim_time, bodies = self.cell.sim.bodies()
             record.bodies.append({b.name: np.array(b.position) for b in bodies})
+            # The last joint sample is one published after the run ended (the one before may be up to a
+            # throttle period and a delivery old: on a loaded machine at full sim speed, far from the end).
+            self._final_taken.clear()
+            self._final.set()
+            self._final_taken.wait(5.0)
             with self._lock:
+                self._final.clear()
                 self._current = None
 
 
