@@ -202,6 +202,12 @@ class KinemaApp(App[None]):
         initial_mode: str = "objectives",
         camera: str | None = None,
     ) -> None:
+        if initial_mode not in SCREEN_CLASSES:
+            raise ValueError(f"no screen {initial_mode!r}; the screens are {', '.join(SCREEN_CLASSES)}")
+        # The first screen is the app's default mode, composed when the app is: switching to it from
+        # Textual's blank default screen restyled every widget of it twice more before the first frame.
+        # Textual's App.__init__ reads the mode through the instance, so each app can start on its own.
+        self.DEFAULT_MODE = initial_mode  # type: ignore[misc]
         super().__init__()
         self.camera_topic = camera
         # True while a teleoperation session (DoTeleoperateAction) is open in a dialog.
@@ -249,7 +255,6 @@ class KinemaApp(App[None]):
     # -- lifecycle ----------------------------------------------------------------------------------
 
     def on_mount(self) -> None:
-        self.switch_mode(self.initial_mode)
         # Joining the runtime imports the transport (zenoh, numpy) on the connection's thread; begun
         # after the first frame, it does not hold the interpreter while the screen is being drawn.
         self.call_after_refresh(self._open_connection)
