@@ -1,13 +1,16 @@
-"""The way to the first frame: the first screen is composed and styled once."""
+"""The way to the first frame: the first screen is composed and styled once, the collector held meanwhile."""
 
 from __future__ import annotations
 
 import asyncio
+import gc
+from collections.abc import Iterator
 
 import pytest
 from textual.dom import DOMNode
 from textual.screen import Screen
 
+from kinema.tui import startup_gc
 from kinema.tui.app import KinemaApp
 from kinema.tui.fake_connection import FakeConnection
 from kinema.tui.screens.base import breakpoint_classes
@@ -23,6 +26,15 @@ class RestyleRecordingApp(KinemaApp):
     def update_styles(self, node: DOMNode, animate: bool = True) -> None:
         self.restyled.append(node)
         super().update_styles(node, animate)
+
+
+@pytest.fixture
+def collector() -> Iterator[None]:
+    """Leave the garbage collector as the test found it (on, nothing frozen)."""
+    yield
+    startup_gc.release()
+    gc.unfreeze()
+    gc.enable()
 
 
 @pytest.mark.parametrize("size", [(80, 24), (120, 40)])
@@ -92,3 +104,29 @@ def test_breakpoint_classes_are_textuals(
 def test_an_unknown_first_screen_is_an_error_naming_the_screens(fake: FakeConnection) -> None:
     with pytest.raises(ValueError, match=r"no screen 'object'.*objectives.*waypoints"):
         KinemaApp(fake, initial_mode="object")
+
+
+def test_held_collector_resumes_after_the_first_frame_with_the_start_up_frozen(
+    fake: FakeConnection, collector: None
+) -> None:
+    startup_gc.hold()
+    assert not gc.isenabled()
+    app = KinemaApp(fake)
+
+    async def main() -> None:
+        async with app.run_test(size=(120, 40)) as pilot:
+            await pilot.pause()
+            await pilot.pause()
+            assert gc.isenabled()
+            assert gc.get_freeze_count() > 10_000  # Textual's and the screen's objects
+
+    asyncio.run(main())
+
+
+def test_a_collector_turned_off_by_someone_else_stays_off(collector: None) -> None:
+    gc.disable()
+    startup_gc.hold()
+    startup_gc.settle()
+    assert not gc.isenabled()
+    startup_gc.release()
+    assert not gc.isenabled()

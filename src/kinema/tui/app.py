@@ -7,7 +7,6 @@ heartbeat, clock sample and blackboard snapshot, so a fast stream can never queu
 
 from __future__ import annotations
 
-import gc
 import logging
 import threading
 import time
@@ -24,6 +23,7 @@ from textual.notifications import SeverityLevel
 from textual.screen import Screen
 from textual.timer import Timer
 
+from kinema.tui import startup_gc
 from kinema.tui.blackboard_model import BlackboardModel
 from kinema.tui.connection import (
     ApprovalRequested,
@@ -260,10 +260,7 @@ class KinemaApp(App[None]):
         self.call_after_refresh(self._open_connection)
         if self.camera_topic:
             self.action_show_camera(self.camera_topic)
-        # Textual, the stylesheets and the screens make ~10^5 long-lived objects; every full garbage
-        # collection walks them all (hundreds of ms while the blackboard streams). Freezing them after
-        # the first frame keeps those collections to what was allocated since.
-        self.call_after_refresh(gc.freeze)
+        self.call_after_refresh(startup_gc.settle)
 
     def _open_connection(self) -> None:
         if not self._closing:
@@ -715,4 +712,7 @@ def run_app(
         from kinema.tui.screens.camera import load_image_support
 
         load_image_support()
-    KinemaApp(connection, owns_runtime=owns_runtime, initial_mode=initial_mode, camera=camera).run()
+    try:
+        KinemaApp(connection, owns_runtime=owns_runtime, initial_mode=initial_mode, camera=camera).run()
+    finally:
+        startup_gc.release()  # in case the app closed before its first frame
