@@ -11,10 +11,10 @@ from textual import events, on
 from textual.app import App, ComposeResult
 from textual.message import Message
 from textual.screen import Screen
-from textual.widgets import Footer
 
 from kinema.errors import KinemaError
 from kinema.tui.messages import RuntimeCallFailed, RuntimeCallSucceeded
+from kinema.tui.widgets.key_footer import KeyFooter
 from kinema.tui.widgets.nav_bar import NavBar
 from kinema.tui.widgets.status_bar import StatusBar
 
@@ -91,7 +91,7 @@ class KinemaScreen(RuntimeView, Screen[None]):
         yield NavBar(self.MODE)
         yield from self.compose_body()
         yield StatusBar(id="status-bar")
-        yield Footer()
+        yield KeyFooter()
 
     def compose_body(self) -> ComposeResult:
         """The screen's own widgets."""
