@@ -44,7 +44,6 @@ from kinema.tui.connection import (
     TaskPlanning,
     UserInputRequested,
 )
-from kinema.tui.dialogs.confirm import ConfirmDialog, MotionQuestionDialog
 from kinema.tui.messages import (
     KeyDelivered,
     ModeSelected,
@@ -405,6 +404,8 @@ class KinemaApp(App[None]):
 
             self.push_screen(ApprovalDialog(question, request.steps, request.duration), answered)
             return
+        from kinema.tui.dialogs.confirm import MotionQuestionDialog  # dialogs load when first shown
+
         self.push_screen(MotionQuestionDialog(question), answered)
 
     def ask_user_input(self, request: UserInputRequested) -> None:
@@ -585,6 +586,8 @@ class KinemaApp(App[None]):
         def answered(stop: bool | None) -> None:
             if stop:
                 self.exit()
+
+        from kinema.tui.dialogs.confirm import ConfirmDialog
 
         self.push_screen(
             ConfirmDialog(
