@@ -30,19 +30,19 @@ from kinema.tui.connection import (
     RuntimeConnection,
     TaskPlanning,
 )
-from kinema.tui.dialogs.failure import FailureDialog, outcome_text
 from kinema.tui.messages import ObjectiveOutlineLoaded, ObjectiveRunRequested, ObjectivesLoaded
 from kinema.tui.run_outcome import RunOutcome
 from kinema.tui.screens.base import LOAD_ATTEMPTS, KinemaScreen
 from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
 from kinema.tui.widgets.objective_list import ObjectiveList, ObjectiveSearch
-from kinema.tui.widgets.override_form import OverrideForm
 from kinema.tui.widgets.task_panel import TaskPanel
 
+# What only a tab or a dialog shows is imported when first shown: not before the first frame.
 if TYPE_CHECKING:
     from textual.widgets import TextArea
 
     from kinema.tui.widgets.fitted_table import FittedTable
+    from kinema.tui.widgets.override_form import OverrideForm
 
 ALL = "__all__"
 
@@ -366,7 +366,7 @@ class ObjectivesScreen(KinemaScreen):
 
     def _override_form(self) -> OverrideForm | None:
         """The Parameters tab's form, or None while that tab was never shown."""
-        return next(iter(self.query(OverrideForm)), None)
+        return cast("OverrideForm | None", next(iter(self.query("#override-form")), None))
 
     async def on_tabbed_content_tab_activated(self, event: TabbedContent.TabActivated) -> None:
         if event.tabbed_content.id == "objective-tabs":
@@ -386,6 +386,8 @@ class ObjectivesScreen(KinemaScreen):
 
             await pane.mount(TextArea(self._xml, language="xml", read_only=True, id="objective-xml"))
         elif pane.id == "parameters":
+            from kinema.tui.widgets.override_form import OverrideForm
+
             form = OverrideForm(id="override-form")
             await pane.mount(form)
             if objective is not None:
@@ -427,6 +429,8 @@ class ObjectivesScreen(KinemaScreen):
         text = Text()
         text.append("✘ failed" if failed else "◼ cancelled", style="bold red" if failed else "bold yellow")
         text.append("  ctrl+o whole message · Esc hides\n", style="dim")
+        from kinema.tui.dialogs.failure import outcome_text
+
         text.append_text(outcome_text(outcome))
         panel.update(text)
         panel.set_class(True, "shown")
@@ -444,6 +448,8 @@ class ObjectivesScreen(KinemaScreen):
         if outcome is None:
             self.notify("The selected objective has no failed or cancelled run to show.")
             return
+        from kinema.tui.dialogs.failure import FailureDialog
+
         self.app.push_screen(FailureDialog(outcome))
 
     def runtime_task_planning(self, task: TaskPlanning) -> None:
