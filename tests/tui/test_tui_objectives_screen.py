@@ -26,6 +26,8 @@ def test_library_is_listed_favorites_first_and_the_first_is_shown(fake: FakeConn
         assert tree.outline is not None and tree.outline.tree_id == "Pick Object"
         # The subtree was expanded from its own document.
         assert any(node.path == "Wait and Log::3/Sleep::5" for node in tree.outline.nodes())
+        await pilot.press("f3")  # the XML tab
+        await settle(pilot)
         assert '<BehaviorTree ID="Pick Object"' in app.screen.query_one("#objective-xml", TextArea).text
 
     drive(fake, scenario)
@@ -222,11 +224,40 @@ def test_the_ports_tab_shows_each_parameters_type(fake: FakeConnection) -> None:
     from textual.widgets import DataTable
 
     async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        app.screen.query_one(TabbedContent).active = "ports"  # as a click on its tab does
+        await settle(pilot)
         table = app.screen.query_one("#port-table", DataTable)
         rows = [[str(cell) for cell in table.get_row_at(i)] for i in range(table.row_count)]
         assert rows[:2] == [
             ["waypoint_name", "input", "std::string", "Look at Table", "Where to look before picking"],
             ["speed", "input", "double", "0.5", "Velocity scale factor"],
         ]
+
+    drive(fake, scenario)
+
+
+def test_tabs_first_shown_after_another_objective_was_selected_show_that_one(fake: FakeConnection) -> None:
+    """The XML, Parameters and Ports tabs are filled when first shown: with the objective selected then."""
+
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        await pilot.press("down")  # Open Gripper, no ports
+        await settle(pilot)
+        assert app.screen.selected.name == "Open Gripper"
+        await pilot.press("f3")
+        await settle(pilot)
+        assert '<BehaviorTree ID="Open Gripper"' in app.screen.query_one("#objective-xml", TextArea).text
+        app.screen.query_one(TabbedContent).active = "ports"
+        await settle(pilot)
+        assert app.screen.query_one("#port-table").row_count == 0
+        await pilot.press("up")  # Pick Object: the tabs shown before follow the selection
+        await settle(pilot)
+        assert app.screen.query_one("#port-table").row_count == 3
+        await pilot.press("f3")
+        await settle(pilot)
+        assert '<BehaviorTree ID="Pick Object"' in app.screen.query_one("#objective-xml", TextArea).text
+        await pilot.press("f4")
+        await settle(pilot)
+        fields = [field.name for field in app.screen.query_one(OverrideForm).query(Input)]
+        assert fields == ["waypoint_name", "speed"]
 
     drive(fake, scenario)

@@ -225,7 +225,7 @@ def test_the_tutorial_objective_runs_with_values_from_the_form_and_a_failure_sta
 ) -> None:
     """example_config's "Add Numbers" (the tutorial's objective): the form lists a and b (int); with
     values it adds them; without, MyBehavior fails and the screen keeps saying why."""
-    from textual.widgets import Input, OptionList, Static
+    from textual.widgets import Input, OptionList, Static, TabbedContent
 
     from kinema.tui.widgets.override_form import OverrideForm
 
@@ -253,6 +253,8 @@ def test_the_tutorial_objective_runs_with_values_from_the_form_and_a_failure_sta
                 lambda: screen.selected is not None and screen.selected.name == "Add Numbers",
                 "Add Numbers selected",
             )
+            screen.query_one(TabbedContent).active = "parameters"  # as a click on its tab does
+            await wait_for(pilot, lambda: bool(screen.query(OverrideForm)), "the Parameters tab")
             form = screen.query_one(OverrideForm)
             await wait_for(pilot, lambda: len(form.query(Input)) == 2, "the parameter form")
             assert [(p.name, p.type_name) for p in screen.selected.ports] == [("a", "int"), ("b", "int")]

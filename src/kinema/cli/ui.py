@@ -70,6 +70,9 @@ def ui(
     if replay is not None:
         _replay(replay)
         return
+    from kinema.tui import startup_gc
+
+    startup_gc.hold()  # until the first frame (see startup_gc)
     # With --camera the first screen draws images: ask the terminal what it can draw while the app's
     # modules load. The questions wait for answers (up to 0.1 s each in a terminal that gives none) and
     # must be asked before the app owns the terminal. Without --camera the app asks when the camera view

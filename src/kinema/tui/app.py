@@ -7,7 +7,6 @@ heartbeat, clock sample and blackboard snapshot, so a fast stream can never queu
 
 from __future__ import annotations
 
-import gc
 import logging
 import threading
 import time
@@ -24,6 +23,7 @@ from textual.notifications import SeverityLevel
 from textual.screen import Screen
 from textual.timer import Timer
 
+from kinema.tui import startup_gc
 from kinema.tui.blackboard_model import BlackboardModel
 from kinema.tui.connection import (
     ApprovalRequested,
@@ -44,7 +44,6 @@ from kinema.tui.connection import (
     TaskPlanning,
     UserInputRequested,
 )
-from kinema.tui.dialogs.confirm import ConfirmDialog, MotionQuestionDialog
 from kinema.tui.messages import (
     KeyDelivered,
     ModeSelected,
@@ -202,6 +201,12 @@ class KinemaApp(App[None]):
         initial_mode: str = "objectives",
         camera: str | None = None,
     ) -> None:
+        if initial_mode not in SCREEN_CLASSES:
+            raise ValueError(f"no screen {initial_mode!r}; the screens are {', '.join(SCREEN_CLASSES)}")
+        # The first screen is the app's default mode, composed when the app is: switching to it from
+        # Textual's blank default screen restyled every widget of it twice more before the first frame.
+        # Textual's App.__init__ reads the mode through the instance, so each app can start on its own.
+        self.DEFAULT_MODE = initial_mode  # type: ignore[misc]
         super().__init__()
         self.camera_topic = camera
         # True while a teleoperation session (DoTeleoperateAction) is open in a dialog.
@@ -249,16 +254,12 @@ class KinemaApp(App[None]):
     # -- lifecycle ----------------------------------------------------------------------------------
 
     def on_mount(self) -> None:
-        self.switch_mode(self.initial_mode)
         # Joining the runtime imports the transport (zenoh, numpy) on the connection's thread; begun
         # after the first frame, it does not hold the interpreter while the screen is being drawn.
         self.call_after_refresh(self._open_connection)
         if self.camera_topic:
             self.action_show_camera(self.camera_topic)
-        # Textual, the stylesheets and the screens make ~10^5 long-lived objects; every full garbage
-        # collection walks them all (hundreds of ms while the blackboard streams). Freezing them after
-        # the first frame keeps those collections to what was allocated since.
-        self.call_after_refresh(gc.freeze)
+        self.call_after_refresh(startup_gc.settle)
 
     def _open_connection(self) -> None:
         if not self._closing:
@@ -403,6 +404,8 @@ class KinemaApp(App[None]):
 
             self.push_screen(ApprovalDialog(question, request.steps, request.duration), answered)
             return
+        from kinema.tui.dialogs.confirm import MotionQuestionDialog  # dialogs load when first shown
+
         self.push_screen(MotionQuestionDialog(question), answered)
 
     def ask_user_input(self, request: UserInputRequested) -> None:
@@ -591,6 +594,8 @@ class KinemaApp(App[None]):
             if stop:
                 self.exit()
 
+        from kinema.tui.dialogs.confirm import ConfirmDialog
+
         self.push_screen(
             ConfirmDialog(
                 "Close Kinema? This stops the runtime that `kinema run` started.", "Quit and stop", "Stay"
@@ -717,4 +722,7 @@ def run_app(
         from kinema.tui.screens.camera import load_image_support
 
         load_image_support()
-    KinemaApp(connection, owns_runtime=owns_runtime, initial_mode=initial_mode, camera=camera).run()
+    try:
+        KinemaApp(connection, owns_runtime=owns_runtime, initial_mode=initial_mode, camera=camera).run()
+    finally:
+        startup_gc.release()  # in case the app closed before its first frame

@@ -7,13 +7,14 @@ import time
 from collections.abc import Callable
 from typing import TYPE_CHECKING, Any
 
-from textual.app import ComposeResult
+from textual import events, on
+from textual.app import App, ComposeResult
 from textual.message import Message
 from textual.screen import Screen
-from textual.widgets import Footer
 
 from kinema.errors import KinemaError
 from kinema.tui.messages import RuntimeCallFailed, RuntimeCallSucceeded
+from kinema.tui.widgets.key_footer import KeyFooter
 from kinema.tui.widgets.nav_bar import NavBar
 from kinema.tui.widgets.status_bar import StatusBar
 
@@ -74,6 +75,13 @@ class KinemaScreen(RuntimeView, Screen[None]):
 
     MODE = ""
 
+    def __init__(self) -> None:
+        super().__init__()
+        # Textual sets the size classes (-narrow, -tall, ...) on the first resize, after the widgets were
+        # composed and styled, and then styles them all again; set up front, that resize changes nothing.
+        self.add_class(*breakpoint_classes(self.app), update=False)
+        self._resumed = False
+
     @property
     def kinema(self) -> KinemaApp:
         """The app, typed."""
@@ -83,7 +91,7 @@ class KinemaScreen(RuntimeView, Screen[None]):
         yield NavBar(self.MODE)
         yield from self.compose_body()
         yield StatusBar(id="status-bar")
-        yield Footer()
+        yield KeyFooter()
 
     def compose_body(self) -> ComposeResult:
         """The screen's own widgets."""
@@ -95,6 +103,14 @@ class KinemaScreen(RuntimeView, Screen[None]):
 
     def on_unmount(self) -> None:
         self.kinema.unregister_view(self)
+
+    @on(events.ScreenResume)
+    def _first_resume(self, event: events.ScreenResume) -> None:
+        # The first resume comes just after the screen was composed, every widget styled: Textual's
+        # restyle of them all on resume would only repeat that work before the first frame.
+        if not self._resumed:
+            self._resumed = True
+            event.refresh_styles = False
 
     def on_screen_resume(self) -> None:
         self.show_status(self.kinema.status)
@@ -152,3 +168,15 @@ class KinemaScreen(RuntimeView, Screen[None]):
                 self.app.post_message(RuntimeCallSucceeded(what))
 
         self.run_worker(work, thread=True, group=what, name=what)
+
+
+def breakpoint_classes(app: App[object]) -> list[str]:
+    """The size classes Textual gives a screen of ``app`` at the terminal's size (``HORIZONTAL_BREAKPOINTS``
+    and ``VERTICAL_BREAKPOINTS``: for each, the class of the largest breakpoint the size reaches)."""
+    width, height = app.size
+    chosen = []
+    for size, breakpoints in ((width, app.HORIZONTAL_BREAKPOINTS), (height, app.VERTICAL_BREAKPOINTS)):
+        reached = [(at, name) for at, name in breakpoints or () if size >= at]
+        if reached:
+            chosen.append(max(reached)[1])
+    return chosen

@@ -19,10 +19,11 @@ from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.message import Message
 from textual.screen import Screen
-from textual.widgets import Footer, Select, Static
+from textual.widgets import Select, Static
 
 from kinema.tui.connection import CameraImage, ConnectionState
 from kinema.tui.screens.base import RuntimeView
+from kinema.tui.widgets.key_footer import KeyFooter
 
 _image_widgets: Any = None
 _image_unavailable = ""
@@ -134,7 +135,7 @@ class CameraScreen(RuntimeView, Screen[None]):
                 picture = self.widget_class(id="camera-picture")
                 picture.display = False
                 yield picture
-        yield Footer()
+        yield KeyFooter()
 
     def on_mount(self) -> None:
         self.set_interval(REDRAW_PERIOD_S, self._redraw)

@@ -5,6 +5,8 @@ While PlanMTCTask plans a task, a panel above the tree shows its stages live (st
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING, cast
+
 from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
@@ -17,7 +19,6 @@ from textual.widgets import (
     Static,
     TabbedContent,
     TabPane,
-    TextArea,
 )
 from textual.widgets.option_list import Option
 
@@ -29,15 +30,19 @@ from kinema.tui.connection import (
     RuntimeConnection,
     TaskPlanning,
 )
-from kinema.tui.dialogs.failure import FailureDialog, outcome_text
 from kinema.tui.messages import ObjectiveOutlineLoaded, ObjectiveRunRequested, ObjectivesLoaded
 from kinema.tui.run_outcome import RunOutcome
 from kinema.tui.screens.base import LOAD_ATTEMPTS, KinemaScreen
 from kinema.tui.widgets.behavior_tree_view import BehaviorTreeView
-from kinema.tui.widgets.fitted_table import PORT_COLUMNS, FittedTable
 from kinema.tui.widgets.objective_list import ObjectiveList, ObjectiveSearch
-from kinema.tui.widgets.override_form import OverrideForm
 from kinema.tui.widgets.task_panel import TaskPanel
+
+# What only a tab or a dialog shows is imported when first shown: not before the first frame.
+if TYPE_CHECKING:
+    from textual.widgets import TextArea
+
+    from kinema.tui.widgets.fitted_table import FittedTable
+    from kinema.tui.widgets.override_form import OverrideForm
 
 ALL = "__all__"
 
@@ -123,6 +128,10 @@ class ObjectivesScreen(KinemaScreen):
         self.failure_shown: RunOutcome | None = None
         # Outcomes the user hid (Esc): they stay hidden when the objective is selected again.
         self._dismissed: set[int] = set()
+        # The selected objective's XML, for the XML tab (whose editor is made when the tab is first shown).
+        self._xml = ""
+        # F4 asked for the first parameter's field, and the form was not there yet.
+        self._focus_form_when_filled = False
 
     def compose_body(self) -> ComposeResult:
         with Horizontal(classes="split"):
@@ -151,12 +160,10 @@ class ObjectivesScreen(KinemaScreen):
                 with TabbedContent(initial="tree", id="objective-tabs"):
                     with TabPane("Tree", id="tree"):
                         yield BehaviorTreeView(id="behavior-tree")
-                    with TabPane("XML", id="xml"):
-                        yield TextArea("", language="xml", read_only=True, id="objective-xml")
-                    with TabPane("Parameters", id="parameters"):
-                        yield OverrideForm(id="override-form")
-                    with TabPane("Ports", id="ports"):
-                        yield FittedTable(PORT_COLUMNS, id="port-table")
+                    # Filled when first shown (_fill_tab): the first frame needs only the tree.
+                    yield TabPane("XML", id="xml")
+                    yield TabPane("Parameters", id="parameters")
+                    yield TabPane("Ports", id="ports")
 
     def on_mount(self) -> None:
         super().on_mount()
@@ -226,7 +233,7 @@ class ObjectivesScreen(KinemaScreen):
     def on_input_submitted(self, event: Input.Submitted) -> None:
         if event.input.id == "objective-search":
             pass  # the search box gave the list the focus itself (ObjectiveSearch)
-        elif event.input in self.query_one(OverrideForm).query(Input):
+        elif (form := self._override_form()) is not None and event.input in form.query(Input):
             # Enter in a parameter runs the objective with the form's values. The keys are the list's
             # again (Enter runs again): the field the run hides must not keep the focus.
             self.set_focus(self.query_one("#objective-list", OptionList))
@@ -274,10 +281,11 @@ class ObjectivesScreen(KinemaScreen):
             hint.append(f"{objective.name} is a subtree: run an objective that uses it", style="dim")
         self.query_one("#run-hint", Static).update(hint)
         self._show_outcome_of_selected()
-        self.query_one("#port-table", FittedTable).set_rows(
-            [(p.name, p.direction, p.type_name, p.default, p.description) for p in objective.ports]
-        )
-        self.run_worker(self.query_one(OverrideForm).show_objective(objective), group="override-form")
+        for table in self.query("#port-table"):  # the Ports tab's, once it was shown
+            cast("FittedTable", table).set_rows(port_rows(objective))
+        form = self._override_form()
+        if form is not None:
+            self.run_worker(form.show_objective(objective), group="override-form")
         self.query_one(BehaviorTreeView).show_outline(None, "loading …")
         connection = self.kinema.connection
         self.call_runtime(
@@ -289,7 +297,9 @@ class ObjectivesScreen(KinemaScreen):
     def on_objective_outline_loaded(self, message: ObjectiveOutlineLoaded) -> None:
         if self.selected is None or message.name != self.selected.name:
             return
-        self.query_one("#objective-xml", TextArea).load_text(message.xml)
+        self._xml = message.xml
+        for area in self.query("#objective-xml"):  # the XML tab's, once it was shown
+            cast("TextArea", area).load_text(message.xml)
         view = self.query_one(BehaviorTreeView)
         view.show_outline(message.outline, message.error)
         latest = self.kinema.node_statuses.get(message.name)
@@ -311,7 +321,9 @@ class ObjectivesScreen(KinemaScreen):
                 severity="warning",
             )
             return
-        self.post_message(ObjectiveRunRequested(self.selected.name, self.query_one(OverrideForm).overrides()))
+        form = self._override_form()
+        overrides = form.overrides() if form is not None else {}  # no form shown: nothing typed
+        self.post_message(ObjectiveRunRequested(self.selected.name, overrides))
 
     def run_by_name(self, name: str) -> None:
         """Run objective ``name`` with its defaults (the command palette's "Run ..." commands)."""
@@ -341,9 +353,55 @@ class ObjectivesScreen(KinemaScreen):
         self.query_one(TabbedContent).active = tab
         if tab == "parameters":
             # Typing goes into the form at once: a value's letters are not the screen's keys (x cancels).
-            fields = self.query_one(OverrideForm).query(Input)
-            if fields:
-                self.set_focus(fields.first())
+            form = self._override_form()
+            if form is None:
+                self._focus_form_when_filled = True  # the tab is being filled (on_tabbed_content_...)
+            else:
+                self._focus_first_field(form)
+
+    def _focus_first_field(self, form: OverrideForm) -> None:
+        fields = form.query(Input)
+        if fields:
+            self.set_focus(fields.first())
+
+    def _override_form(self) -> OverrideForm | None:
+        """The Parameters tab's form, or None while that tab was never shown."""
+        return cast("OverrideForm | None", next(iter(self.query("#override-form")), None))
+
+    async def on_tabbed_content_tab_activated(self, event: TabbedContent.TabActivated) -> None:
+        if event.tabbed_content.id == "objective-tabs":
+            await self._fill_tab(event.pane)
+
+    async def _fill_tab(self, pane: TabPane) -> None:
+        """Make the widgets of a tab shown for the first time, showing the selected objective.
+
+        Only the Tree tab's are made with the screen: the XML editor, the parameter form and the port
+        table were a sixth of the widgets of the first frame, and none of them is seen in it.
+        """
+        if pane.children or pane.id == "tree":
+            return
+        objective = self.selected
+        if pane.id == "xml":
+            from textual.widgets import TextArea
+
+            await pane.mount(TextArea(self._xml, language="xml", read_only=True, id="objective-xml"))
+        elif pane.id == "parameters":
+            from kinema.tui.widgets.override_form import OverrideForm
+
+            form = OverrideForm(id="override-form")
+            await pane.mount(form)
+            if objective is not None:
+                await form.show_objective(objective)
+            if self._focus_form_when_filled:
+                self._focus_form_when_filled = False
+                self._focus_first_field(form)
+        elif pane.id == "ports":
+            from kinema.tui.widgets.fitted_table import PORT_COLUMNS, FittedTable
+
+            table = FittedTable(PORT_COLUMNS, id="port-table")
+            await pane.mount(table)
+            if objective is not None:
+                table.set_rows(port_rows(objective))
 
     # -- live status -------------------------------------------------------------------------------
 
@@ -371,6 +429,8 @@ class ObjectivesScreen(KinemaScreen):
         text = Text()
         text.append("✘ failed" if failed else "◼ cancelled", style="bold red" if failed else "bold yellow")
         text.append("  ctrl+o whole message · Esc hides\n", style="dim")
+        from kinema.tui.dialogs.failure import outcome_text
+
         text.append_text(outcome_text(outcome))
         panel.update(text)
         panel.set_class(True, "shown")
@@ -388,6 +448,8 @@ class ObjectivesScreen(KinemaScreen):
         if outcome is None:
             self.notify("The selected objective has no failed or cancelled run to show.")
             return
+        from kinema.tui.dialogs.failure import FailureDialog
+
         self.app.push_screen(FailureDialog(outcome))
 
     def runtime_task_planning(self, task: TaskPlanning) -> None:
@@ -396,6 +458,11 @@ class ObjectivesScreen(KinemaScreen):
     def runtime_node_statuses(self, batch: NodeStatusBatch) -> None:
         if self.selected is not None and self.selected.name == batch.objective_name:
             self.query_one(BehaviorTreeView).apply_statuses(batch.updates)
+
+
+def port_rows(objective: ObjectiveSummary) -> list[tuple[str, str, str, str, str]]:
+    """The Ports tab's rows: name, direction, type, default, description."""
+    return [(p.name, p.direction, p.type_name, p.default, p.description) for p in objective.ports]
 
 
 def _load_outline(connection: RuntimeConnection, name: str) -> ObjectiveOutlineLoaded:

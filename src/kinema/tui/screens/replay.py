@@ -16,11 +16,12 @@ from textual.app import App, ComposeResult
 from textual.binding import Binding
 from textual.containers import Horizontal, Vertical
 from textual.screen import Screen
-from textual.widgets import Footer, Static
+from textual.widgets import Static
 
 from kinema.tui.connection import NodeStatus, NodeStatusUpdate
 from kinema.tui.widgets.behavior_tree_view import STATUS_MARK, BehaviorTreeView
 from kinema.tui.widgets.fitted_table import Column, FittedTable
+from kinema.tui.widgets.key_footer import KeyFooter
 
 if TYPE_CHECKING:
     from kinema.tui.tree_outline import TreeOutline
@@ -89,7 +90,7 @@ class ReplayScreen(Screen[None]):
                     ),
                     id="replay-entries",
                 )
-        yield Footer()
+        yield KeyFooter()
 
     def on_mount(self) -> None:
         recording = self.replay.recording

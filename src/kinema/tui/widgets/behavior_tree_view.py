@@ -50,7 +50,8 @@ class BehaviorTreeView(Tree["OutlineNode"]):
     """
 
     def __init__(self, *, id: str | None = None) -> None:
-        super().__init__("(no objective selected)", id=id)
+        # Text, not a string: a string label is parsed as markup, which imports rich's emoji table.
+        super().__init__(Text("(no objective selected)"), id=id)
         self.outline: TreeOutline | None = None
         self.statuses: dict[int, NodeStatus] = {}
         self.halted: set[int] = set()

@@ -1,0 +1,132 @@
+"""The way to the first frame: the first screen is composed and styled once, the collector held meanwhile."""
+
+from __future__ import annotations
+
+import asyncio
+import gc
+from collections.abc import Iterator
+
+import pytest
+from textual.dom import DOMNode
+from textual.screen import Screen
+
+from kinema.tui import startup_gc
+from kinema.tui.app import KinemaApp
+from kinema.tui.fake_connection import FakeConnection
+from kinema.tui.screens.base import breakpoint_classes
+
+
+class RestyleRecordingApp(KinemaApp):
+    """The app, remembering each node Textual restyled with all its descendants."""
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        super().__init__(*args, **kwargs)  # type: ignore[arg-type]
+        self.restyled: list[DOMNode] = []
+
+    def update_styles(self, node: DOMNode, animate: bool = True) -> None:
+        self.restyled.append(node)
+        super().update_styles(node, animate)
+
+
+@pytest.fixture
+def collector() -> Iterator[None]:
+    """Leave the garbage collector as the test found it (on, nothing frozen)."""
+    yield
+    startup_gc.release()
+    gc.unfreeze()
+    gc.enable()
+
+
+@pytest.mark.parametrize("size", [(80, 24), (120, 40)])
+@pytest.mark.parametrize("mode", ["objectives", "blackboard"])
+def test_the_first_screen_is_not_restyled_as_a_whole_before_it_is_used(
+    fake: FakeConnection, mode: str, size: tuple[int, int]
+) -> None:
+    # Textual restyles a screen and every widget in it when the screen resumes and when its size classes
+    # change; neither has anything new to apply to a screen composed a moment ago.
+    app = RestyleRecordingApp(fake, initial_mode=mode)
+
+    async def main() -> None:
+        async with app.run_test(size=size) as pilot:
+            await pilot.pause()
+            await pilot.pause()
+            assert app.current_mode == mode
+            assert app.screen_stack == [app.screen]
+            assert set(breakpoint_classes(app)) <= app.screen.classes
+            assert [node for node in app.restyled if isinstance(node, Screen)] == []
+
+    asyncio.run(main())
+
+
+def test_a_screen_shown_again_is_restyled(fake: FakeConnection) -> None:
+    """The first resume skips the restyle, later ones do not (the styles may have changed meanwhile)."""
+    app = RestyleRecordingApp(fake, initial_mode="objectives")
+
+    async def main() -> None:
+        async with app.run_test(size=(120, 40)) as pilot:
+            await pilot.pause()
+            objectives = app.screen
+            await app.action_switch_mode("logs")
+            await pilot.pause()
+            app.restyled.clear()
+            await app.action_switch_mode("objectives")
+            await pilot.pause()
+            assert objectives in app.restyled
+
+    asyncio.run(main())
+
+
+@pytest.mark.parametrize(
+    ("size", "classes"),
+    [
+        ((80, 24), ["-narrow", "-short"]),
+        ((99, 31), ["-narrow", "-short"]),
+        ((100, 32), ["-normal", "-tall"]),
+        ((200, 60), ["-normal", "-tall"]),
+    ],
+)
+def test_breakpoint_classes_are_textuals(
+    fake: FakeConnection, size: tuple[int, int], classes: list[str]
+) -> None:
+    app = KinemaApp(fake, initial_mode="logs")
+
+    async def main() -> None:
+        async with app.run_test(size=size) as pilot:
+            await pilot.pause()
+            assert breakpoint_classes(app) == classes
+            # The classes Textual itself gave the screen at this size.
+            given = app.screen.classes & {"-narrow", "-normal", "-short", "-tall"}
+            assert given == set(classes)
+
+    asyncio.run(main())
+
+
+def test_an_unknown_first_screen_is_an_error_naming_the_screens(fake: FakeConnection) -> None:
+    with pytest.raises(ValueError, match=r"no screen 'object'.*objectives.*waypoints"):
+        KinemaApp(fake, initial_mode="object")
+
+
+def test_held_collector_resumes_after_the_first_frame_with_the_start_up_frozen(
+    fake: FakeConnection, collector: None
+) -> None:
+    startup_gc.hold()
+    assert not gc.isenabled()
+    app = KinemaApp(fake)
+
+    async def main() -> None:
+        async with app.run_test(size=(120, 40)) as pilot:
+            await pilot.pause()
+            await pilot.pause()
+            assert gc.isenabled()
+            assert gc.get_freeze_count() > 10_000  # Textual's and the screen's objects
+
+    asyncio.run(main())
+
+
+def test_a_collector_turned_off_by_someone_else_stays_off(collector: None) -> None:
+    gc.disable()
+    startup_gc.hold()
+    startup_gc.settle()
+    assert not gc.isenabled()
+    startup_gc.release()
+    assert not gc.isenabled()
