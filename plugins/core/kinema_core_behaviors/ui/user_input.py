@@ -98,6 +98,35 @@ async def ask_user(behavior: Any, request: dict[str, Any], timeout: float = ANSW
     return await asyncio.wrap_future(client.call_async(request, timeout))
 
 
+#: :func:`_ask_for`'s answer when no user is attached and ``--auto-approve`` answers for them (the caller
+#: decides what a user changing nothing would have answered).
+NO_USER_AUTO = object()
+
+
+async def _ask_for(
+    behavior: Any, request: dict[str, Any], timeout: float, *, what: str, giving: str, refused: str
+) -> Any:
+    """The user's accepted answer to ``request``; :data:`NO_USER_AUTO` when no user is attached and
+    auto-approval is on; None when there is no answer (the failure is reported, naming the behavior, with
+    ``what`` was asked, what the user was to be ``giving``, and what the user did when ``refused``)."""
+    name = type(behavior).__name__
+    try:
+        response = await ask_user(behavior, request, timeout)
+    except TransportError as error:
+        behavior.logger.publish_failure(f"{name}: no {what} from the user: {error.message}")
+        return None
+    if response is None:
+        if auto_approve():
+            return NO_USER_AUTO
+        behavior.logger.publish_failure(no_user_message(behavior, giving))
+        return None
+    if not response.accepted:
+        said = f": {response.message}" if str(response.message) else ""
+        behavior.logger.publish_failure(f"{name}: the user {refused}{said}")
+        return None
+    return response
+
+
 def _tool_pose(behavior: Any) -> Any:
     """The config's tool frame where it is now, as a PoseStamped in the world frame."""
     from ..poses.frame_tree import current_frame_tree
@@ -140,28 +169,22 @@ class RetrievePoseParameter(AsyncBehavior):
             self.logger.publish_failure(f"RetrievePoseParameter: {error}")
             return False
         prompt = "Give the target pose"
-        try:
-            response = await ask_user(
-                self,
-                _request(self, "pose", prompt, initial_pose=start),
-                ANSWER_SECONDS if timeout < 0 else timeout,
-            )
-        except TransportError as error:
-            self.logger.publish_failure(f"RetrievePoseParameter: no pose from the user: {error.message}")
-            return False
+        response = await _ask_for(
+            self,
+            _request(self, "pose", prompt, initial_pose=start),
+            ANSWER_SECONDS if timeout < 0 else timeout,
+            what="pose",
+            giving="give a pose",
+            refused="gave no pose",
+        )
         if response is None:
-            if not auto_approve():
-                self.logger.publish_failure(no_user_message(self, "give a pose"))
-                return False
+            return False
+        if response is NO_USER_AUTO:
             self.logger.publish_warn(
                 f"{prompt} — answered automatically with the tool frame where it is ({AUTO_APPROVE_ENV}=1)"
             )
             self.set_output("pose", start)
             return True
-        if not response.accepted:
-            said = f": {response.message}" if str(response.message) else ""
-            self.logger.publish_failure(f"RetrievePoseParameter: the user gave no pose{said}")
-            return False
         self.set_output("pose", response.pose)
         return True
 
@@ -220,30 +243,22 @@ class RetrieveRobotStateParameter(AsyncBehavior):
             self.logger.publish_failure(f"RetrieveRobotStateParameter: {error}")
             return False
         prompt = "Give the target joint values" + (f" ({slot.replace('_', ' ')})" if slot else "")
-        try:
-            response = await ask_user(
-                self,
-                _request(self, "joint_state", prompt, initial_joint_state=start),
-                ANSWER_SECONDS if timeout < 0 else timeout,
-            )
-        except TransportError as error:
-            self.logger.publish_failure(
-                f"RetrieveRobotStateParameter: no joint values from the user: {error.message}"
-            )
-            return False
+        response = await _ask_for(
+            self,
+            _request(self, "joint_state", prompt, initial_joint_state=start),
+            ANSWER_SECONDS if timeout < 0 else timeout,
+            what="joint values",
+            giving="give joint values",
+            refused="gave no joint values",
+        )
         if response is None:
-            if not auto_approve():
-                self.logger.publish_failure(no_user_message(self, "give joint values"))
-                return False
+            return False
+        if response is NO_USER_AUTO:
             self.logger.publish_warn(
                 f"{prompt} — answered automatically with the joints where they are ({AUTO_APPROVE_ENV}=1)"
             )
             self.set_output("joint_state", start)
             return True
-        if not response.accepted:
-            said = f": {response.message}" if str(response.message) else ""
-            self.logger.publish_failure(f"RetrieveRobotStateParameter: the user gave no joint values{said}")
-            return False
         answer = response.joint_state
         asked = [str(name) for name in start.name]
         names, positions = [str(name) for name in answer.name], [float(p) for p in answer.position]
@@ -335,15 +350,17 @@ class GetPointsFromUser(AsyncBehavior):
         request = _request(
             self, "points", prompt, image_topic=view, point_prompts=prompts, point_names=names[: len(prompts)]
         )
-        try:
-            response = await ask_user(self, request)
-        except TransportError as error:
-            self.logger.publish_failure(f"GetPointsFromUser: no points from the user: {error.message}")
-            return False
+        response = await _ask_for(
+            self,
+            request,
+            ANSWER_SECONDS,
+            what="points",
+            giving=f"click points on {view}",
+            refused="clicked no points",
+        )
         if response is None:
-            if not auto_approve():
-                self.logger.publish_failure(no_user_message(self, f"click points on {view}"))
-                return False
+            return False
+        if response is NO_USER_AUTO:
             try:
                 width, height = await asyncio.to_thread(self._image_size, view)
             except PortValueError as error:
@@ -354,10 +371,6 @@ class GetPointsFromUser(AsyncBehavior):
                 f"{prompt} — answered automatically with the image's centre ({AUTO_APPROVE_ENV}=1)"
             )
         else:
-            if not response.accepted:
-                said = f": {response.message}" if str(response.message) else ""
-                self.logger.publish_failure(f"GetPointsFromUser: the user clicked no points{said}")
-                return False
             pixels = [(float(p.x), float(p.y)) for p in response.points]
             if len(pixels) != len(prompts):
                 self.logger.publish_failure(
