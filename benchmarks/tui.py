@@ -87,18 +87,12 @@ def _strip_escapes(data: bytes) -> bytes:
     return re.sub(rb"\x1b\[[0-9;?]*[A-Za-z]|\x1b[()][A-Za-z0-9]|\x1b\][^\x07]*\x07", b"", data)
 
 
-def _free_port() -> int:
-    import socket
-
-    with socket.socket() as probe:
-        probe.bind(("127.0.0.1", 0))
-        return int(probe.getsockname()[1])
-
-
 def first_paint(runs: int) -> None:
     # The real app (`kinema ui`), attached to an endpoint where no runtime answers yet: what a user sees
     # first whether or not the runtime is up (the screen is drawn before the connection is made).
-    real = [sys.executable, "-m", "kinema.cli.main", "ui", "--connect", f"tcp/127.0.0.1:{_free_port()}"]
+    from kinema.transport import free_endpoint
+
+    real = [sys.executable, "-m", "kinema.cli.main", "ui", "--connect", free_endpoint()]
     demo = [sys.executable, "-m", "kinema.cli.main", "ui", "--demo"]
     bare = [sys.executable, "-c", BARE_APP]
     paint, demo_paint, ready, peer = [], [], [], []

@@ -233,15 +233,12 @@ def test_the_status_line_shows_the_watchdog_warning_until_it_clears() -> None:
 def test_closing_while_the_runtime_is_unreachable_does_not_wait_for_the_attempt() -> None:
     """Quitting `kinema ui` that is still trying to reach a runtime: joining a router that does not answer
     takes zenoh about 2 s, and the app used to wait for the attempt (up to 5 s) before it closed."""
-    import socket
     import time
 
+    from kinema.transport import free_endpoint
     from kinema.tui.sdk_connection import SdkConnection
 
-    with socket.socket() as probe:  # a free port: nothing answers there
-        probe.bind(("127.0.0.1", 0))
-        port = probe.getsockname()[1]
-    connection = SdkConnection(f"tcp/127.0.0.1:{port}")
+    connection = SdkConnection(free_endpoint())  # a free port: nothing answers there
     events: list[object] = []
     connection.open(events.append)
     attempt = connection._thread
