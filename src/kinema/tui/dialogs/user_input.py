@@ -65,7 +65,39 @@ class _UserInputDialog(ModalScreen[UserInputAnswer]):
         self.dismiss(UserInputAnswer(False, "cancelled in the TUI"))
 
 
-class PoseDialog(_UserInputDialog):
+class _FormDialog(_UserInputDialog):
+    """A question answered with a form: OK, or Enter in its last field, gives the answer (``_give``);
+    Enter in another field moves on; Cancel or Escape cancels. The handlers live here only: Textual calls
+    a message handler on every class of the MRO, so the form dialogs define none of their own."""
+
+    def compose_buttons(self) -> ComposeResult:
+        with Horizontal(classes="dialog-buttons"):
+            yield Button("OK", variant="primary", id="ok")
+            yield Button("Cancel (Esc)", id="cancel")
+
+    def is_last_field(self, field: Input) -> bool:
+        """Whether Enter in ``field`` gives the answer (by default Enter in any field does)."""
+        return True
+
+    def on_input_submitted(self, event: Input.Submitted) -> None:
+        event.stop()
+        if self.is_last_field(event.input):
+            self._give()
+        else:
+            self.focus_next()
+
+    def on_button_pressed(self, event: Button.Pressed) -> None:
+        event.stop()
+        if event.button.id == "ok":
+            self._give()
+        else:
+            self.action_cancel()
+
+    def _give(self) -> None:
+        raise NotImplementedError
+
+
+class PoseDialog(_FormDialog):
     """A target pose: frame, position (m) and orientation (quaternion x y z w), prefilled with the tool's
     pose now. Enter in the last field or OK gives it."""
 
@@ -79,26 +111,13 @@ class PoseDialog(_UserInputDialog):
             yield Input(_text(request.position), id="pose-position")
             yield Label("Orientation x y z w (quaternion)")
             yield Input(_text(request.orientation), id="pose-orientation")
-            with Horizontal(classes="dialog-buttons"):
-                yield Button("OK", variant="primary", id="ok")
-                yield Button("Cancel (Esc)", id="cancel")
+            yield from self.compose_buttons()
 
     def on_mount(self) -> None:
         self.set_focus(self.query_one("#pose-position", Input))
 
-    def on_input_submitted(self, event: Input.Submitted) -> None:
-        event.stop()
-        if event.input.id == "pose-orientation":
-            self._give()
-        else:
-            self.focus_next()
-
-    def on_button_pressed(self, event: Button.Pressed) -> None:
-        event.stop()
-        if event.button.id == "ok":
-            self._give()
-        else:
-            self.action_cancel()
+    def is_last_field(self, field: Input) -> bool:
+        return field.id == "pose-orientation"
 
     def _give(self) -> None:
         frame = self.query_one("#pose-frame", Input).value.strip() or "world"
@@ -116,7 +135,7 @@ class PoseDialog(_UserInputDialog):
         )
 
 
-class JointStateDialog(_UserInputDialog):
+class JointStateDialog(_FormDialog):
     """A value per joint (rad, or m for a prismatic joint), each prefilled with where the joint is now.
     Enter in the last field or OK gives them."""
 
@@ -129,27 +148,14 @@ class JointStateDialog(_UserInputDialog):
             ):
                 yield Label(name)
                 yield Input(_text((value,)), id=f"joint-{index}")
-            with Horizontal(classes="dialog-buttons"):
-                yield Button("OK", variant="primary", id="ok")
-                yield Button("Cancel (Esc)", id="cancel")
+            yield from self.compose_buttons()
 
     def on_mount(self) -> None:
         if self.request.joint_names:
             self.set_focus(self.query_one("#joint-0", Input))
 
-    def on_input_submitted(self, event: Input.Submitted) -> None:
-        event.stop()
-        if event.input.id == f"joint-{len(self.request.joint_names) - 1}":
-            self._give()
-        else:
-            self.focus_next()
-
-    def on_button_pressed(self, event: Button.Pressed) -> None:
-        event.stop()
-        if event.button.id == "ok":
-            self._give()
-        else:
-            self.action_cancel()
+    def is_last_field(self, field: Input) -> bool:
+        return field.id == f"joint-{len(self.request.joint_names) - 1}"
 
     def _give(self) -> None:
         values: list[float] = []
@@ -163,7 +169,7 @@ class JointStateDialog(_UserInputDialog):
         self.dismiss(UserInputAnswer(True, "", joint_positions=tuple(values)))
 
 
-class PointsDialog(_UserInputDialog):
+class PointsDialog(_FormDialog):
     """One pixel per prompt on the latest image of the request's topic: click the image (the pixel under
     the pointer, as near as the terminal's cells allow) or type ``column row`` into the point's field."""
 
@@ -198,9 +204,7 @@ class PointsDialog(_UserInputDialog):
             for index, prompt in enumerate(request.point_prompts):
                 yield Label(f"{index + 1}. {prompt} (column row, pixels)")
                 yield Input("", placeholder="click the image, or type e.g. 320 240", id=f"point-{index}")
-            with Horizontal(classes="dialog-buttons"):
-                yield Button("OK", variant="primary", id="ok")
-                yield Button("Cancel (Esc)", id="cancel")
+            yield from self.compose_buttons()
 
     def on_mount(self) -> None:
         if self._watch is not None and self.request.image_topic:
@@ -255,17 +259,6 @@ class PointsDialog(_UserInputDialog):
                 field.value = f"{column} {row}"
                 return
         self.notify("Every point is given; clear one to click it again.", severity="information")
-
-    def on_input_submitted(self, event: Input.Submitted) -> None:
-        event.stop()
-        self._give()
-
-    def on_button_pressed(self, event: Button.Pressed) -> None:
-        event.stop()
-        if event.button.id == "ok":
-            self._give()
-        else:
-            self.action_cancel()
 
     def _give(self) -> None:
         points: list[tuple[float, float]] = []
