@@ -26,14 +26,13 @@ import shutil
 import statistics
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
-from kinema.sdk import ObjectiveClient
-from kinema.transport import free_endpoint
+from headless_cell import headless_lab_sim
 
-READY = "objectives can be started"
+from kinema.sdk import ObjectiveClient
+
 OBJECTIVE = "Close Gripper"
 
 
@@ -61,52 +60,29 @@ def main() -> None:
     parser.add_argument("--smoke", action="store_true", help="one timed round (the test suite)")
     args = parser.parse_args()
     rounds = 1 if args.smoke else args.rounds
-    endpoint = free_endpoint()
     kinema = _kinema()
-    with tempfile.TemporaryDirectory(prefix="kinema-cli-start-") as home:
-        env = {
-            **os.environ,
-            "KINEMA_ZENOH_CONNECT": endpoint,
-            "KINEMA_CONFIG": "lab_sim",
-            **{f"XDG_{n}_HOME": str(Path(home) / n.lower()) for n in ("CONFIG", "DATA", "STATE", "CACHE")},
+    with headless_lab_sim("kinema-cli-start-", kinema) as cell:
+        env, endpoint = cell.env, cell.endpoint
+        commands = {
+            "python -c pass": [sys.executable, "-c", "pass"],
+            "kinema --help": [*kinema, "--help"],
+            "kinema objective list": [*kinema, "objective", "list"],
+            f'kinema objective run "{OBJECTIVE}"': [*kinema, "objective", "run", OBJECTIVE],
         }
-        supervisor = subprocess.Popen(
-            [*kinema, "run", "--headless"],
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-            env=env,
-        )
-        try:
-            assert supervisor.stdout is not None
-            for line in supervisor.stdout:
-                if READY in line:
-                    break
-            else:
-                raise SystemExit("kinema run stopped before it was ready")
-            commands = {
-                "python -c pass": [sys.executable, "-c", "pass"],
-                "kinema --help": [*kinema, "--help"],
-                "kinema objective list": [*kinema, "objective", "list"],
-                f'kinema objective run "{OBJECTIVE}"': [*kinema, "objective", "run", OBJECTIVE],
-            }
-            times: dict[str, list[float]] = {name: [] for name in commands}
-            times["the objective alone (SDK, warm)"] = []
-            with ObjectiveClient(endpoint, timeout=30) as client:
-                for number in range(rounds + 1):
-                    for name, argv in commands.items():
-                        elapsed = _timed(argv, env)
-                        if number:
-                            times[name].append(elapsed)
-                    start = time.perf_counter()
-                    result = client.execute(OBJECTIVE)
-                    if not result.succeeded:
-                        raise SystemExit(f"{OBJECTIVE!r} failed through the SDK: {result}")
+        times: dict[str, list[float]] = {name: [] for name in commands}
+        times["the objective alone (SDK, warm)"] = []
+        with ObjectiveClient(endpoint, timeout=30) as client:
+            for number in range(rounds + 1):
+                for name, argv in commands.items():
+                    elapsed = _timed(argv, env)
                     if number:
-                        times["the objective alone (SDK, warm)"].append(time.perf_counter() - start)
-        finally:
-            supervisor.terminate()
-            supervisor.wait(30)
+                        times[name].append(elapsed)
+                start = time.perf_counter()
+                result = client.execute(OBJECTIVE)
+                if not result.succeeded:
+                    raise SystemExit(f"{OBJECTIVE!r} failed through the SDK: {result}")
+                if number:
+                    times["the objective alone (SDK, warm)"].append(time.perf_counter() - start)
 
     median = {name: statistics.median(values) * 1000 for name, values in times.items()}
     peer = median["python -c pass"]

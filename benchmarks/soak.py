@@ -21,18 +21,16 @@ from __future__ import annotations
 
 import argparse
 import os
-import signal
 import subprocess
 import sys
-import tempfile
 import time
 from pathlib import Path
 
+from headless_cell import headless_lab_sim
+
 from kinema.sdk import ObjectiveStatus, QuickClient
-from kinema.transport import free_endpoint
 
 OBJECTIVE = "3 Waypoints Pick and Place"
-READY = "objectives can be started"
 # The runs after which the agent's RSS is compared with the import floor (fewer in a shorter soak).
 FLOOR_RUNS = 20
 FLOOR_SCRIPT = (
@@ -94,76 +92,46 @@ def main() -> None:
     parser.add_argument("--smoke", action="store_true", help="6 cycles, a sample every 3 (the test suite)")
     args = parser.parse_args()
     cycles, every, warmup = (6, 3, 1) if args.smoke else (args.cycles, args.every, 5)
-    endpoint = free_endpoint()
-    with tempfile.TemporaryDirectory(prefix="kinema-soak-") as home:
-        env = {
-            **os.environ,
-            "KINEMA_ZENOH_CONNECT": endpoint,
-            "KINEMA_CONFIG": "lab_sim",
-            **{f"XDG_{n}_HOME": str(Path(home) / n.lower()) for n in ("CONFIG", "DATA", "STATE", "CACHE")},
-        }
-        supervisor = subprocess.Popen(
-            [sys.executable, "-m", "kinema", "run", "--headless"],
-            stdout=subprocess.PIPE,
-            stderr=subprocess.STDOUT,
-            text=True,
-            env=env,
-        )
-        try:
-            assert supervisor.stdout is not None
-            for line in supervisor.stdout:
-                if READY in line:
-                    break
-            else:
-                raise RuntimeError("kinema run stopped before it was ready")
-            agent = _agent_pid(supervisor.pid)
-            with QuickClient(endpoint, timeout=30) as quick:
-                for number in range(warmup):
-                    _cycle(quick, 0.2 + 0.1 * (number % 7))
-                base = _sample(agent)
-                print(
-                    f"agent pid {agent}; after {warmup} warm-up cycles: threads {base[0]}, fds {base[1]}, "
-                    f"RSS {base[2] / 1024:.1f} MB\n"
-                )
-                print(
-                    f"{'cycle':>6} {'threads':>8} {'(+)':>5} {'fds':>6} {'(+)':>5} {'RSS MB':>8} {'ratio':>6}"
-                )
-                started = time.monotonic()
-                samples: list[tuple[int, int]] = []
-                floor_runs = min(FLOOR_RUNS, warmup + cycles)
-                at_floor_runs = base[2]
-                for number in range(1, cycles + 1):
-                    _cycle(quick, 0.2 + 0.1 * (number % 7))
-                    if warmup + number == floor_runs:
-                        at_floor_runs = _sample(agent)[2]
-                    if number % every == 0 or number == cycles:
-                        threads, fds, rss = _sample(agent)
-                        samples.append((number, rss))
-                        print(
-                            f"{number:>6} {threads:>8} {threads - base[0]:>+5} {fds:>6} {fds - base[1]:>+5} "
-                            f"{rss / 1024:>8.1f} {rss / base[2]:>6.2f}",
-                            flush=True,
-                        )
-                print(f"\n{cycles} cycles in {time.monotonic() - started:.0f} s")
-                later = samples[len(samples) // 2 :]
-                if len(later) >= 2:
+    with headless_lab_sim("kinema-soak-") as cell:
+        agent = _agent_pid(cell.supervisor.pid)
+        with QuickClient(cell.endpoint, timeout=30) as quick:
+            for number in range(warmup):
+                _cycle(quick, 0.2 + 0.1 * (number % 7))
+            base = _sample(agent)
+            print(
+                f"agent pid {agent}; after {warmup} warm-up cycles: threads {base[0]}, fds {base[1]}, "
+                f"RSS {base[2] / 1024:.1f} MB\n"
+            )
+            print(f"{'cycle':>6} {'threads':>8} {'(+)':>5} {'fds':>6} {'(+)':>5} {'RSS MB':>8} {'ratio':>6}")
+            started = time.monotonic()
+            samples: list[tuple[int, int]] = []
+            floor_runs = min(FLOOR_RUNS, warmup + cycles)
+            at_floor_runs = base[2]
+            for number in range(1, cycles + 1):
+                _cycle(quick, 0.2 + 0.1 * (number % 7))
+                if warmup + number == floor_runs:
+                    at_floor_runs = _sample(agent)[2]
+                if number % every == 0 or number == cycles:
+                    threads, fds, rss = _sample(agent)
+                    samples.append((number, rss))
                     print(
-                        f"RSS slope over cycles {later[0][0]}-{later[-1][0]}: "
-                        f"{_slope_kb_per_cycle(later):+.2f} kB/cycle"
+                        f"{number:>6} {threads:>8} {threads - base[0]:>+5} {fds:>6} {fds - base[1]:>+5} "
+                        f"{rss / 1024:>8.1f} {rss / base[2]:>6.2f}",
+                        flush=True,
                     )
-                floor = _import_floor_kb()
+            print(f"\n{cycles} cycles in {time.monotonic() - started:.0f} s")
+            later = samples[len(samples) // 2 :]
+            if len(later) >= 2:
                 print(
-                    f"agent RSS after {floor_runs} runs {at_floor_runs / 1024:.1f} MB; import floor "
-                    f"(mujoco, pinocchio, zenoh) {floor / 1024:.1f} MB; ratio agent / floor "
-                    f"{at_floor_runs / floor:.2f}x"
+                    f"RSS slope over cycles {later[0][0]}-{later[-1][0]}: "
+                    f"{_slope_kb_per_cycle(later):+.2f} kB/cycle"
                 )
-        finally:
-            supervisor.send_signal(signal.SIGINT)
-            try:
-                supervisor.wait(30)
-            except subprocess.TimeoutExpired:
-                supervisor.kill()
-                supervisor.wait(10)
+            floor = _import_floor_kb()
+            print(
+                f"agent RSS after {floor_runs} runs {at_floor_runs / 1024:.1f} MB; import floor "
+                f"(mujoco, pinocchio, zenoh) {floor / 1024:.1f} MB; ratio agent / floor "
+                f"{at_floor_runs / floor:.2f}x"
+            )
 
 
 if __name__ == "__main__":

@@ -42,6 +42,7 @@ RATIO_LINES = {
 # Scripts in benchmarks/ that are not benchmarks, or whose smoke run another test owns (and why).
 NOT_HERE = {
     "latency.py": "timing helpers imported by sdk_latency.py and transport_rtt.py",
+    "headless_cell.py": "starts `kinema run --headless` for cli_start.py and soak.py",
     "own_robot.py": "tests/sim/own_robot/test_own_robot_benchmark.py (needs example-robot-data)",
 }
 # script -> (importable module, why the benchmark needs it)
