@@ -1038,9 +1038,13 @@ class ObjectiveServer:
         status: ObjectiveStatus,
         completed: Tree | None = None,
     ) -> None:
-        """End ``run``: its clients get the result first (its done callbacks), then the listeners hear
-        the status changes, the last tick's node changes and blackboard (of ``completed``, the tree that
-        returned SUCCESS or FAILURE) and the result; :meth:`ObjectiveRun.wait` returns after them."""
+        """End ``run``: the listeners are handed the last blackboard (of ``completed``, the tree that
+        returned SUCCESS or FAILURE), then its clients get the result (its done callbacks), then the
+        listeners hear the status changes, the last tick's node changes and the result;
+        :meth:`ObjectiveRun.wait` returns after them.
+
+        The blackboard goes first so that a client that asks for the latched snapshot once its
+        ``execute`` returned sees this run's, not the one before (listeners only hand it to a worker)."""
         result = run._settle(result)
         if result.cancelled and status is ObjectiveStatus.SUCCESS:
             status = ObjectiveStatus.CANCELLED
@@ -1053,11 +1057,12 @@ class ObjectiveServer:
         self._ended_at = time.monotonic()
         told = self._status == (status, run.objective_name)
         self._status = (status, run.objective_name)
+        if completed is not None:
+            self._maybe_snapshot(run, completed, force=True)
         answered = run._answer(result)
         try:
             if completed is not None:
                 self._flush_node_changes(run)
-                self._maybe_snapshot(run, completed, force=True)
             if not told:
                 self._tell_status(status, run.objective_name)
             if answered:
