@@ -204,7 +204,12 @@ def test_saved_objective_files_show_up_and_a_broken_one_is_reported_with_its_lin
                 (tmp_path / "count_again.xml").write_text(new)
                 with contextlib.suppress(AssertionError):
                     await wait_for(pilot, lambda: len(screen.objectives) == 2, "the saved objective", 2.0)
-            assert any(notice.ok and "count_again.xml" in notice.message for notice in app.reloads)
+            # The list and the reload notice come by different messages: either may arrive first.
+            await wait_for(
+                pilot,
+                lambda: any(notice.ok and "count_again.xml" in notice.message for notice in app.reloads),
+                "the reload notice of count_again.xml",
+            )
 
             (tmp_path / "broken.xml").write_text(
                 '<root BTCPP_format="4">\n  <BehaviorTree ID="B">\n    <Sequence>\n'
