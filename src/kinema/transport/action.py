@@ -961,11 +961,34 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         ``feedback_callback(feedback)`` is called on a zenoh thread for each feedback message.
         Check ``handle.accepted``; ``handle.result()`` raises when the goal was rejected.
         """
+        return self.send_goal_cdr(self.serialize_goal(goal), feedback_callback, timeout=timeout)
+
+    def serialize_goal(self, goal: GoalT | dict[str, Any] | None) -> bytes:
+        """The CDR of a goal (message, dict of fields, or None for defaults), for :meth:`send_goal_cdr`."""
         action = self.action
         goal_msg = from_dict(action.goal, goal) if goal is None or isinstance(goal, dict) else goal
         if type_of(goal_msg) != action.goal:
             raise TransportError(f"goal of {self.name} must be {action.goal}, got {type_of(goal_msg)}")
+        return self._send_goal.registry.serialize(goal_msg, action.goal)
+
+    def send_goal_cdr(
+        self,
+        goal_cdr: bytes,
+        feedback_callback: Callable[[FeedbackT], Any] | None = None,
+        *,
+        timeout: float = 5.0,
+    ) -> ClientGoalHandle[ResultT, FeedbackT]:
+        """:meth:`send_goal` with the goal already serialised (:meth:`serialize_goal`): a caller that sends
+        the same goal again and again serialises it once.
+
+        Raises:
+            TransportError: ``goal_cdr`` is not a little-endian CDR payload, or no server answered.
+        """
         goal_id = uuid.uuid4().bytes
+        try:
+            payload = send_goal_request(goal_id, goal_cdr)
+        except ValueError as error:
+            raise TransportError(f"goal of {self.name}: {error}") from None
         handle = ClientGoalHandle(self, goal_id, feedback_callback)
         with self._lock:
             self._forget_finished()
@@ -974,7 +997,6 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         started = time.monotonic()
         answered_by: list[tuple[int, Any, Any]] = []
         try:
-            payload = send_goal_request(goal_id, self._send_goal.registry.serialize(goal_msg, action.goal))
             # The result is asked for with the goal: a goal that ends quickly costs one round trip.
             # The acceptance is the first reply, taken as it comes; the result follows on a Kinema server.
             response = self._send_goal._call_payload(
