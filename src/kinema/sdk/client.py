@@ -101,7 +101,11 @@ class ObjectiveHandle:
 
     @property
     def status(self) -> str:
-        """The goal's status: ACCEPTED, EXECUTING, CANCELING, SUCCEEDED, CANCELED or ABORTED."""
+        """The goal's status: ACCEPTED, EXECUTING, CANCELING, SUCCEEDED, CANCELED or ABORTED.
+
+        Read from the agent's status topic, which the client subscribes to at the first read: right
+        after that it may still say ACCEPTED for a moment.
+        """
         return self._goal.status_name
 
     @property
