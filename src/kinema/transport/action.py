@@ -989,9 +989,15 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
             payload = send_goal_request(goal_id, goal_cdr)
         except ValueError as error:
             raise TransportError(f"goal of {self.name}: {error}") from None
-        handle = ClientGoalHandle(self, goal_id, feedback_callback)
         with self._lock:
             self._forget_finished()
+            earlier = list(self._pending.values())
+        for other in earlier:
+            # A result that arrived for a goal nobody waits for or looks at (a goal started and left to
+            # run) is read now, so that its handle and its request can go.
+            other.done()
+        handle = ClientGoalHandle(self, goal_id, feedback_callback)
+        with self._lock:
             self._handles[goal_id] = handle
             self._pending[goal_id] = handle
         started = time.monotonic()
@@ -1036,20 +1042,25 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
             self._pending.pop(handle.goal_id, None)
 
     def _watch_status(self) -> None:
-        """Subscribe to the server's status topic, once (it is latched: the current statuses come first)."""
+        """Subscribe to the server's status topic, once (it is latched: the current statuses come first).
+
+        Never raises: reading a status must not fail (a closing session leaves the last known one)."""
         if self._status_sub is not None:
             return
         with self._status_lock:
             if self._status_sub is not None or self._closed:
                 return
-            self._status_sub = Subscription(
-                self.node,
-                self.action.status,
-                f"{self.name}/_action/status",
-                self._on_status,
-                LATCHED_QOS,
-                raw=True,
-            )
+            try:
+                self._status_sub = Subscription(
+                    self.node,
+                    self.action.status,
+                    f"{self.name}/_action/status",
+                    self._on_status,
+                    LATCHED_QOS,
+                    raw=True,
+                )
+            except Exception:
+                log.debug("%s: cannot subscribe to the goal status topic", self.name, exc_info=True)
 
     def _wait_result_on_thread(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
         # The server did not answer the result with the goal (rmw_zenoh): its status topic tells how the
