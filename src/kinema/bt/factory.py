@@ -7,6 +7,7 @@ import inspect
 import itertools
 from collections.abc import Callable, Iterable
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from kinema.bt.blackboard import Blackboard
 from kinema.bt.clock import Clock, WallClock
@@ -29,6 +30,9 @@ from kinema.bt.status import NodeStatus
 from kinema.bt.tree import Tree
 from kinema.bt.xmlparser import TreeDefinition, TreeLibrary
 from kinema.errors import did_you_mean
+
+if TYPE_CHECKING:
+    from lxml import etree
 
 # A serial per factory (never reused, unlike id()): part of the key of compiled tree plans.
 _FACTORY_SERIALS = itertools.count(1)
@@ -247,9 +251,10 @@ class BehaviorTreeFactory:
 
     # -- trees -----------------------------------------------------------------------------------
 
-    def register_behavior_tree_from_text(self, xml: str, filename: str = "<string>") -> None:
-        """Load every ``<BehaviorTree>`` of an XML text (includes resolve against the current path)."""
-        self.library.load_text(xml, filename, self._manifests, registry=self.plan_key())
+    def register_behavior_tree_from_text(self, xml: str, filename: str = "<string>") -> etree._Element:
+        """Load every ``<BehaviorTree>`` of an XML text (includes resolve against the current path); returns
+        the document's root element (the same parse, kept while the text is loaded again)."""
+        return self.library.load_text(xml, filename, self._manifests, registry=self.plan_key())
 
     def register_behavior_tree_from_file(self, path: str | Path) -> None:
         """Load every ``<BehaviorTree>`` of an XML file."""

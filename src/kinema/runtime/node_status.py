@@ -235,11 +235,11 @@ class NodeStatusRecorder:
     changes over as a :class:`NodeStatusBatch`; remembers the last leaf that failed (the failure
     message names it)."""
 
-    __slots__ = ("_last_failure", "_log", "_pending", "table")
+    __slots__ = ("_last_failure", "_log", "_pending", "_table")
 
     def __init__(self) -> None:
         self._log: TransitionLog | None = None
-        self.table: NodeTable | None = None
+        self._table: NodeTable | None = None
         self._pending: list[NodeStatusBatch] = []
         self._last_failure: tuple[str, str] | None = None
 
@@ -247,7 +247,15 @@ class NodeStatusRecorder:
         """Record the transitions of ``tree`` through its transition log (one per tree)."""
         self.detach()
         self._log = tree.record_transitions()
-        self.table = NodeTable(self._log.nodes)
+        self._table = None
+
+    @property
+    def table(self) -> NodeTable | None:
+        """The node table of the attached (or last) tree, made when first needed: for a run that ends
+        in its first tick, after its client has the result (None before any tree was attached)."""
+        if self._table is None and self._log is not None:
+            self._table = NodeTable(self._log.nodes)
+        return self._table
 
     def detach(self) -> None:
         """Stop recording the attached tree (what was recorded stays readable)."""
@@ -261,12 +269,13 @@ class NodeStatusRecorder:
         log = self._log
         if log is None or not log.codes:
             return
-        assert self.table is not None
-        batch = NodeStatusBatch(self.table, *log.take_columns())
+        table = self.table
+        assert table is not None
+        batch = NodeStatusBatch(table, *log.take_columns())
         failed = batch.last_leaf_failure()
         if failed is not None:
             index = failed // CODES_PER_NODE
-            self._last_failure = (self.table.paths[index], self.table.node_ids[index])
+            self._last_failure = (table.paths[index], table.node_ids[index])
         self._pending.append(batch)
 
     @property

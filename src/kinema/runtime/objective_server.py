@@ -59,6 +59,8 @@ from kinema.runtime.tick_watchdog import (
 from kinema.runtime.watchdog import StuckCode, stuck_code
 
 if TYPE_CHECKING:
+    from lxml import etree
+
     from kinema.bt import BehaviorTreeFactory, Tree
     from kinema.bt.xmlparser import SubtreeModel
 
@@ -81,6 +83,8 @@ ABANDON_AFTER_S = 0.07
 # A tree that re-ticks itself for a whole tick period pauses this long before the tick it owes, so that
 # it cannot starve the transport and a simulator running in the same process.
 RETICK_PAUSE_S = 0.005
+# Where errors in an objective sent as an XML string say they are.
+_XML_NAME = "<objective XML>"
 
 
 @dataclass(frozen=True)
@@ -954,9 +958,7 @@ class ObjectiveServer:
         if size > MAX_OBJECTIVE_XML_BYTES:
             limit = MAX_OBJECTIVE_XML_BYTES / 1e6
             raise ObjectiveError(f"the objective XML is {size / 1e6:.1f} MB; the limit is {limit:.1f} MB")
-        name = main_tree_id(xml)
-        tree, model = _create_from_scratch_text(factory, xml, name)
-        return tree, name, model
+        return _create_from_scratch_text(factory, xml)
 
     def _tick(self, worker: TickWorker) -> None:
         tree, run = self._tree, self._run
@@ -1134,7 +1136,11 @@ def main_tree_id(xml: str) -> str:
     """
     from kinema.bt.xmlsource import parse_xml
 
-    root = parse_xml(xml, "<objective XML>")
+    return _main_tree_of(parse_xml(xml, _XML_NAME))
+
+
+def _main_tree_of(root: etree._Element) -> str:
+    """:func:`main_tree_id` of a parsed document."""
     main = root.get("main_tree_to_execute")
     if main:
         return main
@@ -1159,10 +1165,11 @@ def blackboard_entries(tree: Tree) -> list[tuple[str, str, str, Any]]:
 
 
 def _create_from_scratch_text(
-    factory: BehaviorTreeFactory, xml: str, name: str
-) -> tuple[Tree, SubtreeModel | None]:
-    """Build the main tree (``name``) of an ad-hoc XML document without adding its trees to ``factory``;
-    with the model of that tree's ports, as the document and the library declare it.
+    factory: BehaviorTreeFactory, xml: str
+) -> tuple[Tree, str, SubtreeModel | None]:
+    """Build the main tree of an ad-hoc XML document (:func:`main_tree_id`) without adding its trees to
+    ``factory``; with its name and the model of its ports, as the document and the library declare it.
+    The document is parsed once (the library keeps the parse of a text it loaded recently).
 
     An XML string sent to ``/do_objective`` may define trees named like library objectives; they must
     shadow the library for this run only, never replace it for later runs.
@@ -1177,8 +1184,8 @@ def _create_from_scratch_text(
     )
     factory.library = scratch
     try:
-        tree = factory.create_tree_from_text(xml, filename="<objective XML>")
-        return tree, scratch.subtree_models.get(name)
+        name = _main_tree_of(factory.register_behavior_tree_from_text(xml, filename=_XML_NAME))
+        return factory.create_tree(name), name, scratch.subtree_models.get(name)
     finally:
         factory.library = saved
 

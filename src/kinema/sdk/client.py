@@ -101,7 +101,11 @@ class ObjectiveHandle:
 
     @property
     def status(self) -> str:
-        """The goal's status: ACCEPTED, EXECUTING, CANCELING, SUCCEEDED, CANCELED or ABORTED."""
+        """The goal's status: ACCEPTED, EXECUTING, CANCELING, SUCCEEDED, CANCELED or ABORTED.
+
+        Read from the agent's status topic, which the client subscribes to at the first read: right
+        after that it may still say ACCEPTED for a moment.
+        """
         return self._goal.status_name
 
     @property
@@ -194,6 +198,9 @@ class ObjectiveClient:
         self._by_name: bool | None = None  # whether the agent serves /kinema/run_objective
         self._ready = False
         self._action_ready = False
+        # The last goal sent without overrides, serialised: ((action name, objective name, XML), CDR).
+        # Running the same objective again sends these bytes again.
+        self._last_goal: tuple[tuple[str, str, str], bytes] | None = None
 
     # -- plumbing ------------------------------------------------------------------------------------
 
@@ -277,13 +284,8 @@ class ObjectiveClient:
             raise TransportError("start() needs an objective name or an objective XML string")
         self.wait_for_runtime()
         action = self._action_for(by_name=bool(name))
-        goal = {
-            "objective_name": name,
-            "objective_xml_string": "" if name else xml,
-            "parameter_overrides": parameter_messages(overrides),
-        }
         try:
-            handle = action.send_goal(goal, timeout=self.timeout)
+            handle = action.send_goal_cdr(self._goal_cdr(action, name, xml, overrides), timeout=self.timeout)
         except TransportError as error:
             if name or "answered within" not in str(error):
                 raise
@@ -296,6 +298,22 @@ class ObjectiveClient:
         if not handle.accepted:
             raise TransportError(f"the agent rejected objective {name or '<XML>'!r}")
         return ObjectiveHandle(handle, name or _xml_name(xml))
+
+    def _goal_cdr(self, action: ActionClient, name: str, xml: str, overrides: Overrides) -> bytes:
+        """The serialised goal of ``action`` (the last one again when nothing changed)."""
+        key = (action.name, name, "" if name else xml)
+        last = self._last_goal
+        if overrides is None and last is not None and last[0] == key:
+            return last[1]
+        goal = {
+            "objective_name": name,
+            "objective_xml_string": key[2],
+            "parameter_overrides": parameter_messages(overrides),
+        }
+        cdr = action.serialize_goal(goal)
+        if overrides is None:
+            self._last_goal = (key, cdr)
+        return cdr
 
     def _action_for(self, *, by_name: bool) -> ActionClient:
         """The action to send a goal to, once its server is on the graph."""

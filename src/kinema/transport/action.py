@@ -14,8 +14,11 @@ A Kinema client asks for the result with the goal: its ``send_goal`` request car
 the ``get_result`` response (one request and one round trip for a goal that ends at once). Servers that do
 not know the parameter ignore it and answer once (rmw_zenoh); the client then asks ``get_result`` as rcl
 does. The replies wait in a channel that the thread which needs the result reads itself (``result()``), so
-no other thread is woken for them. A Kinema server also holds a ``get_result`` that comes before its goal
-until the goal is decided (:data:`EARLY_RESULT_HOLD_S` at most): what earlier Kinema clients sent.
+no other thread is woken for them. A client subscribes to the ``status`` topic when a goal's status is
+first read (or it falls back to ``get_result``), not before: a caller that only waits for results is not
+woken by the status array that every goal publishes as it ends. A Kinema server also holds a
+``get_result`` that comes before its goal until the goal is decided (:data:`EARLY_RESULT_HOLD_S` at
+most): what earlier Kinema clients sent.
 """
 
 from __future__ import annotations
@@ -675,7 +678,7 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         self.goal_id = goal_id
         self.accepted = False
         self.stamp: Any = None
-        self.status = STATUS_UNKNOWN
+        self._status = STATUS_UNKNOWN
         self._feedback_callback = feedback_callback
         self._done = threading.Event()
         self._outcome: GoalResult[ResultT] | None = None
@@ -703,9 +706,25 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
         return uuid.UUID(bytes=self.goal_id)
 
     @property
+    def status(self) -> int:
+        """The latest known status (``STATUS_*``), from the server's status topic while the goal runs.
+
+        The first read of a running goal's status subscribes its client to that topic (latched: the
+        server's current statuses come first), so it may still say ACCEPTED for a moment.
+        """
+        if not self._done.is_set():
+            self.client._watch_status()
+        return self._status
+
+    @status.setter
+    def status(self, status: int) -> None:
+        self._status = status
+
+    @property
     def status_name(self) -> str:
         """Name of the latest known status."""
-        return STATUS_NAMES.get(self.status, str(self.status))
+        status = self.status
+        return STATUS_NAMES.get(status, str(status))
 
     def done(self) -> bool:
         """True once the result (or a failure to get it) arrived."""
@@ -872,7 +891,7 @@ class ClientGoalHandle(Generic[ResultT, FeedbackT]):
             self._outcome, self._error = outcome, error
             self.finished_at = time.monotonic()
             if outcome is not None:
-                self.status = outcome.status
+                self._status = outcome.status
             self._done.set()
             callbacks, self._callbacks = self._callbacks, []
         self.client._ended(self)
@@ -914,9 +933,10 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         self._feedback_sub = Subscription(
             node, action.feedback_message, f"{base}/feedback", self._on_feedback, QoS()
         )
-        self._status_sub = Subscription(
-            node, action.status, f"{base}/status", self._on_status, LATCHED_QOS, raw=True
-        )
+        # Declared when a goal's status is first read, or when a goal's result is asked with get_result
+        # (see _watch_status).
+        self._status_sub: Subscription | None = None
+        self._status_lock = threading.Lock()
         # A server that dies may never end the request that waits for a goal's result: its endpoints
         # leaving the graph end that wait, and the goal's handle then asks the graph (_wait_result).
         node.session.graph_cache().add_removal_listener(self._on_endpoint_removed)
@@ -941,20 +961,48 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         ``feedback_callback(feedback)`` is called on a zenoh thread for each feedback message.
         Check ``handle.accepted``; ``handle.result()`` raises when the goal was rejected.
         """
+        return self.send_goal_cdr(self.serialize_goal(goal), feedback_callback, timeout=timeout)
+
+    def serialize_goal(self, goal: GoalT | dict[str, Any] | None) -> bytes:
+        """The CDR of a goal (message, dict of fields, or None for defaults), for :meth:`send_goal_cdr`."""
         action = self.action
         goal_msg = from_dict(action.goal, goal) if goal is None or isinstance(goal, dict) else goal
         if type_of(goal_msg) != action.goal:
             raise TransportError(f"goal of {self.name} must be {action.goal}, got {type_of(goal_msg)}")
+        return self._send_goal.registry.serialize(goal_msg, action.goal)
+
+    def send_goal_cdr(
+        self,
+        goal_cdr: bytes,
+        feedback_callback: Callable[[FeedbackT], Any] | None = None,
+        *,
+        timeout: float = 5.0,
+    ) -> ClientGoalHandle[ResultT, FeedbackT]:
+        """:meth:`send_goal` with the goal already serialised (:meth:`serialize_goal`): a caller that sends
+        the same goal again and again serialises it once.
+
+        Raises:
+            TransportError: ``goal_cdr`` is not a little-endian CDR payload, or no server answered.
+        """
         goal_id = uuid.uuid4().bytes
-        handle = ClientGoalHandle(self, goal_id, feedback_callback)
+        try:
+            payload = send_goal_request(goal_id, goal_cdr)
+        except ValueError as error:
+            raise TransportError(f"goal of {self.name}: {error}") from None
         with self._lock:
             self._forget_finished()
+            earlier = list(self._pending.values())
+        for other in earlier:
+            # A result that arrived for a goal nobody waits for or looks at (a goal started and left to
+            # run) is read now, so that its handle and its request can go.
+            other.done()
+        handle = ClientGoalHandle(self, goal_id, feedback_callback)
+        with self._lock:
             self._handles[goal_id] = handle
             self._pending[goal_id] = handle
         started = time.monotonic()
         answered_by: list[tuple[int, Any, Any]] = []
         try:
-            payload = send_goal_request(goal_id, self._send_goal.registry.serialize(goal_msg, action.goal))
             # The result is asked for with the goal: a goal that ends quickly costs one round trip.
             # The acceptance is the first reply, taken as it comes; the result follows on a Kinema server.
             response = self._send_goal._call_payload(
@@ -981,8 +1029,8 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         sequence, replies, cancel = answered_by[0]
         handle._early = (replies, sequence, started + timeout)
         handle._early_cancel = cancel
-        if handle.status == STATUS_UNKNOWN:
-            handle.status = STATUS_ACCEPTED
+        if handle._status == STATUS_UNKNOWN:
+            handle._status = STATUS_ACCEPTED
         handle._decide(True)
         return handle
 
@@ -993,7 +1041,31 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
             self._handles.pop(handle.goal_id, None)
             self._pending.pop(handle.goal_id, None)
 
+    def _watch_status(self) -> None:
+        """Subscribe to the server's status topic, once (it is latched: the current statuses come first).
+
+        Never raises: reading a status must not fail (a closing session leaves the last known one)."""
+        if self._status_sub is not None:
+            return
+        with self._status_lock:
+            if self._status_sub is not None or self._closed:
+                return
+            try:
+                self._status_sub = Subscription(
+                    self.node,
+                    self.action.status,
+                    f"{self.name}/_action/status",
+                    self._on_status,
+                    LATCHED_QOS,
+                    raw=True,
+                )
+            except Exception:
+                log.debug("%s: cannot subscribe to the goal status topic", self.name, exc_info=True)
+
     def _wait_result_on_thread(self, handle: ClientGoalHandle[ResultT, FeedbackT]) -> None:
+        # The server did not answer the result with the goal (rmw_zenoh): its status topic tells how the
+        # goal ended if the server goes away first (_wait_result).
+        self._watch_status()
         threading.Thread(
             target=self._wait_result, args=(handle,), name=f"kinema-result{self.name}", daemon=True
         ).start()
@@ -1068,13 +1140,13 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         try:
             statuses = statuses_of(payload, pending)
             if statuses is None:  # not little-endian CDR: the generic deserializer reads it
-                message = self._status_sub._registry.deserialize(payload, self.action.status)
+                message = self.node.session.registry.deserialize(payload, self.action.status)
                 statuses = {_uuid_bytes(s.goal_info.goal_id): int(s.status) for s in message.status_list}
             for goal_id, status in statuses.items():
                 handle = pending.get(goal_id)
                 # done() also takes a result that arrived for a goal whose caller has not asked yet.
                 if handle is not None and not handle.done():
-                    handle.status = status
+                    handle._status = status
         except Exception:
             log.warning("%s: unreadable goal status message ignored", self.name, exc_info=True)
 
@@ -1082,10 +1154,13 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         """Stop; waiting ``result()`` calls raise TransportError."""
         if self._closed:
             return
-        self._closed = True
         self.node.session.graph_cache().remove_removal_listener(self._on_endpoint_removed)
-        for entity in (self._send_goal, self._cancel, self._get_result, self._feedback_sub, self._status_sub):
-            entity.close()
+        with self._status_lock:
+            self._closed = True
+            status_sub = self._status_sub
+        for entity in (self._send_goal, self._cancel, self._get_result, self._feedback_sub, status_sub):
+            if entity is not None:
+                entity.close()
         with self._lock:
             handles = list(self._handles.values())
         for handle in handles:

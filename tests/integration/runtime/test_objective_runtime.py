@@ -147,6 +147,21 @@ def test_valid_overrides_apply(client: ObjectiveClient) -> None:
     assert typed.succeeded
 
 
+def test_a_goal_sent_again_is_the_one_asked_for(client: ObjectiveClient) -> None:
+    # The client keeps the last goal sent without overrides serialised: it must never stand in for
+    # another objective, another XML document, or a call that gives overrides.
+    given = {"delay": "1", "greeting": "hello"}
+    for _ in range(2):
+        assert client.execute("Typed", given).succeeded
+        bare = client.execute("Typed")
+        assert bare.failed and "msec" in bare.error_message, bare
+    assert client.execute("Quick").succeeded
+    failing = TEST_SIMPLE.replace("AlwaysSuccess", "AlwaysFailure")
+    for _ in range(2):
+        assert client.do_xml(TEST_SIMPLE).succeeded
+        assert client.do_xml(failing).failed
+
+
 @pytest.mark.parametrize(
     ("overrides", "reason"),
     [

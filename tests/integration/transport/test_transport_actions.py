@@ -357,6 +357,20 @@ def test_a_result_nobody_waits_for_still_ends_the_goal(connect: Callable[[], Ses
     assert with_callback.result(timeout=0.1).result.sequence.tolist() == [0, 1, 1]
 
 
+def test_a_goal_left_to_run_is_let_go_once_it_ended(connect: Callable[[], Session]) -> None:
+    # Nobody waits for the first goal nor reads its status: its result is read when the next goal is
+    # sent, and the client forgets it instead of holding it (and its request) until it closes.
+    Node(connect(), "server").create_action_server(FIB, "/left", _fibonacci)
+    client = _client(connect, "/left")
+    left = client.send_goal({"order": 2})
+    assert client.send_goal({"order": 3}).result(timeout=10).succeeded
+    deadline = time.monotonic() + 10
+    while left.goal_id in client._pending:
+        assert time.monotonic() < deadline, "the goal left to run was never let go"
+        client.send_goal({"order": 1}).result(timeout=10)
+    assert left.status == STATUS_SUCCEEDED and client._status_sub is None
+
+
 def test_a_deferred_goal_is_published_executing_when_its_work_says_so(connect: Callable[[], Session]) -> None:
     # As rclcpp's execute(): a goal that ends at once is published once, ended; one that runs on shows
     # EXECUTING from the moment its work calls execute().
