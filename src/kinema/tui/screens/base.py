@@ -115,6 +115,16 @@ class KinemaScreen(RuntimeView, Screen[None]):
     def on_screen_resume(self) -> None:
         self.show_status(self.kinema.status)
 
+    @on(events.Resize)
+    def _same_size(self, event: events.Resize) -> None:
+        # Textual hands a new screen the terminal's size up to three times on the way to the first frame
+        # (laid out on resume, then the app's first resize, then that resize again when the app is idle),
+        # and lays every widget out and renders again each time. A resize to the size the screen was
+        # laid out at changes nothing: Textual's own handler is skipped.
+        if self.is_attached and self._compositor.size == event.size:
+            event.stop()
+            event.prevent_default()
+
     def show_status(self, status: RuntimeStatus) -> None:
         """Show the runtime status in this screen's status bar."""
         for bar in self.query(StatusBar):
