@@ -7,6 +7,7 @@ import gc
 from collections.abc import Iterator
 
 import pytest
+import textual.screen
 from textual import events
 from textual.dom import DOMNode
 from textual.geometry import Size
@@ -178,5 +179,33 @@ def test_a_resize_to_the_size_the_screen_has_lays_nothing_out_again(
             assert laid_out == [Size(90, 30)]
             assert app.screen.query_one("#status-bar").region.bottom == 29  # laid out at the new size
             assert {"-narrow", "-short"} <= app.screen.classes
+
+    asyncio.run(main())
+
+
+def test_the_first_frame_is_drawn_once_the_start_is_over_not_on_a_tick_of_the_update_timer(
+    fake: FakeConnection, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Textual draws on the ticks of each screen's update timer (60 Hz); with ticks 10 s apart, only a
+    # frame drawn as soon as the start is over arrives in time.
+    monkeypatch.setattr(textual.screen, "UPDATE_PERIOD", 10.0)
+    drawn: list[Screen[object]] = []
+    original = KinemaApp._display
+
+    def recording(self: KinemaApp, screen: Screen[object], renderable: object) -> None:
+        if not self._batch_count:  # within the start's batch update the app draws nothing
+            drawn.append(screen)
+        original(self, screen, renderable)  # type: ignore[arg-type]
+
+    monkeypatch.setattr(KinemaApp, "_display", recording)
+    app = KinemaApp(fake, initial_mode="objectives")
+
+    async def main() -> None:
+        async with app.run_test(size=(120, 40)):
+            for _ in range(40):  # not the pilot's pause, which makes the screen draw itself
+                if drawn:
+                    break
+                await asyncio.sleep(0.05)
+            assert drawn and drawn[-1] is app.screen
 
     asyncio.run(main())

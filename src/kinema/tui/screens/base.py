@@ -81,6 +81,7 @@ class KinemaScreen(RuntimeView, Screen[None]):
         # composed and styled, and then styles them all again; set up front, that resize changes nothing.
         self.add_class(*breakpoint_classes(self.app), update=False)
         self._resumed = False
+        self._drawn = False
 
     @property
     def kinema(self) -> KinemaApp:
@@ -114,6 +115,16 @@ class KinemaScreen(RuntimeView, Screen[None]):
 
     def on_screen_resume(self) -> None:
         self.show_status(self.kinema.status)
+
+    @on(events.Idle)
+    def _draw_first_frame(self) -> None:
+        # Textual draws a screen on the ticks of its 60 Hz update timer, which the screen resumes when it
+        # goes idle with something to draw; resumed, the timer waits for its next tick. For the first frame
+        # that was 17-19 ms of doing nothing once the app's start was over: it is drawn right away instead.
+        if self._drawn or self.app._batch_count or not self.is_current:
+            return
+        self._drawn = True
+        self._on_timer_update()
 
     @on(events.Resize)
     def _same_size(self, event: events.Resize) -> None:
