@@ -5,8 +5,11 @@ from __future__ import annotations
 import asyncio
 import gc
 from collections.abc import Iterator
+from typing import Any
 
 import pytest
+import textual.css.parse as parse_module
+import textual.css.stylesheet as stylesheet_module
 import textual.screen
 from textual import events
 from textual.dom import DOMNode
@@ -192,10 +195,10 @@ def test_the_first_frame_is_drawn_once_the_start_is_over_not_on_a_tick_of_the_up
     drawn: list[Screen[object]] = []
     original = KinemaApp._display
 
-    def recording(self: KinemaApp, screen: Screen[object], renderable: object) -> None:
+    def recording(self: KinemaApp, screen: Screen[object], renderable: Any) -> None:
         if not self._batch_count:  # within the start's batch update the app draws nothing
             drawn.append(screen)
-        original(self, screen, renderable)  # type: ignore[arg-type]
+        original(self, screen, renderable)
 
     monkeypatch.setattr(KinemaApp, "_display", recording)
     app = KinemaApp(fake, initial_mode="objectives")
@@ -207,5 +210,33 @@ def test_the_first_frame_is_drawn_once_the_start_is_over_not_on_a_tick_of_the_up
                     break
                 await asyncio.sleep(0.05)
             assert drawn and drawn[-1] is app.screen
+
+    asyncio.run(main())
+
+
+def test_the_apps_stylesheet_is_parsed_once_and_again_for_a_new_theme(
+    fake: FakeConnection, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    parsed: list[str] = []
+    original = parse_module.parse
+
+    def recording(scope: str, css: str, read_from: tuple[str, str], *args: Any, **kwargs: Any) -> Any:
+        parsed.append(read_from[0])
+        return original(scope, css, read_from, *args, **kwargs)
+
+    monkeypatch.setattr(stylesheet_module, "parse", recording)
+    app = KinemaApp(fake, initial_mode="objectives")
+
+    def app_tcss() -> int:
+        return sum(path.endswith("app.tcss") for path in parsed)
+
+    async def main() -> None:
+        async with app.run_test(size=(120, 40)) as pilot:
+            await pilot.pause()
+            assert app_tcss() == 1  # Textual's refresh when it first showed the screen parsed it twice more
+            dark = app.screen.styles.background
+            app.theme = "textual-light"
+            await pilot.pause()
+            assert app_tcss() == 2 and app.screen.styles.background != dark
 
     asyncio.run(main())
