@@ -5,10 +5,17 @@ from __future__ import annotations
 import asyncio
 import gc
 from collections.abc import Iterator
+from typing import Any
 
 import pytest
+import textual.css.parse as parse_module
+import textual.css.stylesheet as stylesheet_module
+import textual.screen
+from textual import events
 from textual.dom import DOMNode
+from textual.geometry import Size
 from textual.screen import Screen
+from textual.widgets._footer import FooterKey
 
 from kinema.tui import startup_gc
 from kinema.tui.app import KinemaApp
@@ -130,3 +137,106 @@ def test_a_collector_turned_off_by_someone_else_stays_off(collector: None) -> No
     assert not gc.isenabled()
     startup_gc.release()
     assert not gc.isenabled()
+
+
+def test_the_footers_keys_are_styled_once_and_only_the_palette_key_is_compact(fake: FakeConnection) -> None:
+    # Textual's footer keys start compact and are made wide by the footer right after they mount: two
+    # restyles of each on the way to the first frame. They start as the footer is.
+    app = RestyleRecordingApp(fake, initial_mode="objectives")
+
+    async def main() -> None:
+        async with app.run_test(size=(120, 40)) as pilot:
+            await pilot.pause()
+            await pilot.pause()
+            keys = list(app.screen.query(FooterKey))
+            assert len(keys) > 3
+            palette = [key for key in keys if key.has_class("-command-palette")]
+            assert [key for key in keys if key.has_class("-compact")] == palette
+            assert all(not key.compact for key in keys if key not in palette)
+            assert [node for node in app.restyled if isinstance(node, FooterKey)] == palette
+
+    asyncio.run(main())
+
+
+def test_a_resize_to_the_size_the_screen_has_lays_nothing_out_again(
+    fake: FakeConnection, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    laid_out: list[Size] = []
+    original = Screen._on_resize
+
+    async def recording(self: Screen[object], event: events.Resize) -> None:
+        laid_out.append(event.size)
+        await original(self, event)
+
+    monkeypatch.setattr(Screen, "_on_resize", recording)
+    app = KinemaApp(fake, initial_mode="objectives")
+
+    async def main() -> None:
+        async with app.run_test(size=(120, 40)) as pilot:
+            await pilot.pause()
+            app.screen.post_message(events.Resize(Size(120, 40), Size(120, 40)))
+            await pilot.pause()
+            assert laid_out == []  # the start's resizes too (each laid the screen out again)
+            await pilot.resize_terminal(90, 30)
+            await pilot.pause(0.1)
+            assert laid_out == [Size(90, 30)]
+            assert app.screen.query_one("#status-bar").region.bottom == 29  # laid out at the new size
+            assert {"-narrow", "-short"} <= app.screen.classes
+
+    asyncio.run(main())
+
+
+def test_the_first_frame_is_drawn_once_the_start_is_over_not_on_a_tick_of_the_update_timer(
+    fake: FakeConnection, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Textual draws on the ticks of each screen's update timer (60 Hz); with ticks 10 s apart, only a
+    # frame drawn as soon as the start is over arrives in time.
+    monkeypatch.setattr(textual.screen, "UPDATE_PERIOD", 10.0)
+    drawn: list[Screen[object]] = []
+    original = KinemaApp._display
+
+    def recording(self: KinemaApp, screen: Screen[object], renderable: Any) -> None:
+        if not self._batch_count:  # within the start's batch update the app draws nothing
+            drawn.append(screen)
+        original(self, screen, renderable)
+
+    monkeypatch.setattr(KinemaApp, "_display", recording)
+    app = KinemaApp(fake, initial_mode="objectives")
+
+    async def main() -> None:
+        async with app.run_test(size=(120, 40)):
+            for _ in range(40):  # not the pilot's pause, which makes the screen draw itself
+                if drawn:
+                    break
+                await asyncio.sleep(0.05)
+            assert drawn and drawn[-1] is app.screen
+
+    asyncio.run(main())
+
+
+def test_the_apps_stylesheet_is_parsed_once_and_again_for_a_new_theme(
+    fake: FakeConnection, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    parsed: list[str] = []
+    original = parse_module.parse
+
+    def recording(scope: str, css: str, read_from: tuple[str, str], *args: Any, **kwargs: Any) -> Any:
+        parsed.append(read_from[0])
+        return original(scope, css, read_from, *args, **kwargs)
+
+    monkeypatch.setattr(stylesheet_module, "parse", recording)
+    app = KinemaApp(fake, initial_mode="objectives")
+
+    def app_tcss() -> int:
+        return sum(path.endswith("app.tcss") for path in parsed)
+
+    async def main() -> None:
+        async with app.run_test(size=(120, 40)) as pilot:
+            await pilot.pause()
+            assert app_tcss() == 1  # Textual's refresh when it first showed the screen parsed it twice more
+            dark = app.screen.styles.background
+            app.theme = "textual-light"
+            await pilot.pause()
+            assert app_tcss() == 2 and app.screen.styles.background != dark
+
+    asyncio.run(main())

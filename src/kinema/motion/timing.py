@@ -2,17 +2,15 @@
 
 from __future__ import annotations
 
-import importlib
 import itertools
 import logging
-import sys
-import types
-from typing import Any
 
 import numpy as np
 
 from kinema.errors import MotionError
+from kinema.motion.clamped_spline import ClampedCubicSpline
 from kinema.motion.robot_model import RobotModel
+from kinema.motion.toppra_import import import_toppra
 from kinema.motion.trajectory import JointPath, JointTrajectory
 
 log = logging.getLogger(__name__)
@@ -21,75 +19,6 @@ log = logging.getLogger(__name__)
 # with chord-length parameterization). The limits are therefore derated and the result verified by sampling.
 _DERATE = 0.9
 _CHECK_DT = 0.002
-
-
-class _DeferredModule(types.ModuleType):
-    """Stands in for a module that is imported only when one of its attributes is first used."""
-
-    def __getattr__(self, name: str) -> Any:
-        if name.startswith("__"):  # __file__, __path__ ... asked by tools walking modules load nothing
-            raise AttributeError(name)
-        return getattr(importlib.import_module(self.__name__), name)
-
-
-# numpy's submodules that scipy's array API layer (``scipy._lib.array_api_compat.numpy``, imported by
-# toppra's scipy.interpolate) imports with ``from numpy import *`` and never uses: about 8 MB resident
-# (f2py alone brings charset_normalizer and unittest).
-_UNUSED_NUMPY_PARTS = ("f2py", "testing", "ma", "polynomial", "ctypeslib", "char", "rec")
-
-
-def _defer_unused_numpy_parts() -> None:
-    """Make the numpy submodules in ``_UNUSED_NUMPY_PARTS`` load on their first attribute use.
-
-    Each not yet imported is put in ``sys.modules`` (and on ``numpy``) through the standard library's
-    ``importlib.util.LazyLoader``: importing it, or ``from numpy import *``, gives the module without
-    running it; the first attribute read runs it, so code that uses it sees no difference.
-    """
-    import importlib.util
-
-    for part in _UNUSED_NUMPY_PARTS:
-        name = f"numpy.{part}"
-        if name in sys.modules:
-            continue
-        spec = importlib.util.find_spec(name)
-        if spec is None or spec.loader is None:
-            continue
-        spec.loader = importlib.util.LazyLoader(spec.loader)
-        module = importlib.util.module_from_spec(spec)
-        sys.modules[name] = module
-        spec.loader.exec_module(module)
-        setattr(np, part, module)  # as the import system does; numpy's own __getattr__ would import again
-
-
-def _import_toppra() -> Any:
-    """``toppra``, imported without loading matplotlib or numpy's parts nothing here uses.
-
-    toppra imports ``matplotlib.pyplot`` at its top for plotting helpers that timing never calls; that
-    costs a long-running agent about 30 MB (matplotlib, PIL, kiwisolver, fonttools) and 0.3 s. While
-    toppra is imported, placeholders stand for ``matplotlib`` and ``matplotlib.pyplot`` (unless matplotlib
-    is already loaded); they leave ``sys.modules`` right after, so anyone else gets the real one, and
-    toppra's own ``plt`` imports it on first use. When toppra is what brings scipy in, numpy's unused
-    submodules that scipy imports are deferred first (:func:`_defer_unused_numpy_parts`).
-    """
-    if "scipy" not in sys.modules:
-        _defer_unused_numpy_parts()
-    if "toppra" in sys.modules or "matplotlib" in sys.modules:
-        import toppra
-
-        return toppra
-    placeholders = {name: _DeferredModule(name) for name in ("matplotlib", "matplotlib.pyplot")}
-    placeholders["matplotlib"].pyplot = placeholders["matplotlib.pyplot"]  # type: ignore[attr-defined]
-    placeholders["matplotlib"].__path__ = []  # a package, so the submodule import looks no further
-    sys.modules.update(placeholders)
-    try:
-        import toppra
-        import toppra.algorithm
-        import toppra.constraint
-    finally:
-        for name, placeholder in placeholders.items():
-            if sys.modules.get(name) is placeholder:
-                del sys.modules[name]
-    return toppra
 
 
 def _densify(points: np.ndarray, max_step: float) -> np.ndarray:
@@ -174,7 +103,7 @@ def time_parameterize(
             exceeded after derating (when toppra finds no timing at all, the path is timed rest to rest
             at each waypoint).
     """
-    ta = _import_toppra()
+    ta = import_toppra()
     algo, constraint = ta.algorithm, ta.constraint
 
     for label, value in (("velocity", velocity_scale), ("acceleration", acceleration_scale)):
@@ -203,7 +132,7 @@ def time_parameterize(
     # printed each toppra warning once per handler. Its records reach the process's own log through the
     # root logger.
     logging.getLogger("toppra").setLevel(logging.WARNING)
-    spline = ta.SplineInterpolator(s, wp, bc_type="clamped")
+    spline = ClampedCubicSpline(s, wp)
     derate = _DERATE
     for _ in range(4):
         constraints = [

@@ -55,6 +55,7 @@ from kinema.tui.repeat_limiter import RepeatLimiter, held_back, watchdog_kind
 from kinema.tui.run_outcome import RunOutcome, parse_outcome
 from kinema.tui.runtime_status import ACTIVE_STATUSES, RuntimeStatus
 from kinema.tui.screens.base import KinemaScreen, RuntimeView
+from kinema.tui.stylesheet import OnceParsedStylesheet
 from kinema.tui.widgets.nav_bar import SCREENS
 
 log = logging.getLogger("kinema.tui")
@@ -243,6 +244,8 @@ class KinemaApp(App[None]):
         self._connection_open = False
         self._closing = False
         self.sub_title = connection.endpoint + ("  (closing stops the runtime)" if owns_runtime else "")
+        # Nothing is read into the stylesheet yet: the sources are read when the app runs.
+        self.stylesheet = OnceParsedStylesheet(variables=self.get_css_variables())
 
     def _run_started(self, name: str) -> None:
         """A new run of objective ``name``: forget the last one's statuses and outcome, reset the views."""

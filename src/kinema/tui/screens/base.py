@@ -81,6 +81,7 @@ class KinemaScreen(RuntimeView, Screen[None]):
         # composed and styled, and then styles them all again; set up front, that resize changes nothing.
         self.add_class(*breakpoint_classes(self.app), update=False)
         self._resumed = False
+        self._drawn = False
 
     @property
     def kinema(self) -> KinemaApp:
@@ -114,6 +115,26 @@ class KinemaScreen(RuntimeView, Screen[None]):
 
     def on_screen_resume(self) -> None:
         self.show_status(self.kinema.status)
+
+    @on(events.Idle)
+    def _draw_first_frame(self) -> None:
+        # Textual draws a screen on the ticks of its 60 Hz update timer, which the screen resumes when it
+        # goes idle with something to draw; resumed, the timer waits for its next tick. For the first frame
+        # that was 17-19 ms of doing nothing once the app's start was over: it is drawn right away instead.
+        if self._drawn or self.app._batch_count or not self.is_current:
+            return
+        self._drawn = True
+        self._on_timer_update()
+
+    @on(events.Resize)
+    def _same_size(self, event: events.Resize) -> None:
+        # Textual hands a new screen the terminal's size up to three times on the way to the first frame
+        # (laid out on resume, then the app's first resize, then that resize again when the app is idle),
+        # and lays every widget out and renders again each time. A resize to the size the screen was
+        # laid out at changes nothing: Textual's own handler is skipped.
+        if self.is_attached and self._compositor.size == event.size:
+            event.stop()
+            event.prevent_default()
 
     def show_status(self, status: RuntimeStatus) -> None:
         """Show the runtime status in this screen's status bar."""
