@@ -162,13 +162,18 @@ def test_mpc_sphere_clearance_backs_the_gripper_out_to_the_safe_distance(library
     # From when the spheres were drawn (right before MPCSphereClearance starts) to the end of the run.
     during = [clearance(positions) for t, positions in samples if t >= drawn_at]
     assert len(during) > 100
+    # Backed out (within 1.5 s of sim time on a quiet machine), the target keeps pulling the gripper in and
+    # the clearance holds it at the edge: it swings about the safe distance (0.247-0.271 m when quiet, wider
+    # when the machine is loaded and the solver's commands come late). Where it holds is the second half's
+    # median, not whichever sample came last.
+    held = float(np.median(during[len(during) // 2 :]))
     print(
         f"MPCSphereClearance: clearance {during[0]:.3f} m at the start, {min(during):.3f} at least, "
-        f"{during[-1]:.3f} at the end"
+        f"{held:.3f} held (median of the second half), {during[-1]:.3f} at the end"
     )
     assert during[0] < 0.25  # it starts inside the safe distance ...
     assert min(during) > during[0] - 0.01  # ... comes no closer ...
-    assert during[-1] > 0.25 - 0.02  # ... and backs out to it (the target pulls it to the edge)
+    assert held > 0.25 - 0.02  # ... and backs out to it and stays there (the target pulls it to the edge)
 
 
 # MoveIt Pro's "Look at Base" joint values (its ur_waypoints.yaml); collision-free on Kinema's lab_sim.
