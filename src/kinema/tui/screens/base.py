@@ -191,7 +191,7 @@ class KinemaScreen(RuntimeView, Screen[None]):
         self.run_worker(work, thread=True, group=what, name=what)
 
 
-def breakpoint_classes(app: App[object]) -> list[str]:
+def breakpoint_classes(app: App[Any]) -> list[str]:
     """The size classes Textual gives a screen of ``app`` at the terminal's size (``HORIZONTAL_BREAKPOINTS``
     and ``VERTICAL_BREAKPOINTS``: for each, the class of the largest breakpoint the size reaches)."""
     width, height = app.size
