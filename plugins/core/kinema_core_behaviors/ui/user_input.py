@@ -127,6 +127,39 @@ async def _ask_for(
     return response
 
 
+async def _ask_from_here(
+    behavior: Any,
+    kind: str,
+    prompt: str,
+    start: Any,
+    timeout_sec: float,
+    *,
+    what: str,
+    giving: str,
+    refused: str,
+    start_is: str,
+) -> Any:
+    """The user's answer to a ``kind`` question whose form is prefilled with ``start`` (the request's
+    ``initial_<kind>``), waited for ``timeout_sec`` (negative: up to :data:`ANSWER_SECONDS`); None when
+    there is none (reported as :func:`_ask_for` does). With no user attached and auto-approval on, ``start``
+    is the answer: it is written to the output port ``kind`` with a warning that it is ``start_is``, and
+    :data:`NO_USER_AUTO` is returned."""
+    response = await _ask_for(
+        behavior,
+        _request(behavior, kind, prompt, **{f"initial_{kind}": start}),
+        ANSWER_SECONDS if timeout_sec < 0 else timeout_sec,
+        what=what,
+        giving=giving,
+        refused=refused,
+    )
+    if response is NO_USER_AUTO:
+        behavior.logger.publish_warn(
+            f"{prompt} — answered automatically with {start_is} ({AUTO_APPROVE_ENV}=1)"
+        )
+        behavior.set_output(kind, start)
+    return response
+
+
 def _tool_pose(behavior: Any) -> Any:
     """The config's tool frame where it is now, as a PoseStamped in the world frame."""
     from ..poses.frame_tree import current_frame_tree
@@ -168,24 +201,21 @@ class RetrievePoseParameter(AsyncBehavior):
         except KinemaError as error:
             self.logger.publish_failure(f"RetrievePoseParameter: {error}")
             return False
-        prompt = "Give the target pose"
-        response = await _ask_for(
+        response = await _ask_from_here(
             self,
-            _request(self, "pose", prompt, initial_pose=start),
-            ANSWER_SECONDS if timeout < 0 else timeout,
+            "pose",
+            "Give the target pose",
+            start,
+            timeout,
             what="pose",
             giving="give a pose",
             refused="gave no pose",
+            start_is="the tool frame where it is",
         )
         if response is None:
             return False
-        if response is NO_USER_AUTO:
-            self.logger.publish_warn(
-                f"{prompt} — answered automatically with the tool frame where it is ({AUTO_APPROVE_ENV}=1)"
-            )
-            self.set_output("pose", start)
-            return True
-        self.set_output("pose", response.pose)
+        if response is not NO_USER_AUTO:
+            self.set_output("pose", response.pose)
         return True
 
 
@@ -243,21 +273,20 @@ class RetrieveRobotStateParameter(AsyncBehavior):
             self.logger.publish_failure(f"RetrieveRobotStateParameter: {error}")
             return False
         prompt = "Give the target joint values" + (f" ({slot.replace('_', ' ')})" if slot else "")
-        response = await _ask_for(
+        response = await _ask_from_here(
             self,
-            _request(self, "joint_state", prompt, initial_joint_state=start),
-            ANSWER_SECONDS if timeout < 0 else timeout,
+            "joint_state",
+            prompt,
+            start,
+            timeout,
             what="joint values",
             giving="give joint values",
             refused="gave no joint values",
+            start_is="the joints where they are",
         )
         if response is None:
             return False
         if response is NO_USER_AUTO:
-            self.logger.publish_warn(
-                f"{prompt} — answered automatically with the joints where they are ({AUTO_APPROVE_ENV}=1)"
-            )
-            self.set_output("joint_state", start)
             return True
         answer = response.joint_state
         asked = [str(name) for name in start.name]
