@@ -149,7 +149,7 @@ class QuickClient:
             replies = self._session.get(
                 key,
                 payload=quick.encode(payload),
-                target=zenoh.QueryTarget.ALL_COMPLETE,
+                target=zenoh.QueryTarget.BEST_MATCHING,  # one server, as ServiceClient (QUERY_TARGET)
                 consolidation=zenoh.ConsolidationMode.NONE,
                 timeout=timeout,
             )

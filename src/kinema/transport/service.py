@@ -36,6 +36,12 @@ log = logging.getLogger(__name__)
 
 # How long a client waits between attempts while no server matches (discovery still propagating).
 _RETRY_PAUSE = 0.02
+# Where a request goes: zenoh's best matching complete queryable, one server. rmw_zenoh's clients ask
+# ALL_COMPLETE (every complete server answers, the first reply is taken); the target is the client's
+# choice, servers answer either the same way, and one server per request is what a service call
+# means (an action goal is never started twice). ALL_COMPLETE also cost 30-45 us per round trip here
+# (benchmarks/sdk_latency.py's floor against the same query with that target).
+QUERY_TARGET = zenoh.QueryTarget.BEST_MATCHING
 
 
 def _as_message(value: Any, type_name: str, what: str) -> Any:
@@ -384,7 +390,7 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
         replies = self.node.session.zenoh.get(
             f"{self.key}?{parameters}" if parameters else self.key,
             handler,
-            target=zenoh.QueryTarget.ALL_COMPLETE,
+            target=QUERY_TARGET,
             consolidation=zenoh.ConsolidationMode.NONE,
             payload=payload,
             attachment=attachment,
