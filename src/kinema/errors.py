@@ -52,6 +52,11 @@ class TransportError(KinemaError):
     """A message could not be sent, received or answered over the transport."""
 
 
+class NoAnswerError(TransportError):
+    """No server answered a request within its timeout: none was reachable (not there, not discovered
+    yet, or access rules keep the request from it), or the one that took it stayed silent."""
+
+
 class MotionError(KinemaError):
     """Planning, kinematics or time parameterization failed."""
 

@@ -25,7 +25,7 @@ import time
 from collections.abc import Iterable, Mapping
 from typing import TYPE_CHECKING, Any, Literal, overload
 
-from kinema.errors import TransportError
+from kinema.errors import NoAnswerError, TransportError
 from kinema.runtime import names
 from kinema.runtime.overrides import ParameterOverride
 from kinema.runtime.result import ObjectiveResult
@@ -286,8 +286,8 @@ class ObjectiveClient:
         action = self._action_for(by_name=bool(name))
         try:
             handle = action.send_goal_cdr(self._goal_cdr(action, name, xml, overrides), timeout=self.timeout)
-        except TransportError as error:
-            if name or "answered within" not in str(error):
+        except NoAnswerError as error:
+            if name:
                 raise
             # The agent is there (wait_for_runtime) but its XML door did not answer: access rules.
             raise TransportError(

@@ -34,7 +34,7 @@ from typing import TYPE_CHECKING, Any, Generic
 
 import zenoh
 
-from kinema.errors import TransportError
+from kinema.errors import NoAnswerError, TransportError
 from kinema.interfaces import ActionType
 from kinema.interfaces.definition import FeedbackT, GoalT, ResultT
 from kinema.transport.goal_status_cdr import (
@@ -1018,7 +1018,7 @@ class ActionClient(Generic[GoalT, ResultT, FeedbackT]):
         except TransportError as error:
             self._drop(handle)
             if str(error).startswith("no server for service"):
-                raise TransportError(
+                raise NoAnswerError(
                     f"no action server {self.name} [{self.type_name}] answered within {timeout:g} s"
                 ) from error
             raise

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING, Any, Generic
 
 import zenoh
 
-from kinema.errors import TransportError
+from kinema.errors import NoAnswerError, TransportError
 from kinema.interfaces import ServiceType
 from kinema.interfaces.definition import RequestT, ResponseT
 from kinema.transport.attachment import GID_SIZE, Attachment, encode_attachment
@@ -332,14 +332,14 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
                 # A server took the request but did not reply in time (or the last slice was too short
                 # for a reply to come back): say which.
                 if self.service_is_ready():
-                    raise TransportError(f"service {self.name} did not answer within {timeout:g} s") from None
+                    raise NoAnswerError(f"service {self.name} did not answer within {timeout:g} s") from None
                 outcome = None
             if outcome is not None:
                 if answered_by is not None:
                     answered_by.append((*attempt, cancel))
                 return outcome
             if time.monotonic() + _RETRY_PAUSE >= deadline:
-                raise TransportError(
+                raise NoAnswerError(
                     f"no server for service {self.name} [{self.type_name}] answered within {timeout:g} s"
                     f"{self._mismatch_hint()}"
                 )
