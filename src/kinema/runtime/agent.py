@@ -878,10 +878,12 @@ class Agent:
 
         Subscribe it to the behavior host.
         """
+        if str(event.kind) == "objectives_changed" and self.source is not None:
+            # Before the notice goes out: a client that asks for the list as soon as it reads the notice
+            # (the TUI does) must get the new one, and no later notice comes while the files stay as they are.
+            self.source.invalidate_objectives()
         plugin_log.log(logging.INFO if event.ok else logging.ERROR, "%s", event)
         self._streams.publish_log(LOG_INFO if event.ok else LOG_ERROR, str(event))
-        if str(event.kind) == "objectives_changed" and self.source is not None:
-            self.source.invalidate_objectives()
 
 
 def _info_dict(info: ObjectiveInfo, parameters: Sequence[Any] | None = None) -> dict[str, Any]:

@@ -80,3 +80,30 @@ def test_an_objective_saved_before_hot_reload_reports_it_runs_by_name(tmp_path: 
         result = server.submit(ObjectiveRequest("Nowhere")).wait(5)
     assert result is not None and result.failed
     assert "unknown objective 'Nowhere'" in result.error_message
+
+
+def test_a_client_that_lists_objectives_as_soon_as_it_reads_the_reload_notice_gets_the_new_list(
+    tmp_path: Path,
+) -> None:
+    # The TUI asks for the list when the notice arrives; the notice went out before the library was
+    # marked stale, so a quick enough ask got the old list, and no second notice came while the files
+    # stayed as they were (the TUI showed one objective for good; a loaded CI machine hit it).
+    from types import SimpleNamespace
+
+    from kinema.plugins.events import ReloadEvent, ReloadKind
+    from kinema.runtime.agent import Agent
+
+    (tmp_path / "good.xml").write_text(GOOD)
+    source = _source(tmp_path)
+    source.factory()  # as the agent loads it at start
+    assert [info.id for info in source.objectives()] == ["Good"]
+    (tmp_path / "later.xml").write_text(GOOD.replace("Good", "Later"))
+    seen_with_notice: list[list[str]] = []
+
+    def publish_log(level: int, text: str) -> None:
+        seen_with_notice.append([info.id for info in source.objectives()])
+
+    agent = SimpleNamespace(source=source, _streams=SimpleNamespace(publish_log=publish_log))
+    event = ReloadEvent(ReloadKind.OBJECTIVES_CHANGED, str(tmp_path), "objectives changed: later.xml")
+    Agent.on_reload_event(agent, event)  # type: ignore[arg-type]
+    assert seen_with_notice == [["Good", "Later"]]
