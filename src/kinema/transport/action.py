@@ -30,7 +30,7 @@ import uuid
 from collections import deque
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, Any, Generic
+from typing import TYPE_CHECKING, Any, Generic, NamedTuple
 
 import zenoh
 
@@ -46,7 +46,12 @@ from kinema.transport.goal_status_cdr import (
 from kinema.transport.keys import LATCHED_QOS, QoS, fully_qualified
 from kinema.transport.messages import from_dict, type_of
 from kinema.transport.pubsub import Publisher, Subscription
-from kinema.transport.send_goal_cdr import response_reader, send_goal_request
+from kinema.transport.send_goal_cdr import (
+    read_send_goal_request,
+    response_reader,
+    send_goal_request,
+    send_goal_response,
+)
 from kinema.transport.service import Responder, ServiceClient, ServiceServer
 
 if TYPE_CHECKING:
@@ -140,6 +145,25 @@ class GoalResult(Generic[ResultT]):
     def succeeded(self) -> bool:
         """True when the goal SUCCEEDED."""
         return self.status == STATUS_SUCCEEDED
+
+
+class _GoalRequest(NamedTuple):
+    """A send_goal request as the server reads it: the goal's UUID (16 bytes) and the goal."""
+
+    goal_id: bytes
+    goal: Any
+
+
+class _Acceptance(NamedTuple):
+    """A send_goal response as the server writes it."""
+
+    accepted: bool
+    sec: int
+    nanosec: int
+
+
+def _write_acceptance(response: _Acceptance) -> bytes:
+    return send_goal_response(response.accepted, response.sec, response.nanosec)
 
 
 class ServerGoalHandle:
@@ -358,8 +382,7 @@ class ActionServer:
         self._deferred = deferred
         self._feedback_class = registry.message_class(self.action.feedback_message)
         self._get_result_class = registry.message_class(self.action.get_result.response)
-        self._send_goal_response_class = registry.message_class(self.action.send_goal.response)
-        self._time_class = registry.message_class("builtin_interfaces/msg/Time")
+        self._registry = registry
         self._goals: dict[bytes, ServerGoalHandle] = {}
         self._active: dict[bytes, ServerGoalHandle] = {}
         # The ended goals in the order they ended (the status array lists them first, and they expire
@@ -388,6 +411,8 @@ class ActionServer:
             self._on_send_goal,
             after_reply=self._after_send_goal,
             keep_open=_asks_result,
+            request_reader=self._read_send_goal,
+            response_writer=_write_acceptance,
         )
         self._unknown_payload = registry.serialize(
             from_dict(action.get_result.response, {"status": STATUS_UNKNOWN}), action.get_result.response
@@ -402,8 +427,18 @@ class ActionServer:
         with self._lock:
             return list(self._goals.values())
 
-    def _on_send_goal(self, request: Any) -> Any:
-        goal_id = _uuid_bytes(request.goal_id)
+    def _read_send_goal(self, payload: bytes) -> _GoalRequest:
+        """The goal id and goal of a send_goal request: the UUID read where it lies and only the goal
+        deserialised (a little-endian request), or the whole request through the generic deserializer."""
+        fields = read_send_goal_request(payload)
+        if fields is None:
+            message = self._registry.deserialize(payload, self.action.send_goal.request)
+            return _GoalRequest(_uuid_bytes(message.goal_id), message.goal)
+        goal_id, goal_cdr = fields
+        return _GoalRequest(goal_id, self._registry.deserialize(goal_cdr, self.action.goal))
+
+    def _on_send_goal(self, request: _GoalRequest) -> _Acceptance:
+        goal_id = request.goal_id
         with self._lock:
             duplicate = goal_id in self._goals
         accepted = not duplicate and not self._closed
@@ -426,13 +461,15 @@ class ActionServer:
             for _deadline, responder in early:
                 _answer_unknown(responder, self._unknown_payload)
         stamp = handle.stamp if handle else _stamp_now()
-        return self._send_goal_response_class(accepted=accepted, stamp=self._time_class(**stamp))
+        return _Acceptance(accepted, stamp["sec"], stamp["nanosec"])
 
-    def _after_send_goal(self, request: Any, response: Any, result_responder: Responder | None) -> None:
+    def _after_send_goal(
+        self, request: _GoalRequest, response: _Acceptance, result_responder: Responder | None
+    ) -> None:
         if not response.accepted:
             return
         with self._lock:
-            handle = self._goals.get(_uuid_bytes(request.goal_id))
+            handle = self._goals.get(request.goal_id)
         if handle is None:
             if result_responder is not None:
                 _answer_unknown(result_responder, self._unknown_payload)

@@ -1,12 +1,13 @@
-"""An action's ``send_goal`` request and response laid out directly, for the client's hot path.
+"""An action's ``send_goal`` request and response laid out directly, for the hot path of both sides.
 
 Every action's ``Name_SendGoal`` has the same frame: the request is the goal's UUID (16 bytes) followed by
 the goal, the response a bool and a ``builtin_interfaces/Time``. A client sending a goal used to build the
 UUID as a numpy array inside a request object, and read the response through the generic deserializer;
 both showed in the round trip of a trivial objective. Here the request is the goal's own CDR behind the
 UUID (the goal starts at offset 16, a multiple of every CDR alignment, so its bytes are the same either
-way), and the response is read as the two fixed fields it is. The tests check both against the generic
-serializer.
+way), and the response is read as the two fixed fields it is. A server reads the UUID straight from the
+request and deserialises only the goal behind it, and writes its response as those two fields. The tests
+check all of it against the generic serializer.
 """
 
 from __future__ import annotations
@@ -18,6 +19,7 @@ CDR_LE_HEADER = b"\x00\x01\x00\x00"
 # accepted (bool), 3 bytes of padding, stamp.sec (int32), stamp.nanosec (uint32).
 _RESPONSE = struct.Struct("<?3xiI")
 _RESPONSE_SIZE = len(CDR_LE_HEADER) + _RESPONSE.size
+_GOAL_AT = len(CDR_LE_HEADER) + 16
 
 
 def send_goal_request(goal_id: bytes, goal_cdr: bytes) -> bytes:
@@ -25,6 +27,20 @@ def send_goal_request(goal_id: bytes, goal_cdr: bytes) -> bytes:
     if len(goal_id) != 16 or goal_cdr[:4] != CDR_LE_HEADER:
         raise ValueError("send_goal_request needs a 16-byte goal id and a little-endian CDR goal")
     return CDR_LE_HEADER + goal_id + goal_cdr[4:]
+
+
+def read_send_goal_request(payload: bytes) -> tuple[bytes, bytes] | None:
+    """``(goal_id, goal_cdr)`` of a little-endian request payload, the goal as a payload of its own (the
+    inverse of :func:`send_goal_request`); None for another encoding (the caller then uses the generic
+    deserializer)."""
+    if len(payload) < _GOAL_AT or payload[:4] != CDR_LE_HEADER:
+        return None
+    return payload[4:_GOAL_AT], CDR_LE_HEADER + payload[_GOAL_AT:]
+
+
+def send_goal_response(accepted: bool, sec: int, nanosec: int) -> bytes:
+    """The little-endian response payload: whether the goal was accepted, and when."""
+    return CDR_LE_HEADER + _RESPONSE.pack(accepted, sec, nanosec)
 
 
 def read_send_goal_response(payload: bytes) -> tuple[bool, int, int] | None:

@@ -123,8 +123,11 @@ class Responder:
         """
         server = self._server
         try:
-            message = _as_message(response, server.service.response, f"response of {server.name}")
-            payload = server.registry.serialize(message, server.service.response)
+            if server._response_writer is not None:
+                payload = server._response_writer(response)
+            else:
+                message = _as_message(response, server.service.response, f"response of {server.name}")
+                payload = server.registry.serialize(message, server.service.response)
         except TransportError as error:
             self.error(str(error))
             return
@@ -173,6 +176,8 @@ class ServiceServer(Entity):
     ``responder.reply(...)`` from any thread (used by action servers for ``get_result``).
     ``after_reply(request, response, responder)`` runs once the response is sent; ``responder`` is the
     request's, still open, when ``keep_open(query, response)`` said so (else None).
+    ``request_reader(payload)`` and ``response_writer(response)`` stand in for the generic deserializer and
+    serializer (a layout read and written directly); the reader raises TransportError on a bad payload.
     """
 
     kind = EntityKind.SERVICE_SERVER
@@ -188,6 +193,8 @@ class ServiceServer(Entity):
         deferred: bool = False,
         after_reply: Callable[[Any, Any, Responder | None], None] | None = None,
         keep_open: Callable[[Any, Any], bool] | None = None,
+        request_reader: Callable[[bytes], Any] | None = None,
+        response_writer: Callable[[Any], bytes] | None = None,
     ) -> None:
         super().__init__(node, name, service.name, service.dds_name, service.type_hash, SERVICE_QOS)
         self.service = service
@@ -196,6 +203,8 @@ class ServiceServer(Entity):
         self._deferred = deferred
         self._after_reply = after_reply
         self._keep_open = keep_open
+        self._request_reader = request_reader
+        self._response_writer = response_writer
         self._pool = _HandlerPool(max_concurrent, f"kinema-srv{name}") if max_concurrent > 1 else None
         self._queryable = node.session.zenoh.declare_queryable(self.key, channel(), complete=True)
         node.session._track_dispatcher(dispatch(self._queryable, self._on_query, f"-srv{name}"))
@@ -221,7 +230,11 @@ class ServiceServer(Entity):
         try:
             payload = query.payload.to_bytes() if query.payload is not None else b""
             note_message_size(len(payload))
-            request = self.registry.deserialize(payload, self.service.request)
+            reader = self._request_reader
+            if reader is not None:
+                request = reader(payload)
+            else:
+                request = self.registry.deserialize(payload, self.service.request)
         except TransportError as error:
             responder.error(f"service {self.name}: bad request: {error}")
             return

@@ -9,7 +9,13 @@ import pytest
 
 from kinema.interfaces import load_interfaces
 from kinema.transport.messages import from_dict
-from kinema.transport.send_goal_cdr import read_send_goal_response, response_reader, send_goal_request
+from kinema.transport.send_goal_cdr import (
+    read_send_goal_request,
+    read_send_goal_response,
+    response_reader,
+    send_goal_request,
+    send_goal_response,
+)
 
 GOAL_ID = bytes(range(3, 19))
 # Goals whose fields need every alignment: strings and sequences (4), doubles and durations (8), bools (1).
@@ -53,6 +59,11 @@ def test_the_request_is_the_generic_one(action_type: str, goal: dict[str, Any]) 
     )
     generic = registry.serialize(request, action.send_goal.request)
     assert send_goal_request(GOAL_ID, registry.serialize(goal_message, action.goal)) == generic
+    # A server reads the UUID where it lies and the goal behind it as the generic deserializer reads it.
+    read = read_send_goal_request(generic)
+    assert read is not None and read[0] == GOAL_ID
+    goal_read = registry.deserialize(generic, action.send_goal.request).goal
+    assert read[1] == registry.serialize(goal_read, action.goal)
 
 
 @pytest.mark.parametrize("accepted", [True, False])
@@ -67,6 +78,7 @@ def test_the_response_reads_as_the_generic_deserializer_reads_it(
         response_type,
     )
     assert read_send_goal_response(payload) == (accepted, *stamp)
+    assert send_goal_response(accepted, *stamp) == payload
     assert response_reader(registry, response_type)(payload) == registry.deserialize(payload, response_type)
 
 
@@ -77,3 +89,8 @@ def test_a_big_endian_response_goes_to_the_generic_deserializer() -> None:
     assert read_send_goal_response(big_endian) is None
     message = response_reader(registry, response_type)(big_endian)
     assert message.accepted and (message.stamp.sec, message.stamp.nanosec) == (5, 9)
+
+
+def test_a_big_endian_request_goes_to_the_generic_deserializer() -> None:
+    assert read_send_goal_request(b"\x00\x00\x00\x00" + GOAL_ID + b"\x00\x00\x00\x07") is None
+    assert read_send_goal_request(b"\x00\x01\x00\x00" + GOAL_ID[:8]) is None  # too short for a UUID
