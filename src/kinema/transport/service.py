@@ -39,8 +39,8 @@ _RETRY_PAUSE = 0.02
 # Where a request goes: zenoh's best matching complete queryable, one server. rmw_zenoh's clients ask
 # ALL_COMPLETE (every complete server answers, the first reply is taken); the target is the client's
 # choice, servers answer either the same way, and one server per request is what a service call
-# means (an action goal is never started twice). ALL_COMPLETE also cost 30-45 us per round trip here
-# (benchmarks/sdk_latency.py's floor against the same query with that target).
+# means (an action goal is never started twice). ALL_COMPLETE also cost 30-45 us more per round trip
+# (a raw query with either target, in one run on a 2-core machine: 188-206 against 234-239 us).
 QUERY_TARGET = zenoh.QueryTarget.BEST_MATCHING
 
 
