@@ -73,14 +73,14 @@ with open_session(sys.argv[1]) as session:
 """
 
 
-def start_agent(folder: Path, endpoint: str, *, host_router: bool = True) -> subprocess.Popen[bytes]:
-    """The agent serving ``folder``'s objectives: hosting the router at ``endpoint``, or joining it."""
+def start_agent(folder: Path, endpoint: str) -> subprocess.Popen[bytes]:
+    """The agent serving ``folder``'s objectives, joining the router at ``endpoint`` (see start_router)."""
     read_fd, write_fd = os.pipe()
     argv = [
         sys.executable,
         "-m",
         "kinema.runtime.agent_process",
-        "--host-router" if host_router else "--connect",
+        "--connect",
         endpoint,
         "--objectives",
         str(folder),
@@ -162,7 +162,7 @@ def main() -> None:
         folder = Path(tmp)
         (folder / "trivial.xml").write_text(TRIVIAL)
         router = start_router(endpoint)
-        agent = start_agent(folder, endpoint, host_router=False)
+        agent = start_agent(folder, endpoint)
         echo = subprocess.Popen(
             [sys.executable, "-c", ECHO_SERVER, endpoint, ECHO_KEY, ECHO_ACTION],
             stdin=subprocess.PIPE,
