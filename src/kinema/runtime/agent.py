@@ -66,6 +66,9 @@ NO_XML_HERE = (
 
 # Most node status changes in one ``/objective_server/node_status`` message (4 bytes each: 200 kB).
 NODE_STATUS_CHUNK = 50_000
+# How long a run's end waits for the blackboard worker to finish a snapshot it is in before publishing
+# the final one itself; past that the worker publishes it.
+BLACKBOARD_SETTLE_WAIT_S = 0.25
 
 
 def _stamp(seconds: float) -> dict[str, int]:
@@ -132,10 +135,12 @@ class _Streams:
         self._owed: list[tuple[ObjectiveStatus, str]] = []
         # The objective whose "Running" line is not logged yet (see _pay_owed).
         self._running_unlogged: str | None = None
-        self._last_blackboard: list[tuple[str, str, str, str]] | None = None
+        # The last snapshot published: its objective and its rendered entries.
+        self._last_blackboard: tuple[str, list[tuple[str, str, str, str]]] | None = None
         self._render_cache: dict[int, tuple[Any, str]] = {}
-        # Whether the last snapshot handed to the worker was empty (another empty one would change nothing).
-        self._handed_empty = False
+        # The objective whose empty snapshot was the last handed to the worker (another empty one of the
+        # same objective would change nothing).
+        self._handed_empty: str | None = None
         self._lock = threading.Lock()
         # Built once: a status change publishes a heartbeat from the tick thread.
         from kinema.transport.messages import load_interfaces
@@ -275,10 +280,16 @@ class _Streams:
         return encoder
 
     def on_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
-        if not entries and self._handed_empty:
+        if not entries and self._handed_empty == objective_name:
             return  # the worker would find nothing changed: do not wake it
-        self._handed_empty = not entries
+        self._handed_empty = None if entries else objective_name
         self._work.submit(lambda: self._publish_blackboard(objective_name, entries), key="blackboard")
+
+    def settle_blackboard(self) -> None:
+        """Publish the snapshot handed over last now, on this thread (the tick thread, as a run ends):
+        its client must find this run's snapshot latched once it has the result, and the worker would
+        publish it only after a wake. Rendering stays bounded (large values render as their size)."""
+        self._work.run_queued_here(BLACKBOARD_SETTLE_WAIT_S)
 
     def _publish_blackboard(self, objective_name: str, entries: list[tuple[str, str, str, Any]]) -> None:
         from kinema.transport.messages import msg
@@ -296,9 +307,9 @@ class _Streams:
             if hasattr(value, "__msgtype__"):
                 self._render_cache[id(value)] = (value, text)
             rendered.append((scope, key, type_name, text))
-        if rendered == self._last_blackboard:
+        if self._last_blackboard == (objective_name, rendered):
             return
-        self._last_blackboard = rendered
+        self._last_blackboard = (objective_name, rendered)
         self._blackboard.publish(
             msg(
                 names.BLACKBOARD_TYPE,

@@ -52,6 +52,30 @@ class HandOff:
         with self._cond:
             return self._cond.wait_for(lambda: not self._jobs and not self._busy, timeout)
 
+    def run_queued_here(self, timeout: float) -> bool:
+        """Run the jobs queued so far on the calling thread, in order, once the worker is not in one (no
+        wake of the worker to wait for); False, leaving them to the worker, when it stays in one beyond
+        ``timeout``."""
+        with self._cond:
+            if not self._cond.wait_for(lambda: not self._busy, timeout):
+                return False
+            jobs = [job for _key, job in self._jobs]
+            self._jobs.clear()
+            if not jobs:
+                return True
+            self._busy = True
+        try:
+            for job in jobs:
+                try:
+                    job()  # type: ignore[operator]
+                except Exception:
+                    log.exception("%s: a job raised", self.name)
+        finally:
+            with self._cond:
+                self._busy = False
+                self._cond.notify_all()
+        return True
+
     @property
     def running(self) -> bool:
         """Whether the worker thread is alive."""

@@ -1045,8 +1045,10 @@ class ObjectiveServer:
         listeners hear the status changes, the last tick's node changes and the result;
         :meth:`ObjectiveRun.wait` returns after them.
 
-        The blackboard goes first so that a client that asks for the latched snapshot once its
-        ``execute`` returned sees this run's, not the one before (listeners only hand it to a worker)."""
+        The blackboard goes first, and a listener with ``settle_blackboard()`` publishes it before the
+        client is answered, so that a client that asks for the latched snapshot once its ``execute``
+        returned sees this run's, not the one before (handed to a worker, it went out only after the
+        worker's wake, and a loaded machine answered the client first)."""
         result = run._settle(result)
         if result.cancelled and status is ObjectiveStatus.SUCCESS:
             status = ObjectiveStatus.CANCELLED
@@ -1061,6 +1063,13 @@ class ObjectiveServer:
         self._status = (status, run.objective_name)
         if completed is not None:
             self._maybe_snapshot(run, completed, force=True)
+            for listener in self._listeners:
+                settle = getattr(listener, "settle_blackboard", None)
+                if settle is not None:
+                    try:
+                        settle()
+                    except Exception:
+                        log.exception("a blackboard listener raised")
         answered = run._answer(result)
         try:
             if completed is not None:

@@ -260,3 +260,39 @@ def test_only_a_run_still_running_a_beat_later_gets_a_running_line(caplog: pytes
     assert [r.getMessage() for r in caplog.records if "Running" in r.getMessage()] == [
         "objective 'Slow': Running"
     ]
+
+
+def test_a_runs_last_blackboard_is_published_before_its_client_is_answered_and_names_its_objective() -> None:
+    """The last snapshot was left to the worker thread, so a client that read the latched blackboard right
+    after its result could get the run before's (a loaded CI machine did). Settled, it is out at once; and
+    an objective with the same (here empty) entries as the one before still gets a snapshot naming it."""
+    from kinema.runtime.agent import _Streams
+
+    published: list[tuple[str, list[str]]] = []
+
+    class Publisher:
+        def __init__(self, topic: str) -> None:
+            self.topic = topic
+
+        def publish(self, message: Any) -> None:
+            if "blackboard" in self.topic:
+                published.append((message.objective_name, [entry.value_yaml for entry in message.entries]))
+
+        def publish_raw(self, payload: bytes) -> None:
+            pass
+
+    node = SimpleNamespace(create_publisher=lambda _type, topic, **_: Publisher(topic))
+    streams = _Streams(node, None, SimpleNamespace())  # type: ignore[arg-type]
+    try:
+        streams.on_blackboard("Quick", [("Quick", "answer", "int", 42)])
+        streams.settle_blackboard()
+        assert published == [("Quick", ["42"])]  # on this thread, before settle returned
+        streams.on_blackboard("Empty", [])
+        streams.settle_blackboard()
+        streams.on_blackboard("Also Empty", [])
+        streams.settle_blackboard()
+        streams.on_blackboard("Also Empty", [])  # the same again: nothing to publish
+        streams.settle_blackboard()
+        assert published == [("Quick", ["42"]), ("Empty", []), ("Also Empty", [])]
+    finally:
+        streams.close()
