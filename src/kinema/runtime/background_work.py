@@ -64,16 +64,7 @@ class HandOff:
             if not jobs:
                 return True
             self._busy = True
-        try:
-            for job in jobs:
-                try:
-                    job()  # type: ignore[operator]
-                except Exception:
-                    log.exception("%s: a job raised", self.name)
-        finally:
-            with self._cond:
-                self._busy = False
-                self._cond.notify_all()
+        self._run(jobs)
         return True
 
     @property
@@ -103,11 +94,17 @@ class HandOff:
                     return
                 _key, job = self._jobs.popleft()
                 self._busy = True
-            try:
-                job()  # type: ignore[operator]
-            except Exception:
-                log.exception("%s: a job raised", self.name)
-            finally:
-                with self._cond:
-                    self._busy = False
-                    self._cond.notify_all()
+            self._run([job])
+
+    def _run(self, jobs: list[object]) -> None:
+        """Run ``jobs`` in order on this thread (busy set by the caller), then let waiters see it idle."""
+        try:
+            for job in jobs:
+                try:
+                    job()  # type: ignore[operator]
+                except Exception:
+                    log.exception("%s: a job raised", self.name)
+        finally:
+            with self._cond:
+                self._busy = False
+                self._cond.notify_all()
