@@ -100,8 +100,23 @@ def test_move_along_square_traces_a_square_through_its_corners(library_cell: Lib
     _fresh(states)
     path = np.array([_tool(model, message, fk) for message in states[seen:]])
     corners = start + np.array([[0, 0.2, 0], [0.2, 0.2, 0], [0.2, 0, 0], [0, 0, 0]])
-    misses = [float(np.linalg.norm(path - corner, axis=1).min()) for corner in corners]
+    misses = [_closest_pass(path, corner) for corner in corners]
     assert max(misses) <= 0.005, f"closest passes by the corners (m): {np.round(misses, 4).tolist()}"
+
+
+def _closest_pass(path: Any, point: Any) -> float:
+    """How close the tool's path comes to ``point``: the path is the polyline through the sampled tool
+    positions, so a joint state the best-effort topic dropped near a corner does not count as a miss."""
+    import numpy as np
+
+    if len(path) == 1:
+        return float(np.linalg.norm(path[0] - point))
+    starts, ends = path[:-1], path[1:]
+    steps = ends - starts
+    lengths = np.einsum("ij,ij->i", steps, steps)
+    along = np.einsum("ij,ij->i", point - starts, steps) / np.where(lengths > 0, lengths, 1.0)
+    nearest = starts + np.clip(along, 0.0, 1.0)[:, None] * steps
+    return float(np.linalg.norm(nearest - point, axis=1).min())
 
 
 def _fresh(states: list[Any], timeout: float = 10.0) -> None:
