@@ -888,7 +888,9 @@ if TYPE_CHECKING:
         desired: trajectory_msgs__msg__JointTrajectoryPoint
         actual: trajectory_msgs__msg__JointTrajectoryPoint
         error: trajectory_msgs__msg__JointTrajectoryPoint
-        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_Feedback"
+        __msgtype__: ClassVar[str] = (
+            "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_Feedback"
+        )
 
     @dataclass
     class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_FeedbackMessage:
@@ -896,14 +898,18 @@ if TYPE_CHECKING:
 
         goal_id: unique_identifier_msgs__msg__UUID
         feedback: moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Feedback
-        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_FeedbackMessage"
+        __msgtype__: ClassVar[str] = (
+            "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_FeedbackMessage"
+        )
 
     @dataclass
     class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_GetResult_Request:
         """moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_GetResult_Request."""
 
         goal_id: unique_identifier_msgs__msg__UUID
-        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_GetResult_Request"
+        __msgtype__: ClassVar[str] = (
+            "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_GetResult_Request"
+        )
 
     @dataclass
     class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_GetResult_Response:
@@ -911,7 +917,9 @@ if TYPE_CHECKING:
 
         status: int
         result: moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Result
-        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_GetResult_Response"
+        __msgtype__: ClassVar[str] = (
+            "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_GetResult_Response"
+        )
 
     @dataclass
     class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Goal:
@@ -926,7 +934,9 @@ if TYPE_CHECKING:
         goal_time_tolerance: builtin_interfaces__msg__Duration
         admittance_parameters: moveit_pro_controllers_msgs__msg__AdmittanceParameters
         absolute_force_torque_threshold: np.ndarray[tuple[int, ...], np.dtype[np.float64]]
-        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_Goal"
+        __msgtype__: ClassVar[str] = (
+            "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_Goal"
+        )
 
     @dataclass
     class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Result:
@@ -940,7 +950,9 @@ if TYPE_CHECKING:
         OLD_HEADER_TIMESTAMP: ClassVar[int] = -3
         PATH_TOLERANCE_VIOLATED: ClassVar[int] = -4
         GOAL_TOLERANCE_VIOLATED: ClassVar[int] = -5
-        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_Result"
+        __msgtype__: ClassVar[str] = (
+            "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_Result"
+        )
 
     @dataclass
     class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_SendGoal_Request:
@@ -948,7 +960,9 @@ if TYPE_CHECKING:
 
         goal_id: unique_identifier_msgs__msg__UUID
         goal: moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Goal
-        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_SendGoal_Request"
+        __msgtype__: ClassVar[str] = (
+            "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_SendGoal_Request"
+        )
 
     @dataclass
     class moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_SendGoal_Response:
@@ -956,7 +970,9 @@ if TYPE_CHECKING:
 
         accepted: bool
         stamp: builtin_interfaces__msg__Time
-        __msgtype__: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_SendGoal_Response"
+        __msgtype__: ClassVar[str] = (
+            "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance_SendGoal_Response"
+        )
 
     @dataclass
     class moveit_pro_controllers_msgs__msg__AdmittanceParameters:
@@ -1605,7 +1621,9 @@ if TYPE_CHECKING:
         type_name: ClassVar[str] = "moveit_pro_controllers_msgs/action/FollowJointTrajectoryWithAdmittance"
         Goal: TypeAlias = moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Goal
         Result: TypeAlias = moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Result
-        Feedback: TypeAlias = moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Feedback
+        Feedback: TypeAlias = (
+            moveit_pro_controllers_msgs__action__FollowJointTrajectoryWithAdmittance_Feedback
+        )
 
     class DoObjectiveSequence(
         ActionDefinition[

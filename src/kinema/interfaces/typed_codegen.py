@@ -21,6 +21,9 @@ from kinema.interfaces import interfaces_dir
 from kinema.interfaces.registry import TypeRegistry
 
 TARGET = Path(__file__).with_name("typed.py")
+# pyproject.toml's ruff line-length, and the indentation of the declarations (an ``if TYPE_CHECKING:`` block).
+LINE_LENGTH = 110
+_DECLARATION_INDENT = "    "
 
 HEADER = '''"""Typed message, service and action classes of the interfaces Kinema ships.
 
@@ -117,6 +120,17 @@ def _literal(value: Any) -> str:
     return text
 
 
+def _assignment(head: str, value: str) -> list[str]:
+    """``head value`` as one line, or with ``value`` in parentheses on a line of its own when that line
+    (inside the module's ``if TYPE_CHECKING:`` block) would pass the house's line length, as ruff
+    formats it: the generated file stays format-clean."""
+    line = f"{head}{value}"
+    if len(_DECLARATION_INDENT) + len(line) <= LINE_LENGTH:
+        return [line]
+    indent = line[: len(line) - len(line.lstrip())]
+    return [f"{head}(", f"{indent}    {value}", f"{indent})"]
+
+
 def _message_class(type_name: str, constants: list[Any], fields: list[Any]) -> list[str]:
     lines = ["@dataclass", f"class {_python_name(type_name)}:", f'    """{type_name}."""', ""]
     if not fields:  # as rosbags builds an empty message
@@ -124,16 +138,17 @@ def _message_class(type_name: str, constants: list[Any], fields: list[Any]) -> l
     lines += [f"    {normalize_fieldname(name)}: {get_typehint(desc)}" for name, desc in fields]
     for name, base, value in constants:
         hint = get_typehint((Nodetype.BASE, (base, 0)))
-        lines.append(f"    {normalize_fieldname(name)}: ClassVar[{hint}] = {_literal(value)}")
-    lines.append(f"    __msgtype__: ClassVar[str] = {_literal(type_name)}")
+        lines += _assignment(f"    {normalize_fieldname(name)}: ClassVar[{hint}] = ", _literal(value))
+    lines += _assignment("    __msgtype__: ClassVar[str] = ", _literal(type_name))
     return lines
 
 
 def _definition(short: str, base: str, type_name: str, parts: dict[str, str]) -> list[str]:
     arguments = [f"        {_python_name(message)}," for message in parts.values()]
     lines = [f"class {short}(", f"    {base}[", *arguments, "    ]", "):", f'    """{type_name}."""', ""]
-    lines.append(f"    type_name: ClassVar[str] = {_literal(type_name)}")
-    lines += [f"    {alias}: TypeAlias = {_python_name(message)}" for alias, message in parts.items()]
+    lines += _assignment("    type_name: ClassVar[str] = ", _literal(type_name))
+    for alias, message in parts.items():
+        lines += _assignment(f"    {alias}: TypeAlias = ", _python_name(message))
     return lines
 
 
@@ -142,7 +157,7 @@ def _table(name: str, entries: dict[str, str]) -> list[str]:
 
 
 def _indent(lines: list[str]) -> list[str]:
-    return [f"    {line}" if line else "" for line in lines]
+    return [f"{_DECLARATION_INDENT}{line}" if line else "" for line in lines]
 
 
 def generate(registry: TypeRegistry | None = None) -> str:
