@@ -14,6 +14,7 @@ def example() -> None:
 @click.option("--name", default="/add_two_ints", show_default=True, help="Service name to serve.")
 @click.option(
     "--connect",
+    "-e",
     default=None,
     metavar="ENDPOINT",
     help="Router to join (default: $KINEMA_ZENOH_CONNECT, else tcp/127.0.0.1:7447).",

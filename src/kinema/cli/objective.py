@@ -326,6 +326,7 @@ def check(
 
 connect_option = click.option(
     "--connect",
+    "-e",
     default=None,
     metavar="ENDPOINT",
     help="Router to join (default: $KINEMA_ZENOH_CONNECT, else tcp/127.0.0.1:7447).",

@@ -25,6 +25,7 @@ from kinema.cli.options import selection_options
 @click.option("-l", "--list", "list_configs", is_flag=True, help="List the config packages and exit.")
 @click.option(
     "--connect",
+    "-e",
     default=None,
     metavar="ENDPOINT",
     help="Router endpoint(s) to host or join, comma-separated (default: $KINEMA_ZENOH_CONNECT, else "

@@ -15,6 +15,7 @@ SCREEN_CHOICES = ("configs", "objectives", "blackboard", "behaviors", "logs", "w
 @click.command()
 @click.option(
     "--connect",
+    "-e",
     "endpoint",
     default=None,
     metavar="ENDPOINT",

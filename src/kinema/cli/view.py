@@ -12,6 +12,7 @@ from kinema.cli.options import selection_options
 @click.command()
 @click.option(
     "--connect",
+    "-e",
     "endpoint",
     default=None,
     metavar="ENDPOINT",
