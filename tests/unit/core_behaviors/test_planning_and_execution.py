@@ -64,6 +64,37 @@ def test_plan_to_joint_goal_times_a_path_from_the_current_state(
     assert (speeds <= 0.5 * limits + 1e-6).all()
 
 
+@pytest.mark.parametrize(
+    "written",
+    [
+        {"name": ARM, "position": MID},
+        {"joint_state": {"name": ARM, "position": MID}},
+        dict(zip(ARM, MID, strict=True)),
+    ],
+    ids=["JointState", "RobotJointState", "joint map"],
+)
+def test_a_joint_goal_written_out_as_yaml_plans_like_the_message(
+    behavior: Any, context: BehaviorContext, at_home: Any, written: dict[str, Any]
+) -> None:
+    # What `-p target_joint_state={name: [...], position: [...]}` or a YAML file hands the port: a dict.
+    run = tick_behavior(behavior("PlanToJointGoal"), {"joint_goal": written}, context=context, timeout=120.0)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    np.testing.assert_allclose(run.outputs["joint_trajectory_msg"].points[-1].positions, MID, atol=1e-6)
+
+
+def test_a_joint_goal_dict_of_the_wrong_shape_says_which_shapes_work(
+    behavior: Any, context: BehaviorContext, at_home: Any
+) -> None:
+    run = tick_behavior(
+        behavior("PlanToJointGoal"), {"joint_goal": {"name": ARM, "position": 0.5}}, context=context
+    )
+    assert run.status == NodeStatus.FAILURE
+    assert "a JointState's name and position are lists" in run.toasts[-1], run.toasts
+    run = tick_behavior(behavior("PlanToJointGoal"), {"joint_goal": {"elbow_joint": [1.0]}}, context=context)
+    assert run.status == NodeStatus.FAILURE
+    assert "{name: [joint1, joint2], position: [0.0, 1.57]}" in run.toasts[-1], run.toasts
+
+
 def test_a_goal_in_collision_fails_naming_the_links(
     behavior: Any, context: BehaviorContext, at_home: Any
 ) -> None:

@@ -62,17 +62,33 @@ def robot_state_message(names: Sequence[str], positions: Sequence[float]) -> Any
 def joint_positions(value: Any, what: str) -> dict[str, float]:
     """Joint positions by name from a JointState, a RobotJointState, a waypoint or a ``{name: value}`` dict.
 
+    A dict may also be a JointState or RobotJointState written out (``{name: [...], position: [...]}``,
+    ``{joint_state: {name: [...], position: [...]}}``), as a ``-p`` override or YAML file spells one.
+
     Raises:
         ObjectiveError: the value is none of these, or names and positions disagree in length.
     """
-    if isinstance(value, Mapping):
+    if isinstance(value, Mapping) and isinstance(value.get("joint_state"), Mapping):
+        value = value["joint_state"]
+    if isinstance(value, Mapping) and not _written_joint_state(value):
         try:
             return {str(name): float(position) for name, position in value.items()}
         except (TypeError, ValueError) as error:
-            raise ObjectiveError(f"{what} must map joint names to numbers: {error}") from None
-    state = getattr(value, "joint_state", value)
-    names = getattr(state, "name", None)
-    positions = getattr(state, "position", None)
+            raise ObjectiveError(
+                f"{what} must map joint names to numbers ({{joint1: 0.0, joint2: 1.57}}) or be a "
+                f"sensor_msgs/JointState ({{name: [joint1, joint2], position: [0.0, 1.57]}}): {error}"
+            ) from None
+    if isinstance(value, Mapping):
+        names, positions = value["name"], value["position"]
+        if not isinstance(names, list | tuple) or not isinstance(positions, list | tuple):
+            raise ObjectiveError(
+                f"{what}: a JointState's name and position are lists "
+                f"({{name: [joint1, joint2], position: [0.0, 1.57]}}), got {str(dict(value))[:80]!r}"
+            )
+    else:
+        state = getattr(value, "joint_state", value)
+        names = getattr(state, "name", None)
+        positions = getattr(state, "position", None)
     if names is None or positions is None:
         raise ObjectiveError(
             f"{what} must be a sensor_msgs/JointState (e.g. from RetrieveWaypoint or GetJointState), "
@@ -80,7 +96,15 @@ def joint_positions(value: Any, what: str) -> dict[str, float]:
         )
     if len(names) != len(positions):
         raise ObjectiveError(f"{what} names {len(names)} joints but gives {len(positions)} positions")
-    return {str(name): float(position) for name, position in zip(names, positions, strict=True)}
+    try:
+        return {str(name): float(position) for name, position in zip(names, positions, strict=True)}
+    except (TypeError, ValueError) as error:
+        raise ObjectiveError(f"{what}: a joint position is not a number: {error}") from None
+
+
+def _written_joint_state(value: Mapping[Any, Any]) -> bool:
+    """A dict holding a JointState's fields (``name`` and ``position``) rather than joint names."""
+    return "name" in value and "position" in value
 
 
 def trajectory_message(trajectory: JointTrajectory, frame_id: str = "") -> Any:

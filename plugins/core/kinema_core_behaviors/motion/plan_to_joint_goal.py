@@ -51,7 +51,11 @@ class PlanToJointGoal(AsyncBehavior):
     def provided_ports(cls) -> list[PortInfo]:
         return [
             input_port(
-                "joint_goal", None, "{target_joint_state}", "Goal joint state (sensor_msgs/JointState)."
+                "joint_goal",
+                None,
+                "{target_joint_state}",
+                "Goal joint state (sensor_msgs/JointState; written out: {name: [...], position: [...]} "
+                "or {joint: value, ...}).",
             ),
             cell_input_port("planning_group_name", str, "planning_group", "The planning group that moves."),
             input_port("link_padding", float, 0.01, "Clearance (m) kept between the robot and the scene."),
