@@ -61,7 +61,8 @@ def _load_library(workspace: Path | None, config: str | None, verbose: bool) -> 
 def list_(workspace: Path | None, config: str | None, as_json: bool, no_check: bool, verbose: bool) -> None:
     """List the objectives of the config's objective libraries, and which of them cannot load and why.
 
-    Columns: R = runnable (subtree-only objectives are not), * = favorite, ! = cannot load. Each objective
+    Columns: R = offered to run (- for a subtree-only objective: the UI does not offer it, but
+    `objective run NAME -p PORT=VALUE` runs it), * = favorite, ! = cannot load. Each objective
     that cannot load (its file or a SubTree it reaches does not validate against the config's behaviors)
     is listed after the table, one line each, with the first problem as file:line: message. Files that
     cannot be read are reported as file:line: message on stderr; the other objectives are still listed.
