@@ -211,12 +211,21 @@ def _check_srdf(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport) -> N
         value = element.get(attribute, "")
         if value in valid:
             return True
+        if not value.strip():
+            return False  # an element without the attribute is skipped: its note says so (below)
         report.problem(
             f"<{element.tag} {attribute}={value!r}>: {value!r} is not a {what}; {did_you_mean(value, valid)}",
             where(element),
         )
         return False
 
+    from kinema.errors import MotionError
+    from kinema.motion.srdf import parse_srdf
+
+    try:
+        report.warnings.extend(parse_srdf(path).notes)
+    except MotionError as error:
+        report.problem(error.message, error.location or path)
     joints, links = list(urdf.joints), urdf.links
     groups = {g.get("name", ""): g for g in root.findall("group")}
     parent_of = {j.child: j.parent for j in urdf.joints.values()}

@@ -8,6 +8,7 @@ appear in ``q``; :meth:`RobotModel.pin_configuration` expands ``q`` into pinocch
 
 from __future__ import annotations
 
+import logging
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -22,6 +23,8 @@ from kinema.motion.srdf import GroupDefinition, SemanticDescription, parse_srdf
 
 if TYPE_CHECKING:
     import pinocchio as pin
+
+log = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
@@ -191,6 +194,8 @@ class RobotModel:
         except (RuntimeError, ValueError) as exc:
             raise MotionError(f"pinocchio cannot load URDF {urdf_path}: {exc}") from exc
         semantic = parse_srdf(srdf_path) if srdf_path is not None else SemanticDescription()
+        for note in semantic.notes:
+            log.warning("%s", note)
         limits = parse_joint_limits(joint_limits_path) if joint_limits_path is not None else None
         robot = cls(model, urdf_path, joints, semantic, limits)
         # Where package:// and relative mesh paths of the URDF are found (the collision model's meshes).

@@ -132,11 +132,18 @@ def _check_srdf_names(semantic: SemanticDescription, robot: ResolvedRobot, srdf:
         if effector.parent_link not in links:
             problems.append(f"end effector {effector.name!r} names link {effector.parent_link!r}")
     if problems:
+        # The names of the kinds the problems are about, so that the right one is at hand.
+        valid = [
+            f" The URDF's {kind}: {', '.join(sorted(names))}"
+            for kind, names in (("joints", joints), ("links", links))
+            if any(f" {kind[:-1]} " in problem for problem in problems)
+        ]
         raise ScaffoldError(
             f"{srdf}: the SRDF does not fit the URDF {robot.source.name}: "
             + "; ".join(problems[:8])
             + (f" (and {len(problems) - 8} more)" if len(problems) > 8 else "")
-            + f". The URDF's joints: {', '.join(sorted(joints))}"
+            + "."
+            + ".".join(valid)
         )
 
 
@@ -207,6 +214,7 @@ def plan_robot(
             raise ScaffoldError(str(error)) from None
         _check_srdf_names(semantic, robot, srdf)
         srdf_text = Path(srdf).read_text()
+        notes += semantic.notes
     groups = {
         n: _group_joints(n, semantic.groups, joints) for n, g in semantic.groups.items() if not g.subgroups
     }

@@ -75,12 +75,34 @@ def test_named_states_from_the_srdf(model):
         model.named_state("gripper", "shut")
 
 
-def test_srdf_errors_point_at_the_file_and_line(tmp_path):
+def test_srdf_elements_missing_an_attribute_are_skipped_with_a_note_at_their_line(tmp_path):
+    # As MoveIt's SRDF reader skips them (logging an error): a file MoveIt loads, Kinema loads.
     bad = tmp_path / "bad.srdf"
     bad.write_text(
-        '<robot name="r">\n  <group name="arm">\n    <chain base_link="a"/>\n  </group>\n</robot>\n'
+        '<robot name="r">\n  <group name="arm">\n    <chain base_link="a"/>\n    <joint name="j1"/>\n'
+        '  </group>\n  <group_state name="home">\n    <joint name="j1" value="0.5"/>\n  </group_state>\n'
+        '  <disable_collisions link1="a"/>\n</robot>\n'
     )
-    with pytest.raises(MotionError, match=r"tip_link") as info:
+    semantic = parse_srdf(bad)
+    assert semantic.groups["arm"].chains == () and semantic.groups["arm"].joints == ("j1",)
+    # A state without its group keeps its values (pinocchio reads them so; example-robot-data writes them so).
+    assert semantic.group_states[("", "home")] == {"j1": 0.5}
+    assert semantic.disabled_collisions == frozenset()
+    assert semantic.notes == (
+        f"{bad}:3: <chain> has no 'tip_link' attribute; skipped, as MoveIt skips it",
+        f"{bad}:6: <group_state name='home'> names no group; its joint values are kept (MoveIt skips such a "
+        "state)",
+        f"{bad}:9: <disable_collisions> has no 'link2' attribute; skipped, as MoveIt skips it",
+    )
+
+
+def test_a_group_state_value_that_is_no_number_is_an_error_at_its_line(tmp_path):
+    bad = tmp_path / "bad.srdf"
+    bad.write_text(
+        '<robot name="r">\n  <group_state name="home" group="arm">\n    <joint name="j1" value="up"/>\n'
+        "  </group_state>\n</robot>\n"
+    )
+    with pytest.raises(MotionError, match=r"joint 'j1' has the value 'up', not a number") as info:
         parse_srdf(bad)
     assert str(info.value).startswith(f"{bad}:3:")
 

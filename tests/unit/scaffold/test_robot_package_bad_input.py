@@ -117,6 +117,19 @@ def _srdf_chain_upside_down(robot: Path) -> tuple[Path, tuple[str, ...], str]:
     )
 
 
+def _srdf_chain_names_no_link(robot: Path) -> tuple[Path, tuple[str, ...], str]:
+    srdf = robot / "bot.srdf"
+    srdf.write_text(
+        '<robot name="bot"><group name="arm"><chain base_link="world" tip_link="arm"/></group></robot>'
+    )
+    return (
+        robot / "bot.urdf",
+        ("--srdf", str(srdf)),
+        f"{srdf}: the SRDF does not fit the URDF bot.urdf: group 'arm' chain names link 'world'. The URDF's "
+        "links: arm, base",
+    )
+
+
 def _xacro_error(robot: Path) -> tuple[Path, tuple[str, ...], str]:
     xacro = robot / "bot.urdf.xacro"
     text = urdf_text().replace(
@@ -143,10 +156,19 @@ def _no_movable_joints(robot: Path) -> tuple[Path, tuple[str, ...], str]:
         _lfs_pointer,
         _srdf_names_other_joints,
         _srdf_chain_upside_down,
+        _srdf_chain_names_no_link,
         _xacro_error,
         _no_movable_joints,
     ],
-    ids=["missing mesh", "LFS pointer mesh", "SRDF joints", "SRDF chain", "xacro error", "no movable joints"],
+    ids=[
+        "missing mesh",
+        "LFS pointer mesh",
+        "SRDF joints",
+        "SRDF chain",
+        "SRDF chain link",
+        "xacro error",
+        "no movable joints",
+    ],
 )
 def test_bad_input_is_one_clear_error_and_writes_nothing(
     workspace_root: Path, robot: Path, make: object, capsys: pytest.CaptureFixture[str]
