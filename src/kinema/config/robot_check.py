@@ -124,6 +124,8 @@ def robot_report(resolved: ResolvedConfig) -> RobotReport:
     _check_joint_limits(resolved, urdf, report)
     _check_waypoints(resolved, urdf, report)
     _check_cell(resolved, urdf, scene, report)
+    if not report.problems:  # each name is known: where the robot stands at each waypoint means something
+        _check_waypoint_collisions(resolved, index, report)
     return report
 
 
@@ -331,6 +333,43 @@ def _check_waypoints(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport)
                 f"waypoint {waypoint.name!r} names {_joints(unknown)} not in {urdf.source.name}; "
                 f"{did_you_mean(unknown[0], urdf.movable_joints)}",
                 document.location((number, "joint_state", "name")),
+            )
+
+
+def _check_waypoint_collisions(resolved: ResolvedConfig, index: PackageIndex, report: RobotReport) -> None:
+    """A waypoint where two of the robot's links overlap (the SRDF's disabled pairs left out) is a warning:
+    no motion can start or end there, and the usual cause is a pair the SRDF should disable (links that
+    touch by design, as MoveIt's setup assistant finds them in the default state)."""
+    from kinema.config.robot_description import planning_urdf
+    from kinema.config.waypoints import Waypoint
+    from kinema.config.yamlsource import load_yaml_file
+    from kinema.motion.collision import CollisionChecker, disable_collisions_advice, self_collisions
+    from kinema.motion.robot_model import RobotModel
+
+    try:
+        srdf = resolved.srdf_path
+        model = RobotModel.from_urdf(
+            planning_urdf(resolved, check_meshes=False), srdf, package_dirs=index.package_dirs()
+        )
+        checker = CollisionChecker(model)
+        path = resolved.waypoints_path
+        document = load_yaml_file(path) if path is not None else None
+    except KinemaError:
+        return  # the checks above report why
+    if document is None or not isinstance(document.data, list):
+        return
+    for number, item in enumerate(document.data):
+        try:
+            waypoint = Waypoint.from_dict(item, document, number)
+        except ConfigError:
+            continue
+        pairs = self_collisions(checker, waypoint.joint_positions())
+        if pairs:
+            overlaps = ", ".join(f"{a} - {b}" for a, b in pairs)
+            advice = disable_collisions_advice(pairs, srdf.name)
+            report.warnings.append(
+                f"{document.location((number, 'name'))}: waypoint {waypoint.name!r} is in self-collision "
+                f"({overlaps}): no motion can start or end there. {advice}"
             )
 
 

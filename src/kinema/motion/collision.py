@@ -12,7 +12,7 @@ their own link and its touch links (exact, as self-collision is), and against ot
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -289,3 +289,23 @@ class CollisionChecker:
                 if not self.is_valid(a + (b - a) * (s / steps)):
                     return i
         return None
+
+
+def self_collisions(checker: CollisionChecker, positions: Mapping[str, float]) -> list[tuple[str, str]]:
+    """The pairs of the robot's links in collision at ``positions`` (joint values by name; the model's
+    other joints at their neutral value, names it does not know left out), the pairs the checker allows
+    not counted: where a named state (a waypoint, ``Home``) leaves the planner no start or goal."""
+    model = checker.model
+    known = set(model.joint_names)
+    q = model.configuration({name: value for name, value in positions.items() if name in known})
+    return checker.colliding_pairs(q)
+
+
+def disable_collisions_advice(pairs: Sequence[tuple[str, str]], srdf: str) -> str:
+    """What to add to ``srdf`` if the link ``pairs`` touch by design: one ``<disable_collisions>`` each
+    (reason ``Default``, as MoveIt's setup assistant names a pair in collision in the default state)."""
+    elements = " ".join(
+        f'<disable_collisions link1="{first}" link2="{second}" reason="Default"/>' for first, second in pairs
+    )
+    them = "the pair" if len(pairs) == 1 else "the pairs"
+    return f"If these links touch by design, disable {them} in {srdf}: {elements}"

@@ -18,12 +18,15 @@ What it decides, and where a user changes it (config.yaml says it again beside e
 - the planning group: the SRDF's largest group of joints that names no other group; without an SRDF (or
   an SRDF without groups) a group ``manipulator`` over the URDF's longest chain of movable joints;
 - the gripper: the movable joints outside the planning group that are no mimic of another; with one such
-  joint it is the gripper, open and closed from the SRDF group states called ``open``/``close(d)`` of a
-  group holding it, else from its limits (a prismatic finger opens at its upper limit, a revolute
-  knuckle at its lower one);
+  joint it is the gripper (without an SRDF, the longest chain's last joint is left out of the group when
+  its name says grip, finger, jaw or claw: an arm whose jaw ends the chain), open and closed from the
+  SRDF group states called ``open``/``close(d)`` of a group holding it, else from its limits (a
+  prismatic finger opens at its upper limit, a revolute knuckle at its lower one);
 - the tool frame: the SRDF end effector's parent link, else the planning group's tip;
 - ``Home``: the first SRDF group state named ``home``, ``ready`` or ``default`` that covers the planning
-  group, else every joint at 0 clipped into its limits. The simulation starts there;
+  group, else every joint at 0 clipped into its limits. The simulation starts there. Link pairs in
+  collision at Home are disabled in a generated SRDF (reason ``Default``, as MoveIt's setup assistant
+  does); a given SRDF is left as it is, and a note says which pairs overlap;
 - accelerations: the URDF has none, so each joint's is twice its velocity limit per second.
 
 Nothing is written when anything fails: the package is made in a temporary folder and moved into place.
@@ -32,9 +35,10 @@ Nothing is written when anything fails: the package is made in a temporary folde
 from __future__ import annotations
 
 import math
+import re
 import shutil
 import tempfile
-from collections.abc import Callable, Mapping
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -51,6 +55,8 @@ BASE_PACKAGE = "kinema_base"
 GRIPPER_CONTROLLER = "gripper_controller"
 ARM_CONTROLLER = "joint_trajectory_controller"
 HOME = "Home"
+#: The last joint of a generated group's chain with such a name is the gripper, not part of the group.
+GRIPPER_NAME = re.compile(r"grip|finger|jaw|claw", re.IGNORECASE)
 
 
 @dataclass
@@ -160,8 +166,16 @@ def _below(tip: str, base: str, parents: Mapping[str, str]) -> bool:
 
 
 def _generated_srdf(
-    robot: ResolvedRobot, group: str, base: str, tip: str, semantic: SemanticDescription
+    robot: ResolvedRobot,
+    group: str,
+    base: str,
+    tip: str,
+    semantic: SemanticDescription,
+    in_default: Sequence[tuple[str, str]] = (),
 ) -> str:
+    """The SRDF of a robot without one: its longest chain as the group, and the link pairs MoveIt's setup
+    assistant disables first: ``Adjacent`` (a joint's two links) and ``Default`` (``in_default``: in
+    collision at Home, links that touch by design)."""
     root = etree.Element("robot", name=robot.name)
     root.append(
         etree.Comment(
@@ -170,13 +184,33 @@ def _generated_srdf(
     )
     element = etree.SubElement(root, "group", name=group)
     etree.SubElement(element, "chain", base_link=base, tip_link=tip)
-    pairs = {tuple(sorted(p)) for p in semantic.disabled_collisions}
+    reasons: dict[tuple[str, ...], str] = {}
+    for pair in (*semantic.disabled_collisions, *in_default):
+        reasons.setdefault(tuple(sorted(pair)), "Default")
     for joint in robot.joints():
-        pairs.add(tuple(sorted((joint.parent, joint.child))))
-    for a, b in sorted(pairs):
-        if len({a, b}) == 2:
-            etree.SubElement(root, "disable_collisions", link1=a, link2=b, reason="Adjacent")
+        reasons[tuple(sorted((joint.parent, joint.child)))] = "Adjacent"
+    for (a, b), reason in sorted(reasons.items()):
+        if a != b:
+            etree.SubElement(root, "disable_collisions", link1=a, link2=b, reason=reason)
     return '<?xml version="1.0"?>\n' + etree.tostring(root, pretty_print=True, encoding="unicode")
+
+
+def _home_collisions(
+    robot: ResolvedRobot, srdf_text: str, home: Mapping[str, float]
+) -> list[tuple[str, str]]:
+    """The link pairs in collision at ``home`` (the SRDF's disabled pairs left out).
+
+    Raises:
+        MotionError: pinocchio cannot load the robot or build its collision model.
+    """
+    from kinema.motion.collision import CollisionChecker, self_collisions
+    from kinema.motion.robot_model import RobotModel
+
+    with tempfile.TemporaryDirectory() as folder:
+        urdf = robot.write_urdf(Path(folder) / "robot.urdf")
+        srdf = Path(folder) / "robot.srdf"
+        srdf.write_text(srdf_text)
+        return self_collisions(CollisionChecker(RobotModel.from_urdf(urdf, srdf)), home)
 
 
 def _clip(joint: UrdfJoint, value: float) -> float:
@@ -226,6 +260,11 @@ def plan_robot(
         base, tip, chain = longest_chain(robot.urdf_text)
         group = "manipulator"
         group_joints = [j for j in chain if joints[j].mimic is None]
+        last = group_joints[-1]
+        if len(group_joints) > 1 and GRIPPER_NAME.search(last):
+            # An arm whose jaw is the chain's last joint (a Unitree Z1, an SO-100): the jaw is the gripper.
+            group_joints, tip = group_joints[:-1], joints[last].parent
+            notes.append(f"gripper {last!r}: the longest chain's last joint, named like a gripper")
         srdf_text = _generated_srdf(robot, group, base, tip, semantic)
         semantic = _parse_srdf_text(srdf_text)
         notes.append(f"planning group {group!r}: the URDF's longest chain, {base} → {tip}")
@@ -274,6 +313,28 @@ def plan_robot(
         if closed_state is not None:
             closed = float(closed_state[gripper])
         home[gripper] = opened
+    generated = not groups
+    try:
+        overlapping = _home_collisions(robot, srdf_text, home)
+    except MotionError as error:
+        overlapping = []
+        notes.append(f"{HOME} was not checked for self-collision: {error.message}")
+    if overlapping and generated:
+        srdf_text = _generated_srdf(robot, group, base, tip, semantic, overlapping)
+        semantic = _parse_srdf_text(srdf_text)
+        notes.append(
+            f"{len(overlapping)} link pair(s) in collision at {HOME} are disabled in the SRDF (reason "
+            f"Default, as MoveIt's setup assistant does: links that touch by design): "
+            + ", ".join(f"{a} - {b}" for a, b in overlapping)
+        )
+    elif overlapping:
+        from kinema.motion.collision import disable_collisions_advice
+
+        notes.append(
+            f"{HOME} is in self-collision ("
+            + ", ".join(f"{a} - {b}" for a, b in overlapping)
+            + f"): no motion can start or end there. {disable_collisions_advice(overlapping, 'the SRDF')}"
+        )
     waypoints = {HOME: dict(home)}
     for (_group, state), values in semantic.group_states.items():
         waypoint = dict(home)
