@@ -261,3 +261,41 @@ def test_tabs_first_shown_after_another_objective_was_selected_show_that_one(fak
         assert fields == ["waypoint_name", "speed"]
 
     drive(fake, scenario)
+
+
+def test_cancel_works_from_the_search_box_and_escape_leaves_it(fake: FakeConnection) -> None:
+    # A new user typing in the search box pressed ctrl+x to stop a moving arm: the box took it as "cut".
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        await pilot.press("slash", *"grip")
+        await settle(pilot)
+        search = app.screen.query_one("#objective-search", Input)
+        assert app.focused is search
+        await pilot.press("ctrl+x")
+        await settle(pilot)
+        assert fake.called("cancel_objective") == [()]
+        assert search.value == "grip"
+        await pilot.press("escape")
+        await settle(pilot)
+        assert app.focused is app.screen.query_one("#objective-list", OptionList)
+        assert search.value == "grip" and listed(app) == ["Open Gripper"]
+
+    drive(fake, scenario)
+
+
+def test_asking_to_quit_twice_asks_once(fake: FakeConnection) -> None:
+    from kinema.tui.dialogs.confirm import ConfirmDialog
+
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        await pilot.press("ctrl+q")
+        await settle(pilot)
+        await pilot.press("ctrl+q")
+        await settle(pilot)
+        assert sum(isinstance(screen, ConfirmDialog) for screen in app.screen_stack) == 1
+        await pilot.press("n")
+        await settle(pilot)
+        assert not any(isinstance(screen, ConfirmDialog) for screen in app.screen_stack)
+        await pilot.press("ctrl+q")  # and it asks again once the first answer is in
+        await settle(pilot)
+        assert isinstance(app.screen, ConfirmDialog)
+
+    drive(fake, scenario, owns_runtime=True)

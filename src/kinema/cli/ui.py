@@ -66,7 +66,8 @@ def ui(
 
     Closing the UI leaves the runtime running. The Configs screen browses the workspace selected with
     -w/-c (or `kinema configure`). Keys: 1-6 switch screens, 7 shows a camera image, ctrl+p opens the
-    command palette, q quits.
+    command palette, ctrl+x cancels the running objective, ctrl+q quits (on the objective list, letters
+    and q search; Esc leaves the search box).
     """
     if replay is not None:
         _replay(replay)

@@ -191,6 +191,9 @@ class KinemaApp(App[None]):
             "Cancel",
             id="app.cancel",
             tooltip="Cancel the running objective from any screen",
+            # Before any focused widget's own ctrl+x (a text field's "cut"): stopping the robot must work
+            # wherever the cursor is.
+            priority=True,
         ),
     ]
 
@@ -212,6 +215,8 @@ class KinemaApp(App[None]):
         self.camera_topic = camera
         # True while a teleoperation session (DoTeleoperateAction) is open in a dialog.
         self.teleoperating = False
+        # True while the "Close Kinema?" question is open.
+        self._asking_to_quit = False
         self.connection = connection
         self.owns_runtime = owns_runtime
         self.initial_mode = initial_mode
@@ -593,11 +598,16 @@ class KinemaApp(App[None]):
             self.exit()
             return
 
+        from kinema.tui.dialogs.confirm import ConfirmDialog
+
+        if self._asking_to_quit:
+            return  # already asking: a second ctrl+q must not stack another question
+        self._asking_to_quit = True
+
         def answered(stop: bool | None) -> None:
+            self._asking_to_quit = False
             if stop:
                 self.exit()
-
-        from kinema.tui.dialogs.confirm import ConfirmDialog
 
         self.push_screen(
             ConfirmDialog(

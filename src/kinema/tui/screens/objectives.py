@@ -99,7 +99,7 @@ class ObjectivesScreen(KinemaScreen):
             "dismiss_failure",
             "Dismiss",
             id="objectives.dismiss",
-            tooltip="Hide the failure explanation of the last run",
+            tooltip="Leave the search box; else hide the failure explanation of the last run",
             show=False,  # the failure panel says so; the footer has no room to spare
         ),
         Binding(
@@ -438,6 +438,11 @@ class ObjectivesScreen(KinemaScreen):
         self.failure_shown = outcome
 
     def action_dismiss_failure(self) -> None:
+        search = self.query_one("#objective-search", Input)
+        if search.has_focus:
+            # Esc leaves the search box (its filter stays) for the list, where keys act again.
+            self.set_focus(self.query_one("#objective-list", OptionList))
+            return
         if self.failure_shown is not None:
             self._dismissed.add(id(self.failure_shown))
         self.query_one("#failure-panel", Static).set_class(False, "shown")
