@@ -95,10 +95,10 @@ def run(
 ) -> None:
     """Start Kinema: host the zenoh router (or join one), the agent and the config's drivers.
 
-    Prints one line once objectives can be started, writes every process's log to a per-run folder
-    (see `kinema logs`), and blocks until Ctrl-C or `kinema down`. One runtime per cell: when the router
-    already has an agent (or drivers) it refuses to start another, and says how to join or stop it;
-    -n and -o start the two halves of one cell.
+    Prints a line per driver, then one once objectives can be started (and one when it stopped), writes
+    every process's log to a per-run folder (see `kinema logs`), and blocks until Ctrl-C or `kinema down`.
+    One runtime per cell: when the router already has an agent (or drivers) it refuses to start another,
+    and says how to join or stop it; -n and -o start the two halves of one cell.
 
     The network is closed by default: the router listens beyond loopback only on tls/ endpoints, with
     client certificates and access rules from `kinema security init`, or in plain text with --insecure.

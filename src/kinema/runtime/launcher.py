@@ -426,6 +426,7 @@ class Launcher:
         previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
         signal.signal(signal.SIGTERM, lambda *_: self.request_stop("SIGTERM"))
         signal.signal(signal.SIGINT, lambda *_: self.request_stop("Ctrl-C"))
+        ready = False
         try:
             self.start()
             assert self.run_folder is not None
@@ -439,6 +440,7 @@ class Launcher:
                 f"Kinema is running: {what} (config {self.options.config}, {role} at "
                 f"{self.endpoint}, logs in {self.run_folder.path}). Stop with Ctrl-C or `kinema down`."
             )
+            ready = True
             self._watch_cell()
             if self.options.ui is not None:
                 return self.options.ui(self)
@@ -446,6 +448,10 @@ class Launcher:
             return self.wait()
         finally:
             self.stop()
+            if ready:
+                # The last line in the terminal: after the UI's screen is gone, the ready line above would
+                # otherwise read as if the runtime were still up.
+                self.options.echo(f"Kinema stopped (config {self.options.config}).")
             for sig, handler in previous.items():
                 signal.signal(sig, handler)
 

@@ -198,4 +198,7 @@ def test_ctrl_c_stops_everything_and_removes_the_record(
     kinema_run.send_signal(signal.SIGINT)
     assert kinema_run.wait(20) == 0
     assert not any(pid_alive(pid) for pid in children)
+    # The terminal's last word says the runtime is gone (the ready line above it said it was running).
+    assert kinema_run.stdout is not None
+    assert kinema_run.stdout.read().strip().splitlines()[-1] == "Kinema stopped (config lab_sim)."
     assert not list((Path(env["XDG_STATE_HOME"]) / "kinema" / "instances").glob("*.json"))
