@@ -241,6 +241,25 @@ def test_toasts_notify_and_the_log_panel_filters_by_level(fake: FakeConnection) 
     drive(fake, scenario, mode="logs")
 
 
+def test_long_log_lines_wrap_whole_at_80_columns_after_the_scrollbar_appears(fake: FakeConnection) -> None:
+    # A new user read "(targe 0.7929)" for "(target 0.7929)": lines were wrapped wider than the panel, and
+    # the end of each was out of sight.
+    words = " ".join(f"word{index:02d}" for index in range(30))
+
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        for number in range(40):
+            fake.emit(LogEntry(f"{number}: {words}", LogLevel.INFO))
+        await settle(pilot)
+        panel = app.screen.query_one(RichLog)
+        assert panel.show_vertical_scrollbar and len(panel.lines) > panel.scrollable_content_region.height
+        width = panel.scrollable_content_region.width
+        assert max(line.cell_length for line in panel.lines) <= width
+        text = " ".join(line.text.strip() for line in panel.lines)
+        assert text.count(words) == 40
+
+    drive(fake, scenario, mode="logs", size=(80, 24))
+
+
 # -- Waypoints -----------------------------------------------------------------------------------
 
 

@@ -61,7 +61,9 @@ class LogsScreen(KinemaScreen):
             with Horizontal(classes="toolbar"):
                 yield Select(LEVEL_CHOICES, value=self.level, allow_blank=False, id="log-level")
                 yield Static("", id="log-count", classes="muted")
-            yield RichLog(id="log-panel", wrap=True, max_lines=5000)
+            # min_width: RichLog renders every line at least 78 cells wide by default, wider than the
+            # panel in an 80-column terminal, which hid the end of each wrapped line.
+            yield RichLog(id="log-panel", wrap=True, max_lines=5000, min_width=20)
 
     def on_mount(self) -> None:
         super().on_mount()
