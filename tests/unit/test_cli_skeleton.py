@@ -28,3 +28,27 @@ def test_help_lists_verbs_and_does_not_import_heavy_modules():
 def test_unknown_verb_exits_non_zero(capsys):
     assert main(["no-such-verb"]) != 0
     assert "No such command" in capsys.readouterr().err
+
+
+def test_a_mistyped_verb_gets_a_suggestion(capsys):
+    assert main(["objectives", "list"]) != 0
+    assert "No such command 'objectives'; did you mean 'objective'?" in capsys.readouterr().err
+
+
+def test_each_verb_summary_in_help_is_a_whole_sentence(capsys, monkeypatch):
+    # A summary cut at a fixed length ended mid-sentence: "Generate a new package: from a template, or a
+    # robot's config package from its..."
+    monkeypatch.setenv("COLUMNS", "80")
+    assert main(["--help"]) == 0
+    listing = capsys.readouterr().out.split("Commands:", 1)[1]
+    summaries: dict[str, str] = {}
+    verb = ""
+    for line in listing.splitlines():
+        if line.startswith("  ") and not line.startswith("   "):
+            verb, _, text = line.strip().partition(" ")
+            summaries[verb] = text.strip()
+        elif line.strip():
+            summaries[verb] += " " + line.strip()
+    assert "objective" in summaries and "run" in summaries
+    for verb, summary in summaries.items():
+        assert summary.endswith((".", ")")) and "..." not in summary, (verb, summary)

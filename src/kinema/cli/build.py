@@ -90,7 +90,7 @@ def build(
     for problem in problems:
         click.secho(str(problem), err=True, fg="red")
     errors += len(problems)
-    click.echo(f"validated {file_count} objective files: {len(problems)} problems")
+    click.echo(f"validated {_count(file_count, 'objective file')}: {_count(len(problems), 'problem')}")
 
     model = write_tree_nodes_model(registry, _model_path(found.root, resolved.name))
     click.echo(f"TreeNodesModel for Groot2: {model}")
@@ -100,9 +100,9 @@ def build(
     for robot_problem in robot.problems:
         click.secho(str(robot_problem), err=True, fg="red")
     errors += len(robot.problems)
-    click.echo(f"checked the robot: {len(robot.problems)} problems")
+    click.echo(f"checked the robot: {_count(len(robot.problems), 'problem')}")
     if errors:
-        click.secho(f"build failed: {errors} errors", err=True, fg="red")
+        click.secho(f"build failed: {_count(errors, 'error')}", err=True, fg="red")
         raise click.exceptions.Exit(1)
 
 
@@ -195,3 +195,8 @@ def _plugin_installed() -> bool:
     from importlib import metadata
 
     return any(entry.name == "kinema" for entry in metadata.entry_points(group="pytest11"))
+
+
+def _count(number: int, noun: str) -> str:
+    """``1 problem``, ``2 problems``."""
+    return f"{number} {noun}{'' if number == 1 else 's'}"

@@ -70,12 +70,22 @@ class LazyGroup(click.Group):
         assert isinstance(command, click.Command), f"{target} is not a click command"
         return command
 
+    def resolve_command(
+        self, ctx: click.Context, args: list[str]
+    ) -> tuple[str | None, click.Command | None, list[str]]:
+        name = args[0] if args else ""
+        if name and not name.startswith("-") and self.get_command(ctx, name) is None:
+            from kinema.errors import did_you_mean
+
+            ctx.fail(f"No such command {name!r}; {did_you_mean(name, self.list_commands(ctx))}")
+        return super().resolve_command(ctx, args)
+
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         rows = []
         for verb in self.list_commands(ctx):
             command = self.get_command(ctx, verb)
             if command is not None and not command.hidden:
-                rows.append((verb, command.get_short_help_str(limit=80)))
+                rows.append((verb, command.get_short_help_str(limit=200)))
         if rows:
             with formatter.section("Commands"):
                 formatter.write_dl(rows)

@@ -98,7 +98,7 @@ def behaviors(
     markdown: bool,
     behavior_ids: tuple[str, ...],
 ) -> None:
-    """List the behaviors the active config can use, with their ports and metadata (or only ID...).
+    """List the behaviors the active config can use (or only the IDs given), with their ports and metadata.
 
     With --markdown, print them as a behavior reference (docs/behavior-reference.md is this for lab_sim).
     """

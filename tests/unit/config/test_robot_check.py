@@ -121,7 +121,7 @@ def test_a_waypoint_naming_an_unknown_joint_fails_the_build(
         "did you mean 'shoulder_pan_joint' or 'shoulder_lift_joint'? Valid: elbow_joint, linear_rail_joint, "
         "robotiq_85_left_finger_joint,"
     ) in out
-    assert "checked the robot: 1 problems" in out and "build failed" in out
+    assert "checked the robot: 1 problem\n" in out and "build failed" in out
 
 
 def test_a_controller_joint_no_actuator_drives_fails_the_build(
@@ -142,7 +142,7 @@ def test_a_controller_joint_no_actuator_drives_fails_the_build(
         "'robotiq_85_left_finger_joint', which no actuator of the MuJoCo scene lab_sim_scene.xml drives"
     ) in out
     assert "actuators: linear_rail_joint, shoulder_pan_joint," in out
-    assert "checked the robot: 1 problems" in out
+    assert "checked the robot: 1 problem\n" in out
 
 
 def test_a_planning_group_the_srdf_lacks_fails_the_build(
