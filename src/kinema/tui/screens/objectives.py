@@ -147,7 +147,10 @@ class ObjectivesScreen(KinemaScreen):
                         "Favorites", id="favorites", compact=True, tooltip="Only favorites (ctrl+f)"
                     )
                     yield Checkbox(
-                        "Runnable", id="runnable", compact=True, tooltip="Only runnable objectives (ctrl+u)"
+                        "Runnable",
+                        id="runnable",
+                        compact=True,
+                        tooltip="Only runnable objectives (ctrl+u); ◦ marks a subtree-only one",
                     )
                 yield ObjectiveList(search="objective-search", id="objective-list")
                 yield Static("", id="objective-count", classes="muted")
@@ -212,10 +215,13 @@ class ObjectivesScreen(KinemaScreen):
         options.clear_options()
         for objective in self.shown_objectives:
             label = Text()
-            label.append("★ " if objective.favorite else "  ", style="yellow")
-            label.append(objective.name, style="" if objective.runnable else "dim")
-            if not objective.runnable:
-                label.append("  subtree", style="dim italic")
+            if objective.favorite:
+                label.append("★ ", style="yellow")
+            else:
+                # A subtree-only objective is marked before its name: a tag after it wrapped onto a line
+                # of its own in a narrow list, where it read as another objective.
+                label.append("  " if objective.runnable else "◦ ", style="dim")
+            label.append(objective.name, style="" if objective.runnable else "dim italic")
             options.add_option(Option(label, id=objective.name))
         self.query_one("#objective-count", Static).update(
             f"{len(self.shown_objectives)} of {len(self.objectives)} objectives"
