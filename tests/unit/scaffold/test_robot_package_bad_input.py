@@ -7,6 +7,7 @@ workspace's ``src/`` holds exactly what it held before (no package folder, no le
 from __future__ import annotations
 
 import shutil
+from collections.abc import Callable
 from pathlib import Path
 
 import pytest
@@ -90,44 +91,32 @@ def _lfs_pointer(robot: Path) -> tuple[Path, tuple[str, ...], str]:
     return robot / "bot.urdf", (), f"mesh {mesh} is a Git LFS pointer file (run `git lfs pull`)"
 
 
-def _srdf_names_other_joints(robot: Path) -> tuple[Path, tuple[str, ...], str]:
-    srdf = robot / "bot.srdf"
-    srdf.write_text(
-        '<robot name="bot"><group name="arm"><joint name="shoulder"/><joint name="elbow"/></group>'
-        '<group_state name="home" group="arm"><joint name="wrist" value="0"/></group_state></robot>'
-    )
-    return (
-        robot / "bot.urdf",
-        ("--srdf", str(srdf)),
-        f"{srdf}: the SRDF does not fit the URDF bot.urdf: group 'arm' names joint 'elbow'; group state "
-        "'home' (arm) names joint 'wrist'. The URDF's joints: shoulder",
-    )
+def _srdf_not_fitting(body: str, problem: str) -> Callable[[Path], tuple[Path, tuple[str, ...], str]]:
+    """A case: the URDF, an SRDF of ``body`` naming what the URDF lacks, and the error's ``problem``."""
+
+    def make(robot: Path) -> tuple[Path, tuple[str, ...], str]:
+        srdf = robot / "bot.srdf"
+        srdf.write_text(f'<robot name="bot">{body}</robot>')
+        message = f"{srdf}: the SRDF does not fit the URDF bot.urdf: {problem}"
+        return robot / "bot.urdf", ("--srdf", str(srdf)), message
+
+    return make
 
 
-def _srdf_chain_upside_down(robot: Path) -> tuple[Path, tuple[str, ...], str]:
-    srdf = robot / "bot.srdf"
-    srdf.write_text(
-        '<robot name="bot"><group name="arm"><chain base_link="arm" tip_link="base"/></group></robot>'
-    )
-    return (
-        robot / "bot.urdf",
-        ("--srdf", str(srdf)),
-        f"{srdf}: the SRDF does not fit the URDF bot.urdf: group 'arm' chain's tip 'base' is not below its "
-        "base 'arm'.",
-    )
-
-
-def _srdf_chain_names_no_link(robot: Path) -> tuple[Path, tuple[str, ...], str]:
-    srdf = robot / "bot.srdf"
-    srdf.write_text(
-        '<robot name="bot"><group name="arm"><chain base_link="world" tip_link="arm"/></group></robot>'
-    )
-    return (
-        robot / "bot.urdf",
-        ("--srdf", str(srdf)),
-        f"{srdf}: the SRDF does not fit the URDF bot.urdf: group 'arm' chain names link 'world'. The URDF's "
-        "links: arm, base",
-    )
+_srdf_names_other_joints = _srdf_not_fitting(
+    '<group name="arm"><joint name="shoulder"/><joint name="elbow"/></group>'
+    '<group_state name="home" group="arm"><joint name="wrist" value="0"/></group_state>',
+    "group 'arm' names joint 'elbow'; group state 'home' (arm) names joint 'wrist'. "
+    "The URDF's joints: shoulder",
+)
+_srdf_chain_upside_down = _srdf_not_fitting(
+    '<group name="arm"><chain base_link="arm" tip_link="base"/></group>',
+    "group 'arm' chain's tip 'base' is not below its base 'arm'.",
+)
+_srdf_chain_names_no_link = _srdf_not_fitting(
+    '<group name="arm"><chain base_link="world" tip_link="arm"/></group>',
+    "group 'arm' chain names link 'world'. The URDF's links: arm, base",
+)
 
 
 def _xacro_error(robot: Path) -> tuple[Path, tuple[str, ...], str]:
