@@ -142,6 +142,22 @@ class ObjectiveLibrary:
         order = self._load_order
         return sorted(winning, key=lambda path: order.get(path, len(order)))
 
+    def unreadable(self, path: Path) -> bool:
+        """True when ``path`` is one of the files this library could not read (see :attr:`errors`)."""
+        where = str(path)
+        return any(error.location is not None and error.location.file == where for error in self.errors)
+
+    def keep(self, path: Path, infos: list[ObjectiveInfo]) -> list[ObjectiveInfo]:
+        """Take back ``infos``, the objectives ``path`` defined when it last read, for a file that no
+        longer reads (its error stays in :attr:`errors`); an ID another file now defines is left to it.
+        Returns the objectives taken back."""
+        kept = [info for info in infos if info.id not in self.objectives]
+        for info in kept:
+            self.objectives[info.id] = info
+        if kept:
+            self._load_order.setdefault(path, len(self._load_order))
+        return kept
+
     def own_library(self) -> LibraryPath:
         """The first library folder owned by the most-derived config package (where saves go).
 

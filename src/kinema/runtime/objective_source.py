@@ -64,6 +64,9 @@ class LibraryTreeSource:
         self._objectives_stale = True
         self._problems: dict[str, LibraryProblem] = {}
         self._loaded: list[str] = []
+        # Each objective file's text and objectives when it last registered: a file that fails later is
+        # registered from these (see _register).
+        self._last_good: dict[Path, tuple[str, list[ObjectiveInfo]]] = {}
 
     # -- TreeSource ---------------------------------------------------------------------------------
 
@@ -118,15 +121,17 @@ class LibraryTreeSource:
         """The library's objectives with their metadata (sorted by ID)."""
         with self._lock:
             if self._library is None or self._objectives_stale:
-                self._library = self._load_library()
+                self._reload_library()
+            assert self._library is not None
             return self._library.sorted()
 
     def _rebuild(self, registry: Any) -> None:
         from kinema.bt import BehaviorTreeFactory
 
         if self._library is None or self._objectives_stale:
-            self._library = self._load_library()
+            self._reload_library()
             self._objectives_stale = False
+        assert self._library is not None
         for error in self._library.errors:
             log.warning("objective library: %s", error)
         for warning in self._library.warnings:
@@ -141,12 +146,11 @@ class LibraryTreeSource:
         for info in self._library.objectives.values():
             ids_by_file.setdefault(info.file, []).append(info.id)
         for path in files:
-            try:
-                factory.register_behavior_tree_from_file(path)
-            except KinemaError as error:
-                log.warning("objective file %s not loaded: %s", path, error)
+            failure = self._register(factory, path, ids_by_file.get(path, []))
+            if failure is not None:
+                log.warning("objective file %s not loaded: %s", path, failure)
                 for objective_id in ids_by_file.get(path, []):
-                    problems[objective_id] = LibraryProblem(str(path), str(error))
+                    problems[objective_id] = LibraryProblem(str(path), str(failure))
         for note in factory.library.spelling_notes:
             log.warning("objective library: %s", note)
         from kinema.config.cell import substitute_config_defaults
@@ -158,6 +162,43 @@ class LibraryTreeSource:
         registered = set(factory.registered_behavior_trees())
         self._loaded = sorted(i for i in self._library.objectives if i in registered and i not in problems)
         log.info("objective library: %d objectives runnable, %d not loaded", len(self._loaded), len(problems))
+
+
+    def _reload_library(self) -> None:
+        """Read the objective files again; a file that no longer reads keeps the objectives it had.
+
+        Hot reload does not report a file saved broken; a rebuild for another reason (a behavior package
+        reloaded, another file saved) must not drop that file's objectives either.
+        """
+        library = self._library = self._load_library()
+        for path, (_text, infos) in self._last_good.items():
+            if library.unreadable(path) and library.keep(path, infos):
+                log.warning("objective file %s does not read; its last good version stays", path)
+
+    def _register(self, factory: BehaviorTreeFactory, path: Path, ids: list[str]) -> KinemaError | None:
+        """Register ``path``'s trees in ``factory``, or its last good version when it does not load now
+        (the error is logged); the error when neither loads."""
+        assert self._library is not None
+        try:
+            text = path.read_text(encoding="utf-8")
+        except OSError:
+            text = None
+        try:
+            factory.register_behavior_tree_from_file(path)
+        except KinemaError as error:
+            good = self._last_good.get(path)
+            if good is None or good[0] == text:
+                return error
+            try:
+                factory.library.current_path = path.resolve().parent  # its includes resolve from there
+                factory.register_behavior_tree_from_text(good[0], str(path))
+            except KinemaError:
+                return error
+            log.warning("objective file %s does not load (%s); its last good version runs", path, error)
+            return None
+        if text is not None:
+            self._last_good[path] = (text, [self._library.objectives[i] for i in ids])
+        return None
 
 
 def library_from_folders(folders: list[Path]) -> ObjectiveLibrary:

@@ -107,3 +107,30 @@ def test_a_client_that_lists_objectives_as_soon_as_it_reads_the_reload_notice_ge
     event = ReloadEvent(ReloadKind.OBJECTIVES_CHANGED, str(tmp_path), "objectives changed: later.xml")
     Agent.on_reload_event(agent, event)  # type: ignore[arg-type]
     assert seen_with_notice == [["Good", "Later"]]
+
+
+def test_a_file_saved_broken_keeps_its_last_good_version_through_a_rebuild(tmp_path: Path) -> None:
+    # Hot reload does not report a broken save, so the objective ran its last good version; then a
+    # behavior package reloaded, the source rebuilt from the files, and the objective was gone.
+    (tmp_path / "good.xml").write_text(GOOD)
+    (tmp_path / "other.xml").write_text(GOOD.replace("Good", "Other"))
+    source = _source(tmp_path)
+    assert source.objective_names() == ["Good", "Other"]
+    with ObjectiveServer(source) as server:
+        for broken in (
+            GOOD.replace("</BehaviorTree>", "</BehaviourTree>"),  # not XML: the library cannot read it
+            GOOD.replace("AlwaysSuccess", "AlwaysSucess"),  # reads, but does not load
+        ):
+            (tmp_path / "good.xml").write_text(broken)
+            source.invalidate_objectives()  # what a behavior reload or another saved file leads to
+            assert source.objective_names() == ["Good", "Other"]
+            assert [info.id for info in source.objectives()] == ["Good", "Other"]
+            assert server.submit(ObjectiveRequest("Good")).wait(5).succeeded  # type: ignore[union-attr]
+        # Fixed, the file's new version runs: here it fails, so it is the new one.
+        (tmp_path / "good.xml").write_text(GOOD.replace("AlwaysSuccess", "AlwaysFailure"))
+        source.invalidate_objectives()
+        assert server.submit(ObjectiveRequest("Good")).wait(5).failed  # type: ignore[union-attr]
+        # Deleted, it is gone.
+        (tmp_path / "good.xml").unlink()
+        source.invalidate_objectives()
+        assert source.objective_names() == ["Other"]
