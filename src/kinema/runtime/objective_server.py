@@ -869,7 +869,10 @@ class ObjectiveServer:
                 tree, name, model = self._build(run.request)
                 run.objective_name = name
                 defaults = model_defaults(model)
-                apply_overrides(tree, run.request.overrides, objective_name=name, defaults=defaults)
+                declared = tuple(model.ports) if model is not None else ()
+                apply_overrides(
+                    tree, run.request.overrides, objective_name=name, defaults=defaults, parameters=declared
+                )
                 given = {o.name for o in (*defaults, *run.request.overrides)}
                 run.unset_parameters = tuple(p for p in (model.ports if model else ()) if p not in given)
         except Abandoned:

@@ -84,11 +84,14 @@ def apply_overrides(
     *,
     objective_name: str = "",
     defaults: Sequence[ParameterOverride] = (),
+    parameters: Sequence[str] = (),
 ) -> None:
     """Convert every override and write them all into ``tree``'s blackboards, or none of them.
 
     ``defaults`` (from :func:`model_defaults`) are written first into the root blackboard, each where a
     port reads its name and no override (for the root) sets it; one that does not convert is skipped.
+    ``parameters`` are the ports the objective declares: an override of a name no port reads suggests
+    them (rather than every key of the blackboard, the outputs its behaviors write included).
 
     Raises:
         ObjectiveError: naming the override, the objective and what would have been accepted.
@@ -106,7 +109,8 @@ def apply_overrides(
             log.debug("default left out: %s", error)
     for override in overrides:
         for blackboard, scope in _target_blackboards(tree, override, objective_name):
-            writes.append((blackboard, override.name, _convert(blackboard, scope, override, objective_name)))
+            value = _convert(blackboard, scope, override, objective_name, () if scope else parameters)
+            writes.append((blackboard, override.name, value))
     for blackboard, key, value in writes:
         blackboard.set(key, value)
 
@@ -140,11 +144,17 @@ def _subtree_scopes(tree: Tree) -> list[tuple[str, set[str], Blackboard]]:
     return scopes
 
 
-def _convert(blackboard: Blackboard, scope: str, override: ParameterOverride, objective_name: str) -> Any:
+def _convert(
+    blackboard: Blackboard,
+    scope: str,
+    override: ParameterOverride,
+    objective_name: str,
+    parameters: Sequence[str] = (),
+) -> Any:
     where = f"parameter override {override.name!r} of objective {objective_name!r}"
     entry = blackboard.get_entry(override.name)
     if entry is None:
-        keys = _visible_keys(blackboard)
+        keys = list(parameters) or _visible_keys(blackboard)
         place = f"subtree {scope!r}" if scope else "the objective"
         raise ObjectiveError(
             f"{where}: no port of {place} reads the blackboard key {override.name!r}; "

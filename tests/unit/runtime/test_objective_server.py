@@ -318,6 +318,30 @@ def test_an_adhoc_document_s_main_tree_reads_the_defaults_its_model_declares(
     assert result is not None and result.failed and "Missing parameter [msec]" in result.error_message
 
 
+def test_an_override_no_port_reads_suggests_the_objective_s_parameters_not_its_inner_keys(
+    server: ObjectiveServer,
+) -> None:
+    # It listed every key of the blackboard, the outputs the objective's behaviors write included.
+    xml = """<root BTCPP_format="4" main_tree_to_execute="Copies">
+      <BehaviorTree ID="Copies">
+        <Sequence>
+          <SetBlackboard value="{amount}" output_key="copy"/>
+          <LoopDouble queue="1;2" value="{inner_result}"><AlwaysSuccess/></LoopDouble>
+        </Sequence>
+      </BehaviorTree>
+      <TreeNodesModel>
+        <SubTree ID="Copies"><input_port name="amount" default="1"/></SubTree>
+      </TreeNodesModel>
+    </root>"""
+    overrides = (ParameterOverride("amout", "2"),)
+    result = server.submit(ObjectiveRequest(objective_xml=xml, overrides=overrides)).wait(5)
+    assert result is not None and result.failed
+    assert "no port of the objective reads the blackboard key 'amout'; did you mean 'amount'?" in (
+        result.error_message
+    ), result.error_message
+    assert "inner_result" not in result.error_message
+
+
 def test_namespaced_overrides_reach_only_that_subtree(server: ObjectiveServer) -> None:
     overrides = (ParameterOverride("msec", "5", ("inner_call",)),)
     ok = server.submit(ObjectiveRequest("Outer", overrides=overrides)).wait(5)
