@@ -176,12 +176,26 @@ def build_tree(
     Raises:
         ObjectiveError: the XML is invalid or uses an unknown behavior or port (with file:line).
     """
+    return _build(xml, registry, behaviors, _context(context, node), blackboard)[0]
+
+
+def _build(
+    xml: str | Path,
+    registry: BehaviorRegistry | None,
+    behaviors: Iterable[type],
+    context: BehaviorContext,
+    blackboard: Blackboard | None,
+) -> tuple[Tree, Any]:
+    """The main tree of ``xml`` and the model of the ports its objective declares (None if none)."""
     combined = dict(registry or {})
     combined.update(registry_of(behaviors))
-    factory = BehaviorRegistry(combined).create_factory(_context(context, node))
+    factory = BehaviorRegistry(combined).create_factory(context)
     if isinstance(xml, Path):
-        return factory.create_tree_from_file(xml, blackboard)
-    return factory.create_tree_from_text(xml, blackboard)
+        tree = factory.create_tree_from_file(xml, blackboard)
+    else:
+        tree = factory.create_tree_from_text(xml, blackboard)
+    main = tree.subtrees[0].tree_id if tree.subtrees else ""
+    return tree, factory.library.subtree_models.get(main)
 
 
 def run_objective(
@@ -192,14 +206,36 @@ def run_objective(
     node: Any = None,
     context: BehaviorContext | None = None,
     timeout: float = DEFAULT_TIMEOUT,
+    overrides: Mapping[str, Any] | None = None,
 ) -> ObjectiveRunResult:
-    """Build the main tree of ``xml`` and tick it to completion; return status, blackboard and toasts."""
+    """Build the main tree of ``xml`` and tick it to completion; return status, blackboard and toasts.
+
+    As the runtime runs an objective on its own: the ports it declares start from their defaults, and
+    ``overrides`` (port name -> value; a string is read as YAML, as ``kinema objective run -p`` gives
+    it) replace them. A behavior that raises lets its exception through, so that pytest shows where.
+
+    Raises:
+        ObjectiveError: the XML does not build, or an override names no port or does not convert.
+    """
+    from kinema.runtime.overrides import ParameterOverride, apply_overrides, model_defaults
+
     context = _context(context, node)
     messages: list[LogMessage] = []
     unsubscribe = context.log_sink.subscribe(messages.append)
     try:
         blackboard = Blackboard.create()
-        tree = build_tree(xml, registry=registry, behaviors=behaviors, context=context, blackboard=blackboard)
+        tree, model = _build(xml, registry, behaviors, context, blackboard)
+        given = [
+            ParameterOverride(name, value, from_yaml=isinstance(value, str))
+            for name, value in (overrides or {}).items()
+        ]
+        apply_overrides(
+            tree,
+            given,
+            objective_name=tree.subtrees[0].tree_id if tree.subtrees else "",
+            defaults=model_defaults(model),
+            parameters=tuple(model.ports) if model is not None else (),
+        )
         status, ticks = tick_until_done(tree, timeout)
         values = {key: _value(blackboard, key) for key in blackboard.keys()}
         return ObjectiveRunResult(status, values, messages, ticks)
