@@ -107,7 +107,8 @@ class LibraryTreeSource:
             loaded = time.strftime("%H:%M", time.localtime(record.loaded_at))
             # The error names the package ("plugin 'p': behavior package 'p' failed to import: ...").
             ids = ", ".join(behavior_ids)
-            notes.append(f"{where}{error.message}; {ids} runs the version from {loaded} instead")
+            runs = "runs" if len(behavior_ids) == 1 else "run"
+            notes.append(f"{where}{error.message}; {ids} {runs} the version from {loaded} instead")
         return "; ".join(notes)
 
     # -- library --------------------------------------------------------------------------------

@@ -49,7 +49,9 @@ class ObjectiveResult:
         if self.cancelled:
             detail = f": {self.error_message}" if self.error_message else ""
             return f"objective {name}was cancelled{detail}"
-        return f"objective {name}failed ({self.code_name}): {self.error_message}"
+        # The runtime's messages name the objective already ("objective 'X' failed: node ..."): once will do.
+        detail = self.error_message.removeprefix(f"objective {name}failed: ")
+        return f"objective {name}failed ({self.code_name}): {detail}"
 
     @classmethod
     def success(cls, objective_name: str = "") -> ObjectiveResult:

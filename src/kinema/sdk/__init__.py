@@ -24,6 +24,7 @@ _EXPORTS = {
     "NodeStatusDecoder": "kinema.sdk.streams",
     "ServerStatus": "kinema.sdk.streams",
     "MoveItErrorCode": "kinema.runtime.error_codes",
+    "ObjectivePort": "kinema.config.objective_file",
     "ObjectiveStatus": "kinema.runtime.objective_status",
     "ParameterOverride": "kinema.runtime.overrides",
     "ObjectiveResult": "kinema.runtime.result",
@@ -47,6 +48,7 @@ __all__ = [
     "NodeStatusDecoder",
     "ObjectiveClient",
     "ObjectiveHandle",
+    "ObjectivePort",
     "ObjectiveResult",
     "ObjectiveStatus",
     "ObjectiveTimeoutError",
@@ -58,6 +60,7 @@ __all__ = [
 ]
 
 if TYPE_CHECKING:
+    from kinema.config.objective_file import ObjectivePort
     from kinema.runtime.error_codes import MoveItErrorCode
     from kinema.runtime.objective_status import ObjectiveStatus
     from kinema.runtime.overrides import ParameterOverride

@@ -163,8 +163,10 @@ class BlackboardSnapshot:
         if kind is float and isinstance(data, int) and not isinstance(data, bool):
             return float(data)  # type: ignore[return-value]
         if not isinstance(data, kind) or (kind is int and isinstance(data, bool)):
+            article = "an" if kind.__name__[:1].lower() in "aeiou" else "a"
             raise TypeError(
-                f"blackboard key {key!r} holds {data!r} ({self.entry(key).type_name}), not a {kind.__name__}"
+                f"blackboard key {key!r} holds {data!r} ({self.entry(key).type_name}), "
+                f"not {article} {kind.__name__}"
             )
         return data
 
@@ -175,7 +177,8 @@ class BlackboardSnapshot:
         return cls(message.objective_name, _seconds(message.stamp), entries)
 
     def as_dict(self) -> dict[str, dict[str, str]]:
-        """``{scope: {key: value}}``."""
+        """``{scope: {key: text}}``: each value as the runtime rendered it (YAML text). ``snapshot[key]``,
+        :meth:`scope` and :meth:`value` give the values parsed into Python types."""
         out: dict[str, dict[str, str]] = {}
         for entry in self.entries:
             out.setdefault(entry.scope, {})[entry.key] = entry.value

@@ -32,3 +32,6 @@ def test_string_form_names_the_objective_and_the_code() -> None:
     )
     assert str(failed) == "objective 'Pick' failed (CONTROL_FAILED): node 'Pick/Seq/Move' returned FAILURE"
     assert "cancelled" in str(ObjectiveResult.preempted("by user", "Pick"))
+    # The runtime's own message names the objective already: not twice.
+    named = ObjectiveResult.failure("objective 'Pick' failed: node 'Move::2' [Move]: too far", "Pick")
+    assert str(named) == "objective 'Pick' failed (FAILURE): node 'Move::2' [Move]: too far"

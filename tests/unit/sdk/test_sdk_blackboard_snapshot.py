@@ -40,7 +40,7 @@ def test_typed_access() -> None:
     total: int = snap.value("sum", int)
     assert total == 42
     assert snap.value("sum", float) == 42.0
-    with pytest.raises(TypeError, match=r"'label' holds '42' \(std::string\), not a int"):
+    with pytest.raises(TypeError, match=r"'label' holds '42' \(std::string\), not an int"):
         snap.value("label", int)
     with pytest.raises(TypeError):
         snap.value("done", int)
