@@ -221,3 +221,22 @@ def test_add_to_config_handles_sparse_and_flow_style_files(tmp_path: Path, text:
         "relative_path": "objectives",
     }
     assert add_to_config(config, "my_pkg", "my_pkg::MyPkgBehaviorsLoader") == []
+
+
+def test_every_place_that_lists_the_behavior_types_lists_the_same_ones() -> None:
+    # The CLI's choices, the template's cookiecutter.json and its hook must offer what the scaffold bakes.
+    import json
+    import re
+
+    from kinema.cli.new import new
+
+    command = new.commands["behavior"]
+    option = next(p for p in command.params if p.name == "behavior_type")
+    template = Path(__file__).resolve().parents[2] / "cookiecutters" / "behavior_package"
+    offered = json.loads((template / "cookiecutter.json").read_text())["behavior_type"]
+    hook = (template / "hooks" / "pre_gen_project.py").read_text()
+    hooked = re.findall(r'"(\w+)"', hook.split("TYPES = (", 1)[1].split(")", 1)[0])
+    for listed in (list(option.type.choices), offered, hooked):  # type: ignore[attr-defined]
+        assert sorted(listed) == sorted(BEHAVIOR_TYPES)
+    for behavior_type in BEHAVIOR_TYPES:
+        assert (template / "templates" / behavior_type / "behavior.py.jinja").is_file(), behavior_type

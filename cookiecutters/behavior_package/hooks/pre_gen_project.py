@@ -11,7 +11,15 @@ import sys
 
 SNAKE = re.compile(r"^[a-z](?:[a-z0-9]|_(?!_))*$")
 CAMEL = re.compile(r"^[A-Z][A-Za-z0-9]*$")
-TYPES = ("sync", "async", "service_client", "action_client", "topic_subscriber", "topic_publisher")
+TYPES = (
+    "sync",
+    "stateful",
+    "async",
+    "service_client",
+    "action_client",
+    "topic_subscriber",
+    "topic_publisher",
+)
 
 # tojson escapes single quotes, so the rendered single-quoted raw string holds exactly the JSON text.
 # fmt: off

@@ -200,12 +200,21 @@ def _new_robot_config(
     "--type",
     "behavior_type",
     type=click.Choice(
-        ["sync", "async", "service_client", "action_client", "topic_subscriber", "topic_publisher"]
+        [
+            "sync",
+            "stateful",
+            "async",
+            "service_client",
+            "action_client",
+            "topic_subscriber",
+            "topic_publisher",
+        ]
     ),
     default="async",
     show_default=True,
-    help="The base class: sync (one tick), async (work off the tick thread), service_client (AddTwoInts), "
-    "action_client (Fibonacci), topic_subscriber / topic_publisher (std_msgs/String).",
+    help="The base class: sync (one tick), stateful (over several ticks, on the tick thread), async (work "
+    "off the tick thread), service_client (AddTwoInts), action_client (Fibonacci), topic_subscriber / "
+    "topic_publisher (std_msgs/String).",
 )
 @click.option(
     "-p",

@@ -26,7 +26,15 @@ from kinema.scaffold.generate import generate
 from kinema.scaffold.names import module_name_problem, package_name_problem
 
 TEMPLATE = "behavior_package"
-BEHAVIOR_TYPES = ("sync", "async", "service_client", "action_client", "topic_subscriber", "topic_publisher")
+BEHAVIOR_TYPES = (
+    "sync",
+    "stateful",
+    "async",
+    "service_client",
+    "action_client",
+    "topic_subscriber",
+    "topic_publisher",
+)
 
 
 @dataclass
