@@ -52,3 +52,8 @@ def test_each_verb_summary_in_help_is_a_whole_sentence(capsys, monkeypatch):
     assert "objective" in summaries and "run" in summaries
     for verb, summary in summaries.items():
         assert summary.endswith((".", ")")) and "..." not in summary, (verb, summary)
+
+
+def test_a_mistyped_subcommand_gets_a_suggestion(capsys):
+    assert main(["objective", "lsit"]) != 0
+    assert "No such command 'lsit'; did you mean 'list'?" in capsys.readouterr().err

@@ -7,6 +7,7 @@ from typing import Any
 
 import click
 
+from kinema.cli.groups import VerbGroup
 from kinema.cli.options import (
     print_notices,
     print_warnings,
@@ -17,7 +18,7 @@ from kinema.cli.options import (
 )
 
 
-@click.group()
+@click.group(cls=VerbGroup)
 def config() -> None:
     """Inspect robot config packages and their inheritance."""
 

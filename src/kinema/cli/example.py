@@ -4,8 +4,10 @@ from __future__ import annotations
 
 import click
 
+from kinema.cli.groups import VerbGroup
 
-@click.group()
+
+@click.group(cls=VerbGroup)
 def example() -> None:
     """Demo programs from the tutorials (each runs until Ctrl-C)."""
 

@@ -13,6 +13,7 @@ import sys
 import click
 
 from kinema import __version__
+from kinema.cli.groups import VerbGroup
 from kinema.errors import KinemaError
 
 # verb -> "module:attribute". A verb is offered only when its module exists, so `kinema --help`
@@ -52,7 +53,7 @@ def _module_exists(module: str) -> bool:
         return False
 
 
-class LazyGroup(click.Group):
+class LazyGroup(VerbGroup):
     """A click group whose subcommands are imported on first use."""
 
     def list_commands(self, ctx: click.Context) -> list[str]:
@@ -69,16 +70,6 @@ class LazyGroup(click.Group):
         command = getattr(module, attribute)
         assert isinstance(command, click.Command), f"{target} is not a click command"
         return command
-
-    def resolve_command(
-        self, ctx: click.Context, args: list[str]
-    ) -> tuple[str | None, click.Command | None, list[str]]:
-        name = args[0] if args else ""
-        if name and not name.startswith("-") and self.get_command(ctx, name) is None:
-            from kinema.errors import did_you_mean
-
-            ctx.fail(f"No such command {name!r}; {did_you_mean(name, self.list_commands(ctx))}")
-        return super().resolve_command(ctx, args)
 
     def format_commands(self, ctx: click.Context, formatter: click.HelpFormatter) -> None:
         rows = []

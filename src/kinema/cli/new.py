@@ -6,10 +6,11 @@ from pathlib import Path
 
 import click
 
+from kinema.cli.groups import VerbGroup
 from kinema.cli.options import workspace_option
 
 
-@click.group()
+@click.group(cls=VerbGroup)
 def new() -> None:
     """Generate a new package: from a template, or a robot's config package from its URDF."""
 

@@ -7,6 +7,7 @@ from typing import TYPE_CHECKING
 
 import click
 
+from kinema.cli.groups import VerbGroup
 from kinema.cli.options import (
     print_notices,
     print_warnings,
@@ -20,7 +21,7 @@ if TYPE_CHECKING:
     from kinema.config import ObjectiveLibrary
 
 
-@click.group()
+@click.group(cls=VerbGroup)
 def objective() -> None:
     """List, inspect and run the objectives of a config package.
 

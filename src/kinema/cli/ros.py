@@ -20,6 +20,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
+from kinema.cli.groups import VerbGroup
 from kinema.errors import TransportError
 
 if TYPE_CHECKING:
@@ -129,7 +130,7 @@ def _discover_type(
 # -- topic ---------------------------------------------------------------------------------------
 
 
-@click.group()
+@click.group(cls=VerbGroup)
 def topic() -> None:
     """Inspect and use topics (list, echo, pub, hz)."""
 
@@ -333,7 +334,7 @@ def topic_hz(
 # -- service -------------------------------------------------------------------------------------
 
 
-@click.group()
+@click.group(cls=VerbGroup)
 def service() -> None:
     """Inspect and call services (list, call)."""
 
@@ -390,7 +391,7 @@ def service_call(
 # -- action --------------------------------------------------------------------------------------
 
 
-@click.group()
+@click.group(cls=VerbGroup)
 def action() -> None:
     """Inspect actions and send goals (list, send_goal)."""
 
@@ -464,7 +465,7 @@ def _indent(text: str) -> str:
 # -- node ----------------------------------------------------------------------------------------
 
 
-@click.group()
+@click.group(cls=VerbGroup)
 def node() -> None:
     """Inspect the nodes on the network (list)."""
 

@@ -6,8 +6,10 @@ from pathlib import Path
 
 import click
 
+from kinema.cli.groups import VerbGroup
 
-@click.group(invoke_without_command=True)
+
+@click.group(cls=VerbGroup, invoke_without_command=True)
 @click.option(
     "-d",
     "--dir",

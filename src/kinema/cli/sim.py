@@ -13,6 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
+from kinema.cli.groups import VerbGroup
 from kinema.errors import DriverError
 
 if TYPE_CHECKING:
@@ -39,7 +40,7 @@ def _client(connect: str | None, timeout: float) -> Iterator[SimClient]:
         yield SimClient(Node(session, f"_kinema_sim_cli_{os.getpid()}"), timeout)
 
 
-@click.group()
+@click.group(cls=VerbGroup)
 def sim() -> None:
     """Inspect and reset the running MuJoCo simulation (free bodies, keyframes, joints)."""
 

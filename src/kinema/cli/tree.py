@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Any
 
 import click
 
+from kinema.cli.groups import VerbGroup
 from kinema.cli.options import selection_options
 
 if TYPE_CHECKING:
@@ -44,7 +45,7 @@ def _factory(with_behaviors: bool) -> BehaviorTreeFactory:
     return host.registry.create_factory()
 
 
-@click.group()
+@click.group(cls=VerbGroup)
 def tree() -> None:
     """Run, validate and describe behavior-tree objectives (BT.CPP v4 XML)."""
 
