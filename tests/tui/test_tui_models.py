@@ -230,6 +230,19 @@ def test_the_status_line_shows_the_watchdog_warning_until_it_clears() -> None:
     assert "⚠" not in render_status(status).plain
 
 
+def test_the_status_line_says_how_to_get_a_runtime_in_80_columns() -> None:
+    # It showed "○ disconnected tcp/127.0.0.1:17901 — no Kinema router answers at" and the advice was cut.
+    from kinema.tui.widgets.status_bar import render_status
+
+    status = RuntimeStatus()
+    endpoint = "tcp/127.0.0.1:17901"
+    detail = f"no Kinema router answers at {endpoint} (start one with `kinema run`, or point --connect ...)"
+    status.apply_connection(ConnectionChanged(ConnectionState.DISCONNECTED, endpoint, detail))
+    line = render_status(status).plain
+    assert line == f"○ disconnected {endpoint} — none answers: `kinema run` starts one"
+    assert len(line) <= 78  # the bar's padding leaves 78 columns
+
+
 def test_closing_while_the_runtime_is_unreachable_does_not_wait_for_the_attempt() -> None:
     """Quitting `kinema ui` that is still trying to reach a runtime: joining a router that does not answer
     takes zenoh about 2 s, and the app used to wait for the attempt (up to 5 s) before it closed."""

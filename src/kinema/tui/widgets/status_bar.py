@@ -63,7 +63,7 @@ def render_status(status: RuntimeStatus) -> Text:
         text.append(f" {status.endpoint}", style="dim")
     if status.state is ConnectionState.DISCONNECTED:
         if status.detail:
-            text.append(f" — {status.detail}", style="red")
+            text.append(f" — {_short_detail(status.detail)}", style="red")
         return text
     text.append("  │  ")
     if status.objective:
@@ -89,3 +89,12 @@ def render_status(status: RuntimeStatus) -> Text:
 def _whole_seconds(warning: str) -> str:
     """``... for 3.4 s`` as ``... for 3 s``."""
     return re.sub(r"(\d+)\.\d s\b", r"\1 s", warning)
+
+
+def _short_detail(detail: str) -> str:
+    """Why the connection is down, short enough for one line at 80 columns: the endpoint is shown before
+    it already, and "no Kinema router answers at <endpoint> (start one with ...)" lost its advice."""
+    if detail.startswith("no Kinema router answers"):
+        return "none answers: `kinema run` starts one"
+    return detail
+
