@@ -339,9 +339,13 @@ def _gripper(
     if entry is None:
         if not grippers:
             return None
+        found = _gripper_from_srdf(resolved, control, grippers[0]) if len(grippers) == 1 else None
+        if found is not None:
+            return found
         raise ConfigError(
             f"controller {grippers[0].name!r} is a gripper controller, but robot.gripper does not say where "
-            "open and closed are: add robot.gripper {controller, joint, open_position, closed_position}",
+            "open and closed are: add robot.gripper {controller, joint, open_position, closed_position}, "
+            "or group states 'open' and 'close' of an SRDF group holding its joint",
             location=resolved.location_of("ros2_control"),
         )
     if not isinstance(entry, Mapping):
@@ -369,6 +373,36 @@ def _gripper(
         joint=str(joint),
         open_position=_number(resolved, entry["open_position"], "robot.gripper.open_position"),
         closed_position=_number(resolved, entry["closed_position"], "robot.gripper.closed_position"),
+    )
+
+
+def _gripper_from_srdf(
+    resolved: ResolvedConfig, control: dict[str, Any], controller: ControllerSpec
+) -> GripperConfig | None:
+    """A MoveIt Pro config's gripper, with no ``robot.gripper``: the controller's joint (ros2_control
+    yaml), open and closed from the SRDF group states ``open`` and ``close`` (or ``closed``) of a group
+    holding that joint, as MoveIt Pro's own gripper objectives move it. None when either is missing."""
+    from kinema.errors import KinemaError
+    from kinema.motion.srdf import parse_srdf
+
+    joint = _params(control, controller.name).get("joint") or (
+        controller.joints[0] if controller.joints else ""
+    )
+    if not joint:
+        return None
+    try:
+        states = parse_srdf(resolved.srdf_path).group_states
+    except KinemaError:
+        return None  # no SRDF, or one that does not read: robot_check and the planner say why
+    by_name = {name.lower(): values for (_group, name), values in states.items() if joint in values}
+    opened, closed = by_name.get("open"), by_name.get("close", by_name.get("closed"))
+    if opened is None or closed is None:
+        return None
+    return GripperConfig(
+        controller=controller.name,
+        joint=str(joint),
+        open_position=float(opened[joint]),
+        closed_position=float(closed[joint]),
     )
 
 

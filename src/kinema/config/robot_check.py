@@ -22,11 +22,8 @@ file (and line where known) and the names that would have been valid:
   like the joint, as the MuJoCo driver finds them), the tool frame is a URDF link, the F/T sensor's sites
   are in the scene.
 
-Where an ``<include>`` of the scene is looked for: beside the including file, then beside the scene (the
-two places MuJoCo itself looks), then in the ``mujoco_assets`` folder of each workspace package. The last
-is MoveIt Pro's layout, where a config's scene includes ``ur5e/...`` from ``picknik_accessories`` and its
-build installs those files beside the scene; asset files (meshes, textures) follow the same rule after
-the scene's folder, and files found there reach MuJoCo through its in-memory file system.
+Where an ``<include>`` or an asset of the scene is looked for is :mod:`kinema.config.mujoco_scene`'s rule,
+the one the simulation driver and ``kinema view`` load the scene by.
 
 A later check that needs an earlier one's result is skipped when that failed (no SRDF check without a
 URDF), so one mistake is reported once.
@@ -34,7 +31,6 @@ URDF), so one mistake is reported once.
 
 from __future__ import annotations
 
-import os
 from collections.abc import Callable, Iterable, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -42,26 +38,12 @@ from typing import TYPE_CHECKING, Any
 
 from lxml import etree
 
-from kinema.config.robot_files import is_ascii_stl
+from kinema.config.mujoco_scene import SceneFiles, asset_folders
 from kinema.errors import ConfigError, KinemaError, SourceLocation, did_you_mean
 
 if TYPE_CHECKING:
     from kinema.config.inheritance import ResolvedConfig
     from kinema.config.robot_files import PackageIndex
-
-#: Asset elements of MJCF that name a file, the attributes that do, and the compiler folder they use.
-_ASSET_FILES: dict[str, tuple[tuple[str, ...], str]] = {
-    "mesh": (("file",), "meshdir"),
-    "skin": (("file",), "meshdir"),
-    "hfield": (("file",), "meshdir"),
-    "texture": (
-        ("file", "fileright", "fileleft", "fileup", "filedown", "filefront", "fileback"),
-        "texturedir",
-    ),
-}
-_LFS_PREFIX = b"version https://git-lfs.github.com/spec/v1"
-#: LFS pointers named one by one before the rest are counted (a fresh clone has dozens).
-_POINTERS_SHOWN = 3
 
 
 @dataclass
@@ -395,15 +377,11 @@ def _check_scene(resolved: ResolvedConfig, urdf: _Urdf | None, report: RobotRepo
     if path is None:
         return None
     report.checked.append(path)
-    fallbacks = [
-        package.path / "mujoco_assets"
-        for package in resolved.workspace.packages.values()
-        if (package.path / "mujoco_assets").is_dir()
-    ]
-    files = _SceneFiles(path, fallbacks, report)
+    files = SceneFiles(path, asset_folders(resolved.workspace))
     if not files.check():
+        report.problems.extend(files.problems)  # every problem of its files, not only the first
         return None
-    model = _load_mujoco(path, files.virtual, report)
+    model = _attempt(report, files.model)
     if model is None:
         return None
     import mujoco
@@ -442,141 +420,6 @@ def _check_scene(resolved: ResolvedConfig, urdf: _Urdf | None, report: RobotRepo
             resolved.location_of(key),
         )
     return scene
-
-
-def _load_mujoco(path: Path, virtual: Mapping[str, Path], report: RobotReport) -> Any:
-    import mujoco
-
-    assets = {name: file.read_bytes() for name, file in virtual.items()}
-    try:
-        return mujoco.MjModel.from_xml_path(str(path), assets or None)
-    except (ValueError, RuntimeError) as exc:  # the files are there: what is left is the model itself
-        report.problem(f"MuJoCo cannot load the scene: {' '.join(str(exc).split())}", path)
-        return None
-
-
-class _SceneFiles:
-    """The files an MJCF scene and its includes name, found and checked before MuJoCo reads them.
-
-    Attributes:
-        virtual: files found only in a ``mujoco_assets`` folder, by the name MuJoCo will ask for.
-    """
-
-    def __init__(self, main: Path, fallbacks: list[Path], report: RobotReport) -> None:
-        self.main = main
-        self.fallbacks = fallbacks
-        self.report = report
-        self.virtual: dict[str, Path] = {}
-        self.documents: list[tuple[Path, etree._Element]] = []
-        self.pointers: list[tuple[str, Path, SourceLocation]] = []
-        self.ok = True
-
-    def check(self) -> bool:
-        """Read the scene and its includes and check every file; False when something is wrong."""
-        self._read(self.main, set())
-        compiler: dict[str, str] = {}
-        for _file, root in self.documents:
-            for element in root.iter("compiler"):
-                if element.get("assetdir"):
-                    compiler["meshdir"] = compiler["texturedir"] = element.get("assetdir", "")
-                for attribute in ("meshdir", "texturedir"):
-                    if element.get(attribute):
-                        compiler[attribute] = element.get(attribute, "")
-        for file, root in self.documents:
-            for element in root.iter(*_ASSET_FILES):
-                attributes, folder = _ASSET_FILES[str(element.tag)]
-                for attribute in attributes:
-                    if element.get(attribute):
-                        self._asset(element, attribute, compiler.get(folder, ""), file)
-        self._report_pointers()
-        return self.ok
-
-    def _problem(self, message: str, location: SourceLocation) -> None:
-        self.ok = False
-        self.report.problem(message, location)
-
-    def _read(self, file: Path, stack: set[Path]) -> None:
-        try:
-            root = etree.parse(str(file), etree.XMLParser(remove_comments=True)).getroot()
-        except etree.XMLSyntaxError as exc:
-            self._problem(
-                f"the MuJoCo scene is not valid XML: {exc.msg}", SourceLocation(str(file), exc.lineno or 0)
-            )
-            return
-        except OSError as exc:
-            self._problem(f"cannot read the MuJoCo scene: {exc}", SourceLocation(str(file)))
-            return
-        self.documents.append((file, root))
-        for include in root.iter("include"):
-            name = include.get("file", "")
-            where = SourceLocation(str(file), include.sourceline or 0)
-            places = [file.parent, self.main.parent, *self.fallbacks]
-            found = self._find(name, places, where, "include")
-            if found is None:
-                continue
-            if found.resolve() in stack:
-                self._problem(f"<include file={name!r}> includes itself ({found})", where)
-                continue
-            if self._pointer(found):
-                self.pointers.append(("include", found, where))
-                continue
-            if not _under(found, (file.parent, self.main.parent)):
-                self.virtual[name] = found
-            self._read(found, stack | {file.resolve()})
-
-    def _asset(self, element: etree._Element, attribute: str, folder: str, file: Path) -> None:
-        name = element.get(attribute, "")
-        relative = os.path.join(folder, name) if folder else name
-        where = SourceLocation(str(file), element.sourceline or 0)
-        found = self._find(relative, [self.main.parent, *self.fallbacks], where, str(element.tag))
-        if found is None:
-            return
-        if self._pointer(found):
-            self.pointers.append((str(element.tag), found, where))
-            return
-        if element.tag == "mesh" and is_ascii_stl(found):
-            self._problem(
-                f"mesh {found} is a text STL, which MuJoCo cannot read: save it as binary STL or OBJ", where
-            )
-        elif not _under(found, (self.main.parent,)):
-            self.virtual[relative] = found
-
-    def _find(self, name: str, places: list[Path], where: SourceLocation, kind: str) -> Path | None:
-        if not name:
-            self._problem(f"<{kind}> without a file name", where)
-            return None
-        candidates = [Path(name)] if Path(name).is_absolute() else [place / name for place in places]
-        for candidate in dict.fromkeys(candidates):
-            if candidate.is_file():
-                return candidate
-        looked = "; ".join(str(c) for c in dict.fromkeys(candidates))
-        self._problem(f"{kind} file {name!r} not found (looked for {looked})", where)
-        return None
-
-    @staticmethod
-    def _pointer(path: Path) -> bool:
-        try:
-            with path.open("rb") as handle:
-                return handle.read(len(_LFS_PREFIX)) == _LFS_PREFIX
-        except OSError:
-            return False
-
-    def _report_pointers(self) -> None:
-        for kind, path, where in self.pointers[:_POINTERS_SHOWN]:
-            self._problem(f"{kind} {path} is a Git LFS pointer file (run `git lfs pull`)", where)
-        rest = self.pointers[_POINTERS_SHOWN:]
-        if rest:
-            folders = sorted({str(path.parent) for _, path, _ in rest})
-            self._problem(
-                f"{len(rest)} more files the MuJoCo scene names are Git LFS pointer files (run `git lfs "
-                f"pull`), in {', '.join(folders)}",
-                rest[0][2],
-            )
-
-
-def _under(path: Path, folders: Iterable[Path]) -> bool:
-    resolved = path.resolve()
-    return any(resolved.is_relative_to(folder.resolve()) for folder in folders)
 
 
 # -- controllers, gripper, tool frame, sensor -------------------------------------------------------------

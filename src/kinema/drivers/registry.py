@@ -85,7 +85,12 @@ class DriverSpec:
 
 
 def _has_mujoco_model(config: ResolvedConfig) -> bool:
-    return config.get("hardware.simulation.mujoco_model") is not None
+    """A MuJoCo scene is named: Kinema's ``hardware.simulation.mujoco_model``, or MoveIt Pro's xacro argument
+    ``urdf_params: - mujoco_model: PATH`` of a config that is not for real hardware (``simulated: false``).
+    Whether the file is there is the driver's to say, with its path."""
+    if config.get("hardware.simulation.mujoco_model") is not None:
+        return True
+    return "mujoco_model" in config.urdf_params and config.get("hardware.simulated") is not False
 
 
 DRIVERS: dict[str, DriverSpec] = {
@@ -112,5 +117,5 @@ def driver_spec(name: str) -> DriverSpec:
 
 
 def drivers_for_config(config: ResolvedConfig) -> list[DriverSpec]:
-    """The drivers ``config`` needs, e.g. ``mujoco`` when it sets ``hardware.simulation.mujoco_model``."""
+    """The drivers ``config`` needs, e.g. ``mujoco`` when it names a MuJoCo scene (see _has_mujoco_model)."""
     return [spec for spec in DRIVERS.values() if spec.wanted_by(config)]

@@ -17,6 +17,7 @@ One :class:`CellFrames` belongs to a :class:`~kinema.behaviors.BehaviorContext` 
 
 from __future__ import annotations
 
+import pathlib
 import threading
 import time
 from typing import TYPE_CHECKING, Any
@@ -45,10 +46,12 @@ def fixed_camera_frames(mjcf_path: Any) -> dict[str, np.ndarray]:
     import mujoco
 
     import kinema.mujoco_gl  # noqa: F401  (MuJoCo's OpenGL backend is chosen before mujoco loads)
+    from kinema.config.mujoco_scene import load_scene
+    from kinema.errors import ConfigError
 
     try:
-        model = mujoco.MjModel.from_xml_path(str(mjcf_path))
-    except ValueError:
+        model = load_scene(pathlib.Path(mjcf_path))
+    except ConfigError:
         return {}
     data = mujoco.MjData(model)
     mujoco.mj_forward(model, data)  # camera poses come from mj_camlight, which this runs

@@ -462,10 +462,13 @@ class PlanningScene:
         """
         import mujoco
 
+        from kinema.config.mujoco_scene import load_scene
+        from kinema.errors import ConfigError
+
         try:
-            m = mujoco.MjModel.from_xml_path(str(scene_path))
-        except ValueError as exc:
-            raise MotionError(f"MuJoCo cannot load scene {scene_path}: {exc}") from exc
+            m = load_scene(Path(scene_path))
+        except ConfigError as exc:
+            raise MotionError(str(exc)) from None
         d = mujoco.MjData(m)
         key = mujoco.mj_name2id(m, mujoco.mjtObj.mjOBJ_KEY, keyframe)
         if key >= 0:

@@ -164,7 +164,6 @@ class LibraryTreeSource:
         self._loaded = sorted(i for i in self._library.objectives if i in registered and i not in problems)
         log.info("objective library: %d objectives runnable, %d not loaded", len(self._loaded), len(problems))
 
-
     def _reload_library(self) -> None:
         """Read the objective files again; a file that no longer reads keeps the objectives it had.
 

@@ -88,15 +88,11 @@ class SceneModel:
         Raises:
             ConfigError: the file is missing or MuJoCo cannot load it.
         """
-        import mujoco
+        from kinema.config.mujoco_scene import load_scene
 
         if not path.is_file():
             raise ConfigError(f"MuJoCo scene {path} does not exist")
-        try:
-            model = mujoco.MjModel.from_xml_path(str(path))
-        except ValueError as error:
-            raise ConfigError(f"{path}: MuJoCo cannot load the scene: {error}") from error
-        return cls(model, end_effector, keyframe)
+        return cls(load_scene(path), end_effector, keyframe)
 
     # -- building the scene ---------------------------------------------------------------------------
 

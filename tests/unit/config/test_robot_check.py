@@ -324,6 +324,14 @@ def test_an_include_is_found_in_a_packages_mujoco_assets(lab_sim: Path) -> None:
     scene = lab_sim / "src" / "lab_sim" / "description" / "lab_sim_scene.xml"
     edit(scene, "</mujoco>", '<include file="props/props.xml"/>\n</mujoco>')
     assert check_robot(resolve_config("lab_sim", Workspace.discover(lab_sim))) == []
+    # The simulation driver, kinema view and the planning scene load it by the same rule (they gave
+    # MuJoCo's "Error opening file 'props/props.xml'" where the build was happy).
+    import mujoco
+
+    from kinema.config.mujoco_scene import load_scene
+
+    model = load_scene(scene)
+    assert mujoco.mj_name2id(model, mujoco.mjtObj.mjOBJ_BODY, "prop") >= 0
 
 
 # -- MoveIt Pro's own lab_sim, as a clone without `git lfs pull` has it -------------------------------------
@@ -354,6 +362,23 @@ def test_moveit_pro_lab_sim_stops_at_the_lfs_pointers_and_absent_packages(
     # the xacro with urdf_params.
     assert resolved.chain == ["picknik_ur_base_config", "lab_sim"]
     assert resolved.urdf_params["mujoco_model"] == "description/scene.xml"
+    # kinema run starts the simulation for it (urdf_params names the scene), which stops at the same
+    # first problem: it ran with no simulation at all, and every motion waited for controllers in vain.
+    from kinema.config.mujoco_scene import load_scene
+    from kinema.drivers.registry import drivers_for_config
+
+    assert [spec.name for spec in drivers_for_config(resolved)] == ["mujoco"]
+    # Its gripper comes from what MoveIt Pro's files say (the controller's joint, the SRDF's open and
+    # close states), not from a Kinema-only robot.gripper section.
+    from kinema.config.cell import CellSettings, GripperConfig
+
+    assert CellSettings.from_config(resolved).gripper == GripperConfig(
+        "robotiq_gripper_controller", "robotiq_85_left_knuckle_joint", 0.05, 0.79
+    )
+    model_path = resolved.mujoco_model_path
+    assert model_path is not None
+    with pytest.raises(ConfigError, match=r"is a Git LFS pointer file \(run `git lfs pull`\) \(and \d+ more"):
+        load_scene(model_path)
     code, out = build(moveit_pro_workspace, "lab_sim", capsys)
     assert code == 1
     robot = out[out.index("TreeNodesModel for Groot2") :]
@@ -373,3 +398,4 @@ def test_moveit_pro_lab_sim_stops_at_the_lfs_pointers_and_absent_packages(
         assert words.lower() not in out.lower(), words
     # The robot's names themselves fit: no SRDF, joint limits or waypoint complaints.
     assert "picknik_ur.srdf" not in robot and "joint_limits.yaml" not in robot and "waypoints" not in robot
+    assert "robot.gripper" not in out

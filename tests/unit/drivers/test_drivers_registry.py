@@ -13,10 +13,14 @@ from kinema.errors import DriverError
 
 
 class NoSimulation:
-    """A resolved config without a MuJoCo scene (only ``get`` is consulted)."""
+    """A resolved config without a MuJoCo scene (only ``get`` and ``urdf_params`` are consulted)."""
+
+    def __init__(self, urdf_params: dict[str, str] | None = None, simulated: bool | None = None) -> None:
+        self.urdf_params = urdf_params or {}
+        self.simulated = simulated
 
     def get(self, key: str, default: Any = None) -> Any:
-        return default
+        return self.simulated if key == "hardware.simulated" else default
 
 
 def test_lab_sim_needs_the_mujoco_driver() -> None:
@@ -25,6 +29,13 @@ def test_lab_sim_needs_the_mujoco_driver() -> None:
 
 def test_a_config_without_a_scene_needs_no_driver() -> None:
     assert drivers_for_config(NoSimulation()) == []  # type: ignore[arg-type]
+
+
+def test_moveit_pro_s_urdf_params_scene_needs_the_mujoco_driver_unless_the_config_is_for_hardware() -> None:
+    # A MoveIt Pro package names its scene as a xacro argument; it ran with no simulation at all.
+    scene = {"mujoco_model": "description/scene.xml"}
+    assert [spec.name for spec in drivers_for_config(NoSimulation(scene))] == ["mujoco"]  # type: ignore[arg-type]
+    assert drivers_for_config(NoSimulation(scene, simulated=False)) == []  # type: ignore[arg-type]
 
 
 def test_the_command_line_runs_the_module_with_the_options_given() -> None:

@@ -156,15 +156,17 @@ def _admittance_options(
 
 
 def _load_model(settings: MujocoDriverSettings) -> Any:
-    import mujoco
+
+    from kinema.config.mujoco_scene import load_scene
+    from kinema.errors import ConfigError
 
     path = settings.model_path
     if not path.is_file():
         raise DriverError(f"MuJoCo scene {path} does not exist")
     try:
-        return mujoco.MjModel.from_xml_path(str(path))
-    except ValueError as error:
-        raise DriverError(f"{path}: MuJoCo cannot load the scene: {error}") from error
+        return load_scene(path)
+    except ConfigError as error:
+        raise DriverError(str(error)) from None
 
 
 class MujocoDriver:

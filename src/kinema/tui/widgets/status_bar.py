@@ -97,4 +97,3 @@ def _short_detail(detail: str) -> str:
     if detail.startswith("no Kinema router answers"):
         return "none answers: `kinema run` starts one"
     return detail
-
