@@ -111,12 +111,15 @@ def init_security_folder(
     """Write (or complete) the security folder at ``path``.
 
     An existing CA is kept (certificates it signed stay valid) unless ``force``; the router's certificate,
-    the client configs and ``router.json5`` are written anew every time.
+    the configs of the clients named and ``router.json5`` are written anew every time. With the CA kept,
+    the clients an earlier run gave access keep it (and their config files): running it again adds
+    clients, and a client named again takes the role given now.
 
     Raises:
         TransportError: a bad address or client name, or the folder cannot be written.
     """
     _check_names([*clients, *machines])
+    clients_named = [*clients, *machines]
     unknown = [name for name in xml_clients if name not in clients]
     if unknown:
         raise TransportError(
@@ -127,7 +130,11 @@ def init_security_folder(
     try:
         path.mkdir(parents=True, exist_ok=True)
         os.chmod(path, 0o700)
+        earlier = (holders(path) or []) if not force else []
         ca_key, ca_cert, reused = _certificate_authority(path, force=force)
+        if reused:
+            clients, machines, xml_clients = _with_earlier(earlier, clients, machines, xml_clients)
+        named = set(clients_named)
         san_ips = list(dict.fromkeys([ipaddress.ip_address("127.0.0.1"), *ips]))
         san_names = ["localhost", socket.gethostname(), *names]
         router_key, router_cert = _leaf("kinema-router", ca_key, ca_cert, san_ips, san_names)
@@ -148,7 +155,7 @@ def init_security_folder(
             ),
         )
         written = []
-        for client in [*clients, *machines]:
+        for client in [name for name in [*clients, *machines] if name in named]:
             key, cert = _leaf(client, ca_key, ca_cert, [], [client])
             config = client_config(tls_endpoints[0], _cert_pem(ca_cert), _cert_pem(cert), _key_pem(key))
             target = path / CLIENTS / f"{client}.json5"
@@ -165,6 +172,29 @@ def init_security_folder(
     except OSError as error:
         raise TransportError(f"cannot write the security folder {path}: {error.strerror or error}") from None
     return SecurityFolder(path, tuple(reachable), tls_endpoints, tuple(written), reused)
+
+
+def _with_earlier(
+    earlier: Sequence[tuple[str, str]],
+    clients: Sequence[str],
+    machines: Sequence[str],
+    xml_clients: Sequence[str],
+) -> tuple[list[str], list[str], list[str]]:
+    """The clients, machines and XML clients of this run plus those of ``earlier`` (``holders``) that it
+    does not name: a name given now takes the role given now."""
+    named = {*clients, *machines}
+    out_clients, out_machines, out_xml = list(clients), list(machines), list(xml_clients)
+    for name, role in earlier:
+        if name in named:
+            continue
+        named.add(name)
+        if role.startswith("machine"):
+            out_machines.append(name)
+        else:
+            out_clients.append(name)
+            if role == "operator with XML":
+                out_xml.append(name)
+    return out_clients, out_machines, out_xml
 
 
 def router_config(
