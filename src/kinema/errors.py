@@ -89,3 +89,12 @@ def did_you_mean(value: str, choices: Iterable[str], *, limit: int = 8) -> str:
     if close:
         return f"did you mean {' or '.join(repr(c) for c in close)}? Valid: {listing}"
     return f"valid: {listing}"
+
+
+def zenoh_message(error: BaseException) -> str:
+    """A zenoh error's text without the place in zenoh's Rust sources it ends with (``at /root/.cargo/
+    .../lib.rs:1507.``): nothing a user can act on."""
+    import re
+
+    return re.sub(r"\s+at /\S+\.rs:\d+\.?$", "", str(error).strip())
+

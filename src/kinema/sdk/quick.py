@@ -14,7 +14,7 @@ import time
 from collections.abc import Callable, Iterable, Mapping
 from typing import Any
 
-from kinema.errors import TransportError
+from kinema.errors import TransportError, zenoh_message
 from kinema.runtime import quick_protocol as quick
 from kinema.runtime.objective_status import ObjectiveStatus
 from kinema.runtime.overrides import ParameterOverride
@@ -115,7 +115,7 @@ class QuickClient:
         try:
             config = zenoh.Config.from_file(config_file) if config_file else zenoh.Config()
         except zenoh.ZError as error:
-            raise TransportError(f"{config_file}: cannot load zenoh config: {error}") from None
+            raise TransportError(f"{config_file}: cannot load zenoh config: {zenoh_message(error)}") from None
         if config_file and connect is None and not os.environ.get("KINEMA_ZENOH_CONNECT"):
             self.endpoints = [str(e) for e in json.loads(config.get_json("connect/endpoints")) or []]
         else:

@@ -25,7 +25,7 @@ import weakref
 from collections.abc import Callable, Iterable, Mapping, Sequence
 from typing import TYPE_CHECKING, Any, Literal
 
-from kinema.errors import TransportError
+from kinema.errors import TransportError, zenoh_message
 from kinema.transport.exposure import ExposureError, check_listeners
 
 if TYPE_CHECKING:
@@ -154,7 +154,7 @@ def build_config(
     try:
         config = zenoh.Config.from_file(config_file) if config_file else zenoh.Config()
     except Exception as error:
-        raise TransportError(f"{config_file}: cannot load zenoh config: {error}") from error
+        raise TransportError(f"{config_file}: cannot load zenoh config: {zenoh_message(error)}") from error
     settings: dict[str, Any] = {
         "mode": mode,
         "scouting/multicast/enabled": False,
@@ -327,7 +327,7 @@ def _open_raw(config: zenoh.Config, what: str) -> zenoh.Session:
     try:
         return zenoh.open(config)
     except zenoh.ZError as error:
-        raise TransportError(f"cannot open a zenoh session ({what}): {error}") from error
+        raise TransportError(f"cannot open a zenoh session ({what}): {zenoh_message(error)}") from error
 
 
 def open_session(
@@ -393,19 +393,51 @@ def open_session(
         endpoints = _configured_endpoints(config, "connect/endpoints", mode)
     check_listeners(config, _configured_endpoints(config, "listen/endpoints", mode), insecure=insecure)
     where = ", ".join(endpoints) or "no endpoint"
-    raw = _open_raw(config, f"{mode} connecting to {where}")
+    try:
+        raw = _open_raw(config, f"{mode} connecting to {where}")
+    except TransportError as error:
+        if "Unable to connect to any of" in str(error):  # a client whose router does not answer
+            raise TransportError(_no_router_message(where, endpoints, config)) from None
+        raise
     session = Session(raw, domain_id=domain, mode=mode, endpoints=endpoints, listen=listen_endpoints)
     if endpoints:
         deadline = time.monotonic() + connect_timeout
         while not (session.connected_routers() or session.connected_peers()):
             if time.monotonic() >= deadline:
                 session.close()
-                raise TransportError(
-                    f"no Kinema router answers at {where} (start one with `kinema run`, "
-                    f"or point --connect / {ENV_CONNECT} at a running one)"
-                )
+                raise TransportError(_no_router_message(where, endpoints, config))
             time.sleep(0.005)
     return session
+
+
+def _no_router_message(where: str, endpoints: Sequence[str], config: zenoh.Config) -> str:
+    """Why nothing answered, with what to do: over TLS, a router may be there and refuse the handshake
+    (a certificate of another CA, an expired one, files that are not there), which looks the same."""
+    message = (
+        f"no Kinema router answers at {where} (start one with `kinema run`, or point --connect / "
+        f"{ENV_CONNECT} at a running one)"
+    )
+    if not any(endpoint.startswith("tls/") for endpoint in endpoints):
+        return message
+    missing = [path for path in _tls_files(config) if not os.path.isfile(path)]
+    if missing:
+        return f"{message}; the TLS files of {ENV_CONFIG} are not there: {', '.join(missing)}"
+    return (
+        f"{message}; if one runs there, it refused this machine's certificate: check that {ENV_CONFIG} is "
+        "a client config of that cell's `kinema security init` (same CA, not expired)"
+    )
+
+
+def _tls_files(config: zenoh.Config) -> list[str]:
+    """The certificate and key files a zenoh config names for its TLS links (inline ones are not files)."""
+    import zenoh
+
+    try:
+        tls = json.loads(config.get_json("transport/link/tls"))
+    except (zenoh.ZError, ValueError):
+        return []
+    keys = ("root_ca_certificate", "connect_certificate", "connect_private_key")
+    return [str(tls[key]) for key in keys if isinstance(tls, dict) and isinstance(tls.get(key), str)]
 
 
 def host_router(

@@ -6,6 +6,7 @@ import subprocess
 import sys
 import textwrap
 from collections.abc import Callable
+from pathlib import Path
 
 import pytest
 
@@ -50,6 +51,35 @@ def test_host_or_join_joins_an_existing_router(endpoints: Callable[[], str]) -> 
 def test_open_session_fails_fast_without_a_router(endpoints: Callable[[], str]) -> None:
     with pytest.raises(TransportError, match=r"no Kinema router answers at tcp/127\.0\.0\.1"):
         open_session(endpoints(), connect_timeout=0.2)
+
+
+def test_a_tls_link_that_gets_nowhere_says_what_may_be_wrong_with_its_certificates(
+    endpoints: Callable[[], str], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # Every TLS failure said only "start one with `kinema run`", with a router running there.
+    port = endpoints().rsplit(":", 1)[1]
+    with pytest.raises(
+        TransportError, match=r"it refused this machine's certificate: check that KINEMA_ZENOH"
+    ):
+        open_session(f"tls/127.0.0.1:{port}", connect_timeout=0.2)
+    config = tmp_path / "laptop.json5"
+    config.write_text(
+        '{ mode: "client", connect: { endpoints: ["tls/127.0.0.1:' + port + '"] }, transport: { link: { tls: '
+        '{ root_ca_certificate: "/nowhere/ca.pem", connect_certificate: "/nowhere/laptop.pem", '
+        'connect_private_key: "/nowhere/laptop.key", enable_mtls: true } } } }'
+    )
+    monkeypatch.setenv("KINEMA_ZENOH_CONFIG", str(config))
+    monkeypatch.delenv("KINEMA_ZENOH_CONNECT", raising=False)
+    with pytest.raises(TransportError) as error:
+        open_session(connect_timeout=0.2)
+    assert "the TLS files of KINEMA_ZENOH_CONFIG are not there: /nowhere/ca.pem, /nowhere/laptop.pem" in str(
+        error.value
+    )
+    # zenoh's own words keep out the place in its Rust sources.
+    monkeypatch.setenv("KINEMA_ZENOH_CONFIG", str(tmp_path / "absent.json5"))
+    with pytest.raises(TransportError) as error:
+        open_session(connect_timeout=0.2)
+    assert ".rs:" not in str(error.value) and "absent.json5: cannot load zenoh config" in str(error.value)
 
 
 def test_environment_selects_endpoint_and_domain(monkeypatch: pytest.MonkeyPatch) -> None:
