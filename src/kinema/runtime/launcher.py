@@ -191,6 +191,16 @@ class Launcher:
             self.stop()
             self.run_folder.discard()  # nothing was started: its logs are not a run's
             raise
+        except KinemaError:
+            started = self.session is not None
+            self.stop()
+            if not started:
+                # Refused before a router was hosted or joined (a listener it may not open, no router to
+                # join): the terminal has the reason, and an empty run must not become `kinema logs`'
+                # newest. A run whose driver or agent did not start keeps its folder: the message points
+                # into it.
+                self.run_folder.discard()
+            raise
         except BaseException:
             self.stop()
             raise

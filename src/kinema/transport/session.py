@@ -533,7 +533,7 @@ def host_or_join(
             target, domain_id, config_file=config_file, config_overrides=config_overrides, insecure=insecure
         )
     except ExposureError as refusal:
-        log.info("not hosting a router at %s (%s); joining one there", target, refusal)
+        log.info("not hosting a router at %s (%s); trying to join one that runs there", target, refusal)
         if before_join is not None:
             before_join(target)
         try:

@@ -91,6 +91,9 @@ def test_a_plain_listener_beyond_loopback_is_refused_and_insecure_warns(
     assert f"refusing to listen on {everywhere}" in refused.stderr, refused.stderr
     assert "kinema security init" in refused.stderr and "--insecure" in refused.stderr
     assert "Traceback" not in refused.stderr + refused.stdout and READY not in refused.stdout
+    # Nothing ran: no run folder is left to become `kinema logs`' newest run.
+    runs = Path(env["XDG_STATE_HOME"]) / "kinema" / "runs"
+    assert not runs.is_dir() or not any(runs.iterdir()), sorted(runs.iterdir())
 
     run = Running(env, "--insecure", "--connect", everywhere)
     running.append(run)
