@@ -19,7 +19,8 @@ def example() -> None:
     "-e",
     default=None,
     metavar="ENDPOINT",
-    help="Router to join (default: $KINEMA_ZENOH_CONNECT, else tcp/127.0.0.1:7447).",
+    help="Router to join (default: $KINEMA_ZENOH_CONNECT, else the endpoint of $KINEMA_ZENOH_CONFIG, else "
+    "tcp/127.0.0.1:7447).",
 )
 def add_two_ints_server(name: str, connect: str | None) -> None:
     """Serve example_interfaces/srv/AddTwoInts (the tutorial's external service); print each request."""

@@ -331,7 +331,8 @@ connect_option = click.option(
     "-e",
     default=None,
     metavar="ENDPOINT",
-    help="Router to join (default: $KINEMA_ZENOH_CONNECT, else tcp/127.0.0.1:7447).",
+    help="Router to join (default: $KINEMA_ZENOH_CONNECT, else the endpoint of $KINEMA_ZENOH_CONFIG, else "
+    "tcp/127.0.0.1:7447).",
 )
 timeout_option = click.option(
     "--timeout",

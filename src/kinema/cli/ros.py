@@ -26,7 +26,10 @@ from kinema.errors import TransportError
 if TYPE_CHECKING:
     from kinema.transport import Graph, Node
 
-_CONNECT_HELP = "Router endpoint to join (default: $KINEMA_ZENOH_CONNECT or tcp/127.0.0.1:7447)."
+_CONNECT_HELP = (
+    "Router endpoint to join (default: $KINEMA_ZENOH_CONNECT, else the endpoint of $KINEMA_ZENOH_CONFIG, "
+    "else tcp/127.0.0.1:7447)."
+)
 
 
 def _common(default_timeout: float) -> Callable[[Callable[..., Any]], Callable[..., Any]]:

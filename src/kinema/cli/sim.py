@@ -19,7 +19,10 @@ from kinema.errors import DriverError
 if TYPE_CHECKING:
     from kinema.drivers.mujoco.client import SimClient
 
-_CONNECT_HELP = "Router endpoint to join (default: $KINEMA_ZENOH_CONNECT or tcp/127.0.0.1:7447)."
+_CONNECT_HELP = (
+    "Router endpoint to join (default: $KINEMA_ZENOH_CONNECT, else the endpoint of $KINEMA_ZENOH_CONFIG, "
+    "else tcp/127.0.0.1:7447)."
+)
 
 
 def _common(func: Callable[..., Any]) -> Callable[..., Any]:

@@ -20,7 +20,7 @@ SCREEN_CHOICES = ("configs", "objectives", "blackboard", "behaviors", "logs", "w
     default=None,
     metavar="ENDPOINT",
     help="Zenoh endpoint of the runtime, e.g. tcp/192.168.1.20:7447 "
-    "(default: $KINEMA_ZENOH_CONNECT, else tcp/127.0.0.1:7447).",
+    "(default: $KINEMA_ZENOH_CONNECT, else the endpoint of $KINEMA_ZENOH_CONFIG, else tcp/127.0.0.1:7447).",
 )
 @click.option(
     "-s",

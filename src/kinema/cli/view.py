@@ -17,7 +17,7 @@ from kinema.cli.options import selection_options
     default=None,
     metavar="ENDPOINT",
     help="Zenoh endpoint of the runtime, e.g. tcp/192.168.1.20:7447 "
-    "(default: $KINEMA_ZENOH_CONNECT, else tcp/127.0.0.1:7447).",
+    "(default: $KINEMA_ZENOH_CONNECT, else the endpoint of $KINEMA_ZENOH_CONFIG, else tcp/127.0.0.1:7447).",
 )
 @click.option("--no-browser", is_flag=True, help="Only print the URL; do not open a browser.")
 @click.option(

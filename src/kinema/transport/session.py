@@ -482,6 +482,23 @@ def host_router(
     return session
 
 
+def default_endpoints() -> list[str]:
+    """Where :func:`open_session` connects when given no endpoint: ``KINEMA_ZENOH_CONNECT``, else the
+    connect endpoints of the ``KINEMA_ZENOH_CONFIG`` file, else ``tcp/127.0.0.1:7447``."""
+    config_file = os.environ.get(ENV_CONFIG)
+    if config_file and not os.environ.get(ENV_CONNECT):
+        import zenoh
+
+        try:
+            config = zenoh.Config.from_file(config_file)
+            found = _configured_endpoints(config, "connect/endpoints", _file_mode(config_file))
+        except Exception:  # open_session says what is wrong with the file
+            found = []
+        if found:
+            return found
+    return resolve_endpoints(None)
+
+
 def _file_mode(config_file: str | None) -> str:
     """The mode a zenoh config file sets (``peer``, zenoh's default, when none or unreadable)."""
     if not config_file:

@@ -150,9 +150,10 @@ class SdkConnection:
     def endpoint(self) -> str:
         if self._endpoint:
             return self._endpoint
-        from kinema.transport import resolve_endpoints
+        from kinema.transport.session import default_endpoints
 
-        return ", ".join(resolve_endpoints(None))
+        # A client config's endpoint (KINEMA_ZENOH_CONFIG) is where the session goes, not 7447.
+        return ", ".join(default_endpoints())
 
     @property
     def config_name(self) -> str | None:

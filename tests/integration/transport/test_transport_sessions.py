@@ -82,6 +82,23 @@ def test_a_tls_link_that_gets_nowhere_says_what_may_be_wrong_with_its_certificat
     assert ".rs:" not in str(error.value) and "absent.json5: cannot load zenoh config" in str(error.value)
 
 
+def test_with_a_client_config_the_default_endpoint_is_the_config_s(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    # kinema ui showed "connected tcp/127.0.0.1:7447" while its session went to the config's TLS endpoint.
+    from kinema.transport.session import default_endpoints
+    from kinema.tui.sdk_connection import SdkConnection
+
+    config = tmp_path / "laptop.json5"
+    config.write_text('{ mode: "client", connect: { endpoints: ["tls/192.0.2.7:7448"] } }')
+    monkeypatch.setenv("KINEMA_ZENOH_CONFIG", str(config))
+    monkeypatch.delenv("KINEMA_ZENOH_CONNECT", raising=False)
+    assert default_endpoints() == ["tls/192.0.2.7:7448"]
+    assert SdkConnection().endpoint == "tls/192.0.2.7:7448"
+    monkeypatch.setenv("KINEMA_ZENOH_CONNECT", "tcp/127.0.0.1:9000")
+    assert default_endpoints() == ["tcp/127.0.0.1:9000"]
+
+
 def test_environment_selects_endpoint_and_domain(monkeypatch: pytest.MonkeyPatch) -> None:
     monkeypatch.setenv("KINEMA_ZENOH_CONNECT", "tcp/10.0.0.5:7447, tcp/10.0.0.6:7447")
     monkeypatch.setenv("ROS_DOMAIN_ID", "7")
