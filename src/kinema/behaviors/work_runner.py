@@ -14,6 +14,7 @@ stop as soon as it runs again: it finishes the tasks it holds, then its thread e
 from __future__ import annotations
 
 import concurrent.futures
+import sys
 import threading
 import time
 from collections.abc import Callable, Coroutine
@@ -73,7 +74,12 @@ class WorkRunner:
         with self._lock:
             if self._loop is None or self._loop_thread is None:
                 return None
-            return time.monotonic() - self._beats[0], self._loop_thread.ident
+            seconds, ident = time.monotonic() - self._beats[0], self._loop_thread.ident
+        if seconds > 2 * LOOP_BEAT_S and _waiting_for_events(ident):
+            # Its beat is late, but the loop waits for work: nothing blocks it, the process did not get
+            # the processor (a machine under load), and the next beat comes once it does.
+            return 0.0, ident
+        return seconds, ident
 
     def retire_blocked_loop(self) -> None:
         """Run new coroutines on a fresh event loop; the current one (blocked) stops once it unblocks."""
@@ -123,6 +129,16 @@ class WorkRunner:
                 started.wait()
                 self._loop, self._loop_thread, self._beats = loop, thread, beats
             return self._loop
+
+
+def _waiting_for_events(thread_id: int | None) -> bool:
+    """True when the event loop on thread ``thread_id`` sits in its selector, waiting for work."""
+    frame = sys._current_frames().get(thread_id) if thread_id is not None else None
+    return (
+        frame is not None
+        and frame.f_code.co_name == "select"
+        and frame.f_code.co_filename.endswith("selectors.py")
+    )
 
 
 def _finish_then_stop(loop: asyncio.AbstractEventLoop) -> None:

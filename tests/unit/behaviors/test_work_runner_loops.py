@@ -54,3 +54,19 @@ def test_a_retired_loop_finishes_its_tasks_then_its_thread_ends_and_the_loop_clo
     fresh_thread.join(10)
     assert not fresh_thread.is_alive()
     assert _fds() <= fds_before, "the retired loops' selectors and self-pipes were not closed"
+
+
+def test_a_late_beat_of_a_loop_that_waits_for_work_is_not_a_blocked_loop() -> None:
+    # On a loaded machine the loop's beat came 2.3 s late with no coroutine running, and the watchdog
+    # reported "in a coroutine for 2.3 s" and retired a loop that nothing blocked.
+    runner = WorkRunner()
+
+    async def quick() -> str:
+        return "done"
+
+    assert runner.run_coroutine(quick()).result(10) == "done"
+    time.sleep(0.1)  # the loop now waits in its selector
+    runner._beats[0] = time.monotonic() - 5.0  # as if the process had not run for 5 s
+    blocked = runner.blocked_loop()
+    assert blocked is not None and blocked[0] == 0.0
+    runner.retire_blocked_loop()
