@@ -190,7 +190,8 @@ def objective_folder(path: Path) -> Path:
     folder = Path(path).expanduser().resolve()
     if not folder.is_dir():
         raise ConfigError(f"{path} is not a folder")
-    if not any(folder.glob("*.xml")) and (folder / "objectives").is_dir():
+    package = (folder / "package.xml").is_file()  # a package's own XML files (package.xml, scenes) are none
+    if (folder / "objectives").is_dir() and (package or not any(folder.glob("*.xml"))):
         folder = folder / "objectives"
     if not any(folder.rglob("*.xml")):
         raise ConfigError(f"{folder} holds no objective XML files")

@@ -33,13 +33,18 @@ USES_HELPER = """<root BTCPP_format="4" main_tree_to_execute="Uses Helper">
 
 @pytest.fixture
 def folder(tmp_path: Path) -> Path:
-    """MoveIt Pro's seven compat objectives, a broken file, and a runnable one whose SubTree is elsewhere."""
+    """A package with MoveIt Pro's seven compat objectives, a broken file, and a runnable one whose SubTree
+    is elsewhere."""
     if not (SHARED / "objectives").is_dir():
         pytest.skip(f"MoveIt Pro's compat objectives are not at {SHARED / 'objectives'}")
     checked = tmp_path / "package"
     shutil.copytree(SHARED / "objectives", checked / "objectives")
     (checked / "objectives" / "broken.xml").write_text(BROKEN)
     (checked / "objectives" / "uses_helper.xml").write_text(USES_HELPER)
+    # A package's own XML files are no objectives: its package.xml and its MuJoCo scene are not counted.
+    (checked / "package.xml").write_text("<package format='3'><name>package</name></package>")
+    (checked / "description").mkdir()
+    (checked / "description" / "scene.xml").write_text("<mujoco/>")
     (tmp_path / "helpers").mkdir()
     (tmp_path / "helpers" / "helper.xml").write_text(SUBTREE_ONLY)
     return checked
