@@ -179,7 +179,8 @@ def down(timeout: float) -> None:
 
     Every `kinema run` recorded in the user's state folder ($XDG_STATE_HOME) stops cleanly, with its
     agent, drivers and router: a cell split with `kinema run -n` and `kinema run -o` stops whole.
-    SIGTERM first, SIGKILL after --timeout seconds.
+    SIGTERM first, SIGKILL after --timeout seconds. A `kinema view` or `kinema ui` started on its own
+    keeps running: it shows that the runtime went away and follows the next one.
     """
     from kinema.runtime.instance import stop_all
 
