@@ -63,10 +63,13 @@ def plan_router(endpoint: str | None, security_dir: Path | None = None) -> Route
         config_file = folder / ROUTER_CONFIG
         if not config_file.is_file():
             host = split_endpoint(secure[0])[1]
+            unspecified = host.strip("[]") in ("0.0.0.0", "::")
+            # A certificate names the addresses clients dial: every address of this machine by default,
+            # never 0.0.0.0 (listening there is fine once the certificate covers the real ones).
+            init = "kinema security init" if unspecified else f"kinema security init --address {host}"
             raise KinemaError(
                 f"listening on {secure[0]} needs the certificates and access rules of a security folder, "
-                f"and {folder} has none: run `kinema security init --address {host}` first (or pass "
-                "--security DIR)"
+                f"and {folder} has none: run `{init}` first (or pass --security DIR)"
             )
     if secure and local is None and not joining_with_certificates:
         environment = resolve_endpoints(None)[0] if os.environ.get("KINEMA_ZENOH_CONNECT") else ""

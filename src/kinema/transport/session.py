@@ -324,6 +324,10 @@ class Session:
 def _open_raw(config: zenoh.Config, what: str) -> zenoh.Session:
     import zenoh
 
+    if os.environ.get("RUST_LOG"):
+        # zenoh logs (TLS handshakes, links) only once asked to: RUST_LOG=zenoh=debug shows why a link
+        # fails. Once per process; a second call is refused quietly.
+        zenoh.try_init_log_from_env()
     try:
         return zenoh.open(config)
     except zenoh.ZError as error:

@@ -86,6 +86,10 @@ def test_run_plans_a_loopback_listener_for_its_own_processes(
     monkeypatch.setenv("KINEMA_SECURITY_DIR", str(tmp_path / "nowhere"))
     with pytest.raises(KinemaError, match=r"kinema security init --address 192\.168\.1\.10"):
         plan_router("tls/192.168.1.10:7448")
+    # Every interface: the certificate covers this machine's addresses, never "--address 0.0.0.0".
+    with pytest.raises(KinemaError, match=r"run `kinema security init` first") as error:
+        plan_router("tls/0.0.0.0:7448")
+    assert "--address" not in str(error.value)
     (tmp_path / "router.json5").write_text("{}")
     plan = plan_router("tls/192.168.1.10:7448", tmp_path)
     assert plan.listen == ("tcp/127.0.0.1:7447", "tls/192.168.1.10:7448")
