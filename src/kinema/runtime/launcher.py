@@ -373,10 +373,17 @@ class Launcher:
                         continue
                     return 1
                 if code is not None:
-                    log.error("%s exited with code %s", child.name, code)
-                    self.options.echo(
-                        f"{child.name} exited unexpectedly (code {code}); see {child.log_file}; stopping"
+                    gave_up = (
+                        f" after {AGENT_RESTARTS} restarts"
+                        if child.name == "agent" and self.agent_restarts >= AGENT_RESTARTS > 0
+                        else ""
                     )
+                    message = (
+                        f"{child.name} exited unexpectedly (code {code}){gave_up}; see {child.log_file}; "
+                        "stopping the runtime"
+                    )
+                    log.error("%s", message)
+                    self.options.echo(message)
                     return 1
         log.info("stopping (%s)", self._stop_reason or "requested")
         return 0
