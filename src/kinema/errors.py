@@ -97,4 +97,3 @@ def zenoh_message(error: BaseException) -> str:
     import re
 
     return re.sub(r"\s+at /\S+\.rs:\d+\.?$", "", str(error).strip())
-

@@ -8,6 +8,7 @@ import click
 
 from kinema.cli.groups import VerbGroup
 from kinema.cli.options import workspace_option
+from kinema.scaffold.names import BEHAVIOR_TYPES
 
 
 @click.group(cls=VerbGroup)
@@ -200,17 +201,7 @@ def _new_robot_config(
     "-t",
     "--type",
     "behavior_type",
-    type=click.Choice(
-        [
-            "sync",
-            "stateful",
-            "async",
-            "service_client",
-            "action_client",
-            "topic_subscriber",
-            "topic_publisher",
-        ]
-    ),
+    type=click.Choice(BEHAVIOR_TYPES),
     default="async",
     show_default=True,
     help="The base class: sync (one tick), stateful (over several ticks, on the tick thread), async (work "

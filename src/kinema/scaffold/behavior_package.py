@@ -23,18 +23,9 @@ from typing import Any
 from kinema.config.workspace import Package, Workspace
 from kinema.errors import ConfigError, ScaffoldError, did_you_mean
 from kinema.scaffold.generate import generate
-from kinema.scaffold.names import module_name_problem, package_name_problem
+from kinema.scaffold.names import BEHAVIOR_TYPES, module_name_problem, package_name_problem
 
 TEMPLATE = "behavior_package"
-BEHAVIOR_TYPES = (
-    "sync",
-    "stateful",
-    "async",
-    "service_client",
-    "action_client",
-    "topic_subscriber",
-    "topic_publisher",
-)
 
 
 @dataclass

@@ -14,6 +14,18 @@ import sys
 
 from kinema.errors import ScaffoldError
 
+#: The kinds of behavior ``kinema new behavior --type`` makes (a template folder each; the template's own
+#: hook lists them again, for cookiecutter run on it directly).
+BEHAVIOR_TYPES = (
+    "sync",
+    "stateful",
+    "async",
+    "service_client",
+    "action_client",
+    "topic_subscriber",
+    "topic_publisher",
+)
+
 _PACKAGE_NAME = re.compile(r"^[a-z](?:[a-z0-9]|_(?!_))*$")
 MAX_NAME_LENGTH = 100
 _NAME_RULE = (
