@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import threading
+import time
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -10,6 +12,8 @@ import click
 if TYPE_CHECKING:
     from kinema.runtime.run_folder import RunFolder
 
+#: How often `kinema logs -f` looks whether its run still runs (seconds).
+RUN_CHECK_S = 0.5
 _RUN_HELP = "A run folder name (see the state folder's runs/) instead of the newest run."
 
 
@@ -26,7 +30,12 @@ def _run_folder(run_name: str | None) -> RunFolder:
 
 
 @click.command()
-@click.option("-f", "--follow", is_flag=True, help="Keep printing new entries as they come (Ctrl-C stops).")
+@click.option(
+    "-f",
+    "--follow",
+    is_flag=True,
+    help="Keep printing new entries as they come, until the run stops (or Ctrl-C).",
+)
 @click.option(
     "--level",
     default="debug",
@@ -57,11 +66,29 @@ def logs(follow: bool, level: str, run_name: str | None, list_recordings: bool) 
     for entry in merged_entries(folder.log_files(), min_level=min_level):
         click.echo(entry.text)
     if follow:
+        stop = threading.Event()
+        threading.Thread(target=_stop_when_the_run_ends, args=(folder, stop), daemon=True).start()
         try:
-            for entry in follow_entries(folder.path, min_level=min_level):
+            for entry in follow_entries(folder.path, min_level=min_level, stop=stop):
                 click.echo(entry.text)
         except KeyboardInterrupt:
             return
+        click.echo(f"(run {folder.name} ended)", err=True)
+
+
+def _stop_when_the_run_ends(folder: RunFolder, stop: threading.Event) -> None:
+    """Set ``stop`` once no live `kinema run` writes into ``folder`` (a moment later, so that its last
+    entries are read): following a run that ended would wait for ever."""
+    from kinema.runtime.instance import running_instances
+
+    def live() -> bool:
+        where = str(folder.path)
+        return any(record.run_folder == where for record in running_instances())
+
+    while live():
+        time.sleep(RUN_CHECK_S)
+    time.sleep(2 * RUN_CHECK_S)  # the follower reads the run's last lines meanwhile
+    stop.set()
 
 
 def _print_recordings(folder: RunFolder) -> None:

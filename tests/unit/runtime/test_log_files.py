@@ -63,3 +63,22 @@ def test_follow_yields_only_what_is_appended_later(tmp_path: Path) -> None:
         handle.write("2026-01-01 10:00:01.000 INFO    [agent] new\n")
     thread.join(5)
     assert seen == ["2026-01-01 10:00:01.000 INFO    [agent] new"]
+
+
+def test_following_a_run_that_no_longer_runs_ends(
+    tmp_path: Path, monkeypatch: pytest.MonkeyPatch, capsys: pytest.CaptureFixture[str]
+) -> None:
+    # `kinema logs -f` followed a stopped run until Ctrl-C.
+    import time
+
+    from kinema.cli.main import main
+
+    monkeypatch.setenv("XDG_STATE_HOME", str(tmp_path))
+    run = tmp_path / "kinema" / "runs" / "20260101-100000-000001-lab_sim"
+    run.mkdir(parents=True)
+    _write(run / "agent.log", ["2026-01-01 10:00:00.100 INFO    [agent] loaded 3 objectives"])
+    started = time.monotonic()
+    assert main(["logs", "-f", "--run", run.name]) == 0
+    assert time.monotonic() - started < 10
+    out, err = capsys.readouterr()
+    assert "loaded 3 objectives" in out and f"(run {run.name} ended)" in err
