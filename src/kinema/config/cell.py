@@ -391,18 +391,13 @@ def _gripper_from_srdf(
     if not joint:
         return None
     try:
-        states = parse_srdf(resolved.srdf_path).group_states
+        opened, closed = parse_srdf(resolved.srdf_path).gripper_positions(str(joint))
     except KinemaError:
         return None  # no SRDF, or one that does not read: robot_check and the planner say why
-    by_name = {name.lower(): values for (_group, name), values in states.items() if joint in values}
-    opened, closed = by_name.get("open"), by_name.get("close", by_name.get("closed"))
     if opened is None or closed is None:
         return None
     return GripperConfig(
-        controller=controller.name,
-        joint=str(joint),
-        open_position=float(opened[joint]),
-        closed_position=float(closed[joint]),
+        controller=controller.name, joint=str(joint), open_position=opened, closed_position=closed
     )
 
 

@@ -56,6 +56,18 @@ class SemanticDescription:
     #: ``file:line: what was skipped and why`` for each element without an attribute it needs.
     notes: tuple[str, ...] = ()
 
+    def gripper_positions(self, joint: str) -> tuple[float | None, float | None]:
+        """``(open, closed)`` of ``joint`` from the group states named ``open`` and ``close`` (or
+        ``closed``) that set it, as MoveIt Pro's gripper objectives move it; None for one not given."""
+        by_name = {
+            name.lower(): values for (_group, name), values in self.group_states.items() if joint in values
+        }
+        opened, closed = by_name.get("open"), by_name.get("close", by_name.get("closed"))
+        return (
+            None if opened is None else float(opened[joint]),
+            None if closed is None else float(closed[joint]),
+        )
+
     def collision_disabled(self, link1: str, link2: str) -> bool:
         """True when the SRDF says the pair ``link1``/``link2`` is never checked."""
         return frozenset((link1, link2)) in self.disabled_collisions

@@ -299,19 +299,17 @@ def plan_robot(
     opened = closed = 0.0
     if gripper is not None:
         joint = joints[gripper]
-        states = {s.lower(): v for (g, s), v in semantic.group_states.items() if gripper in v}
-        open_state = states.get("open")
-        closed_state = states.get("close", states.get("closed"))
         low = joint.lower if joint.lower is not None else 0.0
         high = joint.upper if joint.upper is not None else 0.0
         if joint.kind == "prismatic":
             opened, closed = high, low
         else:
             opened, closed = low, high
+        open_state, closed_state = semantic.gripper_positions(gripper)
         if open_state is not None:
-            opened = float(open_state[gripper])
+            opened = open_state
         if closed_state is not None:
-            closed = float(closed_state[gripper])
+            closed = closed_state
         home[gripper] = opened
     generated = not groups
     try:
