@@ -32,7 +32,7 @@ URDF), so one mistake is reported once.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
@@ -73,6 +73,9 @@ class _Urdf:
     source: Path
     joints: dict[str, Any]  # name -> kinema.config.robot_files.UrdfJoint
     links: list[str]
+    # The collision checker of the robot as the planner loads it (None when pinocchio could not): the
+    # waypoint check reuses it rather than loading the meshes again.
+    checker: Any = None
 
     @property
     def movable_joints(self) -> list[str]:
@@ -107,7 +110,7 @@ def robot_report(resolved: ResolvedConfig) -> RobotReport:
     _check_waypoints(resolved, urdf, report)
     _check_cell(resolved, urdf, scene, report)
     if not report.problems:  # each name is known: where the robot stands at each waypoint means something
-        _check_waypoint_collisions(resolved, index, report)
+        _check_waypoint_collisions(resolved, urdf, report)
     return report
 
 
@@ -152,12 +155,13 @@ def _check_urdf(resolved: ResolvedConfig, index: PackageIndex, report: RobotRepo
         report.problem("the URDF has no movable joints (revolute, continuous or prismatic)", source)
     robot = _attempt(report, lambda: resolve_robot_text(source, text, index=index))
     if robot is not None:
-        _check_pinocchio(resolved, index, report)
+        urdf = replace(urdf, checker=_check_pinocchio(resolved, index, report))
     return urdf
 
 
-def _check_pinocchio(resolved: ResolvedConfig, index: PackageIndex, report: RobotReport) -> None:
-    """Pinocchio loads the URDF the planner loads, and its collision model builds."""
+def _check_pinocchio(resolved: ResolvedConfig, index: PackageIndex, report: RobotReport) -> Any:
+    """Pinocchio loads the URDF the planner loads, and its collision model builds; returns its collision
+    checker (None when it does not load)."""
     from kinema.config.robot_description import planning_urdf
     from kinema.errors import MotionError
     from kinema.motion.collision import CollisionChecker
@@ -165,12 +169,12 @@ def _check_pinocchio(resolved: ResolvedConfig, index: PackageIndex, report: Robo
 
     path = _attempt(report, lambda: planning_urdf(resolved, check_meshes=False))
     if path is None:
-        return
+        return None
     try:
-        model = RobotModel.from_urdf(path, package_dirs=index.package_dirs())
-        CollisionChecker(model)
+        return CollisionChecker(RobotModel.from_urdf(path, package_dirs=index.package_dirs()))
     except MotionError as error:
         report.problem(error.message, error.location or resolved.urdf_path)
+        return None
 
 
 # -- SRDF ------------------------------------------------------------------------------------------------
@@ -318,22 +322,22 @@ def _check_waypoints(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport)
             )
 
 
-def _check_waypoint_collisions(resolved: ResolvedConfig, index: PackageIndex, report: RobotReport) -> None:
+def _check_waypoint_collisions(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport) -> None:
     """A waypoint where two of the robot's links overlap (the SRDF's disabled pairs left out) is a warning:
     no motion can start or end there, and the usual cause is a pair the SRDF should disable (links that
     touch by design, as MoveIt's setup assistant finds them in the default state)."""
-    from kinema.config.robot_description import planning_urdf
     from kinema.config.waypoints import Waypoint
     from kinema.config.yamlsource import load_yaml_file
-    from kinema.motion.collision import CollisionChecker, disable_collisions_advice, self_collisions
-    from kinema.motion.robot_model import RobotModel
+    from kinema.motion.collision import self_collision_warning, self_collisions
+    from kinema.motion.srdf import parse_srdf
 
+    checker = urdf.checker
+    if checker is None:
+        return  # pinocchio did not load the robot: _check_pinocchio said why
     try:
         srdf = resolved.srdf_path
-        model = RobotModel.from_urdf(
-            planning_urdf(resolved, check_meshes=False), srdf, package_dirs=index.package_dirs()
-        )
-        checker = CollisionChecker(model)
+        # The checker was built without the SRDF: its disabled pairs are what the planner allows.
+        checker.allowed_collisions = parse_srdf(srdf).disabled_collisions
         path = resolved.waypoints_path
         document = load_yaml_file(path) if path is not None else None
     except KinemaError:
@@ -347,11 +351,9 @@ def _check_waypoint_collisions(resolved: ResolvedConfig, index: PackageIndex, re
             continue
         pairs = self_collisions(checker, waypoint.joint_positions())
         if pairs:
-            overlaps = ", ".join(f"{a} - {b}" for a, b in pairs)
-            advice = disable_collisions_advice(pairs, srdf.name)
+            where = document.location((number, "name"))
             report.warnings.append(
-                f"{document.location((number, 'name'))}: waypoint {waypoint.name!r} is in self-collision "
-                f"({overlaps}): no motion can start or end there. {advice}"
+                f"{where}: {self_collision_warning(f'waypoint {waypoint.name!r}', pairs, srdf.name)}"
             )
 
 

@@ -301,11 +301,16 @@ def self_collisions(checker: CollisionChecker, positions: Mapping[str, float]) -
     return checker.colliding_pairs(q)
 
 
-def disable_collisions_advice(pairs: Sequence[tuple[str, str]], srdf: str) -> str:
-    """What to add to ``srdf`` if the link ``pairs`` touch by design: one ``<disable_collisions>`` each
-    (reason ``Default``, as MoveIt's setup assistant names a pair in collision in the default state)."""
+def self_collision_warning(what: str, pairs: Sequence[tuple[str, str]], srdf: str) -> str:
+    """``what`` (a waypoint, ``Home``) is in self-collision with the link ``pairs``, and what to add to
+    ``srdf`` if they touch by design: one ``<disable_collisions>`` each (reason ``Default``, as MoveIt's
+    setup assistant names a pair in collision in the default state)."""
+    overlaps = ", ".join(f"{first} - {second}" for first, second in pairs)
     elements = " ".join(
         f'<disable_collisions link1="{first}" link2="{second}" reason="Default"/>' for first, second in pairs
     )
     them = "the pair" if len(pairs) == 1 else "the pairs"
-    return f"If these links touch by design, disable {them} in {srdf}: {elements}"
+    return (
+        f"{what} is in self-collision ({overlaps}): no motion can start or end there. If these links touch "
+        f"by design, disable {them} in {srdf}: {elements}"
+    )

@@ -326,13 +326,9 @@ def plan_robot(
             + ", ".join(f"{a} - {b}" for a, b in overlapping)
         )
     elif overlapping:
-        from kinema.motion.collision import disable_collisions_advice
+        from kinema.motion.collision import self_collision_warning
 
-        notes.append(
-            f"{HOME} is in self-collision ("
-            + ", ".join(f"{a} - {b}" for a, b in overlapping)
-            + f"): no motion can start or end there. {disable_collisions_advice(overlapping, 'the SRDF')}"
-        )
+        notes.append(self_collision_warning(HOME, overlapping, "the SRDF"))
     waypoints = {HOME: dict(home)}
     for (_group, state), values in semantic.group_states.items():
         waypoint = dict(home)
