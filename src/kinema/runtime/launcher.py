@@ -187,18 +187,14 @@ class Launcher:
                     self.options.echo(f"Groot2: connect to 127.0.0.1 port {options.groot2_port}")
             if options.viewer:
                 self._start_viewer()
-        except CellError:
+        except KinemaError as error:
+            # Refused before anything ran (another run holds the cell, a listener it may not open, no
+            # router to join): the terminal has the reason, and the empty run must not become `kinema
+            # logs`' newest. A run whose driver or agent did not start keeps its folder: the message
+            # points into it.
+            refused = isinstance(error, CellError) or self.session is None
             self.stop()
-            self.run_folder.discard()  # nothing was started: its logs are not a run's
-            raise
-        except KinemaError:
-            started = self.session is not None
-            self.stop()
-            if not started:
-                # Refused before a router was hosted or joined (a listener it may not open, no router to
-                # join): the terminal has the reason, and an empty run must not become `kinema logs`'
-                # newest. A run whose driver or agent did not start keeps its folder: the message points
-                # into it.
+            if refused:
                 self.run_folder.discard()
             raise
         except BaseException:
