@@ -874,7 +874,7 @@ class ObjectiveServer:
                     tree, run.request.overrides, objective_name=name, defaults=defaults, parameters=declared
                 )
                 given = {o.name for o in (*defaults, *run.request.overrides)}
-                run.unset_parameters = tuple(p for p in (model.ports if model else ()) if p not in given)
+                run.unset_parameters = tuple(p for p in declared if p not in given)
         except Abandoned:
             raise
         except KinemaError as error:
