@@ -119,7 +119,7 @@ def init_security_folder(
         TransportError: a bad address or client name, or the folder cannot be written.
     """
     _check_names([*clients, *machines])
-    clients_named = [*clients, *machines]
+    given = {*clients, *machines}  # their config files are written; earlier clients keep theirs
     unknown = [name for name in xml_clients if name not in clients]
     if unknown:
         raise TransportError(
@@ -134,7 +134,6 @@ def init_security_folder(
         ca_key, ca_cert, reused = _certificate_authority(path, force=force)
         if reused:
             clients, machines, xml_clients = _with_earlier(earlier, clients, machines, xml_clients)
-        named = set(clients_named)
         san_ips = list(dict.fromkeys([ipaddress.ip_address("127.0.0.1"), *ips]))
         san_names = ["localhost", socket.gethostname(), *names]
         router_key, router_cert = _leaf("kinema-router", ca_key, ca_cert, san_ips, san_names)
@@ -155,7 +154,7 @@ def init_security_folder(
             ),
         )
         written = []
-        for client in [name for name in [*clients, *machines] if name in named]:
+        for client in [name for name in [*clients, *machines] if name in given]:
             key, cert = _leaf(client, ca_key, ca_cert, [], [client])
             config = client_config(tls_endpoints[0], _cert_pem(ca_cert), _cert_pem(cert), _key_pem(key))
             target = path / CLIENTS / f"{client}.json5"

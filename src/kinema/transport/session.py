@@ -495,7 +495,8 @@ def default_endpoints() -> list[str]:
 
         try:
             config = zenoh.Config.from_file(config_file)
-            found = _configured_endpoints(config, "connect/endpoints", _file_mode(config_file))
+            mode = str(json.loads(config.get_json("mode")))
+            found = _configured_endpoints(config, "connect/endpoints", mode)
         except Exception:  # open_session says what is wrong with the file
             found = []
         if found:
