@@ -44,6 +44,7 @@ from kinema.errors import ConfigError, KinemaError, SourceLocation, did_you_mean
 if TYPE_CHECKING:
     from kinema.config.inheritance import ResolvedConfig
     from kinema.config.robot_files import PackageIndex
+    from kinema.motion.srdf import SemanticDescription
 
 
 @dataclass
@@ -105,12 +106,13 @@ def robot_report(resolved: ResolvedConfig) -> RobotReport:
     scene = _check_scene(resolved, urdf, report)
     if urdf is None:
         return report
-    _check_srdf(resolved, urdf, report)
+    semantic = _check_srdf(resolved, urdf, report)
     _check_joint_limits(resolved, urdf, report)
     _check_waypoints(resolved, urdf, report)
     _check_cell(resolved, urdf, scene, report)
-    if not report.problems:  # each name is known: where the robot stands at each waypoint means something
-        _check_waypoint_collisions(resolved, urdf, report)
+    if not report.problems and semantic is not None:
+        # Each name is known: where the robot stands at each waypoint means something.
+        _check_waypoint_collisions(resolved, urdf, semantic, report)
     return report
 
 
@@ -180,17 +182,18 @@ def _check_pinocchio(resolved: ResolvedConfig, index: PackageIndex, report: Robo
 # -- SRDF ------------------------------------------------------------------------------------------------
 
 
-def _check_srdf(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport) -> None:
+def _check_srdf(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport) -> SemanticDescription | None:
+    """Check the SRDF's names against the URDF; its semantic description when it reads."""
     path = _attempt(report, lambda: resolved.srdf_path)
     if path is None:
-        return
+        return None
     report.checked.append(path)
     try:
         root = etree.parse(str(path)).getroot()
     except (OSError, etree.XMLSyntaxError) as exc:
         line = getattr(exc, "lineno", 0) or 0
         report.problem(f"the SRDF cannot be read: {exc}", SourceLocation(str(path), line))
-        return
+        return None
 
     def where(element: etree._Element) -> SourceLocation:
         return SourceLocation(str(path), element.sourceline or 0)
@@ -210,8 +213,10 @@ def _check_srdf(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport) -> N
     from kinema.errors import MotionError
     from kinema.motion.srdf import parse_srdf
 
+    semantic: SemanticDescription | None = None
     try:
-        report.warnings.extend(parse_srdf(path).notes)
+        semantic = parse_srdf(path)
+        report.warnings.extend(semantic.notes)
     except MotionError as error:
         report.problem(error.message, error.location or path)
     joints, links = list(urdf.joints), urdf.links
@@ -259,6 +264,7 @@ def _check_srdf(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport) -> N
                 f"{where(pair)}: <disable_collisions> names {', '.join(map(repr, unknown))}, not a link of "
                 f"{urdf.source.name}; the pair is ignored"
             )
+    return semantic
 
 
 def _is_below(tip: str, base: str, parent_of: Mapping[str, str]) -> bool:
@@ -322,22 +328,23 @@ def _check_waypoints(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport)
             )
 
 
-def _check_waypoint_collisions(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport) -> None:
+def _check_waypoint_collisions(
+    resolved: ResolvedConfig, urdf: _Urdf, semantic: SemanticDescription, report: RobotReport
+) -> None:
     """A waypoint where two of the robot's links overlap (the SRDF's disabled pairs left out) is a warning:
     no motion can start or end there, and the usual cause is a pair the SRDF should disable (links that
     touch by design, as MoveIt's setup assistant finds them in the default state)."""
     from kinema.config.waypoints import Waypoint
     from kinema.config.yamlsource import load_yaml_file
     from kinema.motion.collision import self_collision_warning, self_collisions
-    from kinema.motion.srdf import parse_srdf
 
     checker = urdf.checker
     if checker is None:
         return  # pinocchio did not load the robot: _check_pinocchio said why
+    # The checker was built without the SRDF: its disabled pairs are what the planner allows.
+    checker.allowed_collisions = semantic.disabled_collisions
     try:
         srdf = resolved.srdf_path
-        # The checker was built without the SRDF: its disabled pairs are what the planner allows.
-        checker.allowed_collisions = parse_srdf(srdf).disabled_collisions
         path = resolved.waypoints_path
         document = load_yaml_file(path) if path is not None else None
     except KinemaError:
