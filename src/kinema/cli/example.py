@@ -24,24 +24,16 @@ def example() -> None:
 )
 def add_two_ints_server(name: str, connect: str | None) -> None:
     """Serve example_interfaces/srv/AddTwoInts (the tutorial's external service); print each request."""
-    import signal
-    import threading
-
+    from kinema.process.stop import TERMINATE, StopRequest
     from kinema.transport import Node, open_session
-
-    stop = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
 
     def add(request):  # type: ignore[no-untyped-def]
         total = int(request.a) + int(request.b)
         click.echo(f"request: a={request.a} b={request.b} -> sum={total}")
         return {"sum": total}
 
-    with open_session(connect) as session:
+    with StopRequest().handle_signals(TERMINATE) as stop, open_session(connect) as session:
         node = Node(session, "add_two_ints_server")
         node.create_service("example_interfaces/srv/AddTwoInts", name, add)
         click.echo(f"serving {name} [example_interfaces/srv/AddTwoInts]; Ctrl-C stops")
-        try:
-            stop.wait()
-        except KeyboardInterrupt:
-            pass
+        stop.wait()

@@ -12,7 +12,6 @@ from __future__ import annotations
 import argparse
 import logging
 import os
-import signal
 import sys
 import threading
 from dataclasses import dataclass, field
@@ -20,6 +19,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, Literal
 
 from kinema.errors import KinemaError
+from kinema.process.stop import TERMINATE, StopRequest
 
 if TYPE_CHECKING:
     from kinema.runtime.agent import Agent
@@ -28,8 +28,6 @@ if TYPE_CHECKING:
 log = logging.getLogger("kinema.agent")
 
 ClockChoice = Literal["auto", "wall", "sim"]
-# How often the main thread, waiting for SIGTERM/SIGINT, returns to Python code to run a pending handler.
-SIGNAL_POLL_S = 0.25
 
 
 @dataclass
@@ -279,10 +277,13 @@ def main(argv: list[str] | None = None) -> int:
     from kinema.mujoco_gl import no_rendering
 
     no_rendering()  # it reads MuJoCo scenes (planning scene, camera frames) but never renders
-    stop = threading.Event()
-    signal.signal(signal.SIGTERM, lambda *_: stop.set())
-    signal.signal(signal.SIGINT, lambda *_: stop.set())
-    lifeline.hold()
+    with StopRequest().handle_signals(TERMINATE) as stop:
+        lifeline.hold()
+        return _serve(args, stop)
+
+
+def _serve(args: argparse.Namespace, stop: StopRequest) -> int:
+    """Build the agent, serve until ``stop``, close it; exit 1 with one line on stderr if it cannot start."""
     # Before zenoh's threads start: a refused 50 MB request must not stay resident in their heaps.
     from kinema.transport.heap import bound_heap_growth
 
@@ -332,11 +333,7 @@ def main(argv: list[str] | None = None) -> int:
         with os.fdopen(args.ready_fd, "w") as ready:
             ready.write("ready\n")
     try:
-        # Woken now and then: CPython runs a signal's handler on the main thread only, when it next
-        # executes Python code. A SIGTERM the kernel hands to one of the transport's threads would
-        # otherwise wait for a wake-up that never comes, and the agent would outlive its `kinema down`.
-        while not stop.wait(SIGNAL_POLL_S):
-            pass
+        stop.wait()  # a signal's stop is noticed within kinema.process.stop.POLL_S
     finally:
         log.info("agent stopping")
         agent.close()

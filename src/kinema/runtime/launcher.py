@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Any
 
 from kinema.errors import KinemaError, TransportError
 from kinema.process.lifeline import Lifeline
+from kinema.process.stop import TERMINATE, StopRequest
 from kinema.runtime.cell import CellError
 from kinema.runtime.cell_claim import CellClaim
 from kinema.runtime.instance import InstanceRecord
@@ -130,8 +131,7 @@ class Launcher:
         self.children: list[Child] = []
         self.record: InstanceRecord | None = None
         self.lifeline: Lifeline | None = None
-        self._stop = threading.Event()
-        self._stop_reason = ""
+        self._stop = StopRequest()
         self._echo_stop = threading.Event()
         self._config: Any = None
         self._clock = "auto"
@@ -288,7 +288,7 @@ class Launcher:
                 log.info("%s is ready", child.name)
                 return
         if self._stop.is_set():
-            raise KinemaError(f"interrupted ({self._stop_reason}) while {child.name} was starting")
+            raise KinemaError(f"interrupted ({self._stop.reason}) while {child.name} was starting")
         tail = _tail(child.log_file, 8)
         raise KinemaError(
             f"{child.name} did not start (exit code {child.process.poll()}); end of {child.log_file}:\n{tail}"
@@ -351,9 +351,8 @@ class Launcher:
     # -- run and stop -----------------------------------------------------------------------------------
 
     def request_stop(self, reason: str = "") -> None:
-        """Ask :meth:`wait` to return (signal handlers call this)."""
-        self._stop_reason = self._stop_reason or reason
-        self._stop.set()
+        """Ask :meth:`wait` to return (the TUI calls this when it closes; SIGTERM and Ctrl-C do the same)."""
+        self._stop.set(reason)
 
     def wait(self) -> int:
         """Block until a stop is requested or a child exits; return the exit code for the CLI."""
@@ -381,7 +380,7 @@ class Launcher:
                     log.error("%s", message)
                     self.options.echo(message)
                     return 1
-        log.info("stopping (%s)", self._stop_reason or "requested")
+        log.info("stopping (%s)", self._stop.reason or "requested")
         return 0
 
     def _restart_agent(self, crashed: Child, code: int) -> bool:
@@ -436,37 +435,33 @@ class Launcher:
 
     def run(self) -> int:
         """Start, block (or run the UI), stop; SIGINT and SIGTERM stop cleanly. Returns the exit code."""
-        previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
-        signal.signal(signal.SIGTERM, lambda *_: self.request_stop("SIGTERM"))
-        signal.signal(signal.SIGINT, lambda *_: self.request_stop("Ctrl-C"))
-        ready = False
-        try:
-            self.start()
-            assert self.run_folder is not None
-            role = "hosting the router" if self.hosting else "joined the router"
-            what = (
-                "objectives can be started"
-                if self.options.agent
-                else "drivers only; objectives run by an agent elsewhere"
-            )
-            self.options.echo(
-                f"Kinema is running: {what} (config {self.options.config}, {role} at "
-                f"{self.endpoint}, logs in {self.run_folder.path}). Stop with Ctrl-C or `kinema down`."
-            )
-            ready = True
-            self._watch_cell()
-            if self.options.ui is not None:
-                return self.options.ui(self)
-            self._echo_plugin_reports()
-            return self.wait()
-        finally:
-            self.stop()
-            if ready:
-                # The last line in the terminal: after the UI's screen is gone, the ready line above would
-                # otherwise read as if the runtime were still up.
-                self.options.echo(f"Kinema stopped (config {self.options.config}).")
-            for sig, handler in previous.items():
-                signal.signal(sig, handler)
+        with self._stop.handle_signals(TERMINATE):
+            ready = False
+            try:
+                self.start()
+                assert self.run_folder is not None
+                role = "hosting the router" if self.hosting else "joined the router"
+                what = (
+                    "objectives can be started"
+                    if self.options.agent
+                    else "drivers only; objectives run by an agent elsewhere"
+                )
+                self.options.echo(
+                    f"Kinema is running: {what} (config {self.options.config}, {role} at "
+                    f"{self.endpoint}, logs in {self.run_folder.path}). Stop with Ctrl-C or `kinema down`."
+                )
+                ready = True
+                self._watch_cell()
+                if self.options.ui is not None:
+                    return self.options.ui(self)
+                self._echo_plugin_reports()
+                return self.wait()
+            finally:
+                self.stop()
+                if ready:
+                    # The last line in the terminal: after the UI's screen is gone, the ready line above would
+                    # otherwise read as if the runtime were still up.
+                    self.options.echo(f"Kinema stopped (config {self.options.config}).")
 
     def _open_router(self) -> Session:
         """Host (or join) the router as planned from ``--connect``; say what listens beyond loopback."""
@@ -579,7 +574,7 @@ def _runnable_module(module: str) -> bool:
         return False
 
 
-def _wait_ready(stream: Any, process: subprocess.Popen[bytes], timeout: float, stop: threading.Event) -> bool:
+def _wait_ready(stream: Any, process: subprocess.Popen[bytes], timeout: float, stop: StopRequest) -> bool:
     """Wait for the child's ``ready`` line; False when it exits, times out or a stop is requested."""
     import select
 
@@ -593,7 +588,7 @@ def _wait_ready(stream: Any, process: subprocess.Popen[bytes], timeout: float, s
     return False
 
 
-def _read_line(stream: Any, process: subprocess.Popen[bytes], timeout: float, stop: threading.Event) -> str:
+def _read_line(stream: Any, process: subprocess.Popen[bytes], timeout: float, stop: StopRequest) -> str:
     """The child's first line on ``stream`` ("" when it exits, times out or a stop is requested)."""
     import select
 

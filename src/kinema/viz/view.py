@@ -14,9 +14,7 @@ from __future__ import annotations
 
 import logging
 import os
-import signal
 import sys
-import threading
 import webbrowser
 from collections.abc import Callable
 from dataclasses import dataclass, field
@@ -24,6 +22,7 @@ from pathlib import Path
 from typing import Any
 
 from kinema.errors import ConfigError
+from kinema.process.stop import TERMINATE, StopRequest
 
 log = logging.getLogger("kinema.viz")
 
@@ -205,22 +204,17 @@ def open_browser(url: str) -> bool:
 def run_viewer(options: ViewerOptions, ready: Callable[[str], None] | None = None) -> int:
     """Start the viewer, print the URL, open the browser, block until Ctrl-C or SIGTERM; returns 0."""
     viewer = start_viewer(options)
-    stop = threading.Event()
-    previous = {sig: signal.getsignal(sig) for sig in (signal.SIGINT, signal.SIGTERM)}
-    for sig in previous:
-        signal.signal(sig, lambda *_: stop.set())
-    try:
-        options.echo(
-            f"3D view of {viewer.source.config}: {viewer.url} (runtime at {viewer.endpoint}; Ctrl-C to stop)"
-        )
-        if ready is not None:
-            ready(viewer.url)
-        if options.open_browser and not open_browser(viewer.url):
-            options.echo("no graphical browser here: open the URL above in one")
-        while not stop.wait(0.5):
-            pass
-        return 0
-    finally:
-        viewer.close()
-        for sig, handler in previous.items():
-            signal.signal(sig, handler)
+    with StopRequest().handle_signals(TERMINATE) as stop:
+        try:
+            options.echo(
+                f"3D view of {viewer.source.config}: {viewer.url} "
+                f"(runtime at {viewer.endpoint}; Ctrl-C to stop)"
+            )
+            if ready is not None:
+                ready(viewer.url)
+            if options.open_browser and not open_browser(viewer.url):
+                options.echo("no graphical browser here: open the URL above in one")
+            stop.wait()
+            return 0
+        finally:
+            viewer.close()

@@ -34,7 +34,7 @@ with host_router(sys.argv[1]) as session:
     while count[0] != last or time.monotonic() < settled:
         last = count[0]
         time.sleep(0.2)
-    if count[0] < {COUNT} * 0.9:  # a loaded machine may drop a few best-effort samples, not the stream
+    if count[0] < {COUNT}:
         sys.exit(f"received {{count[0]}} of {COUNT} messages")
     resident_kb, mapping = 0, ""
     for line in open("/proc/self/smaps"):
@@ -49,14 +49,16 @@ with host_router(sys.argv[1]) as session:
 
 WRITER = f"""
 import sys, time
+import zenoh
 from kinema.transport import open_session
 with open_session(sys.argv[1]) as session:
-    publisher = session.zenoh.declare_publisher("{KEY}")
+    # Every message arrives, on a loaded machine too: the pool's offsets advance with each one sent.
+    publisher = session.zenoh.declare_publisher("{KEY}", congestion_control=zenoh.CongestionControl.BLOCK)
     time.sleep(0.5)  # the route to the reader is in place
     for number in range({COUNT}):
         publisher.put(bytes([number % 256]) * {SIZE})
         if number % 100 == 0:
-            time.sleep(0.005)  # as a cell sends them: a stream, not one burst the queues drop
+            time.sleep(0.005)  # as a cell sends them: a stream, not one burst
     time.sleep(1.0)
 """
 

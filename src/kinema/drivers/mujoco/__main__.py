@@ -12,14 +12,12 @@ from __future__ import annotations
 import argparse
 import logging
 import os
-import signal
 import sys
-import threading
 from collections.abc import Sequence
 from pathlib import Path
-from types import FrameType
 
 from kinema.errors import DriverError, KinemaError
+from kinema.process.stop import TERMINATE, StopRequest
 
 log = logging.getLogger("kinema.drivers.mujoco")
 
@@ -90,24 +88,17 @@ def main(argv: Sequence[str] | None = None) -> int:
     from kinema.process.log_files import configure_process_logging
 
     configure_process_logging(args.log_file, verbose=args.verbose)
-    stop = threading.Event()
-
-    def request_stop(signum: int, _frame: FrameType | None) -> None:
-        log.info("received %s; stopping", signal.Signals(signum).name)
-        stop.set()
-
-    signal.signal(signal.SIGTERM, request_stop)
-    signal.signal(signal.SIGINT, request_stop)
-    lifeline.hold()
-    try:
-        return _run(args, stop)
-    except KinemaError as error:
-        log.error("%s", error)
-        print(f"error: {error}", file=sys.stderr)
-        return 1
+    with StopRequest().handle_signals({sig: sig.name for sig in TERMINATE}) as stop:
+        lifeline.hold()
+        try:
+            return _run(args, stop)
+        except KinemaError as error:
+            log.error("%s", error)
+            print(f"error: {error}", file=sys.stderr)
+            return 1
 
 
-def _run(args: argparse.Namespace, stop: threading.Event) -> int:
+def _run(args: argparse.Namespace, stop: StopRequest) -> int:
     from kinema.config import Workspace
     from kinema.drivers.mujoco.driver import MujocoDriver
     from kinema.drivers.mujoco.settings import MujocoDriverSettings
@@ -139,6 +130,7 @@ def _run(args: argparse.Namespace, stop: threading.Event) -> int:
             while not stop.wait(0.2):
                 if driver.failure is not None:
                     raise DriverError(f"the simulation failed: {driver.failure}")
+            log.info("received %s; stopping", stop.reason)
         finally:
             driver.stop()
     return 0
