@@ -179,11 +179,18 @@ def down(timeout: float) -> None:
 
     Every `kinema run` recorded in the user's state folder ($XDG_STATE_HOME) stops cleanly, with its
     agent, drivers and router: a cell split with `kinema run -n` and `kinema run -o` stops whole.
-    SIGTERM first, SIGKILL after --timeout seconds. A `kinema view` or `kinema ui` started on its own
+    SIGTERM first, SIGKILL after --timeout seconds (a run that had to be killed first writes every
+    thread's stack to its logs, to show where it hung). A `kinema view` or `kinema ui` started on its own
     keeps running: it shows that the runtime went away and follows the next one.
     """
     from kinema.runtime.instance import stop_all
 
     for record, clean in stop_all(timeout=timeout):
-        how = "stopped" if clean else "killed (it did not stop in time)"
-        click.echo(f"{how} kinema run (pid {record.pid}, config {record.config or '-'})")
+        what = f"kinema run (pid {record.pid}, config {record.config or '-'})"
+        if clean:
+            click.echo(f"stopped {what}")
+        else:
+            click.echo(
+                f"killed (it did not stop in time) {what}; each process wrote its threads' stacks to the "
+                f"end of its log in {record.run_folder}"
+            )

@@ -3,12 +3,18 @@
 Each process of a run (``supervisor``, ``agent``, each driver) writes ``<name>.log`` in the run folder,
 one entry per line: ``2026-11-22 02:40:00.123 INFO    [agent] message``. Lines that do not start with
 a time stamp (a traceback, a stray print) belong to the entry above them.
+
+:data:`STACKS_SIGNAL` makes a process append every thread's Python stack to its log file, from
+faulthandler's C code (it needs no interpreter lock, so a deadlocked process answers too): ``kinema down``
+sends it to a run that did not stop in time before it kills the run.
 """
 
 from __future__ import annotations
 
+import faulthandler
 import logging
 import re
+import signal
 import sys
 import threading
 import time
@@ -21,6 +27,8 @@ DATE_FORMAT = "%Y-%m-%d %H:%M:%S"
 LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
 #: The agent's logger for plugin load errors and hot-reload outcomes; `kinema run` echoes its entries.
 PLUGIN_LOGGER = "kinema.plugins"
+#: Sent to a process of a run, it writes every thread's stack to its log file (see the module's docstring).
+STACKS_SIGNAL = signal.SIGUSR1
 
 _ENTRY = re.compile(r"^(\d{4}-\d\d-\d\d \d\d:\d\d:\d\d\.\d{3}) (DEBUG|INFO|WARNING|ERROR|CRITICAL)\s")
 
@@ -65,6 +73,7 @@ def configure_process_logging(log_file: Path | None, *, verbose: bool = False, e
         file_handler = logging.FileHandler(log_file, encoding="utf-8")
         file_handler.setFormatter(formatter)
         root.addHandler(file_handler)
+        faulthandler.register(STACKS_SIGNAL, file=file_handler.stream, all_threads=True)
     if echo or log_file is None:
         stream = logging.StreamHandler(sys.stderr)
         stream.setFormatter(formatter)

@@ -17,7 +17,11 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from kinema.errors import KinemaError
+from kinema.process.log_files import STACKS_SIGNAL
 from kinema.runtime.run_folder import state_dir
+
+STACKS_WAIT_S = 0.5
+"""How long the processes of a run that did not stop get to write their stacks before they are killed."""
 
 
 def instances_dir() -> Path:
@@ -102,6 +106,9 @@ def running_instances() -> list[InstanceRecord]:
 def stop_instance(record: InstanceRecord, *, timeout: float = 15.0) -> bool:
     """Stop one instance: SIGTERM, wait, then SIGKILL it and its recorded children.
 
+    Before the kill, each process writes its threads' stacks to the end of its log (in the run folder),
+    so a hang can be read after the fact.
+
     Returns:
         True if it stopped cleanly on SIGTERM; False if it had to be killed.
     """
@@ -114,6 +121,7 @@ def stop_instance(record: InstanceRecord, *, timeout: float = 15.0) -> bool:
         _kill_leftovers(record.children)
         record.remove()
         return True
+    _ask_for_stacks([record.pid, *record.children])
     _kill_leftovers([record.pid, *record.children])
     record.remove()
     return False
@@ -134,6 +142,20 @@ def _wait_gone(pids: list[int], timeout: float) -> bool:
             return True
         time.sleep(0.05)
     return not any(pid_alive(pid) for pid in pids)
+
+
+def _ask_for_stacks(pids: list[int]) -> None:
+    """Have each live process append every thread's stack to its log (see kinema.process.log_files)."""
+    asked = False
+    for pid in pids:
+        if pid_alive(pid):
+            try:
+                os.kill(pid, STACKS_SIGNAL)
+                asked = True
+            except ProcessLookupError:
+                pass
+    if asked:
+        time.sleep(STACKS_WAIT_S)
 
 
 def _kill_leftovers(pids: list[int]) -> None:

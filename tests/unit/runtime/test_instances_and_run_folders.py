@@ -76,3 +76,28 @@ def test_stale_records_are_dropped_and_nothing_to_stop_is_an_error() -> None:
     assert running_instances() == []
     with pytest.raises(KinemaError, match="no Kinema instance is running"):
         stop_all()
+
+
+HUNG_SUPERVISOR = """
+import signal, sys, time
+from pathlib import Path
+from kinema.process.log_files import configure_process_logging
+configure_process_logging(Path(sys.argv[1]))
+signal.signal(signal.SIGTERM, signal.SIG_IGN)
+def stuck_in_shutdown():
+    print("up", flush=True)
+    time.sleep(60)
+stuck_in_shutdown()
+"""
+
+
+def test_a_run_that_had_to_be_killed_first_wrote_where_it_hung_to_its_log(tmp_path: Path) -> None:
+    log = tmp_path / "supervisor.log"
+    process = subprocess.Popen([sys.executable, "-c", HUNG_SUPERVISOR, str(log)], stdout=subprocess.PIPE)
+    assert process.stdout is not None and process.stdout.readline().strip() == b"up"
+    record = InstanceRecord(process.pid, "tcp/127.0.0.1:1", str(tmp_path), "lab_sim")
+    record.save()
+    assert not stop_instance(record, timeout=0.3)
+    process.wait(5)
+    text = log.read_text()
+    assert "stuck_in_shutdown" in text and "thread 0x" in text, text
