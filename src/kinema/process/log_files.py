@@ -73,7 +73,8 @@ def configure_process_logging(log_file: Path | None, *, verbose: bool = False, e
         file_handler = logging.FileHandler(log_file, encoding="utf-8")
         file_handler.setFormatter(formatter)
         root.addHandler(file_handler)
-        faulthandler.register(STACKS_SIGNAL, file=file_handler.stream, all_threads=True)
+        if file_handler.stream is not None:  # opened at once (FileHandler without delay)
+            faulthandler.register(STACKS_SIGNAL, file=file_handler.stream, all_threads=True)
     if echo or log_file is None:
         stream = logging.StreamHandler(sys.stderr)
         stream.setFormatter(formatter)
