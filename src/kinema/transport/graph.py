@@ -144,6 +144,11 @@ class GraphCache:
             if listener in self._on_removed:
                 self._on_removed.remove(listener)
 
+    def keys(self) -> set[str]:
+        """The liveliness keys of the entities known now."""
+        with self._changed:
+            return set(self._tokens)
+
     def snapshot(self) -> Graph:
         """The graph as known now."""
         with self._changed:
@@ -172,11 +177,14 @@ class GraphCache:
 def query_graph(session: Session, timeout: float = 2.0) -> Graph:
     """Ask the network for every liveliness token of the session's domain.
 
-    A liveliness query occasionally comes back empty right after links change; when this session has
-    nodes of its own (whose tokens must be in the answer) the query is repeated until they are.
+    A liveliness query occasionally comes back empty, or without some of a session's tokens, right after
+    links change; it is repeated (until ``timeout``) while it lacks this session's own tokens (when it
+    has nodes) or a token that the session's live graph (when it keeps one) already knew as it began.
     """
     deadline = time.monotonic() + timeout
     expect_own = session.node_count() > 0
+    cache = session.live_graph_cache()
+    known = cache.keys() if cache is not None else set()
     while True:
         replies = session.zenoh.liveliness().get(
             f"{LIVELINESS_PREFIX}/{session.domain_id}/**", timeout=max(deadline - time.monotonic(), 0.01)
@@ -190,7 +198,11 @@ def query_graph(session: Session, timeout: float = 2.0) -> Graph:
             if entity is not None:
                 entities[key] = entity
         graph = Graph(tuple(entities.values()))
-        complete = not expect_own or any(entity.zid == session.zid for entity in graph.entities)
+        complete = (not expect_own or any(entity.zid == session.zid for entity in graph.entities)) and (
+            known <= entities.keys()
+        )
         if complete or time.monotonic() >= deadline:
             return graph
         time.sleep(0.005)
+        if cache is not None:
+            known &= cache.keys()  # what left meanwhile is not missing

@@ -245,6 +245,11 @@ class Session:
                 self._graph = GraphCache(self)
             return self._graph
 
+    def live_graph_cache(self) -> GraphCache | None:
+        """The live view of the ROS graph if this session keeps one already (never creates it)."""
+        with self._lock:
+            return self._graph
+
     def _track_dispatcher(self, thread: threading.Thread) -> None:
         with self._lock:
             self._dispatchers = [t for t in self._dispatchers if t.is_alive()]
