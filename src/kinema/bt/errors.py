@@ -12,9 +12,21 @@ from kinema.errors import ObjectiveError, SourceLocation
 
 
 class BTError(ObjectiveError):
-    """Base class of the engine's errors (BT.CPP ``BehaviorTreeException``)."""
+    """Base class of the engine's errors (BT.CPP ``BehaviorTreeException``).
+
+    ``message`` is BT.CPP's ``what()`` text; rendered with its location (``file:line: ...``), the line
+    that text starts with ("Error at line 4: -> ") is not said twice.
+    """
 
     btcpp_type = "BehaviorTreeException"
+
+    def __str__(self) -> str:
+        location = self.location
+        if location is not None and location.line:
+            prefix = f"Error at line {location.line}: "
+            if self.message.startswith(prefix):
+                return f"{location}: {self.message[len(prefix) :].removeprefix('-> ')}"
+        return super().__str__()
 
 
 class BTRuntimeError(BTError):

@@ -562,9 +562,7 @@ def _verify_node(
             return True
     manifest = manifests.get(lookup)
     if manifest is None:
-        if known_trees is not None:
-            return report(line, f"Node not recognized: {lookup}{unknown_hint(lookup, manifests)}")
-        return report(line, f"Node not recognized: {lookup}")
+        return report(line, f"Node not recognized: {lookup}{unknown_hint(lookup, manifests)}")
     category = manifest.category
     count = len(children)
     if category is NodeType.DECORATOR and count != 1:

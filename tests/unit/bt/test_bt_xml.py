@@ -78,7 +78,8 @@ def test_a_reactive_sequence_is_checked_by_its_own_children(comment: str) -> Non
     )
     with pytest.raises(ObjectiveError) as info:
         BehaviorTreeFactory().create_tree_from_text(xml)
-    assert "Error at line 5" in str(info.value)
+    assert str(info.value).startswith("<string>:5: ")  # the line once: BT.CPP's text is in .message
+    assert info.value.message.startswith("Error at line 5: ")
     assert "more than one async child" in str(info.value)
 
 
@@ -104,7 +105,8 @@ def test_a_node_like_one_already_checked_is_checked_again_where_it_differs(
     )
     with pytest.raises(ObjectiveError) as info:
         BehaviorTreeFactory().create_tree_from_text(xml)
-    assert "Error at line 5" in str(info.value)
+    assert str(info.value).startswith("<string>:5: ")
+    assert info.value.message.startswith("Error at line 5: ")
     assert message in str(info.value)
 
 
@@ -266,3 +268,16 @@ def test_an_instance_name_with_a_control_character_is_refused_at_its_line() -> N
         BehaviorTreeFactory().create_tree_from_text(document.format("arm\x7f1"))
     assert caught.value.location is not None and caught.value.location.line == 2
     BehaviorTreeFactory().create_tree_from_text(document.format("arm&#9;1"))
+
+
+def test_an_unknown_node_names_its_line_once_and_the_registered_names_close_to_it() -> None:
+    xml = (
+        '<root BTCPP_format="4">\n<BehaviorTree ID="M">\n<Sequence>\n<AlwaysSucess/>\n'
+        "</Sequence>\n</BehaviorTree>\n</root>"
+    )
+    with pytest.raises(ObjectiveError) as info:
+        BehaviorTreeFactory().create_tree_from_text(xml)
+    assert str(info.value).startswith(
+        "<string>:4: Node not recognized: AlwaysSucess; did you mean 'AlwaysSuccess'"
+    )
+    assert "Error at line" not in str(info.value)
