@@ -130,6 +130,9 @@ class RobotModel:
                     location=SourceLocation(str(urdf_path)),
                 )
         self.joint_names: tuple[str, ...] = tuple(n for n in pin_names if n not in self.mimics)
+        #: Every joint that moves: the active ones, then the mimic followers (what a joint state may name).
+        followers = tuple(n for n in pin_names if n in self.mimics)
+        self.moving_joint_names: tuple[str, ...] = (*self.joint_names, *followers)
         self._index = {n: i for i, n in enumerate(self.joint_names)}
         self._pin_q_index = {n: pin_model.idx_qs[pin_model.getJointId(n)] for n in pin_names}
         self._pin_v_index = {n: pin_model.idx_vs[pin_model.getJointId(n)] for n in pin_names}

@@ -67,6 +67,22 @@ def test_an_unknown_waypoint_fails_naming_the_close_ones(behavior: Any, context:
     assert "3 Waypoint Pick Pose" in run.toasts[-1]
 
 
+def test_a_waypoint_naming_a_joint_the_robot_lacks_fails_instead_of_moving_the_others(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    # Edited by hand while the runtime ran: "elbo_joint" for "elbow_joint".
+    waypoint = _waypoint("Bad", [0.5, 0.1, 0.2, -1.0, 1.5, -2.0, -1.57, 0.3])
+    waypoint["joint_state"]["name"] = [
+        n.replace("elbow_joint", "elbo_joint") for n in waypoint["joint_state"]["name"]
+    ]
+    _serve_waypoints(context.node, [waypoint])
+    run = tick_behavior(behavior("RetrieveWaypoint"), {"waypoint_name": "Bad"}, context=context)
+    assert run.status == NodeStatus.FAILURE
+    assert "waypoint 'Bad' names joint 'elbo_joint'" in run.toasts[-1]
+    assert "did you mean 'elbow_joint'" in run.toasts[-1]
+    assert "waypoint_joint_state" not in run.outputs
+
+
 def test_an_unknown_group_fails_with_the_valid_groups(behavior: Any, context: BehaviorContext) -> None:
     _serve_waypoints(context.node, [_waypoint("Pick", [0.0] * 8)])
     run = tick_behavior(

@@ -66,8 +66,19 @@ class RetrieveWaypoint(ServiceClientBehavior["moveit_studio_agent_msgs/srv/GetWa
             return False
         names = [str(n) for n in waypoint.joint_state.name]
         positions = [float(p) for p in waypoint.joint_state.position]
+        model = self.context.robot_model
+        if model is not None:
+            unknown = [n for n in names if n not in model.moving_joint_names]
+            if unknown:
+                # Edited by hand while the runtime runs (it reads the file again, unchecked): moving the
+                # other joints would end the motion somewhere nobody saved.
+                self.logger.publish_failure(
+                    f"RetrieveWaypoint: waypoint {name!r} names joint {unknown[0]!r}, which robot "
+                    f"{model.name!r} does not have; {did_you_mean(unknown[0], model.moving_joint_names)} "
+                    "(correct it in the waypoints file, or save the waypoint again)"
+                )
+                return False
         if group:
-            model = self.context.robot_model
             if model is not None:
                 if group not in model.groups:
                     self.logger.publish_failure(
