@@ -8,6 +8,7 @@ from pathlib import Path
 import click
 
 from kinema.cli.options import selection_options
+from kinema.errors import KinemaError
 
 
 def _model_path(workspace_root: Path | None, config: str) -> Path:
@@ -75,7 +76,7 @@ def build(
 
     resolved = resolve_config(name, found)
     print_warnings(resolved.warnings)
-    errors += _check_waypoints(resolved)
+    waypoint_error = _read_waypoints(resolved)
     host = BehaviorHost.for_config(resolved)
     report = host.load()
     print_warnings(report.warnings)
@@ -97,6 +98,10 @@ def build(
 
     robot = robot_report(resolved)
     print_warnings(robot.warnings)
+    said = {str(robot_problem) for robot_problem in robot.problems}
+    if waypoint_error is not None and str(waypoint_error) not in said:
+        click.secho(str(waypoint_error), err=True, fg="red")  # the robot check did not say it
+        errors += 1
     for robot_problem in robot.problems:
         click.secho(str(robot_problem), err=True, fg="red")
     errors += len(robot.problems)
@@ -106,21 +111,20 @@ def build(
         raise click.exceptions.Exit(1)
 
 
-def _check_waypoints(resolved: object) -> int:
-    """Read the config's waypoints as the runtime will; 1 (after printing why) when they do not load."""
+def _read_waypoints(resolved: object) -> KinemaError | None:
+    """Read the config's waypoints as the runtime will; the error when they do not load (the robot check
+    names each bad waypoint too: the caller prints this one only when it did not)."""
     from kinema.config.waypoint_location import waypoint_store_for
-    from kinema.errors import KinemaError
 
     try:
         store = waypoint_store_for(resolved)  # type: ignore[arg-type]
         if store is None:
-            return 0
+            return None
         count = len(store.all())
     except KinemaError as error:
-        click.secho(str(error), err=True, fg="red")
-        return 1
+        return error
     click.echo(f"read {count} waypoints from {store.read_path}")
-    return 0
+    return None
 
 
 @click.command()
@@ -148,7 +152,6 @@ def test(packages_select: tuple[str, ...], workspace: Path | None, pytest_args: 
     import subprocess
 
     from kinema.cli.options import resolve_selection
-    from kinema.errors import KinemaError
     from kinema.plugins.dependencies import workspace_behavior_packages
 
     _require_pytest()
@@ -180,8 +183,6 @@ def _require_pytest() -> None:
     """Say which command installs pytest when this Python has none (an install with --no-deps skips it)."""
     import importlib.util
     import shlex
-
-    from kinema.errors import KinemaError
 
     if importlib.util.find_spec("pytest") is None:
         python = shlex.quote(sys.executable)

@@ -124,6 +124,21 @@ def test_a_waypoint_naming_an_unknown_joint_fails_the_build(
     assert "checked the robot: 1 problem\n" in out and "build failed" in out
 
 
+def test_a_waypoint_whose_names_and_positions_differ_in_count_is_one_error_said_once(
+    lab_sim: Path, capsys: pytest.CaptureFixture[str]
+) -> None:
+    waypoints = lab_sim / "src" / "lab_sim" / "waypoints" / "lab_sim_waypoints.yaml"
+    data = yaml.safe_load(waypoints.read_text())
+    first = data[0]
+    first["joint_state"]["name"] = first["joint_state"]["name"][:-1]
+    waypoints.write_text(yaml.safe_dump(data, sort_keys=False))
+    code, out = build(lab_sim, "lab_sim", capsys)
+    assert code == 1
+    message = f"waypoint {first['name']!r} has "
+    assert out.count(message) == 1, out
+    assert "build failed: 1 error\n" in out
+
+
 def test_a_controller_joint_no_actuator_drives_fails_the_build(
     lab_sim: Path, capsys: pytest.CaptureFixture[str]
 ) -> None:
