@@ -71,8 +71,9 @@ def configure(workspace: str | None, config: str | None) -> None:
 def init(path: Path) -> None:
     """Create an empty workspace at PATH (a folder with src/ for your packages).
 
-    Then select it with `kinema configure -w PATH -c lab_sim` and add a config package with
-    `kinema new config NAME --based-on lab_sim`.
+    Then add a config package for your own robot with `kinema new config NAME -w PATH --from-urdf URDF`
+    (docs/own-robot.md), or start from Kinema's bundled simulated lab: `kinema configure -w PATH -c
+    lab_sim`, then `kinema new config NAME --based-on lab_sim`.
     """
     path = path.expanduser()
     if path.exists() and not path.is_dir():
@@ -87,14 +88,23 @@ def init(path: Path) -> None:
             readme.write_text(
                 "# Kinema workspace\n\n"
                 "Packages live in `src/`: config packages (`config/config.yaml`) and behavior packages.\n\n"
+                "Your own robot, from its URDF (a path or a `package://` URI; the SRDF is optional):\n\n"
                 "```bash\n"
-                f"kinema configure -w {path} -c lab_sim\n"
-                "kinema new config my_robot_config --based-on lab_sim\n"
-                "kinema config show -c my_robot_config --provenance\n"
+                "kinema new config my_robot_config -w . --from-urdf path/to/robot.urdf "
+                "--srdf path/to/robot.srdf\n"
+                "kinema build -c my_robot_config -w .\n"
+                "kinema run -c my_robot_config -w .\n"
+                "```\n\n"
+                "Or start from Kinema's bundled simulated lab and change what differs:\n\n"
+                "```bash\n"
+                "kinema configure -w . -c lab_sim\n"
+                "kinema new config my_cell --based-on lab_sim\n"
+                "kinema config show -c my_cell --provenance\n"
                 "```\n",
                 encoding="utf-8",
             )
     except OSError as error:
         raise ConfigError(f"cannot create the workspace {path}: {error.strerror or error}") from None
     click.echo(f"created workspace {path.resolve()}")
-    click.echo(f"next: kinema configure -w {path} -c lab_sim")
+    click.echo(f"next, your own robot:   kinema new config NAME -w {path} --from-urdf URDF [--srdf SRDF]")
+    click.echo(f"  or the bundled lab:   kinema configure -w {path} -c lab_sim")

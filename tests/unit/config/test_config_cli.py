@@ -20,6 +20,9 @@ def test_init_configure_new_show_list_round_trip(capsys, tmp_path: Path):
     workspace = tmp_path / "my_ws"
     code, out, _ = run(capsys, "init", str(workspace))
     assert code == 0 and (workspace / "src").is_dir()
+    # Both ways on: a config from one's own URDF first, the bundled lab as the other.
+    assert f"kinema new config NAME -w {workspace} --from-urdf URDF" in out
+    assert f"kinema configure -w {workspace} -c lab_sim" in out
     code, out, _ = run(capsys, "configure", "-w", str(workspace), "-c", "lab_sim")
     assert code == 0 and "config:    lab_sim" in out
     code, out, _ = run(capsys, "new", "config", "my_cell", "--based-on", "lab_sim", "--no-input")
