@@ -84,7 +84,12 @@ def did_you_mean(value: str, choices: Iterable[str], *, limit: int = 8) -> str:
     if not options:
         return "there are none"
     close = difflib.get_close_matches(value, options, n=3, cutoff=0.6)
-    shown = options if len(options) <= limit else options[:limit]
+    # A cut listing keeps the close names: a "Valid:" list without the one suggested reads as a contradiction.
+    shown = (
+        options
+        if len(options) <= limit
+        else sorted({*close, *[o for o in options if o not in close][: limit - len(close)]})
+    )
     listing = ", ".join(shown) + (f", … ({len(options)} in all)" if len(options) > limit else "")
     if close:
         return f"did you mean {' or '.join(repr(c) for c in close)}? Valid: {listing}"

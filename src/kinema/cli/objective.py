@@ -174,7 +174,13 @@ def show(
         width = max(len(port.name) for port in info.ports)
         type_width = max(len(port.type_name or "-") for port in info.ports)
         for port in info.ports:
-            default = f" = {port.default}" if port.default is not None else ""
+            if port.default is not None and str(port.default).strip():
+                default = f" = {port.default}"
+            elif port.direction != "output":
+                # Not "= " and nothing: a run that reads it without a value fails there.
+                default = f" = (none; -p {port.name}=VALUE sets it)"
+            else:
+                default = ""
             description = f"  ({port.description})" if port.description else ""
             type_name = f"{port.type_name or '-':<{type_width}}"
             click.echo(f"    {port.direction:<6} {port.name:<{width}}  {type_name}{default}{description}")

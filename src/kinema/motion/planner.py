@@ -88,8 +88,7 @@ def goal_configuration(
     for name, value in goal.items():
         if name not in model.joint_names:
             raise MotionError(
-                f"goal names unknown joint {name!r}; valid joints: {', '.join(model.joint_names)}"
-                f" ({did_you_mean(name, model.joint_names)})"
+                f"goal names unknown joint {name!r}; {did_you_mean(name, model.joint_names, limit=32)}"
             )
         if name not in g.joint_names:
             raise MotionError(

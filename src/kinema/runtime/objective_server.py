@@ -980,7 +980,7 @@ class ObjectiveServer:
             raise
         except KinemaError as error:
             self._halt_quietly(worker, tree)
-            message = str(error) + _missing_parameter_hint(str(error), run)
+            message = _with_parameter_advice(str(error), run)
             self._end(run, ObjectiveResult.failure(message, run.objective_name), ObjectiveStatus.FAILURE)
             return
         except BaseException as error:  # SystemExit, KeyboardInterrupt...: fail the run, keep serving
@@ -1123,21 +1123,22 @@ class ObjectiveServer:
             message = self._failure_notes.get(path, "")
         detail = f": {message}" if message else " returned FAILURE"
         text = f"objective {run.objective_name!r} failed: node '{path}' [{registration_id}]{detail}"
-        return text + _missing_parameter_hint(text, run)
+        return _with_parameter_advice(text, run)
 
 
-def _missing_parameter_hint(message: str, run: ObjectiveRun) -> str:
-    """``; give parameter 'NAME' ...`` when ``message`` is a missing blackboard key that is one of the
-    objective's own ports with no default and no override ("" otherwise)."""
+def _with_parameter_advice(message: str, run: ObjectiveRun) -> str:
+    """``message`` led by what to do when it is a missing blackboard key that is one of the objective's own
+    ports with no default and no override (the node's own words follow, for where); else ``message``."""
     if "unable to find the key" not in message:
-        return ""
+        return message
     for name in run.unset_parameters:
         if f"[{name}]" in message:  # "... the key [port] remapped to [name]"
             return (
-                f"; {name!r} is a parameter of objective {run.objective_name!r} without a default: give it "
-                f"(kinema objective run {run.objective_name!r} -p {name}=VALUE, or the SDK's overrides)"
+                f"{name!r} is a parameter of objective {run.objective_name!r} without a default: give it "
+                f"(kinema objective run {run.objective_name!r} -p {name}=VALUE, or the SDK's overrides). "
+                f"Where it was missed: {message}"
             )
-    return ""
+    return message
 
 
 def main_tree_id(xml: str) -> str:

@@ -125,3 +125,5 @@ def test_objective_show_lists_typed_parameters(capsys) -> None:
     out = capsys.readouterr().out
     assert code == 0
     assert "input  link_padding" in out and "double" in out and "ports:       none" not in out
+    # Its default is "", which sets nothing: said as such, with how to give it.
+    assert "= (none; -p waypoint_name=VALUE sets it)" in out

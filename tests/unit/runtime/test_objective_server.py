@@ -446,7 +446,10 @@ def test_a_missing_parameter_without_a_default_is_named_in_the_failure() -> None
         result = running.submit(ObjectiveRequest("Go")).wait(5)
         assert result is not None and result.failed
         assert "unable to find the key [waypoint] remapped to [waypoint_name]" in result.error_message
-        assert "'waypoint_name' is a parameter of objective 'Go' without a default" in result.error_message
+        # What to do first, then where the tree missed it.
+        assert result.error_message.startswith(
+            "'waypoint_name' is a parameter of objective 'Go' without a default"
+        )
         assert "-p waypoint_name=VALUE" in result.error_message
         given = (ParameterOverride("waypoint_name", "Home"),)
         assert running.submit(ObjectiveRequest("Go", overrides=given)).wait(5) == ObjectiveResult.success(
