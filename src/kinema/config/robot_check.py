@@ -39,7 +39,7 @@ from typing import TYPE_CHECKING, Any
 from lxml import etree
 
 from kinema.config.mujoco_scene import SceneFiles, asset_folders
-from kinema.errors import ConfigError, KinemaError, SourceLocation, did_you_mean
+from kinema.errors import ConfigError, KinemaError, MotionError, SourceLocation, did_you_mean
 
 if TYPE_CHECKING:
     from kinema.config.inheritance import ResolvedConfig
@@ -112,7 +112,7 @@ def robot_report(resolved: ResolvedConfig) -> RobotReport:
     _check_cell(resolved, urdf, scene, report)
     if not report.problems and semantic is not None:
         # Each name is known: where the robot stands at each waypoint means something.
-        _check_waypoint_collisions(resolved, urdf, semantic, report)
+        _check_waypoint_collisions(resolved, urdf, semantic, scene, report)
     return report
 
 
@@ -329,14 +329,21 @@ def _check_waypoints(resolved: ResolvedConfig, urdf: _Urdf, report: RobotReport)
 
 
 def _check_waypoint_collisions(
-    resolved: ResolvedConfig, urdf: _Urdf, semantic: SemanticDescription, report: RobotReport
+    resolved: ResolvedConfig,
+    urdf: _Urdf,
+    semantic: SemanticDescription,
+    scene: _Scene | None,
+    report: RobotReport,
 ) -> None:
     """A waypoint where two of the robot's links overlap (the SRDF's disabled pairs left out) is a warning:
     no motion can start or end there, and the usual cause is a pair the SRDF should disable (links that
-    touch by design, as MoveIt's setup assistant finds them in the default state)."""
+    touch by design, as MoveIt's setup assistant finds them in the default state). So is a waypoint where
+    the robot overlaps the scene's static geometry (a table, a wall): the planner refuses it the same way
+    at run time ("goal state is in collision")."""
     from kinema.config.waypoints import Waypoint
     from kinema.config.yamlsource import load_yaml_file
-    from kinema.motion.collision import self_collision_warning, self_collisions
+    from kinema.motion.collision import CollisionChecker, self_collision_warning, self_collisions
+    from kinema.motion.planning_scene import PlanningScene
 
     checker = urdf.checker
     if checker is None:
@@ -351,17 +358,36 @@ def _check_waypoint_collisions(
         return  # the checks above report why
     if document is None or not isinstance(document.data, list):
         return
+    world: CollisionChecker | None = None
+    scene_name = scene.path.name if scene is not None else ""
+    if scene is not None:
+        try:
+            static = PlanningScene.from_mjcf(scene.path, checker.model.link_names)
+        except MotionError:
+            static = None  # _check_scene said why
+        if static is not None and static.objects:
+            world = CollisionChecker(checker.model, static)
+            world.allowed_collisions = semantic.disabled_collisions
+    links = set(checker.model.link_names)
     for number, item in enumerate(document.data):
         try:
             waypoint = Waypoint.from_dict(item, document, number)
         except ConfigError:
             continue
+        where = document.location((number, "name"))
         pairs = self_collisions(checker, waypoint.joint_positions())
         if pairs:
-            where = document.location((number, "name"))
             report.warnings.append(
                 f"{where}: {self_collision_warning(f'waypoint {waypoint.name!r}', pairs, srdf.name)}"
             )
+        if world is not None:
+            touching = [p for p in self_collisions(world, waypoint.joint_positions()) if not set(p) <= links]
+            if touching:
+                overlaps = ", ".join(f"{first} - {second}" for first, second in touching[:4])
+                report.warnings.append(
+                    f"{where}: waypoint {waypoint.name!r} is in collision with the scene ({overlaps}): no "
+                    f"motion can start or end there; move the waypoint, or the object in {scene_name}"
+                )
 
 
 def _joints(names: list[str]) -> str:

@@ -104,6 +104,32 @@ def test_a_panda_package_made_by_the_generator_has_no_problems(tmp_path: Path) -
     assert len(report.checked) == 5  # URDF, MuJoCo scene, SRDF, joint limits, waypoints
 
 
+def test_a_waypoint_inside_the_scenes_table_is_a_warning_at_its_line(tmp_path: Path) -> None:
+    share = PackageIndex().find("example-robot-data")
+    if share is None:
+        pytest.skip("example-robot-data is not installed (pip install example-robot-data, in the test extra)")
+    from kinema.scaffold.robot_package import new_robot_package
+
+    root = tmp_path / "ws"
+    (root / "src").mkdir(parents=True)
+    new_robot_package(
+        "ur5_cell",
+        share / "robots" / "ur_description" / "urdf" / "ur5_robot.urdf",
+        workspace=Workspace.discover(root),
+    )
+    waypoints = root / "src" / "ur5_cell" / "waypoints" / "waypoints.yaml"
+    data = yaml.safe_load(waypoints.read_text())
+    into_table = {**data[0], "name": "IntoTable"}
+    into_table["joint_state"] = {**data[0]["joint_state"], "position": [0.0, 1.2, 0.0, 0.0, 0.0, 0.0]}
+    waypoints.write_text(yaml.safe_dump([*data, into_table], sort_keys=False))
+    report = robot_report(resolve_config("ur5_cell", Workspace.discover(root)))
+    assert [str(p) for p in report.problems] == []
+    hits = [w for w in report.warnings if "in collision with the scene" in w]
+    assert len(hits) == 1, report.warnings  # Home is clear of it
+    assert hits[0].startswith(f"{waypoints}:{line_of(waypoints, 'IntoTable')}: waypoint 'IntoTable' is in")
+    assert "upper_arm_link - table" in hits[0] and "ur5_cell_scene.xml" in hits[0]
+
+
 # -- names that do not cross -----------------------------------------------------------------------------
 
 
