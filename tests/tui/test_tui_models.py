@@ -267,3 +267,37 @@ def test_closing_while_the_runtime_is_unreachable_does_not_wait_for_the_attempt(
     assert took < 1.5, f"close() took {took:.1f} s"
     assert len(events) == events_at_close, "the app got events after it closed the connection"
     assert connection._client is None
+
+
+def test_the_status_line_keeps_how_the_last_run_ended_once_the_server_is_idle() -> None:
+    # It read "Pick Cube Idle 4.2 s" after a success and after a cancel alike.
+    from kinema.tui.widgets.status_bar import render_status
+
+    status = RuntimeStatus()
+    status.apply_connection(ConnectionChanged(ConnectionState.CONNECTED, "tcp/127.0.0.1:7447"))
+    status.apply_heartbeat(Heartbeat(10.0, "Pick Cube", "Running"))
+    status.apply_heartbeat(Heartbeat(14.2, "Pick Cube", "Success"))
+    status.apply_heartbeat(Heartbeat(16.2, "Pick Cube", "Idle"))
+    assert "│  Pick Cube Success 4.2 s · idle" in render_status(status).plain
+    status.apply_heartbeat(Heartbeat(20.0, "Pick Cube", "Running"))
+    assert "Pick Cube Running" in render_status(status).plain and "idle" not in render_status(status).plain
+    status.apply_heartbeat(Heartbeat(21.5, "Pick Cube", "Cancelled"))
+    status.apply_heartbeat(Heartbeat(23.5, "Pick Cube", "Idle"))
+    assert "Pick Cube Cancelled 1.5 s · idle" in render_status(status).plain
+
+
+def test_the_status_line_drops_the_endpoint_before_the_clock_in_80_columns() -> None:
+    # It ended "sim 19.57 s  RTF" at 80 columns: the factor itself was cut.
+    from kinema.tui.connection import ClockSample
+    from kinema.tui.widgets.status_bar import render_status
+
+    status = RuntimeStatus()
+    status.apply_connection(ConnectionChanged(ConnectionState.CONNECTED, "tcp/127.0.0.1:27461"))
+    status.apply_heartbeat(Heartbeat(10.0, "Pick Cube", "Running"))
+    status.apply_heartbeat(Heartbeat(14.2, "Pick Cube", "Success"))
+    status.apply_heartbeat(Heartbeat(16.2, "Pick Cube", "Idle"))
+    status.apply_clock(ClockSample(19.57, 1.0))
+    narrow = render_status(status, 78).plain
+    assert narrow.endswith("sim 19.57 s  RTF 1.00x") and len(narrow) <= 78, narrow
+    assert "tcp/127.0.0.1:27461" not in narrow
+    assert "tcp/127.0.0.1:27461" in render_status(status, 200).plain

@@ -11,6 +11,7 @@ from dataclasses import dataclass
 from kinema.tui.connection import ClockSample, ConnectionChanged, ConnectionState, Heartbeat
 
 ACTIVE_STATUSES = frozenset({"Loading", "Running"})
+ENDED_STATUSES = frozenset({"Success", "Failure", "Cancelled"})
 
 
 @dataclass
@@ -26,6 +27,9 @@ class RuntimeStatus:
     sim_time: float | None = None
     real_time_factor: float | None = None
     warnings: tuple[str, ...] = ()
+    #: How the last run of :attr:`objective` ended, kept once the server says Idle again (a couple of
+    #: seconds after the end): "" while it runs or before any run.
+    last_outcome: str = ""
     _started_at: float | None = None
     _interrupted: tuple[str, float] | None = None
 
@@ -64,6 +68,10 @@ class RuntimeStatus:
             beat.status in ACTIVE_STATUSES or self.status in ACTIVE_STATUSES
         ):
             self.elapsed = max(0.0, beat.process_time - self._started_at)
+        if started or beat.objective_name != self.objective:
+            self.last_outcome = ""
+        if beat.status in ENDED_STATUSES:
+            self.last_outcome = beat.status
         self.objective = beat.objective_name
         self.status = beat.status
         self.warnings = beat.warnings

@@ -48,18 +48,32 @@ class StatusBar(Static):
             None if status.real_time_factor is None else round(status.real_time_factor, 2),
             # The watchdog's seconds grow every beat; whole seconds are enough on screen.
             tuple(_whole_seconds(warning) for warning in status.warnings),
+            status.last_outcome,
+            self.size.width,
         )
         if key != self._shown:
             self._shown = key
-            self.update(render_status(status))
+            # The bar's padding takes a column each side.
+            self.update(render_status(status, self.size.width - 2 if self.size.width > 2 else None))
+
+    def on_resize(self) -> None:
+        self._shown = ()  # the endpoint fits again, or no longer
 
 
-def render_status(status: RuntimeStatus) -> Text:
-    """The status line as rich text (also used by tests to check wording)."""
+def render_status(status: RuntimeStatus, width: int | None = None) -> Text:
+    """The status line as rich text (also used by tests to check wording). With ``width``, a connected
+    runtime's endpoint is left out when the line would not fit with it (the run and the clock come first)."""
+    line = _render(status, with_endpoint=True)
+    if width is not None and status.state is ConnectionState.CONNECTED and line.cell_len > width:
+        line = _render(status, with_endpoint=False)
+    return line
+
+
+def _render(status: RuntimeStatus, *, with_endpoint: bool) -> Text:
     symbol, colour = _STATE_STYLE[status.state]
     text = Text()
     text.append(f"{symbol} {status.state.value}", style=f"bold {colour}")
-    if status.endpoint:
+    if status.endpoint and with_endpoint:
         text.append(f" {status.endpoint}", style="dim")
     if status.state is ConnectionState.DISCONNECTED:
         if status.detail:
@@ -69,9 +83,15 @@ def render_status(status: RuntimeStatus) -> Text:
     if status.objective:
         text.append(status.objective, style="bold")
         text.append(" ")
-    text.append(status.status, style=STATUS_STYLE.get(status.status, ""))
+    if status.status == "Idle" and status.last_outcome and status.objective:
+        # The server says Idle a couple of seconds after a run ends: how it ended stays on the line.
+        text.append(status.last_outcome, style=STATUS_STYLE.get(status.last_outcome, ""))
+    else:
+        text.append(status.status, style=STATUS_STYLE.get(status.status, ""))
     if status.elapsed is not None and status.objective:
         text.append(f" {status.elapsed:.1f} s")
+    if status.status == "Idle" and status.last_outcome and status.objective:
+        text.append(" · idle", style="dim")
     if status.sim_time is not None:
         text.append("  │  sim ")
         text.append(f"{status.sim_time:.2f} s")
