@@ -87,7 +87,9 @@ class BehaviorTreeView(Tree["OutlineNode"]):
             node, parent = stack.pop()
             label = self._label(node, NodeStatus.IDLE)
             if node.children:
-                item = parent.add(label, data=node, expand=True)
+                # MoveIt Pro's editor folds a SubTree marked _collapsed="true"; its status shows on it.
+                folded = node.is_subtree and node.attributes.get("_collapsed", "").lower() == "true"
+                item = parent.add(label, data=node, expand=not folded)
             else:
                 item = parent.add_leaf(label, data=node)
             self._by_uid[node.uid] = item
