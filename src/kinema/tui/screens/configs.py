@@ -156,11 +156,11 @@ class ConfigsScreen(KinemaScreen):
         if message.workspace is None:
             return
         packages = message.workspace.config_packages()
+        preferred = self.kinema.connection.config_name
         for package in packages:
-            options.add_option(Option(_package_label(package), id=package.name))
+            options.add_option(Option(_package_label(package, package.name == preferred), id=package.name))
         info = message.workspace.describe()
         self.query_one("#workspace-info", Static).update(Text(f"{len(packages)} config packages in {info}"))
-        preferred = self.kinema.connection.config_name
         names = [p.name for p in packages]
         if names:
             index = names.index(preferred) if preferred in names else 0
@@ -245,8 +245,10 @@ def _where(package: Package, workspace: Workspace) -> str:
         return f"workspace: {package.path}"
 
 
-def _package_label(package: Package) -> Text:
-    label = Text(package.name)
+def _package_label(package: Package, active: bool) -> Text:
+    """The package's name, marked ``*`` when it is the config this UI shows (as `kinema config list`)."""
+    label = Text("* " if active else "  ", style="bold green")
+    label.append(package.name)
     if package.origin == "bundled":
         label.append("  bundled", style="dim")
     return label
