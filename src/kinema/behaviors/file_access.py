@@ -12,6 +12,10 @@ Whatever role asked, and whichever port carries the path:
   may also lie directly in the system's temporary folder (``/tmp/inspection_image.png``, where MoveIt
   Pro's objectives save scratch images): not in a folder below it, and never read from there, so an
   objective can neither reach another program's temporary files nor read back what others left.
+- **the robot rule**, for files written: never over the files that define the robot — each chain
+  package's ``config/config.yaml``, the URDF, SRDF, joint limits, MuJoCo scene — nor the waypoints file
+  (the agent's ``/edit_waypoints`` writes that, a grant of its own), in a workspace package or a bundled
+  one. An objective that may run ad-hoc XML could otherwise rewrite the robot's joint limits.
 
 :func:`check_file_access` is what :mod:`kinema_core_behaviors.files.locations` calls for every file
 behavior; a third-party behavior that opens a file named by a port should call it too.
@@ -30,6 +34,12 @@ SECURITY_RULE = "security rule: objectives never read or write the security fold
 FILE_RULE = (
     "file rule: objectives read and write only inside the workspace, the config packages and Kinema's "
     "data folder, and also write files directly in the system's temporary folder"
+)
+
+
+ROBOT_RULE = (
+    "robot rule: objectives never write over the files that define the robot (config.yaml, URDF, SRDF, "
+    "joint limits, MuJoCo scene) or its waypoints file (/edit_waypoints changes waypoints)"
 )
 
 
@@ -63,6 +73,29 @@ def allowed_folders(config: Any) -> list[Path]:
     return _unique(folders)
 
 
+def protected_from_writing(config: Any) -> list[Path]:
+    """The files the robot rule keeps objectives from writing, for ``config`` (none offline)."""
+    if config is None:
+        return []
+    files = [Path(package.config_file) for package in config.chain_packages]
+    for name in ("urdf_path", "srdf_path", "joint_limits_path", "mujoco_model_path", "waypoints_path"):
+        try:
+            path = getattr(config, name)
+        except KinemaError:
+            continue  # a file the config names wrongly: kinema build says so
+        if path is not None:
+            files.append(Path(path))
+    from kinema.config.waypoint_location import waypoint_store_for
+
+    try:
+        store = waypoint_store_for(config)
+    except KinemaError:
+        store = None
+    if store is not None:
+        files.append(Path(store.path))  # the copy saves go to (a bundled or inherited file's)
+    return _unique(files)
+
+
 def check_file_access(path: Path, config: Any, *, writing: bool = False) -> Path:
     """``path`` resolved (``..`` and symlinks followed) when the rules allow it.
 
@@ -72,8 +105,8 @@ def check_file_access(path: Path, config: Any, *, writing: bool = False) -> Path
         writing: the file is to be written (a file directly in the system's temporary folder is allowed).
 
     Raises:
-        FileAccessError: inside a security folder, or outside every allowed folder; the message names
-            the rule and the folders allowed.
+        FileAccessError: inside a security folder, outside every allowed folder, or (writing) a file
+            the robot rule protects; the message names the rule (and the folders allowed).
     """
     import tempfile
 
@@ -81,6 +114,8 @@ def check_file_access(path: Path, config: Any, *, writing: bool = False) -> Path
     for folder in security_folders():
         if resolved.is_relative_to(folder.resolve()):
             raise FileAccessError(f"{path} is refused by the {SECURITY_RULE} ({folder})")
+    if writing and any(resolved == file.resolve() for file in protected_from_writing(config)):
+        raise FileAccessError(f"{path} is refused by the {ROBOT_RULE}")
     allowed = allowed_folders(config)
     if any(resolved.is_relative_to(folder.resolve()) for folder in allowed):
         return resolved

@@ -318,7 +318,7 @@ GRANTS: dict[str, Grant] = {
         Grant(
             "xml",
             "run ad-hoc objective XML (/do_objective goals, `kinema objective do`, the SDK's do_xml): "
-            "any behavior with any ports, within the file rule",
+            "any behavior with any ports, within the file, security and robot rules",
             ("{d}/do_objective/_action/send_goal/**", "kinema/{d}/objective_server/start_xml"),
         ),
     )

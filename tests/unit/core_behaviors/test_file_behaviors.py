@@ -379,3 +379,61 @@ def test_a_parameter_override_is_held_to_the_file_rule_like_any_port(
             result = server.submit(ObjectiveRequest("Peek", "", overrides, "test")).wait(30)
             assert result is not None and result.failed, result
             assert f"refused by the {rule}" in caplog.text and "root:" not in caplog.text
+
+
+def test_no_objective_writes_over_the_files_that_define_the_robot(
+    behavior: Any, node: Any, tmp_path: Path
+) -> None:
+    """A client allowed ad-hoc XML replaced lab_sim's joint limits and waypoints with a pose (a save to an
+    absolute path inside a config package): the robot rule refuses it, in the config's package and in an
+    inherited bundled one, and the files stay as they were."""
+    import yaml
+
+    from kinema.config import Workspace, resolve_config
+    from kinema.transport import from_dict
+
+    package = tmp_path / "ws" / "src" / "my_cell"
+    (package / "config").mkdir(parents=True)
+    (package / "objectives").mkdir()
+    (package / "package.xml").write_text(
+        '<?xml version="1.0"?><package format="3"><name>my_cell</name><version>0.0.0</version>'
+        "<description>t</description><maintainer email='t@example.com'>t</maintainer>"
+        "<license>BSD-3-Clause</license></package>"
+    )
+    config = {
+        "based_on_package": "lab_sim",
+        "objectives": {
+            "objective_library_paths": {
+                "my_objectives": {"package_name": "my_cell", "relative_path": "objectives"}
+            }
+        },
+    }
+    (package / "config" / "config.yaml").write_text(yaml.safe_dump(config))
+    resolved = resolve_config("my_cell", Workspace.discover(tmp_path / "ws"))
+    context = BehaviorContext(node, config=resolved)
+    pose = from_dict("geometry_msgs/msg/PoseStamped", {"header": {"frame_id": "world"}})
+    from kinema.config.waypoint_location import waypoint_store_for
+
+    store = waypoint_store_for(resolved)
+    assert store is not None  # its copy of lab_sim's waypoints, in my_cell/waypoints/ (made at a save)
+    targets = [
+        package / "config" / "config.yaml",
+        resolved.joint_limits_path,
+        resolved.waypoints_path,
+        Path(store.path),
+    ]
+    for target in targets:
+        assert target is not None
+        before = target.read_bytes() if target.exists() else None
+        run = tick_behavior(
+            behavior("SavePoseStampedToYaml"),
+            {"message": pose, "yaml_filename": str(target.with_suffix(""))},
+            context=context,
+        )
+        assert run.status == NodeStatus.FAILURE, target
+        assert "refused by the robot rule" in run.toasts[-1], run.toasts
+        assert (target.read_bytes() if target.exists() else None) == before
+    beside = tick_behavior(
+        behavior("SavePoseStampedToYaml"), {"message": pose, "yaml_filename": "my_pose"}, context=context
+    )
+    assert beside.status == NodeStatus.SUCCESS and (package / "objectives" / "my_pose.yaml").is_file()
