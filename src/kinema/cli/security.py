@@ -178,3 +178,19 @@ def init(
         f"on an operator's: copy {result.clients[0].name} there, then "
         f"KINEMA_ZENOH_CONFIG={result.clients[0].name} kinema ui"
     )
+    _say_running_routers_keep_their_rules()
+
+
+def _say_running_routers_keep_their_rules() -> None:
+    """A router reads its access rules once, at start: a client added now is refused until it restarts
+    (its client saw only "no runtime answered")."""
+    from kinema.runtime.instance import running_instances
+
+    for record in running_instances():
+        click.secho(
+            f"note: the running kinema run (pid {record.pid}, config {record.config or '-'}) read the access "
+            "rules when it started: restart it (`kinema down`, then `kinema run --connect ...`) for these "
+            "certificates and rules to take effect",
+            err=True,
+            fg="yellow",
+        )
