@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -365,8 +367,28 @@ def _show_toast(level: str, text: str) -> None:
         click.echo(text)
 
 
+@contextmanager
+def _terminating_interrupts() -> Iterator[None]:
+    """SIGTERM and SIGHUP act as Ctrl-C meanwhile: `timeout 60 kinema objective run ...`, a script that
+    kills the command or a closed terminal cancel the objective; the robot does not go on moving for a
+    command that is gone. Restored before the cancel, so a second signal ends the command at once."""
+    import signal
+
+    def interrupt(_signum: int, _frame: object) -> None:
+        raise KeyboardInterrupt
+
+    caught = [sig for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)) if sig is not None]
+    previous = {sig: signal.signal(sig, interrupt) for sig in caught}
+    try:
+        yield
+    finally:
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
 def _finish(run, wait: bool, source: str = "") -> None:  # type: ignore[no-untyped-def]
-    """Wait for a started objective (Ctrl-C cancels it) and exit 0 only when it succeeded.
+    """Wait for a started objective (Ctrl-C, SIGTERM or SIGHUP cancels it) and exit 0 only when it
+    succeeded.
 
     ``source``: the file the objective's XML came from, named in its messages instead of the runtime's
     ``<objective XML>`` (which only ever saw the text).
@@ -375,7 +397,8 @@ def _finish(run, wait: bool, source: str = "") -> None:  # type: ignore[no-untyp
         click.echo(f"started {run.objective_name!r}")
         return
     try:
-        result = run.result(on_toast=_show_toast)
+        with _terminating_interrupts():
+            result = run.result(on_toast=_show_toast)
     except KeyboardInterrupt:
         click.echo(f"cancelling {run.objective_name!r} ...", err=True)
         run.cancel()
@@ -405,7 +428,8 @@ def run_(name: str, params: tuple[str, ...], no_wait: bool, connect: str | None,
     """Run objective NAME on the running Kinema (a running objective is preempted).
 
     Prints the messages its behaviors publish for the UI (toasts) while it runs. Exits 0 when the
-    objective succeeds, 1 when it fails or is cancelled; Ctrl-C cancels it.
+    objective succeeds, 1 when it fails or is cancelled; Ctrl-C cancels it, and so does SIGTERM (as
+    `timeout` sends it) or a closed terminal.
     """
     from kinema.sdk import ParameterOverride
 

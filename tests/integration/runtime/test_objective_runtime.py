@@ -123,6 +123,27 @@ def test_interrupting_a_wait_cancels_the_objective(agent: Any, client: Objective
     _stops_running(client)
 
 
+def test_sigterm_to_kinema_objective_run_cancels_the_objective(agent: Any, client: ObjectiveClient) -> None:
+    """`timeout 60 kinema objective run ...` ended the command with SIGTERM and left the objective running:
+    the robot went on moving for a command that was gone."""
+    command = subprocess.Popen(
+        [sys.executable, "-m", "kinema", "objective", "run", "Forever", "--connect", agent.endpoint],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+    )
+    try:
+        _wait_for(client, ObjectiveStatus.RUNNING, "Forever")
+        time.sleep(1.0)  # the command has its acceptance and waits for the result (the heartbeat may lead)
+        command.send_signal(signal.SIGTERM)
+        _out, err = command.communicate(timeout=20)
+    finally:
+        command.kill()
+    assert "cancelling 'Forever'" in err, err
+    assert command.returncode == 1
+    _stops_running(client)
+
+
 def test_cancel_objective_service_halts_what_runs(client: ObjectiveClient) -> None:
     handle = client.start("Forever")
     _wait_for(client, ObjectiveStatus.RUNNING, "Forever")
