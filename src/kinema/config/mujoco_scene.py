@@ -37,7 +37,6 @@ ASSET_FILES: dict[str, tuple[tuple[str, ...], str]] = {
         "texturedir",
     ),
 }
-_LFS_PREFIX = b"version https://git-lfs.github.com/spec/v1"
 #: LFS pointers named one by one before the rest are counted (a fresh clone has dozens).
 _POINTERS_SHOWN = 3
 
@@ -158,11 +157,9 @@ class SceneFiles:
 
     @staticmethod
     def _pointer(path: Path) -> bool:
-        try:
-            with path.open("rb") as handle:
-                return handle.read(len(_LFS_PREFIX)) == _LFS_PREFIX
-        except OSError:
-            return False
+        from kinema.config.robot_files import is_lfs_pointer
+
+        return is_lfs_pointer(path)
 
     def _report_pointers(self) -> None:
         for kind, path, where in self.pointers[:_POINTERS_SHOWN]:

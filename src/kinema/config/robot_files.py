@@ -353,6 +353,16 @@ def process_xacro(
 # -- meshes ------------------------------------------------------------------------------------------------
 
 
+def is_lfs_pointer(path: str | Path) -> bool:
+    """True when ``path`` is a Git LFS pointer file (a clone without ``git lfs pull``), not the file itself;
+    False when it is anything else or cannot be read."""
+    try:
+        with Path(path).open("rb") as handle:
+            return handle.read(len(LFS_POINTER_PREFIX)) == LFS_POINTER_PREFIX
+    except OSError:
+        return False
+
+
 def check_mesh(path: str | Path, *, location: SourceLocation | None = None) -> Path:
     """``path`` if it is a readable mesh file.
 

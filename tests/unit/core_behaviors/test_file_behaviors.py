@@ -145,6 +145,29 @@ def test_text_and_image_files(behavior: Any, offline: BehaviorContext, folder: P
     assert np.array_equal(np.asarray(back.data).reshape(4, 6, 3), pixels)
 
 
+def test_a_git_lfs_pointer_is_named_as_one_not_as_a_bad_image_or_a_mesh(
+    behavior: Any, offline: BehaviorContext, folder: Path
+) -> None:
+    """MoveIt Pro's example images and meshes are Git LFS pointers in a clone without `git lfs pull`: the
+    image failed as 'not an image Pillow reads', the mesh was drawn as nothing."""
+    pointer = (
+        "version https://git-lfs.github.com/spec/v1\n"
+        "oid sha256:4d7a214614ab2935c943f9e0ff69d22eadbb8f32b1258daaa5e2ca24d17e2393\nsize 12345\n"
+    )
+    (folder / "real_lab1.png").write_text(pointer)
+    (folder / "gripper_token.dae").write_text(pointer)
+    image = tick_behavior(behavior("LoadImageFromFile"), {"file_path": "real_lab1.png"}, context=offline)
+    from kinema.transport import from_dict
+
+    pose = from_dict("geometry_msgs/msg/PoseStamped", {"header": {"frame_id": "world"}})
+    mesh = tick_behavior(
+        behavior("VisualizeMesh"), {"mesh_path": "gripper_token.dae", "mesh_pose": pose}, context=offline
+    )
+    for run in (image, mesh):
+        assert run.status == NodeStatus.FAILURE
+        assert "is a Git LFS pointer file, not the file itself; run `git lfs pull`" in run.toasts[-1]
+
+
 def test_paths_resolve_in_the_configs_objective_folders(behavior: Any, node: Any, tmp_path: Path) -> None:
     """Saves go to the config's own objectives; reads also find inherited ones; MoveIt Pro's
     ``~/user_ws/src/lab_sim/objectives/...`` names the config's own objectives, not the installed lab_sim."""

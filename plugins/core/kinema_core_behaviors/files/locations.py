@@ -26,6 +26,7 @@ from pathlib import Path
 from typing import Any
 
 from kinema.behaviors.file_access import FileAccessError, check_file_access
+from kinema.config.robot_files import is_lfs_pointer
 
 from ..messages.ports import PortValueError, port_error
 
@@ -171,6 +172,14 @@ def file_to_read(node: Any, port: str, text: str, package: str = "") -> Path:
     for candidate in candidates:
         allowed = _allowed(node, port, text, candidate)
         if allowed.is_file():
+            if is_lfs_pointer(allowed):
+                # A clone without `git lfs pull` (MoveIt Pro's example images and meshes): not the file.
+                raise port_error(
+                    node,
+                    port,
+                    f"= {text!r}: {allowed} is a Git LFS pointer file, not the file itself",
+                    "run `git lfs pull` in its repository",
+                )
             return allowed
     looked = ", ".join(dict.fromkeys(str(c.parent) for c in candidates))
     raise port_error(node, port, f"= {text!r}: no such file", f"looked in {looked}")
