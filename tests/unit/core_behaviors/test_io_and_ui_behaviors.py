@@ -195,6 +195,8 @@ def test_a_breakpoint_resumes_on_its_topic_headless(
         stop.set()
         thread.join(5)
     assert run.status == NodeStatus.SUCCESS
+    # A headless user saw it wait with no word on how to go on: the message says what to send.
+    assert any("kinema topic pub --once /resume_here std_msgs/msg/Empty" in toast for toast in run.toasts)
 
 
 def _markers(context: BehaviorContext) -> list[Any]:

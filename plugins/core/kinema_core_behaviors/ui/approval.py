@@ -189,7 +189,7 @@ class BreakpointSubscriber(_AskUser):
     """Pauses the objective until the user resumes it (TUI question, or a message on ``breakpoint_topic``).
 
     Headless with ``KINEMA_AUTO_APPROVE=1`` it resumes at once (logged); headless without it, it waits
-    for a message on the topic.
+    for a message on the topic, and its message says how to send one.
     """
 
     subcategory = "User Input"
@@ -228,7 +228,12 @@ class BreakpointSubscriber(_AskUser):
                 return bool(asking.result()) if asking in done else True
             if auto_approve():
                 return self.granted_without_user()
-            self.logger.publish_info(f"{self.prompt()} — waiting for a message on the breakpoint topic")
+            topic = str(self.get_input("breakpoint_topic"))
+            self.logger.publish_info(
+                f"{self.prompt()} No UI is attached: resume with `kinema topic pub --once {topic} "
+                "std_msgs/msg/Empty`, or attach one (`kinema ui`); `kinema run --auto-approve` passes "
+                "breakpoints by itself"
+            )
             while not resumed.is_set():
                 await asyncio.sleep(0.05)
             return True
