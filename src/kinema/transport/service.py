@@ -354,7 +354,7 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
             if time.monotonic() + _RETRY_PAUSE >= deadline:
                 raise NoAnswerError(
                     f"no server for service {self.name} [{self.type_name}] answered within {timeout:g} s"
-                    f"{self._mismatch_hint()}"
+                    f"{self._mismatch_hint() or self._access_hint()}"
                 )
             time.sleep(_RETRY_PAUSE)
 
@@ -371,6 +371,15 @@ class ServiceClient(Entity, Generic[RequestT, ResponseT]):
         return (
             f"; a server with another type or interface definition is there: {found}, "
             f"this client uses {self.type_name} ({self.type_hash})"
+        )
+
+    def _access_hint(self) -> str:
+        """Through a TLS router, a request its access rules deny goes unanswered, not refused: say so."""
+        if not any(endpoint.startswith("tls/") for endpoint in self.node.session.endpoints):
+            return ""
+        return (
+            "; through a TLS router this may be its access rules: this machine's certificate may not be "
+            "granted the service (`kinema security` on the robot lists what each role may do)"
         )
 
     def _call_once(self, payload: bytes, timeout: float) -> Any | None:
