@@ -151,8 +151,9 @@ def with_suffix(text: str, suffix: str) -> str:
     return text if lowered.endswith(suffix) else text + suffix
 
 
-def file_to_read(node: Any, port: str, text: str, package: str = "") -> Path:
-    """The existing file ``text`` names.
+def file_to_read(node: Any, port: str, text: str, package: str = "", *, lfs_pointer_ok: bool = False) -> Path:
+    """The existing file ``text`` names (a Git LFS pointer file only with ``lfs_pointer_ok``: a behavior
+    that only shows the file may say so and go on).
 
     Raises:
         PortValueError: empty, or no such file (naming every folder looked in).
@@ -172,7 +173,7 @@ def file_to_read(node: Any, port: str, text: str, package: str = "") -> Path:
     for candidate in candidates:
         allowed = _allowed(node, port, text, candidate)
         if allowed.is_file():
-            if is_lfs_pointer(allowed):
+            if not lfs_pointer_ok and is_lfs_pointer(allowed):
                 # A clone without `git lfs pull` (MoveIt Pro's example images and meshes): not the file.
                 raise port_error(
                     node,

@@ -9,6 +9,7 @@ if TYPE_CHECKING:
     import numpy as np
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, input_port
+from kinema.config.robot_files import is_lfs_pointer
 
 from ..files.locations import file_to_read, split_package_uri
 from ..messages.conversions import duration, pose_matrix
@@ -121,7 +122,8 @@ class PublishMarkers(SyncBehavior):
 class VisualizeMesh(SyncBehavior):
     """Draws the mesh file ``mesh_path`` (STL, OBJ or DAE) at ``mesh_pose`` in ``kinema view``.
 
-    Relative paths are in the objectives folder; ``package://<pkg>/<path>`` names a file of a package.
+    Relative paths are in the objectives folder; ``package://<pkg>/<path>`` names a file of a package. A
+    Git LFS pointer file (a clone without ``git lfs pull``) draws nothing, with a warning, and succeeds.
     """
 
     subcategory = "User Interface"
@@ -138,9 +140,16 @@ class VisualizeMesh(SyncBehavior):
     @fails_on_bad_input
     def tick(self) -> NodeStatus:
         package, text = split_package_uri(str(read_input(self, "mesh_path")))
-        path = file_to_read(self, "mesh_path", text, package)
+        path = file_to_read(self, "mesh_path", text, package, lfs_pointer_ok=True)
         if path.suffix.lower() not in (".stl", ".obj", ".dae"):
             raise port_error(self, "mesh_path", f"= {str(path)!r}", "give an .stl, .obj or .dae file")
+        if is_lfs_pointer(path):
+            # Only a picture: the objective goes on (MoveIt Pro's lab_sim ships its meshes through LFS).
+            self.logger.publish_warn(
+                f"VisualizeMesh: {path} is a Git LFS pointer file, not the mesh: nothing drawn (run `git lfs "
+                "pull` in its repository)"
+            )
+            return NodeStatus.SUCCESS
         frame, pose_fields = pose_dict(pose_matrix(read_message(self, "mesh_pose"), "mesh_pose"))
         marker = {
             "header": {"frame_id": frame},
