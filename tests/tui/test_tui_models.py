@@ -269,15 +269,21 @@ def test_closing_while_the_runtime_is_unreachable_does_not_wait_for_the_attempt(
     assert connection._client is None
 
 
+def _a_run_that_succeeded(endpoint: str) -> RuntimeStatus:
+    """'Pick Cube' ran 4.2 s and succeeded; the server says Idle two seconds later."""
+    status = RuntimeStatus()
+    status.apply_connection(ConnectionChanged(ConnectionState.CONNECTED, endpoint))
+    status.apply_heartbeat(Heartbeat(10.0, "Pick Cube", "Running"))
+    status.apply_heartbeat(Heartbeat(14.2, "Pick Cube", "Success"))
+    status.apply_heartbeat(Heartbeat(16.2, "Pick Cube", "Idle"))
+    return status
+
+
 def test_the_status_line_keeps_how_the_last_run_ended_once_the_server_is_idle() -> None:
     # It read "Pick Cube Idle 4.2 s" after a success and after a cancel alike.
     from kinema.tui.widgets.status_bar import render_status
 
-    status = RuntimeStatus()
-    status.apply_connection(ConnectionChanged(ConnectionState.CONNECTED, "tcp/127.0.0.1:7447"))
-    status.apply_heartbeat(Heartbeat(10.0, "Pick Cube", "Running"))
-    status.apply_heartbeat(Heartbeat(14.2, "Pick Cube", "Success"))
-    status.apply_heartbeat(Heartbeat(16.2, "Pick Cube", "Idle"))
+    status = _a_run_that_succeeded("tcp/127.0.0.1:7447")
     assert "│  Pick Cube Success 4.2 s · idle" in render_status(status).plain
     status.apply_heartbeat(Heartbeat(20.0, "Pick Cube", "Running"))
     assert "Pick Cube Running" in render_status(status).plain and "idle" not in render_status(status).plain
@@ -291,11 +297,7 @@ def test_the_status_line_drops_the_endpoint_before_the_clock_in_80_columns() -> 
     from kinema.tui.connection import ClockSample
     from kinema.tui.widgets.status_bar import render_status
 
-    status = RuntimeStatus()
-    status.apply_connection(ConnectionChanged(ConnectionState.CONNECTED, "tcp/127.0.0.1:27461"))
-    status.apply_heartbeat(Heartbeat(10.0, "Pick Cube", "Running"))
-    status.apply_heartbeat(Heartbeat(14.2, "Pick Cube", "Success"))
-    status.apply_heartbeat(Heartbeat(16.2, "Pick Cube", "Idle"))
+    status = _a_run_that_succeeded("tcp/127.0.0.1:27461")
     status.apply_clock(ClockSample(19.57, 1.0))
     narrow = render_status(status, 78).plain
     assert narrow.endswith("sim 19.57 s  RTF 1.00x") and len(narrow) <= 78, narrow

@@ -170,9 +170,9 @@ def test_a_git_lfs_pointer_is_named_as_one_not_as_a_bad_image_or_a_mesh(
     assert "is a Git LFS pointer file, not the mesh: nothing drawn" in mesh.toasts[-1]
 
 
-def test_paths_resolve_in_the_configs_objective_folders(behavior: Any, node: Any, tmp_path: Path) -> None:
-    """Saves go to the config's own objectives; reads also find inherited ones; MoveIt Pro's
-    ``~/user_ws/src/lab_sim/objectives/...`` names the config's own objectives, not the installed lab_sim."""
+def _my_cell(tmp_path: Path) -> tuple[Path, Any]:
+    """A workspace package ``my_cell`` based on lab_sim with an objectives folder of its own: its folder
+    and its resolved config."""
     import yaml
 
     from kinema.config import Workspace, resolve_config
@@ -194,7 +194,14 @@ def test_paths_resolve_in_the_configs_objective_folders(behavior: Any, node: Any
         },
     }
     (package / "config" / "config.yaml").write_text(yaml.safe_dump(config))
-    resolved = resolve_config("my_cell", Workspace.discover(tmp_path / "ws"))
+    return package, resolve_config("my_cell", Workspace.discover(tmp_path / "ws"))
+
+
+def test_paths_resolve_in_the_configs_objective_folders(behavior: Any, node: Any, tmp_path: Path) -> None:
+    """Saves go to the config's own objectives; reads also find inherited ones; MoveIt Pro's
+    ``~/user_ws/src/lab_sim/objectives/...`` names the config's own objectives, not the installed lab_sim."""
+
+    package, resolved = _my_cell(tmp_path)
     context = BehaviorContext(node, config=resolved)
     installed = {p.name for p in resolved.package_dir("lab_sim").joinpath("objectives").iterdir()}
 
@@ -412,29 +419,10 @@ def test_no_objective_writes_over_the_files_that_define_the_robot(
     """A client allowed ad-hoc XML replaced lab_sim's joint limits and waypoints with a pose (a save to an
     absolute path inside a config package): the robot rule refuses it, in the config's package and in an
     inherited bundled one, and the files stay as they were."""
-    import yaml
 
-    from kinema.config import Workspace, resolve_config
     from kinema.transport import from_dict
 
-    package = tmp_path / "ws" / "src" / "my_cell"
-    (package / "config").mkdir(parents=True)
-    (package / "objectives").mkdir()
-    (package / "package.xml").write_text(
-        '<?xml version="1.0"?><package format="3"><name>my_cell</name><version>0.0.0</version>'
-        "<description>t</description><maintainer email='t@example.com'>t</maintainer>"
-        "<license>BSD-3-Clause</license></package>"
-    )
-    config = {
-        "based_on_package": "lab_sim",
-        "objectives": {
-            "objective_library_paths": {
-                "my_objectives": {"package_name": "my_cell", "relative_path": "objectives"}
-            }
-        },
-    }
-    (package / "config" / "config.yaml").write_text(yaml.safe_dump(config))
-    resolved = resolve_config("my_cell", Workspace.discover(tmp_path / "ws"))
+    package, resolved = _my_cell(tmp_path)
     context = BehaviorContext(node, config=resolved)
     pose = from_dict("geometry_msgs/msg/PoseStamped", {"header": {"frame_id": "world"}})
     from kinema.config.waypoint_location import waypoint_store_for
