@@ -31,6 +31,15 @@ def test_columns_give_way_least_important_first() -> None:
     assert tight[1] == tight[2] == 0 and tight[0] and tight[3]  # then Type; name and description stay
 
 
+def test_a_port_name_is_never_broken_in_the_port_table_of_an_80_column_pane() -> None:
+    # The behaviors pane at 80x24 showed "waypoint_na" over "me": the name column gave way first.
+    from kinema.tui.widgets.fitted_table import PORT_COLUMNS
+
+    natural = [len("velocity_scale_factor"), 5, 6, 12, 60]  # name, direction, type, default, description
+    widths = fit_widths(PORT_COLUMNS, natural, 42, 1)
+    assert widths[0] == natural[0] and widths[4] >= 16  # the name whole, the description readable
+
+
 def lines(widget) -> list[str]:  # type: ignore[no-untyped-def]
     return [widget.render_line(y).text for y in range(widget.size.height)]
 

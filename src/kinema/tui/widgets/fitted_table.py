@@ -39,7 +39,7 @@ class Column:
 
 #: The ports of an objective or a behavior: the description stays, the direction goes first.
 PORT_COLUMNS = (
-    Column("name", "Port", min_width=10, weight=1),
+    Column("name", "Port", min_width=22, weight=1),  # an identifier: read whole, wrapped only past 22
     Column("direction", "Dir", min_width=6, weight=0, drop=3),
     Column("type", "Type", min_width=8, weight=1, drop=2),
     Column("default", "Default", min_width=8, weight=1, drop=1),
