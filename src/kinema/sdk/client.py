@@ -392,15 +392,16 @@ class ObjectiveClient:
         :mod:`kinema.config.objective_parameters` for the rule).
 
         Raises:
-            TransportError: no objective has that name (the message suggests the closest ones).
+            ObjectiveError: no objective has that name (the message suggests the closest ones).
+            TransportError: the agent did not answer.
         """
         from kinema.config.objective_file import ObjectivePort
-        from kinema.errors import did_you_mean
+        from kinema.errors import ObjectiveError, did_you_mean
 
         infos = {str(info.name): info for info in self.objectives()}
         info = infos.get(name)
         if info is None:
-            raise TransportError(f"no objective named {name!r}; {did_you_mean(name, infos)}")
+            raise ObjectiveError(f"no objective named {name!r}; {did_you_mean(name, infos)}")
         directions = {0: "input", 1: "output", 2: "inout"}
         ports = [
             ObjectivePort(

@@ -52,9 +52,10 @@ def test_cli_sdk_and_tui_list_the_same_parameters(lab_sim_agent: Any, name: str)
 
 
 def test_sdk_parameters_of_an_unknown_objective(lab_sim_agent: Any) -> None:
-    from kinema.errors import TransportError
+    from kinema.errors import ObjectiveError
     from kinema.sdk import ObjectiveClient
 
     with ObjectiveClient(lab_sim_agent.endpoint, timeout=10) as client:
-        with pytest.raises(TransportError, match=r"no objective named 'Move to Waypont'.*Move to Waypoint"):
+        # A name that is not there is the objective's error, not the transport's (it answered).
+        with pytest.raises(ObjectiveError, match=r"no objective named 'Move to Waypont'.*Move to Waypoint"):
             client.parameters("Move to Waypont")
