@@ -86,6 +86,10 @@ class SceneViewer:
         self._objective = ("", "")
         self._sim_time: float | None = None
         self._qpos_mismatch: int | None = None
+        #: The config the runtime's agent says it runs (its presence), "" until heard; and why the view
+        #: does not draw that one when it differs (set by the :class:`~kinema.viz.view.Viewer`).
+        self.runtime_config = ""
+        self.follow_note = ""
         self._was_lost = False
         self._rate_window: list[float] = []
         self._node: Node | None = None
@@ -140,6 +144,11 @@ class SceneViewer:
         """The JSON behind the page's banner and info line."""
         verdict = self.liveness.verdict()
         banner, level = verdict.banner, verdict.level
+        if not banner and self.runtime_config and self.config and self.runtime_config != self.config:
+            level = "warning"
+            banner = self.follow_note or (
+                f"The runtime runs config {self.runtime_config}; this view draws {self.config}."
+            )
         if not banner and self._qpos_mismatch is not None:
             level = "warning"
             banner = (

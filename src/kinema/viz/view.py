@@ -15,13 +15,14 @@ from __future__ import annotations
 import logging
 import os
 import sys
+import threading
 import webbrowser
 from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from kinema.errors import ConfigError
+from kinema.errors import ConfigError, KinemaError
 from kinema.process.stop import TERMINATE, StopRequest
 
 log = logging.getLogger("kinema.viz")
@@ -154,6 +155,74 @@ class Viewer:
         except BaseException:
             self.close()
             raise
+        self._options = options
+        self._redraw_lock = threading.Lock()
+        self._watch_agent_config()
+
+    def _watch_agent_config(self) -> None:
+        """Follow the config the runtime's agent runs: after `kinema down` and `kinema run -c OTHER` the
+        page draws OTHER's scene (unless ``-c`` chose what to draw), or says why it cannot."""
+        from kinema.transport.dispatch import channel, dispatch
+        from kinema.transport.presence import AGENT, PRESENCE_PREFIX
+
+        key = f"{PRESENCE_PREFIX}/{self.session.domain_id}/*/{AGENT}/**"
+        try:
+            watch = self.session.zenoh.liveliness().declare_subscriber(key, channel(), history=True)
+        except Exception:
+            log.warning("cannot watch the runtime's config; the view keeps drawing %s", self.source.config)
+            return
+        self._agent_watch = watch  # a zenoh subscriber no one holds is undeclared
+        self.session._track_dispatcher(dispatch(watch, self._on_agent_presence, "-view-agent"))
+
+    def _on_agent_presence(self, sample: Any) -> None:
+        import zenoh
+
+        from kinema.transport.presence import parse_presence
+
+        member = parse_presence(str(sample.key_expr))
+        if member is None or sample.kind == zenoh.SampleKind.DELETE or not member.config:
+            return
+        bridge = self.bridge
+        if bridge is not None:
+            bridge.runtime_config = member.config
+        if self._options.config is None and member.config != self.source.config:
+            # Loading a MuJoCo scene takes a while: not on the transport's thread.
+            threading.Thread(
+                target=self._redraw, args=(member.config,), name="kinema-view-redraw", daemon=True
+            ).start()
+
+    def _redraw(self, config: str) -> None:
+        """Draw ``config``'s scene instead (the page redraws from scratch), or say on the page why not."""
+        from kinema.viz.scene_model import SceneModel
+        from kinema.viz.scene_viewer import SceneViewer
+
+        with self._redraw_lock:
+            old = self.bridge
+            if old is None or config == self.source.config:
+                return
+            try:
+                source = resolve_scene(config, self._options.workspace, self.endpoint)
+                scene = SceneModel.from_file(source.model_path, source.end_effector, source.keyframe)
+            except KinemaError as error:
+                old.follow_note = (
+                    f"The runtime runs config {config}, which this view cannot draw ({error}); it draws "
+                    f"{self.source.config}."
+                )
+                self._options.echo(f"warning: {old.follow_note}")
+                return
+            old.stop()
+            bridge = SceneViewer(
+                self.session,
+                scene,
+                self.server,
+                endpoint=self.endpoint,
+                config=source.config,
+                frame_rate=self._options.frame_rate,
+            )
+            bridge.runtime_config = config
+            self.source, self.bridge = source, bridge
+            bridge.start()
+            self._options.echo(f"3D view now draws config {config} (what the runtime runs)")
 
     @property
     def url(self) -> str:

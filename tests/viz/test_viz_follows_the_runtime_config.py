@@ -1,0 +1,58 @@
+"""`kinema view` left running across `kinema down` and `kinema run -c OTHER` draws OTHER's scene.
+
+A new user's view kept saying (and drawing) lab_sim after the tutorial switched the runtime to
+example_config: the scene was resolved once, at start. Now the view follows the config the runtime's agent
+announces, unless ``-c`` chose what to draw, and says on the page why when it cannot.
+"""
+
+from __future__ import annotations
+
+import socket
+import time
+from collections.abc import Callable
+
+import pytest
+
+
+def _free_port() -> int:
+    with socket.socket() as probe:
+        probe.bind(("127.0.0.1", 0))
+        return int(probe.getsockname()[1])
+
+
+def _until(condition: Callable[[], bool], timeout: float = 20.0) -> bool:
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        if condition():
+            return True
+        time.sleep(0.05)
+    return condition()
+
+
+def test_the_view_draws_the_config_the_runtime_runs_or_says_why_not(monkeypatch: pytest.MonkeyPatch) -> None:
+    from kinema.transport import free_endpoint, host_router, open_session
+    from kinema.transport.presence import AGENT, declare_presence
+    from kinema.viz.view import ViewerOptions, start_viewer
+
+    monkeypatch.setenv("KINEMA_CONFIG", "lab_sim")  # what the view draws first: the active config
+    endpoint = free_endpoint()
+    with host_router(endpoint), open_session(endpoint) as agent_side:
+        notes: list[str] = []
+        viewer = start_viewer(
+            ViewerOptions(endpoint=endpoint, port=_free_port(), open_browser=False, echo=notes.append)
+        )
+        try:
+            assert viewer.source.config == "lab_sim"
+            first = declare_presence(agent_side, AGENT, config="example_config")
+            assert _until(lambda: viewer.source.config == "example_config"), notes
+            assert viewer.bridge is not None and "config example_config" in viewer.bridge.status()["info"]
+            assert "3D view now draws config example_config (what the runtime runs)" in notes
+            first.close()
+            declare_presence(agent_side, AGENT, config="config_of_another_machine")
+            assert _until(lambda: "cannot draw" in (viewer.bridge.status()["banner"] or "")), notes
+            banner = viewer.bridge.status()["banner"]
+            assert "The runtime runs config config_of_another_machine" in banner
+            assert "it draws example_config" in banner
+            assert viewer.source.config == "example_config"
+        finally:
+            viewer.close()
