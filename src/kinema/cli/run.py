@@ -175,7 +175,7 @@ def _list_configs(workspace: Path | None) -> None:
     "--timeout", type=float, default=15.0, show_default=True, help="Seconds to wait for a clean stop."
 )
 def down(timeout: float) -> None:
-    """Stop every `kinema run` of this user on this machine (a `kinema view` or `kinema ui` stays).
+    """Stop every `kinema run` started with this state folder (a `kinema view` or `kinema ui` stays).
 
     Every `kinema run` recorded in the user's state folder ($XDG_STATE_HOME) stops cleanly, with its
     agent, drivers and router: a cell split with `kinema run -n` and `kinema run -o` stops whole.

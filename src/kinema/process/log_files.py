@@ -27,6 +27,9 @@ DATE_FORMAT = "%Y-%m-%d %H:%M:%S"
 LEVELS = ("DEBUG", "INFO", "WARNING", "ERROR", "CRITICAL")
 #: The agent's logger for plugin load errors and hot-reload outcomes; `kinema run` echoes its entries.
 PLUGIN_LOGGER = "kinema.plugins"
+#: Libraries whose INFO lines say nothing to a user of Kinema (``No OpenGL_accelerate module loaded`` in
+#: every MuJoCo driver's log); their warnings still show, and all of it with ``--verbose``.
+QUIET_LIBRARY_LOGGERS = ("OpenGL.acceleratesupport",)
 #: Sent to a process of a run, it writes every thread's stack to its log file (see the module's docstring).
 STACKS_SIGNAL = signal.SIGUSR1
 
@@ -66,6 +69,8 @@ def configure_process_logging(log_file: Path | None, *, verbose: bool = False, e
     """Send this process's ``logging`` output to ``log_file`` in the run format (and stderr if ``echo``)."""
     root = logging.getLogger()
     root.setLevel(logging.DEBUG if verbose else logging.INFO)
+    for chatty in QUIET_LIBRARY_LOGGERS:
+        logging.getLogger(chatty).setLevel(logging.DEBUG if verbose else logging.WARNING)
     formatter = logging.Formatter(LOG_FORMAT, DATE_FORMAT)
     for handler in list(root.handlers):
         root.removeHandler(handler)

@@ -101,3 +101,36 @@ def test_a_run_that_had_to_be_killed_first_wrote_where_it_hung_to_its_log(tmp_pa
     process.wait(5)
     text = log.read_text()
     assert "stuck_in_shutdown" in text and "thread 0x" in text, text
+
+
+def test_a_libraries_info_chatter_stays_out_of_the_run_logs_and_its_warnings_in(tmp_path: Path) -> None:
+    # `kinema logs --level info` showed "No OpenGL_accelerate module loaded" from every driver.
+    import logging
+
+    from kinema.process.log_files import configure_process_logging
+
+    log = tmp_path / "mujoco.log"
+    root = logging.getLogger()
+    handlers, level = list(root.handlers), root.level
+    try:
+        configure_process_logging(log)
+        chatty = logging.getLogger("OpenGL.acceleratesupport")
+        chatty.info("No OpenGL_accelerate module loaded")
+        chatty.warning("a real problem")
+        logging.getLogger("kinema.drivers.mujoco").info("MuJoCo driver ready")
+    finally:
+        for handler in list(root.handlers):
+            root.removeHandler(handler)
+            handler.close()
+        for handler in handlers:
+            root.addHandler(handler)
+        root.setLevel(level)
+        logging.getLogger("OpenGL.acceleratesupport").setLevel(logging.NOTSET)
+        import faulthandler
+
+        from kinema.process.log_files import STACKS_SIGNAL
+
+        faulthandler.unregister(STACKS_SIGNAL)  # it wrote to the log file closed above
+    text = log.read_text()
+    assert "OpenGL_accelerate" not in text
+    assert "a real problem" in text and "MuJoCo driver ready" in text
