@@ -71,6 +71,7 @@ def validate_registration(cls: object, behavior_id: str | None, plugin: str) -> 
         PluginError: naming the plugin, the behavior and what is wrong with it.
     """
     from kinema.bt import TreeNode
+    from kinema.bt.names import port_name_problem
 
     if not isinstance(cls, type):
         raise PluginError(
@@ -120,10 +121,29 @@ def validate_registration(cls: object, behavior_id: str | None, plugin: str) -> 
                 f"plugin '{plugin}': behavior '{name}' declares port '{port_name}' twice",
                 location=location,
             )
+        problem = port_name_problem(port_name)
+        if problem:
+            raise PluginError(
+                f"plugin '{plugin}': behavior '{name}': {problem}",
+                location=_line_naming(location, port_name),
+            )
         seen.add(port_name)
     metadata = _metadata_of(cls, name, plugin, location)
     _check_former_spellings(cls, name, plugin, location)
     return BehaviorRegistration(name, cls, plugin, location, ports, metadata)
+
+
+def _line_naming(location: SourceLocation, text: str) -> SourceLocation:
+    """The first line from the class statement at ``location`` on that quotes ``text`` (where a port is
+    declared), else ``location``."""
+    if not location.line:
+        return location
+    lines = linecache.getlines(location.file)
+    quoted = (f'"{text}"', f"'{text}'")
+    for number in range(location.line, len(lines) + 1):
+        if any(q in lines[number - 1] for q in quoted):
+            return SourceLocation(location.file, number)
+    return location
 
 
 def _check_former_spellings(cls: type, name: str, plugin: str, location: SourceLocation) -> None:
