@@ -895,6 +895,28 @@ class Agent:
             self.source.invalidate_objectives()
         plugin_log.log(logging.INFO if event.ok else logging.ERROR, "%s", event)
         self._streams.publish_log(LOG_INFO if event.ok else LOG_ERROR, str(event))
+        if str(event.kind) == "objectives_changed" and self.source is not None:
+            self._check_changed_objectives(event.paths)
+
+    def _check_changed_objectives(self, paths: Sequence[str]) -> None:
+        """Say now what `kinema build` would say about objective files saved while the runtime runs (a port
+        that is not there, an unknown behavior), not only when one runs: a warning each, with file:line."""
+        from pathlib import Path
+
+        from kinema.bt.validation import validate_files
+
+        assert self.source is not None
+        files: list[str | Path] = [path for path in paths if path.endswith(".xml") and Path(path).is_file()]
+        if not files:
+            return
+        try:
+            problems: list[object] = list(validate_files(files, self.source.factory()))
+        except KinemaError as error:
+            problems = [error]
+        for problem in problems:
+            text = f"{problem} (the objective fails there when it runs; `kinema build` lists every problem)"
+            plugin_log.warning("%s", text)
+            self._streams.publish_log(LOG_WARN, text)
 
 
 def _info_dict(info: ObjectiveInfo, parameters: Sequence[Any] | None = None) -> dict[str, Any]:

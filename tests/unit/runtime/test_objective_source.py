@@ -2,7 +2,9 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
+from typing import Any
 
 from kinema.bt import WallClock
 from kinema.runtime.objective_server import ObjectiveRequest, ObjectiveServer
@@ -88,8 +90,6 @@ def test_a_client_that_lists_objectives_as_soon_as_it_reads_the_reload_notice_ge
     # The TUI asks for the list when the notice arrives; the notice went out before the library was
     # marked stale, so a quick enough ask got the old list, and no second notice came while the files
     # stayed as they were (the TUI showed one objective for good; a loaded CI machine hit it).
-    from types import SimpleNamespace
-
     from kinema.plugins.events import ReloadEvent, ReloadKind
     from kinema.runtime.agent import Agent
 
@@ -103,10 +103,44 @@ def test_a_client_that_lists_objectives_as_soon_as_it_reads_the_reload_notice_ge
     def publish_log(level: int, text: str) -> None:
         seen_with_notice.append([info.id for info in source.objectives()])
 
-    agent = SimpleNamespace(source=source, _streams=SimpleNamespace(publish_log=publish_log))
+    agent = _agent_over(source, publish_log)
     event = ReloadEvent(ReloadKind.OBJECTIVES_CHANGED, str(tmp_path), "objectives changed: later.xml")
     Agent.on_reload_event(agent, event)  # type: ignore[arg-type]
     assert seen_with_notice == [["Good", "Later"]]
+
+
+def _agent_over(source: LibraryTreeSource, publish_log: Callable[[int, str], None]) -> Any:
+    """Enough of an Agent for its reload handling: the tree source and a log stream."""
+    from types import SimpleNamespace
+
+    from kinema.runtime.agent import Agent
+
+    agent = SimpleNamespace(source=source, _streams=SimpleNamespace(publish_log=publish_log))
+    agent._check_changed_objectives = lambda paths: Agent._check_changed_objectives(agent, paths)  # type: ignore[arg-type]
+    return agent
+
+
+def test_an_objective_saved_with_a_wrong_port_is_reported_at_the_save_not_at_its_run(tmp_path: Path) -> None:
+    # A new user changed mass_kg= to mass_gk= while the runtime ran: it said only "Objectives changed".
+    from kinema.plugins.events import ReloadEvent, ReloadKind
+    from kinema.runtime.agent import Agent
+
+    good = tmp_path / "good.xml"
+    good.write_text(GOOD)
+    source = _source(tmp_path)
+    source.factory()
+    good.write_text(
+        GOOD.replace("<AlwaysSuccess/>", '<Sequence>\n<SetBlackboard value="1" ky="x"/></Sequence>')
+    )
+    said: list[tuple[int, str]] = []
+    agent = _agent_over(source, lambda level, text: said.append((level, text)))
+    event = ReloadEvent(
+        ReloadKind.OBJECTIVES_CHANGED, str(tmp_path), "Objectives changed: good.xml", paths=(str(good),)
+    )
+    Agent.on_reload_event(agent, event)  # type: ignore[arg-type]
+    warnings = [text for level, text in said if level == 2]
+    assert len(warnings) == 1, said
+    assert warnings[0].startswith(f"{good}:2: ") and "[ky]" in warnings[0], warnings
 
 
 def test_a_file_saved_broken_keeps_its_last_good_version_through_a_rebuild(tmp_path: Path) -> None:
