@@ -547,7 +547,8 @@ class Launcher:
         CellWatch(self.session, report)  # closed with the session
 
     def _echo_plugin_reports(self) -> None:
-        """Print the agent's plugin load errors and hot-reload outcomes here as they are logged.
+        """Print the agent's plugin load errors, hot-reload outcomes and watchdog reports here as they are
+        logged.
 
         Without a UI this terminal is where the user looks; the log file (``kinema logs``) has them too.
         """
@@ -556,10 +557,14 @@ class Launcher:
         assert self.run_folder is not None
         entries = follow_entries(self.run_folder.path, stop=self._echo_stop, from_start=True)
         marker = f"[{PLUGIN_LOGGER}] "
+        # The watchdog's reports (behavior code stuck in a call) too: runtime.md promises them here.
+        watchdog = "[kinema.objective_server] watchdog: "
 
         def echo() -> None:
             for entry in entries:
                 rest = entry.text.partition(marker)[2]
+                if not rest and watchdog in entry.text:
+                    rest = "watchdog: " + entry.text.partition(watchdog)[2]
                 if rest:
                     self.options.echo(f"{entry.process}: {entry.level.lower()}: {rest}")
 

@@ -142,3 +142,32 @@ def test_objective_run_says_when_it_runs_code_whose_latest_file_failed_to_load(
     assert f"{behaviors}:{line_no}" in said and "SyntaxError" in said, said
     assert "runs older code" in said  # said as it starts
     assert re.search(r"note: .*Wave runs the version from \d\d:\d\d instead", said), said
+
+
+def test_a_wrong_port_saved_and_a_stuck_behavior_are_said_in_the_run_terminal(
+    terminal: Terminal, workspace: Path, env: dict[str, str]
+) -> None:
+    # A new user read only "Objectives changed" for an objective saved with a wrong port, and nothing in
+    # the headless terminal about a behavior stuck in tick (runtime.md says the watchdog reports there).
+    objective = workspace / "src" / "my_cell" / "objectives" / "slow.xml"
+    objective.write_text(
+        '<root BTCPP_format="4">\n  <BehaviorTree ID="Slow Wave">\n    <Wave mass_gk="1"/>\n'
+        "  </BehaviorTree>\n</root>\n"
+    )
+    wrong = terminal.wait_for(f"{objective}:3", "[mass_gk]")
+    assert wrong.startswith("agent: warning:"), wrong
+    behaviors = workspace / "src" / "waves" / "waves" / "behaviors.py"
+    behaviors.write_text(
+        BEHAVIOR.replace("def tick(self):", "def tick(self):\n        import time\n\n        time.sleep(2.5)")
+    )
+    terminal.wait_for("Reloaded waves: Wave")
+    objective.write_text(objective.read_text().replace(' mass_gk="1"', ""))
+    terminal.wait_for("Objectives changed: slow.xml")
+    subprocess.run(
+        [sys.executable, "-m", "kinema", "objective", "run", "Slow Wave", "--timeout", "30"],
+        capture_output=True,
+        env=env,
+        timeout=120,
+    )
+    stuck = terminal.wait_for("watchdog: behavior 'Wave'", "has been in tick")
+    assert stuck.startswith("agent: warning:"), stuck
