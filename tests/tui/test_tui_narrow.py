@@ -98,3 +98,26 @@ def test_waypoint_positions_are_never_cut(fake: FakeConnection) -> None:
             assert "-1.5708" in text and "+0.7929" in text, text
 
         drive(fake, scenario, mode="waypoints", size=size)
+
+
+def test_at_80_columns_two_long_objective_names_can_be_told_apart(fake: FakeConnection) -> None:
+    # Cut with an ellipsis, both read "Execute MTC S…"; wrapped without an indent, "Solution" read as an
+    # objective of its own. A long name wraps under itself, behind its mark.
+    from textual.widgets import OptionList
+
+    from kinema.tui.connection import ObjectiveSummary
+
+    fake.objectives = [
+        ObjectiveSummary("Execute MTC Solution", runnable=False),
+        ObjectiveSummary("Execute MTC Solution JTC", runnable=False),
+    ]
+
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        await settle(pilot)
+        shown = [line.strip("▊▎▁▔ ") for line in lines(app.screen.query_one("#objective-list", OptionList))]
+        text = [line for line in shown if line]
+        assert any(line.endswith("JTC") for line in text), text
+        first = next(i for i, line in enumerate(text) if line.startswith("◦ Execute"))
+        assert not text[first + 1].startswith("◦"), text  # its continuation, not another objective
+
+    drive(fake, scenario, size=NARROW)

@@ -7,6 +7,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, cast
 
+from rich.table import Table
 from rich.text import Text
 from textual.app import ComposeResult
 from textual.binding import Binding
@@ -214,15 +215,7 @@ class ObjectivesScreen(KinemaScreen):
         options = self.query_one("#objective-list", OptionList)
         options.clear_options()
         for objective in self.shown_objectives:
-            label = Text()
-            if objective.favorite:
-                label.append("★ ", style="yellow")
-            else:
-                # A subtree-only objective is marked before its name: a tag after it wrapped onto a line
-                # of its own in a narrow list, where it read as another objective.
-                label.append("  " if objective.runnable else "◦ ", style="dim")
-            label.append(objective.name, style="" if objective.runnable else "dim italic")
-            options.add_option(Option(label, id=objective.name))
+            options.add_option(Option(_objective_row(objective), id=objective.name))
         self.query_one("#objective-count", Static).update(
             f"{len(self.shown_objectives)} of {len(self.objectives)} objectives"
         )
@@ -492,3 +485,19 @@ def _load_outline(connection: RuntimeConnection, name: str) -> ObjectiveOutlineL
     except KinemaError as error:
         return ObjectiveOutlineLoaded(name, xml, None, str(error))
     return ObjectiveOutlineLoaded(name, xml, outline)
+
+
+def _objective_row(objective: ObjectiveSummary) -> Table:
+    """One entry of the objective list: its mark, then its name, which wraps under itself (a narrow list
+    cut 'Execute MTC Solution' and 'Execute MTC Solution JTC' to the same 'Execute MTC S…', and a wrapped
+    name without the indent read as another objective)."""
+    row = Table.grid(padding=0)
+    row.add_column(width=2, no_wrap=True)
+    row.add_column()
+    if objective.favorite:
+        mark = Text("★ ", style="yellow")
+    else:
+        # A subtree-only objective is marked before its name (a tag after it wrapped out of sight).
+        mark = Text("  " if objective.runnable else "◦ ", style="dim")
+    row.add_row(mark, Text(objective.name, style="" if objective.runnable else "dim italic"))
+    return row
