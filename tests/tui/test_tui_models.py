@@ -303,3 +303,9 @@ def test_the_status_line_drops_the_endpoint_before_the_clock_in_80_columns() -> 
     assert narrow.endswith("sim 19.57 s  RTF 1.00x") and len(narrow) <= 78, narrow
     assert "tcp/127.0.0.1:27461" not in narrow
     assert "tcp/127.0.0.1:27461" in render_status(status, 200).plain
+    # A long objective name: the factor goes too, whole, rather than cut at the edge.
+    status.apply_heartbeat(Heartbeat(20.0, "3 Waypoints Pick and Place", "Running"))
+    status.apply_heartbeat(Heartbeat(25.8, "3 Waypoints Pick and Place", "Running"))
+    running = render_status(status, 78).plain
+    assert running.endswith("3 Waypoints Pick and Place Running 5.8 s  │  sim 19.57 s"), running
+    assert len(running) <= 78

@@ -61,15 +61,23 @@ class StatusBar(Static):
 
 
 def render_status(status: RuntimeStatus, width: int | None = None) -> Text:
-    """The status line as rich text (also used by tests to check wording). With ``width``, a connected
-    runtime's endpoint is left out when the line would not fit with it (the run and the clock come first)."""
+    """The status line as rich text (also used by tests to check wording). With ``width``, what does not
+    fit is left out whole, least needed first (a connected runtime's endpoint, the real-time factor, the
+    sim time), rather than cut at the edge: the run's objective, status and time come first."""
     line = _render(status, with_endpoint=True)
-    if width is not None and status.state is ConnectionState.CONNECTED and line.cell_len > width:
-        line = _render(status, with_endpoint=False)
+    if width is None or status.state is not ConnectionState.CONNECTED:
+        return line
+    # What goes first when the line is too long: the endpoint, then the real-time factor, then sim time.
+    for endpoint, factor, clock in ((False, True, True), (False, False, True), (False, False, False)):
+        if line.cell_len <= width:
+            break
+        line = _render(status, with_endpoint=endpoint, with_factor=factor, with_clock=clock)
     return line
 
 
-def _render(status: RuntimeStatus, *, with_endpoint: bool) -> Text:
+def _render(
+    status: RuntimeStatus, *, with_endpoint: bool, with_factor: bool = True, with_clock: bool = True
+) -> Text:
     symbol, colour = _STATE_STYLE[status.state]
     text = Text()
     text.append(f"{symbol} {status.state.value}", style=f"bold {colour}")
@@ -92,10 +100,10 @@ def _render(status: RuntimeStatus, *, with_endpoint: bool) -> Text:
         text.append(f" {status.elapsed:.1f} s")
     if status.status == "Idle" and status.last_outcome and status.objective:
         text.append(" · idle", style="dim")
-    if status.sim_time is not None:
+    if status.sim_time is not None and with_clock:
         text.append("  │  sim ")
         text.append(f"{status.sim_time:.2f} s")
-        if status.real_time_factor is not None:
+        if status.real_time_factor is not None and with_factor:
             text.append(f"  RTF {status.real_time_factor:.2f}x")
     if status.warnings:
         # The watchdog: a behavior stuck in tick is the first thing a user must see.
