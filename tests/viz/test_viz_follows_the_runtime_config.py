@@ -56,3 +56,27 @@ def test_the_view_draws_the_config_the_runtime_runs_or_says_why_not(monkeypatch:
             assert viewer.source.config == "example_config"
         finally:
             viewer.close()
+
+
+def test_the_page_keeps_how_the_last_run_ended_once_the_server_is_idle() -> None:
+    # The info line read "objective 3 Waypoints Pick and Place: Idle" after a cancel (and after a success).
+    from types import SimpleNamespace
+
+    from kinema.resources import bundled_dir
+    from kinema.transport import open_session
+    from kinema.viz.scene_model import SceneModel
+    from kinema.viz.scene_viewer import SceneViewer
+
+    model = SceneModel.from_file(bundled_dir("configs") / "lab_sim" / "description" / "lab_sim_scene.xml")
+    with open_session([]) as session:
+        viewer = SceneViewer(session, model, SimpleNamespace(), config="lab_sim")  # type: ignore[arg-type]
+
+        def beat(name: str, status: str) -> str:
+            viewer._on_heartbeat(SimpleNamespace(objective_name=name, objective_status=status))
+            return str(viewer.status()["info"])
+
+        assert "objective Pick: Running" in beat("Pick", "Running")
+        beat("Pick", "Cancelled")
+        assert "objective Pick: Cancelled · idle" in beat("Pick", "Idle")
+        assert "objective Pick: Cancelled · idle" in beat("Pick", "Idle")  # every later beat too
+        assert "objective Place: Idle" in beat("Place", "Idle")

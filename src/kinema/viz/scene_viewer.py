@@ -48,6 +48,9 @@ JOINT_STATES_MAX_SIM_SPEED = 2.0
 SCENE_STATE_ABSENT_S = 1.0
 
 
+_ENDED = frozenset({"Success", "Failure", "Cancelled"})
+
+
 class SceneViewer:
     """Draws a runtime's scene into a :class:`MeshcatServer` (see the module docstring).
 
@@ -227,7 +230,13 @@ class SceneViewer:
 
     def _on_heartbeat(self, message: Any) -> None:
         self.liveness.heard_heartbeat()
-        self._objective = (str(message.objective_name), str(message.objective_status))
+        name, state = str(message.objective_name), str(message.objective_status)
+        previous_name, previous_state = self._objective
+        if state == "Idle" and name == previous_name and previous_state in _ENDED:
+            state = f"{previous_state} · idle"  # how the run ended stays on the page (the TUI does the same)
+        elif state == "Idle" and name == previous_name and previous_state.endswith(" · idle"):
+            state = previous_state
+        self._objective = (name, state)
 
     def _on_marker_array(self, message: Any) -> None:
         for marker in message.markers:
