@@ -44,9 +44,10 @@ def test_the_view_draws_the_config_the_runtime_runs_or_says_why_not(monkeypatch:
         try:
             assert viewer.source.config == "lab_sim"
             first = declare_presence(agent_side, AGENT, config="example_config")
-            assert _until(lambda: viewer.source.config == "example_config"), notes
+            said = "3D view now draws config example_config (what the runtime runs)"
+            assert _until(lambda: said in notes), notes  # said once the new scene is drawn
+            assert viewer.source.config == "example_config"
             assert viewer.bridge is not None and "config example_config" in viewer.bridge.status()["info"]
-            assert "3D view now draws config example_config (what the runtime runs)" in notes
             first.close()
             declare_presence(agent_side, AGENT, config="config_of_another_machine")
             assert _until(lambda: "cannot draw" in (viewer.bridge.status()["banner"] or "")), notes
