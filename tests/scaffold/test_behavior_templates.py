@@ -108,6 +108,11 @@ def test_a_behavior_added_to_a_package_is_registered_and_tested(workspace: Path)
     assert added.loader_name == "adders::AddersBehaviorsLoader"
     assert (package_dir / "adders" / "add_client.py").is_file()
     assert sorted(load_behavior_package(package_dir)) == ["AddClient", "Adders"]
+    # The package README's table lists it too (it listed only the first behavior).
+    readme = (package_dir / "README.md").read_text()
+    first, second = "| `Adders` | async | `adders/adders.py` |", "| `AddClient` | service_client |"
+    assert f"{first}\n{second} `adders/add_client.py` |\n" in readme
+    assert package_dir / "README.md" in added.files
     returncode, output = _run_package_tests(package_dir)
     assert returncode == 0, output
     assert "6 passed" in output

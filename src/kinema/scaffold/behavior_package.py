@@ -163,7 +163,12 @@ def new_behavior(
         from kinema.config.atomic_write import atomic_write_text
 
         atomic_write_text(init, new_init)
-        result = NewBehavior(behavior_id, package, package_dir, loader, False, [*targets.values(), init])
+        written = [*targets.values(), init]
+        readme = package_dir / "README.md"
+        row = f"| `{behavior_id}` | {context['behavior_type']} | `{module_dir.name}/{name}.py` |"
+        if _add_table_row(readme, row):
+            written.append(readme)
+        result = NewBehavior(behavior_id, package, package_dir, loader, False, written)
 
     if config_package is not None:
         result.config_file = config_package.config_file
@@ -174,6 +179,27 @@ def new_behavior(
             objectives=(result.package_dir / "objectives").is_dir(),
         )
     return result
+
+
+def _add_table_row(readme: Path, row: str) -> bool:
+    """Add ``row`` after the last row of the template README's behavior table; False (nothing written)
+    when there is no README or its table is gone (the user rewrote it)."""
+    from kinema.config.atomic_write import atomic_write_text
+
+    try:
+        lines = readme.read_text(encoding="utf-8").splitlines(keepends=True)
+    except OSError:
+        return False
+    title = "| Behavior | Type | Module |"
+    header = next((i for i, line in enumerate(lines) if line.startswith(title)), None)
+    if header is None:
+        return False
+    end = header + 1
+    while end < len(lines) and lines[end].startswith("|"):
+        end += 1
+    lines.insert(end, row + "\n")
+    atomic_write_text(readme, "".join(lines))
+    return True
 
 
 def _check_id_is_free(behavior_id: str, workspace: Workspace, config: str) -> None:
