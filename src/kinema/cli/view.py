@@ -47,8 +47,8 @@ def view(
     Attaches to the runtime started with `kinema run` (here or at --connect), serves the 3D view on
     127.0.0.1 only and prints its URL; works offline. The scene is the MuJoCo model of the runtime's
     config (-c to name another). Runs until Ctrl-C; the page says so when the runtime goes away and
-    follows it again when it comes back: a runtime started again with another config has that config's scene drawn
-    (unless -c named one).
+    follows it again when it comes back: a runtime started again with another config has that
+    config's scene drawn (unless -c named one).
     """
     from kinema.viz.view import ViewerOptions, run_viewer
 
