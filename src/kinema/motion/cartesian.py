@@ -115,7 +115,12 @@ def plan_cartesian_path(
                 break
             jump = float(np.abs(q_next[cols] - q[cols]).max())
             if jump > jump_threshold:
-                reason = f"joint jump of {jump:.3f} exceeds the threshold {jump_threshold}"
+                reason = (
+                    f"joint jump of {jump:.3f} exceeds the threshold {jump_threshold} at "
+                    f"{np.round(target[:3, 3], 4).tolist()}: usually the path nears the edge of the arm's "
+                    "reach or a singularity there (a shorter move or a joint-space move avoids it; a larger "
+                    "threshold allows the jump)"
+                )
                 break
             if checker.first_invalid(np.array([q, q_next]), 0.01) is not None:
                 reason = f"collision: {checker.describe(q_next)}"

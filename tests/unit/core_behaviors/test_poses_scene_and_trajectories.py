@@ -545,7 +545,10 @@ def test_cartesian_path_honours_ik_joint_space_density(
         context=context,
         timeout=30.0,
     )
-    assert strict.status == NodeStatus.FAILURE and "exceeds the threshold 0.0001" in strict.toasts[-1]
+    assert strict.status == NodeStatus.FAILURE and "exceeds the threshold 0.0001 at [" in strict.toasts[-1]
+    # Where, and what it usually means (a new user read only the numbers for a target out of reach).
+    assert "the edge of the arm's reach or a singularity there" in strict.toasts[-1]
+    assert "a larger threshold allows the jump" in strict.toasts[-1]
 
 
 def test_a_camera_of_the_scene_is_a_frame(behavior: Any, context: BehaviorContext, at_home: Any) -> None:
