@@ -197,6 +197,8 @@ def test_behaviors_catalog_and_reload_events(fake: FakeConnection) -> None:
         details = str(app.screen.query_one("#behavior-details").render())
         assert "Adds two integers." in details and "workspace: src/my_behaviors" in details
         assert "src/my_behaviors/my_behavior.py:12" in details
+        # No reload yet: the port table has the room of the empty reload list (at 80x24 one port showed).
+        assert not app.screen.query_one("#reload-table", DataTable).display
         fake.emit(
             ReloadNotice(
                 False,
@@ -211,7 +213,13 @@ def test_behaviors_catalog_and_reload_events(fake: FakeConnection) -> None:
         reloads = table_rows(app.screen.query_one("#reload-table", DataTable))
         assert reloads[0][1] == "✘" and "src/my_behaviors/my_behavior.py:7: SyntaxError" in reloads[0][3]
         assert reloads[1][1] == "✔"
+        assert app.screen.query_one("#reload-table", DataTable).display
         assert any("my_behavior.py:7: SyntaxError" in text for text in app.shown)
+        # Esc leaves the search box for the list, so that the screen keys (1-6) switch screens again.
+        await pilot.press("slash", "M")
+        assert app.focused is not None and app.focused.id == "behavior-search"
+        await pilot.press("escape")
+        assert app.focused is not None and app.focused.id == "behavior-table"
         assert len(fake.called("list_behaviors")) == 2  # a good reload lists the behaviors again
 
     drive(fake, scenario, mode="behaviors")

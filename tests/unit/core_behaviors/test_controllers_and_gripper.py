@@ -207,6 +207,8 @@ def test_the_grasp_check_fails_a_close_on_nothing_only_when_asked(
     if expected == NodeStatus.FAILURE:
         assert "the gripper closed on nothing" in run.toasts[-1]
         assert "ForceSuccess" in run.toasts[-1]
+        # A pick cancelled half-way leaves the cube elsewhere: the next run's failure says how to reset.
+        assert "`kinema sim reset` puts the objects back" in run.toasts[-1]
 
 
 def test_forcesuccess_lets_a_pick_that_closed_on_nothing_go_on(

@@ -75,7 +75,8 @@ class MoveGripperAction(ActionClientBehavior["control_msgs/action/GripperCommand
             self.logger.publish_failure(
                 f"MoveGripperAction: the gripper closed on nothing: it reached {outcome.position:.4f} "
                 f"(target {target:.4f}) without stopping on an object, and require_grasp is true. Check "
-                "that the object is where the gripper closed, or wrap the pick in ForceSuccess to go on "
+                "that the object is where the gripper closed (in simulation, after a cancelled pick, "
+                "`kinema sim reset` puts the objects back), or wrap the pick in ForceSuccess to go on "
                 "without it."
             )
             return False

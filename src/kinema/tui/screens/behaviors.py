@@ -24,6 +24,14 @@ class BehaviorsScreen(KinemaScreen):
     BINDINGS = [
         Binding("slash", "search", "Search", id="behaviors.search", tooltip="Search behaviors"),
         Binding("f5", "reload", "Reload", id="behaviors.reload", tooltip="List the behaviors again"),
+        Binding(
+            "escape",
+            "leave_search",
+            "Leave search",
+            id="behaviors.leave_search",
+            tooltip="Leave the search box (its filter stays) for the list",
+            show=False,
+        ),
     ]
 
     def __init__(self) -> None:
@@ -40,7 +48,9 @@ class BehaviorsScreen(KinemaScreen):
                 yield Static("", id="behavior-title", classes="pane-title")
                 yield Static("", id="behavior-details")
                 yield FittedTable(PORT_COLUMNS, id="behavior-ports")
-                yield Label("Hot reload", classes="pane-title")
+                # Shown from the first reload on: until then the port table has the room (at 80x24 it
+                # showed one port above an empty reload table).
+                yield Label("Hot reload", classes="pane-title", id="reload-title")
                 yield DataTable(id="reload-table", cursor_type="row", zebra_stripes=True)
 
     def on_mount(self) -> None:
@@ -56,6 +66,7 @@ class BehaviorsScreen(KinemaScreen):
         reloads.add_column("Message", key="message")
         for notice in self.kinema.reloads:
             self._add_reload(notice)
+        self._show_reloads(bool(self.kinema.reloads))
         self.set_focus(table)
         if self.kinema.status.state is ConnectionState.CONNECTED:
             self.action_reload()
@@ -135,6 +146,15 @@ class BehaviorsScreen(KinemaScreen):
             message = Text.assemble((f"{notice.location}: ", "bold"), notice.message)
         table.add_row(stamp, mark, Text(notice.subject), message)
         table.move_cursor(row=table.row_count - 1)
+        self._show_reloads(True)
+
+    def _show_reloads(self, shown: bool) -> None:
+        self.query_one("#reload-title", Label).display = shown
+        self.query_one("#reload-table", DataTable).display = shown
+
+    def action_leave_search(self) -> None:
+        if self.query_one("#behavior-search", Input).has_focus:
+            self.set_focus(self.query_one("#behavior-table", DataTable))
 
     def action_search(self) -> None:
         self.set_focus(self.query_one("#behavior-search", Input))
