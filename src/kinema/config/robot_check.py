@@ -362,7 +362,7 @@ def _check_waypoint_collisions(
     scene_name = scene.path.name if scene is not None else ""
     if scene is not None:
         try:
-            static = PlanningScene.from_mjcf(scene.path, checker.model.link_names)
+            static = PlanningScene.from_mjcf(scene.path, checker.model.link_names, loaded=scene.model)
         except MotionError:
             static = None  # _check_scene said why
         if static is not None and static.objects:
@@ -405,6 +405,7 @@ class _Scene:
     joints: list[str]
     actuators: list[str]
     sites: list[str]
+    model: Any = None  # the loaded mujoco.MjModel, for the waypoint check against its fixed geometry
 
 
 def _check_scene(resolved: ResolvedConfig, urdf: _Urdf | None, report: RobotReport) -> _Scene | None:
@@ -434,6 +435,7 @@ def _check_scene(resolved: ResolvedConfig, urdf: _Urdf | None, report: RobotRepo
         joints=joints,
         actuators=names(mujoco.mjtObj.mjOBJ_ACTUATOR, model.nu),
         sites=names(mujoco.mjtObj.mjOBJ_SITE, model.nsite),
+        model=model,
     )
     if urdf is not None:
         missing = [j for j in urdf.active_joints if j not in joints]

@@ -16,6 +16,7 @@ import threading
 from collections.abc import Callable, Iterable, Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 
@@ -445,6 +446,7 @@ class PlanningScene:
         *,
         include_free_bodies: bool = False,
         keyframe: str = "default",
+        loaded: Any = None,
     ) -> PlanningScene:
         """Collect the static geoms of a MuJoCo scene (everything welded to the world) as collision objects.
 
@@ -456,6 +458,7 @@ class PlanningScene:
             robot_links: link names of the robot (bodies with these names, and their subtrees, are skipped).
             include_free_bodies: also add free bodies (objects to pick) at their pose in ``keyframe``.
             keyframe: keyframe giving the free bodies' poses (the model's initial pose when absent).
+            loaded: the ``mujoco.MjModel`` of ``scene_path`` when the caller loaded it already.
 
         Raises:
             MotionError: the file cannot be loaded by MuJoCo.
@@ -466,7 +469,7 @@ class PlanningScene:
         from kinema.errors import ConfigError
 
         try:
-            m = load_scene(Path(scene_path))
+            m = loaded if loaded is not None else load_scene(Path(scene_path))
         except ConfigError as exc:
             raise MotionError(str(exc)) from None
         d = mujoco.MjData(m)
