@@ -256,9 +256,9 @@ class BehaviorTreeFactory:
         the document's root element (the same parse, kept while the text is loaded again)."""
         return self.library.load_text(xml, filename, self._manifests, registry=self.plan_key())
 
-    def register_behavior_tree_from_file(self, path: str | Path) -> None:
-        """Load every ``<BehaviorTree>`` of an XML file."""
-        self.library.load_file(path, self._manifests)
+    def register_behavior_tree_from_file(self, path: str | Path) -> etree._Element:
+        """Load every ``<BehaviorTree>`` of an XML file; returns the document's root element."""
+        return self.library.load_file(path, self._manifests)
 
     def registered_behavior_trees(self) -> list[str]:
         """IDs of the loaded trees, sorted."""

@@ -422,30 +422,38 @@ def _force_torque_sensor(
     )
 
 
-# A subtree port default that is the running config's value, written in a <TreeNodesModel> as
-# ``default="$(config moveit_params.joint_group_name)"``. Kinema's core subtrees use it, so they name no
-# robot's group or link.
-_CONFIG_DEFAULT = re.compile(r"^\$\(config\s+([A-Za-z0-9_.]+)\)$")
+# A subtree port default that is (or holds) the running config's value, written in a <TreeNodesModel> as
+# ``default="$(config moveit_params.joint_group_name)"`` or
+# ``default="/$(config robot.default_camera)/color"``. Kinema's core subtrees use it, so they name no robot's
+# group, link or camera.
+_CONFIG_DEFAULT = re.compile(r"\$\(config\s+([A-Za-z0-9_.]+)\)")
 
 
 def config_default_key(text: str | None) -> str | None:
-    """The config key a ``$(config KEY)`` port default names, or None for any other default."""
-    found = _CONFIG_DEFAULT.match(text.strip()) if text else None
+    """The config key a ``$(config KEY)`` port default names (the first), or None for any other default."""
+    found = _CONFIG_DEFAULT.search(text) if text else None
     return found.group(1) if found else None
 
 
+def _with_config_values(text: str, resolved: ResolvedConfig | None) -> str:
+    """``text`` with each ``$(config KEY)`` replaced by the config's value; ``""`` when one is unset."""
+    values = [resolved.get(key) if resolved is not None else None for key in _CONFIG_DEFAULT.findall(text)]
+    if any(value is None for value in values):
+        return ""
+    found = iter(values)
+    return _CONFIG_DEFAULT.sub(lambda _match: str(next(found)), text)
+
+
 def substitute_config_defaults(subtree_models: Mapping[str, Any], resolved: ResolvedConfig | None) -> None:
-    """Replace each ``$(config KEY)`` default of the subtree models with the config's value at KEY.
+    """Replace each ``$(config KEY)`` in the subtree models' port defaults with the config's value at KEY.
 
     A key the config does not set leaves the port without a default, so a caller that does not give the
     port fails with the engine's "mandatory port" message; without a config (``resolved`` None) the same.
     """
     for model in subtree_models.values():
         for port in model.ports.values():
-            key = config_default_key(port.default_str)
-            if key is None:
+            if config_default_key(port.default_str) is None:
                 continue
-            value = resolved.get(key) if resolved is not None else None
-            text = "" if value is None else str(value)
+            text = _with_config_values(port.default_str.strip(), resolved)
             port.default = text
             port.default_str = text

@@ -187,13 +187,20 @@ def _build(
     blackboard: Blackboard | None,
 ) -> tuple[Tree, Any]:
     """The main tree of ``xml`` and the model of the ports its objective declares (None if none)."""
+    from kinema.config.cell import substitute_config_defaults
+
     combined = dict(registry or {})
     combined.update(registry_of(behaviors))
     factory = BehaviorRegistry(combined).create_factory(context)
+    library = factory.library
+    before = set(library.trees)
     if isinstance(xml, Path):
-        tree = factory.create_tree_from_file(xml, blackboard)
+        root = factory.register_behavior_tree_from_file(xml)
     else:
-        tree = factory.create_tree_from_text(xml, blackboard)
+        root = factory.register_behavior_tree_from_text(xml)
+    # As the runtime does: a subtree port default "$(config KEY)" is the context's config value.
+    substitute_config_defaults(library.subtree_models, context.config)
+    tree = factory.create_tree(library.main_tree_of(root, before), blackboard)
     main = tree.subtrees[0].tree_id if tree.subtrees else ""
     return tree, factory.library.subtree_models.get(main)
 

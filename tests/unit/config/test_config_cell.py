@@ -156,7 +156,13 @@ def test_a_subtree_default_can_name_a_config_key() -> None:
         """<root BTCPP_format="4"><BehaviorTree ID="T"><AlwaysSuccess/></BehaviorTree>
         <TreeNodesModel><SubTree ID="T">
           <input_port name="group" default="$(config moveit_params.joint_group_name)"/>
+          <input_port name="image" default="/$(config robot.default_camera)/color"/>
+          <input_port name="unset" default="/$(config robot.no_such_key)/color"/>
         </SubTree></TreeNodesModel></root>"""
     )
     substitute_config_defaults(factory.library.subtree_models, resolve_config("lab_sim", None))
-    assert factory.library.subtree_models["T"].ports["group"].default_str == "manipulator"
+    ports = factory.library.subtree_models["T"].ports
+    assert ports["group"].default_str == "manipulator"
+    # Inside a longer default too (a camera's topic); a key the config does not set leaves no default.
+    assert ports["image"].default_str == "/wrist_camera/color"
+    assert ports["unset"].default_str == ""

@@ -39,6 +39,46 @@ CALLS = """<root BTCPP_format="4" main_tree_to_execute="Calls">
 </root>
 """
 
+# lab_sim's ML objectives call these subtrees of MoveIt Pro's base config (written as they write them).
+ML_CALLS = """<root BTCPP_format="4" main_tree_to_execute="ML Calls">
+  <BehaviorTree ID="ML Calls">
+    <Sequence>
+      <SubTree ID="Segment Image from Text Prompt Subtree" _collapsed="true"
+        masks_visualization_topic="/masks_visualization" masks2d="{masks2d}" model_package="moveit_pro_sam3"
+        text_prompt="conical flask" confidence_threshold="0.5" image_topic_name="/wrist_camera/color" />
+      <SubTree ID="Segment Image from No Negative Text Prompt Subtree" _collapsed="true"
+        masks_visualization_topic="/masks_visualization" model_package="moveit_pro_sam3"
+        confidence_threshold="0.5" text_prompt="an object" image_topic_name="/wrist_camera/color"
+        masks2d="{masks2d}" />
+      <SubTree ID="Segment Point Cloud from Text Prompt Subtree" _collapsed="true"
+        camera_topic_name="/wrist_camera/camera_info" image_topic_name="/wrist_camera/color"
+        masks_visualization_topic="/masks_visualization" model_package="moveit_pro_sam3"
+        points_topic_name="/wrist_camera/points" text_prompt="an object" confidence_threshold="0.5"
+        masks3d="{masks3d}" point_cloud="{point_cloud}" point_cloud_vector="{point_cloud_vector}" />
+      <SubTree ID="Segment Point Cloud from Clicked Point Subtree" _collapsed="true"
+        camera_topic_name="/wrist_camera/camera_info" decoder_model_path="models/sam2_decoder.onnx"
+        encoder_model_path="models/sam2_hiera_large_encoder.onnx" image_topic_name="/wrist_camera/color"
+        masks_visualization_topic="/masks_visualization" model_package="moveit_pro_sam2"
+        points_topic_name="/wrist_camera/points" />
+    </Sequence>
+  </BehaviorTree>
+</root>
+"""
+
+# The ports of MoveIt Pro's SAM3 image subtrees.
+SAM3 = {
+    "confidence_threshold",
+    "decoder_model_path",
+    "encoder_model_path",
+    "geometry_encoder_model_path",
+    "image_topic_name",
+    "masks_visualization_topic",
+    "masks2d",
+    "model_package",
+    "text_encoder_model_path",
+    "text_prompt",
+}
+
 # Each subtree's ports: MoveIt Pro's (the ports its callers pass), and Kinema's own (marked in descriptions).
 PORTS = {
     "Move to Waypoint (JTC)": {
@@ -91,6 +131,31 @@ PORTS = {
         "gripper_open_position",
         "gripper_closed_position",
     },
+    # MoveIt Pro's base config's ML subtrees (their TreeNodesModel ports).
+    "Segment Image from Text Prompt Subtree": SAM3,
+    "Segment Image from No Negative Text Prompt Subtree": SAM3,
+    "Segment Point Cloud from Text Prompt Subtree": (SAM3 - {"masks2d"})
+    | {"camera_topic_name", "points_topic_name", "masks3d", "point_cloud", "point_cloud_vector"},
+    "Segment Image from Point Subtree": {
+        "decoder_model_path",
+        "encoder_model_path",
+        "image_topic_name",
+        "masks_visualization_topic",
+        "masks2d",
+        "model_package",
+        "pixel_coords",
+    },
+    "Segment Point Cloud from Clicked Point Subtree": {
+        "camera_topic_name",
+        "decoder_model_path",
+        "encoder_model_path",
+        "image_topic_name",
+        "masks_visualization_topic",
+        "model_package",
+        "points_topic_name",
+    },
+    "Create Point Cloud Vector From Masks": {"masks3d", "point_cloud", "point_cloud_vector"},
+    "Visualize Segmented Point Cloud": {"masks3d", "point_cloud"},
 }
 
 
@@ -105,12 +170,13 @@ def lab_sim_library():  # type: ignore[no-untyped-def]
     return ObjectiveLibrary.load(resolved), host.registry.create_factory()
 
 
-def test_moveit_pro_calls_of_the_core_subtrees_validate(lab_sim_library, tmp_path: Path) -> None:  # type: ignore[no-untyped-def]
+@pytest.mark.parametrize("xml", [CALLS, ML_CALLS], ids=["motion", "ml"])
+def test_moveit_pro_calls_of_the_core_subtrees_validate(lab_sim_library, tmp_path: Path, xml: str) -> None:  # type: ignore[no-untyped-def]
     from kinema.runtime.library_check import file_problem
 
     library, factory = lab_sim_library
     calls = tmp_path / "calls.xml"
-    calls.write_text(CALLS)
+    calls.write_text(xml)
     assert file_problem(library, calls, factory) is None
 
 

@@ -49,3 +49,45 @@ def test_the_exemplar_behavior_declares_the_ports_lab_sim_sets(behavior: Any) ->
     } == set(ports)
     outputs = {name for name, port in ports.items() if port.direction.name == "OUTPUT"}
     assert outputs == {"masks2d", "mask_count", "confidence_scores", "confidence_scores_str"}
+
+
+def _calling(subtree_file: str, call: str) -> str:
+    """Kinema's core subtree file with a main tree that makes ``call``."""
+    from pathlib import Path
+
+    from lxml import etree
+
+    core = Path(__file__).resolve().parents[3] / "objectives" / subtree_file
+    root = etree.fromstring(core.read_bytes())
+    root.set("main_tree_to_execute", "Caller")
+    root.insert(0, etree.fromstring(f'<BehaviorTree ID="Caller">{call}</BehaviorTree>'))
+    return etree.tostring(root, encoding="unicode")
+
+
+def test_the_text_prompt_subtree_takes_the_configs_camera_when_no_topic_is_given(
+    registry: Any, context: Any
+) -> None:
+    """MoveIt Pro's copy defaults to its wrist camera; Kinema's to the config's default camera: lab_sim's
+    images reach the model, which then fails honestly (Kinema runs no segmentation model)."""
+    from kinema.testing import publish_repeatedly, run_objective
+    from kinema.transport import from_dict
+
+    image = from_dict(
+        "sensor_msgs/msg/Image",
+        {
+            "header": {"frame_id": "wrist_camera_optical_frame"},
+            "height": 2,
+            "width": 2,
+            "encoding": "rgb8",
+            "step": 6,
+            "data": list(range(12)),
+        },
+    )
+    xml = _calling(
+        "segment_image_from_text_prompt_subtree.xml",
+        '<SubTree ID="Segment Image from Text Prompt Subtree" text_prompt="conical flask" />',
+    )
+    with publish_repeatedly(context.node, "sensor_msgs/msg/Image", "/wrist_camera/color", image):
+        run = run_objective(xml, registry=registry, context=context, timeout=30.0)
+    assert run.status is NodeStatus.FAILURE
+    assert run.toasts and run.toasts[-1].startswith("GetMasks2DFromExemplar: Kinema does not run"), run.toasts
