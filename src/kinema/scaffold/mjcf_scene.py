@@ -23,7 +23,10 @@ limits and mimic joints right, and the spec is then edited and written with ``Mj
   far from its stability bound, the implicit integrator takes the damping, and light wrist joints get
   gains as soft as heavy shoulders are stiff, so every joint settles in about 0.1 s.
 - Joints get ``armature`` (rotor inertia, which real geared joints have and which keeps the lightest
-  links' inertia from collapsing) and the URDF's damping.
+  links' inertia from collapsing) and the URDF's damping up to a quarter of the servo's ``kv``
+  (:data:`DAMPING_SHARE`), but not its friction: a real arm's drive controllers overcome both, and a
+  position servo with neither integral nor feed-forward terms would stop short by ``friction / kp`` and
+  lag a moving target by ``damping · v / kp`` (the xArm7's URDF: 0.06 rad short, 0.3 rad behind).
 - URDF ``<mimic>`` joints become joint equality constraints ``follower = offset + multiplier·leader``
   (MuJoCo's import makes them; their coefficients are checked and their solref stiffened) with no actuator.
 - The world: a floor, a light, a table (a box body named ``table``) whose top the robot's base stands on
@@ -59,6 +62,9 @@ TIMESTEP = 0.002
 
 NATURAL_FREQUENCY = 40.0
 """ω of every position servo, rad/s (about 6 Hz): see the module docstring for the gain rule."""
+
+DAMPING_SHARE = 0.25
+"""The most of a URDF joint's damping a scene keeps, as a share of its servo's ``kv`` (see generate_scene)."""
 
 ARMATURE_REVOLUTE = 0.01
 """Rotor inertia added to revolute joints, kg·m²."""
@@ -351,6 +357,9 @@ def generate_scene(
             continue
         joint.armature = ARMATURE_PRISMATIC if info.kind == "prismatic" else ARMATURE_REVOLUTE
         joint.damping = [max(info.damping, 0.0), 0.0, 0.0]
+        # A real drive's controller overcomes its joint's friction; a servo without an integral term
+        # would stop short of its target by friction / kp (the xArm's 1 N·m: 0.06 rad on its wrist).
+        joint.frictionloss = 0.0
 
     # Mimic joints: MuJoCo's URDF import makes the equality constraints; keep them right and stiff.
     existing = {(e.name1, e.name2): e for e in spec.equalities if e.type == mujoco.mjtEq.mjEQ_JOINT}
@@ -403,13 +412,20 @@ def generate_scene(
     stand = np.array(data_.xpos[min(model.body(link).id for link in mounted)]) if mounted else np.zeros(3)
     reach = _reach(model, data_, stand)
 
+    spec_joints = {joint.name: joint for joint in spec.joints}
     for info in actuated:
         joint_id = model.joint(info.name).id
         dof = int(model.jnt_dofadr[joint_id])
         inertia = float(inertia_matrix[dof, dof])
         actuator = spec.add_actuator(name=info.name, target=info.name, trntype=mujoco.mjtTrn.mjTRN_JOINT)
         omega = NATURAL_FREQUENCY
-        actuator.set_to_position(kp=inertia * omega**2, kv=2.0 * inertia * omega)
+        kv = 2.0 * inertia * omega
+        actuator.set_to_position(kp=inertia * omega**2, kv=kv)
+        # The URDF's damping, up to a quarter of the servo's own: more makes the servo lag behind a moving
+        # target by damping·v/kp (the xArm's 10 N·m·s/rad: 0.3 rad at 1 rad/s), which a real drive's
+        # controller compensates and this servo cannot.
+        spec_joint = spec_joints[info.name]
+        spec_joint.damping = [min(float(spec_joint.damping[0]), DAMPING_SHARE * kv), 0.0, 0.0]
         if bool(model.jnt_limited[joint_id]):
             low, high = (float(v) for v in model.jnt_range[joint_id])
             actuator.ctrlrange = [low, high]

@@ -50,9 +50,12 @@ UR5_HOME = {
     "wrist_2_joint": -1.57,
     "wrist_3_joint": 0.0,
 }
+# The xArm7's URDF gives every joint friction (1 N·m) and damping (2-10 N·m·s/rad).
+XARM7_HOME = {f"joint{i}": 0.0 for i in range(1, 8)} | {"joint2": -0.5, "joint4": 0.6, "joint6": 1.1}
 ROBOTS = {
     "panda": ("panda_description/urdf/panda.urdf", PANDA_HOME),
     "ur5": ("ur_description/urdf/ur5_robot.urdf", UR5_HOME),
+    "xarm7": ("xarm_description/urdf/xarm7.urdf", XARM7_HOME),
 }
 
 
@@ -308,8 +311,9 @@ def test_a_pose_reaching_into_the_table_touches_it(generated: Generated) -> None
     """The home check above can fail: the robot's collision meshes do collide with the table."""
     model = generated.model
     data = at_keyframe(model, "home")
-    lift = "panda_joint2" if "panda_joint2" in generated.home else "shoulder_lift_joint"
-    data.joint(lift).qpos[0] = 1.7 if lift == "panda_joint2" else 0.6
+    lifts = {"panda_joint2": 1.7, "shoulder_lift_joint": 0.6, "joint2": 1.9}
+    lift = next(name for name in lifts if name in generated.home)
+    data.joint(lift).qpos[0] = lifts[lift]
     mujoco.mj_forward(model, data)
     table = model.body("table").id
     touching = {
