@@ -150,6 +150,7 @@ def show(
     import json
     from dataclasses import replace
 
+    from kinema.config.cell import config_default_key, config_default_value
     from kinema.config.objective_parameters import objective_interface
 
     library = _load_library(workspace, config, verbose)
@@ -176,7 +177,11 @@ def show(
         width = max(len(port.name) for port in info.ports)
         type_width = max(len(port.type_name or "-") for port in info.ports)
         for port in info.ports:
-            if port.default is not None and str(port.default).strip():
+            if port.default is not None and config_default_key(str(port.default)) is not None:
+                # What a run starts from: the config's value now (none when the config does not set it).
+                value = config_default_value(str(port.default), library.resolved)
+                default = f" = {value or '(none: the config does not set it)'}  [from {port.default}]"
+            elif port.default is not None and str(port.default).strip():
                 default = f" = {port.default}"
             elif port.direction != "output":
                 # Not "= " and nothing: a run that reads it without a value fails there.

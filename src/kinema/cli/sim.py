@@ -45,7 +45,7 @@ def _client(connect: str | None, timeout: float) -> Iterator[SimClient]:
 
 @click.group(cls=VerbGroup)
 def sim() -> None:
-    """Inspect and reset the running MuJoCo simulation (free bodies, keyframes, joints)."""
+    """Inspect and reset the running MuJoCo simulation (free bodies, joints, keyframes)."""
 
 
 @sim.command("bodies")
@@ -70,6 +70,55 @@ def bodies(as_json: bool, connect: str | None, timeout: float) -> None:
     for body in found:
         x, y, z = body.position
         click.echo(f"{body.name:<{width}}  {x:8.4f} {y:8.4f} {z:8.4f}")
+
+
+@sim.command("joints")
+@click.option("--json", "as_json", is_flag=True, help="Print {joints: {name: position}, velocities: {...}}.")
+@_common
+def joints(as_json: bool, connect: str | None, timeout: float) -> None:
+    """Print each joint's position (rad or m) and velocity, from the next /joint_states message."""
+    import json
+    import threading
+
+    from kinema.drivers.mujoco.names import JOINT_STATES_TOPIC, JOINT_STATES_TYPE
+    from kinema.transport import Node, open_session
+
+    received: list[Any] = []
+    arrived = threading.Event()
+
+    def take(message: Any) -> None:
+        if not arrived.is_set():
+            received.append(message)
+            arrived.set()
+
+    with open_session(connect, connect_timeout=min(max(timeout, 0.5), 5.0)) as session:
+        node = Node(session, f"_kinema_sim_cli_{os.getpid()}")
+        node.create_subscription(JOINT_STATES_TYPE, JOINT_STATES_TOPIC, take)
+        if not arrived.wait(timeout):
+            raise DriverError(
+                f"no {JOINT_STATES_TOPIC} message within {timeout:g} s: is a simulation running "
+                "(`kinema run`)? (--timeout waits longer)"
+            )
+    message = received[0]
+    names = list(message.name)
+    positions = [float(v) for v in message.position]
+    velocities = [float(v) for v in message.velocity] if len(message.velocity) == len(names) else []
+    if as_json:
+        click.echo(
+            json.dumps(
+                {
+                    "joints": dict(zip(names, positions, strict=True)),
+                    "velocities": dict(zip(names, velocities, strict=False)),
+                },
+                indent=2,
+            )
+        )
+        return
+    width = max((len(name) for name in names), default=5)
+    click.echo(f"{'joint':<{width}}  {'position':>10}  {'velocity':>10}")
+    for index, name in enumerate(names):
+        velocity = f"{velocities[index]:10.4f}" if velocities else f"{'-':>10}"
+        click.echo(f"{name:<{width}}  {positions[index]:10.4f}  {velocity}")
 
 
 @sim.command("keyframes")

@@ -435,7 +435,7 @@ def config_default_key(text: str | None) -> str | None:
     return found.group(1) if found else None
 
 
-def _with_config_values(text: str, resolved: ResolvedConfig | None) -> str:
+def config_default_value(text: str, resolved: ResolvedConfig | None) -> str:
     """``text`` with each ``$(config KEY)`` replaced by the config's value; ``""`` when one is unset."""
     values = [resolved.get(key) if resolved is not None else None for key in _CONFIG_DEFAULT.findall(text)]
     if any(value is None for value in values):
@@ -454,6 +454,6 @@ def substitute_config_defaults(subtree_models: Mapping[str, Any], resolved: Reso
         for port in model.ports.values():
             if config_default_key(port.default_str) is None:
                 continue
-            text = _with_config_values(port.default_str.strip(), resolved)
+            text = config_default_value(port.default_str.strip(), resolved)
             port.default = text
             port.default_str = text

@@ -21,7 +21,9 @@ What it decides, and where a user changes it (config.yaml says it again beside e
   joint it is the gripper (without an SRDF, the longest chain's last joint is left out of the group when
   its name says grip, finger, jaw or claw: an arm whose jaw ends the chain), open and closed from the
   SRDF group states called ``open``/``close(d)`` of a group holding it, else from its limits (a
-  prismatic finger opens at its upper limit, a revolute knuckle at its lower one);
+  prismatic finger opens at its upper limit, a revolute knuckle at its lower one, a guess the notes
+  say: one-jaw grippers differ). The generated Open/Close Gripper objectives read the positions from
+  config.yaml (``$(config robot.gripper.open_position)``), so an edit there is all a wrong guess needs;
 - the tool frame: the SRDF end effector's parent link, else the planning group's tip;
 - ``Home``: the first SRDF group state named ``home``, ``ready`` or ``default`` that covers the planning
   group, else every joint at 0 clipped into its limits. The simulation starts there. Link pairs in
@@ -310,6 +312,12 @@ def plan_robot(
             opened = open_state
         if closed_state is not None:
             closed = closed_state
+        if joint.kind != "prismatic" and (open_state is None or closed_state is None):
+            notes.append(
+                f"gripper {gripper!r} is a revolute jaw: open ({opened:g}) and closed ({closed:g}) are a "
+                "guess from its limits; run Open Gripper and, if it closes, swap robot.gripper.open_position "
+                "and closed_position in config.yaml"
+            )
         home[gripper] = opened
     generated = not groups
     try:
@@ -408,17 +416,22 @@ def _waypoints_yaml(plan: RobotPlan) -> str:
 
 def _gripper_objective(plan: RobotPlan, objective: str, position: float, *, grasp_check: bool = False) -> str:
     """Open Gripper / Close Gripper; Close Gripper takes ``require_grasp`` for picks (as lab_sim's does)."""
-    action = f'<Action ID="MoveGripperAction" position="{position:g}"/>'
-    port = ""
+    key = "open_position" if objective == "Open Gripper" else "closed_position"
+    action = '<Action ID="MoveGripperAction" position="{position}"/>'
+    port = (
+        f'\n      <input_port name="position" default="$(config robot.gripper.{key})">Where the gripper '
+        f"goes (default: the config's robot.gripper.{key}).</input_port>"
+    )
     if grasp_check:
-        action = f'<Action ID="MoveGripperAction" position="{position:g}" require_grasp="{{require_grasp}}"/>'
-        port = (
+        action = '<Action ID="MoveGripperAction" position="{position}" require_grasp="{require_grasp}"/>'
+        port += (
             '\n      <input_port name="require_grasp" default="false">true for a pick: the gripper closing '
             "all the way (on nothing) fails instead of succeeding.</input_port>"
         )
     return f"""<?xml version="1.0" encoding="UTF-8"?>
 <root BTCPP_format="4" main_tree_to_execute="{objective}">
-  <!-- Made by kinema new config (from the URDF): {plan.gripper_joint} to {position:g}. -->
+  <!-- Made by kinema new config (from the URDF): {plan.gripper_joint} to {position:g} when it was made;
+       config.yaml's robot.gripper.{key} says where. -->
   <BehaviorTree ID="{objective}" _description="{objective.split()[0]} the gripper" _favorite="true">
     {action}
   </BehaviorTree>

@@ -63,6 +63,15 @@ def test_sim_set_joints_then_reset(
     assert sim.joint_states.latest(("elbow_joint", "shoulder_pan_joint")) == pytest.approx(
         [1.2, 0.3], abs=2e-3
     )
+    # `kinema sim joints` reads them back (what `set-joints` set, the arm's other joints where they were).
+    code, output = run("sim", "joints", "--connect", router_endpoint)
+    assert code == 0, output
+    rows = {line.split()[0]: line.split()[1:] for line in output.splitlines()[1:]}
+    assert float(rows["elbow_joint"][0]) == pytest.approx(1.2, abs=2e-3)
+    assert float(rows["shoulder_pan_joint"][0]) == pytest.approx(0.3, abs=2e-3)
+    code, output = run("sim", "joints", "--json", "--connect", router_endpoint)
+    assert code == 0, output
+    assert json.loads(output)["joints"]["elbow_joint"] == pytest.approx(1.2, abs=2e-3)
     code, output = run("sim", "reset", "--connect", router_endpoint)
     assert code == 0, output
     assert "default" in output

@@ -4,6 +4,7 @@ Gripper exist and planning moves the arm only."""
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -62,5 +63,19 @@ def test_a_chain_ending_in_a_joint_named_like_a_jaw_gives_that_joint_to_the_grip
     assert f"note: gripper {gripper!r}: the longest chain's last joint, named like a gripper" in out
     assert config["robot"]["gripper"]["joint"] == gripper
     assert objectives == ["close_gripper.xml", "open_gripper.xml"]
+    # One-jaw grippers differ (an SO-ARM closes at its lower limit): the guess says so, and how to fix it.
+    assert f"note: gripper {gripper!r} is a revolute jaw: open (-1.5) and closed (0) are a guess" in out
+    # The objectives read config.yaml, so swapping the two values there is the whole fix.
+    config_file = package / "config" / "config.yaml"
+    swapped = re.sub(r"open_position: \S+", "open_position: 0", config_file.read_text())
+    config_file.write_text(re.sub(r"closed_position: \S+", "closed_position: -1.5", swapped))
+    shown = {}
+    for objective in ("Open Gripper", "Close Gripper"):
+        assert main(["objective", "show", objective, "-c", "jaw_cell", "-w", str(workspace_root)]) == 0
+        shown[objective] = capsys.readouterr().out
+    opens = r"position +double = 0  \[from \$\(config robot.gripper.open_position\)\]"
+    closes = r"position +double = -1.5  \[from \$\(config robot.gripper.closed_position\)\]"
+    assert re.search(opens, shown["Open Gripper"]), shown["Open Gripper"]
+    assert re.search(closes, shown["Close Gripper"]), shown["Close Gripper"]
     srdf = (package / "description" / "jaw_cell.srdf").read_text()
     assert '<chain base_link="base" tip_link="l2"/>' in srdf
