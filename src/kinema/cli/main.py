@@ -43,6 +43,7 @@ VERBS: dict[str, str] = {
     "shell": "kinema.cli.shell:shell",
     "example": "kinema.cli.example:example",
     "sim": "kinema.cli.sim:sim",
+    "waypoint": "kinema.cli.waypoint:waypoint",
 }
 
 

@@ -366,6 +366,8 @@ class Agent:
         waypoints: the waypoint store served by the waypoint services (optional).
         log_sink: the behaviors' log sink; its messages are published as toasts (optional).
         clock: the runtime clock, for the heartbeat's ``ros_timestamp``.
+        waypoint_groups: the planning groups a waypoint saved without any is recorded for (the config's
+            planning group), so that UIs list its group.
     """
 
     def __init__(
@@ -378,9 +380,11 @@ class Agent:
         log_sink: LogSink | None = None,
         clock: Clock | None = None,
         node: Node | None = None,
+        waypoint_groups: Sequence[str] = (),
     ) -> None:
         from kinema.transport import Node
 
+        self.waypoint_groups = list(waypoint_groups)
         self.session = session
         self.server = server
         self.source = source
@@ -851,7 +855,7 @@ class Agent:
             name=name,
             joint_names=[str(n) for n in state.name],
             positions=[float(p) for p in state.position],
-            joint_group_names=groups,
+            joint_group_names=groups or list(self.waypoint_groups),
         )
         self.waypoints.save(waypoint)
         return waypoint

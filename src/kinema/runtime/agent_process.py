@@ -113,7 +113,17 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
     source.factory()  # load now: errors show at start, and the first objective starts fast
     waypoints = _waypoint_store(options, resolved)
     server = ObjectiveServer(source, tick_rate_hz=options.tick_rate_hz)
-    agent = Agent(session, server, source=source, waypoints=waypoints, log_sink=sink, clock=clock, node=node)
+    group = resolved.get("moveit_params.joint_group_name") if resolved is not None else None
+    agent = Agent(
+        session,
+        server,
+        source=source,
+        waypoints=waypoints,
+        log_sink=sink,
+        clock=clock,
+        node=node,
+        waypoint_groups=[str(group)] if group else [],
+    )
     _add_debugging_doors(agent, options)
     if host is not None:
         host.subscribe(agent.on_reload_event)

@@ -39,6 +39,7 @@ from kinema.sdk.streams import (
 )
 
 if TYPE_CHECKING:
+    from kinema.config import Waypoint
     from kinema.config.objective_file import ObjectivePort
     from kinema.transport import ActionClient, ClientGoalHandle, Node, ServiceClient, Session
 
@@ -81,6 +82,21 @@ def parameter_messages(overrides: Overrides) -> list[dict[str, Any]]:
             text = value if isinstance(value, str) else yaml.safe_dump(value, default_flow_style=True).strip()
             messages.append({**base, "description": {"name": item.name, "type": 0}, "string_value": text})
     return messages
+
+
+def _waypoint_from(message: Any) -> Waypoint:
+    """A ``moveit_studio_agent_msgs/Waypoint`` message as a :class:`kinema.config.Waypoint`."""
+    from kinema.config import Waypoint
+
+    state = message.joint_state
+    return Waypoint(
+        name=str(message.name),
+        joint_names=[str(n) for n in state.name],
+        positions=[float(p) for p in state.position],
+        joint_group_names=[str(g) for g in message.joint_group_names],
+        description=str(message.description),
+        favorite=bool(message.favorite),
+    )
 
 
 def _result_from(error_code: Any, error_message: str, objective_name: str) -> ObjectiveResult:
@@ -414,6 +430,46 @@ class ObjectiveClient:
             for port in info.ports
         ]
         return [port for port in ports if port.direction != "output"]
+
+    # -- waypoints -----------------------------------------------------------------------------------
+
+    def waypoints(self) -> list[Waypoint]:
+        """The config's saved waypoints (``kinema.config.Waypoint``: name, joints, positions, groups)."""
+        response = self._call_waypoints(names.GET_WAYPOINTS_TYPE, names.GET_WAYPOINTS, {})
+        return [_waypoint_from(message) for message in response.waypoints]
+
+    def save_waypoint(self, name: str, joint_group_names: Iterable[str] = ()) -> Waypoint:
+        """Save the robot's current joint positions as waypoint ``name`` (replacing one of that name).
+
+        ``joint_group_names``: the planning groups it is for (default: the config's planning group).
+
+        Raises:
+            ObjectiveError: the agent refused (no joint states yet, a bad name; its message says).
+        """
+        request = {"operation": 0, "waypoint_name": name, "joint_group_names": list(joint_group_names)}
+        response = self._call_waypoints(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, request)
+        return _waypoint_from(response.new_waypoint)
+
+    def rename_waypoint(self, name: str, new_name: str) -> Waypoint:
+        """Rename waypoint ``name`` to ``new_name``; raises ObjectiveError naming the valid ones."""
+        request = {"operation": 1, "waypoint_name": name, "existing_waypoint_new_name": new_name}
+        response = self._call_waypoints(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, request)
+        return _waypoint_from(response.new_waypoint)
+
+    def erase_waypoint(self, name: str) -> None:
+        """Delete waypoint ``name``; raises ObjectiveError naming the valid ones."""
+        request = {"operation": 2, "waypoint_name": name}
+        self._call_waypoints(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, request)
+
+    def _call_waypoints(self, srv_type: str, service: str, request: dict[str, Any]) -> Any:
+        from kinema.errors import ObjectiveError
+
+        self.wait_for_runtime()
+        response = self._client(srv_type, service).call(request, timeout=self.timeout)
+        status = getattr(response, "status", None)
+        if status is not None and not status.success:
+            raise ObjectiveError(str(status.error_message) or f"{service} refused the request")
+        return response
 
     # -- streams -------------------------------------------------------------------------------------
 

@@ -59,7 +59,7 @@ from kinema.ui_topics import (
 )
 
 if TYPE_CHECKING:
-    from kinema.config import ResolvedConfig, Workspace
+    from kinema.config import ResolvedConfig, Waypoint, Workspace
     from kinema.sdk import ObjectiveClient
     from kinema.sdk.streams import NodeStatusChanges
 
@@ -494,10 +494,7 @@ class SdkConnection:
         self._require_client().cancel()
 
     def list_waypoints(self) -> list[WaypointSummary]:
-        from kinema.runtime import names
-
-        response = self._call(names.GET_WAYPOINTS_TYPE, names.GET_WAYPOINTS, {})
-        return [_waypoint_summary(w) for w in response.waypoints]
+        return [_waypoint_summary(w) for w in self._require_client().waypoints()]
 
     def move_to_waypoint(self, name: str) -> None:
         client = self._require_client()
@@ -520,28 +517,13 @@ class SdkConnection:
         client.start(xml=xml)
 
     def save_waypoint(self, name: str, joint_group_names: tuple[str, ...] = ()) -> WaypointSummary:
-        from kinema.runtime import names
-
-        response = self._call(
-            names.EDIT_WAYPOINTS_TYPE,
-            names.EDIT_WAYPOINTS,
-            {"operation": 0, "waypoint_name": name, "joint_group_names": list(joint_group_names)},
-        )
-        return _waypoint_summary(response.new_waypoint)
+        return _waypoint_summary(self._require_client().save_waypoint(name, joint_group_names))
 
     def rename_waypoint(self, name: str, new_name: str) -> None:
-        from kinema.runtime import names
-
-        self._call(
-            names.EDIT_WAYPOINTS_TYPE,
-            names.EDIT_WAYPOINTS,
-            {"operation": 1, "waypoint_name": name, "existing_waypoint_new_name": new_name},
-        )
+        self._require_client().rename_waypoint(name, new_name)
 
     def erase_waypoint(self, name: str) -> None:
-        from kinema.runtime import names
-
-        self._call(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, {"operation": 2, "waypoint_name": name})
+        self._require_client().erase_waypoint(name)
 
     def list_behaviors(self) -> list[BehaviorSummary]:
         """The engine's built-in nodes plus the behaviors the runtime's config loads.
@@ -701,15 +683,14 @@ def _objective_summary(info: Any) -> ObjectiveSummary:
     )
 
 
-def _waypoint_summary(message: Any) -> WaypointSummary:
-    state = message.joint_state
+def _waypoint_summary(waypoint: Waypoint) -> WaypointSummary:
     return WaypointSummary(
-        name=str(message.name),
-        description=str(message.description),
-        favorite=bool(message.favorite),
-        joint_names=tuple(str(n) for n in state.name),
-        positions=tuple(float(p) for p in state.position),
-        joint_group_names=tuple(str(g) for g in message.joint_group_names),
+        name=waypoint.name,
+        description=waypoint.description,
+        favorite=waypoint.favorite,
+        joint_names=tuple(waypoint.joint_names),
+        positions=tuple(waypoint.positions),
+        joint_group_names=tuple(waypoint.joint_group_names),
     )
 
 

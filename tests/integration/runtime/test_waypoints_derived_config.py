@@ -47,3 +47,44 @@ def test_saving_a_waypoint_writes_the_derived_package_and_says_so(
     assert [item["name"] for item in yaml.safe_load(copy.read_text())] == [*inherited, "My Spot"]
     assert any(str(copy) in toast for toast in toasts), toasts
     assert "saved waypoints go to" in derived_config_agent.log_file.read_text()
+
+
+def test_the_waypoint_verbs_save_list_rename_and_erase_with_the_configs_group(
+    derived_config_agent: Any, tmp_path: Path, capsys: Any
+) -> None:
+    """`kinema waypoint ...` without the UI; a waypoint saved without a group is for the config's planning
+    group (the UI's save sends none; the Waypoints tab then showed no group)."""
+    from kinema.cli.main import main
+    from kinema.transport import Node, open_session
+
+    endpoint = derived_config_agent.endpoint
+
+    def run(*args: str) -> tuple[int, str]:
+        code = main(["waypoint", *args, "--connect", endpoint, "--timeout", "10"])
+        captured = capsys.readouterr()
+        return code, captured.out + captured.err
+
+    with open_session(endpoint) as session:
+        joints = Node(session, "joints").create_publisher(
+            driver_names.JOINT_STATES_TYPE, driver_names.JOINT_STATES_TOPIC
+        )
+        deadline = time.monotonic() + 15
+        while True:
+            joints.publish({"name": ["linear_rail_joint", "elbow_joint"], "position": [0.3, 1.25]})
+            code, output = run("save", "Bench Spot")
+            if code == 0 or time.monotonic() > deadline:
+                break
+            time.sleep(0.1)
+    assert code == 0, output
+    assert "saved waypoint 'Bench Spot' (manipulator): linear_rail_joint=0.3, elbow_joint=1.25" in output
+    code, output = run("list")
+    assert code == 0 and any(
+        line.split()[:3] == ["Bench", "Spot", "manipulator"] for line in output.splitlines()
+    ), output
+    assert run("rename", "Bench Spot", "Bench")[0] == 0
+    code, output = run("erase", "Bench Spot")
+    assert code == 1 and "did you mean 'Bench'" in output, output
+    code, output = run("erase", "Bench")
+    assert code == 0 and "it was linear_rail_joint=0.3, elbow_joint=1.25" in output, output
+    code, output = run("list", "--json")
+    assert "Bench" not in output and "Look at Table" in output
