@@ -24,7 +24,9 @@ What it decides, and where a user changes it (config.yaml says it again beside e
   prismatic finger opens at its upper limit, a revolute knuckle at its lower one, a guess the notes
   say: one-jaw grippers differ). The generated Open/Close Gripper objectives read the positions from
   config.yaml (``$(config robot.gripper.open_position)``), so an edit there is all a wrong guess needs;
-- the tool frame: the SRDF end effector's parent link, else the planning group's tip;
+- the tool frame: the SRDF end effector's parent link, else the planning group's tip (the deepest link of a
+  group of joints that ends with fixed ones), or the tool point fixed beyond it (a single path of fixed
+  joints ending in a link named like tcp, tool, eef, frame, grasp or tip), said in a note;
 - ``Home``: the first SRDF group state named ``home``, ``ready`` or ``default`` that covers the planning
   group, else every joint at 0 clipped into its limits. The simulation starts there. Link pairs in
   collision at Home are disabled in a generated SRDF (reason ``Default``, as MoveIt's setup assistant
@@ -215,6 +217,31 @@ def _home_collisions(
         return self_collisions(CollisionChecker(RobotModel.from_urdf(urdf, srdf)), home)
 
 
+_TOOL_POINT = re.compile(r"tcp|tool|eef|end_effector|ee_link|frame|grasp|tip", re.IGNORECASE)
+
+
+def _depth(joints: Mapping[str, UrdfJoint], link: str) -> int:
+    """How many joints lie between ``link`` and the URDF's root."""
+    parent_of = {joint.child: joint.parent for joint in joints.values()}
+    depth = 0
+    while link in parent_of and depth <= len(joints):
+        link, depth = parent_of[link], depth + 1
+    return depth
+
+
+def _tool_point(joints: Mapping[str, UrdfJoint], tip: str) -> str:
+    """The link fixed beyond ``tip`` that names a tool point (the SO-ARM's ``gripper_frame_link``, the
+    Panda's ``panda_hand_tcp``): followed while each link has exactly one fixed child; ``tip`` itself when
+    that path ends in no such name (or branches: the UR5's ``ee_link`` and ``tool0`` are left to the user)."""
+    link = tip
+    for _ in range(len(joints)):
+        fixed = [j.child for j in joints.values() if j.parent == link and not j.movable]
+        if len(fixed) != 1:
+            break
+        link = fixed[0]
+    return link if link != tip and _TOOL_POINT.search(link) else tip
+
+
 def _clip(joint: UrdfJoint, value: float) -> float:
     low = joint.lower if joint.lower is not None else -math.inf
     high = joint.upper if joint.upper is not None else math.inf
@@ -276,7 +303,18 @@ def plan_robot(
     else:
         definition = semantic.groups.get(group)
         tip_links = [t for _, t in definition.chains] if definition else []
-        tool_frame = tip_links[-1] if tip_links else joints[group_joints[-1]].child
+        if tip_links:
+            tool_frame = tip_links[-1]
+        else:
+            # A group of joints may end with fixed ones (the xArm's joint_eef): its tip is the deepest link.
+            listed = [joints[j].child for j in (definition.joints if definition else ()) if j in joints]
+            tool_frame = max([joints[group_joints[-1]].child, *listed], key=lambda link: _depth(joints, link))
+        tool_point = _tool_point(joints, tool_frame)
+        if tool_point != tool_frame:
+            notes.append(
+                f"tool frame {tool_point!r}: the tool point fixed to the planning group's tip {tool_frame!r}"
+            )
+            tool_frame = tool_point
     others = [j for j in active if j not in group_joints]
     gripper = others[0] if len(others) == 1 else None
     if len(others) > 1:
@@ -285,18 +323,20 @@ def plan_robot(
             "robot.gripper in config.yaml if one of them is the gripper"
         )
     home: dict[str, float] = {n: _clip(joints[n], 0.0) for n in active}
+    home_state: tuple[str, str] | None = None  # the SRDF group state Home is
     for state in ("home", "ready", "default"):
-        found = next(
+        home_state = next(
             (
-                v
-                for (g, s), v in semantic.group_states.items()
-                if s.lower() == state and set(group_joints) <= set(v)
+                key
+                for key, v in semantic.group_states.items()
+                if key[1].lower() == state and set(group_joints) <= set(v)
             ),
             None,
         )
-        if found is not None:
+        if home_state is not None:
+            found = semantic.group_states[home_state]
             home.update({k: float(v) for k, v in found.items() if k in home})
-            notes.append(f"{HOME}: the SRDF group state {state!r}")
+            notes.append(f"{HOME}: the SRDF group state {home_state[1]!r}")
             break
     opened = closed = 0.0
     if gripper is not None:
@@ -339,6 +379,8 @@ def plan_robot(
         notes.append(self_collision_warning(HOME, overlapping, "the SRDF"))
     waypoints = {HOME: dict(home)}
     for (_group, state), values in semantic.group_states.items():
+        if (_group, state) == home_state and state.lower() == HOME.lower():
+            continue  # "home" is Home (a "ready" or "default" it came from stays a waypoint of that name)
         waypoint = dict(home)
         waypoint.update({k: float(v) for k, v in values.items() if k in waypoint})
         waypoints.setdefault(state, waypoint)
