@@ -51,20 +51,10 @@ class CollisionChecker:
     """
 
     def __init__(self, model: RobotModel, scene: PlanningScene | None = None, padding: float = 0.0) -> None:
-        import pinocchio as pin
-
         self.model = model
         self.scene = scene if scene is not None else PlanningScene()
         self._padding = float(padding)
-        try:
-            self._robot_geoms = pin.buildGeomFromUrdf(
-                model.pin_model,
-                str(model.urdf_path),
-                pin.GeometryType.COLLISION,
-                package_dirs=list(getattr(model, "package_dirs", [])),
-            )
-        except (RuntimeError, ValueError) as exc:
-            raise MotionError(f"cannot build collision geometry from {model.urdf_path}: {exc}") from exc
+        self._robot_geoms = model.collision_geometry().copy()  # shares the model's shapes
         self._data = model.new_data()
         self._scene_version = -1
         self._allowed: frozenset[frozenset[str]] = frozenset()

@@ -514,3 +514,14 @@ def test_a_router_without_an_agent_is_reported_after_the_timeout(free_endpoint: 
         with pytest.raises(TransportError, match="no Kinema runtime answers"):
             with ObjectiveClient(free_endpoint, timeout=0.5) as client:
                 client.execute("Quick")
+
+
+def test_the_agent_loads_the_robot_model_and_collision_shapes_at_start(lab_sim_agent: Any) -> None:
+    """Beside the tick thread, not on the first objective that plans (a mesh robot's first plan waited
+    3-4 s for them)."""
+    import time
+
+    deadline = time.monotonic() + 30
+    while "robot model and collision shapes loaded" not in lab_sim_agent.log_file.read_text():
+        assert time.monotonic() < deadline, lab_sim_agent.log_file.read_text()
+        time.sleep(0.1)
