@@ -4,6 +4,10 @@ After a run that failed or was cancelled the view explains it: nodes keep how th
 was RUNNING when the run stopped shows HALTED), the path from the root to the failed node is
 highlighted and expanded, the cursor is put on the failed node, and that node opens onto its ports and
 the failure message. Everything stays until the next run starts.
+
+While a run goes on, the view keeps the deepest node that started running in sight (the line of its folded
+SubTree when it runs inside one), so a long objective at 80x24 shows where it is; once the user moves the
+cursor or scrolls, the view stays where they put it until the next run.
 """
 
 from __future__ import annotations
@@ -13,6 +17,7 @@ from collections.abc import Iterable
 from typing import TYPE_CHECKING
 
 from rich.text import Text
+from textual import events
 from textual.widgets import Tree
 from textual.widgets.tree import TreeNode
 
@@ -64,6 +69,41 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         self._by_uid: dict[int, TreeNode[OutlineNode]] = {}
         self._parents: dict[int, int | None] = {}
         self._details: list[TreeNode[OutlineNode]] = []
+        # Whether the view follows the running node: until the user moves or scrolls during a run.
+        self.following = True
+
+    # The user's own moves stop the view from following the run (until the next run starts).
+    def action_cursor_up(self) -> None:
+        self.following = False
+        super().action_cursor_up()
+
+    def action_cursor_down(self) -> None:
+        self.following = False
+        super().action_cursor_down()
+
+    def action_page_up(self) -> None:
+        self.following = False
+        super().action_page_up()
+
+    def action_page_down(self) -> None:
+        self.following = False
+        super().action_page_down()
+
+    def action_scroll_home(self) -> None:
+        self.following = False
+        super().action_scroll_home()
+
+    def action_scroll_end(self) -> None:
+        self.following = False
+        super().action_scroll_end()
+
+    def _on_mouse_scroll_down(self, event: events.MouseScrollDown) -> None:
+        self.following = False
+        super()._on_mouse_scroll_down(event)
+
+    def _on_mouse_scroll_up(self, event: events.MouseScrollUp) -> None:
+        self.following = False
+        super()._on_mouse_scroll_up(event)
 
     def show_outline(self, outline: TreeOutline | None, message: str = "") -> None:
         """Replace the tree with ``outline`` (or an empty tree labelled ``message``)."""
@@ -110,6 +150,7 @@ class BehaviorTreeView(Tree["OutlineNode"]):
         if self.outline is None:
             return 0
         found = 0
+        started: list[int] = []
         for update in updates:
             node = self.outline.find(update.uid, update.node_path)
             if node is None:
@@ -117,6 +158,8 @@ class BehaviorTreeView(Tree["OutlineNode"]):
             found += 1
             if update.status is NodeStatus.RUNNING and self.run_over:
                 continue  # the ended run's start, reported after its end: it keeps showing how it ended
+            if update.status is NodeStatus.RUNNING:
+                started.append(node.uid)
             previous = self.statuses.get(node.uid, NodeStatus.IDLE)
             if update.status is NodeStatus.IDLE and previous in _RESULTS:
                 continue  # parents reset finished children to IDLE; keep showing how they ended
@@ -128,12 +171,34 @@ class BehaviorTreeView(Tree["OutlineNode"]):
                 self.halted.discard(node.uid)
             self.statuses[node.uid] = update.status
             self._relabel(node.uid)
+        running = [uid for uid in started if self.statuses.get(uid) is NodeStatus.RUNNING]
+        if running and self.following:
+            self._show_running(max(running, key=self._depth))
         return found
+
+    def _depth(self, uid: int) -> int:
+        depth, parent = 0, self._parents.get(uid)
+        while parent is not None:
+            depth, parent = depth + 1, self._parents.get(parent)
+        return depth
+
+    def _show_running(self, uid: int) -> None:
+        """Scroll the running node ``uid`` (or the folded SubTree it runs in) into view."""
+        item = self._by_uid.get(uid)
+        shown = item
+        ancestor = item.parent if item is not None else None
+        while ancestor is not None and ancestor is not self.root:
+            if not ancestor.is_expanded:
+                shown = ancestor  # the outermost folded ancestor is the line on screen
+            ancestor = ancestor.parent
+        if shown is not None:
+            self.call_after_refresh(self.scroll_to_node, shown, animate=False)
 
     def reset_statuses(self) -> None:
         """Show every node as idle (a new run started)."""
         self._clear_failure()
         self.run_over = False
+        self.following = True
         uids = set(self.statuses) | self.halted
         self.statuses = {}
         self.halted = set()
