@@ -96,7 +96,7 @@ class CollisionChecker:
                     f"collision object {attached.object_id!r} is attached to {attached.link!r}, which is no "
                     "link of the robot"
                 )
-            frame_id = pin_model.getFrameId(attached.link)
+            frame_id = self.model.frame_id(attached.link)
             frame = pin_model.frames[frame_id]
             joint_T_link = np.asarray(frame.placement.homogeneous)
             for shape in attached.primitives:

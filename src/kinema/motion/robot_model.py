@@ -9,6 +9,7 @@ appear in ``q``; :meth:`RobotModel.pin_configuration` expands ``q`` into pinocch
 from __future__ import annotations
 
 import logging
+import math
 import threading
 from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
@@ -87,6 +88,31 @@ def _parse_urdf_joints(path: Path) -> dict[str, _UrdfJoint]:
     return joints
 
 
+CONTINUOUS_RANGE = 2.0 * math.pi
+"""A URDF ``continuous`` joint plans as a revolute joint within ±this (two turns), rad."""
+
+
+def _has_continuous(joints: Mapping[str, _UrdfJoint]) -> bool:
+    return any(joint.kind == "continuous" for joint in joints.values())
+
+
+def _continuous_as_revolute(path: Path) -> str:
+    """The URDF with each ``continuous`` joint made ``revolute`` within ±:data:`CONTINUOUS_RANGE` (its effort
+    and velocity kept): pinocchio gives a continuous joint two coordinates (cos, sin), which planning,
+    limits and trajectories here do not take; two turns either way cover what an arm's wrist is asked."""
+    root = etree.parse(str(path)).getroot()
+    for joint in root.findall("joint"):
+        if joint.get("type") != "continuous":
+            continue
+        joint.set("type", "revolute")
+        limit = joint.find("limit")
+        if limit is None:
+            limit = etree.SubElement(joint, "limit", effort="0", velocity="0")
+        limit.set("lower", repr(-CONTINUOUS_RANGE))
+        limit.set("upper", repr(CONTINUOUS_RANGE))
+    return etree.tostring(root, encoding="unicode")
+
+
 class RobotModel:
     """A kinematic robot model for planning, built with pinocchio from a URDF.
 
@@ -121,7 +147,7 @@ class RobotModel:
             if pin_model.nqs[jid] != 1 or pin_model.nvs[jid] != 1:
                 raise MotionError(
                     f"joint {name!r} in {urdf_path} has {pin_model.nqs[jid]} coordinates; "
-                    "only revolute (with limits) and prismatic joints are supported"
+                    "only revolute, continuous (planned within two turns) and prismatic joints are supported"
                 )
         for follower, mimic in self.mimics.items():
             if mimic.leader not in pin_names or mimic.leader in self.mimics:
@@ -220,7 +246,8 @@ class RobotModel:
         urdf_path = Path(urdf_path)
         joints = _parse_urdf_joints(urdf_path)
         try:
-            model = pin.buildModelFromUrdf(str(urdf_path))
+            bounded = _continuous_as_revolute(urdf_path) if _has_continuous(joints) else None
+            model = pin.buildModelFromXML(bounded) if bounded else pin.buildModelFromUrdf(str(urdf_path))
         except (RuntimeError, ValueError) as exc:
             raise MotionError(f"pinocchio cannot load URDF {urdf_path}: {exc}") from exc
         semantic = parse_srdf(srdf_path) if srdf_path is not None else SemanticDescription()
@@ -317,7 +344,13 @@ class RobotModel:
         """
         if not self.pin_model.existFrame(frame):
             raise MotionError(f"unknown frame {frame!r}; {did_you_mean(frame, self.link_names)}")
-        return self.pin_model.getFrameId(frame)
+        pin = _pin()
+        # A fixed joint named like its child link (the Unitree Z1's gripperStator) makes two frames of
+        # that name; the link's is the one meant (pinocchio refuses the name alone as ambiguous).
+        if self.pin_model.existFrame(frame, pin.FrameType.BODY):
+            return int(self.pin_model.getFrameId(frame, pin.FrameType.BODY))
+        matches = [i for i, f in enumerate(self.pin_model.frames) if f.name == frame]
+        return matches[0]
 
     # -- configurations ---------------------------------------------------------------------------
 

@@ -119,3 +119,51 @@ def test_group_with_unknown_joint_is_rejected(tmp_path, description):
     srdf.write_text('<robot name="r"><group name="arm"><joint name="elbo_joint"/></group></robot>')
     with pytest.raises(MotionError, match=r"unknown joint 'elbo_joint'.*elbow_joint"):
         RobotModel.from_urdf(description.urdf, srdf)
+
+
+def _two_link_urdf(path, *, joint_type: str, fixed_named_like_link: bool = False):
+    """A base, one arm link on a joint of ``joint_type``, and a tool link on a fixed joint (named like the
+    tool link with ``fixed_named_like_link``, as the Unitree Z1's gripperStator)."""
+    tool_joint = "tool" if fixed_named_like_link else "tool_joint"
+    limit = (
+        '<limit effort="5" velocity="2"/>'
+        if joint_type == "continuous"
+        else ('<limit lower="-1" upper="1" effort="5" velocity="2"/>')
+    )
+    path.write_text(
+        f"""<?xml version="1.0"?>
+<robot name="twolink">
+  <link name="base"/><link name="arm"/><link name="tool"/>
+  <joint name="turn" type="{joint_type}"><parent link="base"/><child link="arm"/>
+    <origin xyz="0 0 0.1"/><axis xyz="0 0 1"/>{limit}</joint>
+  <joint name="{tool_joint}" type="fixed"><parent link="arm"/><child link="tool"/>
+    <origin xyz="0.2 0 0"/></joint>
+</robot>
+"""
+    )
+    return path
+
+
+def test_a_continuous_joint_plans_as_a_revolute_one_within_two_turns(tmp_path):
+    """Kinova's (and many arms') wrists are continuous in their URDF: the model loads them with one
+    coordinate and limits of two turns either way, its effort and velocity kept."""
+    import math
+
+    from kinema.motion import RobotModel, fk
+
+    model = RobotModel.from_urdf(_two_link_urdf(tmp_path / "twolink.urdf", joint_type="continuous"))
+    assert model.joint_names == ("turn",)
+    limits = model.limits["turn"]
+    assert (limits.lower, limits.upper) == pytest.approx((-2 * math.pi, 2 * math.pi))
+    assert limits.max_velocity == pytest.approx(2.0)
+    tool = fk(model, model.configuration({"turn": math.pi / 2}), "tool")[:3, 3]
+    assert tool == pytest.approx([0.0, 0.2, 0.1], abs=1e-9)
+
+
+def test_a_fixed_joint_named_like_its_link_leaves_the_link_reachable_by_name(tmp_path):
+    """pinocchio makes two frames of that name and refuses the name alone; the link is the one meant."""
+    from kinema.motion import RobotModel, fk
+
+    path = _two_link_urdf(tmp_path / "twolink.urdf", joint_type="revolute", fixed_named_like_link=True)
+    model = RobotModel.from_urdf(path)
+    assert fk(model, model.configuration({"turn": 0.0}), "tool")[:3, 3] == pytest.approx([0.2, 0.0, 0.1])
