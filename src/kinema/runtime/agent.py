@@ -22,7 +22,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from kinema.drivers.mujoco.names import JOINT_STATES_TOPIC, JOINT_STATES_TYPE
-from kinema.errors import KinemaError, ObjectiveError
+from kinema.errors import KinemaError, ObjectiveError, did_you_mean
 from kinema.process.log_files import PLUGIN_LOGGER
 from kinema.runtime import names
 from kinema.runtime.background_work import HandOff
@@ -368,6 +368,7 @@ class Agent:
         clock: the runtime clock, for the heartbeat's ``ros_timestamp``.
         waypoint_groups: the planning groups a waypoint saved without any is recorded for (the config's
             planning group), so that UIs list its group.
+        robot_groups: the robot's planning groups (its SRDF's), which a saved waypoint's groups must be.
     """
 
     def __init__(
@@ -381,10 +382,12 @@ class Agent:
         clock: Clock | None = None,
         node: Node | None = None,
         waypoint_groups: Sequence[str] = (),
+        robot_groups: Callable[[], Sequence[str]] | None = None,
     ) -> None:
         from kinema.transport import Node
 
         self.waypoint_groups = list(waypoint_groups)
+        self._robot_groups = robot_groups
         self.session = session
         self.server = server
         self.source = source
@@ -785,7 +788,6 @@ class Agent:
                     return {"status": {"success": True}, "xml": Path(info.file).read_text(encoding="utf-8")}
                 except OSError as error:
                     return {"status": {"success": False, "error_message": f"{info.file}: {error}"}}
-        from kinema.errors import did_you_mean
 
         known = [info.id for info in self.source.objectives()]
         message = (
@@ -847,6 +849,13 @@ class Agent:
         from kinema.config import Waypoint
 
         assert self.waypoints is not None
+        known = list(self._robot_groups()) if self._robot_groups is not None else []
+        for group in groups:
+            if known and group not in known:
+                raise ObjectiveError(
+                    f"cannot save waypoint {name!r}: {group!r} is no planning group of the robot; "
+                    f"{did_you_mean(group, known)}"
+                )
         payload = self._joint_state
         if payload is None:
             raise ObjectiveError(f"cannot save waypoint {name!r}: no /joint_states received yet")

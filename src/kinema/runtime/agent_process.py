@@ -129,6 +129,7 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
         clock=clock,
         node=node,
         waypoint_groups=[str(group)] if group else [],
+        robot_groups=lambda: _robot_groups(context),
     )
     _add_debugging_doors(agent, options)
     if host is not None:
@@ -180,6 +181,15 @@ def _warn_without_clock(clock: Any, after_s: float = 10.0) -> None:
             )
 
     threading.Thread(target=check, name="kinema-clock-watch", daemon=True).start()
+
+
+def _robot_groups(context: BehaviorContext) -> list[str]:
+    """The robot's planning groups (none known when its model does not load: nothing is refused then)."""
+    try:
+        model = context.robot_model
+    except KinemaError:
+        return []
+    return sorted(model.groups) if model is not None else []
 
 
 def _load_planning(context: BehaviorContext) -> None:

@@ -81,6 +81,10 @@ def test_the_waypoint_verbs_save_list_rename_and_erase_with_the_configs_group(
     assert code == 0 and any(
         line.split()[:3] == ["Bench", "Spot", "manipulator"] for line in output.splitlines()
     ), output
+    # A group the robot does not have is refused, naming the robot's.
+    code, output = run("save", "Elsewhere", "-g", "manipulater")
+    assert code == 1 and "'manipulater' is no planning group" in output, output
+    assert "did you mean 'manipulator'" in output, output
     assert run("rename", "Bench Spot", "Bench")[0] == 0
     code, output = run("erase", "Bench Spot")
     assert code == 1 and "did you mean 'Bench'" in output, output
