@@ -375,6 +375,17 @@ def _check_waypoint_collisions(
         except ConfigError:
             continue
         where = document.location((number, "name"))
+        limits = checker.model.limits
+        outside = [
+            (joint, value, limits[joint])
+            for joint, value in waypoint.joint_positions().items()
+            if joint in limits and not limits[joint].lower - 1e-6 <= value <= limits[joint].upper + 1e-6
+        ]
+        for joint, value, limit in outside[:3]:
+            report.warnings.append(
+                f"{where}: waypoint {waypoint.name!r} has {joint} = {value:g}, outside its limits "
+                f"[{limit.lower:.4g}, {limit.upper:.4g}]: the planner refuses it as a goal; move it inside"
+            )
         pairs = self_collisions(checker, waypoint.joint_positions())
         if pairs:
             report.warnings.append(

@@ -382,7 +382,16 @@ def plan_robot(
         if (_group, state) == home_state and state.lower() == HOME.lower():
             continue  # "home" is Home (a "ready" or "default" it came from stays a waypoint of that name)
         waypoint = dict(home)
-        waypoint.update({k: float(v) for k, v in values.items() if k in waypoint})
+        for joint_name, value in values.items():
+            if joint_name not in waypoint:
+                continue
+            waypoint[joint_name] = _clip(joints[joint_name], float(value))
+            if waypoint[joint_name] != float(value):
+                # The scene's keyframe is clipped by MuJoCo anyway: the waypoint says the same place.
+                notes.append(
+                    f"waypoint {state!r}: the SRDF gives {joint_name} = {float(value):g}, outside its "
+                    f"limits; clipped to {waypoint[joint_name]:g}"
+                )
         waypoints.setdefault(state, waypoint)
     return RobotPlan(
         name=name,

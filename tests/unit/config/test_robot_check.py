@@ -128,6 +128,15 @@ def test_a_waypoint_inside_the_scenes_table_is_a_warning_at_its_line(tmp_path: P
     assert len(hits) == 1, report.warnings  # Home is clear of it
     assert hits[0].startswith(f"{waypoints}:{line_of(waypoints, 'IntoTable')}: waypoint 'IntoTable' is in")
     assert "upper_arm_link - table" in hits[0] and "ur5_cell_scene.xml" in hits[0]
+    # A waypoint outside a joint's limits (an SRDF state the Kinova's URDF limits exclude) is said too.
+    beyond = {**data[0], "name": "Beyond"}
+    beyond["joint_state"] = {**data[0]["joint_state"], "position": [0.0, -1.0, 7.5, 0.0, 0.0, 0.0]}
+    waypoints.write_text(yaml.safe_dump([*data, beyond], sort_keys=False))
+    report = robot_report(resolve_config("ur5_cell", Workspace.discover(root)))
+    (outside,) = [w for w in report.warnings if "outside its limits" in w]
+    assert outside.startswith(
+        f"{waypoints}:{line_of(waypoints, 'Beyond')}: waypoint 'Beyond' has elbow_joint = 7.5"
+    )
 
 
 # -- names that do not cross -----------------------------------------------------------------------------

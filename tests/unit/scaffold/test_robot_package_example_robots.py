@@ -1,6 +1,6 @@
-"""``kinema new config``'s tool frame and waypoints on robots of example-robot-data two new users brought:
-the xArm7 (an SRDF group of joints ending with the fixed ``joint_eef``, and a group state ``home``) and the
-SO-101 (no SRDF; its tool point ``gripper_frame_link`` is fixed beyond the chain's tip)."""
+"""``kinema new config`` on robots of example-robot-data that new users brought: the xArm7 (an SRDF group of
+joints ending with the fixed ``joint_eef``, and a group state ``home``), the SO-101 (no SRDF; its tool point
+``gripper_frame_link`` is fixed beyond the chain's tip) and the Kinova (an SRDF state outside its limits)."""
 
 from __future__ import annotations
 
@@ -52,3 +52,21 @@ def test_a_tool_point_fixed_beyond_the_chain_is_the_tool_frame(robots: Path) -> 
         index=PackageIndex(environ={}),
     )
     assert ur5.tool_frame == "ee_link"  # unchanged: its chain already ends there
+
+
+def test_an_srdf_state_outside_the_limits_is_clipped_as_the_scene_is_and_said(robots: Path) -> None:
+    """The Kinova's SRDF state arm_up has joint_3 = -1.5707, outside the URDF's [0.33, 5.95]: MuJoCo clips
+    the scene's keyframe, so the waypoint says the same place (it said -1.5707 and only failed when run)."""
+    folder = robots / "kinova_description"
+    plan = plan_robot(
+        "kinova_cell",
+        folder / "robots" / "kinova.urdf",
+        srdf=folder / "srdf" / "kinova.srdf",
+        xacro_args=None,
+        index=PackageIndex(environ={}),
+    )
+    assert plan.waypoints["arm_up"]["j2s6s200_joint_3"] == pytest.approx(0.331613, abs=1e-6)
+    assert any(
+        note.startswith("waypoint 'arm_up': the SRDF gives j2s6s200_joint_3 = -1.5707, outside its limits")
+        for note in plan.notes
+    ), plan.notes
