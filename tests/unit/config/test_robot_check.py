@@ -327,8 +327,8 @@ def test_a_urdf_the_planner_cannot_load_is_a_problem(lab_sim: Path) -> None:
         (
             urdf,
             None,
-            f"joint 'linear_rail_joint' in {urdf} has 4 coordinates; only revolute (with limits) and "
-            "prismatic joints are supported",
+            f"joint 'linear_rail_joint' in {urdf} has 4 coordinates; only revolute, continuous (planned "
+            "within two turns) and prismatic joints are supported",
         ),
     )
 
