@@ -892,6 +892,11 @@ class Agent:
             except Exception:
                 log.debug("could not send a toast to the JSON client of run %d", run_id, exc_info=True)
 
+    def warn(self, message: str) -> None:
+        """A warning for whoever watches: the agent's log (``kinema logs``, the run terminal) and a toast."""
+        log.warning("%s", message)
+        self._streams.publish_log(LOG_WARN, message)
+
     def report_cell_conflict(self, message: str) -> None:
         """Two agents or two drivers share this network (see :mod:`kinema.runtime.cell`): log and toast."""
         log.error("%s", message)

@@ -136,7 +136,9 @@ def build_agent(options: AgentOptions, session: Session) -> Agent:
         host.subscribe(agent.on_reload_event)
         if options.hot_reload:
             folders = [p.path for p in resolved.objective_library_paths] if resolved is not None else []
-            host.watch([*folders, *extra])
+            watcher = host.watch([*folders, *extra])
+            if resolved is not None:
+                _watch_config_files(watcher, resolved, agent)
     elif options.hot_reload and extra:
         from kinema.plugins import BehaviorHost
 
@@ -181,6 +183,27 @@ def _warn_without_clock(clock: Any, after_s: float = 10.0) -> None:
             )
 
     threading.Thread(target=check, name="kinema-clock-watch", daemon=True).start()
+
+
+def _watch_config_files(watcher: Any, resolved: Any, agent: Agent) -> None:
+    """Say, when a chain package's config.yaml changes, that the running runtime keeps the config it
+    started with (objective files reload; the robot's settings need a restart). A user who edited
+    robot.gripper or robot.tool_frame and ran again saw the old values at work and nothing saying why."""
+
+    def changed(folder: Path, paths: tuple[Path, ...], _first: float) -> None:
+        names = ", ".join(sorted({str(path) for path in paths if path.name == "config.yaml"}))
+        if not names:
+            return
+        text = (
+            f"{names} changed: this runtime keeps the config it started with; restart it (`kinema down`, "
+            f"then `kinema run -c {resolved.name}`) to use the change"
+        )
+        agent.warn(text)
+
+    for package in resolved.chain_packages:
+        folder = Path(package.config_file).parent
+        if folder.is_dir():
+            watcher.add(folder, (".yaml",), changed)
 
 
 def _robot_groups(context: BehaviorContext) -> list[str]:

@@ -158,16 +158,25 @@ def lab_sim_agent(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[Ag
         yield running
 
 
-@pytest.fixture
+@pytest.fixture(params=[False], ids=[""])
 def derived_config_agent(request: pytest.FixtureRequest, tmp_path: Path) -> Iterator[AgentProcess]:
-    """An agent for config ``my_cell`` (based on the bundled lab_sim) of a workspace at ``tmp_path/ws``."""
+    """An agent for config ``my_cell`` (based on the bundled lab_sim) of a workspace at ``tmp_path/ws``
+    (watching its files when parametrized ``indirect`` with True)."""
     package = tmp_path / "ws" / "src" / "my_cell"
     (package / "config").mkdir(parents=True)
     (package / "config" / "config.yaml").write_text('based_on_package: "lab_sim"\n')
     (package / "package.xml").write_text("<package><name>my_cell</name></package>\n")
     workspace = str(tmp_path / "ws")
     with running_agent(
-        request, tmp_path, "--config", "my_cell", "--workspace", workspace, "--clock", "wall"
+        request,
+        tmp_path,
+        "--config",
+        "my_cell",
+        "--workspace",
+        workspace,
+        "--clock",
+        "wall",
+        hot_reload=request.param,
     ) as running:
         yield running
 

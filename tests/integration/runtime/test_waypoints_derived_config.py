@@ -6,6 +6,7 @@ import time
 from pathlib import Path
 from typing import Any
 
+import pytest
 import yaml
 
 from kinema.drivers.mujoco import names as driver_names
@@ -92,3 +93,26 @@ def test_the_waypoint_verbs_save_list_rename_and_erase_with_the_configs_group(
     assert code == 0 and "it was linear_rail_joint=0.3, elbow_joint=1.25" in output, output
     code, output = run("list", "--json")
     assert "Bench" not in output and "Look at Table" in output
+
+
+@pytest.mark.parametrize("derived_config_agent", [True], indirect=True, ids=["watching"])
+def test_an_edited_config_yaml_is_said_to_need_a_restart(derived_config_agent: Any, tmp_path: Path) -> None:
+    """Objective files reload while the runtime runs; config.yaml does not: a user who changed
+    robot.gripper saw the old values at work and nothing saying why."""
+    from kinema.transport import Node, open_session
+
+    config = tmp_path / "ws" / "src" / "my_cell" / "config" / "config.yaml"
+    with open_session(derived_config_agent.endpoint) as session:
+        toasts: list[str] = []
+        Node(session, "watcher").create_subscription(
+            names.LOG_TYPE, names.LOG, lambda message: toasts.append(message.message)
+        )
+        time.sleep(0.5)  # the watcher and the subscription settle
+        config.write_text(config.read_text() + "\nrobot:\n  tool_frame: grasp_link\n")
+        deadline = time.monotonic() + 15
+        while not any("changed: this runtime keeps the config it started with" in t for t in toasts):
+            assert time.monotonic() < deadline, toasts
+            time.sleep(0.05)
+    (notice,) = [t for t in toasts if "keeps the config" in t]
+    assert str(config) in notice and "kinema run -c my_cell" in notice
+    assert "keeps the config it started with" in derived_config_agent.log_file.read_text()
