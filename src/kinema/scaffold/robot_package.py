@@ -154,6 +154,8 @@ def _check_srdf_names(semantic: SemanticDescription, robot: ResolvedRobot, srdf:
             + (f" (and {len(problems) - 8} more)" if len(problems) > 8 else "")
             + "."
             + ".".join(valid)
+            + (". " if valid else " ")
+            + "Fix the SRDF, or leave out --srdf: an SRDF is then made from the URDF (its longest chain)."
         )
 
 
@@ -317,6 +319,13 @@ def plan_robot(
             tool_frame = tool_point
     others = [j for j in active if j not in group_joints]
     gripper = others[0] if len(others) == 1 else None
+    fixed_fingers = [j.name for j in joints.values() if not j.movable and GRIPPER_NAME.search(j.name)]
+    if not others and fixed_fingers:
+        notes.append(
+            f"no gripper: the URDF's {', '.join(fixed_fingers[:4])} are fixed joints (a hand that cannot "
+            "move); make them revolute or prismatic in the URDF, or give your own MuJoCo scene (--mjcf) and "
+            "robot.gripper in config.yaml"
+        )
     if len(others) > 1:
         notes.append(
             f"no gripper: {len(others)} movable joints are outside {group!r} ({', '.join(others)}); set "

@@ -107,7 +107,7 @@ _srdf_names_other_joints = _srdf_not_fitting(
     '<group name="arm"><joint name="shoulder"/><joint name="elbow"/></group>'
     '<group_state name="home" group="arm"><joint name="wrist" value="0"/></group_state>',
     "group 'arm' names joint 'elbow'; group state 'home' (arm) names joint 'wrist'. "
-    "The URDF's joints: shoulder",
+    "The URDF's joints: shoulder. Fix the SRDF, or leave out --srdf: an SRDF is then made from the URDF",
 )
 _srdf_chain_upside_down = _srdf_not_fitting(
     '<group name="arm"><chain base_link="arm" tip_link="base"/></group>',

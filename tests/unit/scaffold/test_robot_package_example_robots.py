@@ -70,3 +70,19 @@ def test_an_srdf_state_outside_the_limits_is_clipped_as_the_scene_is_and_said(ro
         note.startswith("waypoint 'arm_up': the SRDF gives j2s6s200_joint_3 = -1.5707, outside its limits")
         for note in plan.notes
     ), plan.notes
+
+
+def test_a_hand_whose_finger_joints_are_fixed_is_said_to_be_no_gripper(robots: Path) -> None:
+    plan = plan_robot(
+        "kinova_cell",
+        robots / "kinova_description" / "robots" / "kinova.urdf",
+        srdf=None,
+        xacro_args=None,
+        index=PackageIndex(environ={}),
+    )
+    assert plan.gripper_joint is None
+    assert any(note.startswith("no gripper: the URDF's j2s6s200_joint_finger_1") for note in plan.notes), (
+        plan.notes
+    )
+    # Its continuous wrists plan within two turns (the package did not build before).
+    assert plan.waypoints["Home"]["j2s6s200_joint_1"] == 0.0
