@@ -78,28 +78,24 @@ def bodies(as_json: bool, connect: str | None, timeout: float) -> None:
 def joints(as_json: bool, connect: str | None, timeout: float) -> None:
     """Print each joint's position (rad or m) and velocity, from the next /joint_states message."""
     import json
-    import threading
 
     from kinema.drivers.mujoco.names import JOINT_STATES_TOPIC, JOINT_STATES_TYPE
+    from kinema.sdk.streams import MessageStream
     from kinema.transport import Node, open_session
-
-    received: list[Any] = []
-    arrived = threading.Event()
-
-    def take(message: Any) -> None:
-        if not arrived.is_set():
-            received.append(message)
-            arrived.set()
 
     with open_session(connect, connect_timeout=min(max(timeout, 0.5), 5.0)) as session:
         node = Node(session, f"_kinema_sim_cli_{os.getpid()}")
-        node.create_subscription(JOINT_STATES_TYPE, JOINT_STATES_TOPIC, take)
-        if not arrived.wait(timeout):
-            raise DriverError(
-                f"no {JOINT_STATES_TOPIC} message within {timeout:g} s: is a simulation running "
-                "(`kinema run`)? (--timeout waits longer)"
-            )
-    message = received[0]
+        with MessageStream(
+            lambda callback: node.create_subscription(JOINT_STATES_TYPE, JOINT_STATES_TOPIC, callback),
+            lambda message: message,
+            timeout=timeout,
+        ) as stream:
+            message = next(iter(stream), None)
+    if message is None:
+        raise DriverError(
+            f"no {JOINT_STATES_TOPIC} message within {timeout:g} s: is a simulation running "
+            "(`kinema run`)? (--timeout waits longer)"
+        )
     names = list(message.name)
     positions = [float(v) for v in message.position]
     velocities = [float(v) for v in message.velocity] if len(message.velocity) == len(names) else []
