@@ -186,12 +186,13 @@ def _warn_without_clock(clock: Any, after_s: float = 10.0) -> None:
 
 
 def _watch_config_files(watcher: Any, resolved: Any, agent: Agent) -> None:
-    """Say, when a chain package's config.yaml changes, that the running runtime keeps the config it
-    started with (objective files reload; the robot's settings need a restart). A user who edited
-    robot.gripper or robot.tool_frame and ran again saw the old values at work and nothing saying why."""
+    """Say, when a YAML file of a chain package's config folder changes (its config.yaml, MoveIt Pro's
+    ros2_control and MoveIt parameter files), that the running runtime keeps the config it started with:
+    objective files reload, the robot's settings need a restart. A user who edited robot.gripper or
+    robot.tool_frame and ran again saw the old values at work and nothing saying why."""
 
     def changed(folder: Path, paths: tuple[Path, ...], _first: float) -> None:
-        names = ", ".join(sorted({str(path) for path in paths if path.name == "config.yaml"}))
+        names = ", ".join(sorted({str(path) for path in paths}))
         if not names:
             return
         text = (
