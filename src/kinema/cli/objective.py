@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import click
 
@@ -339,6 +339,14 @@ def check(
 
 # -- running objectives on a live runtime (run, cancel, do, status) ------------------------------------
 
+running_config_option = click.option(
+    "--config",
+    "-c",
+    "config",
+    metavar="NAME",
+    default=None,
+    help="The config package the running runtime must serve (the command refuses to run on another).",
+)
 connect_option = click.option(
     "--connect",
     "-e",
@@ -427,9 +435,12 @@ def _finish(run, wait: bool, source: str = "") -> None:  # type: ignore[no-untyp
     help="Override a parameter (VALUE is YAML, parsed into the port's type); repeatable.",
 )
 @click.option("--no-wait", is_flag=True, help="Return once the objective started instead of when it ends.")
+@running_config_option
 @connect_option
 @timeout_option
-def run_(name: str, params: tuple[str, ...], no_wait: bool, connect: str | None, timeout: float) -> None:
+def run_(
+    name: str, params: tuple[str, ...], no_wait: bool, config: str | None, connect: str | None, timeout: float
+) -> None:
     """Run objective NAME on the running Kinema (a running objective is preempted).
 
     Prints the messages its behaviors publish for the UI (toasts) while it runs. Exits 0 when the
@@ -440,20 +451,36 @@ def run_(name: str, params: tuple[str, ...], no_wait: bool, connect: str | None,
 
     overrides = [ParameterOverride.parse(param) for param in params]
     with _client(connect, timeout) as client:
+        _check_running_config(client, config)
         _finish(client.start(name, overrides), not no_wait)
 
 
 @objective.command("do")
 @click.argument("file", type=click.File("r"))
 @click.option("--no-wait", is_flag=True, help="Return once the objective started instead of when it ends.")
+@running_config_option
 @connect_option
 @timeout_option
-def do_(file, no_wait: bool, connect: str | None, timeout: float) -> None:  # type: ignore[no-untyped-def]
+def do_(file, no_wait: bool, config: str | None, connect: str | None, timeout: float) -> None:  # type: ignore[no-untyped-def]
     """Run the BT.CPP v4 XML in FILE (`-` reads stdin) as an ad-hoc objective (its main tree)."""
     xml = file.read()
     source = "" if file.name == "<stdin>" else file.name
     with _client(connect, timeout) as client:
+        _check_running_config(client, config)
         _finish(client.start(xml=xml), not no_wait, source)
+
+
+def _check_running_config(client: Any, config: str | None) -> None:
+    """With ``-c NAME``: refuse to run on a runtime that serves another config (an objective of the same
+    name would move another robot), saying how to switch."""
+    if not config:
+        return
+    running = client.runtime_configs()
+    if running and config not in running:
+        raise click.ClickException(
+            f"the running runtime serves config {', '.join(running)}, not {config}: stop it "
+            f"(`kinema down`) and start `kinema run -c {config}`, or leave out -c"
+        )
 
 
 @objective.command("cancel")

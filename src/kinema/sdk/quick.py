@@ -231,6 +231,15 @@ class QuickClient:
         warnings = [str(warning) for warning in body.get("warnings", ())]
         return ObjectiveStatus(body["status"]), str(body["objective_name"]), warnings
 
+    def runtime_configs(self, timeout: float = 1.0) -> list[str]:
+        """The config packages the agents on this network run (from their presence tokens; an agent
+        that declares none, an older Kinema or MoveIt Pro's, is not listed)."""
+        from kinema.transport.presence import AGENT, PRESENCE_PREFIX, parse_presence
+
+        replies = self._session.liveliness().get(f"{PRESENCE_PREFIX}/{self.domain_id}/**", timeout=timeout)
+        members = [parse_presence(str(reply.ok.key_expr)) for reply in replies if reply.ok is not None]
+        return sorted({m.config for m in members if m is not None and m.role == AGENT and m.config})
+
     def close(self) -> None:
         """Close the session."""
         self._session.close()

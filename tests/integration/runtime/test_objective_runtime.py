@@ -525,3 +525,24 @@ def test_the_agent_loads_the_robot_model_and_collision_shapes_at_start(lab_sim_a
     while "robot model and collision shapes loaded" not in lab_sim_agent.log_file.read_text():
         assert time.monotonic() < deadline, lab_sim_agent.log_file.read_text()
         time.sleep(0.1)
+
+
+def test_objective_run_with_a_config_refuses_a_runtime_of_another_one(lab_sim_agent: Any) -> None:
+    """`kinema objective run NAME -c CONFIG` on a runtime of another config would move another robot."""
+
+    def run(*args: str) -> subprocess.CompletedProcess[str]:
+        return subprocess.run(
+            [sys.executable, "-m", "kinema", "objective", *args, "--connect", lab_sim_agent.endpoint],
+            capture_output=True,
+            text=True,
+            timeout=60,
+        )
+
+    refused = run("run", "Open Gripper", "-c", "panda_cell")
+    assert refused.returncode == 1, refused.stdout
+    assert (
+        "serves config lab_sim, not panda_cell" in refused.stderr
+        and "kinema run -c panda_cell" in refused.stderr
+    )
+    same = run("run", "Hello Tree", "-c", "lab_sim")
+    assert same.returncode == 0 and "'Hello Tree' succeeded" in same.stdout, same.stderr
