@@ -9,11 +9,13 @@ from __future__ import annotations
 
 from collections.abc import Iterator
 from contextlib import contextmanager
+from pathlib import Path
 from typing import TYPE_CHECKING
 
 import click
 
 from kinema.cli.groups import VerbGroup
+from kinema.cli.options import selection_options
 
 if TYPE_CHECKING:
     from kinema.config import Waypoint
@@ -51,14 +53,25 @@ def waypoint() -> None:
 
 @waypoint.command("list")
 @click.option("--json", "as_json", is_flag=True, help="Print [{name, groups, joints: {name: position}}].")
+@selection_options
 @connect_option
 @timeout_option
-def list_(as_json: bool, connect: str | None, timeout: float) -> None:
-    """List the saved waypoints (* marks favorites) with their planning groups; --json adds the joints."""
+def list_(
+    as_json: bool, workspace: Path | None, config: str | None, connect: str | None, timeout: float
+) -> None:
+    """List the saved waypoints (* marks favorites) with their planning groups; --json adds the joints.
+
+    They come from the running runtime; with none running, from the waypoints file of the selected config
+    (-w/-c, else the one `kinema configure` set), which the runtime would serve."""
     import json
 
-    with _client(connect, timeout) as client:
-        found = client.waypoints()
+    from kinema.errors import TransportError
+
+    try:
+        with _client(connect, timeout) as client:
+            found = client.waypoints()
+    except TransportError:
+        found = _from_file(workspace, config)
     if as_json:
         rows = [{"name": w.name, "groups": w.joint_group_names, "joints": w.joint_positions()} for w in found]
         click.echo(json.dumps(rows, indent=2))
@@ -70,6 +83,20 @@ def list_(as_json: bool, connect: str | None, timeout: float) -> None:
     for item in found:
         groups = ", ".join(item.joint_group_names) or "-"
         click.echo(f"{'*' if item.favorite else ' '} {item.name:<{width}}  {groups}")
+
+
+def _from_file(workspace: Path | None, config: str | None) -> list[Waypoint]:
+    """The selected config's waypoints as its file holds them (no runtime answered), said on stderr."""
+    from kinema.cli.options import resolve_selection
+    from kinema.config import resolve_config
+    from kinema.config.waypoint_location import waypoint_store_for
+
+    found, name = resolve_selection(workspace, config)
+    store = waypoint_store_for(resolve_config(name, found))
+    if store is None:
+        raise click.ClickException(f"no runtime answered, and config {name!r} names no waypoints file")
+    click.secho(f"note: no runtime answered; the waypoints of config {name} in {store.read_path}", err=True)
+    return store.all()
 
 
 @waypoint.command("save")
