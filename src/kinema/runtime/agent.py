@@ -892,9 +892,10 @@ class Agent:
             except Exception:
                 log.debug("could not send a toast to the JSON client of run %d", run_id, exc_info=True)
 
-    def warn(self, message: str) -> None:
-        """A warning for whoever watches: the agent's log (``kinema logs``, the run terminal) and a toast."""
-        log.warning("%s", message)
+    def warn_reload(self, message: str) -> None:
+        """A warning about files watched for hot reload, where its outcomes go: the plugin log (``kinema
+        logs``; ``kinema run``'s terminal echoes it) and a toast."""
+        plugin_log.warning("%s", message)
         self._streams.publish_log(LOG_WARN, message)
 
     def report_cell_conflict(self, message: str) -> None:

@@ -199,7 +199,7 @@ def _watch_config_files(watcher: Any, resolved: Any, agent: Agent) -> None:
             f"{names} changed: this runtime keeps the config it started with; restart it (`kinema down`, "
             f"then `kinema run -c {resolved.name}`) to use the change"
         )
-        agent.warn(text)
+        agent.warn_reload(text)
 
     for package in resolved.chain_packages:
         folder = Path(package.config_file).parent
