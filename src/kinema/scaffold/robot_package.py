@@ -28,9 +28,10 @@ What it decides, and where a user changes it (config.yaml says it again beside e
   group of joints that ends with fixed ones), or the tool point fixed beyond it (a single path of fixed
   joints ending in a link named like tcp, tool, eef, frame, grasp or tip), said in a note;
 - ``Home``: the first SRDF group state named ``home``, ``ready`` or ``default`` that covers the planning
-  group, else every joint at 0 clipped into its limits. The simulation starts there. Link pairs in
-  collision at Home are disabled in a generated SRDF (reason ``Default``, as MoveIt's setup assistant
-  does); a given SRDF is left as it is, and a note says which pairs overlap;
+  group, else every joint at 0 (a joint whose limits exclude 0 at the middle of its range). The
+  simulation starts there. Link pairs in collision at Home are disabled in a generated SRDF (reason
+  ``Default``, as MoveIt's setup assistant does); a given SRDF is left as it is, and a note says which
+  pairs overlap;
 - accelerations: the URDF has none, so each joint's is twice its velocity limit per second.
 
 Nothing is written when anything fails: the package is made in a temporary folder and moved into place.
@@ -38,6 +39,7 @@ Nothing is written when anything fails: the package is made in a temporary folde
 
 from __future__ import annotations
 
+import logging
 import math
 import re
 import shutil
@@ -212,11 +214,18 @@ def _home_collisions(
     from kinema.motion.collision import CollisionChecker, self_collisions
     from kinema.motion.robot_model import RobotModel
 
-    with tempfile.TemporaryDirectory() as folder:
-        urdf = robot.write_urdf(Path(folder) / "robot.urdf")
-        srdf = Path(folder) / "robot.srdf"
-        srdf.write_text(srdf_text)
-        return self_collisions(CollisionChecker(RobotModel.from_urdf(urdf, srdf)), home)
+    # The SRDF's notes were said already, at the user's file: not again at this temporary copy.
+    model_log = logging.getLogger("kinema.motion.robot_model")
+    was_disabled, model_log.disabled = model_log.disabled, True
+    try:
+        with tempfile.TemporaryDirectory() as folder:
+            urdf = robot.write_urdf(Path(folder) / "robot.urdf")
+            srdf = Path(folder) / "robot.srdf"
+            srdf.write_text(srdf_text)
+            # The checker reads the collision meshes through the URDF: while the copy is there.
+            return self_collisions(CollisionChecker(RobotModel.from_urdf(urdf, srdf)), home)
+    finally:
+        model_log.disabled = was_disabled
 
 
 _TOOL_POINT = re.compile(r"tcp|tool|eef|end_effector|ee_link|frame|grasp|tip", re.IGNORECASE)
@@ -242,6 +251,16 @@ def _tool_point(joints: Mapping[str, UrdfJoint], tip: str) -> str:
             break
         link = fixed[0]
     return link if link != tip and _TOOL_POINT.search(link) else tip
+
+
+def _rest(joint: UrdfJoint) -> float:
+    """Where a joint rests at the generated Home: 0, or the middle of its range when 0 is outside it (the
+    nearest limit is a hard stop: a Kinova's shoulder and elbow clipped to theirs fold the arm into the
+    table)."""
+    low, high = joint.lower, joint.upper
+    if low is not None and high is not None and not low <= 0.0 <= high:
+        return round((low + high) / 2.0, 6)
+    return _clip(joint, 0.0)
 
 
 def _clip(joint: UrdfJoint, value: float) -> float:
@@ -331,7 +350,7 @@ def plan_robot(
             f"no gripper: {len(others)} movable joints are outside {group!r} ({', '.join(others)}); set "
             "robot.gripper in config.yaml if one of them is the gripper"
         )
-    home: dict[str, float] = {n: _clip(joints[n], 0.0) for n in active}
+    home: dict[str, float] = {n: _rest(joints[n]) for n in active}
     home_state: tuple[str, str] | None = None  # the SRDF group state Home is
     for state in ("home", "ready", "default"):
         home_state = next(

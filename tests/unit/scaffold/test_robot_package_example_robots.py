@@ -54,7 +54,9 @@ def test_a_tool_point_fixed_beyond_the_chain_is_the_tool_frame(robots: Path) -> 
     assert ur5.tool_frame == "ee_link"  # unchanged: its chain already ends there
 
 
-def test_an_srdf_state_outside_the_limits_is_clipped_as_the_scene_is_and_said(robots: Path) -> None:
+def test_an_srdf_state_outside_the_limits_is_clipped_as_the_scene_is_and_said(
+    robots: Path, caplog: pytest.LogCaptureFixture
+) -> None:
     """The Kinova's SRDF state arm_up has joint_3 = -1.5707, outside the URDF's [0.33, 5.95]: MuJoCo clips
     the scene's keyframe, so the waypoint says the same place (it said -1.5707 and only failed when run)."""
     folder = robots / "kinova_description"
@@ -66,6 +68,9 @@ def test_an_srdf_state_outside_the_limits_is_clipped_as_the_scene_is_and_said(ro
         index=PackageIndex(environ={}),
     )
     assert plan.waypoints["arm_up"]["j2s6s200_joint_3"] == pytest.approx(0.331613, abs=1e-6)
+    # The SRDF's own notes are said once, at the user's file (not again at a temporary copy's).
+    assert sum("names no group" in note for note in plan.notes) == 1
+    assert not [r.getMessage() for r in caplog.records if "names no group" in r.getMessage()]
     assert any(
         note.startswith("waypoint 'arm_up': the SRDF gives j2s6s200_joint_3 = -1.5707, outside its limits")
         for note in plan.notes
@@ -86,3 +91,9 @@ def test_a_hand_whose_finger_joints_are_fixed_is_said_to_be_no_gripper(robots: P
     )
     # Its continuous wrists plan within two turns (the package did not build before).
     assert plan.waypoints["Home"]["j2s6s200_joint_1"] == 0.0
+    # Its shoulder and elbow exclude 0: Home has them mid-range, not against the stop the arm folded into
+    # the table at (and through itself).
+    assert plan.home["j2s6s200_joint_2"] == pytest.approx((0.820305 + 5.462881) / 2, abs=1e-3)
+    assert not any(
+        "in collision at Home" in note or "Home is in self-collision" in note for note in plan.notes
+    )
