@@ -474,9 +474,10 @@ def _joint_limits_yaml(plan: RobotPlan) -> str:
 
 
 def _waypoints_yaml(plan: RobotPlan) -> str:
+    others = " and the SRDF's group states" if len(plan.waypoints) > 1 else ""
     lines = [
-        "# Waypoints of " + plan.name + ": Home (where the simulation starts) and the SRDF's group states.",
-        "# Saved and edited by the waypoint behaviors and kinema's UIs (MoveIt Pro's waypoint format).",
+        f"# Waypoints of {plan.name}: Home (where the simulation starts){others}.",
+        "# Saved and edited by `kinema waypoint` and the UIs (MoveIt Pro's waypoint format).",
     ]
     for name, values in plan.waypoints.items():
         joint_names = list(values)
