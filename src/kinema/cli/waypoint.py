@@ -69,6 +69,7 @@ def list_(
 
     try:
         with _client(connect, timeout) as client:
+            _check_running_config(client, config)
             found = client.waypoints()
     except TransportError:
         found = _from_file(workspace, config)
@@ -83,6 +84,21 @@ def list_(
     for item in found:
         groups = ", ".join(item.joint_group_names) or "-"
         click.echo(f"{'*' if item.favorite else ' '} {item.name:<{width}}  {groups}")
+
+
+def _check_running_config(client: ObjectiveClient, config: str | None) -> None:
+    """With ``-c NAME`` and a runtime running: it must serve that config (else its waypoints are another
+    robot's), as ``kinema objective run -c`` checks."""
+    if not config:
+        return
+    from kinema.transport.presence import AGENT, query_presences
+
+    running = sorted({m.config for m in query_presences(client.session) if m.role == AGENT and m.config})
+    if running and config not in running:
+        raise click.ClickException(
+            f"the running runtime serves config {', '.join(running)}, not {config}: its waypoints are "
+            f"that config's; stop it (`kinema down`) to read {config}'s file, or leave out -c"
+        )
 
 
 def _from_file(workspace: Path | None, config: str | None) -> list[Waypoint]:

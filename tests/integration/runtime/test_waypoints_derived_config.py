@@ -93,6 +93,9 @@ def test_the_waypoint_verbs_save_list_rename_and_erase_with_the_configs_group(
     assert code == 0 and "it was linear_rail_joint=0.3, elbow_joint=1.25" in output, output
     code, output = run("list", "--json")
     assert "Bench" not in output and "Look at Table" in output
+    # -c names what the runtime must serve: another config's waypoints are not listed as if they were its.
+    code, output = run("list", "-c", "lab_sim")
+    assert code == 1 and "serves config my_cell, not lab_sim" in output, output
 
 
 @pytest.mark.parametrize("derived_config_agent", [True], indirect=True, ids=["watching"])
