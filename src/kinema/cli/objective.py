@@ -13,6 +13,7 @@ from kinema.cli.groups import VerbGroup
 from kinema.cli.options import (
     print_notices,
     print_warnings,
+    refuse_other_config,
     resolve_selection,
     running_selection,
     selection_options,
@@ -471,15 +472,10 @@ def do_(file, no_wait: bool, config: str | None, connect: str | None, timeout: f
 
 
 def _check_running_config(client: Any, config: str | None) -> None:
-    """With ``-c NAME``: refuse to run on a runtime that serves another config (an objective of the same
-    name would move another robot), saying how to switch."""
-    if not config:
-        return
-    running = client.runtime_configs()
-    if running and config not in running:
-        raise click.ClickException(
-            f"the running runtime serves config {', '.join(running)}, not {config}: stop it "
-            f"(`kinema down`) and start `kinema run -c {config}`, or leave out -c"
+    """With ``-c NAME``: refuse to run on a runtime that serves another config."""
+    if config:
+        refuse_other_config(
+            client.runtime_configs(), config, "an objective of that name would move its robot"
         )
 
 

@@ -99,3 +99,14 @@ def print_notices(notices: list[str]) -> None:
     """Print verbose-mode notices on stderr."""
     for notice in notices:
         click.secho(f"note: {notice}", err=True, fg="yellow")
+
+
+def refuse_other_config(running: Iterable[str], config: str | None, why: str) -> None:
+    """With ``-c NAME`` given (``config``): refuse when the running runtime serves other configs
+    (``running``: none known, nothing refused), ``why`` saying what would go wrong, and how to switch."""
+    serving = sorted(set(running))
+    if config and serving and config not in serving:
+        raise click.ClickException(
+            f"the running runtime serves config {', '.join(serving)}, not {config} ({why}): stop it "
+            f"(`kinema down`) and start `kinema run -c {config}`, or leave out -c"
+        )

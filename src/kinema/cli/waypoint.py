@@ -15,7 +15,7 @@ from typing import TYPE_CHECKING
 import click
 
 from kinema.cli.groups import VerbGroup
-from kinema.cli.options import selection_options
+from kinema.cli.options import refuse_other_config, selection_options
 
 if TYPE_CHECKING:
     from kinema.config import Waypoint
@@ -87,18 +87,14 @@ def list_(
 
 
 def _check_running_config(client: ObjectiveClient, config: str | None) -> None:
-    """With ``-c NAME`` and a runtime running: it must serve that config (else its waypoints are another
-    robot's), as ``kinema objective run -c`` checks."""
+    """With ``-c NAME`` and a runtime running: it must serve that config, as ``kinema objective run -c``
+    checks."""
     if not config:
         return
     from kinema.transport.presence import AGENT, query_presences
 
-    running = sorted({m.config for m in query_presences(client.session) if m.role == AGENT and m.config})
-    if running and config not in running:
-        raise click.ClickException(
-            f"the running runtime serves config {', '.join(running)}, not {config}: its waypoints are "
-            f"that config's; stop it (`kinema down`) to read {config}'s file, or leave out -c"
-        )
+    running = [m.config for m in query_presences(client.session) if m.role == AGENT and m.config]
+    refuse_other_config(running, config, "its waypoints are that config's")
 
 
 def _from_file(workspace: Path | None, config: str | None) -> list[Waypoint]:
