@@ -38,6 +38,7 @@ limits and mimic joints right, and the spec is then edited and written with ``Mj
 
 from __future__ import annotations
 
+import re
 import shutil
 from collections.abc import Iterable, Mapping
 from pathlib import Path
@@ -153,6 +154,10 @@ def adjacent_link_pairs(urdf_text: str) -> set[frozenset[str]]:
     return pairs
 
 
+TOOL_POINT_NAME = re.compile(r"tcp|tool|eef|end_effector|ee_link|frame|grasp|tip|gripper", re.IGNORECASE)
+"""A link name that says it is where the tool works (a TCP, a flange's tool frame, a gripper's base)."""
+
+
 def longest_chain(urdf_text: str) -> tuple[str, str, list[str]]:
     """``(base_link, tip_link, joints)``: a planning group for a URDF that comes without an SRDF.
 
@@ -160,7 +165,8 @@ def longest_chain(urdf_text: str) -> tuple[str, str, list[str]]:
     branches into two or more movable joints (a hand whose fingers are not part of the arm: the Panda's
     chain ends at ``panda_hand``). Mimic followers do not count. The base is the parent link of the first
     joint (``base_link`` rather than a ``world`` link fixed above it); the tip is carried on through fixed
-    joints to the last link (a flange or TCP frame), taking the first such child where there are several.
+    joints to the last link (a flange or TCP frame); where they branch, only into a child named like a tool
+    point (:data:`TOOL_POINT_NAME`), the first such.
     Among equally long chains the first in document order wins.
 
     Raises:
@@ -197,8 +203,14 @@ def longest_chain(urdf_text: str) -> tuple[str, str, list[str]]:
         raise ScaffoldError("the URDF has no movable joint: there is nothing to plan for")
     movable = [j for j in path if counts(j)]
     tip = movable[-1].child
-    # Carry the tip on through fixed joints (panda_hand → panda_hand_tcp, wrist_3_link → ee_link).
+    # Carry the tip on through fixed joints (panda_hand → panda_hand_tcp, wrist_3_link → ee_link). Where
+    # they branch, only into a link named like a tool point: Baxter's hand carries a camera, a range
+    # sensor and an accelerometer beside its gripper.
     while fixed := [j for j in children.get(tip, []) if j.kind == "fixed"]:
+        if len(fixed) > 1:
+            fixed = [j for j in fixed if TOOL_POINT_NAME.search(j.child)]
+            if not fixed:
+                break
         tip = fixed[0].child
     return movable[0].parent, tip, [j.name for j in movable]
 

@@ -228,9 +228,6 @@ def _home_collisions(
         model_log.disabled = was_disabled
 
 
-_TOOL_POINT = re.compile(r"tcp|tool|eef|end_effector|ee_link|frame|grasp|tip", re.IGNORECASE)
-
-
 def _depth(joints: Mapping[str, UrdfJoint], link: str) -> int:
     """How many joints lie between ``link`` and the URDF's root."""
     parent_of = {joint.child: joint.parent for joint in joints.values()}
@@ -244,13 +241,15 @@ def _tool_point(joints: Mapping[str, UrdfJoint], tip: str) -> str:
     """The link fixed beyond ``tip`` that names a tool point (the SO-ARM's ``gripper_frame_link``, the
     Panda's ``panda_hand_tcp``): followed while each link has exactly one fixed child; ``tip`` itself when
     that path ends in no such name (or branches: the UR5's ``ee_link`` and ``tool0`` are left to the user)."""
+    from kinema.scaffold.mjcf_scene import TOOL_POINT_NAME
+
     link = tip
     for _ in range(len(joints)):
         fixed = [j.child for j in joints.values() if j.parent == link and not j.movable]
         if len(fixed) != 1:
             break
         link = fixed[0]
-    return link if link != tip and _TOOL_POINT.search(link) else tip
+    return link if link != tip and TOOL_POINT_NAME.search(link) else tip
 
 
 def _rest(joint: UrdfJoint) -> float:

@@ -346,6 +346,13 @@ def test_longest_chain_of_the_example_robots(example_robots: Path) -> None:
     base, tip, joints = longest_chain(ur5.urdf_text)
     assert (base, tip) == ("base_link", "ee_link")
     assert joints == list(UR5_HOME)
+    # Baxter's hand carries a camera, a range sensor and an accelerometer beside its gripper: the tip goes
+    # on only into the gripper (it ended at the hand camera, the first child in the file).
+    baxter = resolve_robot(
+        example_robots / "baxter_description" / "urdf" / "baxter.urdf", index=PackageIndex(environ={})
+    )
+    base, tip, joints = longest_chain(baxter.urdf_text)
+    assert tip == "right_gripper" and joints[0] == "right_s0" and len(joints) == 7
 
 
 def test_adjacent_links_are_one_joint_apart_once_fixed_joints_merge(example_robots: Path) -> None:
