@@ -268,6 +268,7 @@ def generate_scene(
     table: bool = True,
     disabled_collisions: Iterable[tuple[str, str]] = (),
     mesh_cache: str | Path | None = None,
+    notes: list[str] | None = None,
 ) -> Path:
     """Write a MuJoCo scene for ``robot`` to ``<out_dir>/<name>_scene.xml``; return its path.
 
@@ -282,6 +283,8 @@ def generate_scene(
             ``disable_collisions``).
         mesh_cache: where converted meshes are cached between runs (default: the user's cache folder,
             :func:`~kinema.config.robot_files.default_mesh_cache`).
+        notes: what the scene decided that a user should hear is appended here (link pairs whose
+            contacts it excludes because their convex hulls overlap at Home).
 
     Raises:
         ScaffoldError: a keyframe names an unknown joint, or MuJoCo cannot compile the robot.
@@ -459,9 +462,21 @@ def generate_scene(
         spec.add_key(name=key_name, qpos=list(qpos), ctrl=ctrl)
 
     try:
-        spec.compile()
+        compiled = spec.compile()
     except ValueError as exc:
         raise ScaffoldError(f"MuJoCo cannot compile the generated scene: {exc}") from None
+    # MuJoCo collides meshes as their convex hulls, fuller than the meshes the planner checks: two links
+    # that only touch at Home in the planner's eyes (a Baxter's shoulder against its torso) overlap here,
+    # push each other away from Home and make every trajectory miss its tolerance. They touch by design.
+    overlapping = _robot_contacts_at_home(compiled, body_names)
+    for a, b in overlapping:
+        spec.add_exclude(bodyname1=a, bodyname2=b)
+    if overlapping and notes is not None:
+        notes.append(
+            f"the MuJoCo scene excludes contacts between {len(overlapping)} link pair(s) that overlap at "
+            "Home as MuJoCo's convex hulls (the planner checks the meshes): "
+            + ", ".join(f"{a} - {b}" for a, b in overlapping)
+        )
     # to_xml compiles again, reading the meshes: the relative meshdir goes in afterwards.
     document = etree.fromstring(spec.to_xml().encode("utf-8"))
     compiler = document.find("compiler")
@@ -549,6 +564,23 @@ def _give_moving_links_mass(urdf: etree._Element) -> None:
             ixz="0",
             iyz="0",
         )
+
+
+def _robot_contacts_at_home(model: Any, links: Iterable[str]) -> list[tuple[str, str]]:
+    """The pairs of the robot's links in contact at keyframe ``home`` (sorted, each once)."""
+    import mujoco
+
+    robot = {model.body(name).id for name in links if name != "world"}
+    data = mujoco.MjData(model)
+    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
+    mujoco.mj_forward(model, data)
+    pairs: set[tuple[str, str]] = set()
+    for contact in data.contact[: data.ncon]:
+        a, b = int(model.geom_bodyid[contact.geom1]), int(model.geom_bodyid[contact.geom2])
+        if a in robot and b in robot and a != b:
+            first, second = sorted((model.body(a).name, model.body(b).name))
+            pairs.add((first, second))
+    return sorted(pairs)
 
 
 def _reach(model: Any, data: Any, stand: np.ndarray) -> float:

@@ -679,6 +679,7 @@ def new_robot_package(
                 home=plan.home,
                 keyframes=keyframes,
                 disabled_collisions=[tuple(sorted(p)) for p in plan.semantic.disabled_collisions],  # type: ignore[misc]
+                notes=plan.notes,
             )
             scene = path.name
             _add_objects_include(path)

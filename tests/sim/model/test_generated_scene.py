@@ -461,3 +461,22 @@ def test_a_robot_mounted_on_a_world_link_stands_on_the_table_where_its_mount_is(
     assert top[2] == pytest.approx(0.1)
     assert low[0] < 0.5 < top[0] and low[1] < 0.2 < top[1]
     assert data.ncon == 0
+
+
+def test_links_whose_hulls_overlap_at_home_do_not_push_each_other(
+    example_robots: Path, mesh_cache: Path, tmp_path: Path
+) -> None:
+    """MuJoCo collides meshes as convex hulls: Baxter's lower shoulders overlap its torso at Home, pushed
+    the arm 0.36 rad away from it and made every trajectory miss its tolerance. The scene excludes those
+    contacts and says so."""
+    robot = resolve_robot(
+        example_robots / "baxter_description" / "urdf" / "baxter.urdf", index=PackageIndex(environ={})
+    )
+    notes: list[str] = []
+    scene = generate_scene(robot, tmp_path, home={}, mesh_cache=mesh_cache, notes=notes)
+    assert any("right_lower_shoulder - torso" in note for note in notes), notes
+    model = mujoco.MjModel.from_xml_path(str(scene))
+    data = at_keyframe(model, "home")
+    while data.time < 1.0:
+        mujoco.mj_step(model, data)
+    assert abs(data.joint("right_s0").qpos[0]) < 0.01, data.joint("right_s0").qpos
