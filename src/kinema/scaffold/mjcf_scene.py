@@ -154,19 +154,29 @@ def adjacent_link_pairs(urdf_text: str) -> set[frozenset[str]]:
     return pairs
 
 
-TOOL_POINT_NAME = re.compile(r"tcp|tool|eef|end_effector|ee_link|frame|grasp|tip|gripper", re.IGNORECASE)
-"""A link name that says it is where the tool works (a TCP, a flange's tool frame, a gripper's base)."""
+TOOL_POINT_WORDS = ("tcp", "ee_link", "tool", "grasp", "eef", "end_effector", "gripper", "tip", "frame")
+"""Words of a link name that say it is where the tool works, strongest first (a TCP, a flange's tool
+frame, a gripper's base; a bare ``frame`` last: the PR2's palm carries an ``led_frame`` beside its
+``tool_frame``)."""
+TOOL_POINT_NAME = re.compile("|".join(TOOL_POINT_WORDS), re.IGNORECASE)
+
+
+def _tool_point_rank(link: str) -> int:
+    """How strongly ``link``'s name says tool point (lower is stronger; ``len(TOOL_POINT_WORDS)``: not)."""
+    lowered = link.lower()
+    return next((i for i, word in enumerate(TOOL_POINT_WORDS) if word in lowered), len(TOOL_POINT_WORDS))
 
 
 def longest_chain(urdf_text: str) -> tuple[str, str, list[str]]:
     """``(base_link, tip_link, joints)``: a planning group for a URDF that comes without an SRDF.
 
-    The chain of movable joints from the root with the most joints, stopping at a link where the tree
-    branches into two or more movable joints (a hand whose fingers are not part of the arm: the Panda's
-    chain ends at ``panda_hand``). Mimic followers do not count. The base is the parent link of the first
+    The chain of movable joints with the most joints, from the root or from a link where the tree branches
+    into two or more movable joints, and stopping at such a link (a hand whose fingers are not part of the
+    arm: the Panda's chain ends at ``panda_hand``; a mobile manipulator's arm starts at its torso, where
+    the head branches off). Mimic followers do not count. The base is the parent link of the first
     joint (``base_link`` rather than a ``world`` link fixed above it); the tip is carried on through fixed
     joints to the last link (a flange or TCP frame); where they branch, only into a child named like a tool
-    point (:data:`TOOL_POINT_NAME`), the first such.
+    point (:data:`TOOL_POINT_WORDS`), the strongest such.
     Among equally long chains the first in document order wins.
 
     Raises:
@@ -191,7 +201,9 @@ def longest_chain(urdf_text: str) -> tuple[str, str, list[str]]:
         if movable > best[0]:
             best = (movable, list(path))
         if movable > 0 and branches(link):
-            return
+            # A chain ends where the tree branches (a hand into its fingers), and new ones start there: a
+            # mobile manipulator's torso branches into its arms and head, a humanoid's into its limbs.
+            path, movable = [], 0
         for joint in children.get(link, []):
             path.append(joint)
             walk(joint.child, path, movable + counts(joint))
@@ -208,7 +220,9 @@ def longest_chain(urdf_text: str) -> tuple[str, str, list[str]]:
     # sensor and an accelerometer beside its gripper.
     while fixed := [j for j in children.get(tip, []) if j.kind == "fixed"]:
         if len(fixed) > 1:
-            fixed = [j for j in fixed if TOOL_POINT_NAME.search(j.child)]
+            fixed = sorted(
+                (j for j in fixed if TOOL_POINT_NAME.search(j.child)), key=lambda j: _tool_point_rank(j.child)
+            )
             if not fixed:
                 break
         tip = fixed[0].child
@@ -328,6 +342,13 @@ def generate_scene(
     )
     urdf.insert(0, extension)
     _give_moving_links_mass(urdf)
+    repaired = _make_inertias_physical(urdf)
+    if repaired and notes is not None:
+        notes.append(
+            f"{len(repaired)} link(s) of the URDF have an inertia no rigid body has (a principal moment of 0 "
+            "or less, or one larger than the other two together); the MuJoCo scene uses the nearest one that "
+            "is: " + ", ".join(repaired[:6]) + (f" (+{len(repaired) - 6} more)" if len(repaired) > 6 else "")
+        )
     try:
         spec = mujoco.MjSpec.from_string(etree.tostring(urdf, encoding="unicode"))
     except ValueError as exc:
@@ -564,6 +585,46 @@ def _give_moving_links_mass(urdf: etree._Element) -> None:
             ixz="0",
             iyz="0",
         )
+
+
+def _make_inertias_physical(urdf: etree._Element) -> list[str]:
+    """Repair the inertias MuJoCo refuses (not positive definite, or a principal moment above the sum of
+    the other two: the PR2's and TIAGo's URDFs have both), keeping their principal axes; returns the links
+    repaired. Valid inertias are left exactly as written."""
+    repaired = []
+    for link in urdf.findall("link"):
+        inertia = link.find("inertial/inertia")
+        if inertia is None:
+            continue
+        try:
+            xx, yy, zz, xy, xz, yz = (
+                float(inertia.get(key, "0")) for key in ("ixx", "iyy", "izz", "ixy", "ixz", "iyz")
+            )
+        except ValueError:
+            continue
+        matrix = np.array([[xx, xy, xz], [xy, yy, yz], [xz, yz, zz]])
+        moments, axes = np.linalg.eigh(matrix)
+        floor = max(float(moments.max()) * 1e-3, 1e-12)
+        fixed = np.where(moments > 0.0, moments, floor)
+        for _ in range(3):  # each principal moment at most the sum of the other two
+            for index in range(3):
+                others = fixed.sum() - fixed[index]
+                if fixed[index] > others * (1.0 + 1e-9):
+                    fixed[np.argmin(fixed)] += (fixed[index] - others) * (1.0 + 1e-6)
+        if np.array_equal(fixed, moments):
+            continue
+        rebuilt = axes @ np.diag(fixed) @ axes.T
+        for key, (row, column) in {
+            "ixx": (0, 0),
+            "iyy": (1, 1),
+            "izz": (2, 2),
+            "ixy": (0, 1),
+            "ixz": (0, 2),
+            "iyz": (1, 2),
+        }.items():
+            inertia.set(key, repr(float(rebuilt[row, column])))
+        repaired.append(link.get("name", ""))
+    return repaired
 
 
 def _robot_contacts_at_home(model: Any, links: Iterable[str]) -> list[tuple[str, str]]:

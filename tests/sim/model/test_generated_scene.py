@@ -353,6 +353,28 @@ def test_longest_chain_of_the_example_robots(example_robots: Path) -> None:
     )
     base, tip, joints = longest_chain(baxter.urdf_text)
     assert tip == "right_gripper" and joints[0] == "right_s0" and len(joints) == 7
+    # Mobile manipulators: the arm, from the torso where the head branches off (a wheel's two joints won
+    # before), to the strongest tool point (the PR2's palm carries an led_frame beside its tool_frame).
+    for urdf, first, expected_tip in (
+        ("tiago_description/robots/tiago.urdf", "arm_1_joint", "hand_tool_link"),
+        ("pr2_description/urdf/pr2.urdf", "r_shoulder_pan_joint", "r_gripper_tool_frame"),
+    ):
+        robot = resolve_robot(example_robots / urdf, index=PackageIndex(environ={}))
+        base, tip, joints = longest_chain(robot.urdf_text)
+        assert (base, joints[0], tip, len(joints)) == ("torso_lift_link", first, expected_tip, 7)
+
+
+def test_inertias_no_rigid_body_has_are_repaired_and_said(
+    example_robots: Path, mesh_cache: Path, tmp_path: Path
+) -> None:
+    """The PR2's and TIAGo's URDFs have inertias MuJoCo refuses ("inertia must satisfy A + B >= C",
+    "must have positive eigenvalues"): the scene was not made at all."""
+    robot = resolve_robot(example_robots / "pr2_description/urdf/pr2.urdf", index=PackageIndex(environ={}))
+    notes: list[str] = []
+    scene = generate_scene(robot, tmp_path, home={}, mesh_cache=mesh_cache, notes=notes)
+    assert mujoco.MjModel.from_xml_path(str(scene)).nbody > 50
+    (note,) = [n for n in notes if "inertia no rigid body has" in n]
+    assert "sensor_mount_link" in note
 
 
 def test_adjacent_links_are_one_joint_apart_once_fixed_joints_merge(example_robots: Path) -> None:
