@@ -505,6 +505,8 @@ def generate_scene(
         compiler = etree.SubElement(document, "compiler")
         document.insert(0, compiler)
     compiler.set("meshdir", "meshes")
+    # The written inertias are rounded: one at the edge of A + B >= C (TIAGo's arm_1_link) would fail to load.
+    compiler.set("balanceinertia", "true")
     option = document.find("option")
     if option is None:
         option = etree.Element("option")

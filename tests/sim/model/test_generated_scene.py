@@ -375,6 +375,12 @@ def test_inertias_no_rigid_body_has_are_repaired_and_said(
     assert mujoco.MjModel.from_xml_path(str(scene)).nbody > 50
     (note,) = [n for n in notes if "inertia no rigid body has" in n]
     assert "sensor_mount_link" in note
+    # TIAGo's written scene, its inertias rounded, still loads (arm_1_link is at the edge of A + B >= C).
+    tiago = resolve_robot(
+        example_robots / "tiago_description/robots/tiago.urdf", index=PackageIndex(environ={})
+    )
+    scene = generate_scene(tiago, tmp_path / "tiago", home={}, mesh_cache=mesh_cache)
+    assert mujoco.MjModel.from_xml_path(str(scene)).body("arm_1_link").id > 0
 
 
 def test_adjacent_links_are_one_joint_apart_once_fixed_joints_merge(example_robots: Path) -> None:
