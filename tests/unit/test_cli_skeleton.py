@@ -15,7 +15,8 @@ def test_version_prints_the_package_version(capsys):
 def test_help_lists_verbs_and_does_not_import_heavy_modules():
     code = (
         "import sys; from kinema.cli.main import main; rc = main(['--help']);"
-        "heavy = [m for m in ('mujoco', 'pinocchio', 'zenoh', 'textual', 'meshcat', 'ompl')"
+        # kinema.config: `kinema new` reached it through kinema.scaffold (40-100 ms of `kinema --help`).
+        "heavy = [m for m in ('mujoco', 'pinocchio', 'zenoh', 'textual', 'meshcat', 'ompl', 'kinema.config')"
         " if m in sys.modules];"
         "print('HEAVY', heavy); raise SystemExit(rc)"
     )
