@@ -12,8 +12,6 @@ entry point, so generating never writes replay files into the user's home direct
 
 from __future__ import annotations
 
-import json
-import logging
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
@@ -62,6 +60,8 @@ def load_template(template_name: str) -> Template:
         raise ScaffoldError(
             f"no template named {template_name!r}; {did_you_mean(template_name, available_templates())}"
         )
+    import json  # here, not at the top: `kinema --help` imports this module (through `kinema new`)
+
     try:
         raw = json.loads(spec.read_text(encoding="utf-8"))
     except (OSError, ValueError) as error:
@@ -169,6 +169,8 @@ def _render(template: Template, output_dir: Path, values: dict[str, str]) -> Pat
     context["_cookiecutter"] = {k: v for k, v in context["cookiecutter"].items() if not k.startswith("_")}
     # cookiecutter logs a failing hook with logger.exception; the hook already printed its ERROR line and
     # the ScaffoldError below says the rest, so its traceback must not reach the user.
+    import logging
+
     hook_logger = logging.getLogger("cookiecutter")
     quiet = logging.NullHandler()
     hook_logger.addHandler(quiet)
