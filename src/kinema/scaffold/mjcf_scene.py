@@ -439,6 +439,18 @@ def generate_scene(
         if joint_name in home_values:
             data_.qpos[model.jnt_qposadr[i]] = home_values[joint_name]
     mujoco.mj_forward(model, data_)
+    # MuJoCo collides meshes as their convex hulls, fuller than the meshes the planner checks: two links
+    # that only touch at Home in the planner's eyes (a Baxter's shoulder against its torso) overlap here,
+    # push each other away from Home and make every trajectory miss its tolerance. They touch by design.
+    overlapping = _robot_contacts(model, data_, body_names)
+    for a, b in overlapping:
+        spec.add_exclude(bodyname1=a, bodyname2=b)
+    if overlapping and notes is not None:
+        notes.append(
+            f"the MuJoCo scene excludes contacts between {len(overlapping)} link pair(s) that overlap at "
+            "Home as MuJoCo's convex hulls (the planner checks the meshes): "
+            + ", ".join(f"{a} - {b}" for a, b in overlapping)
+        )
     inertia_matrix = np.zeros((model.nv, model.nv))
     mujoco.mj_fullM(model, data_, inertia_matrix)  # MuJoCo 4: (m, d, dst); MjData.qM is gone
     groups = rigid_groups(robot.urdf_text)
@@ -483,21 +495,9 @@ def generate_scene(
         spec.add_key(name=key_name, qpos=list(qpos), ctrl=ctrl)
 
     try:
-        compiled = spec.compile()
+        spec.compile()
     except ValueError as exc:
         raise ScaffoldError(f"MuJoCo cannot compile the generated scene: {exc}") from None
-    # MuJoCo collides meshes as their convex hulls, fuller than the meshes the planner checks: two links
-    # that only touch at Home in the planner's eyes (a Baxter's shoulder against its torso) overlap here,
-    # push each other away from Home and make every trajectory miss its tolerance. They touch by design.
-    overlapping = _robot_contacts_at_home(compiled, body_names)
-    for a, b in overlapping:
-        spec.add_exclude(bodyname1=a, bodyname2=b)
-    if overlapping and notes is not None:
-        notes.append(
-            f"the MuJoCo scene excludes contacts between {len(overlapping)} link pair(s) that overlap at "
-            "Home as MuJoCo's convex hulls (the planner checks the meshes): "
-            + ", ".join(f"{a} - {b}" for a, b in overlapping)
-        )
     # to_xml compiles again, reading the meshes: the relative meshdir goes in afterwards.
     document = etree.fromstring(spec.to_xml().encode("utf-8"))
     compiler = document.find("compiler")
@@ -629,14 +629,9 @@ def _make_inertias_physical(urdf: etree._Element) -> list[str]:
     return repaired
 
 
-def _robot_contacts_at_home(model: Any, links: Iterable[str]) -> list[tuple[str, str]]:
-    """The pairs of the robot's links in contact at keyframe ``home`` (sorted, each once)."""
-    import mujoco
-
+def _robot_contacts(model: Any, data: Any, links: Iterable[str]) -> list[tuple[str, str]]:
+    """The pairs of the robot's links in contact in ``data`` (after ``mj_forward``; sorted, each once)."""
     robot = {model.body(name).id for name in links if name != "world"}
-    data = mujoco.MjData(model)
-    mujoco.mj_resetDataKeyframe(model, data, model.key("home").id)
-    mujoco.mj_forward(model, data)
     pairs: set[tuple[str, str]] = set()
     for contact in data.contact[: data.ncon]:
         a, b = int(model.geom_bodyid[contact.geom1]), int(model.geom_bodyid[contact.geom2])
