@@ -148,11 +148,12 @@ def main() -> None:
     parser.add_argument(
         "--block-warmup", type=int, default=100, help="untimed calls at the start of each turn's block"
     )
-    parser.add_argument("--cold", type=int, default=5, help="cold CLI runs")
+    parser.add_argument("--cold", type=int, default=5, help="cold CLI runs (0: none)")
     parser.add_argument("--smoke", action="store_true", help="few calls, one cold run (the test suite)")
     args = parser.parse_args()
     if args.smoke:
-        args.calls, args.warmup, args.rounds, args.block_warmup, args.cold = 40, 8, 2, 4, 1
+        args.calls, args.warmup, args.rounds, args.block_warmup = 40, 8, 2, 4
+        args.cold = min(args.cold, 1)
 
     from kinema.sdk import ObjectiveClient
     from kinema.transport import free_endpoint
@@ -224,6 +225,8 @@ def main() -> None:
                 met = p50 <= 3 * floor and p99 <= 5 * floor99
                 print(f"{name}: within 3x (p50) and 5x (p99) of the floor: {'met' if met else 'NOT met'}")
 
+            if args.cold <= 0:
+                return  # --cold 0: the round trips only
             env = {**os.environ, "KINEMA_ZENOH_CONNECT": endpoint}
             xml_file = folder / "trivial_do.xml"
             xml_file.write_text(TRIVIAL)
