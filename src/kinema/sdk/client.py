@@ -435,7 +435,7 @@ class ObjectiveClient:
 
     def waypoints(self) -> list[Waypoint]:
         """The config's saved waypoints (``kinema.config.Waypoint``: name, joints, positions, groups)."""
-        response = self._call_waypoints(names.GET_WAYPOINTS_TYPE, names.GET_WAYPOINTS, {})
+        response = self._call_service(names.GET_WAYPOINTS_TYPE, names.GET_WAYPOINTS, {})
         return [_waypoint_from(message) for message in response.waypoints]
 
     def save_waypoint(self, name: str, joint_group_names: Iterable[str] = ()) -> Waypoint:
@@ -447,21 +447,35 @@ class ObjectiveClient:
             ObjectiveError: the agent refused (no joint states yet, a bad name; its message says).
         """
         request = {"operation": 0, "waypoint_name": name, "joint_group_names": list(joint_group_names)}
-        response = self._call_waypoints(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, request)
+        response = self._call_service(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, request)
         return _waypoint_from(response.new_waypoint)
 
     def rename_waypoint(self, name: str, new_name: str) -> Waypoint:
         """Rename waypoint ``name`` to ``new_name``; raises ObjectiveError naming the valid ones."""
         request = {"operation": 1, "waypoint_name": name, "existing_waypoint_new_name": new_name}
-        response = self._call_waypoints(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, request)
+        response = self._call_service(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, request)
         return _waypoint_from(response.new_waypoint)
 
     def erase_waypoint(self, name: str) -> None:
         """Delete waypoint ``name``; raises ObjectiveError naming the valid ones."""
         request = {"operation": 2, "waypoint_name": name}
-        self._call_waypoints(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, request)
+        self._call_service(names.EDIT_WAYPOINTS_TYPE, names.EDIT_WAYPOINTS, request)
 
-    def _call_waypoints(self, srv_type: str, service: str, request: dict[str, Any]) -> Any:
+    def objective_xml(self, name: str) -> str:
+        """The XML file that defines objective ``name``, as saved in the agent's library (``$(config ...)``
+        left as written).
+
+        Raises:
+            ObjectiveError: the agent has no such objective (its message names the close ones).
+        """
+        response = self._call_service(
+            names.GET_OBJECTIVE_XML_TYPE, names.GET_OBJECTIVE_XML, {"objective_name": name}
+        )
+        return str(response.xml)
+
+    def _call_service(self, srv_type: str, service: str, request: dict[str, Any]) -> Any:
+        """Call one of the agent's services; a response whose ``status`` says it refused raises
+        ObjectiveError with the agent's message."""
         from kinema.errors import ObjectiveError
 
         self.wait_for_runtime()

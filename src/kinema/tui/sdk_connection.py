@@ -129,7 +129,6 @@ class SdkConnection:
         self._heartbeat_timeout = heartbeat_timeout
         self._listener: EventListener | None = None
         self._client: ObjectiveClient | None = None
-        self._service_clients: dict[str, Any] = {}
         self._lock = threading.Lock()
         self._state_lock = threading.Lock()
         self._stop = threading.Event()
@@ -236,7 +235,6 @@ class SdkConnection:
         # screen that sees "connected" must find a client to call.
         with self._lock:
             self._client = client
-            self._service_clients = {}
         node = client.node
         try:
             node.create_subscription(names.HEARTBEAT_TYPE, names.HEARTBEAT, self._on_heartbeat, latched=True)
@@ -267,7 +265,6 @@ class SdkConnection:
     def _drop_client(self) -> None:
         with self._lock:
             client, self._client = self._client, None
-            self._service_clients = {}
         if client is not None:
             try:
                 client.close()
@@ -462,19 +459,6 @@ class SdkConnection:
             raise TransportError(f"not connected to a runtime at {self.endpoint} (is `kinema run` running?)")
         return client
 
-    def _call(self, srv_type: str, name: str, request: dict[str, Any]) -> Any:
-        client = self._require_client()
-        with self._lock:
-            service = self._service_clients.get(name)
-            if service is None:
-                service = client.node.create_client(srv_type, name)
-                self._service_clients[name] = service
-        response = service.call(request, timeout=CALL_TIMEOUT_S)
-        status = getattr(response, "status", None)
-        if status is not None and not status.success:
-            raise ObjectiveError(str(status.error_message) or f"{name} refused the request")
-        return response
-
     def workspace(self) -> Workspace:
         return self._selection()[0]
 
@@ -482,10 +466,7 @@ class SdkConnection:
         return [_objective_summary(info) for info in self._require_client().objectives()]
 
     def objective_xml(self, name: str) -> str:
-        from kinema.runtime import names
-
-        response = self._call(names.GET_OBJECTIVE_XML_TYPE, names.GET_OBJECTIVE_XML, {"objective_name": name})
-        return str(response.xml)
+        return self._require_client().objective_xml(name)
 
     def start_objective(self, name: str, overrides: Mapping[str, str]) -> None:
         self._require_client().start(name, dict(overrides) or None)

@@ -6,9 +6,11 @@ import time
 from pathlib import Path
 from typing import Any
 
+import pytest
 import yaml
 
 from kinema.drivers.mujoco import names as driver_names
+from kinema.errors import ObjectiveError
 from kinema.runtime import names
 
 
@@ -67,3 +69,7 @@ def test_a_new_objective_file_can_run_without_a_restart(lively_agent: Any, tmp_p
             assert time.monotonic() < deadline, "the new objective never appeared"
             time.sleep(0.1)
         assert client.execute("Brand New").succeeded
+        # The SDK reads an objective's file back as saved (what the TUI's Tree tab shows).
+        assert client.objective_xml("Brand New") == (tmp_path / "objectives" / "brand_new.xml").read_text()
+        with pytest.raises(ObjectiveError, match=r"no objective named 'Brand Nw'.*Brand New"):
+            client.objective_xml("Brand Nw")
