@@ -157,7 +157,9 @@ def test(packages_select: tuple[str, ...], workspace: Path | None, pytest_args: 
     _require_pytest()
     found, _ = resolve_selection(workspace, None, need_config=False)
     if found.root is None:
-        raise KinemaError("no workspace is selected: pass -w PATH or run `kinema configure -w PATH`")
+        from kinema.config.workspace import select_workspace_hint
+
+        raise KinemaError(f"no workspace is selected: {select_workspace_hint()}")
     packages = workspace_behavior_packages(found.root, packages_select)
     if not packages:
         click.echo(f"no behavior packages in {found.root / 'src'} (create one with `kinema new behavior`)")

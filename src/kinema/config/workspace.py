@@ -218,6 +218,23 @@ def find_workspace_root(path: Path) -> Path:
     )
 
 
+def select_workspace_hint() -> str:
+    """How to select a workspace, for a message saying that none is: the one the current folder is in
+    when it is in one (a user who ran ``kinema init ws && cd ws``), else how to select or create one."""
+    here = Path.cwd()
+    try:
+        root = find_workspace_root(here)
+    except (ConfigError, OSError):
+        return (
+            "pass -w PATH, or select one with `kinema configure -w PATH` (create one with `kinema init PATH`)"
+        )
+    where = "." if root == here.resolve() else str(root)
+    return (
+        f"you are in the workspace {root}: pass -w {where}, or select it for later commands with "
+        f"`kinema configure -w {where}`"
+    )
+
+
 def _scan(folder: Path, origin: str) -> list[Package]:
     """Find the packages under ``folder`` (not descending into a package)."""
     found: list[Package] = []

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
 
-from kinema.config.workspace import Package, Workspace
+from kinema.config.workspace import Package, Workspace, select_workspace_hint
 from kinema.errors import ConfigError, ScaffoldError, did_you_mean
 from kinema.scaffold.generate import generate
 from kinema.scaffold.names import BEHAVIOR_TYPES, module_name_problem, package_name_problem
@@ -108,8 +108,8 @@ def new_behavior(
     check_behavior_type(behavior_type)
     if workspace.root is None:
         raise ScaffoldError(
-            "no workspace is selected, so there is no src/ to create the behavior package in; pass -w PATH, "
-            "or select one with `kinema configure -w PATH` (create one with `kinema init PATH`)"
+            f"no workspace is selected, so there is no src/ to create the behavior package in; "
+            f"{select_workspace_hint()}"
         )
     behavior_id = behavior_id_for(name)
     context = {"behavior_name": name, "behavior_id": behavior_id, "behavior_type": behavior_type}

@@ -11,7 +11,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from pathlib import Path
 
-from kinema.config.workspace import Workspace
+from kinema.config.workspace import Workspace, select_workspace_hint
 from kinema.errors import ScaffoldError, did_you_mean
 from kinema.scaffold.generate import Prompt, Validator, generate
 from kinema.scaffold.names import check_package_name
@@ -27,8 +27,8 @@ def default_output_dir(workspace: Workspace) -> Path:
     """
     if workspace.root is None:
         raise ScaffoldError(
-            "no workspace is selected, so there is no src/ to create the package in; pass -o DIR, "
-            "or select one with `kinema configure -w PATH` (create one with `kinema init PATH`)"
+            "no workspace is selected, so there is no src/ to create the package in (-o DIR names a "
+            f"folder instead); {select_workspace_hint()}"
         )
     return workspace.root / "src"
 

@@ -274,3 +274,20 @@ def test_a_misspelt_config_key_is_a_warning_without_verbose(capsys, tmp_path: Pa
     for verb in (("config", "show"), ("objective", "list", "--no-check")):
         code, _, err = run(capsys, *verb, "-w", str(workspace), "-c", "my_cell")
         assert code == 0 and expected in err and "did you mean 'waypoints_file'" in err, err
+
+
+def test_with_no_workspace_selected_new_config_names_the_one_you_are_in(
+    capsys, tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+):
+    """`kinema init ws && cd ws && kinema new config ...` without -w: the refusal says `-w .`."""
+    monkeypatch.delenv("KINEMA_WORKSPACE", raising=False)
+    assert run(capsys, "init", str(tmp_path / "ws"))[0] == 0
+    monkeypatch.chdir(tmp_path / "ws")
+    code, _out, err = run(capsys, "new", "config", "cell", "--based-on", "lab_sim", "--no-input")
+    assert code != 0
+    assert f"you are in the workspace {(tmp_path / 'ws').resolve()}: pass -w ." in err
+    assert not (tmp_path / "ws" / "src" / "cell").exists()
+    # Outside any workspace it says how to select or create one.
+    monkeypatch.chdir(tmp_path)
+    code, _out, err = run(capsys, "new", "config", "cell", "--based-on", "lab_sim", "--no-input")
+    assert code != 0 and "create one with `kinema init PATH`" in err
