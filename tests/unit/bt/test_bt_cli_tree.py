@@ -27,6 +27,19 @@ def test_run_the_bundled_example() -> None:
     assert out.rstrip().endswith("final status: SUCCESS")
 
 
+def test_every_runnable_example_runs_to_success_and_its_steps_are_not_offered() -> None:
+    """What `kinema objective list` marks runnable (R) in the bundled examples succeeds when run alone; a
+    step of another objective (Count Up needs Hello Tree's counter) is marked not runnable."""
+    from kinema.config.objective_file import parse_objective_file
+
+    infos = parse_objective_file(HELLO).objectives
+    assert {info.id: info.runnable for info in infos} == {"Hello Tree": True, "Count Up": False}
+    for info in infos:
+        if info.runnable:
+            code, out = run_cli("tree", "run", str(HELLO), "--tree", info.id, "-q")
+            assert code == 0, f"{info.id}: {out}"
+
+
 def test_run_exits_1_on_failure_and_respects_tree(tmp_path: Path) -> None:
     path = tmp_path / "two.xml"
     path.write_text(
