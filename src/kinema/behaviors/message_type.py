@@ -8,6 +8,9 @@ PoseStamped port gets the same one, across hot reloads too (the engine compares 
 A value is an instance when it is a message of that ROS type (the rosbags dataclasses Kinema's transport
 builds), whichever typestore built it.
 
+Calling the type builds a message of it (``PoseStamped(pose={"position": {"x": 0.1}})``), for tests and
+for behaviors that write message ports.
+
 Literal port text (rare for messages) is read as MoveIt Pro's JSON serialisation of the message,
 ``json:{"pose": {...}}``, or as YAML flow text without the prefix (what ``ros2 topic pub`` takes).
 """
@@ -33,9 +36,25 @@ class MessageTypeMeta(type):
     def __repr__(cls) -> str:
         return f"<message type {cls.ros_type}>"
 
+    def __call__(cls, **fields: Any) -> Any:
+        """A message of this type: ``message_type("sensor_msgs/msg/JointState")(name=["a"], position=[0.5])``.
+
+        Fields not given get their defaults; a nested message may be a dict of its fields. What a test
+        hands ``tick_behavior`` for a message port, or a behavior writes to one.
+
+        Raises:
+            TransportError: a field the message does not have (naming the valid ones), or a value of the
+                wrong type.
+        """
+        from kinema.transport import from_dict
+
+        if not getattr(cls, "ros_type", ""):
+            raise TypeError("MessageValue is the base of message port types; use message_type(ROS_TYPE)")
+        return from_dict(cls.ros_type, fields)
+
 
 class MessageValue(metaclass=MessageTypeMeta):
-    """Base of the generated message port types (never instantiated)."""
+    """Base of the generated message port types; calling one builds a message of its ROS type."""
 
     ros_type: ClassVar[str] = ""
 

@@ -94,6 +94,11 @@ def _convert_base(base: str, value: Any, where: str) -> Any:
     raise TransportError(f"{_at(where)}expected {base}, got {type(value).__name__} {value!r}")
 
 
+# Default values the ROS interface definitions state (``float64 w 1``), which the rosbags definitions of
+# ROS's common interfaces do not carry: an unset orientation is the identity rotation, as in rclpy and rclcpp.
+_STATED_DEFAULTS: dict[str, dict[str, Any]] = {"geometry_msgs/msg/Quaternion": {"w": 1.0}}
+
+
 def _default(registry: TypeRegistry, desc: Any, where: str) -> Any:
     kind, rest = desc
     if kind == Nodetype.BASE:
@@ -164,11 +169,15 @@ def _build(registry: TypeRegistry, type_name: str, data: Any, where: str) -> Any
                 f"{_at(where)}{type_name} has no field {key!r} ({did_you_mean(str(key), names)})"
             )
     values = {}
+    stated = _STATED_DEFAULTS.get(type_name, {})
     for name, desc in fields:
         path = f"{where}.{name}" if where else name
-        values[name] = (
-            _convert(registry, desc, data[name], path) if name in data else _default(registry, desc, path)
-        )
+        if name in data:
+            values[name] = _convert(registry, desc, data[name], path)
+        elif name in stated:
+            values[name] = stated[name]
+        else:
+            values[name] = _default(registry, desc, path)
     return cls(**values)
 
 
