@@ -206,6 +206,12 @@ class BehaviorHost:
             self._watcher = watcher
             return watcher
 
+    def settle_reloads(self, timeout: float) -> bool:
+        """Wait (up to ``timeout`` s) for the files saved so far to be reloaded or reported: False when a
+        reload is still going on then. True at once when hot reload is off."""
+        watcher = self._watcher  # not under the lock: a reload holds it while it imports
+        return True if watcher is None else watcher.settle(timeout)
+
     def stop_watching(self) -> None:
         """Stop hot reload (safe to call when it is not running)."""
         with self._lock:

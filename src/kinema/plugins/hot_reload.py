@@ -92,6 +92,8 @@ class DirectoryWatcher:
         self._observer: BaseObserver | None = None
         self._worker: threading.Thread | None = None
         self._stopping = False
+        # A burst taken from pending whose callback has not returned yet (see settle).
+        self._reporting = False
 
     def add(self, folder: Path, suffixes: Iterable[str], on_change: OnChange) -> None:
         """Watch ``folder`` (recursively) for files ending in one of ``suffixes`` (e.g. ``.py``)."""
@@ -197,9 +199,33 @@ class DirectoryWatcher:
                 if not due:
                     self._lock.wait(timeout=wait)
                     continue
-            for watched, paths, first_event in due:
-                current = fingerprint(watched.folder, watched.suffixes)
-                if current == watched.last_fingerprint:
-                    continue
-                watched.last_fingerprint = current
-                watched.on_change(watched.folder, paths, first_event)
+                self._reporting = True
+            try:
+                for watched, paths, first_event in due:
+                    current = fingerprint(watched.folder, watched.suffixes)
+                    if current == watched.last_fingerprint:
+                        continue
+                    watched.last_fingerprint = current
+                    watched.on_change(watched.folder, paths, first_event)
+            finally:
+                with self._lock:
+                    self._reporting = False
+                    self._lock.notify_all()
+
+    def settle(self, timeout: float) -> bool:
+        """Wait until every change seen so far is reported and its callback has returned: what asks next
+        (a run) sees a file saved a moment ago, not the version before it. True once settled; False after
+        ``timeout`` while changes keep coming or a callback still runs, and at once on the watcher's own
+        thread (a callback that asks must not wait for itself)."""
+        if threading.current_thread() is self._worker:
+            return False
+        deadline = time.monotonic() + timeout
+        with self._lock:
+            while not self._stopping and (
+                self._reporting or any(watched.pending for watched in self._watched.values())
+            ):
+                remaining = deadline - time.monotonic()
+                if remaining <= 0:
+                    return False
+                self._lock.wait(remaining)
+        return True

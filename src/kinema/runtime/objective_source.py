@@ -25,6 +25,10 @@ if TYPE_CHECKING:
 
 log = logging.getLogger("kinema.objective_server")
 
+# How long a run waits for the reload of files saved just before it (debounce plus import, usually well
+# under a second); a package still importing after that is used as it was.
+RELOAD_SETTLE_S = 3.0
+
 
 @dataclass(frozen=True)
 class LibraryProblem:
@@ -71,7 +75,16 @@ class LibraryTreeSource:
     # -- TreeSource ---------------------------------------------------------------------------------
 
     def factory(self) -> BehaviorTreeFactory:
-        """The factory for the next run (rebuilt when behaviors or objectives changed)."""
+        """The factory for the next run (rebuilt when behaviors or objectives changed).
+
+        Files saved a moment ago are reloaded first: a run started right after a save (`sed -i ...
+        && kinema objective run ...`) uses the saved code, not the version before it.
+        """
+        if self._host is not None and not self._host.settle_reloads(RELOAD_SETTLE_S):
+            log.warning(
+                "a hot reload was still going on after %.0f s; this run uses the behaviors loaded before it",
+                RELOAD_SETTLE_S,
+            )
         with self._lock:
             registry = self._host.registry if self._host is not None else None
             if self._factory is None or self._objectives_stale or registry is not self._registry:

@@ -97,3 +97,26 @@ def test_fingerprint_changes_with_content_and_names_only(tmp_path: Path) -> None
     assert fingerprint(tmp_path, (".py",)) == first
     (tmp_path / "a.py").write_text("2")
     assert fingerprint(tmp_path, (".py",)) != first
+
+
+def test_settle_returns_once_a_save_is_reported_and_its_callback_returned(tmp_path: Path) -> None:
+    """A run asks the watcher to settle first: it waits out the debounce and the reload (the callback)."""
+    module = tmp_path / "behavior.py"
+    module.write_text("VALUE = 0\n")
+    done: list[str] = []
+
+    def slow_reload(folder: Path, paths: tuple[Path, ...], started: float) -> None:
+        threading.Event().wait(0.3)  # an import that takes a while
+        done.append(module.read_text())
+
+    watcher = DirectoryWatcher(debounce=0.1)
+    watcher.add(tmp_path, (".py",), slow_reload)
+    with watcher:
+        assert watcher.settle(0.01)  # nothing saved: at once
+        for value in (1, 2):
+            module.write_text(f"VALUE = {value}\n")
+            threading.Event().wait(0.05)  # the file system's notice reaches the watcher
+            assert not watcher.settle(0.05)  # within the debounce, then the reload: not settled yet
+            assert watcher.settle(10)
+            assert done[-1] == f"VALUE = {value}\n"
+    assert len(done) == 2
