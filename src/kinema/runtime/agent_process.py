@@ -200,6 +200,10 @@ def _watch_config_files(watcher: Any, resolved: Any, agent: Agent) -> None:
             f"then `kinema run -c {resolved.name}`) to use the change"
         )
         agent.warn_reload(text)
+        if agent.source is not None:
+            # An objective the edit added (a new behavior package's library) is refused as unknown until
+            # then: the refusal says why.
+            agent.source.restart_note = text
 
     for package in resolved.chain_packages:
         folder = Path(package.config_file).parent

@@ -950,7 +950,9 @@ class ObjectiveServer:
                 if problem:
                     raise ObjectiveError(f"objective {request.objective_name!r} cannot run: {problem}")
                 alternatives = did_you_mean(request.objective_name, names)
-                raise ObjectiveError(f"unknown objective {request.objective_name!r}; {alternatives}")
+                restart = getattr(self._source, "restart_note", "")
+                note = f"\nnote: {restart}" if restart else ""
+                raise ObjectiveError(f"unknown objective {request.objective_name!r}; {alternatives}{note}")
             tree = factory.create_tree(request.objective_name)
             return tree, request.objective_name, factory.library.subtree_models.get(request.objective_name)
         xml = request.objective_xml

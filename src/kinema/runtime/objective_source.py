@@ -71,6 +71,8 @@ class LibraryTreeSource:
         # Each objective file's text and objectives when it last registered: a file that fails later is
         # registered from these (see _register).
         self._last_good: dict[Path, tuple[str, list[ObjectiveInfo]]] = {}
+        # Set when a config file changed after the start (needs a restart); named in "unknown objective".
+        self.restart_note = ""
 
     # -- TreeSource ---------------------------------------------------------------------------------
 

@@ -119,3 +119,11 @@ def test_an_edited_config_yaml_is_said_to_need_a_restart(derived_config_agent: A
     (notice,) = [t for t in toasts if "keeps the config" in t]
     assert str(config) in notice and "kinema run -c my_cell" in notice
     assert "keeps the config it started with" in derived_config_agent.log_file.read_text()
+    # An objective such an edit adds (a new behavior package's library) is unknown until the restart, and
+    # its refusal says so, not only the run's terminal.
+    from kinema.sdk import ObjectiveClient
+
+    with ObjectiveClient(derived_config_agent.endpoint, timeout=10) as client:
+        refused = client.execute("UrTools Example")
+    assert refused.failed and "unknown objective 'UrTools Example'" in refused.error_message
+    assert "note: " in refused.error_message and "kinema run -c my_cell" in refused.error_message
