@@ -9,6 +9,8 @@ import pytest
 CONFIG_YAML = """\
 # my_config: the robot config of this test workspace.
 based_on_package: "example_config"
+# A line longer than 80 characters, as a generated robot config writes its planning group's joints:
+robot_notes: [shoulder_pan_joint, shoulder_lift_joint, elbow_joint, wrist_1_joint, wrist_2_joint]
 
 objectives:
   # Our own objectives.

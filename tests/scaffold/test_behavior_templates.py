@@ -156,6 +156,10 @@ def test_the_workspace_config_gets_the_loader_and_keeps_its_comments(workspace_w
     text = config_file.read_text()
     for comment in ("# my_config: the robot config", "# Our own objectives.", "# More behaviors go here."):
         assert comment in text
+    # Long lines stay as written (ruamel's default folds at 80 columns, leaving a trailing space).
+    joints = "shoulder_pan_joint, shoulder_lift_joint, elbow_joint, wrist_1_joint, wrist_2_joint"
+    assert f"\nrobot_notes: [{joints}]\n" in text
+    assert not any(line != line.rstrip() for line in text.splitlines())
     resolved = resolve_config("my_config", Workspace.discover(workspace_with_config))
     assert resolved.behavior_loader_plugins["my_adder"] == ["my_adder::MyAdderBehaviorsLoader"]
     # Unioned with the parents' loaders: example_config's tutorial behaviors stay active.

@@ -296,6 +296,7 @@ def add_to_config(config_file: Path, package: str, loader: str, *, objectives: b
     yaml = YAML()
     yaml.preserve_quotes = True
     yaml.indent(mapping=2, sequence=4, offset=2)
+    yaml.width = 4096  # never fold a long line the file did not fold
     try:
         data = yaml.load(config_file.read_text(encoding="utf-8"))
     except YAMLError as error:
