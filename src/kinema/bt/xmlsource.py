@@ -126,6 +126,9 @@ def parse_xml(text: str | bytes, filename: str = "<string>") -> etree._Element:
     return root
 
 
+_TAG_MISMATCH = re.compile(r"Opening and ending tag mismatch: (\S+) line (\d+) and (\S+)")
+
+
 def _parse_strict(strict: str, filename: str, parser: etree.XMLParser) -> etree._Element | None:
     try:
         return etree.fromstring(strict.encode("utf-8"), parser=parser)
@@ -135,6 +138,15 @@ def _parse_strict(strict: str, filename: str, parser: etree.XMLParser) -> etree.
         if "Excessive depth" in message:
             # libxml2's own nesting guard fires first; say what BT.CPP would say.
             message = f"elements nest deeper than {MAX_DEPTH} levels"
+        mismatch = _TAG_MISMATCH.fullmatch(message)
+        if mismatch is not None:
+            # libxml2's "Sequence line 3 and BehaviorTree" read as two lines in one message (the one at
+            # the start of the message is where the closing tag is).
+            opened, opened_line, closing = mismatch.groups()
+            message = (
+                f"</{closing}> here, while <{opened}> of line {opened_line} is still open: its closing tag "
+                "is missing or misspelt"
+            )
         raise ObjectiveError(
             f"XML syntax error: {message}", location=SourceLocation(filename, line)
         ) from None

@@ -120,6 +120,22 @@ def test_errors_carry_file_and_line(tmp_path: Path) -> None:
     assert str(info.value).startswith(f"{path}:3: ")
 
 
+def test_a_missing_closing_tag_names_the_open_element_and_both_lines(tmp_path: Path) -> None:
+    """libxml2 says "Opening and ending tag mismatch: Sequence line 3 and BehaviorTree" at line 5: a user read
+    the two line numbers as one mistake; the message says which element is left open, and where."""
+    path = tmp_path / "unclosed.xml"
+    path.write_text(
+        '<root BTCPP_format="4">\n  <BehaviorTree ID="M">\n    <Sequence>\n      <AlwaysSuccess/>\n'
+        "  </BehaviorTree>\n</root>\n"
+    )
+    with pytest.raises(ObjectiveError) as info:
+        BehaviorTreeFactory().create_tree_from_file(path)
+    assert str(info.value) == (
+        f"{path}:5: XML syntax error: </BehaviorTree> here, while <Sequence> of line 3 is still open: its "
+        "closing tag is missing or misspelt"
+    )
+
+
 def test_lenient_attribute_values() -> None:
     xml = (
         '<root BTCPP_format="4"><BehaviorTree ID="M"><Sequence><Script code="A := 1; B := 2"/>'
