@@ -82,7 +82,8 @@ class LibraryTreeSource:
         Files saved a moment ago are reloaded first: a run started right after a save (`sed -i ...
         && kinema objective run ...`) uses the saved code, not the version before it.
         """
-        if self._host is not None and not self._host.settle_reloads(RELOAD_SETTLE_S):
+        settle = getattr(self._host, "settle_reloads", None)  # a host that watches files has it
+        if settle is not None and not settle(RELOAD_SETTLE_S):
             log.warning(
                 "a hot reload was still going on after %.0f s; this run uses the behaviors loaded before it",
                 RELOAD_SETTLE_S,

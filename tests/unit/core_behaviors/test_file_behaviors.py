@@ -390,6 +390,37 @@ def test_a_config_allows_its_packages_and_the_data_folder(behavior: Any, node: A
     assert refused.status == NodeStatus.FAILURE and "refused by the file rule" in refused.toasts[-1]
 
 
+def test_a_bundled_config_saves_into_the_user_data_folder_not_into_kinema(behavior: Any, node: Any) -> None:
+    """A MoveIt Pro objective run on the bundled lab_sim saved tool_pose.yaml into Kinema's own source tree
+    (a checkout, or site-packages): saves for a bundled config go to the user data folder, which reads look
+    in first."""
+    import platformdirs
+
+    from kinema.config import resolve_config
+    from kinema.transport import from_dict
+
+    resolved = resolve_config("lab_sim")
+    context = BehaviorContext(node, config=resolved)
+    bundled = resolved.package_dir("lab_sim") / "objectives"
+    before = sorted(p.name for p in bundled.iterdir())
+    pose = from_dict(
+        "geometry_msgs/msg/PoseStamped", {"header": {"frame_id": "world"}, "pose": {"position": {"x": 0.25}}}
+    )
+    saved = tick_behavior(
+        behavior("SavePoseStampedToYaml"),
+        {"message": pose, "yaml_filename": "~/user_ws/src/lab_sim/objectives/tool_pose", "overwrite": True},
+        context=context,
+    )
+    assert saved.status == NodeStatus.SUCCESS, saved.toasts
+    assert sorted(p.name for p in bundled.iterdir()) == before
+    assert (platformdirs.user_data_path("kinema") / "files" / "lab_sim" / "tool_pose.yaml").is_file()
+    loaded = tick_behavior(
+        behavior("LoadPoseStampedFromYaml"), {"file_path": "tool_pose.yaml"}, context=context
+    )
+    assert loaded.status == NodeStatus.SUCCESS, loaded.toasts
+    assert loaded.outputs["output"].pose.position.x == 0.25
+
+
 def test_a_parameter_override_is_held_to_the_file_rule_like_any_port(
     registry: Any, node: Any, caplog: pytest.LogCaptureFixture
 ) -> None:

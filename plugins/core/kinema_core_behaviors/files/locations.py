@@ -4,6 +4,10 @@
   objective library of the config (most-derived package first), writes go to the most-derived package's
   own library. A relative path may not climb out of that folder (``../``): a save never lands outside
   the folder it was meant for.
+- A config bundled with Kinema (lab_sim) is never written into: its saves go to
+  ``<user data>/kinema/files/<config>/`` (as its waypoints go beside it, see
+  :mod:`kinema.config.waypoint_location`), which reads look in first. Kinema's installation (or a
+  checkout of it) stays as it was.
 - ``~/user_ws/src/<package>/objectives/<rest>`` (MoveIt Pro's workspace path, common in its objectives)
   is ``<rest>`` relative to the objectives folder as above, so a copy of the objective in another config
   reads and writes its own config's files, never an installed package's. Other
@@ -38,17 +42,30 @@ def objective_folders(node: Any) -> list[Path]:
     resolved = node.context.config
     if resolved is None:
         return [Path.cwd()]
+    saved = [user_files_dir(resolved.name)] if _is_bundled(resolved) else []
     chain = list(resolved.chain)
     ranked = sorted(
         resolved.objective_library_paths,
         key=lambda lib: chain.index(lib.package) if lib.package in chain else -1,
         reverse=True,
     )
-    return list(dict.fromkeys(lib.path for lib in ranked)) or [Path.cwd()]
+    return list(dict.fromkeys([*saved, *(Path(lib.path) for lib in ranked)])) or [Path.cwd()]
+
+
+def user_files_dir(config_name: str) -> Path:
+    """Where files saved by the objectives of bundled config ``config_name`` go (not created here)."""
+    import platformdirs
+
+    return platformdirs.user_data_path("kinema") / "files" / config_name
+
+
+def _is_bundled(resolved: Any) -> bool:
+    return getattr(resolved.package, "origin", "") == "bundled"
 
 
 def save_folder(node: Any, port: str) -> Path:
-    """Where relative saves go: the first objective library of the config's own package.
+    """Where relative saves go: the first objective library of the config's own package (for a bundled
+    config, :func:`user_files_dir`).
 
     Raises:
         PortValueError: the config has no library folder of its own (saving into an inherited or
@@ -57,6 +74,10 @@ def save_folder(node: Any, port: str) -> Path:
     resolved = node.context.config
     if resolved is None:
         return Path.cwd()
+    if _is_bundled(resolved):
+        folder = user_files_dir(resolved.name)
+        folder.mkdir(parents=True, exist_ok=True)
+        return folder
     for lib in resolved.objective_library_paths:
         if lib.package == resolved.name:
             return Path(lib.path)
