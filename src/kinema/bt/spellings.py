@@ -252,6 +252,7 @@ def apply_objective_parameters(
     filename: str,
     registered: Mapping[str, object],
     spellings: Mapping[str, list[FormerSpelling]],
+    problems: list[BTRuntimeError] | None = None,
 ) -> list[SpellingNote]:
     """Read MoveIt Pro's ``LoadObjectiveParameters`` as the ports it gave (see the module docstring).
 
@@ -260,20 +261,31 @@ def apply_objective_parameters(
     the port of that name (or the port a former spelling renames it to) unless the node sets the port
     itself; a value with no such port is left out and named in the note.
 
+    With ``problems`` (a validator reading the whole file), such a file is added to it instead and read as
+    giving nothing, so that the file's other problems are reported too.
+
     Raises:
         BTRuntimeError: the file is not named literally, is not beside the objective, or is not a mapping
-            of behavior names to parameters (naming the file and line).
+            of behavior names to parameters (naming the file and line); not with ``problems``.
     """
     if OBJECTIVE_PARAMETERS_LOADER in registered:
         return []  # a plugin provides the old behavior itself
     notes: list[SpellingNote] = []
     for tree in root.iterchildren("BehaviorTree"):
         loaded: dict[str, dict[str, dict[str, object]]] = {}
+        unread: set[str] = set()
         for element in tree.iterdescendants(etree.Element):
             behavior = _element_id(element)
             location = SourceLocation(filename, element.sourceline or 0)
             if behavior == OBJECTIVE_PARAMETERS_LOADER:
-                name, sections = _load_parameters(element, filename)
+                try:
+                    name, sections = _load_parameters(element, filename)
+                except BTRuntimeError as error:
+                    if problems is None:
+                        raise
+                    problems.append(error)
+                    name, sections = element.get("config_file_name") or "", {}
+                    unread.add(_blackboard_key(element.get(_PARAMETERS_PORT) or "{parameters}"))
                 key = _blackboard_key(element.get(_PARAMETERS_PORT) or "{parameters}")
                 loaded[key] = sections
                 label = element.get("name")
@@ -294,6 +306,9 @@ def apply_objective_parameters(
                 continue
             value = element.get(_PARAMETERS_PORT)
             if value is None or behavior is None or _blackboard_key(value) not in loaded:
+                continue
+            if _blackboard_key(value) in unread:
+                del element.attrib[_PARAMETERS_PORT]  # the file's problem is reported once, at the loader
                 continue
             sections = loaded[_blackboard_key(value)]
             section = sections.get(element.get("name") or "") or sections.get(behavior) or {}

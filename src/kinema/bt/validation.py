@@ -72,6 +72,8 @@ def validate_files(
             problems.append(Problem(location, error.message))
             continue
         documents.append((filename, root))
+    loaded_past = scratch.library.load_problems
+    problems += [Problem(error.location or SourceLocation(""), error.message) for error in loaded_past]
     if warnings is not None:
         warnings.extend(Problem(note.location, note.message) for note in notes)
     manifests = scratch.manifests()

@@ -174,6 +174,8 @@ class TreeLibrary:
         # today's spelling as each document loads, each leaving a note (kinema.bt.spellings).
         self.spellings: Mapping[str, list[FormerSpelling]] = {}
         self.spelling_notes: deque[SpellingNote] = deque(maxlen=_MAX_SPELLING_NOTES)
+        # What a validating load (verify=False) found and went on past: a parameter file that does not load.
+        self.load_problems: list[BTRuntimeError] = []
         # Documents loaded from text, by (text, filename, verify, registry), oldest first: loading the
         # same objective again (a hot reload of an unchanged file, /do_objective with the same XML)
         # skips parsing, verifying and compiling it. The cache is the library's own and goes with its
@@ -253,7 +255,12 @@ class TreeLibrary:
             raise located_error("The XML must have a root node called <root>", filename, line_of(root))
         for include in root.findall("include"):
             self._load_include(include, filename, manifests, include_stack, verify)
-        self.spelling_notes.extend(apply_objective_parameters(root, filename, manifests, self.spellings))
+        # A validator (verify=False) hears of a parameter file that does not load among the file's other
+        # problems; a load for a run stops at it.
+        parameter_problems = None if verify else self.load_problems
+        self.spelling_notes.extend(
+            apply_objective_parameters(root, filename, manifests, self.spellings, parameter_problems)
+        )
         if self.spellings:
             self.spelling_notes.extend(rewrite_former_spellings(root, filename, self.spellings, manifests))
         skeletons: dict[etree._Element, Skeleton] | None = {} if verify else None

@@ -61,11 +61,18 @@ def subtree_closure(library: ObjectiveLibrary, objective_id: str) -> list[Path]:
 
 
 def file_problem(library: ObjectiveLibrary, path: Path, factory: BehaviorTreeFactory) -> str | None:
-    """The first problem of ``path`` validated with its SubTree closure, or None when it would load."""
+    """The first problem of ``path`` validated with its SubTree closure, and how many more there are (on
+    its first line: a summary shows one line per file); None when it would load."""
     from kinema.bt.validation import validate_files
 
     found = validate_files(list(file_closure(library, path)), factory)
-    return str(found[0]) if found else None
+    if not found:
+        return None
+    first, _, rest = str(found[0]).partition("\n")
+    if len(found) > 1:
+        more = len(found) - 1
+        first += f" (and {more} more problem{'s' if more > 1 else ''}: `kinema tree validate` lists them all)"
+    return f"{first}\n{rest}" if rest else first
 
 
 def library_problems(library: ObjectiveLibrary, factory: BehaviorTreeFactory) -> dict[str, str]:

@@ -329,9 +329,9 @@ class CheckWorkspace:
         verdicts = []
         for path in self.files():
             defined = by_file.get(path.resolve(), [])
-            problem = unreadable.get(path.resolve())
-            if problem is None:
-                problem = file_problem(library, path, factory)
+            # Validated even when the library could not load it: every problem is counted, not only the one
+            # that stopped the load (a missing parameter file hid nine more in a MoveIt Pro objective).
+            problem = file_problem(library, path, factory) or unreadable.get(path.resolve())
             verdicts.append(
                 FileVerdict(
                     path=path.relative_to(self.objectives),

@@ -280,3 +280,24 @@ def test_load_objective_parameters_without_its_file_names_where_it_looked(
     assert "no file 'gone.yaml' beside the objective" in str(raised.value) and str(tmp_path) in str(
         raised.value
     )
+
+
+def test_validating_a_file_whose_parameter_file_is_missing_reports_its_other_problems_too(
+    registry: BehaviorRegistry, tmp_path: Any
+) -> None:
+    """A MoveIt Pro objective without its YAML showed only that; with the YAML, nine more problems showed.
+    Validation names the missing file and goes on (a run still stops at it, as above)."""
+    from kinema.bt.validation import validate_files
+
+    objective = tmp_path / "old.xml"
+    objective.write_text(
+        _tree(
+            '<Sequence><Action ID="LoadObjectiveParameters" config_file_name="gone.yaml"/>'
+            '<Action ID="DetectAprilTags" parameters="{parameters}"/><NoSuchBehavior/></Sequence>'
+        )
+    )
+    problems = [str(problem) for problem in validate_files([objective], registry.create_factory())]
+    assert any("no file 'gone.yaml' beside the objective" in p for p in problems), problems
+    assert any("Node not recognized: NoSuchBehavior" in p for p in problems), problems
+    # The behavior that took {parameters} is not also said to lack a `parameters` port.
+    assert not any("parameters" in p and "DetectAprilTags" in p for p in problems), problems

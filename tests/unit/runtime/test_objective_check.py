@@ -14,7 +14,10 @@ SHARED = Path(__file__).resolve().parents[3].parent / "shared" / "compat" / "mov
 
 BROKEN = """<root BTCPP_format="4" main_tree_to_execute="Broken">
   <BehaviorTree ID="Broken">
-    <Action ID="NoSuchBehavior" />
+    <Sequence>
+      <Action ID="NoSuchBehavior" />
+      <Action ID="NorThisOne" />
+    </Sequence>
   </BehaviorTree>
 </root>
 """
@@ -59,6 +62,8 @@ def test_check_counts_the_files_that_validate_and_says_why_the_others_do_not(fol
     broken = next(line for line in lines if "broken.xml" in line)
     # The problem names the user's file (not the temporary copy) and the unknown behavior.
     assert str(folder / "objectives" / "broken.xml") in broken and "NoSuchBehavior" in broken, broken
+    # One line per file, counting the rest (a missing parameter file hid nine more in a MoveIt Pro file).
+    assert "(and 1 more problem: `kinema tree validate` lists them all)" in broken, broken
     assert any("uses_helper.xml" in line and "Helper" in line for line in lines), result.output
     assert "7 of 9 objective files validate against lab_sim" in lines[-1], result.output
 
