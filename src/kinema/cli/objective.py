@@ -301,8 +301,11 @@ def check(
     root = getattr(found, "root", None)
 
     def on_file(verdict: FileVerdict) -> None:
-        if verdict.problem is not None and not as_json:
+        if as_json:
+            return
+        if verdict.problem is not None:
             click.echo(f"cannot load  {verdict.path}: {verdict.problem.splitlines()[0]}")
+        print_warnings(verdict.warnings)
 
     def on_run(verdict: RunVerdict) -> None:
         if as_json:

@@ -13,6 +13,7 @@ from kinema.cli.options import selection_options
 
 if TYPE_CHECKING:
     from kinema.bt import BehaviorTreeFactory, NodeStatus, TreeNode
+    from kinema.config import ResolvedConfig
 
 _COLORS = {"SUCCESS": "green", "FAILURE": "red", "RUNNING": "yellow", "SKIPPED": "blue", "IDLE": "cyan"}
 
@@ -141,8 +142,9 @@ def validate(
 
     Inside a workspace (FILES under its src/, or one chosen with -w, $KINEMA_WORKSPACE or `kinema
     configure`), or with -c, the files are checked against the active config's behaviors and the
-    subtrees of its objective libraries, as `kinema build` and the runtime load them. Elsewhere, or with
-    --no-config, against the built-in nodes (and the bundled behaviors with --behaviors).
+    subtrees of its objective libraries, as `kinema build` and the runtime load them, and a waypoint the
+    files name that the config has not saved is a warning. Elsewhere, or with --no-config, against the
+    built-in nodes (and the bundled behaviors with --behaviors).
 
     Every problem is printed as file:line: message. A SubTree may call a tree defined in another of
     the FILES. A node written in a former spelling (MoveIt Pro's CreateStampedPose, say) is checked as
@@ -153,13 +155,16 @@ def validate(
     from kinema.bt.validation import Problem, count_trees, validate_files
     from kinema.cli.options import print_warnings
 
-    factory = None if no_config else _config_factory(files, workspace, config)
-    built_in_only = factory is None and not behaviors
-    if factory is None:
-        factory = _factory(behaviors)
+    chosen = None if no_config else _config_factory(files, workspace, config)
+    built_in_only = chosen is None and not behaviors
+    factory = chosen[0] if chosen is not None else _factory(behaviors)
     spelled: list[Problem] = []
     problems = validate_files(list(files), factory, warnings=spelled)
     print_warnings(str(note) for note in spelled)
+    if chosen is not None:
+        from kinema.config.waypoint_uses import config_waypoint_warnings
+
+        print_warnings(config_waypoint_warnings(files, chosen[1]))
     if built_in_only and any("Node not recognized" in p.message for p in problems):
         click.echo(
             "note: only the built-in nodes were known; -c NAME (or a file inside a workspace) checks "
@@ -184,9 +189,9 @@ def validate(
 
 def _config_factory(
     files: tuple[Path, ...], workspace: Path | None, config: str | None
-) -> BehaviorTreeFactory | None:
-    """The active config's behaviors and library subtrees in one factory, when a workspace or a config is
-    chosen (see ``validate``); None otherwise. Says on stderr which config it is."""
+) -> tuple[BehaviorTreeFactory, ResolvedConfig] | None:
+    """The active config's behaviors and library subtrees in one factory, and the config, when a workspace
+    or a config is chosen (see ``validate``); None otherwise. Says on stderr which config it is."""
     from kinema.bt.xmlsource import parse_xml_file
     from kinema.config import ObjectiveLibrary, Workspace, active_selection, resolve_config
     from kinema.config.workspace import find_workspace_root
@@ -236,7 +241,7 @@ def _config_factory(
         "built-in nodes only)",
         err=True,
     )
-    return factory
+    return factory, resolved
 
 
 @tree.command()

@@ -26,7 +26,8 @@ def validate_objectives(
 
     Files that do not parse and duplicate definitions are problems too, with their ``file:line``. The
     warnings (``file:line: ...``) are the library's (an objective ID defined twice in one folder) and one
-    per node written in a former spelling (``CreateStampedPose is MoveIt Pro's old name of ...``).
+    per node written in a former spelling (``CreateStampedPose is MoveIt Pro's old name of ...``) and one
+    per waypoint name an objective writes that the config has not saved.
     """
     from kinema.bt.validation import Problem, validate_files
     from kinema.config import ObjectiveLibrary
@@ -38,7 +39,10 @@ def validate_objectives(
     files = library.files()
     spelled: list[Problem] = []
     problems += validate_files(list(files), registry.create_factory(), warnings=spelled)
-    return len(files), problems, [*library.warnings, *(str(note) for note in spelled)]
+    from kinema.config.waypoint_uses import config_waypoint_warnings
+
+    waypoints = config_waypoint_warnings(files, resolved)
+    return len(files), problems, [*library.warnings, *(str(note) for note in spelled), *waypoints]
 
 
 def write_tree_nodes_model(registry: BehaviorRegistry, path: Path) -> Path:

@@ -69,12 +69,14 @@ class FileVerdict:
         objectives: the IDs it defines (MoveIt Pro's files define one).
         runnable: those of them that are runnable (not subtree-only).
         problem: why it does not validate (``file:line: message``), None when it does.
+        warnings: what validates but will fail where it runs (a waypoint the config has not saved).
     """
 
     path: Path
     objectives: tuple[str, ...]
     runnable: tuple[str, ...]
     problem: str | None
+    warnings: tuple[str, ...] = ()
 
     @property
     def valid(self) -> bool:
@@ -173,6 +175,7 @@ class CheckReport:
                     "objectives": list(verdict.objectives),
                     "runnable": list(verdict.runnable),
                     "problem": verdict.problem,
+                    "warnings": list(verdict.warnings),
                 }
                 for verdict in self.files
             ],
@@ -314,6 +317,7 @@ class CheckWorkspace:
             PluginError: a behavior plugin of the config does not load.
         """
         from kinema.config import ObjectiveLibrary
+        from kinema.config.waypoint_uses import config_waypoint_warnings
         from kinema.plugins import BehaviorHost
         from kinema.runtime.library_check import file_problem
 
@@ -332,12 +336,14 @@ class CheckWorkspace:
             # Validated even when the library could not load it: every problem is counted, not only the one
             # that stopped the load (a missing parameter file hid nine more in a MoveIt Pro objective).
             problem = file_problem(library, path, factory) or unreadable.get(path.resolve())
+            waypoint_warnings = config_waypoint_warnings([path], resolved, self.config)
             verdicts.append(
                 FileVerdict(
                     path=path.relative_to(self.objectives),
                     objectives=tuple(info.id for info in defined),
                     runnable=tuple(info.id for info in defined if info.runnable),
                     problem=None if problem is None else self.originals(problem),
+                    warnings=tuple(map(self.originals, waypoint_warnings)),
                 )
             )
         return verdicts
