@@ -37,6 +37,7 @@ from kinema.motion.task_stages import (
     GENERATORS,
     AllowCollisions,
     BatchPoseIK,
+    CartesianMoveToJointState,
     Connect,
     CurrentState,
     FromSolution,
@@ -55,6 +56,8 @@ if TYPE_CHECKING:
     from kinema.motion.robot_model import RobotModel
 
 JOIN_TOLERANCE = 1e-6  # rad or m: sub-trajectories must meet this closely
+# rad or m: how far a straight line's IK may end from the joint state it moves to and still count as it
+GOAL_BRANCH_TOLERANCE = 0.05
 OCTOMAP_NAME = "<octomap>"  # MoveIt's collision name of the octomap
 OCTOMAP_OBJECT = "octomap"  # the world object Kinema's octomap is (UpdatePlanningSceneService)
 
@@ -100,10 +103,15 @@ class StageReport:
 
 @dataclass(frozen=True, eq=False)
 class SubTrajectory:
-    """The timed motion of one stage, over its group's joints."""
+    """The timed motion of one stage, over its group's joints.
+
+    ``stage_index`` is the stage's place in the task (-1 when unknown); the sub-trajectories of a
+    replayed solution carry the index of the stage that replays them.
+    """
 
     stage: str
     trajectory: JointTrajectory
+    stage_index: int = -1
 
 
 @dataclass(frozen=True)
@@ -115,12 +123,14 @@ class SceneChange:
         before: how many sub-trajectories come before it.
         description: what changed, for a person (``collisions allowed: gripper - cube``).
         allowed: the pairs whose contact is allowed from here on (the rules in force after it).
+        stage_index: the stage's place in the task (-1 when unknown).
     """
 
     stage: str
     before: int
     description: str
     allowed: frozenset[frozenset[str]] = frozenset()
+    stage_index: int = -1
 
 
 @dataclass(frozen=True, eq=False)
@@ -500,21 +510,9 @@ class _Planner:
             if isinstance(stage, PlanToJointState):
                 return self.joint_motion(index, stage.motion, q_from, dict(stage.goal))
             if isinstance(stage, PlanToPose):
-                from kinema.motion.inverse_kinematics import IkOptions, ik
-
-                self.group(index, stage.motion.group)
-                checker = self.check(index, stage.motion.link_padding)
-                world_T_target = self.world_T(stage.target, q_from)
-                q_goal = ik(
-                    self.model,
-                    world_T_target,
-                    q_from,
-                    stage.motion.group,
-                    stage.ik_frame,
-                    options=IkOptions(attempts=stage.ik_attempts, rng_seed=stage.motion.seed),
-                    accept=checker.is_valid,
-                )
-                return self.joint_motion(index, stage.motion, q_from, q_goal)
+                return self.plan_to_pose(index, stage, q_from)
+            if isinstance(stage, CartesianMoveToJointState):
+                return self.cartesian_to_joint_state(index, stage, q_from)
         except MotionError as error:
             raise _StageFailure(index, str(error)) from error
         raise _StageFailure(index, f"a {type(stage).__name__} stage cannot follow a state here")
@@ -561,6 +559,114 @@ class _Planner:
         rows = np.repeat(q_from[None, :], len(path.positions), axis=0)
         rows[:, list(g.indices)] = path.positions
         return rows, rows[-1].copy()
+
+    def plan_to_pose(
+        self, index: int, stage: PlanToPose, q_from: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """IK for the target, then a free motion there; with orientation constraints, a motion that keeps
+        them (the free one when it does, else a straight Cartesian line)."""
+        from kinema.motion.cartesian import plan_cartesian_path
+        from kinema.motion.inverse_kinematics import IkOptions, ik
+        from kinema.motion.orientation_constraints import OrientationKeeper
+
+        self.group(index, stage.motion.group)
+        checker = self.check(index, stage.motion.link_padding)
+        world_T_target = self.world_T(stage.target, q_from)
+        keeper = OrientationKeeper(self.model, q_from, stage.orientation_constraints)
+        goal_problem = keeper.target_problem(world_T_target, stage.ik_frame)
+        if goal_problem:
+            raise MotionError(goal_problem)
+        q_goal = ik(
+            self.model,
+            world_T_target,
+            q_from,
+            stage.motion.group,
+            stage.ik_frame,
+            options=IkOptions(attempts=stage.ik_attempts, rng_seed=stage.motion.seed),
+            accept=lambda q: checker.is_valid(q) and not keeper.violation(q[None, :]),
+        )
+        rows, end = self.joint_motion(index, stage.motion, q_from, q_goal)
+        free_problem = keeper.violation(rows)
+        if not free_problem:
+            return rows, end
+        # The free motion turns the link too far: a straight line of the IK frame turns it steadily from
+        # the start orientation to the target's, both of which keep the constraints.
+        result = plan_cartesian_path(checker, q_from, [world_T_target], stage.motion.group, stage.ik_frame)
+        if result.fraction < 1.0 - 1e-9:
+            why = f" ({result.reason})" if result.reason else ""
+            raise MotionError(
+                f"the free motion breaks the orientation constraint ({free_problem}), and a straight line to "
+                f"the target stopped at {100 * result.fraction:.0f} %{why}"
+            )
+        g = self.model.group(stage.motion.group)
+        line = np.repeat(q_from[None, :], len(result.path.positions), axis=0)
+        line[:, list(g.indices)] = result.path.positions
+        line_problem = keeper.violation(line)
+        if line_problem:
+            raise MotionError(
+                f"no motion keeps the orientation constraint: neither the free motion ({free_problem}) "
+                f"nor a straight line ({line_problem})"
+            )
+        return line, line[-1].copy()
+
+    def cartesian_to_joint_state(
+        self, index: int, stage: CartesianMoveToJointState, q_from: np.ndarray
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """A straight line of the tip to where ``stage.goal`` puts it, ending exactly at the goal."""
+        from kinema.motion.cartesian import plan_cartesian_path
+        from kinema.motion.kinematics import fk
+        from kinema.motion.planner import goal_configuration
+
+        g = self.group(index, stage.motion.group)
+        for name in stage.goal:
+            if name not in self.model.joint_names:
+                from kinema.errors import did_you_mean
+
+                raise MotionError(
+                    f"the joint state names unknown joint {name!r}; "
+                    f"{did_you_mean(name, self.model.joint_names, limit=32)}"
+                )
+        goal = {n: v for n, v in stage.goal.items() if n in g.joint_names}
+        if not goal:
+            raise MotionError(
+                f"the joint state names no joint of planning group {stage.motion.group!r} "
+                f"({', '.join(g.joint_names)})"
+            )
+        tip = stage.tip_frame or g.tip_link
+        if not tip:
+            raise MotionError(
+                f"planning group {stage.motion.group!r} has no tip link (the SRDF gives it no chain)"
+            )
+        checker = self.check(index, stage.motion.link_padding)
+        q_goal = goal_configuration(checker, q_from, goal, stage.motion.group)
+        cols = list(g.indices)
+        if np.abs(q_goal[cols] - q_from[cols]).max() <= JOIN_TOLERANCE:
+            return np.vstack([q_from, q_goal]), q_goal
+        result = plan_cartesian_path(checker, q_from, [fk(self.model, q_goal, tip)], stage.motion.group, tip)
+        if result.fraction < 1.0 - 1e-9:
+            why = f": {result.reason}" if result.reason else ""
+            raise MotionError(
+                f"the straight line of {tip} to the joint state stopped at {100 * result.fraction:.0f} %{why}"
+            )
+        rows = np.repeat(q_from[None, :], len(result.path.positions), axis=0)
+        rows[:, cols] = result.path.positions
+        off = q_goal[cols] - rows[-1, cols]
+        worst = int(np.argmax(np.abs(off)))
+        if abs(off[worst]) > GOAL_BRANCH_TOLERANCE:
+            raise MotionError(
+                f"the straight line brings {tip} where the joint state puts it, but in another joint "
+                f"configuration ({g.joint_names[worst]} {rows[-1, cols][worst]:.3f}, not "
+                f"{q_goal[cols][worst]:.3f} rad); plan to the joint state instead"
+            )
+        # Spread the last few milliradians along the motion rather than jumping at its end.
+        rows[:, cols] += np.linspace(0.0, 1.0, len(rows))[:, None] * off[None, :]
+        bad = next((k for k, row in enumerate(rows) if not checker.is_valid(row)), None)
+        if bad is not None:
+            raise MotionError(f"the straight line of {tip} collides at {100 * bad / (len(rows) - 1):.0f} %")
+        if len(rows) < 2:
+            rows = np.vstack([q_from, q_goal])
+        rows[-1] = q_goal
+        return rows, q_goal
 
     def along_axis(
         self, index: int, stage: MoveAlongFrameAxis, q: np.ndarray, *, backwards: bool
@@ -754,10 +860,10 @@ def plan_task(
         for piece in pieces:
             stage = task.stages[piece.index]
             if piece.change is not None:
-                changes.append(replace(piece.change, before=len(subs)))
+                changes.append(replace(piece.change, before=len(subs), stage_index=piece.index))
                 continue
             if piece.timed is not None:
-                subs.append(SubTrajectory(stage.name, piece.timed))
+                subs.append(SubTrajectory(stage.name, piece.timed, piece.index))
                 continue
             g = planner.model.group(piece.motion.group)
             path = JointPath(g.joint_names, piece.rows[:, list(g.indices)])
@@ -773,7 +879,7 @@ def plan_task(
             except MotionError as error:
                 raise _StageFailure(piece.index, f"timing failed: {error}") from error
             planner.add_seconds(piece.index, time.monotonic() - timing_began)
-            subs.append(SubTrajectory(stage.name, trajectory))
+            subs.append(SubTrajectory(stage.name, trajectory, piece.index))
     except _StageFailure as failure:
         planner.failed(failure.index, failure.reason)
         reports = planner.reports()

@@ -6,8 +6,8 @@ stages. Three kinds:
 - **generators** fix a robot state on their own: :class:`CurrentState`, :class:`BatchPoseIK` (the IK
   solution of one of several candidate poses) and :class:`FromSolution` (an earlier solution, replayed);
 - **propagators** move from the state before them (or, when a generator follows them, back from the
-  state after them): :class:`MoveAlongFrameAxis` always; :class:`PlanToJointState` and :class:`PlanToPose`
-  only forwards;
+  state after them): :class:`MoveAlongFrameAxis` always; :class:`PlanToJointState`, :class:`PlanToPose`
+  and :class:`CartesianMoveToJointState` only forwards;
 - **connectors** (:class:`Connect`) join the state before them to the state after them with a
   collision-free joint-space motion;
 - **scene changes** (:class:`AllowCollisions`) move nothing: they change the collision rules of the
@@ -98,15 +98,58 @@ class PlanToJointState:
     name: str = "plan to joint state"
 
 
+@dataclass(frozen=True)
+class OrientationConstraint:
+    """Keep ``link`` turned at most ``angle_tolerance`` (rad) from its orientation where the stage starts.
+
+    The angle is that of the rotation between the two orientations (about any axis), so 0.2 lets the
+    link tilt or twist by up to 0.2 rad along the whole motion, its end included.
+    """
+
+    link: str
+    angle_tolerance: float
+
+    def __post_init__(self) -> None:
+        if not np.isfinite(self.angle_tolerance) or self.angle_tolerance < 0:
+            raise MotionError(
+                f"orientation constraint on {self.link!r}: angle_tolerance must be a non-negative angle "
+                f"(rad), got {self.angle_tolerance}"
+            )
+
+
 @dataclass(frozen=True, eq=False)
 class PlanToPose:
-    """Propagator (forwards only): put ``ik_frame`` at ``target`` (IK from several seeds, then OMPL)."""
+    """Propagator (forwards only): put ``ik_frame`` at ``target`` (IK from several seeds, then OMPL).
+
+    With ``orientation_constraints`` the goal must keep each constrained link within its tolerance, and
+    so must the motion: the free motion is used when it does, else a straight Cartesian line of
+    ``ik_frame`` (which turns it steadily from the start orientation to the target's); the stage fails
+    naming the link and the angle reached when neither does.
+    """
 
     target: Target
     ik_frame: str
     motion: MotionSettings = field(default_factory=MotionSettings)
     ik_attempts: int = 20
     name: str = "plan to pose"
+    orientation_constraints: Sequence[OrientationConstraint] = ()
+
+
+@dataclass(frozen=True, eq=False)
+class CartesianMoveToJointState:
+    """Propagator (forwards only): move the tip of the group in a straight line to where ``goal`` puts it,
+    ending at ``goal`` (joint name -> position).
+
+    The tip is ``tip_frame``, or the group's tip link. Goal joints outside the group are left where they
+    are. The straight line must be followed all the way, and reach the goal's own joint configuration (not
+    another IK branch with the same tip pose); the few milliradians the line's IK ends away from it are
+    spread along the motion so it ends exactly at ``goal``.
+    """
+
+    goal: Mapping[str, float]
+    motion: MotionSettings = field(default_factory=lambda: MotionSettings(link_padding=0.0))
+    tip_frame: str | None = None
+    name: str = "cartesian move to joint state"
 
 
 @dataclass(frozen=True, eq=False)
@@ -202,6 +245,7 @@ Stage = (
     | FromSolution
     | PlanToJointState
     | PlanToPose
+    | CartesianMoveToJointState
     | Connect
     | MoveAlongFrameAxis
     | BatchPoseIK

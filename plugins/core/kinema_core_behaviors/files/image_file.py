@@ -75,7 +75,7 @@ def image_pixels(node: Any, port: str, image: Any) -> tuple[np.ndarray, str]:
 
 
 class LoadImageFromFile(AsyncBehavior):
-    """Reads a PNG or JPEG file into a ``sensor_msgs/Image`` (rgb8, rgba8 or mono8)."""
+    """Reads a PNG or JPEG file into a ``sensor_msgs/Image`` (rgb8, rgba8 or mono8) in frame ``frame_id``."""
 
     subcategory = "File Management"
 
@@ -90,6 +90,13 @@ class LoadImageFromFile(AsyncBehavior):
                 "else to the objectives folder.",
             ),
             input_port("package_name", str, "", "Package the relative file_path is in (empty: objectives)."),
+            input_port(
+                "frame_id",
+                str,
+                "",
+                "The image's header.frame_id: the camera frame it is taken to be seen from (later "
+                "behaviors that place its pixels in 3D read it), e.g. 'camera'.",
+            ),
             message_output("image", IMAGE, "{image}", "The image."),
         ]
 
@@ -114,7 +121,8 @@ class LoadImageFromFile(AsyncBehavior):
                 self, "file_path", f"file {path} is not an image Pillow reads: {error}", ""
             ) from None
         encoding = {"RGB": "rgb8", "RGBA": "rgba8", "L": "mono8"}[picture.mode]
-        self.set_output("image", image_message(np.asarray(picture), encoding))
+        frame_id = read_text(self, "frame_id")
+        self.set_output("image", image_message(np.asarray(picture), encoding, frame_id))
         return True
 
 

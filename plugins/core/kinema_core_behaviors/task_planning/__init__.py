@@ -2,7 +2,8 @@
 
 InitializeMTCTask creates a task, the SetupMTC* behaviors append stages, PlanMTCTask plans it into a
 solution, and the core subtree "Execute MTC Solution" (or ConvertMtcSolutionToJointTrajectory and
-ExecuteTrajectory) runs it. WaitForMTCSolutionApproval lives with the other approvals (ui).
+ExecuteTrajectory) runs it; SplitMTCSolution cuts a solution in two to run its halves separately.
+WaitForMTCSolutionApproval lives with the other approvals (ui).
 """
 
 from __future__ import annotations
@@ -12,6 +13,7 @@ from .set_collision_rule import SetupMTCSetCollisionRule
 from .setup_stages import (
     InitializeMTCTask,
     SetupMTCBatchPoseIK,
+    SetupMTCCartesianMoveToRobotState,
     SetupMTCConnectWithProRRT,
     SetupMTCCurrentState,
     SetupMTCFromSolution,
@@ -19,12 +21,14 @@ from .setup_stages import (
     SetupMTCPlanToPose,
     SetupMTCPlanToRobotState,
 )
+from .split_solution import SplitMTCSolution
 
 BEHAVIORS = (
     ConvertMtcSolutionToJointTrajectory,
     InitializeMTCTask,
     PlanMTCTask,
     SetupMTCBatchPoseIK,
+    SetupMTCCartesianMoveToRobotState,
     SetupMTCConnectWithProRRT,
     SetupMTCCurrentState,
     SetupMTCFromSolution,
@@ -32,4 +36,5 @@ BEHAVIORS = (
     SetupMTCPlanToPose,
     SetupMTCPlanToRobotState,
     SetupMTCSetCollisionRule,
+    SplitMTCSolution,
 )

@@ -230,6 +230,15 @@ class SetupMTCPlanToPose(_SetupStage):
                 "current state",
                 "The stage whose state frames are resolved at (Kinema: the state before this stage).",
             ),
+            input_port(
+                "orientation_constraint",
+                None,
+                "[]",
+                "Links to keep turned at most angle_tolerance (rad) from their orientation where the stage "
+                "starts, target included: '[{link_name: grasp_link, angle_tolerance: 0.2}]'; '[]': none. "
+                "Kinema checks the free motion and, when it turns a link too far, moves the ik_frame in a "
+                "straight line instead; the stage fails naming the link and angle when neither keeps it.",
+            ),
         ]
 
     def stage(self, task: MtcTask) -> Any:
@@ -237,8 +246,50 @@ class SetupMTCPlanToPose(_SetupStage):
 
         target = pose_matrix(self.get_input("target_pose"), "target_pose")
         return PlanToPose(
-            target, str(self.get_input("ik_frame")), self.motion(), name=stage_name(task, "plan to pose")
+            target,
+            str(self.get_input("ik_frame")),
+            self.motion(),
+            name=stage_name(task, "plan to pose"),
+            orientation_constraints=orientation_constraints(self.get_input("orientation_constraint")),
         )
+
+
+def orientation_constraints(value: Any) -> list[Any]:
+    """The ``orientation_constraint`` port's constraints: a list of ``{link_name, angle_tolerance}``,
+    written as YAML (``[{link_name: grasp_link, angle_tolerance: 0.2}]``) or passed on the blackboard.
+
+    Raises:
+        KinemaError: not such a list, or an entry without a link name or with a bad tolerance.
+    """
+    import yaml
+
+    from kinema.motion.task_stages import OrientationConstraint
+
+    shape = "a list like [{link_name: grasp_link, angle_tolerance: 0.2}]"
+    if value is None or (isinstance(value, str) and not value.strip()):
+        return []
+    if isinstance(value, str):
+        try:
+            value = yaml.safe_load(value)
+        except yaml.YAMLError as error:
+            raise KinemaError(f"port [orientation_constraint] is not YAML ({error}); give {shape}") from None
+    if isinstance(value, dict):
+        value = [value]
+    if not isinstance(value, list | tuple):
+        raise KinemaError(f"port [orientation_constraint] must be {shape}, got {value!r}")
+    constraints = []
+    for k, item in enumerate(value):
+        if not isinstance(item, dict) or not str(item.get("link_name") or "").strip():
+            raise KinemaError(f"port [orientation_constraint] entry {k} names no link_name; give {shape}")
+        try:
+            tolerance = float(item.get("angle_tolerance", 0.0))
+        except (TypeError, ValueError):
+            raise KinemaError(
+                f"port [orientation_constraint] entry {k}: angle_tolerance must be a number (rad), got "
+                f"{item.get('angle_tolerance')!r}"
+            ) from None
+        constraints.append(OrientationConstraint(str(item["link_name"]).strip(), tolerance))
+    return constraints
 
 
 class SetupMTCPlanToRobotState(_SetupStage):
@@ -274,6 +325,42 @@ class SetupMTCPlanToRobotState(_SetupStage):
         if not goal:
             raise KinemaError("port [joint_state] names no joint")
         return PlanToJointState(goal, self.motion(), name=stage_name(task, "plan to joint state"))
+
+
+class SetupMTCCartesianMoveToRobotState(_SetupStage):
+    """Adds a stage that moves the tip of the planning group in a straight line to where ``joint_state``
+    puts it, ending at ``joint_state`` (a retreat along the way the robot came, as MoveIt Pro's "Retreat To
+    Initial Pose" does after a push).
+
+    The tip is the group's tip link (its SRDF chain's end); joints of ``joint_state`` outside the group
+    (the gripper of a saved robot state) are left where they are. Like SetupMTCMoveAlongFrameAxis it keeps
+    no link padding. Planning fails when the straight line is blocked or unreachable, or when it reaches
+    the tip's goal pose in another joint configuration than ``joint_state`` (then plan to it instead).
+    """
+
+    MOTION = MotionPorts(planning=False, padding=0.0)
+
+    @classmethod
+    def stage_ports(cls) -> list[PortInfo]:
+        return [
+            input_port(
+                "joint_state",
+                None,
+                "{target_joint_state}",
+                "Where the motion ends (sensor_msgs/JointState or moveit_msgs/RobotState, e.g. a saved "
+                "current state).",
+            ),
+        ]
+
+    def stage(self, task: MtcTask) -> Any:
+        from kinema.motion.task_stages import CartesianMoveToJointState
+
+        goal = joint_positions(self.get_input("joint_state"), "joint_state")
+        if not goal:
+            raise KinemaError("port [joint_state] names no joint")
+        return CartesianMoveToJointState(
+            goal, self.motion(), name=stage_name(task, "cartesian move to joint state")
+        )
 
 
 class SetupMTCMoveAlongFrameAxis(_SetupStage):

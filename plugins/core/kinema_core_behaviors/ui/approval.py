@@ -188,8 +188,9 @@ class WaitForMTCSolutionApproval(_AskUser):
 class BreakpointSubscriber(_AskUser):
     """Pauses the objective until the user resumes it (TUI question, or a message on ``breakpoint_topic``).
 
-    Headless with ``KINEMA_AUTO_APPROVE=1`` it resumes at once (logged); headless without it, it waits
-    for a message on the topic, and its message says how to send one.
+    ``message`` is what the user is asked ("Approve satellite grappling"); the question then also names
+    where the objective stopped. Headless with ``KINEMA_AUTO_APPROVE=1`` it resumes at once (logged);
+    headless without it, it waits for a message on the topic, and its message says how to send one.
     """
 
     subcategory = "User Input"
@@ -202,10 +203,19 @@ class BreakpointSubscriber(_AskUser):
                 str,
                 "/moveit_pro_breakpoint",
                 "Topic whose next message (std_msgs/Empty) resumes the objective.",
-            )
+            ),
+            input_port(
+                "message",
+                str,
+                "",
+                "What the user is asked before resuming (shown in the UI and logs); '': 'resume?'.",
+            ),
         ]
 
     def prompt(self) -> str:
+        message = str(self.get_input_or("message", "") or "").strip()
+        if message:
+            return f"{message} (breakpoint at {self.full_path})"
         return f"Breakpoint at {self.full_path}: resume?"
 
     async def do_work(self) -> bool:
