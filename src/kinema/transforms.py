@@ -48,6 +48,7 @@ __all__ = [
     "quaternion_from_matrix",
     "quaternion_from_wxyz",
     "rotate_twist",
+    "rotation_angle",
     "rotation_from_euler",
     "rotation_from_rotvec",
     "rotation_matrix",
@@ -194,6 +195,12 @@ def slerp(start_xyzw: Any, end_xyzw: Any, t: float) -> np.ndarray:
 def angle_between(start_xyzw: Any, end_xyzw: Any) -> float:
     """The angle (rad, in [0, pi]) of the rotation that takes orientation ``start`` to ``end``."""
     return float((_rotation(end_xyzw) * _rotation(start_xyzw).inv()).magnitude())
+
+
+def rotation_angle(a: np.ndarray, b: np.ndarray) -> float:
+    """The angle (rad, in [0, pi]) of the rotation that takes ``(3, 3)`` rotation matrix ``a`` to ``b``."""
+    cosine = (float(np.trace(np.asarray(a).T @ np.asarray(b))) - 1.0) / 2.0
+    return float(np.arccos(np.clip(cosine, -1.0, 1.0)))
 
 
 def average_pose(poses: Sequence[np.ndarray], weights: Sequence[float] | None = None) -> np.ndarray:

@@ -32,6 +32,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from kinema import transforms
 from kinema.errors import MotionError
 
 if TYPE_CHECKING:
@@ -551,9 +552,7 @@ class PoseTrackingMpc:
         world_T_frame = np.array(self._data.oMf[self._frame_id].homogeneous)
         target = np.asarray(world_T_target, dtype=float)
         position = float(np.linalg.norm(world_T_frame[:3, 3] - target[:3, 3]))
-        relative = world_T_frame[:3, :3].T @ target[:3, :3]
-        angle = float(np.arccos(np.clip((np.trace(relative) - 1.0) / 2.0, -1.0, 1.0)))
-        return position, angle
+        return position, transforms.rotation_angle(world_T_frame[:3, :3], target[:3, :3])
 
     def _clearance_at(self, q0: np.ndarray, obstacles: Obstacles) -> float:
         """Distance of the nearest clearance frame to an obstacle at ``q0`` (frames placed by _error_now)."""

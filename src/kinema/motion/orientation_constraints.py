@@ -16,18 +16,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from kinema.errors import MotionError
+from kinema.transforms import rotation_angle
 
 if TYPE_CHECKING:
     from kinema.motion.robot_model import RobotModel
     from kinema.motion.task_stages import OrientationConstraint
 
 CHECK_STEP = 0.02  # rad or m: largest joint change between two checked configurations
-
-
-def rotation_angle(a: np.ndarray, b: np.ndarray) -> float:
-    """The angle (rad, in [0, pi]) of the rotation taking ``(3, 3)`` rotation ``a`` to ``b``."""
-    cosine = (float(np.trace(a.T @ b)) - 1.0) / 2.0
-    return float(np.arccos(np.clip(cosine, -1.0, 1.0)))
 
 
 class OrientationKeeper:

@@ -95,7 +95,7 @@ def _tool_points(model: Any, solution: Any, frame: str = "grasp_link") -> np.nda
 def _worst_turn(model: Any, solution: Any, link: str = "grasp_link") -> float:
     """The largest angle (rad) ``link`` turns from its start orientation along the solution."""
     from kinema.motion import fk
-    from kinema.motion.orientation_constraints import rotation_angle
+    from kinema.transforms import rotation_angle
 
     index = {n: i for i, n in enumerate(solution.joint_names)}
     q = solution.start.copy()
