@@ -6,6 +6,7 @@ from .create_stationary_trajectory import CreateStationaryTrajectory
 from .execute_trajectory import ExecuteTrajectory
 from .execute_trajectory_with_admittance import ExecuteTrajectoryWithAdmittance
 from .generate_coverage_path import GenerateCoveragePath
+from .generate_point_to_point_trajectory import GeneratePointToPointTrajectory
 from .get_joint_state import GetJointState
 from .get_robot_state_from_trajectory import GetRobotStateFromTrajectory
 from .move_gripper_action import MoveGripperAction
@@ -24,4 +25,5 @@ BEHAVIORS = (
     PlanToJointGoal,
     ValidateTrajectory,
     GenerateCoveragePath,
+    GeneratePointToPointTrajectory,
 )
