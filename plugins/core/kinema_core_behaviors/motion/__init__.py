@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from .compute_inverse_kinematics import ComputeInverseKinematics
 from .create_stationary_trajectory import CreateStationaryTrajectory
 from .execute_trajectory import ExecuteTrajectory
 from .execute_trajectory_with_admittance import ExecuteTrajectoryWithAdmittance
@@ -15,6 +16,7 @@ from .plan_to_joint_goal import PlanToJointGoal
 from .validate_trajectory import ValidateTrajectory
 
 BEHAVIORS = (
+    ComputeInverseKinematics,
     CreateStationaryTrajectory,
     ExecuteTrajectory,
     ExecuteTrajectoryWithAdmittance,
