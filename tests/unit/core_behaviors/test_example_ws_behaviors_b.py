@@ -267,6 +267,20 @@ def test_ik_out_of_reach_or_only_in_collision_fails_saying_why(
         assert "rejected (e.g. in collision)" in run.toasts[-1], run.toasts
 
 
+def test_ik_link_padding_keeps_solutions_away_from_the_scene(
+    behavior: Any, context: BehaviorContext, robot_at: Any
+) -> None:
+    from kinema.motion import fk
+
+    model = context.robot_model
+    target = [_pose("world", fk(model, _q(model, MID), "grasp_link"))]
+    with robot_at(context, HOME):
+        assert _ik(behavior, context, target, "grasp_link", link_padding=0.0).status == NodeStatus.SUCCESS
+        padded = _ik(behavior, context, target, "grasp_link", link_padding=0.5)
+    assert padded.status == NodeStatus.FAILURE
+    assert "rejected (e.g. in collision)" in padded.toasts[-1], padded.toasts
+
+
 def test_ik_wants_one_known_tip_per_pose(behavior: Any, context: BehaviorContext, robot_at: Any) -> None:
     pose = _pose("world", np.eye(4))
     with robot_at(context, HOME):
