@@ -30,6 +30,7 @@ _EXPORTS = {
     "CellFrames": "cell_frames",
     "JointStateMonitor": "joint_state_monitor",
     "ik": "inverse_kinematics",
+    "ik_tips": "inverse_kinematics",
     "IkOptions": "inverse_kinematics",
     "PlanningScene": "planning_scene",
     "CollisionObject": "planning_scene",

@@ -2,7 +2,8 @@
 
 from __future__ import annotations
 
-from collections.abc import Callable
+import time
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -29,6 +30,8 @@ class IkOptions:
         max_step: largest joint change per iteration (rad or m); without it the first Gauss-Newton step
             from a far seed jumps to a limit or flips the wrist and the iteration gets stuck.
         rng_seed: seed of the random restarts (deterministic by default).
+        timeout: seconds after which no further random restart begins (the seed's attempt always
+            runs); None: all ``attempts`` may run.
     """
 
     position_tolerance: float = 1e-4
@@ -39,6 +42,7 @@ class IkOptions:
     damping: float = 1e-6
     max_step: float = 0.2
     rng_seed: int = 0
+    timeout: float | None = None
 
 
 def ik(
@@ -75,30 +79,76 @@ def ik(
     Raises:
         MotionError: "no IK solution", with the remaining error and the reason.
     """
-    import pinocchio as pin
-
-    opts = options or IkOptions()
-    g = model.group(group)
-    tip = frame or g.tip_link
+    tip = frame or model.group(group).tip_link
     if tip is None:
         raise MotionError(f"group {group!r} has no tip link; pass frame= (one of the robot's links)")
-    fid = model.frame_id(tip)
-    target = pin.SE3(np.asarray(world_T_target, dtype=float))
+    return ik_tips(
+        model,
+        [(tip, world_T_target)],
+        seed,
+        group,
+        position_only=position_only,
+        options=options,
+        accept=accept,
+    )
+
+
+def ik_tips(
+    model: RobotModel,
+    targets: Sequence[tuple[str, np.ndarray]],
+    seed: np.ndarray,
+    group: str,
+    *,
+    position_only: bool = False,
+    options: IkOptions | None = None,
+    accept: Callable[[np.ndarray], bool] | None = None,
+) -> np.ndarray:
+    """Find a configuration that puts every frame of ``targets`` at its pose at once (multi-tip IK).
+
+    The same search as :func:`ik` (which is this with one tip), on the tips' stacked errors and
+    Jacobians: a solution has every tip within the tolerances. Tips on branches of the group (two arms
+    of one group, two fingers) are solved together, sharing the joints they have in common.
+
+    Args:
+        model: the robot model.
+        targets: ``(frame, world_T_frame)`` pairs, each pose of shape ``(4, 4)`` in the world frame.
+        seed, group, position_only, options, accept: as for :func:`ik`.
+
+    Raises:
+        MotionError: no targets, a frame named twice, or "no IK solution" with the remaining error
+            (the worst tip's) and the reason.
+    """
+    import pinocchio as pin
+
+    if not targets:
+        raise MotionError("IK needs at least one (frame, pose) target")
+    tips = [frame for frame, _ in targets]
+    if len(set(tips)) != len(tips):
+        raise MotionError(f"IK targets name a frame twice: {', '.join(tips)}")
+    opts = options or IkOptions()
+    g = model.group(group)
+    fids = [model.frame_id(tip) for tip in tips]
+    goals = [pin.SE3(np.asarray(pose, dtype=float)) for _, pose in targets]
     cols = np.array(g.indices)
     lo, hi = model.lower[cols], model.upper[cols]
     data = model.new_data()
     pm = model.pin_model
-    rows = slice(0, 3) if position_only else slice(0, 6)
     m = 3 if position_only else 6
+    rows = m * len(tips)
     rng = np.random.default_rng(opts.rng_seed)
     seed = np.clip(np.asarray(seed, dtype=float), model.lower, model.upper)
     best_error = (np.inf, np.inf)
     rejected = 0
     found: list[np.ndarray] = []
+    started = time.monotonic()
+    attempts = 0
 
     for attempt in range(opts.attempts):
         if len(found) >= opts.restart_solutions:
             break
+        if attempt > 0 and opts.timeout is not None and time.monotonic() - started > opts.timeout:
+            break
+        attempts += 1
         q = seed.copy()
         if attempt > 0:
             q[cols] = rng.uniform(lo, hi)
@@ -106,14 +156,20 @@ def ik(
         for iteration in range(opts.max_iterations + 1):
             pq = model.pin_configuration(q)
             pin.framesForwardKinematics(pm, data, pq)
-            current_T_target = data.oMf[fid].actInv(target)
-            err = pin.log(current_T_target).vector
-            if position_only:
-                # Position error in the world frame, so the Jacobian rows below match it.
-                err = np.concatenate([target.translation - data.oMf[fid].translation, np.zeros(3)])
-                pos_err, rot_err = float(np.linalg.norm(err[:3])), 0.0
-            else:
-                pos_err, rot_err = float(np.linalg.norm(err[:3])), float(np.linalg.norm(err[3:]))
+            errors, offsets = [], []
+            pos_err = rot_err = 0.0
+            for fid, target in zip(fids, goals, strict=True):
+                current_T_target = data.oMf[fid].actInv(target)
+                offsets.append(current_T_target)
+                if position_only:
+                    # Position error in the world frame, so the Jacobian rows below match it.
+                    err = target.translation - data.oMf[fid].translation
+                    pos_err = max(pos_err, float(np.linalg.norm(err)))
+                else:
+                    err = pin.log(current_T_target).vector
+                    pos_err = max(pos_err, float(np.linalg.norm(err[:3])))
+                    rot_err = max(rot_err, float(np.linalg.norm(err[3:])))
+                errors.append(err)
             if pos_err < opts.position_tolerance and rot_err < opts.orientation_tolerance:
                 if accept is None or accept(q):
                     if attempt == 0:
@@ -126,15 +182,17 @@ def ik(
                 best_error = (pos_err, rot_err)
             if iteration == opts.max_iterations:
                 break
-            if position_only:
-                J = pin.computeFrameJacobian(pm, data, pq, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
-                J = (J @ model.mimic_map)[rows][:, cols]
-                e = err[:3]
-            else:
-                J = pin.computeFrameJacobian(pm, data, pq, fid, pin.ReferenceFrame.LOCAL)
-                J = (pin.Jlog6(current_T_target.inverse()) @ J @ model.mimic_map)[:, cols]
-                e = err
-            dq = J.T @ np.linalg.solve(J @ J.T + opts.damping * np.eye(m), e)
+            jacobians = []
+            for fid, current_T_target in zip(fids, offsets, strict=True):
+                if position_only:
+                    J = pin.computeFrameJacobian(pm, data, pq, fid, pin.ReferenceFrame.LOCAL_WORLD_ALIGNED)
+                    jacobians.append((J @ model.mimic_map)[:3][:, cols])
+                else:
+                    J = pin.computeFrameJacobian(pm, data, pq, fid, pin.ReferenceFrame.LOCAL)
+                    jacobians.append((pin.Jlog6(current_T_target.inverse()) @ J @ model.mimic_map)[:, cols])
+            J = np.vstack(jacobians)
+            e = np.concatenate(errors)
+            dq = J.T @ np.linalg.solve(J @ J.T + opts.damping * np.eye(rows), e)
             largest = float(np.abs(dq).max())
             if largest > opts.max_step:
                 dq *= opts.max_step / largest
@@ -146,9 +204,12 @@ def ik(
         if rejected
         else "the target may be out of reach or outside the joint limits"
     )
+    where = "; ".join(
+        f"{tip!r} in group {group!r} at position {np.round(target.translation, 4).tolist()}"
+        for tip, target in zip(tips, goals, strict=True)
+    )
     raise MotionError(
-        f"no IK solution for {tip!r} in group {group!r} at position "
-        f"{np.round(target.translation, 4).tolist()} after {opts.attempts} seed(s) of "
+        f"no IK solution for {where} after {attempts} seed(s) of "
         f"{opts.max_iterations} iteration(s) each: best error "
         f"{best_error[0]:.4f} m / {best_error[1]:.4f} rad; {reason}"
     )

@@ -29,8 +29,29 @@ def _densify(points: np.ndarray, max_step: float) -> np.ndarray:
     return np.array(out)
 
 
+def _sample_times(duration: float, sample_period: float, uniform: bool) -> np.ndarray:
+    """Times of the returned points: ``0, T, 2T, ...`` and the end when ``uniform``, else evenly spread
+    with spacing at most ``T``.
+
+    Uniform spacing is what a controller sampling at a fixed rate expects; a last interval shorter than a
+    thousandth of ``T`` is merged into the one before, so times always increase by a usable step.
+    """
+    if not uniform:
+        count = max(2, int(np.ceil(duration / sample_period)) + 1)
+        return np.linspace(0.0, duration, count)
+    times = np.arange(0.0, duration, sample_period)
+    if duration - times[-1] < 1e-3 * sample_period and len(times) > 1:
+        times = times[:-1]
+    return np.r_[times, duration]
+
+
 def _rest_to_rest(
-    names: tuple[str, ...], points: np.ndarray, vmax: np.ndarray, amax: np.ndarray, sample_period: float
+    names: tuple[str, ...],
+    points: np.ndarray,
+    vmax: np.ndarray,
+    amax: np.ndarray,
+    sample_period: float,
+    uniform: bool = False,
 ) -> JointTrajectory:
     """Time each straight segment of ``points`` with a joint-synchronised trapezoid, at rest at each point."""
     pieces: list[tuple[np.ndarray, np.ndarray, float, float, float]] = []  # start, delta, T, t_acc, u_peak
@@ -46,9 +67,8 @@ def _rest_to_rest(
             t_acc = u_speed / u_accel
             pieces.append((a, delta, 1.0 / u_speed + t_acc, t_acc, u_speed))
     duration = sum(piece[2] for piece in pieces)
-    count = max(2, int(np.ceil(duration / sample_period)) + 1)
-    times = np.linspace(0.0, duration, count)
-    q = np.zeros((count, len(names)))
+    times = _sample_times(duration, sample_period, uniform)
+    q = np.zeros((len(times), len(names)))
     qd, qdd = np.zeros_like(q), np.zeros_like(q)
     begin = 0.0
     for index, (a, delta, total, t_acc, peak) in enumerate(pieces):
@@ -83,6 +103,7 @@ def time_parameterize(
     *,
     sample_period: float = 0.01,
     max_step: float = 0.05,
+    uniform_sampling: bool = False,
 ) -> JointTrajectory:
     """Time ``path`` as fast as the joints' velocity and acceleration limits (times the scale factors) allow.
 
@@ -95,8 +116,11 @@ def time_parameterize(
         model: gives the joints' ``max_velocity`` and ``max_acceleration``.
         velocity_scale: fraction of the velocity limits to use, in (0, 1].
         acceleration_scale: fraction of the acceleration limits to use, in (0, 1].
-        sample_period: spacing of the returned points, seconds.
+        sample_period: spacing of the returned points, seconds (at most this, spread evenly over the
+            duration, unless ``uniform_sampling``).
         max_step: largest joint change between spline knots (rad or m).
+        uniform_sampling: points exactly ``sample_period`` apart from 0, plus one at the end (a
+            trajectory "sampled at a rate", as MoveIt Pro's ``trajectory_sampling_rate`` asks).
 
     Raises:
         MotionError: a scale factor outside (0, 1], a joint without finite limits, or the limits still
@@ -158,7 +182,7 @@ def time_parameterize(
                 len(instance.gridpoints),
                 len(grid),
             )
-            return _rest_to_rest(path.joint_names, points, vmax, amax, sample_period)
+            return _rest_to_rest(path.joint_names, points, vmax, amax, sample_period, uniform_sampling)
         ts = np.arange(0.0, traj.duration, _CHECK_DT)
         over = max(
             float(np.max(np.abs(traj(ts, 1)) / vmax)),
@@ -171,9 +195,7 @@ def time_parameterize(
         raise MotionError(
             f"toppra's trajectory exceeds the joint limits by {100 * (over - 1):.0f} % after derating"
         )
-    duration = float(traj.duration)
-    count = max(2, int(np.ceil(duration / sample_period)) + 1)
-    times = np.linspace(0.0, duration, count)
+    times = _sample_times(float(traj.duration), sample_period, uniform_sampling)
     q, qd, qdd = traj(times), traj(times, 1), traj(times, 2)
     qd[0] = qd[-1] = 0.0
     q[0], q[-1] = points[0], points[-1]

@@ -12,7 +12,7 @@ from typing import Any
 from kinema.behaviors import FormerSpelling, NodeStatus, PortInfo, SyncBehavior, input_port
 from kinema.errors import did_you_mean
 
-from .conversions import ROBOT_STATE_TYPE, robot_state_message
+from .conversions import JOINT_STATE_TYPE, ROBOT_STATE_TYPE
 from .ports import fails_on_bad_input, message_output, port_error, read_input
 
 
@@ -48,7 +48,10 @@ def as_robot_state(node: Any, port: str, value: Any) -> Any:
 class CreateRobotState(SyncBehavior):
     """Builds a robot state (``RobotJointState``) setting ``joint_names`` to ``positions``.
 
-    When the runtime has a robot model, every name must be one of its joints.
+    It writes the state twice when asked: as a ``RobotJointState`` on ``robot_state`` and as a
+    ``sensor_msgs/JointState`` on ``joint_state_msg`` (what GeneratePointToPointTrajectory reads), both
+    with ``velocities`` when given. When the runtime has a robot model, every name must be one of its
+    joints.
     """
 
     subcategory = "Messages"
@@ -59,6 +62,13 @@ class CreateRobotState(SyncBehavior):
         return [
             input_port("joint_names", list[str], "", "Joint names (';'-separated)."),
             input_port("positions", list[float], "", "One position per joint (';'-separated)."),
+            input_port(
+                "velocities",
+                list[float],
+                "",
+                "One velocity per joint (';'-separated, rad/s or m/s); unset or empty: the state has no "
+                "velocities.",
+            ),
             message_output(
                 "robot_state",
                 ROBOT_STATE_TYPE,
@@ -66,6 +76,14 @@ class CreateRobotState(SyncBehavior):
                 "The robot state. The default entry is the one SetMujocoState reads by default: MoveIt Pro's "
                 "'Reset MuJoCo Robot' wires CreateRobotState to SetMujocoState by defaults only, and 'Load "
                 "MuJoCo Robot State' writes {joint_state_msg} for the same SetMujocoState.",
+            ),
+            message_output(
+                "joint_state_msg",
+                JOINT_STATE_TYPE,
+                description="The same state as a joint state, with its velocities (as MoveIt Pro's "
+                "trajectory stitching objective feeds GeneratePointToPointTrajectory). No default: "
+                "written only when the objective names an entry, because robot_state's default entry is "
+                "{joint_state_msg} already.",
             ),
         ]
 
@@ -78,6 +96,7 @@ class CreateRobotState(SyncBehavior):
         if len(names) != len(positions):
             problem = f"= {positions}: {len(names)} joint names but {len(positions)} positions"
             raise port_error(self, "positions", problem, "give one position per joint")
+        velocities = self._velocities(len(names))
         model = self.context.robot_model
         if model is not None:
             known = list(model.joint_names)
@@ -89,8 +108,27 @@ class CreateRobotState(SyncBehavior):
                     f"names unknown joint {unknown[0]!r}",
                     did_you_mean(unknown[0], known),
                 )
-        self.set_output("robot_state", robot_state_message(names, positions))
+        from kinema.transport import from_dict
+
+        fields = {"name": names, "position": [float(p) for p in positions], "velocity": velocities}
+        self.set_output("robot_state", from_dict(ROBOT_STATE_TYPE, {"joint_state": fields}))
+        if "joint_state_msg" in self.config.output_ports:
+            self.set_output("joint_state_msg", from_dict(JOINT_STATE_TYPE, fields))
         return NodeStatus.SUCCESS
+
+    def _velocities(self, count: int) -> list[float]:
+        """The ``velocities`` port: none when unset or empty, else one number per joint."""
+        if "velocities" not in self.config.input_ports:
+            return []
+        value = read_input(self, "velocities")
+        try:
+            velocities = [float(v) for v in value]
+        except (TypeError, ValueError):
+            raise port_error(self, "velocities", f"= {value!r} is not a list of numbers") from None
+        if velocities and len(velocities) != count:
+            problem = f"= {velocities}: {count} joint names but {len(velocities)} velocities"
+            raise port_error(self, "velocities", problem, "give one velocity per joint, or none")
+        return velocities
 
 
 class UnpackRobotStateMessage(SyncBehavior):

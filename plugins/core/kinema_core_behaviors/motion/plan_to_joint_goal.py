@@ -29,10 +29,11 @@ class PlanToJointGoal(AsyncBehavior):
     """Plans from the robot's current joint state to ``joint_goal`` for ``planning_group_name``.
 
     The start is the latest ``/joint_states``; the path keeps ``link_padding`` metres between the
-    robot and the planning scene (a straight joint-space move when that is collision-free, OMPL
-    otherwise), and is timed with the joint limits scaled by the velocity and acceleration factors.
+    robot and the planning scene (a straight joint-space move when that is collision-free, else OMPL,
+    or Kinema's seeded RRT-Connect when ``seed`` is set), and is timed with the joint limits scaled by
+    the velocity and acceleration factors, ``trajectory_sampling_rate`` points per second.
     Fails with the planner's reason: unknown joints, a goal outside the limits or in collision, or no
-    path within ``planning_time``.
+    path within ``planning_time`` (or ``max_iterations`` samples of the seeded search).
     """
 
     subcategory = "Motion - Planning"
@@ -76,6 +77,29 @@ class PlanToJointGoal(AsyncBehavior):
             ),
             input_port("planner_id", str, "RRTConnect", "OMPL planner used when a straight move collides."),
             input_port("planning_time", float, 1.0, "Seconds the planner may search."),
+            input_port(
+                "seed",
+                int,
+                "",
+                "Random seed of the search when the straight move collides. Unset: OMPL's planner_id, "
+                "whose generator is process-wide (the same request may take another path later). A "
+                "number: Kinema's seeded RRT-Connect, which gives the same path for the same request and "
+                "seed in any process (planner_id must then be RRTConnect).",
+            ),
+            input_port(
+                "max_iterations",
+                int,
+                5000,
+                "Samples the seeded search may draw before it fails (> 0). Applies only with seed set: "
+                "OMPL's planners are bounded by planning_time alone.",
+            ),
+            input_port(
+                "trajectory_sampling_rate",
+                float,
+                100.0,
+                "Points per second of the timed trajectory (Hz, > 0): points at most 1/rate apart, "
+                "spread evenly over its duration (MoveIt Pro's default is not public; Kinema's: 100).",
+            ),
             output_port(
                 "joint_trajectory_msg",
                 None,
@@ -97,6 +121,13 @@ class PlanToJointGoal(AsyncBehavior):
             return self._fail("orientation constraints are not supported yet; pass '[]'")
         if planner not in PLANNERS:
             return self._fail(f"unknown planner_id {planner!r}; {did_you_mean(planner, PLANNERS)}")
+        seed = int(self.get_input("seed")) if "seed" in self.config.input_ports else None
+        max_iterations = int(self.get_input("max_iterations"))
+        if max_iterations <= 0:
+            return self._fail(f"max_iterations must be > 0 samples, got {max_iterations}")
+        rate = float(self.get_input("trajectory_sampling_rate"))
+        if not rate > 0:
+            return self._fail(f"trajectory_sampling_rate must be > 0 points per second, got {rate:g}")
         try:
             goal = joint_positions(goal_value, "joint_goal")
             model = robot_model(self.context, "PlanToJointGoal")
@@ -110,11 +141,18 @@ class PlanToJointGoal(AsyncBehavior):
                 model.joint_names, self.context.clock
             )
             checker = collision_checker(self.context, "PlanToJointGoal", padding)
-            options = PlanningOptions(planner=planner, timeout=float(self.get_input("planning_time")))
+            options = PlanningOptions(
+                planner=planner,
+                timeout=float(self.get_input("planning_time")),
+                seed=seed,
+                max_iterations=max_iterations,
+            )
             path = plan_joint_goal(checker, start, goal, group, options)
             if self.stop_requested():
                 return False
-            trajectory = time_parameterize(path, model, velocity_scale, acceleration_scale)
+            trajectory = time_parameterize(
+                path, model, velocity_scale, acceleration_scale, sample_period=1.0 / rate
+            )
         except KinemaError as error:
             return self._fail(str(error))
         message = trajectory_message(trajectory)
