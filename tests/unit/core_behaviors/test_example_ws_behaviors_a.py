@@ -1,0 +1,90 @@
+"""Behaviors MoveIt Pro's example workspace uses, batch A: what an objective sees, and how bad input fails.
+
+ReversePoseStampedVector, IsPoseNearIdentity, StopwatchBegin/End, UnpackJointStateMessage,
+SaveCurrentState, BiasedCoinFlip, RepeatUnlessFailureEachTick and RepeatUnlessFailureWithinTick.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import pytest
+
+from kinema.behaviors import (
+    BehaviorContext,
+    NodeStatus,
+    message_type,
+)
+from kinema.testing import publish_repeatedly, run_objective, tick_behavior
+
+PoseStamped = message_type("geometry_msgs/msg/PoseStamped")
+JointState = message_type("sensor_msgs/msg/JointState")
+ARM = ["shoulder_pan_joint", "shoulder_lift_joint", "elbow_joint"]
+
+
+def _xml(body: str) -> str:
+    return (
+        '<root BTCPP_format="4" main_tree_to_execute="Main"><BehaviorTree ID="Main"><Sequence>'
+        f"{body}</Sequence></BehaviorTree></root>"
+    )
+
+
+def _pose(x: float = 0.0, y: float = 0.0, z: float = 0.0, q: tuple[float, ...] = (0, 0, 0, 1)) -> Any:
+    qx, qy, qz, qw = (float(v) for v in q)
+    return PoseStamped(
+        header={"frame_id": "world"},
+        pose={"position": {"x": x, "y": y, "z": z}, "orientation": {"x": qx, "y": qy, "z": qz, "w": qw}},
+    )
+
+
+def _about_z(angle: float) -> tuple[float, ...]:
+    return (0.0, 0.0, math.sin(angle / 2), math.cos(angle / 2))
+
+
+# -- UnpackJointStateMessage --------------------------------------------------------------------------
+
+
+def test_unpack_joint_state_message_writes_each_field(behavior: Any) -> None:
+    state = JointState(
+        header={"frame_id": "base"}, name=ARM, position=[0.1, 0.2, 0.3], effort=[1.0, 2.0, 3.0]
+    )
+    run = tick_behavior(behavior("UnpackJointStateMessage"), {"joint_state": state})
+    assert run.status == NodeStatus.SUCCESS
+    out = run.outputs
+    assert out["name_"] == ARM and out["position"] == [0.1, 0.2, 0.3]
+    assert out["velocity"] == [] and out["effort"] == [1.0, 2.0, 3.0]
+    assert out["header"].frame_id == "base"
+    assert "name" not in out
+
+
+def test_unpack_joint_state_message_refuses_another_message_when_the_tree_is_built(
+    registry: Any, context: BehaviorContext
+) -> None:
+    from kinema.errors import KinemaError
+
+    body = """
+    <Action ID="CreatePoseStamped" pose_stamped="{p}"/>
+    <Action ID="UnpackJointStateMessage" joint_state="{p}" name_="{names}"/>
+    """
+    with pytest.raises(KinemaError) as error:
+        run_objective(_xml(body), registry=registry, context=context)
+    assert "sensor_msgs::msg::JointState" in str(error.value)
+    assert "geometry_msgs::msg::PoseStamped" in str(error.value)
+
+
+def test_unpacked_names_and_positions_feed_create_robot_state(
+    registry: Any, context: BehaviorContext
+) -> None:
+    # demo_trajectory_stitching.xml's chain: GetJointState -> UnpackJointStateMessage -> CreateRobotState.
+    state = {"name": ARM, "position": [0.4, 0.5, 0.6]}
+    body = """
+    <Action ID="GetJointState" joint_state="{js}"/>
+    <Action ID="UnpackJointStateMessage" joint_state="{js}" name_="{names}" position="{positions}"/>
+    <Action ID="CreateRobotState" joint_names="{names}" positions="{positions}" robot_state="{rs}"/>
+    """
+    with publish_repeatedly(context.node, "sensor_msgs/msg/JointState", "/joint_states", state):
+        run = run_objective(_xml(body), registry=registry, context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    assert list(run.blackboard["rs"].joint_state.name) == ARM
+    assert list(run.blackboard["rs"].joint_state.position) == [0.4, 0.5, 0.6]
