@@ -14,7 +14,10 @@ import pytest
 from kinema.behaviors import (
     BehaviorContext,
     NodeStatus,
+    PortInfo,
+    SyncBehavior,
     message_type,
+    output_port,
 )
 from kinema.testing import publish_repeatedly, run_objective, tick_behavior
 
@@ -40,6 +43,59 @@ def _pose(x: float = 0.0, y: float = 0.0, z: float = 0.0, q: tuple[float, ...] =
 
 def _about_z(angle: float) -> tuple[float, ...]:
     return (0.0, 0.0, math.sin(angle / 2), math.cos(angle / 2))
+
+
+# -- ReversePoseStampedVector -------------------------------------------------------------------------
+
+
+def test_reverse_pose_stamped_vector_reverses_in_place_and_into_another_entry(
+    registry: Any, context: BehaviorContext
+) -> None:
+    body = """
+    <Action ID="ResetPoseStampedVector" vector="{poses}"/>
+    <Action ID="ResetPoseStampedVector" vector="{empty}"/>
+    <Action ID="CreatePoseStamped" position_xyz="1;0;0" pose_stamped="{a}"/>
+    <Action ID="CreatePoseStamped" position_xyz="2;0;0" pose_stamped="{b}"/>
+    <Action ID="CreatePoseStamped" position_xyz="3;0;0" pose_stamped="{c}"/>
+    <Action ID="AddPoseStampedToVector" input="{a}" vector="{poses}"/>
+    <Action ID="AddPoseStampedToVector" input="{b}" vector="{poses}"/>
+    <Action ID="AddPoseStampedToVector" input="{c}" vector="{poses}"/>
+    <Action ID="ReversePoseStampedVector" input_vector="{poses}" output_vector="{reversed}"/>
+    <Action ID="ReversePoseStampedVector" input_vector="{reversed}" output_vector="{reversed}"/>
+    <Action ID="ReversePoseStampedVector" input_vector="{poses}" output_vector="{once}"/>
+    <Action ID="ReversePoseStampedVector" input_vector="{empty}" output_vector="{empty}"/>
+    """
+    run = run_objective(_xml(body), registry=registry, context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    xs = {key: [p.pose.position.x for p in run.blackboard[key]] for key in ("poses", "reversed", "once")}
+    assert xs == {"poses": [1.0, 2.0, 3.0], "reversed": [1.0, 2.0, 3.0], "once": [3.0, 2.0, 1.0]}
+    assert run.blackboard["empty"] == []
+
+
+class _MixedVector(SyncBehavior):
+    """A plugin of the user's writing an untyped vector holding a pose and a string."""
+
+    @classmethod
+    def provided_ports(cls) -> list[PortInfo]:
+        return [output_port("vector", None, "{mixed}", "A vector of anything.")]
+
+    def tick(self) -> NodeStatus:
+        self.set_output("vector", [_pose(1.0), "oops"])
+        return NodeStatus.SUCCESS
+
+
+def test_reverse_pose_stamped_vector_names_an_element_that_is_no_pose(
+    registry: Any, context: BehaviorContext
+) -> None:
+    body = """
+    <Action ID="_MixedVector" vector="{mixed}"/>
+    <Action ID="ReversePoseStampedVector" input_vector="{mixed}" output_vector="{reversed}"/>
+    """
+    run = run_objective(_xml(body), registry=registry, behaviors=[_MixedVector], context=context)
+    assert run.status == NodeStatus.FAILURE
+    assert "ReversePoseStampedVector" in run.toasts[-1] and "port [input_vector]" in run.toasts[-1]
+    assert "geometry_msgs::msg::PoseStamped" in run.toasts[-1]
+    assert run.blackboard.get("reversed") is None
 
 
 # -- UnpackJointStateMessage --------------------------------------------------------------------------
