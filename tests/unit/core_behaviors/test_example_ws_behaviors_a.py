@@ -98,6 +98,50 @@ def test_reverse_pose_stamped_vector_names_an_element_that_is_no_pose(
     assert run.blackboard.get("reversed") is None
 
 
+# -- IsPoseNearIdentity ------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("pose", "status", "said"),
+    [
+        (_pose(), NodeStatus.SUCCESS, ()),
+        (_pose(0.02, 0.01, 0.0, _about_z(0.15)), NodeStatus.SUCCESS, ()),
+        (_pose(q=(0, 0, 0, -1)), NodeStatus.SUCCESS, ()),  # -q is the same rotation
+        (_pose(q=(0, 0, 0, 0)), NodeStatus.SUCCESS, ()),  # an unset orientation is the identity
+        (_pose(0.0, 0.04, 0.0), NodeStatus.FAILURE, ("translation 0.04 m exceeds position_tolerance",)),
+        (_pose(q=_about_z(0.3)), NodeStatus.FAILURE, ("rotation 0.3 rad exceeds rotation_tolerance 0.2",)),
+        (
+            _pose(0.0, 0.0, -0.5, _about_z(-1.0)),
+            NodeStatus.FAILURE,
+            ("translation 0.5 m exceeds", "rotation 1 rad exceeds"),
+        ),
+    ],
+)
+def test_is_pose_near_identity_compares_translation_and_rotation_with_the_tolerances(
+    behavior: Any, pose: Any, status: NodeStatus, said: tuple[str, ...]
+) -> None:
+    run = tick_behavior(
+        behavior("IsPoseNearIdentity"),
+        {"pose": pose, "position_tolerance": 0.03, "rotation_tolerance": 0.2},
+    )
+    assert run.status == status, run.toasts
+    if said:
+        assert all(text in run.toasts[-1] for text in said), run.toasts
+    else:
+        assert run.toasts == []
+
+
+def test_is_pose_near_identity_refuses_a_negative_tolerance_and_a_nan_pose(behavior: Any) -> None:
+    negative = tick_behavior(
+        behavior("IsPoseNearIdentity"),
+        {"pose": _pose(), "position_tolerance": -0.1, "rotation_tolerance": 0.2},
+    )
+    assert negative.status == NodeStatus.FAILURE
+    assert "port [position_tolerance] = -0.1; a tolerance must be >= 0" in negative.toasts[-1]
+    nan = tick_behavior(behavior("IsPoseNearIdentity"), {"pose": _pose(float("nan"))})
+    assert nan.status == NodeStatus.FAILURE and "port [pose]" in nan.toasts[-1]
+
+
 # -- UnpackJointStateMessage --------------------------------------------------------------------------
 
 
