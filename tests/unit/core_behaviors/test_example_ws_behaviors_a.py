@@ -19,6 +19,7 @@ from kinema.behaviors import (
     message_type,
     output_port,
 )
+from kinema.bt import ManualClock
 from kinema.testing import publish_repeatedly, run_objective, tick_behavior
 
 PoseStamped = message_type("geometry_msgs/msg/PoseStamped")
@@ -140,6 +141,41 @@ def test_is_pose_near_identity_refuses_a_negative_tolerance_and_a_nan_pose(behav
     assert "port [position_tolerance] = -0.1; a tolerance must be >= 0" in negative.toasts[-1]
     nan = tick_behavior(behavior("IsPoseNearIdentity"), {"pose": _pose(float("nan"))})
     assert nan.status == NodeStatus.FAILURE and "port [pose]" in nan.toasts[-1]
+
+
+# -- StopwatchBegin / StopwatchEnd --------------------------------------------------------------------
+
+
+class _Advance(SyncBehavior):
+    """Moves the test's manual clock 2.5 s on (a stand-in for sim time passing)."""
+
+    def tick(self) -> NodeStatus:
+        self.context.clock.advance(2.5)
+        return NodeStatus.SUCCESS
+
+
+def test_the_stopwatch_measures_runtime_clock_time(registry: Any) -> None:
+    context = BehaviorContext(clock=ManualClock(100.0))
+    body = """
+    <Action ID="StopwatchBegin" timepoint="{t}"/>
+    <Action ID="_Advance"/>
+    <Action ID="StopwatchEnd" timepoint="{t}"/>
+    <Action ID="StopwatchEnd" timepoint="{t}" elapsed_duration="{elapsed}"/>
+    """
+    run = run_objective(_xml(body), registry=registry, behaviors=[_Advance], context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    assert run.blackboard["t"] == 100.0 and run.blackboard["elapsed"] == 2.5
+    assert run.toasts == ["StopwatchEnd: 2.500 s elapsed since StopwatchBegin"] * 2
+    assert run.messages[0].level == "info"
+
+
+def test_stopwatch_end_without_a_begin_fails_saying_so(registry: Any) -> None:
+    context = BehaviorContext(clock=ManualClock())
+    run = run_objective(
+        _xml('<Action ID="StopwatchEnd" timepoint="{never_started}"/>'), registry=registry, context=context
+    )
+    assert run.status == NodeStatus.FAILURE
+    assert "nothing has written blackboard entry 'never_started'" in run.toasts[-1]
 
 
 # -- UnpackJointStateMessage --------------------------------------------------------------------------
