@@ -224,3 +224,33 @@ def test_unpacked_names_and_positions_feed_create_robot_state(
     assert run.status == NodeStatus.SUCCESS, run.toasts
     assert list(run.blackboard["rs"].joint_state.name) == ARM
     assert list(run.blackboard["rs"].joint_state.position) == [0.4, 0.5, 0.6]
+
+
+# -- SaveCurrentState ---------------------------------------------------------------------------------
+
+
+def test_save_current_state_keeps_every_joint_as_a_moveit_robot_state(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    state = {"name": [*ARM, "finger"], "position": [0.1, 0.2, 0.3, 0.04], "velocity": [0.0, 0.0, 0.1, 0.0]}
+    with publish_repeatedly(context.node, "sensor_msgs/msg/JointState", "/joint_states", state):
+        run = tick_behavior(behavior("SaveCurrentState"), context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    saved = run.outputs["saved_robot_state"]
+    assert saved.__msgtype__ == "moveit_msgs/msg/RobotState"
+    assert list(saved.joint_state.name) == [*ARM, "finger"]
+    assert list(saved.joint_state.position) == [0.1, 0.2, 0.3, 0.04]
+    assert list(saved.joint_state.velocity) == [0.0, 0.0, 0.1, 0.0]
+
+
+def test_save_current_state_without_a_driver_fails_with_advice(
+    behavior: Any, context: BehaviorContext, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    import sys
+
+    module = sys.modules[behavior("SaveCurrentState").__module__]
+    monkeypatch.setattr(module, "TIMEOUT", 0.2)
+    run = tick_behavior(behavior("SaveCurrentState"), context=context)
+    assert run.status == NodeStatus.FAILURE
+    assert "SaveCurrentState: no joint state received on /joint_states" in run.toasts[-1]
+    assert "saved_robot_state" not in run.outputs
