@@ -7,6 +7,7 @@ SaveCurrentState, BiasedCoinFlip, RepeatUnlessFailureEachTick and RepeatUnlessFa
 from __future__ import annotations
 
 import math
+import random
 from typing import Any
 
 import pytest
@@ -15,12 +16,13 @@ from kinema.behaviors import (
     BehaviorContext,
     NodeStatus,
     PortInfo,
+    StatefulBehavior,
     SyncBehavior,
     message_type,
     output_port,
 )
 from kinema.bt import ManualClock
-from kinema.testing import publish_repeatedly, run_objective, tick_behavior
+from kinema.testing import build_tree, publish_repeatedly, run_objective, tick_behavior
 
 PoseStamped = message_type("geometry_msgs/msg/PoseStamped")
 JointState = message_type("sensor_msgs/msg/JointState")
@@ -254,3 +256,101 @@ def test_save_current_state_without_a_driver_fails_with_advice(
     assert run.status == NodeStatus.FAILURE
     assert "SaveCurrentState: no joint state received on /joint_states" in run.toasts[-1]
     assert "saved_robot_state" not in run.outputs
+
+
+# -- BiasedCoinFlip -----------------------------------------------------------------------------------
+
+
+def test_biased_coin_flip_follows_its_probability(behavior: Any) -> None:
+    flip = behavior("BiasedCoinFlip")
+    assert {tick_behavior(flip, {"success_probability": 1.0}).status for _ in range(20)} == {
+        NodeStatus.SUCCESS
+    }
+    assert {tick_behavior(flip, {"success_probability": 0.0}).status for _ in range(20)} == {
+        NodeStatus.FAILURE
+    }
+    random.seed(7)
+    wins = [tick_behavior(flip, {"success_probability": 0.25}).status for _ in range(400)]
+    assert 60 <= wins.count(NodeStatus.SUCCESS) <= 140  # 100 expected; outside is ~1e-8 likely
+
+
+@pytest.mark.parametrize("value", [1.5, -0.1, float("nan")])
+def test_biased_coin_flip_refuses_a_value_that_is_no_probability(behavior: Any, value: float) -> None:
+    run = tick_behavior(behavior("BiasedCoinFlip"), {"success_probability": value})
+    assert run.status == NodeStatus.FAILURE
+    assert "port [success_probability]" in run.toasts[-1] and "give a value in [0, 1]" in run.toasts[-1]
+
+
+# -- RepeatUnlessFailureEachTick / RepeatUnlessFailureWithinTick --------------------------------------
+
+
+def _loop(decorator: str, cycles: int, child: str = '<Script code="n += 1"/>') -> str:
+    return _xml(
+        f'<Script code="n := 0"/><Decorator ID="{decorator}" num_cycles="{cycles}">{child}</Decorator>'
+    )
+
+
+@pytest.mark.parametrize("decorator", ["RepeatUnlessFailureEachTick", "RepeatUnlessFailureWithinTick"])
+def test_the_loops_succeed_after_num_cycles_and_fail_at_the_first_failure(
+    registry: Any, context: BehaviorContext, decorator: str
+) -> None:
+    done = run_objective(_loop(decorator, 4), registry=registry, context=context)
+    assert done.status == NodeStatus.SUCCESS and done.blackboard["n"] == 4
+    failing = '<Sequence><Script code="n += 1"/><ScriptCondition code="n &lt; 3"/></Sequence>'
+    for cycles in (10, -1):
+        failed = run_objective(_loop(decorator, cycles, failing), registry=registry, context=context)
+        assert failed.status == NodeStatus.FAILURE and failed.blackboard["n"] == 3
+    none = run_objective(_loop(decorator, 0), registry=registry, context=context)
+    assert none.status == NodeStatus.SUCCESS and none.blackboard["n"] == 0
+    bad = run_objective(_loop(decorator, -2), registry=registry, context=context)
+    assert bad.status == NodeStatus.FAILURE and "port [num_cycles] = -2" in bad.toasts[-1]
+
+
+def test_each_tick_runs_one_instant_iteration_per_tick_where_repeat_and_within_tick_run_all(
+    registry: Any, context: BehaviorContext
+) -> None:
+    def first_tick(decorator: str) -> tuple[NodeStatus, int]:
+        tree = build_tree(_loop(decorator, 3), registry=registry, context=context)
+        status = tree.tick_once()  # re-ticks at once while a node asks for it, as the runtime does
+        return status, tree.root_blackboard.get("n")
+
+    assert first_tick("RepeatUnlessFailureEachTick") == (NodeStatus.RUNNING, 1)
+    assert first_tick("RepeatUnlessFailureWithinTick") == (NodeStatus.SUCCESS, 3)
+    assert first_tick("Repeat") == (NodeStatus.SUCCESS, 3)  # BT.CPP's Repeat: yield + immediate re-tick
+
+
+class _TwoTicks(StatefulBehavior):
+    """RUNNING on the tick that starts it, SUCCESS on the next."""
+
+    def on_start(self) -> NodeStatus:
+        return NodeStatus.RUNNING
+
+    def on_running(self) -> NodeStatus:
+        return NodeStatus.SUCCESS
+
+    def on_halted(self) -> None:
+        pass
+
+
+@pytest.mark.parametrize(
+    ("decorator", "statuses"),
+    [
+        # the next iteration starts on the tick after a success...
+        ("RepeatUnlessFailureEachTick", ["RUNNING", "RUNNING", "RUNNING", "SUCCESS"]),
+        # ...or in the tick that completed the previous one
+        ("RepeatUnlessFailureWithinTick", ["RUNNING", "RUNNING", "SUCCESS"]),
+    ],
+)
+def test_a_running_child_keeps_the_loop_running(
+    registry: Any, context: BehaviorContext, decorator: str, statuses: list[str]
+) -> None:
+    xml = (
+        '<root BTCPP_format="4"><BehaviorTree ID="T">'
+        f'<Decorator ID="{decorator}" num_cycles="2"><Action ID="_TwoTicks"/></Decorator>'
+        "</BehaviorTree></root>"
+    )
+    tree = build_tree(xml, registry=registry, behaviors=[_TwoTicks], context=context)
+    seen = []
+    for _ in range(len(statuses)):
+        seen.append(tree.tick_exactly_once().name)
+    assert seen == statuses
