@@ -48,6 +48,57 @@ def _about_z(angle: float) -> tuple[float, ...]:
     return (0.0, 0.0, math.sin(angle / 2), math.cos(angle / 2))
 
 
+# -- every new ID with exactly the ports MoveIt Pro's example objectives set ------------------------------
+
+EXAMPLE_PORTS = """
+<Action ID="CreatePoseStamped" position_xyz="1;0;0" pose_stamped="{a}"/>
+<Action ID="CreatePoseStamped" position_xyz="2;0;0" pose_stamped="{b}"/>
+<Action ID="ResetPoseStampedVector" vector="{contour_1}"/>
+<Action ID="AddPoseStampedToVector" input="{a}" vector="{contour_1}"/>
+<Action ID="AddPoseStampedToVector" input="{b}" vector="{contour_1}"/>
+<Action ID="ReversePoseStampedVector" input_vector="{contour_1}" output_vector="{contour_1}"/>
+<Action ID="CreatePoseStamped" position_xyz="0.01;0;0" pose_stamped="{error_pose}"/>
+<Action ID="IsPoseNearIdentity" pose="{error_pose}" position_tolerance="0.03" rotation_tolerance="0.2"/>
+<Fallback>
+  <Action ID="BiasedCoinFlip" success_probability="0.500000"/>
+  <AlwaysSuccess/>
+</Fallback>
+<Action ID="StopwatchBegin" timepoint="{timepoint_right}"/>
+<Action ID="SaveCurrentState" saved_robot_state="{initial_robot_state}"/>
+<Action ID="GetJointState" joint_state="{start_joint_state}"/>
+<Action ID="UnpackJointStateMessage" joint_state="{start_joint_state}" effort="{start_effort}"
+        header="{start_header}" name_="{joint_names}" position="{start_position}"
+        velocity="{start_velocity}"/>
+<Script code="tries := 0; picks := 0"/>
+<Decorator ID="Inverter">
+  <Decorator ID="RepeatUnlessFailureEachTick" num_cycles="5">
+    <Decorator ID="Inverter"><Script code="tries += 1"/></Decorator>
+  </Decorator>
+</Decorator>
+<Decorator ID="RepeatUnlessFailureWithinTick" num_cycles="7"><Script code="picks += 1"/></Decorator>
+<Action ID="StopwatchEnd" timepoint="{timepoint_right}"/>
+"""
+
+
+def test_an_objective_using_every_new_id_with_the_example_ports_runs(
+    registry: Any, context: BehaviorContext
+) -> None:
+    state = {"name": ARM, "position": [0.1, 0.2, 0.3], "velocity": [0.0, 0.5, 0.0]}
+    with publish_repeatedly(context.node, "sensor_msgs/msg/JointState", "/joint_states", state):
+        run = run_objective(_xml(EXAMPLE_PORTS), registry=registry, context=context)
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    board = run.blackboard
+    assert [p.pose.position.x for p in board["contour_1"]] == [2.0, 1.0]
+    assert list(board["initial_robot_state"].joint_state.name) == ARM
+    assert list(board["initial_robot_state"].joint_state.velocity) == [0.0, 0.5, 0.0]
+    assert board["joint_names"] == ARM and board["start_position"] == [0.1, 0.2, 0.3]
+    # GetJointState keeps positions only, so the other lists come out empty
+    assert board["start_velocity"] == [] and board["start_effort"] == []
+    assert board["tries"] == 1  # the inverted loop retries only until the first success
+    assert board["picks"] == 7
+    assert any("s elapsed since StopwatchBegin" in toast for toast in run.toasts)
+
+
 # -- ReversePoseStampedVector -------------------------------------------------------------------------
 
 
