@@ -13,6 +13,7 @@ from kinema.plugins import RegisterBehavior, hookimpl
 from . import (
     controllers,
     files,
+    flow,
     io,
     messages,
     motion,
@@ -31,6 +32,7 @@ FAMILIES = (controllers, files, io, messages, motion, planning_scene, poses, ui,
 FAMILIES += (task_planning,)  # issue 13's family, kept on its own line
 FAMILIES += (perception,)  # issue 14's family, kept on its own line
 FAMILIES += (mpc,)  # issue 30's MPC family, kept on its own line
+FAMILIES += (flow,)  # the example-workspace loops and coin flip, kept on its own line
 
 BEHAVIORS = tuple(behavior for family in FAMILIES for behavior in family.BEHAVIORS)
 

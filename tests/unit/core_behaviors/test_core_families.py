@@ -9,6 +9,7 @@ from typing import Any
 FAMILIES = (
     "controllers",
     "files",
+    "flow",
     "io",
     "messages",
     "motion",

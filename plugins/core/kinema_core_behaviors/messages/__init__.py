@@ -12,6 +12,7 @@ from .collision_object import (
     UnpackCollisionObjectMessage,
     UnpackGraspableObjectMessage,
 )
+from .joint_state import UnpackJointStateMessage
 from .pose import CreatePointMessage, CreatePoseMessage, UnpackPointMessage, UnpackPoseMessage
 from .pose_stamped import CreatePoseStamped, UnpackPoseStampedMessage
 from .robot_state import CreateRobotState, UnpackRobotStateMessage
@@ -38,6 +39,7 @@ BEHAVIORS = (
     UnpackStringMessage,
     CreateRobotState,
     UnpackRobotStateMessage,
+    UnpackJointStateMessage,
     CreateCollisionObjectMessage,
     UnpackCollisionObjectMessage,
     CreateGraspableObjectMessage,

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from typing import Any, ClassVar
 
 from kinema.behaviors import NodeStatus, PortInfo, SyncBehavior, output_port
+from kinema.bt.conversions import list_item_type
 
 from .ports import fails_on_bad_input, message_input, message_output, read_message
 
@@ -18,12 +19,29 @@ from .ports import fails_on_bad_input, message_input, message_output, read_messa
 class Field:
     """One output of an unpack behavior: message field ``name`` on the port of the same name.
 
-    ``ros_type`` is the field's message type, or empty for a number (written as a float).
+    ``ros_type`` is the field's message type, or empty for a plain value of ``value_type``: a number
+    (``float``, the default) or a list (``list[float]``, ``list[str]``), converted item by item. ``port``
+    names the port when it is not the field's name (MoveIt Pro's ``name_`` for a JointState's ``name``,
+    since ``name`` is every node's own attribute).
     """
 
     name: str
     ros_type: str
     description: str
+    value_type: Any = float
+    port: str = ""
+
+    @property
+    def port_name(self) -> str:
+        """The output port this field is written to."""
+        return self.port or self.name
+
+    def plain(self, value: Any) -> Any:
+        """``value`` as ``value_type`` (a list's items converted one by one)."""
+        item = list_item_type(self.value_type)
+        if item is not None:
+            return [item(v) for v in value]
+        return self.value_type(value)
 
 
 class UnpackMessage(SyncBehavior):
@@ -43,10 +61,11 @@ class UnpackMessage(SyncBehavior):
             )
         ]
         for f in cls.fields:
+            port = f.port_name
             if f.ros_type:
-                ports.append(message_output(f.name, f.ros_type, f"{{{f.name}}}", f.description))
+                ports.append(message_output(port, f.ros_type, f"{{{port}}}", f.description))
             else:
-                ports.append(output_port(f.name, float, f"{{{f.name}}}", f.description))
+                ports.append(output_port(port, f.value_type, f"{{{port}}}", f.description))
         return ports
 
     @fails_on_bad_input
@@ -54,5 +73,5 @@ class UnpackMessage(SyncBehavior):
         message: Any = read_message(self, self.message_port)
         for f in self.fields:
             value = getattr(message, f.name)
-            self.set_output(f.name, value if f.ros_type else float(value))
+            self.set_output(f.port_name, value if f.ros_type else f.plain(value))
         return NodeStatus.SUCCESS

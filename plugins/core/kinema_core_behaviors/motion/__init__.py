@@ -13,6 +13,7 @@ from .get_robot_state_from_trajectory import GetRobotStateFromTrajectory
 from .move_gripper_action import MoveGripperAction
 from .plan_cartesian_path import PlanCartesianPath
 from .plan_to_joint_goal import PlanToJointGoal
+from .save_current_state import SaveCurrentState
 from .validate_trajectory import ValidateTrajectory
 
 BEHAVIORS = (
@@ -28,4 +29,5 @@ BEHAVIORS = (
     ValidateTrajectory,
     GenerateCoveragePath,
     GeneratePointToPointTrajectory,
+    SaveCurrentState,
 )

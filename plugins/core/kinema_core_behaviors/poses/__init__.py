@@ -5,6 +5,7 @@ from __future__ import annotations
 from .average_pose_stamped import AveragePoseStamped, AveragePoseStampedVector
 from .calculate_pose_offset import CalculatePoseOffset
 from .compute_link_pose_forward_kinematics import ComputeLinkPoseForwardKinematics
+from .is_pose_near_identity import IsPoseNearIdentity
 from .transform_pose import TransformPose
 from .transform_pose_frame import TransformPoseFrame
 from .transform_pose_with_pose import TransformPoseWithPose
@@ -17,4 +18,5 @@ BEHAVIORS = (
     TransformPoseWithPose,
     AveragePoseStamped,
     AveragePoseStampedVector,
+    IsPoseNearIdentity,
 )

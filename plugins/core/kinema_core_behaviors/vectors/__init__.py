@@ -7,6 +7,7 @@ from .edit_vector import InsertInVector, PushBackVector, RemoveFromVector, Repla
 from .for_each import ForEach, ForEachUntilSuccess
 from .read_vector import GetElementOfVector, GetSizeOfVector
 from .reset_vector import ResetPoseStampedVector, ResetVector
+from .reverse_vector import ReversePoseStampedVector
 
 BEHAVIORS = (
     ResetVector,
@@ -20,4 +21,5 @@ BEHAVIORS = (
     ForEach,
     ForEachUntilSuccess,
     AddPoseStampedToVector,
+    ReversePoseStampedVector,
 )

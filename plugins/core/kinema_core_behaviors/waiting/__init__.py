@@ -1,7 +1,8 @@
-"""Waiting: behaviors that pass time on the tree's clock."""
+"""Waiting: behaviors that pass or measure time on the tree's clock."""
 
 from __future__ import annotations
 
+from .stopwatch import StopwatchBegin, StopwatchEnd
 from .wait_for_duration import WaitForDuration
 
-BEHAVIORS = (WaitForDuration,)
+BEHAVIORS = (WaitForDuration, StopwatchBegin, StopwatchEnd)
