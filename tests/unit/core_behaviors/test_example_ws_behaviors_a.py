@@ -370,6 +370,41 @@ def test_each_tick_runs_one_instant_iteration_per_tick_where_repeat_and_within_t
     assert first_tick("Repeat") == (NodeStatus.SUCCESS, 3)  # BT.CPP's Repeat: yield + immediate re-tick
 
 
+def test_an_endless_within_tick_loop_of_instant_children_is_cancelled_on_the_objective_server(
+    registry: Any, tmp_path: Any
+) -> None:
+    """MoveIt Pro's WithinTick loop over a child that always succeeds at once never leaves the tick; Kinema's
+    lets the tick end every WITHIN_TICK_BUDGET_S and is ticked again at once, so a cancel still ends it."""
+    import time
+    from types import SimpleNamespace
+
+    from kinema.bt import WallClock
+    from kinema.runtime.objective_server import ObjectiveRequest, ObjectiveServer
+    from kinema.runtime.objective_source import LibraryTreeSource, library_from_folders
+
+    (tmp_path / "spin.xml").write_text(
+        '<root BTCPP_format="4" main_tree_to_execute="Spin"><BehaviorTree ID="Spin">'
+        + '<Sequence><Script code="n := 0"/><Decorator ID="RepeatUnlessFailureWithinTick" num_cycles="-1">'
+        + '<Script code="n += 1"/></Decorator></Sequence></BehaviorTree></root>'
+    )
+    source = LibraryTreeSource(
+        lambda: library_from_folders([tmp_path]),
+        host=SimpleNamespace(registry=registry),
+        context=None,
+        clock=WallClock(),
+    )
+    with ObjectiveServer(source) as server:
+        run = server.submit(ObjectiveRequest("Spin"))
+        time.sleep(0.3)
+        assert not run.done  # still looping
+        assert server.cancel(run, reason="enough", timeout=5)
+        result = run.wait(5)
+    assert result is not None and result.cancelled, result
+    # Served between two iterations: not by abandoning a tick thread stuck in the loop (which keeps
+    # spinning, a core lost for good).
+    assert "abandoned" not in result.error_message, result.error_message
+
+
 class _TwoTicks(StatefulBehavior):
     """RUNNING on the tick that starts it, SUCCESS on the next."""
 

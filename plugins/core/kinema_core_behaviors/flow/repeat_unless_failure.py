@@ -10,8 +10,11 @@ iteration that completes within one tick leaves the tick thread:
   cancels are served between iterations.
 - **WithinTick** runs the iterations back to back in the same tick as long as the child completes
   synchronously, and returns RUNNING only while the child is RUNNING. A fixed number of instant
-  iterations (building a list of candidates, say) finishes in one tick. With ``num_cycles="-1"`` and a
-  child that always succeeds at once it never returns: use EachTick for such a loop.
+  iterations (building a list of candidates, say) finishes in one tick. A loop that runs longer than
+  :data:`WITHIN_TICK_BUDGET_S` in one tick (``num_cycles="-1"`` over a child that always succeeds at once)
+  returns RUNNING with a wake-up signal and goes on at once, as BT.CPP's Repeat does after each
+  iteration: the objective server can then serve a cancel between two iterations (DESIGN invariant 2),
+  where MoveIt Pro's loop would hold its tick thread for good.
 
 BT.CPP 4.8.2's Repeat sits between the two: after a synchronous success it returns RUNNING *and* emits a
 wake-up signal, so the tree is ticked again at once (``tick_once`` keeps re-ticking), while after a child
@@ -21,6 +24,7 @@ return SKIPPED, as Repeat does, and forget the count (Repeat keeps it).
 
 from __future__ import annotations
 
+import time
 from typing import Any, ClassVar
 
 from kinema.behaviors import NodeStatus, PortInfo, input_port
@@ -29,6 +33,10 @@ from kinema.bt import DecoratorNode
 from kinema.bt.errors import BTLogicError
 
 from ..messages.ports import fails_on_bad_input, port_error, read_input
+
+# How long RepeatUnlessFailureWithinTick loops in one tick before it lets the tick end (and asks for the next
+# one at once): long enough for thousands of instant iterations, short against a cancel.
+WITHIN_TICK_BUDGET_S = 0.02
 
 IDLE, RUNNING, SUCCESS, FAILURE, SKIPPED = (
     NodeStatus.IDLE,
@@ -68,7 +76,11 @@ class _RepeatUnlessFailure(Behavior, DecoratorNode):
             )
         child = self.child
         assert child is not None
+        deadline = time.monotonic() + WITHIN_TICK_BUDGET_S
         while cycles == -1 or self._count < cycles:
+            if self.within_tick and child.status is IDLE and time.monotonic() > deadline:
+                self.emit_wake_up_signal()
+                return RUNNING
             status = child.execute_tick()
             if status is RUNNING:
                 return RUNNING
@@ -104,10 +116,10 @@ class RepeatUnlessFailureWithinTick(_RepeatUnlessFailure):
     """Runs the child until it fails (FAILURE) or has succeeded ``num_cycles`` times (SUCCESS), back to
     back in one tick while the child completes at once.
 
-    It returns RUNNING only while the child is RUNNING (the next iteration then follows in the tick that
-    completes it). Unlike BT.CPP's Repeat it never yields between instant iterations, so ``num_cycles``
-    instant iterations take one tick; ``num_cycles="-1"`` with a child that always succeeds at once never
-    returns (use RepeatUnlessFailureEachTick for that).
+    It returns RUNNING while the child is RUNNING (the next iteration then follows in the tick that
+    completes it). Unlike BT.CPP's Repeat it does not yield between instant iterations, so ``num_cycles``
+    instant iterations take one tick; only a loop still going after :data:`WITHIN_TICK_BUDGET_S` returns
+    RUNNING and is ticked again at once, so that a cancel is served (see the module docstring).
     """
 
     within_tick = True
