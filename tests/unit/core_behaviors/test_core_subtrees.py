@@ -26,6 +26,8 @@ CALLS = """<root BTCPP_format="4" main_tree_to_execute="Calls">
         acceleration_scale_factor="1.0" />
       <SubTree ID="Move to Pose (JTC)" _collapsed="false" target_pose="{target_pose}" link_padding="0.0"
         planning_group_name="manipulator" ik_frame="grasp_link" require_user_approval="true" />
+      <SubTree ID="Move to Pose" _collapsed="true" target_pose="{target_pose}" require_user_approval="true"
+        controller_names="joint_trajectory_admittance_controller;franka_gripper_controller" />
       <SubTree ID="Request Teleoperation" _collapsed="true" enable_user_interaction="true"
         initial_teleop_mode="4"
         user_interaction_prompt="Teleoperate end effector to grasp pose"
@@ -106,6 +108,15 @@ PORTS = {
         "controller_names",
         "controller_action_server",
         "execution_pipeline",
+    },
+    "Move to Pose": {
+        "target_pose",
+        "planning_group_name",
+        "ik_frame",
+        "link_padding",
+        "require_user_approval",
+        "controller_names",
+        "controller_action_server",
     },
     "Move to Pose (JTC)": {
         "target_pose",

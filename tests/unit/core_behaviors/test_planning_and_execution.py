@@ -395,3 +395,41 @@ def test_a_controller_that_goes_away_fails_the_run_within_a_second(
     assert status == NodeStatus.FAILURE, f"still {status} {time.monotonic() - gone:.1f} s after it went away"
     assert "lost the controller" in messages[-1].text
     controller.hang.set()
+
+
+def test_execute_mtc_solution_runs_the_planned_solution_on_the_controller(
+    behavior: Any, context: BehaviorContext, at_home: None
+) -> None:
+    """MoveIt Pro's newer objectives execute a solution with ExecuteMTCSolution (hangar_sim's "Move to Pose
+    No Preview"), where older ones call the "Execute MTC Solution" subtree: the same motion reaches the
+    controller, with the ports those objectives set."""
+    from kinema.transport import from_dict
+
+    task = tick_behavior(behavior("InitializeMTCTask"), {"task_id": "t"}, context=context).outputs["task"]
+    task = tick_behavior(behavior("SetupMTCCurrentState"), {"task": task}, context=context).outputs["task"]
+    goal = from_dict("sensor_msgs/msg/JointState", {"name": ARM, "position": MID})
+    task = tick_behavior(
+        behavior("SetupMTCPlanToRobotState"), {"task": task, "joint_state": goal}, context=context
+    ).outputs["task"]
+    planned = tick_behavior(behavior("PlanMTCTask"), {"task": task}, context=context, timeout=60)
+    assert planned.status == NodeStatus.SUCCESS, planned.toasts
+    solution = planned.outputs["solution"]
+    controller = Controller(context.node)
+    run = tick_behavior(
+        behavior("ExecuteMTCSolution"),
+        {
+            "solution": solution,
+            "execution_pipeline": "jtc",
+            "controller_action_name": "/joint_trajectory_controller/follow_joint_trajectory",
+            "goal_duration_tolerance": -1.0,
+        },
+        context=context,
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    sent = controller.goals[0].trajectory
+    joined = solution.joined()
+    assert list(sent.joint_names) == list(joined.joint_names)
+    assert np.allclose(sent.points[-1].positions, joined.positions[-1])
+    refused = tick_behavior(behavior("ExecuteMTCSolution"), {"solution": task}, context=context)
+    assert refused.status == NodeStatus.FAILURE
+    assert "needs a solution PlanMTCTask planned, got" in refused.toasts[-1], refused.toasts

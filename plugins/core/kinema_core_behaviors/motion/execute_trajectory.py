@@ -139,9 +139,17 @@ class ExecuteTrajectory(AsyncBehavior):
         super().__init__(name, config)
         self._handle: Any = None
 
+    def trajectory_to_run(self) -> Any:
+        """The trajectory_msgs/JointTrajectory to send (a subclass may make it from another port).
+
+        Raises:
+            KinemaError: the port does not give one (the run fails with the message).
+        """
+        return self.get_input("joint_trajectory_msg")
+
     def create_goal(self) -> dict[str, Any]:
         """The FollowJointTrajectory goal: the trajectory and the tolerances given on the ports."""
-        message = self.get_input("joint_trajectory_msg")
+        message = self.trajectory_to_run()
         trajectory_from_message(
             message, "joint_trajectory_msg"
         )  # reject malformed input here, not in the driver
