@@ -11,6 +11,8 @@
 * :func:`load_pcd`, :func:`save_pcd` (``pcd.py``) — PCL's .pcd files;
 * :func:`sample_mesh_surface` (``mesh_sampling.py``) — points spread evenly over an STL's surface;
 * :func:`slice_contour` (``contour.py``) — poses along the outline of a slice of a cloud;
+* :func:`surface_normal`, :func:`pose_on_surface` (``surface_pose.py``) — the normal of a neighbourhood
+  facing a viewpoint, and a pose on the surface with z along it;
 * :func:`camera_in_base` (``calibration.py``) — a camera's pose from three tags on a calibration tool;
 * ``ros_messages.py`` — the edge: ``sensor_msgs`` PointCloud2 / Image / CameraInfo ↔ the above.
 
@@ -39,6 +41,8 @@ _EXPORTS = {
     "save_pcd": "pcd",
     "sample_mesh_surface": "mesh_sampling",
     "slice_contour": "contour",
+    "surface_normal": "surface_pose",
+    "pose_on_surface": "surface_pose",
     "camera_in_base": "calibration",
     "tool_frame_from_tags": "calibration",
 }

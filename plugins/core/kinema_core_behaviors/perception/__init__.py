@@ -1,6 +1,7 @@
 """Perception: camera messages onto the blackboard, AprilTags found in images, point clouds transformed,
-cropped, merged, registered, loaded from files, cut out by image masks and turned into obstacles (planning
-scene, collision spheres). The segmentation-model behaviors are known but fail when they run (no model).
+cropped, merged, registered, loaded from files, cut out by image masks, read as poses on the surface at
+clicked pixels and turned into obstacles (planning scene, collision spheres). The segmentation-model
+behaviors are known but fail when they run (no model).
 
 Ports hold ``sensor_msgs`` messages as MoveIt Pro's do; the work is done on numpy arrays by
 :mod:`kinema.perception`, with the conversions in :mod:`.clouds`.
@@ -20,6 +21,7 @@ from .find_masked_objects import FindMaskedObjects
 from .load_point_cloud_from_file import LoadPointCloudFromFile
 from .masks import GetMasks3DFromMasks2D, GetPointCloudFromMask3D
 from .merge_point_clouds import MergePointClouds
+from .pose_from_pixel_coords import GetPoseFromPixelCoords
 from .register_point_clouds import RegisterPointClouds
 from .segmentation import GetMasks2DFromExemplar, GetMasks2DFromPointQuery
 from .synced_image_and_cloud import GetSyncedImageAndPointCloud
@@ -36,6 +38,7 @@ BEHAVIORS = (
     CropPointsInBox,
     RemovePointsInBox,
     GetCentroidFromPointCloud,
+    GetPoseFromPixelCoords,
     MergePointClouds,
     RegisterPointClouds,
     LoadPointCloudFromFile,
