@@ -87,7 +87,7 @@ def test_a_half_pixel_rounds_to_the_nearest_and_the_whole_cloud_may_be_used(beha
     assert np.allclose(pose_from_message(result.outputs["output_poses"][0].pose)[:3, 3], points[7, 32])
 
 
-def test_push_buttons_transform_pose_puts_the_approach_in_front_of_the_surface(behavior: Any) -> None:
+def test_push_buttons_transform_pose_makes_an_approach_facing_the_surface(behavior: Any) -> None:
     points = tilted_plane()
     found = run(behavior, cloud_message(points), pixels((20, 30)))
     assert found.status == NodeStatus.SUCCESS, found.toasts
@@ -100,8 +100,10 @@ def test_push_buttons_transform_pose_puts_the_approach_in_front_of_the_surface(b
         },
     )
     assert approach.status == NodeStatus.SUCCESS, approach.toasts
-    position = pose_from_message(approach.outputs["output_pose"].pose)[:3, 3]
-    assert np.allclose(position, points[30, 20] + 0.1 * NORMAL, atol=1e-3)
+    pose = pose_from_message(approach.outputs["output_pose"].pose)
+    assert np.allclose(pose[:3, 3], points[30, 20] + 0.1 * NORMAL, atol=1e-3)
+    # ...facing it: the approach's z points into the surface, as a tool's should.
+    assert np.allclose(pose[:3, 2], -NORMAL, atol=1e-3)
 
 
 def test_a_point_on_the_other_side_of_the_camera_still_faces_it(behavior: Any) -> None:

@@ -32,9 +32,9 @@ class GetPoseFromPixelCoords(SyncBehavior):
     (the camera, for the camera's own cloud); its x axis is the cloud frame's x (image right) laid into the
     surface, its y completes the frame (image up, for a surface facing the camera). So TransformPose's
     ``translation_xyz`` 0;0;d gives a pose d in front of the surface on the camera's side (push_button.xml's
-    approach, 0.1 m out). Its ``quaternion_xyzw`` 0.7071;0.7071;0;0 then turns the approach's z to this
-    pose's -y, along the surface (image down); no choice of x and y avoids that. A tool z pointing into the
-    surface is this pose turned half a turn about x (quaternion_xyzw 1;0;0;0). The normal is fitted (PCA) to
+    approach, 0.1 m out), and its ``quaternion_xyzw`` 0.7071;0.7071;0;0 (half a turn about the x+y
+    diagonal) points the approach's z into the surface and swaps x and y: a tool frame sent there faces the
+    surface from 0.1 m out, the convention the objective implies. The normal is fitted (PCA) to
     the points within ``neighbor_radius`` of the pixel's point, taken from ``downsample_fraction``
     of the cloud's points spread evenly over it.
 
