@@ -41,6 +41,16 @@ CALLS = """<root BTCPP_format="4" main_tree_to_execute="Calls">
 </root>
 """
 
+MOVE_TO_POSE = {
+    "target_pose",
+    "planning_group_name",
+    "ik_frame",
+    "link_padding",
+    "require_user_approval",
+    "controller_names",
+    "controller_action_server",
+}
+
 # lab_sim's ML objectives call these subtrees of MoveIt Pro's base config (written as they write them).
 ML_CALLS = """<root BTCPP_format="4" main_tree_to_execute="ML Calls">
   <BehaviorTree ID="ML Calls">
@@ -109,24 +119,8 @@ PORTS = {
         "controller_action_server",
         "execution_pipeline",
     },
-    "Move to Pose": {
-        "target_pose",
-        "planning_group_name",
-        "ik_frame",
-        "link_padding",
-        "require_user_approval",
-        "controller_names",
-        "controller_action_server",
-    },
-    "Move to Pose (JTC)": {
-        "target_pose",
-        "planning_group_name",
-        "ik_frame",
-        "link_padding",
-        "require_user_approval",
-        "controller_names",
-        "controller_action_server",
-    },
+    "Move to Pose": MOVE_TO_POSE,
+    "Move to Pose (JTC)": MOVE_TO_POSE,
     "Request Teleoperation": {
         "enable_user_interaction",
         "user_interaction_prompt",

@@ -92,6 +92,22 @@ def message_vector_inout(
     )
 
 
+def speed_scale_ports(
+    velocity: str | None = "velocity_scale_factor", acceleration: str | None = "acceleration_scale_factor"
+) -> list[PortInfo]:
+    """The ports scaling a motion's speed below the joints' limits, declared once for every behavior that
+    times a motion (MoveIt Pro names them per behavior: ``velocity_scale`` on SetupMTCMoveAlongFrameAxis);
+    a name given as None is left out."""
+    ports = []
+    if velocity:
+        ports.append(input_port(velocity, float, 1.0, "Fraction of the joints' velocity limits, (0, 1]."))
+    if acceleration:
+        ports.append(
+            input_port(acceleration, float, 1.0, "Fraction of the joints' acceleration limits, (0, 1].")
+        )
+    return ports
+
+
 def shown(value: Any, limit: int = 80) -> str:
     """A value as an error message shows it: its type and a short text form."""
     ros_type = getattr(value, "__msgtype__", None)

@@ -10,7 +10,7 @@ from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError, did_you_mean
 
 from ..messages.conversions import TRAJECTORY_TYPE, joint_positions, trajectory_message
-from ..messages.ports import fails_on_bad_input, message_output, port_error, read_input
+from ..messages.ports import fails_on_bad_input, message_output, port_error, read_input, speed_scale_ports
 from .planning_resources import robot_model
 
 # Speeds below this (rad/s or m/s) count as at rest: a simulated arm that has stopped still reports a
@@ -58,15 +58,7 @@ class GeneratePointToPointTrajectory(AsyncBehavior):
                 "move ends at rest.",
             ),
             cell_input_port("planning_group_name", str, "planning_group", "The planning group that moves."),
-            input_port(
-                "velocity_scale_factor", float, 1.0, "Fraction of the joints' velocity limits, (0, 1]."
-            ),
-            input_port(
-                "acceleration_scale_factor",
-                float,
-                1.0,
-                "Fraction of the joints' acceleration limits, (0, 1].",
-            ),
+            *speed_scale_ports(),
             input_port(
                 "jerk_scale_factor",
                 float,

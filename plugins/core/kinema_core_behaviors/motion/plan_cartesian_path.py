@@ -9,6 +9,7 @@ from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError, ObjectiveError, did_you_mean
 
 from ..messages.conversions import pose_matrix, trajectory_message
+from ..messages.ports import speed_scale_ports
 from .joint_states import joint_state_monitor
 from .planned_trajectory import publish_planned_trajectory
 from .planning_resources import collision_checker, robot_model
@@ -54,15 +55,7 @@ class PlanCartesianPath(AsyncBehavior):
             ),
             input_port("ik_cartesian_space_density", float, 0.005, "Distance (m) between IK solutions."),
             input_port("link_padding", float, 0.0, "Clearance (m) kept between the robot and the scene."),
-            input_port(
-                "velocity_scale_factor", float, 1.0, "Fraction of the joints' velocity limits, (0, 1]."
-            ),
-            input_port(
-                "acceleration_scale_factor",
-                float,
-                1.0,
-                "Fraction of the joints' acceleration limits, (0, 1].",
-            ),
+            *speed_scale_ports(),
             input_port(
                 "ik_joint_space_density",
                 float,

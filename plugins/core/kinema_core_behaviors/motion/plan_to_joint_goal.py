@@ -9,6 +9,7 @@ from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError, did_you_mean
 
 from ..messages.conversions import joint_positions, trajectory_message
+from ..messages.ports import speed_scale_ports
 from .joint_states import joint_state_monitor
 from .planned_trajectory import publish_planned_trajectory
 from .planning_resources import collision_checker, robot_model
@@ -60,15 +61,7 @@ class PlanToJointGoal(AsyncBehavior):
             ),
             cell_input_port("planning_group_name", str, "planning_group", "The planning group that moves."),
             input_port("link_padding", float, 0.01, "Clearance (m) kept between the robot and the scene."),
-            input_port(
-                "velocity_scale_factor", float, 1.0, "Fraction of the joints' velocity limits, (0, 1]."
-            ),
-            input_port(
-                "acceleration_scale_factor",
-                float,
-                1.0,
-                "Fraction of the joints' acceleration limits, (0, 1].",
-            ),
+            *speed_scale_ports(),
             input_port(
                 "orientation_constraint",
                 None,

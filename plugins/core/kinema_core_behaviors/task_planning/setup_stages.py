@@ -23,7 +23,7 @@ from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import KinemaError
 
 from ..messages.conversions import joint_positions, pose_matrix
-from ..messages.ports import message_input, message_vector_input
+from ..messages.ports import message_input, message_vector_input, speed_scale_ports
 from .mtc_task import CurrentStateMarker, MtcTask, stage_name, task_input
 
 SUBCATEGORY = "Motion - Task Planning"
@@ -56,16 +56,7 @@ class MotionPorts:
         ports = [
             cell_input_port("planning_group_name", str, "planning_group", "The planning group that moves.")
         ]
-        if self.velocity:
-            ports.append(
-                input_port(self.velocity, float, 1.0, "Fraction of the joints' velocity limits, (0, 1].")
-            )
-        if self.acceleration:
-            ports.append(
-                input_port(
-                    self.acceleration, float, 1.0, "Fraction of the joints' acceleration limits, (0, 1]."
-                )
-            )
+        ports += speed_scale_ports(self.velocity, self.acceleration)
         if self.planning:
             ports += [
                 input_port(
