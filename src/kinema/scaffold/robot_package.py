@@ -28,10 +28,12 @@ What it decides, and where a user changes it (config.yaml says it again beside e
   group of joints that ends with fixed ones), or the tool point fixed beyond it (a single path of fixed
   joints ending in a link named like tcp, tool, eef, frame, grasp or tip), said in a note;
 - ``Home``: the first SRDF group state named ``home``, ``ready`` or ``default`` that covers the planning
-  group, else every joint at 0 (a joint whose limits exclude 0 at the middle of its range). The
-  simulation starts there. Link pairs in collision at Home are disabled in a generated SRDF (reason
-  ``Default``, as MoveIt's setup assistant does); a given SRDF is left as it is, and a note says which
-  pairs overlap;
+  group, else the rest pose, every joint at 0 (a joint whose limits exclude 0 at the middle of its
+  range), when a user can work from it; where it is near-singular, lies on the table or leaves the tool
+  no room to move, the least bent pose from it that does not (:mod:`kinema.scaffold.home_pose` has the
+  rule), said in a note and in config.yaml. The simulation starts there. Link pairs in collision at the
+  rest pose are disabled in a generated SRDF (reason ``Default``, as MoveIt's setup assistant does); a
+  given SRDF is left as it is, and a note says which pairs overlap at Home;
 - accelerations: the URDF has none, so each joint's is twice its velocity limit per second.
 
 Nothing is written when anything fails: the package is made in a temporary folder and moved into place.
@@ -44,9 +46,12 @@ import math
 import re
 import shutil
 import tempfile
-from collections.abc import Callable, Mapping, Sequence
+import textwrap
+from collections.abc import Callable, Iterator, Mapping, Sequence
+from contextlib import contextmanager
 from dataclasses import dataclass, field
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from lxml import etree
 
@@ -54,13 +59,22 @@ from kinema.config.robot_files import PackageIndex, ResolvedRobot, UrdfJoint, re
 from kinema.config.workspace import Workspace
 from kinema.errors import KinemaError, MotionError, ScaffoldError
 from kinema.motion.srdf import GroupDefinition, SemanticDescription, parse_srdf
+from kinema.scaffold.home_pose import HomeChoice, home_note
 from kinema.scaffold.names import check_package_name
+
+if TYPE_CHECKING:
+    from kinema.motion.robot_model import RobotModel
 
 #: The parent of every generated package.
 BASE_PACKAGE = "kinema_base"
 GRIPPER_CONTROLLER = "gripper_controller"
 ARM_CONTROLLER = "joint_trajectory_controller"
 HOME = "Home"
+#: How a user changes the generated Home, said wherever Home's choice is.
+HOME_HOW_TO = (
+    "To start elsewhere, give an SRDF with a group state 'home' (--srdf), or edit Home in "
+    "waypoints/waypoints.yaml and the scene's keyframe 'home' (the simulation starts there)."
+)
 #: The last joint of a generated group's chain with such a name is the gripper, not part of the group.
 GRIPPER_NAME = re.compile(r"grip|finger|jaw|claw", re.IGNORECASE)
 
@@ -82,6 +96,8 @@ class RobotPlan:
     gripper_open: float = 0.0
     gripper_closed: float = 0.0
     notes: list[str] = field(default_factory=list)
+    #: Why Home is what it is, when the rest pose was found wanting (config.yaml says it too).
+    home_note: str | None = None
 
 
 def _package_index(workspace: Workspace) -> PackageIndex:
@@ -203,15 +219,10 @@ def _generated_srdf(
     return '<?xml version="1.0"?>\n' + etree.tostring(root, pretty_print=True, encoding="unicode")
 
 
-def _home_collisions(
-    robot: ResolvedRobot, srdf_text: str, home: Mapping[str, float]
-) -> list[tuple[str, str]]:
-    """The link pairs in collision at ``home`` (the SRDF's disabled pairs left out).
-
-    Raises:
-        MotionError: pinocchio cannot load the robot or build its collision model.
-    """
-    from kinema.motion.collision import CollisionChecker, self_collisions
+@contextmanager
+def _planning_model(robot: ResolvedRobot, srdf_text: str, notes: list[str]) -> Iterator[RobotModel | None]:
+    """The robot as the planner loads it (URDF and SRDF), while a copy of its files exists (the collision
+    meshes are read through the URDF); None, said in a note, when pinocchio cannot load it."""
     from kinema.motion.robot_model import RobotModel
 
     # The SRDF's notes were said already, at the user's file: not again at this temporary copy.
@@ -222,10 +233,54 @@ def _home_collisions(
             urdf = robot.write_urdf(Path(folder) / "robot.urdf")
             srdf = Path(folder) / "robot.srdf"
             srdf.write_text(srdf_text)
-            # The checker reads the collision meshes through the URDF: while the copy is there.
-            return self_collisions(CollisionChecker(RobotModel.from_urdf(urdf, srdf)), home)
+            try:
+                model = RobotModel.from_urdf(urdf, srdf)
+                model.collision_geometry()
+            except MotionError as error:
+                notes.append(f"{HOME} was not checked for collisions: {error.message}")
+                model = None
+            yield model
     finally:
         model_log.disabled = was_disabled
+
+
+def _self_collisions(model: RobotModel, home: Mapping[str, float]) -> list[tuple[str, str]]:
+    """The link pairs in collision at ``home`` (the SRDF's disabled pairs left out)."""
+    from kinema.motion.collision import CollisionChecker, self_collisions
+
+    return self_collisions(CollisionChecker(model), home)
+
+
+def _choose_home(
+    model: RobotModel,
+    group: str,
+    tool_frame: str,
+    rest: Mapping[str, float],
+    table_top: float,
+    notes: list[str],
+) -> HomeChoice | None:
+    """:func:`~kinema.scaffold.home_pose.choose_home`; None, said in a note, when the model cannot tell."""
+    from kinema.scaffold.home_pose import choose_home
+
+    try:
+        return choose_home(model, group, tool_frame, rest, table_top=table_top)
+    except MotionError as error:
+        notes.append(f"{HOME} is the rest pose, not checked for reach: {error.message}")
+        return None
+
+
+def _table_top(robot: ResolvedRobot, model: RobotModel) -> float:
+    """The height of the generated table's top in the URDF's root frame, m: where the scene stands the
+    robot, at its root link, or at the link fixed to a root named ``world`` (MuJoCo merges that one into
+    its world)."""
+    from kinema.motion.kinematics import fk
+
+    if robot.root_link() != "world":
+        return 0.0
+    mount = next((j for j in robot.joints() if j.parent == "world" and j.kind == "fixed"), None)
+    if mount is None:
+        return 0.0
+    return float(fk(model, model.neutral(), mount.child)[2, 3])
 
 
 def _depth(joints: Mapping[str, UrdfJoint], link: str) -> int:
@@ -387,20 +442,37 @@ def plan_robot(
             )
         home[gripper] = opened
     generated = not groups
-    try:
-        overlapping = _home_collisions(robot, srdf_text, home)
-    except MotionError as error:
-        overlapping = []
-        notes.append(f"{HOME} was not checked for self-collision: {error.message}")
+    rest_words = "every joint at 0" + (
+        " (those whose limits exclude 0 mid-range)"
+        if any(_rest(joints[n]) != 0.0 for n in group_joints)
+        else ""
+    )
+    with _planning_model(robot, srdf_text, notes) as model:
+        # As MoveIt's setup assistant does: the pairs in collision at the rest pose touch by design.
+        overlapping = _self_collisions(model, home) if model is not None else []
+        if overlapping and generated:
+            srdf_text = _generated_srdf(robot, group, base, tip, semantic, overlapping)
+            semantic = _parse_srdf_text(srdf_text)
+            if model is not None:
+                model.semantic = semantic
+        choice = None
+        if home_state is None and model is not None:
+            choice = _choose_home(model, group, tool_frame, home, _table_top(robot, model), notes)
+        if choice is not None and choice.changed:
+            home.update(choice.positions)
+            if not generated and model is not None:
+                overlapping = _self_collisions(model, home)
     if overlapping and generated:
-        srdf_text = _generated_srdf(robot, group, base, tip, semantic, overlapping)
-        semantic = _parse_srdf_text(srdf_text)
+        at = "the rest pose (where Home was moved from)" if choice is not None and choice.changed else HOME
         notes.append(
-            f"{len(overlapping)} link pair(s) in collision at {HOME} are disabled in the SRDF (reason "
-            f"Default, as MoveIt's setup assistant does: links that touch by design): "
+            f"{len(overlapping)} link pair(s) in collision at {at} are disabled in the SRDF (reason Default, "
+            f"as MoveIt's setup assistant does: links that touch by design): "
             + ", ".join(f"{a} - {b}" for a, b in overlapping)
         )
-    elif overlapping:
+    chosen_note = home_note(choice, rest_words, HOME_HOW_TO) if choice is not None else None
+    if chosen_note is not None:
+        notes.append(chosen_note)
+    if overlapping and not generated:
         from kinema.motion.collision import self_collision_warning
 
         notes.append(self_collision_warning(HOME, overlapping, "the SRDF"))
@@ -434,6 +506,7 @@ def plan_robot(
         gripper_open=opened,
         gripper_closed=closed,
         notes=notes,
+        home_note=chosen_note,
     )
 
 
@@ -548,7 +621,7 @@ hardware:
     mujoco_model:
       package: "{name}"
       path: "description/{scene}"
-    # The simulation starts in, and resets to, this keyframe ({HOME}'s joint values).
+    # The simulation starts in, and resets to, this keyframe ({HOME}'s joint values).{_home_comment(plan)}
     mujoco_keyframe: "home"
 
 ros_global_params:
@@ -598,6 +671,14 @@ objectives:
     relative_path: "waypoints/waypoints.yaml"
 """
     return text
+
+
+def _home_comment(plan: RobotPlan) -> str:
+    """config.yaml's word on how Home was chosen, when the rest pose was found wanting."""
+    if plan.home_note is None:
+        return ""
+    lines = textwrap.wrap(plan.home_note, width=100, break_long_words=False, break_on_hyphens=False)
+    return "".join(f"\n    # {line}" for line in lines)
 
 
 def _package_xml(name: str, robot: str) -> str:
