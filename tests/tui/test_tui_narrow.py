@@ -121,3 +121,18 @@ def test_at_80_columns_two_long_objective_names_can_be_told_apart(fake: FakeConn
         assert not text[first + 1].startswith("◦"), text  # its continuation, not another objective
 
     drive(fake, scenario, size=NARROW)
+
+
+def test_at_80_columns_the_objective_header_shows_its_package_and_file(fake: FakeConnection) -> None:
+    """The header showed "kinema_objectives:" and nothing more: the absolute path wrapped out of sight."""
+    fake.objectives = [
+        replace(o, file_path=f"/home/someone/.venvs/robots/lib/python3.11/site-packages/kinema/{o.file_path}")
+        for o in fake.objectives
+    ]
+
+    async def scenario(app, pilot) -> None:  # type: ignore[no-untyped-def]
+        await settle(pilot)
+        shown = "\n".join(lines(app.screen.query_one("#objective-description")))
+        assert "lab_sim: objectives/pick_object.xml" in shown, shown
+
+    drive(fake, scenario, size=NARROW)

@@ -5,6 +5,7 @@ While PlanMTCTask plans a task, a panel above the tree shows its stages live (st
 
 from __future__ import annotations
 
+from pathlib import Path
 from typing import TYPE_CHECKING, cast
 
 from rich.table import Table
@@ -264,7 +265,7 @@ class ObjectivesScreen(KinemaScreen):
         if not objective.runnable:
             title.append("  (subtree only)", style="dim italic")
         self.query_one("#objective-title", Static).update(title)
-        where = f"{objective.package}: {objective.file_path}" if objective.package else objective.file_path
+        where = _location(objective)
         description = Text(objective.description or "(no description)")
         if where:
             description.append(f"\n{where}", style="dim")
@@ -501,3 +502,11 @@ def _objective_row(objective: ObjectiveSummary) -> Table:
         mark = Text("  " if objective.runnable else "◦ ", style="dim")
     row.add_row(mark, Text(objective.name, style="" if objective.runnable else "dim italic"))
     return row
+
+
+def _location(objective: ObjectiveSummary) -> str:
+    """Where the objective's file is, short enough for the pane's one line at 80 columns: the package and
+    the file's last two parts (``lab_sim: objectives/pick_object.xml``); the full path was cut off."""
+    parts = Path(objective.file_path).parts if objective.file_path else ()
+    short = "/".join(parts[-2:])
+    return f"{objective.package}: {short}" if objective.package else short
