@@ -13,6 +13,8 @@
 * :func:`slice_contour` (``contour.py``) — poses along the outline of a slice of a cloud;
 * :func:`surface_normal`, :func:`pose_on_surface` (``surface_pose.py``) — the normal of a neighbourhood
   facing a viewpoint, and a pose on the surface with z along it;
+* :func:`fit_line_segment` (``line_fit.py``) — the segment points lie along (RANSAC, then their extent);
+* :func:`fit_face_box` (``face_box.py``) — the box of an object from the face a camera sees of it;
 * :func:`camera_in_base` (``calibration.py``) — a camera's pose from three tags on a calibration tool;
 * ``ros_messages.py`` — the edge: ``sensor_msgs`` PointCloud2 / Image / CameraInfo ↔ the above.
 
@@ -43,6 +45,10 @@ _EXPORTS = {
     "slice_contour": "contour",
     "surface_normal": "surface_pose",
     "pose_on_surface": "surface_pose",
+    "fit_line_segment": "line_fit",
+    "LineSegment": "line_fit",
+    "fit_face_box": "face_box",
+    "FaceBox": "face_box",
     "camera_in_base": "calibration",
     "tool_frame_from_tags": "calibration",
 }

@@ -19,9 +19,8 @@ from ..messages.ports import (
     write_output,
 )
 from .clouds import CAMERA_INFO, POINT_CLOUD, frame_of, read_cloud, target_T_source
+from .graspable_objects import graspable_box
 from .masks import mask_image
-
-GRASPABLE_OBJECT = "moveit_studio_vision_msgs/msg/GraspableObject"
 
 
 def fit_box(points: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -93,13 +92,7 @@ class FindMaskedObjects(SyncBehavior):
     def tick(self) -> NodeStatus:
         import numpy as np
 
-        from kinema.motion.planning_scene_messages import collision_object_message, shape_constants
         from kinema.perception.ros_messages import intrinsics_of
-        from kinema.transport import from_dict
-
-        from ..messages.conversions import pose_stamped_message
-
-        box, add = shape_constants().BOX, collision_object_message().ADD
 
         cloud = read_cloud(self, "point_cloud")
         camera = intrinsics_of(read_message(self, "camera_info", CAMERA_INFO))
@@ -129,23 +122,7 @@ class FindMaskedObjects(SyncBehavior):
             largest_face = max(size[0] * size[1], size[1] * size[2], size[0] * size[2])
             if largest_face < minimum_area:
                 continue
-            stamped = pose_stamped_message(base, pose)
-            objects.append(
-                from_dict(
-                    GRASPABLE_OBJECT,
-                    {
-                        "object": {
-                            "header": {"frame_id": base},
-                            "id": f"object_{index}",
-                            "primitives": [{"type": box, "dimensions": [float(v) for v in size]}],
-                            "primitive_poses": [stamped.pose],
-                            "operation": add,
-                        },
-                        "object_color": {"r": 0.2, "g": 0.6, "b": 0.9, "a": 1.0},
-                        "grasp_info": "",
-                    },
-                )
-            )
+            objects.append(graspable_box(base, f"object_{index}", pose, size))
         write_output(self, "detected_shapes", objects)
         return NodeStatus.SUCCESS
 

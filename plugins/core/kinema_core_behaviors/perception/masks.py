@@ -32,23 +32,51 @@ MASK2D = "moveit_studio_vision_msgs/msg/Mask2D"
 MASK3D = "moveit_studio_vision_msgs/msg/Mask3D"
 
 
-def mask_image(node: Any, port: str, index: int, mask: Any, width: int, height: int) -> np.ndarray:
-    """The HxW boolean image of Mask2D ``mask`` placed at its (x, y) offset in a ``width`` x ``height``
-    image."""
-    import numpy as np
+def mask_layer(node: Any, port: str, index: int, mask: Any) -> np.ndarray:
+    """The boolean image (its own height x width) of Mask2D ``mask``: True on the object's pixels.
 
+    Raises:
+        PortValueError: the element is not a Mask2D, or its image is malformed.
+    """
     if getattr(mask, "__msgtype__", None) != MASK2D:
         raise port_error(
             node, port, f"element {index} is not a {MASK2D}", "give masks from a GetMasks2D behavior"
         )
     layer, _ = image_pixels(node, port, mask.mask)
+    return layer > 0 if layer.ndim == 2 else layer.max(axis=2) > 0
+
+
+def mask_image(node: Any, port: str, index: int, mask: Any, width: int, height: int) -> np.ndarray:
+    """The HxW boolean image of Mask2D ``mask`` placed at its (x, y) offset in a ``width`` x ``height``
+    image."""
+    import numpy as np
+
     full = np.zeros((height, width), dtype=bool)
     x0, y0 = int(mask.x), int(mask.y)
-    rows, cols = np.nonzero(layer > 0 if layer.ndim == 2 else layer.max(axis=2) > 0)
+    rows, cols = np.nonzero(mask_layer(node, port, index, mask))
     rows, cols = rows + y0, cols + x0
     inside = (rows >= 0) & (rows < height) & (cols >= 0) & (cols < width)
     full[rows[inside], cols[inside]] = True
     return full
+
+
+def mask3d_indices(node: Any, port: str, mask3d: Any, cloud_size: int) -> np.ndarray:
+    """The point indices of Mask3D ``mask3d`` (int64), checked against a cloud of ``cloud_size`` points.
+
+    Raises:
+        PortValueError: the mask lists a point the cloud does not have (it was made from another cloud).
+    """
+    import numpy as np
+
+    indices = np.asarray(mask3d.point_indices, dtype=np.int64)
+    if len(indices) and int(indices.max()) >= cloud_size:
+        raise port_error(
+            node,
+            port,
+            f"lists point {int(indices.max())}, the cloud has {cloud_size} points",
+            "use the cloud the mask was made from (GetMasks3DFromMasks2D's point_cloud)",
+        )
+    return indices
 
 
 class GetMasks3DFromMasks2D(SyncBehavior):
@@ -138,14 +166,7 @@ class GetPointCloudFromMask3D(SyncBehavior):
         import numpy as np
 
         cloud = read_cloud(self, "point_cloud")
-        indices = np.asarray(read_message(self, "mask3d", MASK3D).point_indices, dtype=np.int64)
-        if len(indices) and int(indices.max()) >= len(cloud):
-            raise port_error(
-                self,
-                "mask3d",
-                f"lists point {int(indices.max())}, the cloud has {len(cloud)} points",
-                "use the cloud the mask was made from (GetMasks3DFromMasks2D's point_cloud)",
-            )
+        indices = mask3d_indices(self, "mask3d", read_message(self, "mask3d", MASK3D), len(cloud))
         keep = np.zeros(len(cloud), dtype=bool)
         keep[indices] = True
         write_cloud(self, "point_cloud_fragment", cloud.select(keep).finite())
