@@ -13,7 +13,7 @@ from collections.abc import Collection, Iterable
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from kinema.errors import KinemaError, SourceLocation, did_you_mean
+from kinema.errors import KinemaError, SourceLocation
 
 if TYPE_CHECKING:
     from kinema.config.inheritance import ResolvedConfig
@@ -54,15 +54,25 @@ def waypoint_names_used(path: Path) -> list[tuple[SourceLocation, str]]:
 
 def unknown_waypoint_warnings(paths: Iterable[Path], known: Collection[str], config: str) -> list[str]:
     """``file:line: ...`` for each literal waypoint name in ``paths`` that is not among ``known``."""
+    import difflib
+
     warnings = []
     for path in paths:
         for location, name in waypoint_names_used(Path(path)):
-            if name not in known:
-                warnings.append(
-                    f"{location}: waypoint {name!r} is not one of config {config}'s waypoints "
-                    f"({did_you_mean(name, known)}); the objective fails there unless it is saved first "
-                    f"(`kinema waypoint save {name!r}`)"
-                )
+            if name in known:
+                continue
+            # One line each, short: a folder copied from another config names many of its waypoints, and the
+            # full list repeated on every line drowned them (`kinema waypoint list` prints it once).
+            close = difflib.get_close_matches(name, sorted(known), n=3, cutoff=0.6)
+            hint = (
+                "did you mean " + " or ".join(repr(c) for c in close) + "?"
+                if close
+                else f"it has {len(known)}: `kinema waypoint list -c {config}`"
+            )
+            warnings.append(
+                f"{location}: waypoint {name!r} is not one of config {config}'s waypoints ({hint}); the "
+                f"objective fails there unless it is saved first (`kinema waypoint save {name!r}`)"
+            )
     return warnings
 
 

@@ -508,7 +508,8 @@ class _Planner:
             if isinstance(stage, MoveAlongFrameAxis):
                 return self.along_axis(index, stage, q_from, backwards=False)
             if isinstance(stage, PlanToJointState):
-                return self.joint_motion(index, stage.motion, q_from, dict(stage.goal))
+                goal = self.group_goal(index, stage.motion.group, stage.goal)
+                return self.joint_motion(index, stage.motion, q_from, goal)
             if isinstance(stage, PlanToPose):
                 return self.plan_to_pose(index, stage, q_from)
             if isinstance(stage, CartesianMoveToJointState):
@@ -609,6 +610,31 @@ class _Planner:
             )
         return line, line[-1].copy()
 
+    def group_goal(self, index: int, group: str, goal: Mapping[str, float]) -> dict[str, float]:
+        """The positions of ``goal`` (a joint state, perhaps a whole saved robot state) for ``group``'s
+        joints: the robot's other joints (a gripper, its mimic fingers) are left where they are, as MTC's
+        stages read a robot-state goal; a name the robot does not have is an error.
+
+        Raises:
+            MotionError: an unknown joint (with the close names), or no joint of the group.
+        """
+        model = self.model
+        g = self.group(index, group)
+        for name in goal:
+            if name not in model.joint_names and name not in model.mimics:
+                from kinema.errors import did_you_mean
+
+                raise MotionError(
+                    f"the joint state names unknown joint {name!r}; "
+                    f"{did_you_mean(name, model.joint_names, limit=32)}"
+                )
+        mine = {n: float(v) for n, v in goal.items() if n in g.joint_names}
+        if not mine:
+            raise MotionError(
+                f"the joint state names no joint of planning group {group!r} ({', '.join(g.joint_names)})"
+            )
+        return mine
+
     def cartesian_to_joint_state(
         self, index: int, stage: CartesianMoveToJointState, q_from: np.ndarray
     ) -> tuple[np.ndarray, np.ndarray]:
@@ -618,20 +644,7 @@ class _Planner:
         from kinema.motion.planner import goal_configuration
 
         g = self.group(index, stage.motion.group)
-        for name in stage.goal:
-            if name not in self.model.joint_names:
-                from kinema.errors import did_you_mean
-
-                raise MotionError(
-                    f"the joint state names unknown joint {name!r}; "
-                    f"{did_you_mean(name, self.model.joint_names, limit=32)}"
-                )
-        goal = {n: v for n, v in stage.goal.items() if n in g.joint_names}
-        if not goal:
-            raise MotionError(
-                f"the joint state names no joint of planning group {stage.motion.group!r} "
-                f"({', '.join(g.joint_names)})"
-            )
+        goal = self.group_goal(index, stage.motion.group, stage.goal)
         tip = stage.tip_frame or g.tip_link
         if not tip:
             raise MotionError(

@@ -200,11 +200,10 @@ class _Judge:
         least = MIN_HEIGHT * self.length
         tool, lowest = self.heights(q)
         if tool < least:
-            return (
-                f"its tool frame {self.tool_frame} is {tool:.2f} m above the table top (under {least:.2f} m)"
-            )
+            where = f"{_height(tool)} the table top"
+            return f"its tool frame {self.tool_frame} is {where} (under {least:.2f} m above)"
         if lowest is not None and lowest[1] < least:
-            return f"it lies on the table ({lowest[0]} {lowest[1]:.2f} m above it, under {least:.2f} m)"
+            return f"it lies on the table ({lowest[0]} {_height(lowest[1])} it, under {least:.2f} m above)"
         return None
 
     def stuck(self, q: np.ndarray) -> str | None:
@@ -335,3 +334,8 @@ def home_note(choice: HomeChoice, rest_words: str, how_to_change: str) -> str | 
         f"(at rest {choice.rest_manipulability:.3f}), tool frame {choice.tool_height:.2f} m above the table: "
         f"{values}. {how_to_change}"
     )
+
+
+def _height(metres: float) -> str:
+    """``0.12 m above`` or ``0.01 m below``: a height under the table top is said so, not "-0.01 m above"."""
+    return f"{metres:.2f} m above" if metres >= 0 else f"{-metres:.2f} m below"

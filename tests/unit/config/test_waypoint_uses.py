@@ -10,6 +10,7 @@ from click.testing import CliRunner
 
 from kinema.cli.main import cli
 from kinema.config import resolve_config
+from kinema.config.waypoint_location import waypoint_store_for
 from kinema.config.waypoint_uses import config_waypoint_warnings, waypoint_names_used
 
 COPIED = """<root BTCPP_format="4" main_tree_to_execute="Cycle">
@@ -42,6 +43,8 @@ def test_literal_names_and_declared_defaults_are_checked_blackboard_entries_are_
     assert len(warnings) == 2, warnings
     assert warnings[0].startswith(f"{path}:4: waypoint 'Grasp Left' is not one of config lab_sim's waypoints")
     assert "kinema waypoint save 'Grasp Left'" in warnings[0]
+    count = len(waypoint_store_for(resolve_config("lab_sim")).names())  # type: ignore[union-attr]
+    assert f"(it has {count}: `kinema waypoint list -c lab_sim`)" in warnings[0]
     assert warnings[1].startswith(f"{path}:12: waypoint 'Arm Forwrd'")
 
 

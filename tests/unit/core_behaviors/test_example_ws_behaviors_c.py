@@ -420,3 +420,34 @@ def test_an_objective_with_the_example_objectives_ports_pushes_and_retreats(
     line = (back[-1] - back[0]) / np.linalg.norm(back[-1] - back[0])
     off = back - back[0] - np.outer((back - back[0]) @ line, line)
     assert np.linalg.norm(off, axis=1).max() < 1e-3
+
+
+def test_a_saved_robot_state_with_the_gripper_and_its_mimic_fingers_is_a_goal_for_the_arm(
+    lab_sim_model: Any,
+) -> None:
+    """SaveCurrentState saves every /joint_states joint, a gripper's mimic fingers too; the stages that move
+    back to it (PickNik's push_button and retreat_to_initial_pose) failed on them ("unknown joint
+    'robotiq_85_left_finger_joint'", "not in planning group"). The arm's joints are the goal, the rest
+    stay."""
+    from kinema.errors import MotionError
+    from kinema.motion.task_stages import CartesianMoveToJointState, CurrentState, PlanToJointState
+
+    model = lab_sim_model
+    start = model.configuration(_look_at_table())
+    whole = _plan(model, _push_stages(model, start))
+    from kinema.motion.solution_split import split_solution
+
+    approach = split_solution(whole, 3)[0].end
+    saved = {name: float(approach[model.index(name)]) for name in model.joint_names}
+    saved.update({follower: 0.0 for follower in model.mimics})  # as /joint_states lists them
+    assert set(model.mimics) and not set(model.mimics) & set(model.joint_names)
+    arm = [model.index(n) for n in model.group("manipulator").joint_names]
+    for stage in (
+        CartesianMoveToJointState(saved, _manipulator(link_padding=0.0)),
+        PlanToJointState(saved, _manipulator()),
+    ):
+        back = _plan(model, [CurrentState(whole.end), stage])
+        np.testing.assert_allclose(back.end[arm], approach[arm], atol=1e-6)
+    with pytest.raises(MotionError, match="unknown joint 'no_such_joint'"):
+        typo = PlanToJointState({**saved, "no_such_joint": 0.0}, _manipulator())
+        _plan(model, [CurrentState(whole.end), typo])

@@ -430,6 +430,15 @@ def test_execute_mtc_solution_runs_the_planned_solution_on_the_controller(
     joined = solution.joined()
     assert list(sent.joint_names) == list(joined.joint_names)
     assert np.allclose(sent.points[-1].positions, joined.positions[-1])
+    # The half of a split before the first motion moves nothing: done, nothing sent (every joint's hold,
+    # the gripper's too, went to the arm's controller, which refused it).
+    from kinema.motion.solution_split import split_solution
+
+    nothing = split_solution(solution, 1)[0]
+    assert not nothing.sub_trajectories
+    idle = tick_behavior(behavior("ExecuteMTCSolution"), {"solution": nothing}, context=context)
+    assert idle.status == NodeStatus.SUCCESS and "moves nothing" in idle.toasts[-1], idle.toasts
+    assert len(controller.goals) == 1
     refused = tick_behavior(behavior("ExecuteMTCSolution"), {"solution": task}, context=context)
     assert refused.status == NodeStatus.FAILURE
     assert "needs a solution PlanMTCTask planned, got" in refused.toasts[-1], refused.toasts

@@ -21,7 +21,7 @@ from ..messages.ports import (
     read_message,
     read_text,
 )
-from .locations import file_to_read, file_to_write
+from .locations import RELATIVE_READ, RELATIVE_WRITE, file_to_read, file_to_write
 
 IMAGE = "sensor_msgs/msg/Image"
 # encoding -> (Pillow mode, channels)
@@ -86,8 +86,7 @@ class LoadImageFromFile(AsyncBehavior):
                 "file_path",
                 str,
                 "",
-                "The image file; relative to package_name's folder when given, "
-                "else to the objectives folder.",
+                f"The image file; relative to package_name's folder when given, else {RELATIVE_READ}.",
             ),
             input_port("package_name", str, "", "Package the relative file_path is in (empty: objectives)."),
             input_port(
@@ -135,7 +134,7 @@ class SaveImageToFile(AsyncBehavior):
     def provided_ports(cls) -> list[PortInfo]:
         return [
             message_input("image", IMAGE, "{image}", "The image to save (8-bit encodings)."),
-            input_port("file_path", str, "", "File to write; relative paths are in the objectives folder."),
+            input_port("file_path", str, "", f"File to write; {RELATIVE_WRITE}."),
         ]
 
     @fails_on_bad_input

@@ -35,6 +35,15 @@ from kinema.config.robot_files import is_lfs_pointer
 from ..messages.ports import PortValueError, port_error
 
 _USER_WS = re.compile(r"^~/user_ws/src/([^/]+)/(.*)$")
+# What the file ports say about relative names (one wording for every file behavior).
+RELATIVE_READ = (
+    "relative paths are in the config's objectives folders (for a config bundled with Kinema, "
+    "$XDG_DATA_HOME/kinema/files/<config>/ first)"
+)
+RELATIVE_WRITE = (
+    "relative names are in the config's objectives folder (for a config bundled with Kinema, "
+    "$XDG_DATA_HOME/kinema/files/<config>/)"
+)
 
 
 def objective_folders(node: Any) -> list[Path]:

@@ -9,7 +9,7 @@ from kinema.errors import KinemaError
 
 from ..messages.conversions import POSE_STAMPED_TYPE, pose_matrix
 from ..messages.ports import fails_on_bad_input, message_input, port_error, read_input, read_message
-from .locations import file_to_write
+from .locations import RELATIVE_WRITE, file_to_write
 
 
 def urdf_origin(matrix: object) -> str:
@@ -46,7 +46,7 @@ class SavePoseForUrdf(AsyncBehavior):
                 "{calibration_pose_stamped}",
                 "The pose to save, in the joint's parent link.",
             ),
-            input_port("file_name", str, "", "The file to write (relative: in the objectives folder)."),
+            input_port("file_name", str, "", f"The file to write; {RELATIVE_WRITE}."),
         ]
 
     @fails_on_bad_input

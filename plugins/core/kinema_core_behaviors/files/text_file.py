@@ -5,7 +5,7 @@ from __future__ import annotations
 from kinema.behaviors import AsyncBehavior, PortInfo, input_port, output_port
 
 from ..messages.ports import fails_on_bad_input, port_error, read_input
-from .locations import file_to_read
+from .locations import RELATIVE_READ, file_to_read
 
 MAX_BYTES = 10 * 1024 * 1024
 
@@ -18,7 +18,7 @@ class ReadTextFileAsString(AsyncBehavior):
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
         return [
-            input_port("text_filename", str, "", "The file; relative paths are in the objectives folder."),
+            input_port("text_filename", str, "", f"The file; {RELATIVE_READ}."),
             output_port("string_file_contents", str, "{string_file_contents}", "Its content."),
         ]
 

@@ -30,7 +30,7 @@ from ..messages.ports import (
     read_vector,
 )
 from ..messages.robot_state import as_robot_state
-from .locations import file_to_read, file_to_write
+from .locations import RELATIVE_READ, RELATIVE_WRITE, file_to_read, file_to_write
 
 POSE_STAMPED = "geometry_msgs/msg/PoseStamped"
 TRAJECTORY = "trajectory_msgs/msg/JointTrajectory"
@@ -97,7 +97,7 @@ def save(node: Any, port: str, text: str, messages: list[Any], overwrite: bool) 
 
 def _load_ports(ros_type: str, vector: bool, what: str) -> list[PortInfo]:
     out = (message_vector_output if vector else message_output)("output", ros_type, "{output}", what)
-    return [input_port("file_path", str, "", "YAML file; relative paths are in the objectives folder."), out]
+    return [input_port("file_path", str, "", f"YAML file; {RELATIVE_READ}."), out]
 
 
 def _save_ports(ros_type: str, what: str, overwrite: bool = True) -> list[PortInfo]:
@@ -107,7 +107,7 @@ def _save_ports(ros_type: str, what: str, overwrite: bool = True) -> list[PortIn
             "yaml_filename",
             str,
             "",
-            "File to write ('.yaml' is added); relative names are in the objectives folder.",
+            f"File to write ('.yaml' is added); {RELATIVE_WRITE}.",
         ),
     ]
     if overwrite:
@@ -307,7 +307,7 @@ class LoadRobotJointStateFromYaml(_LoadFromYaml):
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
         return [
-            input_port("file_path", str, "", "YAML file; relative paths are in the objectives folder."),
+            input_port("file_path", str, "", f"YAML file; {RELATIVE_READ}."),
             output_port("output", None, "{output}", f"The robot state ({ROBOT_STATE})."),
         ]
 

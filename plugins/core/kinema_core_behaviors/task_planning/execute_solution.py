@@ -41,6 +41,15 @@ class ExecuteMTCSolution(ExecuteTrajectory):
         shared = [port for port in super().provided_ports() if port.name in _SHARED_PORTS]
         return [input_port("solution", None, "{mtc_solution}", "A solution PlanMTCTask planned."), *shared]
 
+    async def do_work(self) -> bool:
+        solution = self.get_input_or("solution", None)
+        if solution is not None and not getattr(solution, "sub_trajectories", True):
+            # A split before the first motion (SplitMTCSolution index 1 after a current state) leaves a half
+            # that moves nothing: done, nothing sent (a hold of every joint, the gripper's too, was refused).
+            self.logger.publish_info(f"{self.registration_id}: the solution moves nothing; nothing sent")
+            return True
+        return await super().do_work()
+
     def trajectory_to_run(self) -> Any:
         from kinema.motion.task import TaskSolution
 
