@@ -235,7 +235,10 @@ def _config_factory(
             factory.register_behavior_tree_from_file(path)
         except KinemaError:
             pass  # `kinema build` and `kinema objective list` report the library's own problems
-    where = f" (workspace {found.root})" if found.root is not None else ""
+    # Where the config package is: a workspace's, or Kinema's own (lab_sim stays bundled in a workspace).
+    origin = getattr(resolved.package, "origin", "")
+    where = f" (workspace {found.root})" if found.root is not None and origin != "bundled" else ""
+    where = " (bundled with Kinema)" if origin == "bundled" else where
     click.echo(
         f"checking against config {name}{where}: its behaviors and objective libraries (--no-config: "
         "built-in nodes only)",

@@ -54,7 +54,10 @@ def test_a_file_of_the_workspace_is_checked_against_its_config(workspace: Path) 
     code, out = _validate("-c", "my_cell", str(path))
     assert code == 0, out
     assert f"{path}: OK (1 trees)" in out
-    assert "checking against config my_cell" in out  # said on stderr, which the runner mixes in
+    assert f"checking against config my_cell (workspace {workspace})" in out  # stderr, mixed in by the runner
+    # A bundled config is not the workspace's, even when one is selected.
+    code, out = _validate("-w", str(workspace), "-c", "lab_sim", str(path))
+    assert "checking against config lab_sim (bundled with Kinema)" in out, out
 
 
 def test_the_config_is_the_default_inside_a_workspace_and_no_config_turns_it_off(
