@@ -142,6 +142,9 @@ def ik_tips(
     found: list[np.ndarray] = []
     started = time.monotonic()
     attempts = 0
+    single = len(fids) == 1
+    damping = opts.damping * np.eye(rows)
+    tip_goals = list(zip(fids, goals, strict=True))
 
     for attempt in range(opts.attempts):
         if len(found) >= opts.restart_solutions:
@@ -158,7 +161,7 @@ def ik_tips(
             pin.framesForwardKinematics(pm, data, pq)
             errors, offsets = [], []
             pos_err = rot_err = 0.0
-            for fid, target in zip(fids, goals, strict=True):
+            for fid, target in tip_goals:
                 current_T_target = data.oMf[fid].actInv(target)
                 offsets.append(current_T_target)
                 if position_only:
@@ -190,9 +193,10 @@ def ik_tips(
                 else:
                     J = pin.computeFrameJacobian(pm, data, pq, fid, pin.ReferenceFrame.LOCAL)
                     jacobians.append((pin.Jlog6(current_T_target.inverse()) @ J @ model.mimic_map)[:, cols])
-            J = np.vstack(jacobians)
-            e = np.concatenate(errors)
-            dq = J.T @ np.linalg.solve(J @ J.T + opts.damping * np.eye(rows), e)
+            # One tip (nearly every call): no stacking, which cost a fifth of a one-tip solve.
+            J = jacobians[0] if single else np.vstack(jacobians)
+            e = errors[0] if single else np.concatenate(errors)
+            dq = J.T @ np.linalg.solve(J @ J.T + damping, e)
             largest = float(np.abs(dq).max())
             if largest > opts.max_step:
                 dq *= opts.max_step / largest
