@@ -20,6 +20,7 @@ from __future__ import annotations
 
 from typing import TYPE_CHECKING, Any
 
+from kinema.bt.xmlparser import EXPLICIT_TAGS
 from kinema.config.objective_file import ObjectivePort
 from kinema.errors import KinemaError
 
@@ -28,7 +29,6 @@ if TYPE_CHECKING:
 
     from kinema.config.objective_file import ObjectiveInfo
 
-_EXPLICIT_TAGS = frozenset({"Action", "Condition", "Control", "Decorator", "SubTree"})
 _UNTYPED = frozenset({"", "BT::AnyTypeAllowed", "BT::Any"})
 
 
@@ -98,7 +98,7 @@ class _Reads:
     def _port_uses(self, element: etree._Element, depth: int) -> list[tuple[str, str, str, str]]:
         """``(key, direction, type name, "node.port")`` for every blackboard key a node element uses."""
         tag = str(element.tag)
-        node_id = element.get("ID", "") if tag in _EXPLICIT_TAGS else tag
+        node_id = element.get("ID", "") if tag in EXPLICIT_TAGS else tag
         label = element.get("name") or node_id
         if tag == "SubTree":
             return self._subtree_uses(element, node_id, label, depth)

@@ -20,11 +20,13 @@ import importlib.util
 import json
 import os
 import sys
-from collections.abc import Iterable
+from collections.abc import Iterable, Mapping
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from lxml import etree
+
+from kinema.bt.xmlparser import EXPLICIT_TAGS
 
 if TYPE_CHECKING:
     from kinema.bt import BehaviorTreeFactory
@@ -35,19 +37,39 @@ if TYPE_CHECKING:
 _CACHE_FORMAT = 1
 
 
-def _subtree_ids(path: Path) -> set[str]:
+def subtree_renames(factory: BehaviorTreeFactory) -> dict[str, str]:
+    """Old node IDs that load as a SubTree today (MoveIt Pro's ``ExecuteMTCTask`` is the "Execute MTC
+    Solution" objective): their objective belongs to a closure as a SubTree's does."""
+    return {
+        old: spelling.current_id
+        for old, spellings in factory.former_spellings.items()
+        for spelling in spellings
+        if spelling.subtree and spelling.current_id
+    }
+
+
+def _subtree_ids(path: Path, renamed: Mapping[str, str]) -> set[str]:
     try:
         root = etree.parse(str(path)).getroot()
     except (OSError, etree.XMLSyntaxError):
         return set()
-    return {str(element.get("ID")) for element in root.iter("SubTree") if element.get("ID")}
+    found = {str(element.get("ID")) for element in root.iter("SubTree") if element.get("ID")}
+    if renamed:
+        for element in root.iter(etree.Element):
+            spelled = element.get("ID") if element.tag in EXPLICIT_TAGS else element.tag
+            if spelled in renamed:
+                found.add(renamed[spelled])
+    return found
 
 
-def file_closure(library: ObjectiveLibrary, path: Path) -> list[Path]:
-    """``path`` followed by the files of every objective its SubTrees reach, through the library (sorted)."""
+def file_closure(
+    library: ObjectiveLibrary, path: Path, renamed: Mapping[str, str] | None = None
+) -> list[Path]:
+    """``path`` followed by the files of every objective its SubTrees reach, through the library (sorted);
+    ``renamed`` (:func:`subtree_renames`) adds the objectives old node IDs load as."""
     seen, todo = {path}, [path]
     while todo:
-        for subtree in _subtree_ids(todo.pop()):
+        for subtree in _subtree_ids(todo.pop(), renamed or {}):
             info = library.objectives.get(subtree)
             if info is not None and info.file not in seen:
                 seen.add(info.file)
@@ -55,9 +77,11 @@ def file_closure(library: ObjectiveLibrary, path: Path) -> list[Path]:
     return [path, *sorted(seen - {path})]
 
 
-def subtree_closure(library: ObjectiveLibrary, objective_id: str) -> list[Path]:
+def subtree_closure(
+    library: ObjectiveLibrary, objective_id: str, renamed: Mapping[str, str] | None = None
+) -> list[Path]:
     """The objective's file followed by the files of every objective its SubTrees reach (sorted)."""
-    return file_closure(library, library.get(objective_id).file)
+    return file_closure(library, library.get(objective_id).file, renamed)
 
 
 def file_problem(library: ObjectiveLibrary, path: Path, factory: BehaviorTreeFactory) -> str | None:
@@ -65,7 +89,7 @@ def file_problem(library: ObjectiveLibrary, path: Path, factory: BehaviorTreeFac
     its first line: a summary shows one line per file); None when it would load."""
     from kinema.bt.validation import validate_files
 
-    found = validate_files(list(file_closure(library, path)), factory)
+    found = validate_files(list(file_closure(library, path, subtree_renames(factory))), factory)
     if not found:
         return None
     first, _, rest = str(found[0]).partition("\n")
@@ -81,8 +105,9 @@ def library_problems(library: ObjectiveLibrary, factory: BehaviorTreeFactory) ->
 
     problems: dict[str, str] = {}
     checked: dict[tuple[Path, ...], str | None] = {}
+    renamed = subtree_renames(factory)
     for info in library.sorted():
-        closure = tuple(subtree_closure(library, info.id))
+        closure = tuple(subtree_closure(library, info.id, renamed))
         if closure not in checked:
             found = validate_files(list(closure), factory)
             checked[closure] = str(found[0]) if found else None

@@ -15,10 +15,10 @@ from dataclasses import dataclass, field
 
 from lxml import etree
 
+from kinema.bt.xmlparser import EXPLICIT_TAGS
 from kinema.bt.xmlsource import parse_xml
 from kinema.errors import ObjectiveError, did_you_mean
 
-_EXPLICIT_TAGS = frozenset({"Action", "Condition", "Control", "Decorator", "SubTree"})
 #: A subtree nested deeper than this is a cycle or a mistake; the engine refuses it too.
 MAX_SUBTREE_DEPTH = 64
 
@@ -168,7 +168,7 @@ class _OutlineBuilder:
 
     def node(self, element: etree._Element, prefix: str, subtree_path: str, depth: int) -> OutlineNode:
         tag = str(element.tag)
-        type_id = element.get("ID", "") if tag in _EXPLICIT_TAGS else tag
+        type_id = element.get("ID", "") if tag in EXPLICIT_TAGS else tag
         name = element.get("name")
         self.uid += 1
         uid = self.uid

@@ -89,3 +89,21 @@ def test_only_needs_run() -> None:
 
     result = CliRunner().invoke(cli, ["objective", "check", ".", "--only", "Close Gripper"])
     assert result.exit_code == 2 and "--only names objectives to run" in result.output
+
+
+def test_a_node_whose_old_name_is_a_subtree_today_brings_that_subtree_into_the_check(tmp_path: Path) -> None:
+    """MoveIt Studio's `<Action ID="ExecuteMTCTask"/>` loads as the "Execute MTC Solution" objective; a file
+    checked alone said that SubTree was unknown (its closure was read from the SubTree elements only)."""
+    from kinema.config import ObjectiveLibrary, resolve_config
+    from kinema.plugins import BehaviorHost
+    from kinema.runtime.library_check import file_problem
+
+    old = tmp_path / "old.xml"
+    old.write_text(
+        '<root BTCPP_format="4" main_tree_to_execute="Old"><BehaviorTree ID="Old">'
+        '<Action ID="ExecuteMTCTask" solution="{solution}"/></BehaviorTree></root>'
+    )
+    resolved = resolve_config("lab_sim")
+    host = BehaviorHost.for_config(resolved)
+    host.load().raise_for_errors()
+    assert file_problem(ObjectiveLibrary.load(resolved), old, host.registry.create_factory()) is None
