@@ -74,6 +74,23 @@ def test_switch_controller_strips_the_slash_and_switches_strictly(
     assert request.strictness == 2
 
 
+def test_controllers_listed_with_spaces_as_moveit_studio_wrote_them_are_each_switched(
+    behavior: Any, context: BehaviorContext
+) -> None:
+    manager = ControllerManager(context.node)
+    run = tick_behavior(
+        behavior("SwitchController"),
+        {
+            "activate_controllers": "/joint_trajectory_controller /robotiq_gripper_controller",
+            "automatic_deactivation": False,
+        },
+        context=context,
+    )
+    assert run.status == NodeStatus.SUCCESS, run.toasts
+    (request,) = manager.requests
+    assert list(request.activate_controllers) == ["joint_trajectory_controller", "robotiq_gripper_controller"]
+
+
 def test_activating_deactivates_controllers_claiming_the_same_joints(
     behavior: Any, context: BehaviorContext
 ) -> None:

@@ -137,6 +137,27 @@ def test_execute_mtc_task_is_the_execute_mtc_solution_subtree(registry: Behavior
     assert "ExecuteMTCTask is MoveIt Pro's old name of the SubTree 'Execute MTC Solution'" in note.message
 
 
+def test_move_to_waypoint_is_the_move_to_waypoint_subtree(registry: BehaviorRegistry) -> None:
+    """MoveIt Studio's objectives moved with a MoveToWaypoint behavior; today it is the "Move to Waypoint"
+    subtree, whose joint_group_name was its planning_group_name."""
+    factory = registry.create_factory()
+    factory.register_behavior_tree_from_text(
+        '<root BTCPP_format="4"><BehaviorTree ID="Move to Waypoint">'
+        '<Action ID="RetrieveWaypoint" waypoint_name="{waypoint_name}"'
+        ' joint_group_name="{joint_group_name}"/></BehaviorTree></root>',
+        filename="move_to_waypoint.xml",
+    )
+    tree = factory.create_tree_from_text(
+        _tree('<Action ID="MoveToWaypoint" waypoint_name="Home" planning_group_name="manipulator"/>'),
+        filename="old.xml",
+    )
+    node = next(iter(tree.nodes()))
+    assert node.registration_id == "SubTree" and node.subtree_id == "Move to Waypoint"
+    (note,) = factory.library.spelling_notes
+    assert "MoveToWaypoint is MoveIt Pro's old name of the SubTree 'Move to Waypoint'" in note.message
+    assert "planning_group_name is joint_group_name" in note.message
+
+
 @pytest.mark.parametrize(
     ("old", "current", "ignored"),
     [

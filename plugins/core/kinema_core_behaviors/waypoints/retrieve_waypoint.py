@@ -4,7 +4,7 @@ from __future__ import annotations
 
 from typing import Any
 
-from kinema.behaviors import PortInfo, ServiceClientBehavior, input_port, output_port
+from kinema.behaviors import FormerSpelling, PortInfo, ServiceClientBehavior, input_port, output_port
 from kinema.behaviors.cell_ports import cell_input_port
 from kinema.errors import did_you_mean
 from kinema.waypoint_services import GET_WAYPOINTS_SERVICE as GET_WAYPOINTS
@@ -21,6 +21,16 @@ class RetrieveWaypoint(ServiceClientBehavior["moveit_studio_agent_msgs/srv/GetWa
     """
 
     subcategory = "Motion - Planning"
+    # MoveIt Studio's MoveToWaypoint behavior is the core "Move to Waypoint" subtree today, which is built
+    # on this behavior; its planning_group_name is the subtree's joint_group_name.
+    former_spellings = (
+        FormerSpelling(
+            "MoveToWaypoint",
+            current_id="Move to Waypoint",
+            subtree=True,
+            ports={"planning_group_name": "joint_group_name"},
+        ),
+    )
 
     @classmethod
     def provided_ports(cls) -> list[PortInfo]:
