@@ -76,7 +76,7 @@ class OrientationKeeper:
 
     def violation(self, rows: np.ndarray) -> str:
         """How the motion through the full configurations ``rows`` (interpolated between them) first breaks
-        a constraint (``grasp_link turns 0.412 rad (> 0.200) at 37 %``), or "" when it keeps them all."""
+        a constraint (``<link> turns 0.412 rad (> 0.200) at 37 %``), or "" when it keeps them all."""
         from kinema.motion.kinematics import fk
 
         if not self.constraints:

@@ -18,7 +18,7 @@ SWITCH_TYPE = "controller_manager_msgs/srv/SwitchController"
 def _names(values: list[str]) -> list[str]:
     """Controller names without blanks or the leading '/' MoveIt Pro objectives sometimes give; a value
     may also list several separated by spaces, as MoveIt Studio's objectives wrote them
-    ("/joint_trajectory_controller /robotiq_gripper_controller"): a controller name has no space."""
+    ("/arm_controller /gripper_controller"): a controller name has no space."""
     return [name.lstrip("/") for value in values for name in value.split() if name.lstrip("/")]
 
 

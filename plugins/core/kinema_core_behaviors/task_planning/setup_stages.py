@@ -226,7 +226,7 @@ class SetupMTCPlanToPose(_SetupStage):
                 None,
                 "[]",
                 "Links to keep turned at most angle_tolerance (rad) from their orientation where the stage "
-                "starts, target included: '[{link_name: grasp_link, angle_tolerance: 0.2}]'; '[]': none. "
+                "starts, target included: '[{link_name: <tool link>, angle_tolerance: 0.2}]'; '[]': none. "
                 "Kinema checks the free motion and, when it turns a link too far, moves the ik_frame in a "
                 "straight line instead; the stage fails naming the link and angle when neither keeps it.",
             ),
@@ -247,7 +247,7 @@ class SetupMTCPlanToPose(_SetupStage):
 
 def orientation_constraints(value: Any) -> list[Any]:
     """The ``orientation_constraint`` port's constraints: a list of ``{link_name, angle_tolerance}``,
-    written as YAML (``[{link_name: grasp_link, angle_tolerance: 0.2}]``) or passed on the blackboard.
+    written as YAML (``[{link_name: <tool link>, angle_tolerance: 0.2}]``) or passed on the blackboard.
 
     Raises:
         KinemaError: not such a list, or an entry without a link name or with a bad tolerance.
@@ -256,7 +256,7 @@ def orientation_constraints(value: Any) -> list[Any]:
 
     from kinema.motion.task_stages import OrientationConstraint
 
-    shape = "a list like [{link_name: grasp_link, angle_tolerance: 0.2}]"
+    shape = "a list like [{link_name: <tool link>, angle_tolerance: 0.2}]"
     if value is None or (isinstance(value, str) and not value.strip()):
         return []
     if isinstance(value, str):
