@@ -76,18 +76,24 @@ def unknown_waypoint_warnings(paths: Iterable[Path], known: Collection[str], con
     return warnings
 
 
-def config_waypoint_warnings(
-    paths: Iterable[Path], resolved: ResolvedConfig, config_name: str | None = None
-) -> list[str]:
-    """:func:`unknown_waypoint_warnings` against ``resolved``'s saved waypoints (none when the config has
-    no waypoints file, or when it does not load: its own check says why); ``config_name`` names the config
-    in the warnings instead of ``resolved`` (a scratch config standing for the user's)."""
+def saved_waypoint_names(resolved: ResolvedConfig) -> list[str] | None:
+    """The names of ``resolved``'s saved waypoints; None when the config has no waypoints file, or when it
+    does not load (its own check says why)."""
     from kinema.config.waypoint_location import waypoint_store_for
 
     try:
         store = waypoint_store_for(resolved)
-        known = store.names() if store is not None else None
+        return store.names() if store is not None else None
     except KinemaError:
-        known = None
+        return None
+
+
+def config_waypoint_warnings(
+    paths: Iterable[Path], resolved: ResolvedConfig, config_name: str | None = None
+) -> list[str]:
+    """:func:`unknown_waypoint_warnings` against ``resolved``'s saved waypoints (none without them, see
+    :func:`saved_waypoint_names`); ``config_name`` names the config in the warnings instead of ``resolved``
+    (a scratch config standing for the user's)."""
+    known = saved_waypoint_names(resolved)
     name = config_name or resolved.name
     return [] if known is None else unknown_waypoint_warnings(paths, known, name)

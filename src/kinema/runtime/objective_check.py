@@ -317,7 +317,7 @@ class CheckWorkspace:
             PluginError: a behavior plugin of the config does not load.
         """
         from kinema.config import ObjectiveLibrary
-        from kinema.config.waypoint_uses import config_waypoint_warnings
+        from kinema.config.waypoint_uses import saved_waypoint_names, unknown_waypoint_warnings
         from kinema.plugins import BehaviorHost
         from kinema.runtime.library_check import file_problem
 
@@ -330,13 +330,17 @@ class CheckWorkspace:
         unreadable = {
             Path(error.location.file).resolve(): str(error) for error in library.errors if error.location
         }
+        # Read once for every file (the waypoints file is the config's, not the checked file's).
+        known_waypoints = saved_waypoint_names(resolved)
         verdicts = []
         for path in self.files():
             defined = by_file.get(path.resolve(), [])
             # Validated even when the library could not load it: every problem is counted, not only the one
             # that stopped the load (a missing parameter file hid nine more in a MoveIt Pro objective).
             problem = file_problem(library, path, factory) or unreadable.get(path.resolve())
-            waypoint_warnings = config_waypoint_warnings([path], resolved, self.config)
+            waypoint_warnings: list[str] = []
+            if known_waypoints is not None:
+                waypoint_warnings = unknown_waypoint_warnings([path], known_waypoints, self.config)
             verdicts.append(
                 FileVerdict(
                     path=path.relative_to(self.objectives),
